@@ -1,0 +1,21 @@
+include(GNUInstallDirs)
+include(CMakePackageConfigHelpers)
+
+install(TARGETS geods EXPORT geodsTargets
+        ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
+        LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
+        INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+install(DIRECTORY include/geods DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+if(TARGET geods_cli)
+  install(TARGETS geods_cli RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+endif()
+
+set(GEODS_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/geods)
+install(EXPORT geodsTargets NAMESPACE geods:: DESTINATION ${GEODS_CMAKE_DIR})
+configure_package_config_file(cmake/geodsConfig.cmake.in
+  ${PROJECT_BINARY_DIR}/geodsConfig.cmake INSTALL_DESTINATION ${GEODS_CMAKE_DIR})
+write_basic_package_version_file(${PROJECT_BINARY_DIR}/geodsConfigVersion.cmake
+  COMPATIBILITY SameMinorVersion)
+install(FILES ${PROJECT_BINARY_DIR}/geodsConfig.cmake ${PROJECT_BINARY_DIR}/geodsConfigVersion.cmake
+              cmake/Nifti.cmake
+        DESTINATION ${GEODS_CMAKE_DIR})

@@ -1,0 +1,91 @@
+#pragma once
+// Small helpers on a single triangle (a, b, c).
+#include <algorithm>
+
+#include "geods/core/aabb.hpp"
+
+namespace geods {
+
+/// Unnormalized normal (b - a) x (c - a); its length is twice the area.
+template <typename T>
+Vec<T, 3> triangle_normal(const Vec<T, 3>& a, const Vec<T, 3>& b, const Vec<T, 3>& c) {
+  return (b - a).cross(c - a);
+}
+
+template <typename T>
+T triangle_area(const Vec<T, 3>& a, const Vec<T, 3>& b, const Vec<T, 3>& c) {
+  return T(0.5) * triangle_normal(a, b, c).norm();
+}
+
+template <typename T>
+Vec<T, 3> triangle_centroid(const Vec<T, 3>& a, const Vec<T, 3>& b, const Vec<T, 3>& c) {
+  return (a + b + c) / T(3);
+}
+
+template <typename T>
+AABB<T, 3> triangle_bounds(const Vec<T, 3>& a, const Vec<T, 3>& b, const Vec<T, 3>& c) {
+  return {a.cwiseMin(b).cwiseMin(c), a.cwiseMax(b).cwiseMax(c)};
+}
+
+/// Barycentric coordinates (u, v, w) of p's projection onto the triangle's
+/// plane, p ~ u a + v b + w c. Returns NaNs for a degenerate triangle.
+template <typename T>
+Vec<T, 3> barycentric(const Vec<T, 3>& p, const Vec<T, 3>& a, const Vec<T, 3>& b, const Vec<T, 3>& c) {
+  const Vec<T, 3> v0 = b - a, v1 = c - a, v2 = p - a;
+  const T d00 = v0.dot(v0), d01 = v0.dot(v1), d11 = v1.dot(v1);
+  const T d20 = v2.dot(v0), d21 = v2.dot(v1);
+  const T denom = d00 * d11 - d01 * d01;
+  const T v = (d11 * d20 - d01 * d21) / denom;
+  const T w = (d00 * d21 - d01 * d20) / denom;
+  return {T(1) - v - w, v, w};
+}
+
+/// Closest point of the triangle to p (Ericson, Real-Time Collision Detection
+/// 5.1.5): the Voronoi regions of vertices, edges and face in turn. Works for
+/// degenerate triangles too (it then returns a point on an edge or vertex).
+template <typename T>
+Vec<T, 3> closest_point_on_triangle(const Vec<T, 3>& p, const Vec<T, 3>& a, const Vec<T, 3>& b,
+                                    const Vec<T, 3>& c) {
+  const Vec<T, 3> ab = b - a, ac = c - a, ap = p - a;
+  const T d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= T(0) && d2 <= T(0)) return a;
+  const Vec<T, 3> bp = p - b;
+  const T d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= T(0) && d4 <= d3) return b;
+  const T vc = d1 * d4 - d3 * d2;
+  if (vc <= T(0) && d1 >= T(0) && d3 <= T(0)) {
+    const T denom = d1 - d3;
+    return denom > T(0) ? Vec<T, 3>(a + (d1 / denom) * ab) : a;
+  }
+  const Vec<T, 3> cp = p - c;
+  const T d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= T(0) && d5 <= d6) return c;
+  const T vb = d5 * d2 - d1 * d6;
+  if (vb <= T(0) && d2 >= T(0) && d6 <= T(0)) {
+    const T denom = d2 - d6;
+    return denom > T(0) ? Vec<T, 3>(a + (d2 / denom) * ac) : a;
+  }
+  const T va = d3 * d6 - d5 * d4;
+  if (va <= T(0) && (d4 - d3) >= T(0) && (d5 - d6) >= T(0)) {
+    const T denom = (d4 - d3) + (d5 - d6);
+    return denom > T(0) ? Vec<T, 3>(b + ((d4 - d3) / denom) * (c - b)) : b;
+  }
+  const T sum = va + vb + vc;
+  if (!(sum > T(0))) {
+    // Degenerate triangle whose regions did not catch p: nearest of the three edges.
+    auto on_segment = [&](const Vec<T, 3>& s, const Vec<T, 3>& e) {
+      const Vec<T, 3> d = e - s;
+      const T len2 = d.squaredNorm();
+      const T t = len2 > T(0) ? std::clamp(d.dot(p - s) / len2, T(0), T(1)) : T(0);
+      return Vec<T, 3>(s + t * d);
+    };
+    Vec<T, 3> best = on_segment(a, b);
+    for (const Vec<T, 3>& q : {on_segment(b, c), on_segment(c, a)})
+      if ((q - p).squaredNorm() < (best - p).squaredNorm()) best = q;
+    return best;
+  }
+  const T v = vb / sum, w = vc / sum;
+  return a + ab * v + ac * w;
+}
+
+}  // namespace geods

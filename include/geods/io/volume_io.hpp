@@ -1,0 +1,34 @@
+#pragma once
+// Reading and writing volumes (dense 3D grids).
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <variant>
+
+#include "geods/core/dtype.hpp"
+#include "geods/core/grid3.hpp"
+
+namespace geods::io {
+
+/// A volume of any of the supported sample types.
+using AnyGrid3 = std::variant<Grid3<std::uint8_t>, Grid3<std::uint16_t>, Grid3<std::int16_t>,
+                              Grid3<float>, Grid3<double>>;
+
+DType dtype_of(const AnyGrid3& grid);
+/// Converts any volume to float samples (same dims, origin, spacing).
+Grid3<float> to_float(const AnyGrid3& grid);
+
+/// Reads by extension: .npy (3D array, C order [z][y][x]), .nrrd/.nhdr (raw or
+/// gzip encoding), .nii/.nii.gz (NIfTI-1 through nifticlib; origin and spacing
+/// from the header). Throws geods::Error naming the file and the problem.
+AnyGrid3 read_volume(const std::filesystem::path& path);
+
+/// Reads a headerless file of nx*ny*nz samples, x fastest, little-endian.
+/// The file size must match exactly.
+AnyGrid3 read_raw_volume(const std::filesystem::path& path, std::array<std::size_t, 3> dims, DType dtype);
+
+/// Writes .npy (shape nz, ny, nx), .nrrd (raw encoding, with origin and
+/// spacing) or .nii/.nii.gz by extension.
+void write_volume(const std::filesystem::path& path, const AnyGrid3& grid);
+
+}  // namespace geods::io

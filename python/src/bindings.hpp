@@ -1,0 +1,10 @@
+#pragma once
+// One bind function per library module, called from module.cpp.
+#include <pybind11/pybind11.h>
+
+namespace geods::python {
+
+void bind_core(pybind11::module_& m);  // bind_core.cpp: predicates, threads
+void bind_io(pybind11::module_& m);    // bind_io.cpp: meshes, volumes, points
+
+}  // namespace geods::python

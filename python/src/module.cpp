@@ -1,0 +1,11 @@
+// The extension module geods._geods: each library module adds its bindings in one line.
+#include <pybind11/pybind11.h>
+
+#include "bindings.hpp"
+
+PYBIND11_MODULE(_geods, m) {
+  m.doc() = "geods: geometric data structures for computer graphics";
+  m.attr("__version__") = GEODS_VERSION;
+  geods::python::bind_core(m);
+  geods::python::bind_io(m);
+}
