@@ -1,0 +1,85 @@
+#!/usr/bin/python3
+"""Rebuilds data/ from the third-party originals (see data/PROVENANCE.md).
+
+Usage: /usr/bin/python3 scripts/import_data.py SHARED_DATA_DIR
+SHARED_DATA_DIR is the folder of original data sets (shared/data in the
+workplace). Conversions are lossless: JS arrays -> PLY/OBJ, npz -> npy,
+TopoJSON arcs -> points and segments (dequantized to degrees).
+"""
+import gzip
+import io
+import json
+import os
+import re
+import shutil
+import sys
+import tarfile
+
+import numpy as np
+
+SRC = sys.argv[1]
+DST = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "data")
+
+
+def npm_arrays(tgz, member):
+    with tarfile.open(os.path.join(SRC, tgz)) as t:
+        text = t.extractfile(member).read().decode()
+    def grab(name):
+        m = re.search(r"exports\.%s\s*=\s*(\[.*?\]\])" % name, text, re.S)
+        return json.loads(m.group(1))
+    return np.array(grab("positions"), np.float32), np.array(grab("cells"), np.int32)
+
+
+def write_ply(path, V, F):
+    header = ("ply\nformat binary_little_endian 1.0\ncomment Stanford bunny (npm bunny 1.0.1)\n"
+              f"element vertex {len(V)}\nproperty float x\nproperty float y\nproperty float z\n"
+              f"element face {len(F)}\nproperty list uchar int vertex_indices\nend_header\n")
+    rec = np.zeros(len(F), dtype=[("n", "u1"), ("i", "<i4", 3)])
+    rec["n"], rec["i"] = 3, F
+    with open(path, "wb") as f:
+        f.write(header.encode())
+        f.write(V.astype("<f4").tobytes())
+        f.write(rec.tobytes())
+
+
+def write_obj(path, V, F, comment):
+    with open(path, "w") as f:
+        f.write(f"# {comment}\n")
+        for v in V:
+            f.write("v %.6g %.6g %.6g\n" % tuple(v))
+        for t in F:
+            f.write("f %d %d %d\n" % tuple(t + 1))
+
+
+def land_arcs():
+    with tarfile.open(os.path.join(SRC, "points_polygons/world-atlas-2.0.2.tgz")) as t:
+        topo = json.load(t.extractfile("package/land-110m.json"))
+    scale, translate = np.array(topo["transform"]["scale"]), np.array(topo["transform"]["translate"])
+    arcs = []
+    for arc in topo["arcs"]:
+        q = np.cumsum(np.array(arc, np.int64), axis=0)  # delta-encoded integer positions
+        keep = np.ones(len(q), bool)
+        keep[1:] = np.any(q[1:] != q[:-1], axis=1)      # drop zero-length steps
+        arcs.append(q[keep] * scale + translate)
+    return arcs
+
+
+def main():
+    os.makedirs(DST, exist_ok=True)
+    V, F = npm_arrays("meshes/bunny-1.0.1.tgz", "package/index.js")
+    write_ply(os.path.join(DST, "bunny.ply"), V, F)
+    V, F = npm_arrays("meshes/teapot-1.0.0.tgz", "package/teapot.js")
+    write_obj(os.path.join(DST, "teapot.obj"), V, F, "Utah teapot (npm teapot 1.0.0), not watertight")
+    shutil.copy(os.path.join(SRC, "textures/brick.png"), os.path.join(DST, "brick.png"))
+    shutil.copy(os.path.join(SRC, "volumes/KmeansTest_T1UCharRaw.nii.gz"), os.path.join(DST, "t1_head.nii.gz"))
+    dem = np.load(os.path.join(SRC, "heightfields/jacksboro_fault_dem.npz"))
+    np.save(os.path.join(DST, "jacksboro_dem.npy"), np.ascontiguousarray(dem["elevation"]))
+    arcs = land_arcs()
+    points = np.unique(np.concatenate(arcs), axis=0)
+    segments = np.concatenate([np.hstack([a[:-1], a[1:]]) for a in arcs if len(a) > 1])
+    np.save(os.path.join(DST, "land_points.npy"), points.astype(np.float64))
+    np.save(os.path.join(DST, "land_segments.npy"), segments.astype(np.float64))
+
+
+if __name__ == "__main__":
+    main()
