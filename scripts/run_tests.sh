@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# The test suite of `make test`: every stage runs, the summary lines of each
+# runner are printed, and the exit status is non-zero if any stage failed.
+set -uo pipefail
+cd "$(dirname "$0")/.."
+jobs=${1:-2}
+failed=()
+
+echo "=== release build"
+cmake --build build/release -j"$jobs" || { echo "FAILED: release build"; exit 1; }
+
+echo "=== release unit tests (ctest)"
+ctest --preset release -j"$jobs" || failed+=("release ctest")
+
+echo "=== python tests (pytest)"
+PYTHONPATH=build/release/python GEODS_CLI=build/release/bin/geods \
+  /usr/bin/python3 -m pytest python/tests -q -p no:cacheprovider || failed+=("pytest")
+
+echo "=== asan+ubsan build and unit tests (ctest)"
+if { [[ -f build/asan/build.ninja ]] || cmake --preset asan >/dev/null; } &&
+   cmake --build build/asan -j"$jobs"; then
+  ctest --preset asan -j"$jobs" || failed+=("asan ctest")
+else
+  failed+=("asan build")
+fi
+
+if ((${#failed[@]})); then
+  echo "FAILED: ${failed[*]}"
+  exit 1
+fi
+echo "all test stages passed"
