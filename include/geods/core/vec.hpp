@@ -1,6 +1,7 @@
 #pragma once
 // Eigen-based fixed-size vectors used throughout geods.
 #include <Eigen/Core>
+#include <Eigen/Geometry>  // cross products
 #include <cstdint>
 
 namespace geods {

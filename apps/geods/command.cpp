@@ -1,0 +1,92 @@
+#include "command.hpp"
+
+#include <cstdio>
+#include <exception>
+#include <iostream>
+
+#include "geods/core/error.hpp"
+#include "geods/core/parallel.hpp"
+#include "progress_bar.hpp"
+
+namespace geods::cli {
+
+std::vector<std::unique_ptr<Command>>& registered_commands() {
+  static std::vector<std::unique_ptr<Command>> commands;
+  return commands;
+}
+
+namespace {
+
+// The first line of a message: the contract is one line on stderr.
+std::string first_line(const std::string& text) { return text.substr(0, text.find('\n')); }
+
+int fail(const std::string& command, const std::string& message) {
+  std::cerr << "geods " << command << ": " << first_line(message) << "\n";
+  return 2;
+}
+
+}  // namespace
+
+int run_cli(int argc, char** argv) {
+  CLI::App app{"geods: geometric data structures for computer graphics.\n"
+               "Every command reads and writes standard files; --json prints one JSON object."};
+  app.set_version_flag("--version", "geods " GEODS_VERSION);
+  app.require_subcommand(1);
+
+  struct Entry {
+    Command* command;
+    CLI::App* sub;
+  };
+  std::vector<Entry> entries;
+  RunContext context;
+  for (auto& command : registered_commands()) {
+    CLI::App* sub = app.add_subcommand(command->name(), command->summary());
+    sub->add_flag("--json", context.json, "Print one JSON object instead of the summary");
+    sub->add_option("--threads", context.threads, "Worker threads (default: all cores; 1: single-threaded)")
+        ->check(CLI::NonNegativeNumber);
+    command->add_options(*sub);
+    entries.push_back({command.get(), sub});
+  }
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    const std::string where = app.get_subcommands().empty() ? "" : app.get_subcommands().front()->get_name();
+    std::cerr << "geods" << (where.empty() ? "" : " " + where) << ": " << first_line(e.what())
+              << " (see --help)\n";
+    return 2;
+  }
+
+  for (const Entry& entry : entries) {
+    if (!entry.sub->parsed()) continue;
+    if (context.threads > 0) set_num_threads(context.threads);
+    context.progress = terminal_progress_bar();
+    Report report;
+    int status = 0;
+    try {
+      entry.command->run(context, report);
+      status = report.json.value("failed_steps", 0) > 0 ? 1 : 0;
+    } catch (const Error& e) {
+      return fail(entry.command->name(), e.what());
+    } catch (const std::bad_alloc&) {
+      return fail(entry.command->name(), "out of memory");
+    } catch (const std::exception& e) {
+      return fail(entry.command->name(), std::string("internal error: ") + e.what());
+    }
+    if (context.json) {
+      std::cout << report.json.dump() << "\n";
+    } else {
+      for (const std::string& line : report.lines) std::cout << line << "\n";
+    }
+    return status;
+  }
+  return 2;
+}
+
+}  // namespace geods::cli

@@ -1,0 +1,54 @@
+#pragma once
+// The command framework of the geods CLI: one Command subclass per
+// cmd_<name>.cpp, registered in one line with register_command<T>().
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "geods/core/progress.hpp"
+
+namespace geods::cli {
+
+using Json = nlohmann::ordered_json;
+
+/// What a command reports: `json` is printed with --json (inputs, parameters,
+/// counts, timings in keys ending in _s), `lines` otherwise.
+struct Report {
+  Json json = Json::object();
+  std::vector<std::string> lines;
+};
+
+/// Options every command shares, filled in before run().
+struct RunContext {
+  bool json = false;
+  int threads = 0;            // 0: all cores
+  ProgressCallback progress;  // a progress bar on a terminal, else empty
+};
+
+class Command {
+ public:
+  virtual ~Command() = default;
+  virtual std::string name() const = 0;
+  virtual std::string summary() const = 0;
+  /// Declares the command's own options on its subcommand.
+  virtual void add_options(CLI::App& app) = 0;
+  /// Does the work. Bad input throws geods::Error (exit code 2).
+  virtual void run(const RunContext& context, Report& report) = 0;
+};
+
+std::vector<std::unique_ptr<Command>>& registered_commands();
+
+template <typename C>
+bool register_command() {
+  registered_commands().push_back(std::make_unique<C>());
+  return true;
+}
+
+/// Runs the CLI: parses argv, dispatches, prints the report; returns the exit code
+/// (0 success, 1 a failed step such as a demo step, 2 bad arguments or input).
+int run_cli(int argc, char** argv);
+
+}  // namespace geods::cli
