@@ -1,0 +1,549 @@
+#!/usr/bin/python3
+"""Side-by-side benchmarks of geods against the anchor libraries -> docs/PERFORMANCE.md.
+
+    /usr/bin/python3 bench/compare/run.py --out docs/PERFORMANCE.md [--only predicates,knn]
+        [--threads 1,2] [--rounds 1] [--reps 3] [--scale 1] [--jobs N] [--data DIR]
+        [--no-setup] [--no-micro]
+
+Steps: (a) scripts/setup.sh --bench (installs the anchor packages, bench/compare/anchor-packages.txt),
+(b) bench/compare/gen_workloads.py (generates the workloads of anchors/WORKLOADS.md once, checks
+their hashes), (c) configures and builds the separate CMake project bench/compare into
+build/compare (ccache), (d) runs each comparison's programs interleaved (geods, anchor, ...,
+geods, anchor, ... for --rounds rounds) with one thread and with all threads, collecting their
+JSON lines, (e) runs the Google Benchmark programs build/release/bin/geods_*_bench if present,
+(f) writes the report (--out) and the raw JSON lines beside it (performance.jsonl).
+
+A comparison is a folder bench/compare/<workload>/ holding its programs, a CMakeLists.txt that
+declares them with geods_compare_program(), and a compare.json read here:
+
+  workload    name, equal to the "workload" field of the JSON lines (and --only)
+  title       section title;  about: one paragraph of Markdown (what is timed, inputs, checks)
+  programs    [{"anchor": "geods", "program": "compare_<workload>_geods"},
+               {"anchor": "cgal", "program": "...", "label": "CGAL Epick", "package": "libcgal-dev"}, ...]
+              run in this order; the first one is the baseline of the ratios (geods)
+  threads     "all": run with every --threads count; "1": single thread only
+  metrics     timing fields to tabulate, e.g. ["build_s", "query_s"]
+  rate        optional {"unit": "Mcalls/s", "scale": 1e-6}: also show count / time * scale
+  agree       optional {"field": "sign_hash", "anchors": ["geods", "cgal"], "label": "..."}:
+              that field must be equal across these anchors for each (variant, threads)
+  args        optional extra command-line arguments for every program
+  rounds      optional number of interleaved rounds when --rounds is not given (default 1)
+  timeout_s   optional per-program time limit (default 1800)
+
+Every program takes --data DIR --threads N --reps N [--scale X] and prints one JSON line per
+measurement: {"workload","anchor","variant","threads","build_s","query_s","count","median_of",...,"ok"}.
+The ratio in the tables is anchor time / geods time: > 1 means geods is faster.
+Standard library only.
+"""
+import argparse
+import datetime
+import glob
+import json
+import math
+import os
+import platform
+import re
+import shlex
+import shutil
+import statistics
+import subprocess
+import sys
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+REPO = os.path.dirname(os.path.dirname(HERE))
+PY = "/usr/bin/python3" if os.path.exists("/usr/bin/python3") else sys.executable
+
+
+def log(*a):
+    print("[bench]", *a, flush=True)
+
+
+def rel(path):
+    return os.path.relpath(path, REPO)
+
+
+# ----------------------------------------------------------------------------- comparisons
+def discover():
+    """All comparisons: bench/compare/*/compare.json, sorted by folder name."""
+    comps = []
+    for path in sorted(glob.glob(os.path.join(HERE, "*", "compare.json"))):
+        with open(path) as f:
+            c = json.load(f)
+        for key in ("workload", "title", "programs", "metrics"):
+            if key not in c:
+                raise SystemExit(f"{rel(path)}: missing key '{key}'")
+        c.setdefault("about", "")
+        c.setdefault("threads", "all")
+        c.setdefault("args", [])
+        c.setdefault("timeout_s", 1800)
+        c.setdefault("rounds", 1)
+        c["dir"] = os.path.dirname(path)
+        comps.append(c)
+    return comps
+
+
+# ----------------------------------------------------------------------------- steps a-c
+def run_cmd(cmd, **kw):
+    log("$", " ".join(shlex.quote(str(x)) for x in cmd))
+    return subprocess.run(cmd, **kw)
+
+
+def setup():
+    script = os.path.join(REPO, "scripts", "setup.sh")
+    if not os.path.exists(script):
+        log("scripts/setup.sh not found; assuming the anchor packages are installed")
+        return
+    if run_cmd([script, "--bench"], cwd=REPO).returncode != 0:
+        log("WARNING: scripts/setup.sh --bench failed; comparisons whose anchor is missing are skipped")
+
+
+def generate(data_dir):
+    r = run_cmd([PY, os.path.join(HERE, "gen_workloads.py"), data_dir], cwd=REPO)
+    if r.returncode != 0:
+        raise SystemExit("workload generation failed")
+    try:
+        with open(os.path.join(data_dir, "VERIFY.json")) as f:
+            return json.load(f)
+    except OSError:
+        return {"reference": None, "ok": False, "checked": 0, "mismatched": [], "missing": []}
+
+
+def configure(build_dir):
+    cmd = ["cmake", "-S", HERE, "-B", build_dir, "-DCMAKE_BUILD_TYPE=Release"]
+    if shutil.which("ninja") and not os.path.exists(os.path.join(build_dir, "Makefile")):
+        cmd += ["-G", "Ninja"]
+    if shutil.which("ccache"):
+        cmd += ["-DCMAKE_CXX_COMPILER_LAUNCHER=ccache"]
+    if run_cmd(cmd, cwd=REPO).returncode != 0:
+        raise SystemExit("configuring bench/compare failed")
+
+
+def known_targets(build_dir):
+    r = subprocess.run(["cmake", "--build", build_dir, "--target", "help"], capture_output=True, text=True)
+    return set(re.findall(r"^(?:\.\.\. )?([A-Za-z0-9_.+-]+)(?::| )", r.stdout, re.M))
+
+
+def build(build_dir, comps, jobs):
+    """Builds every program of comps; returns {program: None | reason it is unavailable}."""
+    targets = known_targets(build_dir)
+    status = {}
+    for c in comps:
+        names = [p["program"] for p in c["programs"]]
+        present = [n for n in names if n in targets]
+        for n in names:
+            if n not in targets:
+                status[n] = "not configured (anchor library missing, see the CMake warnings)"
+        if not present:
+            continue
+        r = run_cmd(["cmake", "--build", build_dir, "-j", str(jobs), "--target", *present], cwd=REPO)
+        if r.returncode != 0:  # find out which ones fail
+            for n in present:
+                rr = run_cmd(["cmake", "--build", build_dir, "-j", str(jobs), "--target", n], cwd=REPO,
+                             capture_output=True, text=True)
+                status[n] = None if rr.returncode == 0 else "build failed"
+        for n in present:
+            status.setdefault(n, None)
+    return status
+
+
+# ----------------------------------------------------------------------------- step d
+def run_comparison(c, bin_dir, data_dir, threads_list, rounds, reps, scale, status, log_dir):
+    """Runs the programs of one comparison interleaved; returns (records, raw lines, problems)."""
+    records, raw, problems = [], [], []
+    tl = threads_list if c["threads"] == "all" else [1]
+    env = dict(os.environ, ANCHORS_REPS=str(reps), ANCHORS_DATA=data_dir)
+    for threads in tl:
+        for rnd in range(rounds):
+            for p in c["programs"]:
+                prog = p["program"]
+                if status.get(prog):
+                    continue
+                cmd = [os.path.join(bin_dir, prog), "--data", data_dir, "--threads", str(threads),
+                       "--reps", str(reps)] + [str(a) for a in c["args"]]
+                if scale != 1.0:
+                    cmd += ["--scale", repr(scale)]
+                log(f"{c['workload']}: {prog} threads={threads} round={rnd + 1}/{rounds}")
+                errlog = os.path.join(log_dir, f"{prog}_t{threads}_r{rnd + 1}.log")
+                t0 = time.time()
+                try:
+                    with open(errlog, "w") as ef:
+                        r = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=ef, text=True, env=env,
+                                           timeout=c["timeout_s"])
+                    out, rc = r.stdout, r.returncode
+                except subprocess.TimeoutExpired as e:
+                    out = e.stdout.decode() if isinstance(e.stdout, bytes) else (e.stdout or "")
+                    rc = "timeout"
+                n = 0
+                for line in out.splitlines():
+                    line = line.strip()
+                    if not line.startswith("{"):
+                        continue
+                    try:
+                        rec = json.loads(line)
+                    except json.JSONDecodeError:
+                        continue
+                    raw.append(line)
+                    rec["_round"] = rnd
+                    records.append(rec)
+                    n += 1
+                log(f"  {n} measurements in {time.time() - t0:.1f} s" + (f", exit {rc}" if rc else ""))
+                if rc:
+                    problems.append(f"`{prog} --threads {threads}` exited with {rc} (stderr: {rel(errlog)})")
+    return records, raw, problems
+
+
+# ----------------------------------------------------------------------------- step e
+def run_micro(timeout_s=900):
+    results = []
+    for exe in sorted(glob.glob(os.path.join(REPO, "build", "release", "bin", "geods_*_bench"))):
+        if not os.access(exe, os.X_OK):
+            continue
+        log("micro:", rel(exe))
+        try:
+            r = subprocess.run([exe, "--benchmark_format=json"], capture_output=True, text=True,
+                               timeout=timeout_s)
+            data = json.loads(r.stdout)
+        except (subprocess.TimeoutExpired, json.JSONDecodeError) as e:
+            results.append({"program": os.path.basename(exe), "error": type(e).__name__})
+            continue
+        results.append({"program": os.path.basename(exe), "benchmarks": data.get("benchmarks", [])})
+    return results
+
+
+# ----------------------------------------------------------------------------- report
+def read_first(path, key):
+    try:
+        with open(path) as f:
+            for line in f:
+                if line.startswith(key):
+                    return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return None
+
+
+def machine_info(build_dir):
+    cpu = read_first("/proc/cpuinfo", "model name") or platform.processor() or "unknown CPU"
+    mem = read_first("/proc/meminfo", "MemTotal")
+    mem_gb = f"{int(mem.split()[0]) / 1048576:.1f} GiB" if mem else "unknown"
+    os_name = "unknown"
+    try:
+        with open("/etc/os-release") as f:
+            for line in f:
+                if line.startswith("PRETTY_NAME="):
+                    os_name = line.split("=", 1)[1].strip().strip('"')
+    except OSError:
+        pass
+    cxx = "c++"
+    cache = os.path.join(build_dir, "CMakeCache.txt")
+    arch = ""
+    if os.path.exists(cache):
+        for line in open(cache):
+            if line.startswith("CMAKE_CXX_COMPILER:"):
+                cxx = line.split("=", 1)[1].strip()
+            if line.startswith("GEODS_COMPARE_ARCH:"):
+                arch = line.split("=", 1)[1].strip()
+    try:
+        compiler = subprocess.run([cxx, "--version"], capture_output=True, text=True).stdout.splitlines()[0]
+    except (OSError, IndexError):
+        compiler = cxx
+    flags = "-O3 -DNDEBUG" + (f" -march={arch}" if arch else "")
+    git = subprocess.run(["git", "-C", REPO, "describe", "--always", "--dirty"], capture_output=True,
+                         text=True).stdout.strip() or "unknown"
+    return {"cpu": cpu, "cores": os.cpu_count(), "memory": mem_gb, "os": os_name,
+            "kernel": platform.release(), "compiler": compiler, "flags": flags, "git": git,
+            "load": os.getloadavg()}
+
+
+def anchor_versions():
+    path = os.path.join(HERE, "anchor-packages.txt")
+    pkgs = [l.strip() for l in open(path) if l.strip() and not l.startswith("#")] if os.path.exists(path) else []
+    out = []
+    for p in pkgs:
+        r = subprocess.run(["dpkg-query", "-W", "-f=${Version}", p], capture_output=True, text=True)
+        out.append((p, r.stdout.strip() if r.returncode == 0 and r.stdout.strip() else "not installed"))
+    return out
+
+
+def fmt_time(s):
+    if s is None or (isinstance(s, float) and math.isnan(s)):
+        return "–"
+    if s >= 1:
+        return f"{s:.3f} s"
+    if s >= 1e-3:
+        return f"{s * 1e3:.2f} ms"
+    return f"{s * 1e6:.1f} µs"
+
+
+def fmt_rate(v):
+    return f"{v:.3g}" if v < 1000 else f"{v:,.0f}"
+
+
+def md_escape(s):
+    return str(s).replace("|", "\\|")
+
+
+def tabulate(c, records):
+    """Markdown table of one comparison and the geometric-mean ratios per (anchor, threads)."""
+    anchors = [p["anchor"] for p in c["programs"]]
+    base = anchors[0]
+    labels = {p["anchor"]: p.get("label", p["anchor"]) for p in c["programs"]}
+    groups = {}  # (variant, threads) -> anchor -> [records]
+    order = []
+    for r in records:
+        key = (r.get("variant", ""), int(r.get("threads", 1)))
+        if key not in groups:
+            groups[key] = {}
+            order.append(key)
+        groups[key].setdefault(r.get("anchor"), []).append(r)
+    first = {k: i for i, k in enumerate(order)}
+    order.sort(key=lambda k: (k[1], first[k]))
+    present = [a for a in anchors if any(a in g for g in groups.values())]
+    metrics = [m for m in c["metrics"]
+               if any(isinstance(r.get(m), (int, float)) and r.get(m) > 0 for r in records)]
+    agree = c.get("agree")
+    head = ["variant", "threads"] + (["metric"] if len(metrics) > 1 else [])
+    for a in present:
+        head.append(a)
+        if a != base:
+            head.append(f"{a} / {base}")
+    if agree:
+        head.append(agree.get("label", f"{agree['field']} agrees"))
+    head.append("ok")
+    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    ratios = {}  # (anchor, threads) -> [ratio]
+    for key in order:
+        g = groups[key]
+        for m in metrics:
+            def med(a):
+                vals = [r.get(m) for r in g.get(a, []) if isinstance(r.get(m), (int, float))]
+                return statistics.median(vals) if vals else None
+            row = [f"`{key[0]}`", str(key[1])] + ([m] if len(metrics) > 1 else [])
+            bt = med(base)
+            for a in present:
+                t = med(a)
+                cell = fmt_time(t)
+                if t and c.get("rate") and g.get(a):
+                    cnt = g[a][0].get("count")
+                    if cnt:
+                        cell += f" ({fmt_rate(cnt / t * c['rate'].get('scale', 1))} {c['rate'].get('unit', '/s')})"
+                row.append(cell)
+                if a != base:
+                    if t and bt:
+                        ratio = t / bt
+                        ratios.setdefault((a, key[1]), []).append(ratio)
+                        row.append(f"**{ratio:.2f}**")
+                    else:
+                        row.append("–")
+            if agree:
+                vals = {a: {r.get(agree["field"]) for r in g.get(a, [])} for a in agree["anchors"] if a in g}
+                if len(vals) < 2:
+                    row.append("–")
+                else:
+                    allv = set().union(*vals.values())
+                    row.append("yes" if len(allv) == 1 else "**NO**")
+            oks = [r.get("ok") for a in present for r in g.get(a, [])]
+            bad = [a for a in present if any(r.get("ok") is not True for r in g.get(a, []))]
+            row.append("yes" if all(o is True for o in oks) else "**NO** (" + ", ".join(bad) + ")")
+            lines.append("| " + " | ".join(md_escape(x) if not x.startswith("`") else x for x in row) + " |")
+    summary = {k: math.exp(sum(math.log(x) for x in v) / len(v)) for k, v in ratios.items() if v}
+    return "\n".join(lines), summary, labels
+
+
+def agreement_failures(c, records):
+    agree = c.get("agree")
+    if not agree:
+        return []
+    bad = []
+    groups = {}
+    for r in records:
+        if r.get("anchor") in agree["anchors"]:
+            groups.setdefault((r.get("variant"), r.get("threads")), set()).add(r.get(agree["field"]))
+    for k, v in sorted(groups.items(), key=str):
+        if len(v) > 1:
+            bad.append(f"{c['workload']} {k[0]} threads={k[1]}: {agree['field']} differs")
+    return bad
+
+
+def micro_table(micro):
+    lines = []
+    for m in micro:
+        lines.append(f"**{m['program']}**\n")
+        if "error" in m:
+            lines.append(f"failed: {m['error']}\n")
+            continue
+        lines.append("| benchmark | real time | CPU time | items/s |")
+        lines.append("|---|---|---|---|")
+        for b in m["benchmarks"]:
+            if b.get("run_type") == "aggregate":
+                continue
+            unit = b.get("time_unit", "ns")
+            ips = b.get("items_per_second")
+            lines.append(f"| `{b.get('name')}` | {b.get('real_time', 0):.4g} {unit} | "
+                         f"{b.get('cpu_time', 0):.4g} {unit} | {fmt_rate(ips) if ips else '–'} |")
+        lines.append("")
+    return "\n".join(lines)
+
+
+def write_report(out, jsonl, cmdline, info, versions, verify, comps, results, status, micro, data_dir,
+                 rounds, reps, threads_list, started):
+    L = []
+    L.append("# geods performance\n")
+    L.append("Written by `bench/compare/run.py` (`make bench`); do not edit by hand. Every ratio is "
+             "**anchor time / geods time measured side by side in the same run** (> 1: geods is faster). "
+             "Workloads and timing rules: `anchors/WORKLOADS.md` (generator copy: "
+             "`bench/compare/gen_workloads.py`).\n")
+    L.append(f"Command: `{cmdline}`\n")
+    L.append("## Machine and run\n")
+    L.append(f"- Date: {started.strftime('%Y-%m-%d %H:%M %Z').strip()} (run took "
+             f"{(datetime.datetime.now(datetime.timezone.utc) - started).total_seconds() / 60:.1f} min)")
+    L.append(f"- CPU: {info['cpu']}, {info['cores']} logical cores; memory {info['memory']}")
+    L.append(f"- Load average at start: {info['load'][0]:.2f} / {info['load'][1]:.2f} / {info['load'][2]:.2f} "
+             "(other jobs on the machine disturb the timings)")
+    L.append(f"- OS: {info['os']}, kernel {info['kernel']}")
+    L.append(f"- Compiler: {info['compiler']}; geods and every comparison program built with `{info['flags']}`")
+    L.append(f"- geods: `{info['git']}`")
+    rtxt = (f"{rounds} interleaved round(s)" if rounds else
+            "interleaved rounds as set per comparison (" +
+            ", ".join(f"{c['workload']}: {c['rounds']}" for c in comps) + ")")
+    L.append(f"- Timing: median of {reps} in-process repetitions (`ANCHORS_REPS`), {rtxt} "
+             f"per program (median over rounds), threads {', '.join(map(str, threads_list))} "
+             "(TBB limited by `tbb::global_control`)")
+    if verify.get("reference") is None:
+        vtxt = "not verified (no reference hash list found)"
+    elif verify.get("ok"):
+        vtxt = f"all {verify['checked']} files match the reference hashes (`{os.path.basename(verify['reference'])}`)"
+    else:
+        vtxt = (f"**MISMATCH**: {len(verify.get('matched', []))}/{verify.get('checked')} files match the "
+                f"reference hashes; differing: {', '.join(verify.get('mismatched', []) + verify.get('missing', []))}")
+    L.append(f"- Workloads: `{data_dir}`; {vtxt}")
+    L.append("- Anchor packages (Debian): " + ", ".join(f"{p} {v}" for p, v in versions))
+    L.append("")
+
+    # summary
+    L.append("## Summary\n")
+    L.append("Geometric mean over the variants of each workload of anchor time / geods time "
+             "(> 1: geods is faster).\n")
+    L.append("| workload | anchor | threads | geomean ratio |")
+    L.append("|---|---|---|---|")
+    sections = []
+    problems_all = []
+    for c in comps:
+        recs, raw, problems = results.get(c["workload"], ([], [], []))
+        problems_all += problems + agreement_failures(c, recs)
+        if not recs:
+            sections.append(f"## {c['workload']} — {c['title']}\n\nNo measurements "
+                            f"({'; '.join(problems) or 'programs unavailable'}).\n")
+            continue
+        table, summary, labels = tabulate(c, recs)
+        for (a, t), g in sorted(summary.items(), key=lambda kv: (kv[0][1], kv[0][0])):
+            L.append(f"| {c['workload']} | {labels.get(a, a)} | {t} | **{g:.2f}** |")
+        s = [f"## {c['workload']} — {c['title']}\n", c["about"] + "\n"]
+        progs = []
+        for p in c["programs"]:
+            st = status.get(p["program"])
+            progs.append(f"`{p['program']}` = {p.get('label', p['anchor'])}"
+                         + (f" (**{st}**)" if st else ""))
+        s.append("Programs: " + "; ".join(progs) + ".\n")
+        s.append(table + "\n")
+        if problems:
+            s.append("Problems: " + "; ".join(problems) + "\n")
+        sections.append("\n".join(s))
+    L.append("")
+    if problems_all:
+        L.append("**Problems in this run:**\n")
+        L += [f"- {p}" for p in problems_all]
+        L.append("")
+    L += sections
+
+    L.append("## Micro benchmarks (Google Benchmark)\n")
+    if micro:
+        L.append("`build/release/bin/geods_*_bench --benchmark_format=json` (geods only, no anchor).\n")
+        L.append(micro_table(micro))
+    else:
+        L.append("None found (`build/release/bin/geods_*_bench`; `make release` builds them).\n")
+
+    L.append("## Raw measurements\n")
+    L.append(f"Every JSON line printed by the programs, in run order: [`{os.path.basename(jsonl)}`]"
+             f"({os.path.basename(jsonl)}).\n")
+    raw_all = [line for c in comps for line in results.get(c["workload"], ([], [], []))[1]]
+    L.append("<details><summary>JSON lines</summary>\n\n```json")
+    L += raw_all
+    L.append("```\n</details>\n")
+    os.makedirs(os.path.dirname(os.path.abspath(out)), exist_ok=True)
+    with open(out, "w") as f:
+        f.write("\n".join(L))
+    with open(jsonl, "w") as f:
+        f.write("\n".join(raw_all) + ("\n" if raw_all else ""))
+    log("wrote", out, "and", jsonl)
+    return problems_all
+
+
+# ----------------------------------------------------------------------------- main
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--out", default=os.path.join(REPO, "docs", "PERFORMANCE.md"), help="report (Markdown)")
+    ap.add_argument("--jsonl", help="raw JSON lines (default: performance.jsonl beside --out)")
+    ap.add_argument("--only", help="comma-separated workloads (folders of bench/compare)")
+    ap.add_argument("--threads", help="comma-separated thread counts (default: 1,<all cores>)")
+    ap.add_argument("--rounds", type=int, help="interleaved runs of every program "
+                    "(default: the comparison's \"rounds\", else 1)")
+    ap.add_argument("--reps", type=int, default=int(os.environ.get("ANCHORS_REPS", 3)),
+                    help="in-process repetitions, median reported (default 3)")
+    ap.add_argument("--scale", type=float, default=1.0, help="problem size factor (quick checks: 0.1)")
+    ap.add_argument("--jobs", type=int, default=os.cpu_count(), help="build jobs")
+    ap.add_argument("--data", default=os.environ.get("ANCHORS_DATA", os.path.join(REPO, "build", "anchors-data")))
+    ap.add_argument("--build-dir", default=os.path.join(REPO, "build", "compare"))
+    ap.add_argument("--no-setup", action="store_true", help="skip scripts/setup.sh --bench")
+    ap.add_argument("--no-micro", action="store_true", help="skip the Google Benchmark programs")
+    args = ap.parse_args()
+
+    started = datetime.datetime.now(datetime.timezone.utc)
+    cmdline = "/usr/bin/python3 bench/compare/run.py " + " ".join(shlex.quote(a) for a in sys.argv[1:])
+    out = os.path.abspath(args.out)
+    jsonl = os.path.abspath(args.jsonl or os.path.join(os.path.dirname(out), "performance.jsonl"))
+    data_dir = os.path.abspath(args.data)
+    build_dir = os.path.abspath(args.build_dir)
+    ncpu = os.cpu_count() or 1
+    threads_list = ([int(t) for t in args.threads.split(",")] if args.threads
+                    else sorted({1, ncpu}))
+
+    comps = discover()
+    if args.only:
+        want = {w.strip() for w in args.only.split(",") if w.strip()}
+        unknown = want - {c["workload"] for c in comps}
+        if unknown:
+            raise SystemExit(f"unknown workload(s): {', '.join(sorted(unknown))}; "
+                             f"known: {', '.join(c['workload'] for c in comps)}")
+        comps = [c for c in comps if c["workload"] in want]
+    log("comparisons:", ", ".join(c["workload"] for c in comps))
+
+    if not args.no_setup:
+        setup()                                   # (a)
+    verify = generate(data_dir)                   # (b)
+    configure(build_dir)                          # (c)
+    status = build(build_dir, comps, args.jobs)
+    for prog, st in status.items():
+        if st:
+            log(f"WARNING: {prog}: {st}")
+
+    log_dir = os.path.join(build_dir, "logs")
+    os.makedirs(log_dir, exist_ok=True)
+    results = {}
+    for c in comps:                               # (d)
+        results[c["workload"]] = run_comparison(c, os.path.join(build_dir, "bin"), data_dir, threads_list,
+                                                args.rounds or c["rounds"], args.reps, args.scale, status,
+                                                log_dir)
+    micro = [] if args.no_micro else run_micro()  # (e)
+    problems = write_report(out, jsonl, cmdline, machine_info(build_dir), anchor_versions(), verify,  # (f)
+                            comps, results, status, micro, rel(data_dir) if data_dir.startswith(REPO) else data_dir,
+                            args.rounds, args.reps, threads_list, started)
+    for p in problems:
+        log("PROBLEM:", p)
+    return 1 if problems else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
