@@ -17,15 +17,20 @@ struct NpyArray {
   std::vector<std::uint8_t> bytes;  // product(shape) * dtype_size(dtype) bytes
 
   std::size_t size() const;  // number of elements
-  /// The elements converted to T (any numeric dtype converts).
+  /// The elements converted to T (any numeric dtype converts). Throws
+  /// geods::Error for a value T cannot hold (NaN or 300.0 to u8, -1 to u32).
   template <typename T> std::vector<T> to_vector() const;
 };
 
-/// Throws geods::Error for malformed headers, Fortran order, object or
-/// unsupported dtypes, shapes whose size overflows or exceeds the file.
+/// Reads dtypes u1..u8, i1..i8, f4, f8 in any byte order and bool (as u8).
+/// Throws geods::Error naming the file for malformed headers, Fortran order,
+/// structured or unsupported dtypes, shapes whose size overflows, and data
+/// that does not exactly fill the rest of the file (checked before allocating).
 NpyArray read_npy(const std::filesystem::path& path);
+/// Writes format 1.0 (2.0 for huge headers), little-endian, C order.
 void write_npy(const std::filesystem::path& path, const NpyArray& array);
 
+/// Writes `data` with the given shape; T is any type with a dtype_of<T>().
 template <typename T>
 void write_npy(const std::filesystem::path& path, std::span<const T> data, std::vector<std::size_t> shape);
 

@@ -20,6 +20,10 @@ struct SvgStyle {
 
 /// Collects shapes given in world coordinates and maps `view` onto a picture
 /// `width` pixels wide (height by the aspect ratio), flipping y so up is up.
+/// Coordinates are converted to pixels here, so stroke widths, point radii and
+/// font sizes are in pixels whatever the world scale. Points and labels are
+/// drawn in their fill colour, or their stroke colour if the fill is "none".
+/// Throws geods::Error for an empty or non-finite view and non-finite shapes.
 class SvgWriter {
  public:
   SvgWriter(const AABB2d& view, double width = 800, double margin = 10);
@@ -32,7 +36,7 @@ class SvgWriter {
   void circle(const Vec2d& center, double radius, const SvgStyle& style = {});  // radius in world units
   void rect(const AABB2d& box, const SvgStyle& style = {});
   void label(const Vec2d& p, const std::string& text, const SvgStyle& style = {});
-  void title(const std::string& text);
+  void title(const std::string& text);  // the picture's <title>
 
   double width() const { return width_; }
   double height() const { return height_; }
@@ -45,6 +49,7 @@ class SvgWriter {
 
   AABB2d view_;
   double width_, height_, margin_, scale_;
+  std::string title_;
   std::string body_;
 };
 

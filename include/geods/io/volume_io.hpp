@@ -20,7 +20,13 @@ Grid3<float> to_float(const AnyGrid3& grid);
 
 /// Reads by extension: .npy (3D array, C order [z][y][x]), .nrrd/.nhdr (raw or
 /// gzip encoding), .nii/.nii.gz (NIfTI-1 through nifticlib; origin and spacing
-/// from the header). Throws geods::Error naming the file and the problem.
+/// from the header). Samples keep the file's type; types without a Grid3 are
+/// widened exactly (int8 to int16, 32-bit integers to double, 64-bit integers
+/// to double if below 2^53, else an error). NIfTI data with a scl_slope other
+/// than 0 or 1 (or a scl_inter) is converted to float as value * slope + inter.
+/// Spacing is the length of each axis's direction; rotations and axis flips
+/// of NRRD/NIfTI orientations are not kept. Throws geods::Error naming the
+/// file and the problem; sizes are checked against the file before allocating.
 AnyGrid3 read_volume(const std::filesystem::path& path);
 
 /// Reads a headerless file of nx*ny*nz samples, x fastest, little-endian.

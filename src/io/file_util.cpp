@@ -1,0 +1,206 @@
+#include "file_util.hpp"
+
+#include <zlib.h>
+
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <fstream>
+#include <limits>
+
+namespace geods::io::detail {
+
+namespace fs = std::filesystem;
+
+void fail(const fs::path& path, const std::string& message) { throw Error(path.string() + ": " + message); }
+
+std::vector<std::uint8_t> read_file(const fs::path& path) {
+  std::error_code ec;
+  const fs::file_status status = fs::status(path, ec);
+  if (!fs::exists(status)) fail(path, "no such file");
+  if (fs::is_directory(status)) fail(path, "is a directory, not a file");
+  // Devices and pipes could be endless (/dev/zero): only regular files are read.
+  if (!fs::is_regular_file(status)) fail(path, "not a regular file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) fail(path, "cannot open for reading");
+  std::vector<std::uint8_t> bytes;
+  // Read in chunks rather than trusting the reported size (it may change, /proc reports 0).
+  constexpr std::size_t chunk = 1 << 20;
+  for (;;) {
+    const std::size_t old = bytes.size();
+    bytes.resize(old + chunk);
+    in.read(reinterpret_cast<char*>(bytes.data() + old), std::streamsize(chunk));
+    bytes.resize(old + std::size_t(in.gcount()));
+    if (!in) break;
+  }
+  if (in.bad()) fail(path, "read error");
+  return bytes;
+}
+
+void write_file(const fs::path& path, std::span<const std::uint8_t> bytes) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  if (!out) fail(path, "cannot open for writing");
+  out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+  out.close();
+  if (!out) fail(path, "write error");
+}
+
+void write_file(const fs::path& path, std::string_view text) {
+  write_file(path, std::span<const std::uint8_t>(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
+}
+
+std::string extension(const fs::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  return ext;
+}
+
+bool is_gzip_name(const fs::path& path, std::string* inner) {
+  if (extension(path) != ".gz") return false;
+  if (inner) *inner = extension(path.stem());
+  return true;
+}
+
+std::vector<std::uint8_t> gunzip(const fs::path& path, std::span<const std::uint8_t> data, std::size_t max_bytes,
+                                 bool prefix) {
+  z_stream zs{};
+  if (inflateInit2(&zs, 15 + 32) != Z_OK) fail(path, "cannot initialize zlib");  // 32: gzip or zlib header
+  std::vector<std::uint8_t> out;
+  std::size_t consumed = 0;
+  int rc = Z_OK;
+  std::uint8_t buffer[1 << 16];
+  for (;;) {
+    // zlib counts in 32-bit units: feed at most 1 GiB at a time.
+    if (zs.avail_in == 0 && consumed < data.size()) {
+      const std::size_t n = std::min<std::size_t>(data.size() - consumed, 1u << 30);
+      zs.next_in = const_cast<Bytef*>(data.data() + consumed);
+      zs.avail_in = uInt(n);
+      consumed += n;
+    }
+    zs.next_out = buffer;
+    zs.avail_out = sizeof(buffer);
+    rc = inflate(&zs, Z_NO_FLUSH);
+    const std::size_t produced = sizeof(buffer) - zs.avail_out;
+    if (out.size() + produced > max_bytes) {
+      inflateEnd(&zs);
+      if (prefix) {
+        out.insert(out.end(), buffer, buffer + (max_bytes - out.size()));
+        return out;
+      }
+      fail(path, "gzip data expands to more than the expected " + std::to_string(max_bytes) + " bytes");
+    }
+    out.insert(out.end(), buffer, buffer + produced);
+    if (rc == Z_STREAM_END) {
+      // Concatenated gzip members are legal (gzip -c a b): continue with the next one.
+      if (zs.avail_in == 0 && consumed == data.size()) break;
+      if (inflateReset(&zs) != Z_OK) break;
+      continue;
+    }
+    if (rc == Z_BUF_ERROR && zs.avail_in == 0 && consumed == data.size()) {
+      inflateEnd(&zs);
+      if (prefix) return out;
+      fail(path, "truncated gzip data");
+    }
+    if (rc != Z_OK && rc != Z_BUF_ERROR) {
+      const std::string msg = zs.msg ? zs.msg : "error " + std::to_string(rc);
+      inflateEnd(&zs);
+      fail(path, "corrupt gzip data (" + msg + ")");
+    }
+  }
+  inflateEnd(&zs);
+  return out;
+}
+
+std::vector<std::uint8_t> gzip(std::span<const std::uint8_t> data) {
+  z_stream zs{};
+  if (deflateInit2(&zs, Z_DEFAULT_COMPRESSION, Z_DEFLATED, 15 + 16, 8, Z_DEFAULT_STRATEGY) != Z_OK)
+    throw Error("gzip: cannot initialize zlib");
+  std::vector<std::uint8_t> out;
+  std::size_t consumed = 0;
+  std::uint8_t buffer[1 << 16];
+  int rc = Z_OK;
+  while (rc != Z_STREAM_END) {
+    if (zs.avail_in == 0 && consumed < data.size()) {
+      const std::size_t n = std::min<std::size_t>(data.size() - consumed, 1u << 30);
+      zs.next_in = const_cast<Bytef*>(data.data() + consumed);
+      zs.avail_in = uInt(n);
+      consumed += n;
+    }
+    zs.next_out = buffer;
+    zs.avail_out = sizeof(buffer);
+    rc = deflate(&zs, consumed == data.size() ? Z_FINISH : Z_NO_FLUSH);
+    out.insert(out.end(), buffer, buffer + (sizeof(buffer) - zs.avail_out));
+  }
+  deflateEnd(&zs);
+  return out;
+}
+
+std::size_t checked_mul(const fs::path& path, std::size_t a, std::size_t b) {
+  if (b != 0 && a > std::numeric_limits<std::size_t>::max() / b)
+    fail(path, "size " + std::to_string(a) + " x " + std::to_string(b) + " overflows");
+  return a * b;
+}
+
+void swap_bytes(std::span<std::uint8_t> bytes, std::size_t width) {
+  if (width < 2) return;
+  for (std::size_t i = 0; i + width <= bytes.size(); i += width) std::reverse(bytes.begin() + i, bytes.begin() + i + width);
+}
+
+bool parse_double(std::string_view token, double& value) {
+  if (!token.empty() && token.front() == '+') token.remove_prefix(1);
+  if (token.empty()) return false;
+  const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
+  // Out-of-range values are reported as errors too, not silently clamped.
+  return ec == std::errc() && end == token.data() + token.size();
+}
+
+bool parse_size(std::string_view token, std::size_t& value) {
+  if (!token.empty() && token.front() == '+') token.remove_prefix(1);
+  if (token.empty()) return false;
+  const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
+  return ec == std::errc() && end == token.data() + token.size();
+}
+
+std::vector<std::string_view> split_fields(std::string_view line, bool commas) {
+  std::vector<std::string_view> fields;
+  auto is_sep = [&](char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f' || (commas && c == ','); };
+  if (commas) {
+    // CSV keeps empty fields so that "1,,2" is an error rather than "1,2".
+    std::size_t start = 0;
+    for (std::size_t i = 0; i <= line.size(); ++i) {
+      if (i == line.size() || line[i] == ',') {
+        fields.push_back(trim(line.substr(start, i - start)));
+        start = i + 1;
+      }
+    }
+    return fields;
+  }
+  std::size_t i = 0;
+  while (i < line.size()) {
+    while (i < line.size() && is_sep(line[i])) ++i;
+    const std::size_t start = i;
+    while (i < line.size() && !is_sep(line[i])) ++i;
+    if (i > start) fields.push_back(line.substr(start, i - start));
+  }
+  return fields;
+}
+
+bool LineReader::next(std::string_view& line) {
+  if (pos_ >= text_.size()) return false;
+  std::size_t end = text_.find('\n', pos_);
+  if (end == std::string_view::npos) end = text_.size();
+  line = text_.substr(pos_, end - pos_);
+  if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+  pos_ = end + 1;
+  ++line_;
+  return true;
+}
+
+std::string_view trim(std::string_view s) {
+  auto ws = [](char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\v' || c == '\f'; };
+  while (!s.empty() && ws(s.front())) s.remove_prefix(1);
+  while (!s.empty() && ws(s.back())) s.remove_suffix(1);
+  return s;
+}
+
+}  // namespace geods::io::detail
