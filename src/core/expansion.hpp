@@ -1,0 +1,142 @@
+#pragma once
+// Shewchuk's floating-point expansions: a number held exactly as a sum of
+// doubles that do not overlap, smallest first. Sums and products of doubles
+// are computed without any rounding error, so the sign of a determinant built
+// from them is exact.
+//
+// Exactness needs every intermediate value to stay clear of overflow and of
+// underflow below 2^-1074; predicates.cpp checks the inputs before using these.
+// Each Expansion<N> has room for N components, fixed at compile time from the
+// shape of the formula, so the exact paths never allocate.
+#include <cmath>
+
+namespace geods::exact {
+
+/// a + b = sum + error, both doubles, exactly (Knuth's branch-free TwoSum).
+struct TwoTerm {
+  double head;  // the rounded result
+  double tail;  // its rounding error
+};
+
+inline TwoTerm two_sum(double a, double b) {
+  const double s = a + b;
+  const double bv = s - a;
+  const double av = s - bv;
+  return {s, (a - av) + (b - bv)};
+}
+
+inline TwoTerm two_diff(double a, double b) {
+  const double d = a - b;
+  const double bv = a - d;
+  const double av = d + bv;
+  return {d, (a - av) + (bv - b)};
+}
+
+/// Valid only when |a| >= |b| (or a == 0); three flops instead of six.
+inline TwoTerm fast_two_sum(double a, double b) {
+  const double s = a + b;
+  return {s, b - (s - a)};
+}
+
+inline TwoTerm two_product(double a, double b) {
+  const double p = a * b;
+  return {p, std::fma(a, b, -p)};
+}
+
+template <int N>
+struct Expansion {
+  static constexpr int capacity = N;
+  double c[N];   // components by increasing magnitude, no zeros
+  int size = 0;  // 0 means the value zero
+
+  /// The sign of the value: its largest component has it.
+  double top() const { return size == 0 ? 0.0 : c[size - 1]; }
+  /// A double near the value (the rounded sum of the components).
+  double estimate() const {
+    double s = 0.0;
+    for (int i = 0; i < size; ++i) s += c[i];
+    return s;
+  }
+};
+
+inline Expansion<1> exact(double a) {
+  Expansion<1> e;
+  if (a != 0.0) e.c[e.size++] = a;
+  return e;
+}
+
+inline Expansion<2> from_two_term(TwoTerm t) {
+  Expansion<2> e;
+  if (t.tail != 0.0) e.c[e.size++] = t.tail;
+  if (t.head != 0.0) e.c[e.size++] = t.head;
+  return e;
+}
+
+/// a * b as an expansion.
+inline Expansion<2> product(double a, double b) { return from_two_term(two_product(a, b)); }
+
+namespace detail {
+
+// Shewchuk's FAST-EXPANSION-SUM-ZEROELIM: merge e and f (f scaled by
+// f_sign = +-1, which is exact) by magnitude, then accumulate with two_sum.
+// Two_sum instead of the first fast_two_sum: same result, no precondition.
+inline int sum(const double* e, int ne, const double* f, int nf, double f_sign, double* h) {
+  int i = 0, j = 0, n = 0;
+  auto next = [&]() {
+    if (j == nf || (i < ne && std::abs(e[i]) < std::abs(f[j]))) return e[i++];
+    return f_sign * f[j++];
+  };
+  if (ne + nf == 0) return 0;
+  double q = next();
+  while (i < ne || j < nf) {
+    const TwoTerm t = two_sum(q, next());
+    if (t.tail != 0.0) h[n++] = t.tail;
+    q = t.head;
+  }
+  if (q != 0.0) h[n++] = q;
+  return n;
+}
+
+// Shewchuk's SCALE-EXPANSION-ZEROELIM: e * b.
+inline int scale(const double* e, int ne, double b, double* h) {
+  if (ne == 0 || b == 0.0) return 0;
+  int n = 0;
+  TwoTerm p = two_product(e[0], b);
+  if (p.tail != 0.0) h[n++] = p.tail;
+  double q = p.head;
+  for (int i = 1; i < ne; ++i) {
+    p = two_product(e[i], b);
+    const TwoTerm s = two_sum(q, p.tail);
+    if (s.tail != 0.0) h[n++] = s.tail;
+    const TwoTerm r = fast_two_sum(p.head, s.head);
+    if (r.tail != 0.0) h[n++] = r.tail;
+    q = r.head;
+  }
+  if (q != 0.0) h[n++] = q;
+  return n;
+}
+
+}  // namespace detail
+
+template <int N, int M>
+Expansion<N + M> operator+(const Expansion<N>& e, const Expansion<M>& f) {
+  Expansion<N + M> h;
+  h.size = detail::sum(e.c, e.size, f.c, f.size, 1.0, h.c);
+  return h;
+}
+
+template <int N, int M>
+Expansion<N + M> operator-(const Expansion<N>& e, const Expansion<M>& f) {
+  Expansion<N + M> h;
+  h.size = detail::sum(e.c, e.size, f.c, f.size, -1.0, h.c);
+  return h;
+}
+
+template <int N>
+Expansion<2 * N> operator*(const Expansion<N>& e, double b) {
+  Expansion<2 * N> h;
+  h.size = detail::scale(e.c, e.size, b, h.c);
+  return h;
+}
+
+}  // namespace geods::exact
