@@ -89,7 +89,7 @@ def load_bunny():
             local = [p for p in BUNNY_TGZ if os.path.exists(p)]
             if not local:
                 log("no local copy of bunny-1.0.1.tgz either (looked in: " + ", ".join(BUNNY_TGZ) + ")")
-                return None
+                return load_bunny_ply()
             log("using local copy", os.path.normpath(local[0]))
             shutil.copyfile(local[0], os.path.join(d, "bunny-1.0.1.tgz"))
         try:
@@ -103,6 +103,27 @@ def load_bunny():
     P = np.array(json.loads(m.group(1)), dtype=np.float64)
     F = np.array(json.loads(c.group(1)), dtype=np.int64)
     return P, F
+
+
+BUNNY_FROM_PLY = False
+
+
+def load_bunny_ply():
+    """Last resort before the icosphere: the project's float32 copy data/bunny.ply (same mesh, but
+    its coordinates are rounded to float32, so the mesh files will not match the reference hashes)."""
+    path = os.path.join(REPO, "data", "bunny.ply")
+    if not os.path.exists(path):
+        return None
+    d = open(path, "rb").read()
+    i = d.index(b"end_header\n") + len(b"end_header\n")
+    nv = int(re.search(rb"element vertex (\d+)", d[:i]).group(1))
+    nf = int(re.search(rb"element face (\d+)", d[:i]).group(1))
+    P = np.frombuffer(d[i:i + nv * 12], dtype="<f4").reshape(-1, 3).astype(np.float64)
+    fr = np.frombuffer(d[i + nv * 12:i + nv * 12 + nf * 13], dtype=[("n", "u1"), ("v", "<i4", (3,))])
+    log("using data/bunny.ply (float32 coordinates: the mesh hashes will differ from the reference)")
+    global BUNNY_FROM_PLY
+    BUNNY_FROM_PLY = True
+    return P, fr["v"].astype(np.int64)
 
 
 def icosphere_noisy():
@@ -236,6 +257,8 @@ def main():
     if b is not None:
         P0, F0 = b
         meta["mesh_source"] = "npm bunny@1.0.1 (Stanford bunny, 1839 v / 3674 f), Loop-subdivided"
+        if BUNNY_FROM_PLY:
+            meta["mesh_source"] = "data/bunny.ply (float32 copy of npm bunny@1.0.1), Loop-subdivided"
     else:
         P0, F0 = icosphere_noisy()
         meta["mesh_source"] = "fallback noisy icosphere (npm bunny unavailable)"

@@ -20,7 +20,11 @@ declares them with geods_compare_program(), and a compare.json read here:
   title       section title;  about: one paragraph of Markdown (what is timed, inputs, checks)
   programs    [{"anchor": "geods", "program": "compare_<workload>_geods"},
                {"anchor": "cgal", "program": "...", "label": "CGAL Epick", "package": "libcgal-dev"}, ...]
-              run in this order; the first one is the baseline of the ratios (geods)
+              run in this order; the first one is the baseline of the ratios (geods).
+              Instead of "program" (a target of the CMake project, in build/compare/bin), an entry
+              may give "command": ["{python}", "{dir}/edt_scipy.py"] (placeholders: {python} =
+              /usr/bin/python3, {dir} = the comparison folder, {bin} = build/compare/bin); it gets
+              the same arguments and must print the same JSON lines.
   threads     "all": run with every --threads count; "1": single thread only
   metrics     timing fields to tabulate, e.g. ["build_s", "query_s"]
   rate        optional {"unit": "Mcalls/s", "scale": 1e-6}: also show count / time * scale
@@ -129,7 +133,7 @@ def build(build_dir, comps, jobs):
     targets = known_targets(build_dir)
     status = {}
     for c in comps:
-        names = [p["program"] for p in c["programs"]]
+        names = [p["program"] for p in c["programs"] if "program" in p]
         present = [n for n in names if n in targets]
         for n in names:
             if n not in targets:
@@ -156,11 +160,16 @@ def run_comparison(c, bin_dir, data_dir, threads_list, rounds, reps, scale, stat
     for threads in tl:
         for rnd in range(rounds):
             for p in c["programs"]:
-                prog = p["program"]
-                if status.get(prog):
-                    continue
-                cmd = [os.path.join(bin_dir, prog), "--data", data_dir, "--threads", str(threads),
-                       "--reps", str(reps)] + [str(a) for a in c["args"]]
+                if "command" in p:
+                    cmd = [a.format(python=PY, dir=c["dir"], bin=bin_dir) for a in p["command"]]
+                    prog = os.path.splitext(os.path.basename(cmd[-1]))[0]
+                else:
+                    prog = p["program"]
+                    if status.get(prog):
+                        continue
+                    cmd = [os.path.join(bin_dir, prog)]
+                cmd += ["--data", data_dir, "--threads", str(threads), "--reps", str(reps)]
+                cmd += [str(a) for a in c["args"]]
                 if scale != 1.0:
                     cmd += ["--scale", repr(scale)]
                 log(f"{c['workload']}: {prog} threads={threads} round={rnd + 1}/{rounds}")
@@ -194,9 +203,9 @@ def run_comparison(c, bin_dir, data_dir, threads_list, rounds, reps, scale, stat
 
 
 # ----------------------------------------------------------------------------- step e
-def run_micro(timeout_s=900):
+def run_micro(pattern=os.path.join(REPO, "build", "release", "bin", "geods_*_bench"), timeout_s=900):
     results = []
-    for exe in sorted(glob.glob(os.path.join(REPO, "build", "release", "bin", "geods_*_bench"))):
+    for exe in sorted(glob.glob(pattern)):
         if not os.access(exe, os.X_OK):
             continue
         log("micro:", rel(exe))
@@ -442,8 +451,9 @@ def write_report(out, jsonl, cmdline, info, versions, verify, comps, results, st
         s = [f"## {c['workload']} — {c['title']}\n", c["about"] + "\n"]
         progs = []
         for p in c["programs"]:
-            st = status.get(p["program"])
-            progs.append(f"`{p['program']}` = {p.get('label', p['anchor'])}"
+            pname = p.get("program") or " ".join(p["command"]).replace("{python} ", "").replace("{dir}/", "")
+            st = status.get(pname)
+            progs.append(f"`{pname}` = {p.get('label', p['anchor'])}"
                          + (f" (**{st}**)" if st else ""))
         s.append("Programs: " + "; ".join(progs) + ".\n")
         s.append(table + "\n")
