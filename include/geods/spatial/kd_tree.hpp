@@ -1,0 +1,671 @@
+#pragma once
+// Balanced k-d tree (seed §2.2, Theorem 4): built in O(n log n) by median splits,
+// O(n) space, axis-parallel range queries in O(n^(1-1/d) + a); exact and (1+eps)
+// approximate k-nearest neighbours, radius search, batch queries in parallel.
+//
+// Layout: a flat array of nodes in depth-first order (the left child of node i is
+// i + 1, the right child is stored) with 32-bit indices, and a permutation of the
+// point indices so that every node owns a contiguous range of it. The points stay
+// in the caller's array (zero-copy, PointView) or in one the tree owns.
+//
+// Split rule: each node splits its points at the median (std::nth_element) along
+// the axis of widest spread of those points. Median splits bound the depth by
+// ceil(log2(n / leaf_size)) whatever the distribution; the widest-spread axis
+// (rather than cycling axes) keeps cells from becoming slivers on clustered and
+// degenerate sets (all points on a line or a plane). Each inner node stores the
+// largest coordinate of its left points and the smallest of its right points on
+// the split axis, so empty space between them is pruned too (as in nanoflann).
+#include <tbb/parallel_invoke.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <memory>
+#include <numeric>
+#include <span>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "geods/core/aabb.hpp"
+#include "geods/core/error.hpp"
+#include "geods/core/parallel.hpp"
+#include "geods/core/vec.hpp"
+#include "geods/spatial/kd_tree_file.hpp"
+#include "geods/spatial/knn_result.hpp"
+#include "geods/spatial/point_view.hpp"
+
+namespace geods::spatial {
+
+/// The dimension template argument for a dimension known only at run time (as in Eigen).
+inline constexpr int Dynamic = -1;
+
+struct KdTreeStats {
+  std::size_t points = 0;
+  std::size_t nodes = 0;
+  std::size_t leaves = 0;
+  std::size_t depth = 0;  // edges on the longest root-to-leaf path
+  std::size_t bytes = 0;  // nodes, permutation and owned points
+};
+
+template <typename T, int Dim = Dynamic>
+class KdTree {
+  static_assert(std::is_same_v<T, float> || std::is_same_v<T, double>, "KdTree<T>: T is float or double");
+  static_assert(Dim == Dynamic || Dim >= 1, "KdTree<T, Dim>: Dim >= 1 or Dynamic");
+
+ public:
+  using Scalar = T;
+  static constexpr int kDim = Dim;
+  static constexpr std::size_t kDefaultLeafSize = 10;
+
+  struct Node {
+    std::uint32_t begin, end;  // the node's points are permutation()[begin, end)
+    std::uint32_t right;       // inner node: index of the right child; 0 marks a leaf
+    std::uint32_t axis;        // inner node: split axis
+    T low, high;               // inner node: max on `axis` over the left points, min over the right ones
+    bool leaf() const { return right == 0; }
+  };
+
+  /// An empty tree (queries return nothing).
+  KdTree() = default;
+
+  /// Builds over the caller's points without copying them: the array must
+  /// outlive the tree, unchanged. Throws geods::Error for NaN/inf coordinates,
+  /// a dimension other than Dim, leaf_size 0 or 2^32 - 1 points or more.
+  explicit KdTree(PointView<T> points, std::size_t leaf_size = kDefaultLeafSize) : view_(points) {
+    build(leaf_size);
+  }
+
+  /// Builds over points the tree owns: `coordinates` holds n * dim values, row by row.
+  KdTree(std::vector<T> coordinates, std::size_t dim, std::size_t leaf_size = kDefaultLeafSize) {
+    if (dim == 0 || coordinates.size() % dim != 0)
+      throw Error("KdTree: " + std::to_string(coordinates.size()) + " coordinates are not rows of dimension " +
+                  std::to_string(dim));
+    adopt(std::move(coordinates), dim);
+    build(leaf_size);
+  }
+
+  // ---------------------------------------------------------------- accessors
+  std::size_t size() const { return view_.count; }
+  bool empty() const { return view_.count == 0; }
+  std::size_t dim() const { return Dim == Dynamic ? view_.dim : std::size_t(Dim); }
+  std::size_t leaf_size() const { return leaf_size_; }
+  /// Coordinates of point i (its index in the input).
+  const T* point(std::size_t i) const { return view_[i]; }
+  PointView<T> points() const { return view_; }
+  const std::vector<Node>& nodes() const { return nodes_; }
+  /// Point indices in tree order: node v owns permutation()[v.begin, v.end).
+  const std::vector<std::uint32_t>& permutation() const { return perm_; }
+  /// Bounding box of all points (empty vectors for an empty tree).
+  const std::vector<T>& bounds_lo() const { return root_lo_; }
+  const std::vector<T>& bounds_hi() const { return root_hi_; }
+
+  // ---------------------------------------------------------------- k nearest neighbours
+  /// The request.k nearest points to `query`, sorted by distance, ties by index;
+  /// fewer if the tree holds fewer or request.max_distance excludes them.
+  /// Cost: O(log n) expected for uniform data and small k.
+  std::vector<Neighbor<T>> query(std::span<const T> query, const KnnRequest& request) const {
+    std::vector<Neighbor<T>> out(check_request(request));
+    out.resize(query_into(query, request, out.data()));
+    return out;
+  }
+  std::vector<Neighbor<T>> query(std::span<const T> q, std::size_t k, double eps = 0) const {
+    return query(q, KnnRequest{k, eps});
+  }
+  std::vector<Neighbor<T>> query(const Vec<T, Dim>& q, std::size_t k, double eps = 0) const
+    requires(Dim != Dynamic)
+  {
+    return query(std::span<const T>(q.data(), Dim), KnnRequest{k, eps});
+  }
+
+  /// Allocation-free form: writes exactly request.k slots to `out` (unused ones
+  /// are {kNoIndex, +inf}) and returns how many neighbours were found.
+  std::size_t query_into(std::span<const T> query, const KnnRequest& request, Neighbor<T>* out) const {
+    const std::size_t k = check_request(request);
+    check_point(query, "query point");
+    const T limit = squared_limit(request.max_distance);
+    KnnResultSet<T> result(out, k, limit);
+    if (!empty()) {
+      // Visit a subtree while its lower bound is <= worst * factor: the slack keeps
+      // exact ties from being pruned by rounding in the incremental distance, and
+      // 1/(1+eps)^2 turns the search approximate.
+      const T slack = T(1) + T(4 * (dim() + 2)) * std::numeric_limits<T>::epsilon();
+      const T approx = slack / T((1 + request.eps) * (1 + request.eps));
+      Scratch<T> dists(dim());
+      const T mindist = initial_distances(query.data(), dists.data());
+      search_knn(0, query.data(), mindist, dists.data(), result, slack, approx);
+    }
+    result.finish();
+    return result.size();
+  }
+
+  /// Every point within Euclidean distance `radius` of `query` (inclusive),
+  /// sorted by distance, ties by index.
+  std::vector<Neighbor<T>> query_radius(std::span<const T> query, double radius) const {
+    check_point(query, "query point");
+    if (!(radius >= 0)) throw Error("KdTree::query_radius: radius must be >= 0, got " + std::to_string(radius));
+    std::vector<Neighbor<T>> out;
+    if (empty()) return out;
+    const T r2 = squared_limit(radius);
+    const T bound = r2 * (T(1) + T(4 * (dim() + 2)) * std::numeric_limits<T>::epsilon());
+    Scratch<T> dists(dim());
+    const T mindist = initial_distances(query.data(), dists.data());
+    search_radius(0, query.data(), mindist, dists.data(), r2, bound, out);
+    std::sort(out.begin(), out.end());
+    return out;
+  }
+  std::vector<Neighbor<T>> query_radius(const Vec<T, Dim>& q, double radius) const
+    requires(Dim != Dynamic)
+  {
+    return query_radius(std::span<const T>(q.data(), Dim), radius);
+  }
+
+  // ---------------------------------------------------------------- box range
+  /// Indices of the points p with lo <= p <= hi on every axis (closed box), in
+  /// tree order. Subtrees whose cell lies inside the box are reported without
+  /// visiting their nodes: O(sqrt(n) + a) in 2D (Theorem 4). `visited`, if given,
+  /// is increased by the number of nodes visited.
+  std::vector<std::uint32_t> query_box(std::span<const T> lo, std::span<const T> hi,
+                                       std::size_t* visited = nullptr) const {
+    std::vector<std::uint32_t> out;
+    range<true>(lo, hi, &out, visited);
+    return out;
+  }
+  /// How many points lie in the closed box; whole subtrees inside the box count
+  /// in O(1) each, so this is O(sqrt(n)) in 2D whatever the answer.
+  std::size_t count_box(std::span<const T> lo, std::span<const T> hi, std::size_t* visited = nullptr) const {
+    return range<false>(lo, hi, nullptr, visited);
+  }
+  std::vector<std::uint32_t> query_box(const AABB<T, Dim>& box) const
+    requires(Dim != Dynamic)
+  {
+    return query_box(std::span<const T>(box.lo.data(), Dim), std::span<const T>(box.hi.data(), Dim));
+  }
+  std::size_t count_box(const AABB<T, Dim>& box) const
+    requires(Dim != Dynamic)
+  {
+    return count_box(std::span<const T>(box.lo.data(), Dim), std::span<const T>(box.hi.data(), Dim));
+  }
+
+  // ---------------------------------------------------------------- batches (parallel over queries)
+  /// request.k slots per query, query i at [i * k, (i + 1) * k); missing ones are {kNoIndex, +inf}.
+  std::vector<Neighbor<T>> query_batch(PointView<T> queries, const KnnRequest& request) const {
+    const std::size_t k = check_request(request);
+    check_batch(queries, dim(), "queries");
+    std::vector<Neighbor<T>> out(queries.count * k);
+    parallel_for(0, queries.count, 64, [&](std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i) query_into(std::span<const T>(queries[i], dim()), request, out.data() + i * k);
+    });
+    return out;
+  }
+  std::vector<std::vector<Neighbor<T>>> query_radius_batch(PointView<T> queries, double radius) const {
+    check_batch(queries, dim(), "queries");
+    std::vector<std::vector<Neighbor<T>>> out(queries.count);
+    parallel_for(0, queries.count, 16, [&](std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i) out[i] = query_radius(std::span<const T>(queries[i], dim()), radius);
+    });
+    return out;
+  }
+  /// Each row of `boxes` holds 2 * dim values: the low corner, then the high corner.
+  std::vector<std::size_t> count_box_batch(PointView<T> boxes) const {
+    check_batch(boxes, 2 * dim(), "boxes");
+    std::vector<std::size_t> out(boxes.count);
+    parallel_for(0, boxes.count, 16, [&](std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i) out[i] = count_box(std::span<const T>(boxes[i], dim()), std::span<const T>(boxes[i] + dim(), dim()));
+    });
+    return out;
+  }
+
+  // ---------------------------------------------------------------- inspection
+  KdTreeStats stats() const {
+    KdTreeStats s;
+    s.points = size();
+    s.nodes = nodes_.size();
+    s.bytes = nodes_.size() * sizeof(Node) + perm_.size() * sizeof(std::uint32_t) +
+              (owned_ ? owned_->size() * sizeof(T) : 0) + 2 * root_lo_.size() * sizeof(T);
+    std::vector<std::pair<std::uint32_t, std::size_t>> stack;
+    if (!nodes_.empty()) stack.push_back({0, 0});
+    while (!stack.empty()) {
+      const auto [v, depth] = stack.back();
+      stack.pop_back();
+      s.depth = std::max(s.depth, depth);
+      if (nodes_[v].leaf()) {
+        ++s.leaves;
+      } else {
+        stack.push_back({v + 1, depth + 1});
+        stack.push_back({nodes_[v].right, depth + 1});
+      }
+    }
+    return s;
+  }
+
+  /// Checks every invariant; throws geods::Error naming the first violation:
+  /// the permutation is a permutation; nodes form a tree in depth-first order
+  /// whose children split their parent's range at its middle (balance); leaves
+  /// hold 1..leaf_size points; low <= high; every point lies in the cell of its
+  /// leaf (the root box cut by the low/high values on the path), so no split lies.
+  void validate() const {
+    const std::size_t n = size();
+    auto fail = [](const std::string& what) { throw Error("KdTree::validate: " + what); };
+    if (perm_.size() != n) fail("permutation has " + std::to_string(perm_.size()) + " entries for " +
+                                std::to_string(n) + " points");
+    std::vector<bool> seen(n, false);
+    for (std::uint32_t i : perm_) {
+      if (i >= n || seen[i]) fail("permutation is not a permutation (entry " + std::to_string(i) + ")");
+      seen[i] = true;
+    }
+    if (n == 0) {
+      if (!nodes_.empty()) fail("nodes without points");
+      return;
+    }
+    if (nodes_.empty()) fail("points without nodes");
+    if (root_lo_.size() != dim() || root_hi_.size() != dim()) fail("root box has the wrong dimension");
+    struct Item {
+      std::uint32_t node;
+      std::vector<T> lo, hi;
+    };
+    std::vector<Item> stack{{0, root_lo_, root_hi_}};
+    std::size_t visited = 0, covered = 0;
+    while (!stack.empty()) {
+      Item item = std::move(stack.back());
+      stack.pop_back();
+      if (++visited > nodes_.size()) fail("node graph is not a tree");
+      const Node& node = nodes_[item.node];
+      const std::string where = "node " + std::to_string(item.node) + ": ";
+      if (node.begin >= node.end || node.end > n) fail(where + "bad point range");
+      if (node.leaf()) {
+        if (node.end - node.begin > leaf_size_) fail(where + "leaf holds more than leaf_size points");
+        if (node.begin != covered) fail(where + "leaves do not cover the permutation in order");
+        covered = node.end;
+        for (std::uint32_t i = node.begin; i < node.end; ++i) {
+          const T* p = point(perm_[i]);
+          for (std::size_t a = 0; a < dim(); ++a)
+            if (!(p[a] >= item.lo[a] && p[a] <= item.hi[a]))
+              fail(where + "point " + std::to_string(perm_[i]) + " lies outside its leaf's cell");
+        }
+        continue;
+      }
+      if (node.end - node.begin <= leaf_size_) fail(where + "inner node small enough to be a leaf");
+      if (node.axis >= dim()) fail(where + "bad split axis");
+      if (std::size_t(item.node) + 1 >= nodes_.size() || node.right <= item.node + 1 || node.right >= nodes_.size())
+        fail(where + "bad child index");
+      const Node& left = nodes_[item.node + 1];
+      const Node& right = nodes_[node.right];
+      const std::uint32_t mid = node.begin + (node.end - node.begin) / 2;
+      if (left.begin != node.begin || left.end != mid || right.begin != mid || right.end != node.end)
+        fail(where + "children do not split the range at its middle");
+      if (!(node.low <= node.high)) fail(where + "low > high");
+      Item l{item.node + 1, item.lo, item.hi}, r{node.right, std::move(item.lo), std::move(item.hi)};
+      l.hi[node.axis] = node.low;
+      r.lo[node.axis] = node.high;
+      stack.push_back(std::move(r));
+      stack.push_back(std::move(l));  // left first: leaves come out in permutation order
+    }
+    if (visited != nodes_.size()) fail("unreachable nodes");
+    if (covered != n) fail("leaves do not cover all points");
+  }
+
+  // ---------------------------------------------------------------- files
+  /// Writes the tree and its points (see kd_tree_file.hpp).
+  void save(const std::filesystem::path& path) const {
+    std::ofstream out(path, std::ios::binary);
+    if (!out) throw Error(path.string() + ": cannot open for writing");
+    KdTreeFileHeader h;
+    h.scalar_bytes = sizeof(T);
+    h.dim = std::uint32_t(dim());
+    h.leaf_size = std::uint32_t(leaf_size_);
+    h.points = size();
+    h.nodes = nodes_.size();
+    write_kd_tree_header(out, h, path);
+    std::vector<T> box(2 * dim(), T(0));
+    std::copy(root_lo_.begin(), root_lo_.end(), box.begin());
+    std::copy(root_hi_.begin(), root_hi_.end(), box.begin() + dim());
+    write_bytes(out, box.data(), box.size() * sizeof(T), path);
+    write_bytes(out, nodes_.data(), nodes_.size() * sizeof(Node), path);
+    write_bytes(out, perm_.data(), perm_.size() * sizeof(std::uint32_t), path);
+    for (std::size_t i = 0; i < size(); ++i) write_bytes(out, point(i), dim() * sizeof(T), path);
+    out.flush();
+    if (!out) throw Error(path.string() + ": cannot write");
+  }
+
+  /// Reads a tree written by save(); the loaded tree owns its points. Throws
+  /// geods::Error for another scalar type or dimension, a bad header, truncation
+  /// or contents that fail validate().
+  static KdTree load(const std::filesystem::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw Error(path.string() + ": cannot open");
+    const KdTreeFileHeader h = read_kd_tree_header(in, path);
+    if (h.scalar_bytes != sizeof(T))
+      throw Error(path.string() + ": k-d tree of " + (h.scalar_bytes == 4 ? "float" : "double") + ", expected " +
+                  (sizeof(T) == 4 ? "float" : "double"));
+    if (Dim != Dynamic && h.dim != std::uint32_t(Dim))
+      throw Error(path.string() + ": k-d tree of dimension " + std::to_string(h.dim) + ", expected " +
+                  std::to_string(Dim));
+    KdTree tree;
+    tree.leaf_size_ = h.leaf_size;
+    std::vector<T> box(2 * h.dim);
+    read_bytes(in, box.data(), box.size() * sizeof(T), path);
+    tree.nodes_.resize(h.nodes);
+    read_bytes(in, tree.nodes_.data(), tree.nodes_.size() * sizeof(Node), path);
+    tree.perm_.resize(h.points);
+    read_bytes(in, tree.perm_.data(), tree.perm_.size() * sizeof(std::uint32_t), path);
+    std::vector<T> coordinates(h.points * h.dim);
+    read_bytes(in, coordinates.data(), coordinates.size() * sizeof(T), path);
+    tree.adopt(std::move(coordinates), h.dim);
+    if (h.points > 0) {
+      tree.root_lo_.assign(box.begin(), box.begin() + h.dim);
+      tree.root_hi_.assign(box.begin() + h.dim, box.end());
+    }
+    try {
+      tree.validate();
+    } catch (const Error& e) {
+      throw Error(path.string() + ": corrupted k-d tree: " + e.what());
+    }
+    return tree;
+  }
+
+ private:
+  static_assert(sizeof(Node) == 16 + 2 * sizeof(T), "Node is written to files as is");
+
+  // A small per-query array: on the stack for compile-time and small run-time dimensions.
+  template <typename U>
+  class Scratch {
+   public:
+    explicit Scratch(std::size_t n) {
+      if (Dim == Dynamic && n > kStack) heap_.resize(n);
+    }
+    U* data() { return heap_.empty() ? stack_.data() : heap_.data(); }
+
+   private:
+    static constexpr std::size_t kStack = Dim == Dynamic ? 64 : std::size_t(Dim);
+    std::array<U, kStack> stack_;
+    std::vector<U> heap_;
+  };
+
+  void adopt(std::vector<T> coordinates, std::size_t dim) {
+    owned_ = std::make_shared<std::vector<T>>(std::move(coordinates));
+    view_ = PointView<T>(owned_->data(), owned_->size() / dim, dim);
+  }
+
+  // ---------------------------------------------------------------- build
+  void build(std::size_t leaf_size) {
+    if (leaf_size == 0 || leaf_size > std::numeric_limits<std::uint32_t>::max())
+      throw Error("KdTree: leaf_size must be >= 1");
+    if (view_.dim == 0 || (Dim != Dynamic && view_.dim != std::size_t(Dim)))
+      throw Error("KdTree: points of dimension " + std::to_string(view_.dim) + ", expected " +
+                  (Dim == Dynamic ? std::string(">= 1") : std::to_string(Dim)));
+    if (view_.stride < view_.dim) throw Error("KdTree: stride smaller than the dimension");
+    if (view_.count >= std::numeric_limits<std::uint32_t>::max())
+      throw Error("KdTree: " + std::to_string(view_.count) + " points, at most 2^32 - 2 are supported");
+    if (view_.count > 0 && view_.data == nullptr) throw Error("KdTree: null point array");
+    leaf_size_ = leaf_size;
+    const std::size_t n = view_.count;
+    for (std::size_t i = 0; i < n; ++i) {
+      const T* p = view_[i];
+      for (std::size_t a = 0; a < dim(); ++a)
+        if (!std::isfinite(p[a]))
+          throw Error("KdTree: point " + std::to_string(i) + " has a non-finite coordinate (axis " +
+                      std::to_string(a) + ")");
+    }
+    perm_.resize(n);
+    std::iota(perm_.begin(), perm_.end(), 0u);
+    if (n == 0) return;
+    // The size of every subtree depends only on its point count, so each one
+    // knows its place in the node array before its siblings are built: the
+    // parallel build writes disjoint parts and its output is deterministic.
+    std::map<std::size_t, std::uint32_t> subtree_nodes;
+    nodes_.resize(count_nodes(n, subtree_nodes));
+    root_lo_.assign(dim(), T(0));
+    root_hi_.assign(dim(), T(0));
+    const bool parallel = num_threads() > 1;
+    build_node(0, 0, std::uint32_t(n), subtree_nodes, parallel, root_lo_.data(), root_hi_.data());
+  }
+
+  std::uint32_t count_nodes(std::size_t m, std::map<std::size_t, std::uint32_t>& memo) const {
+    if (m <= leaf_size_) return 1;
+    if (auto it = memo.find(m); it != memo.end()) return it->second;
+    const std::uint32_t c = 1 + count_nodes(m / 2, memo) + count_nodes(m - m / 2, memo);
+    memo.emplace(m, c);
+    return c;
+  }
+
+  // Builds the subtree of node `v` over perm_[begin, end) and writes its points' bounds to lo/hi.
+  void build_node(std::uint32_t v, std::uint32_t begin, std::uint32_t end,
+                  const std::map<std::size_t, std::uint32_t>& subtree_nodes, bool parallel, T* lo, T* hi) {
+    bounds(begin, end, lo, hi);
+    Node& node = nodes_[v];
+    node = Node{begin, end, 0, 0, T(0), T(0)};
+    const std::size_t m = end - begin;
+    if (m <= leaf_size_) return;
+    std::uint32_t axis = 0;
+    for (std::uint32_t a = 1; a < dim(); ++a)
+      if (hi[a] - lo[a] > hi[axis] - lo[axis]) axis = a;
+    const std::uint32_t mid = begin + std::uint32_t(m / 2);
+    const T* data = view_.data;
+    const std::size_t stride = view_.stride;
+    std::nth_element(perm_.begin() + begin, perm_.begin() + mid, perm_.begin() + end,
+                     [=](std::uint32_t a, std::uint32_t b) { return data[a * stride + axis] < data[b * stride + axis]; });
+    const std::size_t left_count = m / 2;
+    const std::uint32_t right =
+        v + 1 + (left_count <= leaf_size_ ? 1 : subtree_nodes.at(left_count));
+    node.right = right;
+    node.axis = axis;
+    Scratch<T> left_lo(dim()), left_hi(dim()), right_lo(dim()), right_hi(dim());
+    auto build_left = [&] { build_node(v + 1, begin, mid, subtree_nodes, parallel, left_lo.data(), left_hi.data()); };
+    auto build_right = [&] { build_node(right, mid, end, subtree_nodes, parallel, right_lo.data(), right_hi.data()); };
+    if (parallel && m >= kParallelBuild) {
+      tbb::parallel_invoke(build_left, build_right);
+    } else {
+      build_left();
+      build_right();
+    }
+    node.low = left_hi.data()[axis];
+    node.high = right_lo.data()[axis];
+  }
+
+  // Subtrees smaller than this are built on one thread (task overhead dominates below).
+  static constexpr std::size_t kParallelBuild = 1 << 14;
+
+  void bounds(std::uint32_t begin, std::uint32_t end, T* lo, T* hi) const {
+    const T* p = point(perm_[begin]);
+    for (std::size_t a = 0; a < dim(); ++a) lo[a] = hi[a] = p[a];
+    for (std::uint32_t i = begin + 1; i < end; ++i) {
+      p = point(perm_[i]);
+      for (std::size_t a = 0; a < dim(); ++a) {
+        lo[a] = std::min(lo[a], p[a]);
+        hi[a] = std::max(hi[a], p[a]);
+      }
+    }
+  }
+
+  // ---------------------------------------------------------------- search
+  std::size_t check_request(const KnnRequest& request) const {
+    if (request.k == 0) throw Error("KdTree::query: k must be >= 1");
+    if (request.k > (std::size_t(1) << 32)) throw Error("KdTree::query: k is too large");
+    if (!(request.eps >= 0) || std::isinf(request.eps))
+      throw Error("KdTree::query: eps must be finite and >= 0, got " + std::to_string(request.eps));
+    if (!(request.max_distance >= 0))
+      throw Error("KdTree::query: max_distance must be >= 0, got " + std::to_string(request.max_distance));
+    return request.k;
+  }
+
+  void check_point(std::span<const T> q, const char* what) const {
+    if (q.size() != dim())
+      throw Error(std::string("KdTree: ") + what + " of dimension " + std::to_string(q.size()) + ", the tree has " +
+                  std::to_string(dim()));
+    for (T x : q)
+      if (!std::isfinite(x)) throw Error(std::string("KdTree: ") + what + " has a non-finite coordinate");
+  }
+
+  static void check_batch(const PointView<T>& rows, std::size_t width, const char* what) {
+    if (rows.dim != width)
+      throw Error(std::string("KdTree: ") + what + " rows hold " + std::to_string(rows.dim) + " values, expected " +
+                  std::to_string(width));
+    if (rows.count > 0 && (rows.data == nullptr || rows.stride < rows.dim))
+      throw Error(std::string("KdTree: bad ") + what + " array");
+  }
+
+  // Squared distance limit in T; distances beyond T's range mean "no limit".
+  static T squared_limit(double distance) {
+    const double d2 = distance * distance;
+    return d2 >= double(std::numeric_limits<T>::max()) ? std::numeric_limits<T>::infinity() : T(d2);
+  }
+
+  T squared_distance(const T* q, const T* p) const {
+    T d = 0;
+    for (std::size_t a = 0; a < dim(); ++a) {
+      const T t = q[a] - p[a];
+      d += t * t;
+    }
+    return d;
+  }
+
+  // Per-axis squared distances from q to the root box and their sum (Arya & Mount's incremental distance).
+  T initial_distances(const T* q, T* dists) const {
+    T sum = 0;
+    for (std::size_t a = 0; a < dim(); ++a) {
+      T t = 0;
+      if (q[a] < root_lo_[a]) t = root_lo_[a] - q[a];
+      if (q[a] > root_hi_[a]) t = q[a] - root_hi_[a];
+      dists[a] = t * t;
+      sum += dists[a];
+    }
+    return sum;
+  }
+
+  // mindist is a lower bound of the squared distance from q to the cell of node v;
+  // dists holds its per-axis terms. A subtree is entered when mindist <= worst * factor.
+  void search_knn(std::uint32_t v, const T* q, T mindist, T* dists, KnnResultSet<T>& result, T slack,
+                  T approx) const {
+    const Node& node = nodes_[v];
+    if (node.leaf()) {
+      for (std::uint32_t i = node.begin; i < node.end; ++i) {
+        const std::uint32_t j = perm_[i];
+        result.insert(j, squared_distance(q, point(j)));
+      }
+      return;
+    }
+    const std::uint32_t axis = node.axis;
+    const T x = q[axis];
+    const T to_low = x - node.low, to_high = node.high - x;
+    std::uint32_t near = v + 1, far = node.right;
+    T cut = to_high * to_high;  // distance term of the far cell on this axis
+    if (to_low > to_high) {
+      std::swap(near, far);
+      cut = to_low * to_low;
+    }
+    search_knn(near, q, mindist, dists, result, slack, approx);
+    const T old = dists[axis];
+    mindist += cut - old;
+    // While fewer than k are found, the limit is the max distance and eps must not shrink it.
+    const T bound = result.full() ? result.worst() * approx : result.worst() * slack;
+    if (mindist <= bound) {
+      dists[axis] = cut;
+      search_knn(far, q, mindist, dists, result, slack, approx);
+      dists[axis] = old;
+    }
+  }
+
+  void search_radius(std::uint32_t v, const T* q, T mindist, T* dists, T r2, T bound,
+                     std::vector<Neighbor<T>>& out) const {
+    const Node& node = nodes_[v];
+    if (node.leaf()) {
+      for (std::uint32_t i = node.begin; i < node.end; ++i) {
+        const std::uint32_t j = perm_[i];
+        const T d = squared_distance(q, point(j));
+        if (d <= r2) out.push_back({j, d});
+      }
+      return;
+    }
+    const std::uint32_t axis = node.axis;
+    const T x = q[axis];
+    const T to_low = x - node.low, to_high = node.high - x;
+    std::uint32_t near = v + 1, far = node.right;
+    T cut = to_high * to_high;
+    if (to_low > to_high) {
+      std::swap(near, far);
+      cut = to_low * to_low;
+    }
+    search_radius(near, q, mindist, dists, r2, bound, out);
+    const T old = dists[axis];
+    mindist += cut - old;
+    if (mindist <= bound) {
+      dists[axis] = cut;
+      search_radius(far, q, mindist, dists, r2, bound, out);
+      dists[axis] = old;
+    }
+  }
+
+  template <bool Report>
+  std::size_t range(std::span<const T> lo, std::span<const T> hi, std::vector<std::uint32_t>* out,
+                    std::size_t* visited) const {
+    check_point(lo, "box low corner");
+    check_point(hi, "box high corner");
+    if (empty()) return 0;
+    Scratch<T> cell_lo(dim()), cell_hi(dim());
+    std::copy(root_lo_.begin(), root_lo_.end(), cell_lo.data());
+    std::copy(root_hi_.begin(), root_hi_.end(), cell_hi.data());
+    std::size_t count = 0, nodes = 0;
+    range_node<Report>(0, lo.data(), hi.data(), cell_lo.data(), cell_hi.data(), count, out, nodes);
+    if (visited) *visited += nodes;
+    return count;
+  }
+
+  // cell_lo/cell_hi bound the points of node v; they are restored on return.
+  template <bool Report>
+  void range_node(std::uint32_t v, const T* lo, const T* hi, T* cell_lo, T* cell_hi, std::size_t& count,
+                  std::vector<std::uint32_t>* out, std::size_t& visited) const {
+    ++visited;
+    bool inside = true;
+    for (std::size_t a = 0; a < dim(); ++a) {
+      if (cell_lo[a] > hi[a] || cell_hi[a] < lo[a]) return;
+      inside = inside && lo[a] <= cell_lo[a] && cell_hi[a] <= hi[a];
+    }
+    const Node& node = nodes_[v];
+    if (inside) {
+      count += node.end - node.begin;
+      if constexpr (Report) out->insert(out->end(), perm_.begin() + node.begin, perm_.begin() + node.end);
+      return;
+    }
+    if (node.leaf()) {
+      for (std::uint32_t i = node.begin; i < node.end; ++i) {
+        const T* p = point(perm_[i]);
+        bool in = true;
+        for (std::size_t a = 0; a < dim() && in; ++a) in = lo[a] <= p[a] && p[a] <= hi[a];
+        if (in) {
+          ++count;
+          if constexpr (Report) out->push_back(perm_[i]);
+        }
+      }
+      return;
+    }
+    const std::uint32_t axis = node.axis;
+    const T saved_hi = cell_hi[axis];
+    cell_hi[axis] = node.low;
+    range_node<Report>(v + 1, lo, hi, cell_lo, cell_hi, count, out, visited);
+    cell_hi[axis] = saved_hi;
+    const T saved_lo = cell_lo[axis];
+    cell_lo[axis] = node.high;
+    range_node<Report>(node.right, lo, hi, cell_lo, cell_hi, count, out, visited);
+    cell_lo[axis] = saved_lo;
+  }
+
+  PointView<T> view_;
+  std::shared_ptr<const std::vector<T>> owned_;  // the points, when the tree owns them (shared by copies)
+  std::size_t leaf_size_ = kDefaultLeafSize;
+  std::vector<Node> nodes_;
+  std::vector<std::uint32_t> perm_;
+  std::vector<T> root_lo_, root_hi_;
+};
+
+template <typename T>
+using KdTree2 = KdTree<T, 2>;
+template <typename T>
+using KdTree3 = KdTree<T, 3>;
+
+}  // namespace geods::spatial

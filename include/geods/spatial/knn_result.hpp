@@ -1,0 +1,75 @@
+#pragma once
+// What nearest-neighbour queries ask for and return.
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+
+namespace geods::spatial {
+
+/// Index of "no point" in fixed-size result tables (fewer than k found).
+inline constexpr std::uint32_t kNoIndex = std::numeric_limits<std::uint32_t>::max();
+
+/// A point of the set (its index in the caller's array) and its squared distance.
+template <typename T>
+struct Neighbor {
+  std::uint32_t index = kNoIndex;
+  T squared_distance = std::numeric_limits<T>::infinity();
+
+  /// The result order: by distance, ties by index (so results are deterministic).
+  friend bool operator<(const Neighbor& a, const Neighbor& b) {
+    return a.squared_distance < b.squared_distance ||
+           (a.squared_distance == b.squared_distance && a.index < b.index);
+  }
+  friend bool operator==(const Neighbor&, const Neighbor&) = default;
+};
+
+/// A k-nearest-neighbour query.
+struct KnnRequest {
+  std::size_t k = 1;
+  /// Approximation: the i-th reported distance is at most (1 + eps) times the
+  /// true i-th nearest distance. 0 = exact.
+  double eps = 0;
+  /// Only points at Euclidean distance <= max_distance count.
+  double max_distance = std::numeric_limits<double>::infinity();
+};
+
+/// The k best neighbours seen so far, sorted, in a caller-provided array of k
+/// slots. k is small in practice, so insertion into a sorted array beats a heap.
+template <typename T>
+class KnnResultSet {
+ public:
+  /// Accepts points with squared distance <= limit until k are found.
+  KnnResultSet(Neighbor<T>* slots, std::size_t k, T limit) : slots_(slots), k_(k), limit_(limit) {}
+
+  std::size_t size() const { return size_; }
+  bool full() const { return size_ == k_; }
+  /// The squared distance a new point must not exceed to be kept.
+  T worst() const { return full() ? slots_[k_ - 1].squared_distance : limit_; }
+
+  void insert(std::uint32_t index, T squared_distance) {
+    const Neighbor<T> candidate{index, squared_distance};
+    std::size_t pos;
+    if (size_ < k_) {
+      if (!(squared_distance <= limit_)) return;
+      pos = size_++;
+    } else {
+      if (!(candidate < slots_[k_ - 1])) return;
+      pos = k_ - 1;
+    }
+    for (; pos > 0 && candidate < slots_[pos - 1]; --pos) slots_[pos] = slots_[pos - 1];
+    slots_[pos] = candidate;
+  }
+
+  /// Marks the unused slots as "none" (kNoIndex, +inf).
+  void finish() {
+    for (std::size_t i = size_; i < k_; ++i) slots_[i] = Neighbor<T>{};
+  }
+
+ private:
+  Neighbor<T>* slots_;
+  std::size_t k_;
+  std::size_t size_ = 0;
+  T limit_;
+};
+
+}  // namespace geods::spatial

@@ -1,0 +1,403 @@
+// k-d tree: every query against brute force on uniform, clustered, duplicated
+// and degenerate sets; the O(sqrt(n) + a) range bound; files; bad input.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+#include "geods/core/error.hpp"
+#include "geods/core/parallel.hpp"
+#include "geods/core/rng.hpp"
+#include "geods/spatial/kd_tree.hpp"
+
+namespace geods::spatial {
+namespace {
+
+enum class Shape { uniform, clustered, duplicated, line, plane, identical, grid };
+const Shape kShapes[] = {Shape::uniform, Shape::clustered, Shape::duplicated, Shape::line,
+                         Shape::plane,   Shape::identical, Shape::grid};
+
+std::string name(Shape s) {
+  const char* names[] = {"uniform", "clustered", "duplicated", "line", "plane", "identical", "grid"};
+  return names[int(s)];
+}
+
+// n points of dimension d, row-major.
+template <typename T>
+std::vector<T> make_points(Shape shape, std::size_t n, std::size_t d, std::uint64_t seed) {
+  Rng rng(seed);
+  std::vector<double> centers(10 * d), distinct(20 * d), origin(d), dir1(d), dir2(d);
+  for (double& c : centers) c = rng.uniform();
+  for (double& c : distinct) c = rng.uniform();
+  for (std::size_t a = 0; a < d; ++a) origin[a] = rng.uniform(), dir1[a] = rng.normal(), dir2[a] = rng.normal();
+  std::vector<T> p(n * d);
+  for (std::size_t i = 0; i < n; ++i) {
+    T* q = &p[i * d];
+    const std::size_t c = rng.below(10), e = rng.below(20);
+    const double s = rng.uniform(-1, 1), t = rng.uniform(-1, 1);
+    for (std::size_t a = 0; a < d; ++a) {
+      switch (shape) {
+        case Shape::uniform: q[a] = T(rng.uniform()); break;
+        case Shape::clustered: q[a] = T(centers[c * d + a] + 0.01 * rng.normal()); break;
+        case Shape::duplicated: q[a] = T(distinct[e * d + a]); break;
+        case Shape::line: q[a] = T(origin[a] + s * dir1[a]); break;
+        case Shape::plane: q[a] = T(origin[a] + s * dir1[a] + t * dir2[a]); break;
+        case Shape::identical: q[a] = T(0.5); break;
+        case Shape::grid: q[a] = T(rng.below(8)); break;  // many exact distance ties
+      }
+    }
+  }
+  return p;
+}
+
+// Queries: random ones around the data, data points themselves (distance 0, ties), far ones.
+template <typename T>
+std::vector<T> make_queries(const std::vector<T>& points, std::size_t n, std::size_t d, std::size_t m,
+                            std::uint64_t seed) {
+  Rng rng(seed);
+  std::vector<T> q(m * d);
+  for (std::size_t i = 0; i < m; ++i) {
+    for (std::size_t a = 0; a < d; ++a) {
+      if (i % 3 == 1 && n > 0) {
+        q[i * d + a] = points[(i * 7919 % n) * d + a];
+      } else {
+        q[i * d + a] = T(rng.uniform(-0.5, 1.5) * (i % 5 == 4 ? 10 : 1));
+      }
+    }
+  }
+  return q;
+}
+
+template <typename T>
+T sqdist(const T* q, const T* p, std::size_t d) {
+  T s = 0;
+  for (std::size_t a = 0; a < d; ++a) s += (q[a] - p[a]) * (q[a] - p[a]);
+  return s;
+}
+
+template <typename T>
+std::vector<Neighbor<T>> brute_all(const std::vector<T>& p, std::size_t d, const T* q) {
+  std::vector<Neighbor<T>> all(p.size() / d);
+  for (std::size_t i = 0; i < all.size(); ++i) all[i] = {std::uint32_t(i), sqdist(q, &p[i * d], d)};
+  std::sort(all.begin(), all.end());
+  return all;
+}
+
+template <typename T, int Dim>
+void check_queries(Shape shape, std::size_t n, std::size_t d, std::size_t leaf) {
+  SCOPED_TRACE(name(shape) + " n=" + std::to_string(n) + " d=" + std::to_string(d) + " leaf=" + std::to_string(leaf) +
+               (sizeof(T) == 4 ? " float" : " double"));
+  const std::vector<T> pts = make_points<T>(shape, n, d, 17 + n + d);
+  const KdTree<T, Dim> tree(PointView<T>(pts.data(), n, d), leaf);
+  ASSERT_NO_THROW(tree.validate());
+  EXPECT_EQ(tree.size(), n);
+  const std::size_t m = 30;
+  const std::vector<T> qs = make_queries(pts, n, d, m, 99 + n);
+  Rng rng(5 + n);
+  for (std::size_t i = 0; i < m; ++i) {
+    const T* q = &qs[i * d];
+    const std::span<const T> qspan(q, d);
+    const std::vector<Neighbor<T>> all = brute_all(pts, d, q);
+    // Exact k-NN: identical to the sorted brute force, including ties broken by index.
+    for (std::size_t k : {std::size_t(1), std::size_t(5), std::size_t(23)}) {
+      const std::vector<Neighbor<T>> got = tree.query(qspan, k);
+      const std::vector<Neighbor<T>> want(all.begin(), all.begin() + std::min(k, all.size()));
+      ASSERT_EQ(got, want) << "k=" << k << " query " << i;
+    }
+    // k-NN limited by a distance: fewer than k, the rest marked missing.
+    const double r = all.empty() ? 0.1 : std::sqrt(double(all[std::min<std::size_t>(3, all.size() - 1)].squared_distance));
+    {
+      std::vector<Neighbor<T>> slots(8);
+      const std::size_t found = tree.query_into(qspan, KnnRequest{8, 0, r}, slots.data());
+      std::size_t want = 0;
+      while (want < std::min<std::size_t>(8, all.size()) && all[want].squared_distance <= T(r * r)) ++want;
+      ASSERT_EQ(found, want);
+      for (std::size_t j = 0; j < 8; ++j) {
+        if (j < found) {
+          ASSERT_EQ(slots[j], all[j]);
+        } else {
+          ASSERT_EQ(slots[j].index, kNoIndex);
+          ASSERT_TRUE(std::isinf(slots[j].squared_distance));
+        }
+      }
+    }
+    // Approximate k-NN: the i-th distance within (1 + eps) of the true i-th.
+    for (double eps : {0.1, 1.0}) {
+      const std::size_t k = 7;
+      const std::vector<Neighbor<T>> got = tree.query(qspan, k, eps);
+      ASSERT_EQ(got.size(), std::min(k, all.size()));
+      for (std::size_t j = 0; j < got.size(); ++j) {
+        ASSERT_LT(got[j].index, n);
+        ASSERT_EQ(got[j].squared_distance, sqdist(q, &pts[got[j].index * d], d));
+        const double bound = (1 + eps) * std::sqrt(double(all[j].squared_distance));
+        ASSERT_LE(std::sqrt(double(got[j].squared_distance)), bound * (1 + 1e-6) + 1e-12) << "eps=" << eps;
+        if (j > 0) {
+          ASSERT_TRUE(got[j - 1] < got[j]);
+        }
+      }
+    }
+    // Radius: everything within r, sorted.
+    {
+      const std::vector<Neighbor<T>> got = tree.query_radius(qspan, r);
+      std::vector<Neighbor<T>> want;
+      for (const auto& nb : all) {
+        if (nb.squared_distance <= T(r * r)) want.push_back(nb);
+      }
+      ASSERT_EQ(got, want);
+    }
+    // Box: report and count, including boxes that are a point or empty.
+    for (int b = 0; b < 3; ++b) {
+      std::vector<T> lo(d), hi(d);
+      for (std::size_t a = 0; a < d; ++a) {
+        const double c = double(q[a]), w = b == 0 ? 0.0 : rng.uniform(0, b == 1 ? 0.5 : 3.0);
+        lo[a] = T(c - w * rng.uniform());
+        hi[a] = T(c + w * rng.uniform());
+      }
+      std::vector<std::uint32_t> want;
+      for (std::size_t j = 0; j < n; ++j) {
+        bool in = true;
+        for (std::size_t a = 0; a < d; ++a) in = in && lo[a] <= pts[j * d + a] && pts[j * d + a] <= hi[a];
+        if (in) want.push_back(std::uint32_t(j));
+      }
+      std::vector<std::uint32_t> got = tree.query_box(lo, hi);
+      std::sort(got.begin(), got.end());
+      ASSERT_EQ(got, want);
+      ASSERT_EQ(tree.count_box(lo, hi), want.size());
+    }
+  }
+}
+
+template <typename T>
+void check_all_shapes() {
+  for (Shape shape : kShapes) {
+    for (std::size_t n : {0, 1, 9, 100, 1500}) {
+      check_queries<T, 2>(shape, n, 2, 10);
+      check_queries<T, 3>(shape, n, 3, 10);
+      check_queries<T, Dynamic>(shape, n, 16, 10);
+    }
+    check_queries<T, 3>(shape, 300, 3, 1);
+    check_queries<T, Dynamic>(shape, 300, 3, 4);
+    check_queries<T, Dynamic>(shape, 300, 5, 10);
+  }
+}
+
+TEST(KdTree, QueriesMatchBruteForceFloat) { check_all_shapes<float>(); }
+TEST(KdTree, QueriesMatchBruteForceDouble) { check_all_shapes<double>(); }
+
+TEST(KdTree, EmptyTree) {
+  const KdTree<double, 3> tree(PointView<double>(nullptr, 0, 3));
+  const double q[3] = {0, 0, 0};
+  EXPECT_TRUE(tree.query(std::span<const double>(q, 3), 4).empty());
+  EXPECT_TRUE(tree.query_radius(std::span<const double>(q, 3), 1.0).empty());
+  EXPECT_EQ(tree.count_box(std::span<const double>(q, 3), std::span<const double>(q, 3)), 0u);
+  EXPECT_EQ(tree.stats().nodes, 0u);
+  EXPECT_NO_THROW(tree.validate());
+  const KdTree<float, Dynamic> empty;
+  EXPECT_EQ(empty.size(), 0u);
+}
+
+TEST(KdTree, OwnedPointsAndEigenViews) {
+  const std::vector<Vec3f> pts = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 1, 1}};
+  const KdTree<float, 3> view_tree(PointView<float>(std::span<const Vec3f>(pts)), 1);
+  KdTree<float, 3> owned(std::vector<float>(pts[0].data(), pts[0].data() + 15), 3, 1);
+  const KdTree<float, 3> copy = owned;  // copies share the owned points
+  owned = KdTree<float, 3>();
+  EXPECT_NO_THROW(copy.validate());
+  const auto a = view_tree.query(Vec3f(0.9f, 0.9f, 0.8f), 2);
+  const auto b = copy.query(Vec3f(0.9f, 0.9f, 0.8f), 2);
+  EXPECT_EQ(a, b);
+  ASSERT_EQ(a.size(), 2u);
+  EXPECT_EQ(a[0].index, 4u);
+  EXPECT_EQ(copy.count_box(AABB3f({-0.5f, -0.5f, -0.5f}, {0.5f, 1.5f, 1.5f})), 3u);
+}
+
+TEST(KdTree, BalancedAndStats) {
+  const std::size_t n = 100000;
+  const auto pts = make_points<float>(Shape::clustered, n, 3, 3);
+  const KdTree<float, 3> tree(PointView<float>(pts.data(), n, 3), 10);
+  const KdTreeStats s = tree.stats();
+  EXPECT_EQ(s.points, n);
+  EXPECT_EQ(s.nodes, 2 * s.leaves - 1);
+  EXPECT_LE(s.depth, std::size_t(std::ceil(std::log2(double(n) / 10))));  // median splits: balanced
+  EXPECT_GE(s.bytes, s.nodes * sizeof(KdTree<float, 3>::Node));
+}
+
+TEST(KdTree, DeterministicParallelBuildAndBatch) {
+  const std::size_t n = 200000;
+  const auto pts = make_points<double>(Shape::uniform, n, 3, 11);
+  const PointView<double> view(pts.data(), n, 3);
+  const KdTree<double, 3> parallel(view, 8);
+  set_num_threads(1);
+  const KdTree<double, 3> serial(view, 8);
+  set_num_threads(0);
+  ASSERT_EQ(parallel.permutation(), serial.permutation());
+  ASSERT_EQ(parallel.nodes().size(), serial.nodes().size());
+  for (std::size_t i = 0; i < serial.nodes().size(); ++i) {
+    const auto &a = parallel.nodes()[i], &b = serial.nodes()[i];
+    ASSERT_TRUE(a.begin == b.begin && a.end == b.end && a.right == b.right && a.axis == b.axis && a.low == b.low &&
+                a.high == b.high);
+  }
+  // Batches run in parallel over queries and equal one-at-a-time queries.
+  const std::size_t m = 5000;
+  const auto qs = make_queries(pts, n, 3, m, 12);
+  const PointView<double> queries(qs.data(), m, 3);
+  const KnnRequest request{6, 0, 0.05};
+  const auto batch = parallel.query_batch(queries, request);
+  const auto radius = parallel.query_radius_batch(queries, 0.02);
+  std::vector<double> boxes(m * 6);
+  for (std::size_t i = 0; i < m; ++i)
+    for (int a = 0; a < 3; ++a) boxes[i * 6 + a] = qs[i * 3 + a] - 0.03, boxes[i * 6 + 3 + a] = qs[i * 3 + a] + 0.05;
+  const auto counts = parallel.count_box_batch(PointView<double>(boxes.data(), m, 6));
+  for (std::size_t i = 0; i < m; ++i) {
+    std::vector<Neighbor<double>> one(6);
+    serial.query_into({&qs[i * 3], 3}, request, one.data());
+    ASSERT_TRUE(std::equal(one.begin(), one.end(), batch.begin() + i * 6));
+    ASSERT_EQ(radius[i], serial.query_radius(std::span<const double>(&qs[i * 3], 3), 0.02));
+    ASSERT_EQ(counts[i], serial.count_box({&boxes[i * 6], 3}, {&boxes[i * 6 + 3], 3}));
+  }
+}
+
+// Theorem 4: a 2D range query visits O(sqrt(n) + a) nodes; counting visits O(sqrt(n)).
+TEST(KdTree, RangeQueryVisitsSqrtNNodes) {
+  for (Shape shape : {Shape::uniform, Shape::clustered}) {
+    for (std::size_t n : {1000, 10000, 100000, 400000}) {
+      const auto pts = make_points<double>(shape, n, 2, n);
+      const KdTree<double, 2> tree(PointView<double>(pts.data(), n, 2), 10);
+      Rng rng(n);
+      double worst_count = 0, worst_report = 0;
+      for (int b = 0; b < 200; ++b) {
+        const double w = rng.uniform(0, 1), h = rng.uniform(0, 1);
+        const double x = rng.uniform(-0.2, 1), y = rng.uniform(-0.2, 1);
+        const double lo[2] = {x, y}, hi[2] = {x + w, y + h};
+        std::size_t visited_count = 0, visited_report = 0;
+        tree.count_box(lo, hi, &visited_count);
+        const std::size_t a = tree.query_box(lo, hi, &visited_report).size();
+        worst_count = std::max(worst_count, double(visited_count) / std::sqrt(double(n)));
+        worst_report = std::max(worst_report, double(visited_report) / (std::sqrt(double(n)) + double(a)));
+      }
+      SCOPED_TRACE(name(shape) + " n=" + std::to_string(n));
+      EXPECT_LE(worst_count, 12.0);
+      EXPECT_LE(worst_report, 12.0);
+    }
+  }
+}
+
+std::filesystem::path temp_file(const std::string& name) {
+  return std::filesystem::temp_directory_path() / ("geods_kd_" + std::to_string(::getpid()) + "_" + name);
+}
+
+TEST(KdTree, SaveLoadRoundTrip) {
+  const std::size_t n = 3000;
+  const auto pts = make_points<float>(Shape::clustered, n, 3, 4);
+  const KdTree<float, 3> tree(PointView<float>(pts.data(), n, 3), 7);
+  const auto path = temp_file("roundtrip.kdt");
+  tree.save(path);
+  const KdTree<float, 3> loaded = KdTree<float, 3>::load(path);
+  EXPECT_EQ(loaded.permutation(), tree.permutation());
+  EXPECT_EQ(loaded.leaf_size(), 7u);
+  EXPECT_EQ(loaded.stats().nodes, tree.stats().nodes);
+  const auto qs = make_queries(pts, n, 3, 50, 1);
+  for (std::size_t i = 0; i < 50; ++i) {
+    const std::span<const float> q(&qs[i * 3], 3);
+    EXPECT_EQ(loaded.query(q, 5), tree.query(q, 5));
+  }
+  // The runtime-dimension tree reads the same file; the header says what it holds.
+  const auto dynamic = KdTree<float, Dynamic>::load(path);
+  EXPECT_EQ(dynamic.dim(), 3u);
+  EXPECT_EQ(read_kd_tree_header(path).scalar_bytes, 4u);
+  // An empty tree round-trips too.
+  const auto empty_path = temp_file("empty.kdt");
+  KdTree<double, 2>().save(empty_path);
+  EXPECT_EQ((KdTree<double, 2>::load(empty_path).size()), 0u);
+  std::filesystem::remove(path);
+  std::filesystem::remove(empty_path);
+}
+
+std::vector<char> read_all(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), {}};
+}
+void write_all(const std::filesystem::path& p, const std::vector<char>& bytes) {
+  std::ofstream(p, std::ios::binary).write(bytes.data(), std::streamsize(bytes.size()));
+}
+
+TEST(KdTree, CorruptedFilesThrow) {
+  const std::size_t n = 500;
+  const auto pts = make_points<double>(Shape::uniform, n, 2, 8);
+  const KdTree<double, 2> tree(PointView<double>(pts.data(), n, 2));
+  const auto path = temp_file("good.kdt"), bad = temp_file("bad.kdt");
+  tree.save(path);
+  const std::vector<char> good = read_all(path);
+  auto expect_error = [&](std::vector<char> bytes, const std::string& what) {
+    write_all(bad, bytes);
+    EXPECT_THROW((KdTree<double, 2>::load(bad)), Error) << what;
+  };
+  expect_error(std::vector<char>(good.begin(), good.end() - 5), "truncated");
+  expect_error(std::vector<char>(good.begin(), good.begin() + 20), "truncated header");
+  auto bytes = good;
+  bytes.push_back(0);
+  expect_error(bytes, "trailing bytes");
+  bytes = good;
+  bytes[0] = 'X';
+  expect_error(bytes, "magic");
+  bytes = good;
+  bytes[8] = 9;  // version
+  expect_error(bytes, "version");
+  // Permutation entry duplicated: validate() refuses it.
+  const KdTreeFileHeader h = read_kd_tree_header(path);
+  const std::size_t perm_at = 40 + 2 * 2 * 8 + h.nodes * sizeof(KdTree<double, 2>::Node);
+  bytes = good;
+  std::copy(bytes.begin() + perm_at, bytes.begin() + perm_at + 4, bytes.begin() + perm_at + 4);
+  expect_error(bytes, "permutation");
+  // A child index pointing outside the node array.
+  bytes = good;
+  bytes[40 + 32 + 8] = char(0xff), bytes[40 + 32 + 9] = char(0xff);
+  expect_error(bytes, "child index");
+  // A split value that lies about the points below it.
+  bytes = good;
+  const double lie = -1e9;
+  std::memcpy(&bytes[40 + 32 + 16], &lie, sizeof lie);
+  expect_error(bytes, "split value");
+  // Wrong type or dimension.
+  EXPECT_THROW((KdTree<float, 2>::load(path)), Error);
+  EXPECT_THROW((KdTree<double, 3>::load(path)), Error);
+  EXPECT_THROW((KdTree<double, 2>::load(temp_file("missing.kdt"))), Error);
+  std::filesystem::remove(path);
+  std::filesystem::remove(bad);
+}
+
+TEST(KdTree, BadInputThrows) {
+  std::vector<double> pts = {0, 0, 1, 1, 2, 2};
+  EXPECT_NO_THROW((KdTree<double, 2>(PointView<double>(pts.data(), 3, 2))));
+  EXPECT_THROW((KdTree<double, 3>(PointView<double>(pts.data(), 3, 2))), Error);  // dimension mismatch
+  EXPECT_THROW((KdTree<double, 2>(PointView<double>(pts.data(), 3, 2), 0)), Error);  // leaf size 0
+  EXPECT_THROW((KdTree<double, Dynamic>(std::vector<double>(5, 0.0), 2)), Error);  // not rows
+  pts[3] = std::nan("");
+  EXPECT_THROW((KdTree<double, 2>(PointView<double>(pts.data(), 3, 2))), Error);
+  pts[3] = INFINITY;
+  EXPECT_THROW((KdTree<double, 2>(PointView<double>(pts.data(), 3, 2))), Error);
+  pts[3] = 1;
+  const KdTree<double, 2> tree(PointView<double>(pts.data(), 3, 2));
+  const double q[3] = {0.5, 0.5, 0.5};
+  EXPECT_THROW(tree.query(std::span<const double>(q, 3), 1), Error);  // dimension mismatch
+  EXPECT_THROW(tree.query(std::span<const double>(q, 2), 0), Error);  // k = 0
+  EXPECT_THROW(tree.query(std::span<const double>(q, 2), 1, -1.0), Error);  // eps < 0
+  EXPECT_THROW(tree.query_radius(std::span<const double>(q, 2), -1.0), Error);
+  EXPECT_THROW(tree.query_radius(std::span<const double>(q, 2), std::nan("")), Error);
+  const double nan_q[2] = {std::nan(""), 0};
+  EXPECT_THROW(tree.query(std::span<const double>(nan_q, 2), 1), Error);
+  EXPECT_THROW(tree.count_box(std::span<const double>(nan_q, 2), std::span<const double>(q, 2)), Error);
+  EXPECT_THROW(tree.count_box_batch(PointView<double>(q, 1, 3)), Error);  // rows of 2 * dim values
+  const double inverted_lo[2] = {2, 2}, inverted_hi[2] = {0, 0};
+  EXPECT_EQ(tree.count_box(inverted_lo, inverted_hi), 0u);  // an empty box is no error
+}
+
+}  // namespace
+}  // namespace geods::spatial
