@@ -38,10 +38,31 @@ inline TwoTerm fast_two_sum(double a, double b) {
   return {s, b - (s - a)};
 }
 
+#ifdef __FMA__
 inline TwoTerm two_product(double a, double b) {
   const double p = a * b;
   return {p, std::fma(a, b, -p)};
 }
+#else
+// Without hardware FMA in the target (plain x86-64), std::fma is a library
+// call; Dekker's product with Veltkamp's splitting is exact too and inlines.
+// The splitting needs |a| < 2^996, which the callers' input window ensures.
+inline TwoTerm split(double a) {
+  const double c = 134217729.0 * a;  // 2^27 + 1
+  const double big = c - a;
+  const double hi = c - big;
+  return {hi, a - hi};
+}
+
+inline TwoTerm two_product(double a, double b) {
+  const double p = a * b;
+  const TwoTerm as = split(a), bs = split(b);
+  const double err1 = p - as.head * bs.head;
+  const double err2 = err1 - as.tail * bs.head;
+  const double err3 = err2 - as.head * bs.tail;
+  return {p, as.tail * bs.tail - err3};
+}
+#endif
 
 template <int N>
 struct Expansion {

@@ -102,12 +102,13 @@ constexpr double kInsphereBoundB = (5.0 + 72.0 * kEpsilon) * kEpsilon;
 
 // A product that underflows is off by up to eta = 2^-1075 in absolute terms,
 // and later products scale that error by their other factors. The filters add
-// kUnderflowUnit = 32 eta times a bound on those factors; the derivation
-// (worst case for insphere: eta * (8 L Z + 12 L + 12 M + 4), with L the sum
-// of the lifts, Z of the |z| differences, M of the 3x3 minor permanents)
-// leaves a factor of at least 2 to spare. It is far below any bound that
-// matters unless the inputs are near the subnormal range.
-constexpr double kUnderflowUnit = 0x1p-1070;
+// kUnderflowUnit times a bound on those factors (at least 1); the worst case,
+// insphere, needs eta * (8 L Z + 12 L + 12 M + 4), with L the sum of the
+// lifts, Z of the |z| differences and M of the 3x3 minor permanents. The unit
+// is far above 32 eta so that the term stays a normal number: subnormal
+// results are very slow on x86. It only sends determinants below about
+// 1e-301 to the exact stages.
+constexpr double kUnderflowUnit = 0x1p-1000;
 
 // ---------------------------------------------------------------------------
 // Stage 2 guard: the exponent window where expansion arithmetic is exact.

@@ -247,10 +247,7 @@ Frame random_frame(Scale scale, Rng& rng, bool isotropic) {
   double s = 1.0;
   switch (scale) {
     case Scale::Unit: break;
-    case Scale::Offset:
-      s = log_uniform(rng, -6, 0);
-      for (double& o : f.offset) o = random_sign(rng) * log_uniform(rng, 0, 8);
-      break;
+    case Scale::Offset: break;  // see offset_grid
     case Scale::Huge:
       s = log_uniform(rng, 150, 300);
       if (rng.below(2))
@@ -276,8 +273,37 @@ void nudge_point(Point& p, Rng& rng, int ulps) {
   for (double& x : p) x = nudge(x, rng, ulps);
 }
 
+// Integer points on a grid of one-ulp spacing far from the origin (the
+// coordinates o + k ulp(o) are exact): exactly degenerate when the integer
+// configuration is, then half of the time nudged by one ulp.
+Points offset_grid(Rng& rng, const Points& integer_points, int count, int dim) {
+  Points p{};
+  for (int k = 0; k < dim; ++k) {
+    const int e = int(rng.below(80)) - 20;
+    const double origin = random_sign(rng) * 1.5 * std::ldexp(1.0, e), ulp = std::ldexp(1.0, e - 52);
+    for (int i = 0; i < count; ++i) p[i][k] = origin + integer_points[i][k] * ulp;
+  }
+  if (rng.below(2)) nudge_point(p[count - 1], rng, 1);
+  if (dim == 2)
+    for (auto& x : p) x[2] = 0.0;
+  return p;
+}
+
+Points random_integer_flat(Rng& rng, int dim) {
+  Points u{};
+  auto coordinate = [&] { return double(int(rng.below(2049)) - 1024); };
+  for (int i = 0; i < dim; ++i) u[i] = {coordinate(), coordinate(), coordinate()};
+  const double s = double(int(rng.below(5)) - 2), t = double(int(rng.below(5)) - 2);
+  for (int k = 0; k < 3; ++k)
+    u[dim][k] = dim == 2 ? u[0][k] + s * (u[1][k] - u[0][k]) : u[0][k] + s * (u[1][k] - u[0][k]) + t * (u[2][k] - u[0][k]);
+  return u;
+}
+
+Points random_lattice_round(Rng& rng, int dim);
+
 // c on the line ab (orient2d) / d on the plane abc (orient3d), then placed.
 Points near_flat(Scale scale, Rng& rng, int dim) {
+  if (scale == Scale::Offset) return offset_grid(rng, random_integer_flat(rng, dim), dim + 1, dim);
   const Frame f = random_frame(scale, rng, false);
   Points u;
   for (auto& p : u) p = random_unit_point(rng);
@@ -298,6 +324,7 @@ Points near_flat(Scale scale, Rng& rng, int dim) {
 // Points on a circle (dim 2) or sphere (dim 3), the last one nudged.
 Points near_round(Scale scale, Rng& rng, int dim) {
   const int count = dim + 2;
+  if (scale == Scale::Offset) return offset_grid(rng, random_lattice_round(rng, dim), count, dim);
   Points p{};
   if (scale == Scale::Mixed) {
     // Radius 2^k around the origin, points a tiny angle away from the axes:
@@ -386,6 +413,14 @@ Points on_lattice_sphere(Rng& rng, const std::vector<Point>& sphere, int dim) {
   }
   for (int i = 0; i < dim + 2; ++i)
     for (int k = 0; k < dim; ++k) p[i][k] = (p[i][k] + shift[k]) * scale;
+  return p;
+}
+
+Points random_lattice_round(Rng& rng, int dim) {
+  static const std::vector<Point> circle = lattice_sphere(65, 2), sphere = lattice_sphere(9, 3);
+  Points p{};
+  const std::vector<Point>& round = dim == 2 ? circle : sphere;
+  for (int i = 0; i < dim + 2; ++i) p[i] = round[rng.below(round.size())];
   return p;
 }
 
