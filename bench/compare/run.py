@@ -97,9 +97,11 @@ def setup():
     script = os.path.join(REPO, "scripts", "setup.sh")
     if not os.path.exists(script):
         log("scripts/setup.sh not found; assuming the anchor packages are installed")
-        return
+        return None
     if run_cmd([script, "--bench"], cwd=REPO).returncode != 0:
         log("WARNING: scripts/setup.sh --bench failed; comparisons whose anchor is missing are skipped")
+        return "`scripts/setup.sh --bench` failed (see the console); missing anchors are reported below"
+    return None
 
 
 def generate(data_dir):
@@ -396,7 +398,7 @@ def micro_table(micro):
 
 
 def write_report(out, jsonl, cmdline, info, versions, verify, comps, results, status, micro, data_dir,
-                 rounds, reps, threads_list, started):
+                 rounds, reps, threads_list, started, early_problems=()):
     L = []
     L.append("# geods performance\n")
     L.append("Written by `bench/compare/run.py` (`make bench`); do not edit by hand. Every ratio is "
@@ -432,12 +434,12 @@ def write_report(out, jsonl, cmdline, info, versions, verify, comps, results, st
 
     # summary
     L.append("## Summary\n")
-    L.append("Geometric mean over the variants of each workload of anchor time / geods time "
+    L.append("Geometric mean, over the variants (and metrics) of each workload, of anchor time / geods time "
              "(> 1: geods is faster).\n")
     L.append("| workload | anchor | threads | geomean ratio |")
     L.append("|---|---|---|---|")
     sections = []
-    problems_all = []
+    problems_all = list(early_problems)
     for c in comps:
         recs, raw, problems = results.get(c["workload"], ([], [], []))
         problems_all += problems + agreement_failures(c, recs)
@@ -530,8 +532,7 @@ def main():
         comps = [c for c in comps if c["workload"] in want]
     log("comparisons:", ", ".join(c["workload"] for c in comps))
 
-    if not args.no_setup:
-        setup()                                   # (a)
+    setup_problem = None if args.no_setup else setup()  # (a)
     verify = generate(data_dir)                   # (b)
     configure(build_dir)                          # (c)
     status = build(build_dir, comps, args.jobs)
@@ -549,7 +550,8 @@ def main():
     micro = [] if args.no_micro else run_micro()  # (e)
     problems = write_report(out, jsonl, cmdline, machine_info(build_dir), anchor_versions(), verify,  # (f)
                             comps, results, status, micro, rel(data_dir) if data_dir.startswith(REPO) else data_dir,
-                            args.rounds, args.reps, threads_list, started)
+                            args.rounds, args.reps, threads_list, started,
+                            [setup_problem] if setup_problem else [])
     for p in problems:
         log("PROBLEM:", p)
     return 1 if problems else 0
