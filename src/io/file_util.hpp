@@ -81,4 +81,7 @@ inline std::string_view as_text(std::span<const std::uint8_t> bytes) {
 
 std::string_view trim(std::string_view s);
 
+/// True if the double converts to a finite float (casting one that does not is undefined behaviour).
+inline bool fits_float(double v) { return v >= -3.4028234663852886e38 && v <= 3.4028234663852886e38; }
+
 }  // namespace geods::io::detail

@@ -3,8 +3,11 @@
 #include <assimp/scene.h>
 
 #include <assimp/Importer.hpp>
+#include <cctype>
 #include <cmath>
+#include <cstring>
 #include <limits>
+#include <unordered_map>
 
 #include "file_util.hpp"
 #include "geods/io/mesh_io.hpp"
@@ -36,48 +39,230 @@ class RegularFilesOnly : public Assimp::DefaultIOSystem {
   }
 };
 
-// Pre-validation: the cheap checks on counts that a header declares, so that
-// Assimp never sees a small file claiming billions of elements.
-void check_off(const fs::path& path, std::string_view text) {
-  detail::LineReader lines(text);
-  std::string_view line;
-  std::vector<std::string_view> tokens;
-  while (tokens.size() < 3 && lines.next(line)) {
-    const std::size_t hash = line.find('#');
-    for (std::string_view t : detail::split_fields(line.substr(0, hash))) tokens.push_back(t);
+// PLY, OFF and STL are read by our own parsers: they check every count, index
+// and number (Assimp silently accepts truncated PLY faces and out-of-range OFF
+// indices, and leaks on malformed STL) and keep the file's vertex order.
+// Assimp reads OBJ and glTF.
+TriMesh mesh_from_ply(const fs::path& path, std::span<const std::uint8_t> bytes) {
+  const detail::PlyData ply = detail::read_ply(path, bytes);
+  if (ply.dim != 3) fail(path, "vertex element has no z property");
+  TriMesh mesh;
+  const std::size_t n = ply.positions.size() / 3;
+  if (n > std::numeric_limits<std::uint32_t>::max()) fail(path, "more than 2^32 vertices");
+  mesh.vertices.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    for (int c = 0; c < 3; ++c) {
+      const double v = ply.positions[3 * i + std::size_t(c)];
+      if (!detail::fits_float(v)) fail(path, "vertex " + std::to_string(i) + " is out of float range");
+      mesh.vertices[i][c] = float(v);
+    }
   }
-  if (tokens.empty() || tokens[0].size() < 3 || tokens[0].substr(tokens[0].size() - 3) != "OFF")
-    fail(path, "not an OFF file (wrong magic)");
-  tokens.erase(tokens.begin());
-  while (tokens.size() < 2 && lines.next(line))
-    for (std::string_view t : detail::split_fields(line.substr(0, line.find('#')))) tokens.push_back(t);
-  std::size_t nv = 0, nf = 0;
-  if (tokens.size() < 2 || !detail::parse_size(tokens[0], nv) || !detail::parse_size(tokens[1], nf))
-    fail(path, "malformed OFF counts line");
-  if (nf == 0) fail(path, "no triangles (OFF header declares 0 faces)");
-  // Each number takes a digit and a separator: 3 per vertex, at least 4 per face.
-  const std::size_t rest = text.size() - std::min(text.size(), lines.offset());
+  for (std::size_t i = 0; i + 2 < ply.normals.size(); i += 3)
+    mesh.normals.emplace_back(ply.normals[i], ply.normals[i + 1], ply.normals[i + 2]);
+  mesh.triangles.resize(ply.triangles.size() / 3);
+  std::memcpy(mesh.triangles.data(), ply.triangles.data(), ply.triangles.size() * sizeof(std::uint32_t));
+  if (mesh.triangles.empty()) fail(path, "no triangles");
+  return mesh;
+}
+
+// The whitespace-separated tokens of a text file; '#' starts a comment if `comments`.
+class Tokens {
+ public:
+  Tokens(std::string_view text, bool comments) : s_(text), comments_(comments) {}
+  bool next(std::string_view& token) {
+    for (;;) {
+      while (i_ < s_.size() && std::isspace(static_cast<unsigned char>(s_[i_]))) ++i_;
+      if (comments_ && i_ < s_.size() && s_[i_] == '#') {
+        while (i_ < s_.size() && s_[i_] != '\n') ++i_;
+        continue;
+      }
+      break;
+    }
+    if (i_ >= s_.size()) return false;
+    const std::size_t start = i_;
+    while (i_ < s_.size() && !std::isspace(static_cast<unsigned char>(s_[i_])) && !(comments_ && s_[i_] == '#')) ++i_;
+    token = s_.substr(start, i_ - start);
+    return true;
+  }
+  std::size_t remaining() const { return s_.size() - i_; }
+  void skip_line() {
+    while (i_ < s_.size() && s_[i_] != '\n') ++i_;
+  }
+
+ private:
+  std::string_view s_;
+  bool comments_;
+  std::size_t i_ = 0;
+};
+
+TriMesh mesh_from_off(const fs::path& path, std::string_view text) {
+  Tokens tokens(text, true);
+  std::string_view t;
+  if (!tokens.next(t) || t.size() < 3 || t.substr(t.size() - 3) != "OFF") fail(path, "not an OFF file (wrong magic)");
+  if (t != "OFF") fail(path, "unsupported OFF variant '" + std::string(t.substr(0, 20)) + "' (plain OFF only)");
+  auto count = [&](const std::string& what) {
+    std::size_t v = 0;
+    if (!tokens.next(t)) fail(path, "truncated: file ends before the " + what);
+    if (!detail::parse_size(t, v)) fail(path, "malformed " + what);
+    return v;
+  };
+  const std::size_t nv = count("vertex count"), nf = count("face count");
+  count("edge count");
+  // Every number takes a digit and a separator: the counts are bounded by the bytes left.
+  const std::size_t rest = tokens.remaining();
   if (nv > rest / 6 || nf > rest / 8 || nv * 6 + nf * 8 > rest + 1)
     fail(path, "truncated: header declares " + std::to_string(nv) + " vertices and " + std::to_string(nf) +
                    " faces but only " + std::to_string(rest) + " bytes follow");
+  TriMesh mesh;
+  mesh.vertices.resize(nv);
+  for (std::size_t i = 0; i < nv; ++i) {
+    for (int c = 0; c < 3; ++c) {
+      double v = 0;
+      if (!tokens.next(t)) fail(path, "truncated: file ends in vertex " + std::to_string(i) + " of " + std::to_string(nv));
+      if (!detail::parse_double(t, v)) fail(path, "malformed number in vertex " + std::to_string(i));
+      if (!detail::fits_float(v)) fail(path, "vertex " + std::to_string(i) + " has a non-finite or out-of-range coordinate");
+      mesh.vertices[i][c] = float(v);
+    }
+    if (!mesh.vertices[i].allFinite()) fail(path, "vertex " + std::to_string(i) + " has a non-finite coordinate");
+  }
+  for (std::size_t f = 0; f < nf; ++f) {
+    const std::size_t k = count("size of face " + std::to_string(f) + " of " + std::to_string(nf));
+    if (k < 3 || k > tokens.remaining()) fail(path, "face " + std::to_string(f) + " has a bad vertex count " + std::to_string(k));
+    std::uint32_t first = 0, prev = 0;
+    for (std::size_t j = 0; j < k; ++j) {
+      std::size_t v = 0;
+      if (!tokens.next(t)) fail(path, "truncated: file ends in face " + std::to_string(f) + " of " + std::to_string(nf));
+      if (!detail::parse_size(t, v) || v >= nv)
+        fail(path, "face " + std::to_string(f) + " has vertex index '" + std::string(t.substr(0, 20)) + "' out of range (" +
+                       std::to_string(nv) + " vertices)");
+      if (j == 0) first = std::uint32_t(v);
+      else if (j >= 2) mesh.triangles.push_back({first, prev, std::uint32_t(v)});
+      prev = std::uint32_t(v);
+    }
+  }
+  // Anything after the faces (per-face colours) is not kept.
+  if (mesh.triangles.empty()) fail(path, "no triangles");
+  return mesh;
 }
 
-void check_stl(const fs::path& path, std::span<const std::uint8_t> bytes) {
+// OBJ has no counts to check, but Assimp reads "nan" and "inf" as numbers:
+// scan the vertex lines for them ourselves.
+void check_obj(const fs::path& path, std::string_view text) {
+  detail::LineReader lines(text);
+  std::string_view line;
+  while (lines.next(line)) {
+    const auto f = detail::split_fields(line);
+    if (f.empty() || (f[0] != "v" && f[0] != "vn")) continue;
+    for (std::size_t i = 1; i < f.size() && i < 4; ++i) {
+      double v = 0;
+      if (!detail::parse_double(f[i], v) || !std::isfinite(v))
+        fail(path, "line " + std::to_string(lines.line_number()) + ": bad coordinate '" + std::string(f[i].substr(0, 40)) + "'");
+    }
+  }
+}
+
+// STL: facets with their own corners; coincident corners (same float bits,
+// -0 and +0 alike) become one vertex.
+class CornerMerger {
+ public:
+  std::uint32_t add(TriMesh& mesh, const Vec3f& p) {
+    const Vec3f q = p + Vec3f::Zero();  // -0 + 0 = +0
+    std::array<std::uint32_t, 3> key;
+    std::memcpy(key.data(), q.data(), sizeof(key));
+    const auto [it, inserted] = index_.try_emplace(key, std::uint32_t(mesh.vertices.size()));
+    if (inserted) mesh.vertices.push_back(q);
+    return it->second;
+  }
+
+ private:
+  struct Hash {
+    std::size_t operator()(const std::array<std::uint32_t, 3>& k) const {
+      return std::size_t(k[0]) * 0x9e3779b97f4a7c15ull ^ std::size_t(k[1]) * 0xc2b2ae3d27d4eb4full ^ std::size_t(k[2]) * 0x165667b19e3779f9ull;
+    }
+  };
+  std::unordered_map<std::array<std::uint32_t, 3>, std::uint32_t, Hash> index_;
+};
+
+void add_facet(const fs::path& path, TriMesh& mesh, CornerMerger& merger, const Vec3f (&corners)[3], std::size_t facet) {
+  TriMesh::Triangle t;
+  for (int c = 0; c < 3; ++c) {
+    if (!corners[c].allFinite()) fail(path, "facet " + std::to_string(facet) + " has a non-finite coordinate");
+    t[std::size_t(c)] = merger.add(mesh, corners[c]);
+  }
+  mesh.triangles.push_back(t);
+}
+
+TriMesh mesh_from_stl(const fs::path& path, std::span<const std::uint8_t> bytes) {
+  TriMesh mesh;
+  CornerMerger merger;
+  // Binary if the size matches the facet count exactly: binary files may also start with "solid".
   if (bytes.size() >= 84) {
     const std::uint64_t n = detail::load<std::uint32_t>(bytes.data() + 80, false);
     if (84 + 50 * n == bytes.size()) {
-      if (n == 0) fail(path, "no triangles (binary STL with 0 facets)");
-      return;
+      mesh.triangles.reserve(n);
+      for (std::size_t f = 0; f < n; ++f) {
+        const std::uint8_t* p = bytes.data() + 84 + 50 * f + 12;
+        Vec3f corners[3];
+        for (int c = 0; c < 3; ++c)
+          for (int k = 0; k < 3; ++k) corners[c][k] = detail::load<float>(p + 12 * c + 4 * k, false);
+        add_facet(path, mesh, merger, corners, f);
+      }
+      if (mesh.triangles.empty()) fail(path, "no triangles (binary STL with 0 facets)");
+      return mesh;
     }
   }
-  const std::string_view text = detail::trim(detail::as_text(bytes.first(std::min<std::size_t>(bytes.size(), 512))));
-  if (text.substr(0, 5) == "solid") return;
-  if (bytes.size() >= 84)
-    fail(path, "truncated binary STL: header declares " +
-                   std::to_string(detail::load<std::uint32_t>(bytes.data() + 80, false)) + " facets (" +
-                   std::to_string(84 + 50 * std::uint64_t(detail::load<std::uint32_t>(bytes.data() + 80, false))) +
-                   " bytes), file has " + std::to_string(bytes.size()));
-  fail(path, "not an STL file (too short for binary, no 'solid' for ascii)");
+  const std::string_view text = detail::as_text(bytes);
+  if (detail::trim(text.substr(0, 512)).substr(0, 5) != "solid") {
+    if (bytes.size() >= 84)
+      fail(path, "truncated binary STL: header declares " + std::to_string(detail::load<std::uint32_t>(bytes.data() + 80, false)) +
+                     " facets (" + std::to_string(84 + 50 * std::uint64_t(detail::load<std::uint32_t>(bytes.data() + 80, false))) +
+                     " bytes), file has " + std::to_string(bytes.size()));
+    fail(path, "not an STL file (too short for binary, no 'solid' for ascii)");
+  }
+  Tokens tokens(text, false);
+  std::string_view t;
+  auto expect = [&](std::string_view word) {
+    if (!tokens.next(t)) fail(path, "truncated: file ends in facet " + std::to_string(mesh.triangles.size()) + " (expected '" + std::string(word) + "')");
+    if (t != word)
+      fail(path, "malformed ascii STL: expected '" + std::string(word) + "' in facet " + std::to_string(mesh.triangles.size()) +
+                     ", found '" + std::string(t.substr(0, 30)) + "'");
+  };
+  auto number = [&] {
+    double v = 0;
+    if (!tokens.next(t)) fail(path, "truncated: file ends in facet " + std::to_string(mesh.triangles.size()));
+    if (!detail::parse_double(t, v) || !detail::fits_float(v))
+      fail(path, "bad number '" + std::string(t.substr(0, 30)) + "' in facet " + std::to_string(mesh.triangles.size()));
+    return float(v);
+  };
+  bool in_solid = false, ended = false;
+  while (tokens.next(t)) {
+    if (t == "solid") {
+      tokens.skip_line();  // the solid's name
+      in_solid = true;
+    } else if (t == "endsolid") {
+      tokens.skip_line();
+      in_solid = false;
+      ended = true;
+    } else if (t == "facet" && in_solid) {
+      expect("normal");
+      for (int k = 0; k < 3; ++k) number();
+      expect("outer");
+      expect("loop");
+      Vec3f corners[3];
+      for (int c = 0; c < 3; ++c) {
+        expect("vertex");
+        for (int k = 0; k < 3; ++k) corners[c][k] = number();
+      }
+      expect("endloop");
+      expect("endfacet");
+      add_facet(path, mesh, merger, corners, mesh.triangles.size());
+    } else {
+      fail(path, "malformed ascii STL: unexpected '" + std::string(t.substr(0, 30)) + "' after facet " + std::to_string(mesh.triangles.size()));
+    }
+  }
+  if (!ended) fail(path, "truncated: no 'endsolid'");
+  if (mesh.triangles.empty()) fail(path, "no triangles");
+  return mesh;
 }
 
 void check_glb(const fs::path& path, std::span<const std::uint8_t> bytes) {
@@ -90,9 +275,7 @@ void check_glb(const fs::path& path, std::span<const std::uint8_t> bytes) {
 
 void pre_validate(const fs::path& path, const std::string& ext, std::span<const std::uint8_t> bytes) {
   if (bytes.empty()) fail(path, "empty file");
-  if (ext == ".ply") detail::parse_ply_header(path, bytes);
-  else if (ext == ".off") check_off(path, detail::as_text(bytes));
-  else if (ext == ".stl") check_stl(path, bytes);
+  if (ext == ".obj") check_obj(path, detail::as_text(bytes));
   else if (ext == ".glb") check_glb(path, bytes);
 }
 
@@ -156,10 +339,14 @@ TriMesh read_mesh(const fs::path& path) {
   std::vector<std::uint8_t> bytes = detail::read_file(path);
   if (bytes.empty()) fail(path, "empty file");
   if (gz) bytes = detail::gunzip(path, bytes, max_inflated_mesh);
+  if (bytes.empty()) fail(path, "empty file");
+  if (ext == ".ply") return mesh_from_ply(path, bytes);
+  if (ext == ".off") return mesh_from_off(path, detail::as_text(bytes));
+  if (ext == ".stl") return mesh_from_stl(path, bytes);
   pre_validate(path, ext, bytes);
 
-  constexpr unsigned flags = aiProcess_ValidateDataStructure | aiProcess_Triangulate |
-                             aiProcess_JoinIdenticalVertices | aiProcess_PreTransformVertices;
+  constexpr unsigned flags = aiProcess_ValidateDataStructure | aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                             aiProcess_PreTransformVertices;
   Assimp::Importer importer;
   importer.SetIOHandler(new RegularFilesOnly);  // the importer takes ownership
   const aiScene* scene = nullptr;

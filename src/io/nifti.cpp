@@ -69,7 +69,7 @@ Layout check_header(const fs::path& path, std::span<const std::uint8_t> h, std::
   if (!nifti_type(datatype, t))
     fail(path, "unsupported NIfTI datatype " + std::to_string(datatype) + " (" + nifti_datatype_string(datatype) + ")");
   const float vox_offset = load<float>(h.data() + 108, big);
-  if (!(vox_offset >= 348.0f) || vox_offset > float(file_size)) fail(path, "bad NIfTI vox_offset " + std::to_string(vox_offset));
+  if (!(vox_offset >= 348.0f) || vox_offset > float(file_size) || vox_offset > 1e12f) fail(path, "bad NIfTI vox_offset " + std::to_string(vox_offset));
   const std::size_t need = dims[0] * dims[1] * dims[2] * std::size_t(t.bytes);  // < 2^48: no overflow
   const std::size_t start = std::size_t(vox_offset);
   if (!gz && file_size - start < need)
@@ -177,7 +177,8 @@ void write_nifti(const fs::path& path, const AnyGrid3& grid) {
   fs::remove(path, ec);
   nifti_image_write(nim.get());
   nim->data = nullptr;
-  if (!fs::is_regular_file(path, ec) || fs::file_size(path, ec) < header_size) fail(path, "cannot write NIfTI file");
+  const std::size_t min_size = is_gzip_name(path) ? 20 : header_size + 4;
+  if (!fs::is_regular_file(path, ec) || fs::file_size(path, ec) < min_size) fail(path, "cannot write NIfTI file");
 }
 
 }  // namespace geods::io::detail

@@ -158,7 +158,11 @@ AnyGrid3 read_nrrd(const fs::path& path) {
     std::error_code ec;
     if (fs::equivalent(data_path, path, ec))
       fail(path, "'data file' names the header itself");
-    detached = read_file(data_path);
+    try {
+      detached = read_file(data_path);
+    } catch (const Error& e) {
+      fail(path, std::string("data file: ") + e.what());
+    }
     data = detached;
   } else {
     if (!attached_data) fail(path, "truncated: no blank line ending the header (and no 'data file')");
@@ -205,7 +209,7 @@ AnyGrid3 read_nrrd(const fs::path& path) {
       double len = 0;
       for (double x : v) len += x * x;
       len = std::sqrt(len);
-      if (!(len > 0) || !std::isfinite(float(len))) fail(path, "degenerate space direction for axis " + std::to_string(i));
+      if (!(len > 0) || !fits_float(len)) fail(path, "degenerate space direction for axis " + std::to_string(i));
       spacing[i] = float(len);
     }
   } else if (const std::string* s = field("spacings")) {
@@ -214,14 +218,14 @@ AnyGrid3 read_nrrd(const fs::path& path) {
     for (int i = 0; i < 3; ++i) {
       double v = 0;
       if (!parse_double(values[std::size_t(i)], v)) fail(path, "malformed 'spacings'");
-      if (std::isfinite(v) && v > 0 && std::isfinite(float(v))) spacing[i] = float(v);  // "nan" means unknown
+      if (v > 0 && fits_float(v)) spacing[i] = float(v);  // "nan" means unknown
     }
   }
   if (const std::string* s = field("space origin")) {
     const auto v = parse_vector(path, *s, "space origin");
     if (v.size() < 3) fail(path, "'space origin' must have 3 components");
     for (int i = 0; i < 3; ++i) {
-      if (!std::isfinite(float(v[std::size_t(i)]))) fail(path, "'space origin' out of float range");
+      if (!fits_float(v[std::size_t(i)])) fail(path, "'space origin' out of float range");
       origin[i] = float(v[std::size_t(i)]);
     }
   }

@@ -1,7 +1,9 @@
 #include "ply.hpp"
 
 #include <cctype>
+#include <array>
 #include <cmath>
+#include <limits>
 
 #include "file_util.hpp"
 
@@ -150,52 +152,80 @@ PlyHeader parse_ply_header(const fs::path& path, std::span<const std::uint8_t> f
   return h;
 }
 
-std::vector<double> read_ply_vertices(const fs::path& path, std::span<const std::uint8_t> file, int& dim) {
+PlyData read_ply(const fs::path& path, std::span<const std::uint8_t> file) {
   const PlyHeader h = parse_ply_header(path, file);
   BodyReader in(path, file.subspan(h.body_offset), h.format);
-  std::vector<double> xyz;
+  PlyData out;
+  std::size_t num_vertices = 0;
   bool found = false;
   for (const PlyElement& e : h.elements) {
-    int axis[3] = {-1, -1, -1};
-    if (e.name == "vertex") {
-      for (std::size_t i = 0; i < e.properties.size(); ++i) {
-        const PlyProperty& p = e.properties[i];
-        if (p.count_size) continue;
-        if (p.name == "x") axis[0] = int(i);
-        if (p.name == "y") axis[1] = int(i);
-        if (p.name == "z") axis[2] = int(i);
-      }
-      if (axis[0] < 0 || axis[1] < 0) fail(path, "vertex element has no x and y properties");
-      dim = axis[2] < 0 ? 2 : 3;
-      xyz.resize(e.count * std::size_t(dim));  // bounded by the header check
-      found = true;
+    const bool is_vertex = e.name == "vertex" && !found;
+    const bool is_face = e.name == "face";
+    int axis[6] = {-1, -1, -1, -1, -1, -1};  // x y z nx ny nz
+    int indices = -1;
+    for (std::size_t i = 0; i < e.properties.size(); ++i) {
+      const PlyProperty& p = e.properties[i];
+      if (is_face && p.count_size && (p.name == "vertex_indices" || p.name == "vertex_index")) indices = int(i);
+      if (p.count_size) continue;
+      for (int a = 0; a < 6; ++a)
+        if (p.name == std::array<const char*, 6>{"x", "y", "z", "nx", "ny", "nz"}[std::size_t(a)]) axis[a] = int(i);
     }
+    if (is_vertex) {
+      if (axis[0] < 0 || axis[1] < 0) fail(path, "vertex element has no x and y properties");
+      found = true;
+      num_vertices = e.count;
+      out.dim = axis[2] < 0 ? 2 : 3;
+      out.positions.reserve(e.count * std::size_t(out.dim));  // bounded by the header check
+      if (axis[3] >= 0 && axis[4] >= 0 && axis[5] >= 0) out.normals.reserve(e.count * 3);
+    }
+    if (is_face && indices >= 0 && !found) fail(path, "face element before the vertex element");
     std::vector<double> row(e.properties.size());
+    std::vector<std::uint32_t> polygon;
     for (std::size_t k = 0; k < e.count; ++k) {
       for (std::size_t i = 0; i < e.properties.size(); ++i) {
         const PlyProperty& p = e.properties[i];
-        if (p.count_size) {
-          const double n = in.value(p.count_size, false, false, e, k);
-          if (!(n >= 0) || n != std::floor(n)) fail(path, "bad list length in " + e.name + " " + std::to_string(k));
-          if (n > double(in.remaining()))
-            fail(path, "truncated: list of " + std::to_string(std::size_t(n)) + " items in " + e.name + " " + std::to_string(k));
-          for (std::size_t j = 0; j < std::size_t(n); ++j) in.value(p.size, p.is_float, p.is_signed, e, k);
-        } else {
+        if (!p.count_size) {
           row[i] = in.value(p.size, p.is_float, p.is_signed, e, k);
+          continue;
+        }
+        const double n = in.value(p.count_size, false, false, e, k);
+        if (!(n >= 0) || n != std::floor(n)) fail(path, "bad list length in " + e.name + " " + std::to_string(k));
+        if (n > double(in.remaining()))
+          fail(path, "truncated: list of " + std::to_string(std::size_t(n)) + " items in " + e.name + " " + std::to_string(k));
+        polygon.clear();
+        for (std::size_t j = 0; j < std::size_t(n); ++j) {
+          const double v = in.value(p.size, p.is_float, p.is_signed, e, k);
+          if (int(i) != indices) continue;
+          if (!(v >= 0 && v < double(num_vertices)) || v != std::floor(v))
+            fail(path, "face " + std::to_string(k) + " has vertex index " + std::to_string(v) + " out of range (" +
+                           std::to_string(num_vertices) + " vertices)");
+          polygon.push_back(std::uint32_t(v));
+        }
+        if (int(i) == indices) {
+          if (polygon.size() < 3) fail(path, "face " + std::to_string(k) + " has fewer than 3 vertices");
+          for (std::size_t j = 1; j + 1 < polygon.size(); ++j)
+            out.triangles.insert(out.triangles.end(), {polygon[0], polygon[j], polygon[j + 1]});
         }
       }
-      if (found && e.name == "vertex") {
-        for (int d = 0; d < dim; ++d) {
+      if (is_vertex) {
+        for (int d = 0; d < out.dim; ++d) {
           const double v = row[std::size_t(axis[d])];
           if (!std::isfinite(v)) fail(path, "vertex " + std::to_string(k) + " has a non-finite coordinate");
-          xyz[k * std::size_t(dim) + std::size_t(d)] = v;
+          out.positions.push_back(v);
         }
+        if (out.normals.capacity())
+          for (int d = 3; d < 6; ++d) {
+            const double v = row[std::size_t(axis[d])];
+            out.normals.push_back(fits_float(v) ? float(v) : std::numeric_limits<float>::quiet_NaN());
+          }
       }
     }
-    if (e.name == "vertex") break;  // nothing after the vertices is needed
   }
   if (!found) fail(path, "no vertex element");
-  return xyz;
+  const std::span<const std::uint8_t> rest = file.last(in.remaining());
+  if (h.format == PlyFormat::ascii ? !trim(as_text(rest)).empty() : !rest.empty())
+    fail(path, std::to_string(in.remaining()) + " unexpected bytes after the last element");
+  return out;
 }
 
 }  // namespace geods::io::detail

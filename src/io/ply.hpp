@@ -1,6 +1,6 @@
 #pragma once
-// A small PLY parser (not public API): the header for pre-validating meshes
-// before Assimp sees them, and the vertex positions for point sets.
+// A small PLY reader (not public API) for meshes and point sets: every byte of
+// the body is parsed, so truncation, bad numbers and bad indices are caught.
 #include <cstdint>
 #include <filesystem>
 #include <span>
@@ -35,8 +35,16 @@ struct PlyHeader {
 /// in the bytes that follow it (so later allocations are bounded by the file).
 PlyHeader parse_ply_header(const std::filesystem::path& path, std::span<const std::uint8_t> file);
 
-/// The x, y (and z, if present) columns of the "vertex" element, row-major;
-/// `dim` receives 2 or 3. Other elements are parsed and skipped.
-std::vector<double> read_ply_vertices(const std::filesystem::path& path, std::span<const std::uint8_t> file, int& dim);
+struct PlyData {
+  int dim = 3;                        // 2 if the vertices have no z
+  std::vector<double> positions;      // dim per vertex
+  std::vector<float> normals;         // nx ny nz per vertex, or empty
+  std::vector<std::uint32_t> triangles;  // 3 per triangle; polygons are fanned
+};
+
+/// Reads the "vertex" element (x, y, optional z and nx, ny, nz) and the
+/// "face" element's vertex_indices (or vertex_index) lists; other elements
+/// are parsed and skipped. Non-finite positions and out-of-range indices throw.
+PlyData read_ply(const std::filesystem::path& path, std::span<const std::uint8_t> file);
 
 }  // namespace geods::io::detail

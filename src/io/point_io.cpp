@@ -99,10 +99,9 @@ PointMatrix read_points(const fs::path& path) {
   if (ext == ".csv") return read_text_points(path, true);
   if (ext == ".ply") {
     const auto bytes = detail::read_file(path);
-    int dim = 3;
-    const std::vector<double> values = detail::read_ply_vertices(path, bytes, dim);
-    if (values.empty()) fail(path, "no points");
-    return to_matrix(values, std::size_t(dim));
+    const detail::PlyData ply = detail::read_ply(path, bytes);
+    if (ply.positions.empty()) fail(path, "no points");
+    return to_matrix(ply.positions, std::size_t(ply.dim));
   }
   fail(path, "unsupported point format '" + ext + "' (expected .npy, .xyz, .csv or .ply)");
 }

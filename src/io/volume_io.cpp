@@ -1,5 +1,6 @@
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include "file_util.hpp"
 #include "geods/io/npy.hpp"
@@ -104,7 +105,13 @@ Grid3<float> to_float(const AnyGrid3& grid) {
         f.dims = g.dims;
         f.origin = g.origin;
         f.spacing = g.spacing;
-        f.data.assign(g.data.begin(), g.data.end());
+        f.data.resize(g.data.size());
+        // Doubles beyond float's range saturate to +-inf (a plain cast would be undefined).
+        for (std::size_t i = 0; i < g.data.size(); ++i) {
+          const double v = double(g.data[i]);
+          constexpr float inf = std::numeric_limits<float>::infinity();
+          f.data[i] = detail::fits_float(v) || std::isnan(v) ? float(v) : (v > 0 ? inf : -inf);
+        }
         return f;
       },
       grid);

@@ -6,11 +6,13 @@
 
 namespace geods::io {
 
-/// Reads PLY (ascii/binary), OBJ, STL, OFF or glTF/GLB through Assimp; also
-/// .ply.gz/.off.gz. Polygons are triangulated, coincident vertices of
-/// unindexed formats (STL) are merged. Throws geods::Error naming the file
-/// and the problem (missing, unreadable, malformed, no triangles, out-of-range
-/// indices, non-finite coordinates).
+/// Reads PLY (ascii/binary) and OFF with our own strict parsers (vertex order
+/// kept), OBJ, STL and glTF/GLB through Assimp (coincident vertices merged,
+/// node transforms applied); also any of them gzip-compressed (.ply.gz,
+/// .off.gz, ...). Polygons are fan-triangulated; points and lines are skipped.
+/// Throws geods::Error naming the file and the problem (missing, unreadable,
+/// malformed, truncated, no triangles, out-of-range indices, non-finite
+/// coordinates); counts are checked against the file size before allocating.
 TriMesh read_mesh(const std::filesystem::path& path);
 
 enum class MeshEncoding { binary, ascii };

@@ -1,0 +1,9 @@
+// libFuzzer target: read_points; the first byte picks the format (.npy, .xyz, .csv, .ply).
+#include "fuzz_common.hpp"
+#include "geods/io/point_io.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  if (size == 0) return 0;
+  static const char* names[] = {"in.npy", "in.xyz", "in.csv", "in.ply"};
+  return geods::fuzz::read_as(data + 1, size - 1, names[data[0] % 4], [](const auto& p) { geods::io::read_points(p); });
+}

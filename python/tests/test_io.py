@@ -1,0 +1,119 @@
+"""geods io bindings: round trips, the real files of data/, malformed files."""
+import gzip
+
+import numpy as np
+import pytest
+
+import geods
+
+
+def cube():
+    v = np.array([[i & 1, (i >> 1) & 1, (i >> 2) & 1] for i in range(8)], dtype=np.float32)
+    f = np.array([[0, 2, 1], [1, 2, 3], [4, 5, 6], [5, 7, 6], [0, 1, 4], [1, 5, 4],
+                  [2, 6, 3], [3, 6, 7], [0, 4, 2], [2, 4, 6], [1, 3, 5], [3, 7, 5]])
+    return v, f
+
+
+@pytest.mark.parametrize("name,binary", [("c.ply", True), ("c.ply", False), ("c.obj", True),
+                                         ("c.stl", True), ("c.stl", False)])
+def test_mesh_round_trip(tmp_path, name, binary):
+    v, f = cube()
+    geods.write_mesh(tmp_path / name, v, f, binary=binary)
+    rv, rf = geods.read_mesh(str(tmp_path / name))
+    assert rv.dtype == np.float32 and rv.shape == (8, 3)
+    assert rf.dtype == np.int32 and rf.shape == (12, 3)
+    # Same triangles as sets of corner positions (STL may renumber vertices).
+    def tris(vv, ff):
+        return sorted(tuple(sorted(map(tuple, vv[t].tolist()))) for t in ff)
+    assert tris(rv, rf) == tris(v, f)
+
+
+def test_real_meshes(data_dir):
+    v, f = geods.read_mesh(data_dir / "bunny.ply")
+    assert v.shape == (1839, 3) and f.shape == (3674, 3)
+    assert f.min() >= 0 and f.max() < len(v)
+    v, f = geods.read_mesh(data_dir / "teapot.obj")
+    assert f.shape == (992, 3)
+
+
+def test_volume_round_trip_and_meta(tmp_path):
+    for dtype in (np.uint8, np.uint16, np.int16, np.float32, np.float64):
+        a = (np.arange(60).reshape(3, 4, 5) % 50).astype(dtype)
+        for ext in (".npy", ".nrrd", ".nii", ".nii.gz"):
+            p = tmp_path / ("v" + ext)
+            geods.write_volume(p, a, origin=(1, 2, 3), spacing=(0.5, 1, 2))
+            r, origin, spacing = geods.read_volume(p, with_meta=True)
+            assert r.dtype == dtype and r.shape == (3, 4, 5)
+            np.testing.assert_array_equal(r, a)
+            if ext != ".npy":
+                assert origin == (1, 2, 3) and spacing == (0.5, 1, 2)
+    np.save(tmp_path / "n.npy", np.ones((2, 3, 4), dtype=np.float32))
+    assert geods.read_volume(tmp_path / "n.npy").shape == (2, 3, 4)
+
+
+def test_real_volumes(data_dir):
+    head, origin, spacing = geods.read_volume(data_dir / "t1_head.nii.gz", with_meta=True)
+    assert head.shape == (62, 128, 128)
+    assert spacing == (2.0, 2.0, 3.0)
+
+
+def test_points_and_segments(tmp_path, data_dir):
+    rng = np.random.default_rng(1)
+    for d in (2, 3):
+        p = rng.normal(size=(10, d))
+        for ext in (".npy", ".xyz", ".csv", ".ply"):
+            geods.write_points(tmp_path / ("p" + ext), p)
+            np.testing.assert_array_equal(geods.read_points(tmp_path / ("p" + ext)), p)
+    land = geods.read_points(data_dir / "land_points.npy")
+    assert land.shape == (4996, 2)
+    np.testing.assert_array_equal(land, np.load(data_dir / "land_points.npy"))
+    seg = geods.read_segments(data_dir / "land_segments.npy")
+    np.testing.assert_array_equal(seg, np.load(data_dir / "land_segments.npy"))
+    (tmp_path / "s.edg").write_text("1\n0 0 1 2\n")
+    np.testing.assert_array_equal(geods.read_segments(tmp_path / "s.edg"), [[0, 0, 1, 2]])
+
+
+def test_images(tmp_path, data_dir):
+    brick = geods.read_image(data_dir / "brick.png")
+    assert brick.dtype == np.uint8 and brick.shape == (512, 512)
+    for shape in ((5, 7), (5, 7, 2), (5, 7, 3), (5, 7, 4)):
+        a = (np.arange(np.prod(shape)) % 251).astype(np.uint8).reshape(shape)
+        geods.write_png(tmp_path / "a.png", a)
+        np.testing.assert_array_equal(geods.read_image(tmp_path / "a.png"), a)
+
+
+@pytest.mark.parametrize("name,reader,content", [
+    ("missing.ply", geods.read_mesh, None),
+    ("empty.obj", geods.read_mesh, b""),
+    ("bad.ply", geods.read_mesh, b"ply\nformat ascii 1.0\nelement vertex 99999999\nproperty float x\nend_header\n1\n"),
+    ("nan.off", geods.read_mesh, b"OFF\n3 1 0\n0 0 0\n1 nan 0\n0 1 0\n3 0 1 2\n"),
+    ("idx.off", geods.read_mesh, b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n"),
+    ("gz.ply.gz", geods.read_mesh, b"not gzip"),
+    ("bad.nrrd", geods.read_volume, b"NRRD0004\ntype: float\ndimension: 3\nsizes: 1000 1000 1000\nendian: little\nencoding: raw\n\n"),
+    ("bad.nii", geods.read_volume, b"\x00" * 400),
+    ("bad.npy", geods.read_volume, b"\x93NUMPY\x01\x00\x10\x00{'descr': '<f8'}"),
+    ("nan.xyz", geods.read_points, b"1 2 3\nnan 1 2\n"),
+    ("none.csv", geods.read_points, b"x,y\n"),
+    ("bad.edg", geods.read_segments, b"3\n0 0 1 1\n"),
+    ("bad.png", geods.read_image, b"\x89PNG\r\n\x1a\n\x00\x00"),
+])
+def test_malformed_files_raise_value_error_naming_the_file(tmp_path, name, reader, content):
+    p = tmp_path / name
+    if content is not None:
+        p.write_bytes(content)
+    with pytest.raises(ValueError, match=name.replace(".", r"\.")):
+        reader(p)
+
+
+def test_gzip_mesh_and_bad_arguments(tmp_path):
+    v, f = cube()
+    geods.write_mesh(tmp_path / "c.ply", v, f)
+    (tmp_path / "c.ply.gz").write_bytes(gzip.compress((tmp_path / "c.ply").read_bytes()))
+    assert geods.read_mesh(tmp_path / "c.ply.gz")[1].shape == (12, 3)
+    with pytest.raises(ValueError, match="out of range"):
+        geods.write_mesh(tmp_path / "x.ply", v, f + 10)
+    with pytest.raises(ValueError):
+        geods.write_points(tmp_path / "x.xyz", np.zeros((3, 5)))
+    with pytest.raises(ValueError):
+        geods.write_volume(tmp_path / "x.nrrd", np.zeros((2, 2)))
+    assert issubclass(geods.Error, ValueError)
