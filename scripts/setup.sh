@@ -18,7 +18,10 @@ for arg in "$@"; do
   case "$arg" in
     --fuzz) packages+=(clang libclang-rt-14-dev) ;;
     --bench)
-      packages+=(python3-scipy npm)
+      packages+=(python3-scipy)
+      # The workload generator runs `npm pack`; any npm will do (a NodeSource
+      # nodejs ships its own and conflicts with Debian's npm package).
+      command -v npm >/dev/null || packages+=(npm)
       if [[ -f bench/compare/anchor-packages.txt ]]; then
         mapfile -t anchors < <(grep -v '^\s*\(#\|$\)' bench/compare/anchor-packages.txt)
         packages+=("${anchors[@]}")
