@@ -1,0 +1,106 @@
+// geods knn: k nearest neighbours of query points with a k-d tree.
+#include <fmt/format.h>
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <optional>
+
+#include "command.hpp"
+#include "kd_tree_cli.hpp"
+#include "stopwatch.hpp"
+
+namespace geods::cli {
+namespace {
+
+class KnnCommand : public Command {
+ public:
+  std::string name() const override { return "knn"; }
+  std::string summary() const override {
+    return "k nearest neighbours of query points (k-d tree): indices and distances as .npy";
+  }
+  void add_options(CLI::App& app) override {
+    app.add_option("--points", points_, "Points, n x d (.npy any d; .xyz/.csv/.ply)")->required();
+    app.add_option("--queries", queries_, "Query points, m x d")->required();
+    app.add_option("--k", k_, "Neighbours per query")->required()->check(CLI::PositiveNumber);
+    app.add_option("--radius", radius_, "Only neighbours within this distance (fewer than k: index -1, distance inf)");
+    app.add_option("--eps", eps_, "Approximation: distances within (1 + eps) of the true ones (default 0: exact)");
+    app.add_option("--leaf-size", leaf_size_, "Points per leaf of the k-d tree")->check(CLI::PositiveNumber);
+    app.add_option("--indices", indices_, "Output: int64 m x k neighbour indices, -1 where missing");
+    app.add_option("--distances", distances_, "Output: float64 m x k Euclidean distances, ascending, inf where missing");
+  }
+
+  void run(const RunContext&, Report& report) override {
+    if (radius_ && !(*radius_ >= 0)) throw Error("knn: --radius must be >= 0");
+    if (!(eps_ >= 0)) throw Error("knn: --eps must be >= 0");
+    const Table points = read_table(points_);
+    const Table queries = read_table(queries_);
+    if (queries.cols != points.cols)
+      throw Error(fmt::format("{}: queries of dimension {}, but the points ({}) have dimension {}", queries_,
+                              queries.cols, points_, points.cols));
+    const spatial::KnnRequest request{k_, eps_, radius_.value_or(std::numeric_limits<double>::infinity())};
+
+    double build_s = 0, query_s = 0;
+    std::size_t nodes = 0, depth = 0;
+    std::vector<spatial::Neighbor<double>> result;
+    Stopwatch build_watch;
+    with_kd_tree(points, leaf_size_, [&](const auto& tree) {  // called right after the build
+      build_s = build_watch.seconds();
+      const spatial::KdTreeStats stats = tree.stats();
+      nodes = stats.nodes;
+      depth = stats.depth;
+      Stopwatch query_watch;
+      result = tree.query_batch(spatial::PointView<double>(queries.values.data(), queries.rows, queries.cols), request);
+      query_s = query_watch.seconds();
+    });
+
+    std::vector<std::int64_t> indices(result.size());
+    std::vector<double> distances(result.size());
+    std::size_t found = 0;
+    for (std::size_t i = 0; i < result.size(); ++i) {
+      const bool missing = result[i].index == spatial::kNoIndex;
+      indices[i] = missing ? -1 : std::int64_t(result[i].index);
+      distances[i] = missing ? std::numeric_limits<double>::infinity() : std::sqrt(result[i].squared_distance);
+      found += !missing;
+    }
+    const std::vector<std::size_t> shape = {queries.rows, k_};
+    if (!indices_.empty()) io::write_npy<std::int64_t>(indices_, indices, shape);
+    if (!distances_.empty()) io::write_npy<double>(distances_, distances, shape);
+
+    Json& j = report.json;
+    j["points"] = points.rows;
+    j["queries"] = queries.rows;
+    j["k"] = k_;
+    j["dim"] = points.cols;
+    j["eps"] = eps_;
+    if (radius_) j["radius"] = *radius_;
+    j["leaf_size"] = leaf_size_;
+    j["found"] = found;
+    j["tree_nodes"] = nodes;
+    j["tree_depth"] = depth;
+    j["build_s"] = build_s;
+    j["query_s"] = query_s;
+    j["compute_s"] = build_s + query_s;
+    j["queries_per_s"] = query_s > 0 ? double(queries.rows) / query_s : 0.0;
+    report.lines.push_back(fmt::format("knn: {} points of dimension {}, {} queries, k = {}{}{}", points.rows,
+                                       points.cols, queries.rows, k_, eps_ > 0 ? fmt::format(", eps = {}", eps_) : "",
+                                       radius_ ? fmt::format(", radius = {}", *radius_) : ""));
+    report.lines.push_back(fmt::format("  k-d tree: {} nodes, depth {}, built in {:.3f} s", nodes, depth, build_s));
+    report.lines.push_back(fmt::format("  {} neighbours found in {:.3f} s ({:.0f} queries/s)", found, query_s,
+                                       query_s > 0 ? double(queries.rows) / query_s : 0.0));
+    if (!indices_.empty()) report.lines.push_back("  wrote " + indices_);
+    if (!distances_.empty()) report.lines.push_back("  wrote " + distances_);
+  }
+
+ private:
+  std::string points_, queries_, indices_, distances_;
+  std::size_t k_ = 1;
+  std::optional<double> radius_;
+  double eps_ = 0;
+  std::size_t leaf_size_ = spatial::KdTree<double>::kDefaultLeafSize;
+};
+
+const bool registered = register_command<KnnCommand>();
+
+}  // namespace
+}  // namespace geods::cli
