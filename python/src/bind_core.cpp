@@ -36,12 +36,12 @@ PointRows<Dim, N> to_rows(const char* name, const std::array<py::object, N>& arg
   PointRows<Dim, N> rows;
   for (std::size_t i = 0; i < N; ++i) {
     DoubleArray a = DoubleArray::ensure(args[i]);  // null if not convertible
-    const std::string arg = std::string(name) + ": argument '" + kLetters[i] + "'";
-    if (!a) throw Error(arg + " is not a sequence or array of numbers");
+    auto arg = [&] { return std::string(name).append(": argument '").append(1, kLetters[i]).append("'"); };
+    if (!a) throw Error(arg() + " is not a sequence or array of numbers");
     const bool point = a.ndim() == 1 && a.shape(0) == Dim;
     const bool stacked = a.ndim() == 2 && a.shape(1) == Dim;
     if (!point && !stacked)
-      throw Error(arg + " must be a point of " + std::to_string(Dim) + " coordinates or an (n, " +
+      throw Error(arg() + " must be a point of " + std::to_string(Dim) + " coordinates or an (n, " +
                   std::to_string(Dim) + ") array");
     if (i == 0) {
       rows.single = point;
@@ -50,7 +50,7 @@ PointRows<Dim, N> to_rows(const char* name, const std::array<py::object, N>& arg
       throw Error(std::string(name) + ": mix of single points and (n, " + std::to_string(Dim) +
                   ") arrays; pass all arguments in the same form");
     } else if (stacked && a.shape(0) != rows.count) {
-      throw Error(arg + " has " + std::to_string(a.shape(0)) + " rows, argument 'a' has " +
+      throw Error(arg() + " has " + std::to_string(a.shape(0)) + " rows, argument 'a' has " +
                   std::to_string(rows.count));
     }
     rows.data[i] = a.data();
