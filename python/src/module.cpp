@@ -8,4 +8,5 @@ PYBIND11_MODULE(_geods, m) {
   m.attr("__version__") = GEODS_VERSION;
   geods::python::bind_core(m);
   geods::python::bind_io(m);
+  geods::python::bind_spatial(m);
 }
