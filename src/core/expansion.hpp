@@ -8,7 +8,9 @@
 // underflow below 2^-1074; predicates.cpp checks the inputs before using these.
 // Each Expansion<N> has room for N components, fixed at compile time from the
 // shape of the formula, so the exact paths never allocate.
+#include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace geods::exact {
 
@@ -96,6 +98,28 @@ inline Expansion<2> from_two_term(TwoTerm t) {
 /// a * b as an expansion.
 inline Expansion<2> product(double a, double b) { return from_two_term(two_product(a, b)); }
 
+/// Shewchuk's Two_Two_Diff: (a.head + a.tail) - (b.head + b.tail) as four
+/// nonoverlapping components, smallest first, some possibly zero; the last
+/// approximates the value, as his stage-C error bounds assume.
+struct FourTerm {
+  double c[4];
+};
+
+inline FourTerm two_two_diff(TwoTerm a, TwoTerm b) {
+  const TwoTerm low = two_diff(a.tail, b.tail);
+  const TwoTerm mid = two_sum(a.head, low.head);  // a - b.tail = mid + low.tail
+  const TwoTerm low2 = two_diff(mid.tail, b.head);
+  const TwoTerm high = two_sum(mid.head, low2.head);
+  return {{low.tail, low2.tail, high.tail, high.head}};
+}
+
+inline Expansion<4> from_four_term(const FourTerm& t) {
+  Expansion<4> e;
+  for (const double x : t.c)
+    if (x != 0.0) e.c[e.size++] = x;
+  return e;
+}
+
 namespace detail {
 
 // Shewchuk's FAST-EXPANSION-SUM-ZEROELIM: merge e and f (f scaled by
@@ -157,6 +181,25 @@ template <int N>
 Expansion<2 * N> operator*(const Expansion<N>& e, double b) {
   Expansion<2 * N> h;
   h.size = detail::scale(e.c, e.size, b, h.c);
+  return h;
+}
+
+/// e * f: e scaled by each component of f, summed.
+template <int N, int M>
+Expansion<2 * N * M> operator*(const Expansion<N>& e, const Expansion<M>& f) {
+  Expansion<2 * N * M> h, other;
+  Expansion<2 * N * M>* sum = &h;
+  Expansion<2 * N * M>* next = &other;
+  double part[2 * N];
+  for (int j = 0; j < f.size; ++j) {
+    const int n = detail::scale(e.c, e.size, f.c[j], part);
+    next->size = detail::sum(sum->c, sum->size, part, n, 1.0, next->c);
+    std::swap(sum, next);
+  }
+  if (sum != &h) {
+    std::copy_n(other.c, other.size, h.c);
+    h.size = other.size;
+  }
   return h;
 }
 

@@ -1,15 +1,15 @@
 // Adaptive exact predicates after Shewchuk, "Adaptive Precision Floating-Point
 // Arithmetic and Fast Robust Geometric Predicates" (1997).
 //
-// Each predicate runs up to three stages:
-//  1. filter: the determinant in plain doubles with Shewchuk's forward error
-//     bound, widened by an absolute term that covers underflow (his bound
-//     assumes none). Overflow makes the bound inf or NaN, which never passes.
-//  2. expansions, when every input lies in an exponent window where no
-//     product can overflow or lose bits to underflow: the exact determinant of
-//     the rounded coordinate differences (Shewchuk's stage B, exact outright
-//     when the differences were), else the exact lifted determinant of the
-//     original coordinates (his stage D; his stage C is left out).
+// Each predicate runs through:
+//  1. the filter (inline, geods/core/predicates_filter.hpp): the determinant
+//     in plain doubles with Shewchuk's forward error bound, widened by an
+//     absolute term that covers underflow (his bound assumes none);
+//  2. his adaptive stages, when every input lies in an exponent window where
+//     no product can overflow or lose bits to underflow: B, the exact
+//     determinant of the rounded coordinate differences (exact outright when
+//     the differences were); C, B plus the first-order tail terms in doubles;
+//     D, the exact determinant;
 //  3. big integers, for inputs outside the window (huge, tiny, subnormal,
 //     mixed): every coordinate becomes an integer times a common power of two.
 #include "geods/core/predicates.hpp"
@@ -88,27 +88,19 @@ T insphere_formula(const T* a, const T* b, const T* c, const T* d, const T* e) {
 }
 
 // ---------------------------------------------------------------------------
-// Stage 1 constants: Shewchuk's error bounds, in units of the unit roundoff.
+// Error bounds of the later stages (the filter's are in predicates_filter.hpp).
 
-constexpr double kEpsilon = 0x1p-53;
-constexpr double kOrient2dBoundA = (3.0 + 16.0 * kEpsilon) * kEpsilon;
+using detail::kEpsilon;
+using detail::kUnderflowUnit;
+constexpr double kResultBound = (3.0 + 8.0 * kEpsilon) * kEpsilon;
 constexpr double kOrient2dBoundB = (2.0 + 12.0 * kEpsilon) * kEpsilon;
-constexpr double kOrient3dBoundA = (7.0 + 56.0 * kEpsilon) * kEpsilon;
+constexpr double kOrient2dBoundC = (9.0 + 64.0 * kEpsilon) * kEpsilon * kEpsilon;
 constexpr double kOrient3dBoundB = (3.0 + 28.0 * kEpsilon) * kEpsilon;
-constexpr double kIncircleBoundA = (10.0 + 96.0 * kEpsilon) * kEpsilon;
+constexpr double kOrient3dBoundC = (26.0 + 288.0 * kEpsilon) * kEpsilon * kEpsilon;
 constexpr double kIncircleBoundB = (4.0 + 48.0 * kEpsilon) * kEpsilon;
-constexpr double kInsphereBoundA = (16.0 + 224.0 * kEpsilon) * kEpsilon;
+constexpr double kIncircleBoundC = (44.0 + 576.0 * kEpsilon) * kEpsilon * kEpsilon;
 constexpr double kInsphereBoundB = (5.0 + 72.0 * kEpsilon) * kEpsilon;
-
-// A product that underflows is off by up to eta = 2^-1075 in absolute terms,
-// and later products scale that error by their other factors. The filters add
-// kUnderflowUnit times a bound on those factors (at least 1); the worst case,
-// insphere, needs eta * (8 L Z + 12 L + 12 M + 4), with L the sum of the
-// lifts, Z of the |z| differences and M of the 3x3 minor permanents. The unit
-// is far above 32 eta so that the term stays a normal number: subnormal
-// results are very slow on x86. It only sends determinants below about
-// 1e-301 to the exact stages.
-constexpr double kUnderflowUnit = 0x1p-1000;
+constexpr double kInsphereBoundC = (71.0 + 1408.0 * kEpsilon) * kEpsilon * kEpsilon;
 
 // ---------------------------------------------------------------------------
 // Stage 2 guard: the exponent window where expansion arithmetic is exact.
@@ -188,15 +180,45 @@ template <int Degree, int Dim, std::size_t N, typename Formula>
 }
 
 // ---------------------------------------------------------------------------
-// Exact lifted determinants on the original coordinates (stage D). With the
-// homogeneous coordinate 1 appended, orient2d = det3[x y 1], orient3d =
-// det4[x y z 1], incircle = det4[x y |p|^2 1], insphere = det5[x y z |p|^2 1].
+// Expansion helpers for the adaptive stages.
+
+using exact::from_four_term;
+using exact::from_two_term;
+using exact::two_product;
+using exact::two_two_diff;
+
+bool all_zero_tails(std::initializer_list<TwoTerm> differences) {
+  for (const TwoTerm& t : differences)
+    if (t.tail != 0.0) return false;
+  return true;
+}
+
+// p q' - q p' exactly, as Shewchuk's Two_Two_Diff of two products.
+exact::FourTerm cross(double p, double q_prime, double q, double p_prime) {
+  return two_two_diff(two_product(p, q_prime), two_product(q, p_prime));
+}
+
+// m * |v|^2 over the first Dim coordinates of v.
+template <int Dim, int N>
+Expansion<Dim * 4 * N> times_lift(const Expansion<N>& m, const double* v) {
+  if constexpr (Dim == 2) {
+    return (m * v[0]) * v[0] + (m * v[1]) * v[1];
+  } else {
+    return (m * v[0]) * v[0] + (m * v[1]) * v[1] + (m * v[2]) * v[2];
+  }
+}
+
+// The 2x2 minor of exact differences, for stage D.
+Expansion<16> exact_minor(const Expansion<2>& px, const Expansion<2>& py, const Expansion<2>& qx,
+                          const Expansion<2>& qy) {
+  return px * qy - qx * py;
+}
+
+// Exact lifted determinants on the original coordinates, the exact fallback
+// of insphere. With the homogeneous coordinate 1 appended, orient3d =
+// det4[x y z 1] and insphere = det5[x y z |p|^2 1].
 
 Expansion<4> minor2(const double* p, const double* q) { return product(p[0], q[1]) - product(q[0], p[1]); }
-
-Expansion<12> lifted_orient2d(const double* a, const double* b, const double* c) {
-  return minor2(a, b) + minor2(b, c) + minor2(c, a);
-}
 
 // det3 of the rows p, q, r (x, y, z), expanded along z.
 Expansion<24> minor3(const double* p, const double* q, const double* r) {
@@ -207,42 +229,43 @@ Expansion<96> lifted_orient3d(const double* a, const double* b, const double* c,
   return (minor3(a, c, d) - minor3(b, c, d)) + (minor3(a, b, c) - minor3(a, b, d));
 }
 
-// m * |p|^2 over the first Dim coordinates of p (or of a difference vector).
-template <int Dim, int N>
-Expansion<Dim * 4 * N> times_lift(const Expansion<N>& m, const double* p) {
-  if constexpr (Dim == 2) {
-    return (m * p[0]) * p[0] + (m * p[1]) * p[1];
-  } else {
-    return (m * p[0]) * p[0] + (m * p[1]) * p[1] + (m * p[2]) * p[2];
-  }
-}
+}  // namespace
 
 // ---------------------------------------------------------------------------
-// The slow paths of each predicate (stages 2 and 3), out of line so that the
-// filters stay small. `permanent` is the filter's, for Shewchuk's stage B bound.
+// The adaptive stages of each predicate, after Shewchuk's orient2dadapt,
+// orient3dadapt, incircleadapt and insphereadapt, behind the window guard.
+// In the window every value they compute is a multiple of 2^-1074, so its
+// rounding error is relative (or zero), as Shewchuk's bounds assume; only a
+// bound itself, a tiny constant times a permanent, can underflow, which
+// kUnderflowUnit covers. Each stage B first checks the difference tails: when
+// all are zero its expansion is the exact determinant.
 
-bool all_zero_tails(std::initializer_list<TwoTerm> differences) {
-  for (const TwoTerm& t : differences)
-    if (t.tail != 0.0) return false;
-  return true;
-}
+namespace detail {
 
-[[gnu::noinline]] double orient2d_slow(const double* a, const double* b, const double* c, double permanent) {
+double orient2d_adapt(const double* a, const double* b, const double* c, double permanent) {
   const std::array<const double*, 3> points{a, b, c};
   if (!fits_expansions<2, 2>(points))
     return with_big_integers<2, 2>(points, [](const auto& p) { return orient2d_formula(p[0], p[1], p[2]); });
 
   const TwoTerm acx = two_diff(a[0], c[0]), acy = two_diff(a[1], c[1]);
   const TwoTerm bcx = two_diff(b[0], c[0]), bcy = two_diff(b[1], c[1]);
-  const auto det = product(acx.head, bcy.head) - product(acy.head, bcx.head);
-  if (all_zero_tails({acx, acy, bcx, bcy})) return det.top();
-  const double estimate = det.estimate();
-  if (std::abs(estimate) >= kOrient2dBoundB * permanent) return estimate;
-  return lifted_orient2d(a, b, c).top();
+  const auto b_det = from_four_term(cross(acx.head, bcy.head, acy.head, bcx.head));
+  if (all_zero_tails({acx, acy, bcx, bcy})) return b_det.top();
+  double det = b_det.estimate();
+  if (std::abs(det) >= kOrient2dBoundB * permanent + kUnderflowUnit) return det;
+
+  // Stage C: the first-order tail terms in doubles.
+  const double bound = kOrient2dBoundC * permanent + kResultBound * std::abs(det) + kUnderflowUnit;
+  det += (acx.head * bcy.tail + bcy.head * acx.tail) - (acy.head * bcx.tail + bcx.head * acy.tail);
+  if (std::abs(det) >= bound) return det;
+
+  // Stage D: every tail term, exactly.
+  const auto c1 = b_det + from_four_term(cross(acx.tail, bcy.head, acy.tail, bcx.head));
+  const auto c2 = c1 + from_four_term(cross(acx.head, bcy.tail, acy.head, bcx.tail));
+  return (c2 + from_four_term(cross(acx.tail, bcy.tail, acy.tail, bcx.tail))).top();
 }
 
-[[gnu::noinline]] double orient3d_slow(const double* a, const double* b, const double* c, const double* d,
-                                       double permanent) {
+double orient3d_adapt(const double* a, const double* b, const double* c, const double* d, double permanent) {
   const std::array<const double*, 4> points{a, b, c, d};
   if (!fits_expansions<3, 3>(points))
     return with_big_integers<3, 3>(points,
@@ -251,18 +274,33 @@ bool all_zero_tails(std::initializer_list<TwoTerm> differences) {
   const TwoTerm adx = two_diff(a[0], d[0]), ady = two_diff(a[1], d[1]), adz = two_diff(a[2], d[2]);
   const TwoTerm bdx = two_diff(b[0], d[0]), bdy = two_diff(b[1], d[1]), bdz = two_diff(b[2], d[2]);
   const TwoTerm cdx = two_diff(c[0], d[0]), cdy = two_diff(c[1], d[1]), cdz = two_diff(c[2], d[2]);
-  const auto bc = product(bdx.head, cdy.head) - product(cdx.head, bdy.head);
-  const auto ca = product(cdx.head, ady.head) - product(adx.head, cdy.head);
-  const auto ab = product(adx.head, bdy.head) - product(bdx.head, ady.head);
-  const auto det = bc * adz.head + ca * bdz.head + ab * cdz.head;
-  if (all_zero_tails({adx, ady, adz, bdx, bdy, bdz, cdx, cdy, cdz})) return det.top();
-  const double estimate = det.estimate();
-  if (std::abs(estimate) >= kOrient3dBoundB * permanent) return estimate;
-  return lifted_orient3d(a, b, c, d).top();
+  const auto bc = from_four_term(cross(bdx.head, cdy.head, cdx.head, bdy.head));
+  const auto ca = from_four_term(cross(cdx.head, ady.head, adx.head, cdy.head));
+  const auto ab = from_four_term(cross(adx.head, bdy.head, bdx.head, ady.head));
+  const auto b_det = (bc * adz.head + ca * bdz.head) + ab * cdz.head;
+  if (all_zero_tails({adx, ady, adz, bdx, bdy, bdz, cdx, cdy, cdz})) return b_det.top();
+  double det = b_det.estimate();
+  if (std::abs(det) >= kOrient3dBoundB * permanent + kUnderflowUnit) return det;
+
+  const double bound = kOrient3dBoundC * permanent + kResultBound * std::abs(det) + kUnderflowUnit;
+  det += (adz.head * ((bdx.head * cdy.tail + cdy.head * bdx.tail) - (bdy.head * cdx.tail + cdx.head * bdy.tail)) +
+          adz.tail * (bdx.head * cdy.head - bdy.head * cdx.head)) +
+         (bdz.head * ((cdx.head * ady.tail + ady.head * cdx.tail) - (cdy.head * adx.tail + adx.head * cdy.tail)) +
+          bdz.tail * (cdx.head * ady.head - cdy.head * adx.head)) +
+         (cdz.head * ((adx.head * bdy.tail + bdy.head * adx.tail) - (ady.head * bdx.tail + bdx.head * ady.tail)) +
+          cdz.tail * (adx.head * bdy.head - ady.head * bdx.head));
+  if (std::abs(det) >= bound) return det;
+
+  // Stage D: the determinant of the exact differences.
+  const Expansion<2> ax = from_two_term(adx), ay = from_two_term(ady), az = from_two_term(adz);
+  const Expansion<2> bx = from_two_term(bdx), by = from_two_term(bdy), bz = from_two_term(bdz);
+  const Expansion<2> cx = from_two_term(cdx), cy = from_two_term(cdy), cz = from_two_term(cdz);
+  const auto exact = (exact_minor(bx, by, cx, cy) * az + exact_minor(cx, cy, ax, ay) * bz) +
+                     exact_minor(ax, ay, bx, by) * cz;
+  return exact.top();
 }
 
-[[gnu::noinline]] double incircle_slow(const double* a, const double* b, const double* c, const double* d,
-                                       double permanent) {
+double incircle_adapt(const double* a, const double* b, const double* c, const double* d, double permanent) {
   const std::array<const double*, 4> points{a, b, c, d};
   if (!fits_expansions<4, 2>(points))
     return with_big_integers<4, 2>(points,
@@ -272,21 +310,36 @@ bool all_zero_tails(std::initializer_list<TwoTerm> differences) {
   const TwoTerm bdx = two_diff(b[0], d[0]), bdy = two_diff(b[1], d[1]);
   const TwoTerm cdx = two_diff(c[0], d[0]), cdy = two_diff(c[1], d[1]);
   const double ad[2] = {adx.head, ady.head}, bd[2] = {bdx.head, bdy.head}, cd[2] = {cdx.head, cdy.head};
-  const auto bc = product(bdx.head, cdy.head) - product(cdx.head, bdy.head);
-  const auto ca = product(cdx.head, ady.head) - product(adx.head, cdy.head);
-  const auto ab = product(adx.head, bdy.head) - product(bdx.head, ady.head);
-  const auto det = times_lift<2>(bc, ad) + times_lift<2>(ca, bd) + times_lift<2>(ab, cd);
-  if (all_zero_tails({adx, ady, bdx, bdy, cdx, cdy})) return det.top();
-  const double estimate = det.estimate();
-  if (std::abs(estimate) >= kIncircleBoundB * permanent) return estimate;
+  const auto bc = from_four_term(cross(bdx.head, cdy.head, cdx.head, bdy.head));
+  const auto ca = from_four_term(cross(cdx.head, ady.head, adx.head, cdy.head));
+  const auto ab = from_four_term(cross(adx.head, bdy.head, bdx.head, ady.head));
+  const auto b_det = times_lift<2>(bc, ad) + times_lift<2>(ca, bd) + times_lift<2>(ab, cd);
+  if (all_zero_tails({adx, ady, bdx, bdy, cdx, cdy})) return b_det.top();
+  double det = b_det.estimate();
+  if (std::abs(det) >= kIncircleBoundB * permanent + kUnderflowUnit) return det;
 
-  const auto lifted = (times_lift<2>(lifted_orient2d(b, c, d), a) - times_lift<2>(lifted_orient2d(a, c, d), b)) +
-                      (times_lift<2>(lifted_orient2d(a, b, d), c) - times_lift<2>(lifted_orient2d(a, b, c), d));
-  return lifted.top();
+  const double adxh = adx.head, adyh = ady.head, bdxh = bdx.head, bdyh = bdy.head, cdxh = cdx.head, cdyh = cdy.head;
+  const double bound = kIncircleBoundC * permanent + kResultBound * std::abs(det) + kUnderflowUnit;
+  det += ((adxh * adxh + adyh * adyh) * ((bdxh * cdy.tail + cdyh * bdx.tail) - (bdyh * cdx.tail + cdxh * bdy.tail)) +
+          2.0 * (adxh * adx.tail + adyh * ady.tail) * (bdxh * cdyh - bdyh * cdxh)) +
+         ((bdxh * bdxh + bdyh * bdyh) * ((cdxh * ady.tail + adyh * cdx.tail) - (cdyh * adx.tail + adxh * cdy.tail)) +
+          2.0 * (bdxh * bdx.tail + bdyh * bdy.tail) * (cdxh * adyh - cdyh * adxh)) +
+         ((cdxh * cdxh + cdyh * cdyh) * ((adxh * bdy.tail + bdyh * adx.tail) - (adyh * bdx.tail + bdxh * ady.tail)) +
+          2.0 * (cdxh * cdx.tail + cdyh * cdy.tail) * (adxh * bdyh - adyh * bdxh));
+  if (std::abs(det) >= bound) return det;
+
+  // Stage D: the determinant of the exact differences.
+  const Expansion<2> ax = from_two_term(adx), ay = from_two_term(ady);
+  const Expansion<2> bx = from_two_term(bdx), by = from_two_term(bdy);
+  const Expansion<2> cx = from_two_term(cdx), cy = from_two_term(cdy);
+  const auto exact = (exact_minor(bx, by, cx, cy) * (ax * ax + ay * ay) +
+                      exact_minor(cx, cy, ax, ay) * (bx * bx + by * by)) +
+                     exact_minor(ax, ay, bx, by) * (cx * cx + cy * cy);
+  return exact.top();
 }
 
-[[gnu::noinline]] double insphere_slow(const double* a, const double* b, const double* c, const double* d,
-                                       const double* e, double permanent) {
+double insphere_adapt(const double* a, const double* b, const double* c, const double* d, const double* e,
+                      double permanent) {
   const std::array<const double*, 5> points{a, b, c, d, e};
   if (!fits_expansions<5, 3>(points))
     return with_big_integers<5, 3>(
@@ -296,21 +349,53 @@ bool all_zero_tails(std::initializer_list<TwoTerm> differences) {
   const TwoTerm bex = two_diff(b[0], e[0]), bey = two_diff(b[1], e[1]), bez = two_diff(b[2], e[2]);
   const TwoTerm cex = two_diff(c[0], e[0]), cey = two_diff(c[1], e[1]), cez = two_diff(c[2], e[2]);
   const TwoTerm dex = two_diff(d[0], e[0]), dey = two_diff(d[1], e[1]), dez = two_diff(d[2], e[2]);
+  const double ae[3] = {aex.head, aey.head, aez.head}, be[3] = {bex.head, bey.head, bez.head};
+  const double ce[3] = {cex.head, cey.head, cez.head}, de[3] = {dex.head, dey.head, dez.head};
+  const exact::FourTerm ab4 = cross(ae[0], be[1], be[0], ae[1]), bc4 = cross(be[0], ce[1], ce[0], be[1]);
+  const exact::FourTerm cd4 = cross(ce[0], de[1], de[0], ce[1]), da4 = cross(de[0], ae[1], ae[0], de[1]);
+  const exact::FourTerm ac4 = cross(ae[0], ce[1], ce[0], ae[1]), bd4 = cross(be[0], de[1], de[0], be[1]);
+  double det;
   {
-    const double ae[3] = {aex.head, aey.head, aez.head}, be[3] = {bex.head, bey.head, bez.head};
-    const double ce[3] = {cex.head, cey.head, cez.head}, de[3] = {dex.head, dey.head, dez.head};
-    const auto ab = minor2(ae, be), bc = minor2(be, ce), cd = minor2(ce, de);
-    const auto da = minor2(de, ae), ac = minor2(ae, ce), bd = minor2(be, de);
+    const auto ab = from_four_term(ab4), bc = from_four_term(bc4), cd = from_four_term(cd4);
+    const auto da = from_four_term(da4), ac = from_four_term(ac4), bd = from_four_term(bd4);
     const auto abc = bc * ae[2] - ac * be[2] + ab * ce[2];
     const auto bcd = cd * be[2] - bd * ce[2] + bc * de[2];
     const auto cda = da * ce[2] + ac * de[2] + cd * ae[2];
     const auto dab = ab * de[2] + bd * ae[2] + da * be[2];
-    const auto det = (times_lift<3>(abc, de) - times_lift<3>(dab, ce)) +
-                     (times_lift<3>(cda, be) - times_lift<3>(bcd, ae));
-    if (all_zero_tails({aex, aey, aez, bex, bey, bez, cex, cey, cez, dex, dey, dez})) return det.top();
-    const double estimate = det.estimate();
-    if (std::abs(estimate) >= kInsphereBoundB * permanent) return estimate;
+    const auto b_det = (times_lift<3>(abc, de) - times_lift<3>(dab, ce)) +
+                       (times_lift<3>(cda, be) - times_lift<3>(bcd, ae));
+    if (all_zero_tails({aex, aey, aez, bex, bey, bez, cex, cey, cez, dex, dey, dez})) return b_det.top();
+    det = b_det.estimate();
+    if (std::abs(det) >= kInsphereBoundB * permanent + kUnderflowUnit) return det;
   }
+
+  // Stage C, with Shewchuk's rounded 2x2 minors.
+  const double ab3 = ab4.c[3], bc3 = bc4.c[3], cd3 = cd4.c[3], da3 = da4.c[3], ac3 = ac4.c[3], bd3 = bd4.c[3];
+  const auto eps = [](const TwoTerm& px, const TwoTerm& py, const TwoTerm& qx, const TwoTerm& qy) {
+    return (px.head * qy.tail + qy.head * px.tail) - (py.head * qx.tail + qx.head * py.tail);
+  };
+  const double abeps = eps(aex, aey, bex, bey), bceps = eps(bex, bey, cex, cey), cdeps = eps(cex, cey, dex, dey);
+  const double daeps = eps(dex, dey, aex, aey), aceps = eps(aex, aey, cex, cey), bdeps = eps(bex, bey, dex, dey);
+  const auto lift = [](const double* v) { return v[0] * v[0] + v[1] * v[1] + v[2] * v[2]; };
+  const auto lift_tail = [](const TwoTerm& x, const TwoTerm& y, const TwoTerm& z) {
+    return x.head * x.tail + y.head * y.tail + z.head * z.tail;
+  };
+  const double bound = kInsphereBoundC * permanent + kResultBound * std::abs(det) + kUnderflowUnit;
+  det += ((lift(be) * ((ce[2] * daeps + de[2] * aceps + ae[2] * cdeps) +
+                       (cez.tail * da3 + dez.tail * ac3 + aez.tail * cd3)) +
+           lift(de) * ((ae[2] * bceps - be[2] * aceps + ce[2] * abeps) +
+                       (aez.tail * bc3 - bez.tail * ac3 + cez.tail * ab3))) -
+          (lift(ae) * ((be[2] * cdeps - ce[2] * bdeps + de[2] * bceps) +
+                       (bez.tail * cd3 - cez.tail * bd3 + dez.tail * bc3)) +
+           lift(ce) * ((de[2] * abeps + ae[2] * bdeps + be[2] * daeps) +
+                       (dez.tail * ab3 + aez.tail * bd3 + bez.tail * da3)))) +
+         2.0 * ((lift_tail(bex, bey, bez) * (ce[2] * da3 + de[2] * ac3 + ae[2] * cd3) +
+                 lift_tail(dex, dey, dez) * (ae[2] * bc3 - be[2] * ac3 + ce[2] * ab3)) -
+                (lift_tail(aex, aey, aez) * (be[2] * cd3 - ce[2] * bd3 + de[2] * bc3) +
+                 lift_tail(cex, cey, cez) * (de[2] * ab3 + ae[2] * bd3 + be[2] * da3)));
+  if (std::abs(det) >= bound) return det;
+
+  // Stage D: the exact lifted determinant of the original coordinates.
   const auto lifted =
       (times_lift<3>(lifted_orient3d(a, c, d, e), b) - times_lift<3>(lifted_orient3d(b, c, d, e), a)) +
       (times_lift<3>(lifted_orient3d(a, b, c, e), d) - times_lift<3>(lifted_orient3d(a, b, d, e), c)) -
@@ -318,100 +403,7 @@ bool all_zero_tails(std::initializer_list<TwoTerm> differences) {
   return lifted.top();
 }
 
-}  // namespace
-
-// ---------------------------------------------------------------------------
-// The filters (stage 1): Shewchuk's formulas and permanents.
-
-double orient2d(const double* a, const double* b, const double* c) {
-  const double acx = a[0] - c[0], acy = a[1] - c[1];
-  const double bcx = b[0] - c[0], bcy = b[1] - c[1];
-  const double left = acx * bcy, right = acy * bcx;
-  const double det = left - right;
-  const double permanent = std::abs(left) + std::abs(right);
-  if (std::abs(det) > kOrient2dBoundA * permanent + kUnderflowUnit) [[likely]]
-    return det;
-  return orient2d_slow(a, b, c, permanent);
-}
-
-double orient3d(const double* a, const double* b, const double* c, const double* d) {
-  const double adx = a[0] - d[0], ady = a[1] - d[1], adz = a[2] - d[2];
-  const double bdx = b[0] - d[0], bdy = b[1] - d[1], bdz = b[2] - d[2];
-  const double cdx = c[0] - d[0], cdy = c[1] - d[1], cdz = c[2] - d[2];
-  const double bdxcdy = bdx * cdy, cdxbdy = cdx * bdy;
-  const double cdxady = cdx * ady, adxcdy = adx * cdy;
-  const double adxbdy = adx * bdy, bdxady = bdx * ady;
-  const double det = adz * (bdxcdy - cdxbdy) + bdz * (cdxady - adxcdy) + cdz * (adxbdy - bdxady);
-  const double az = std::abs(adz), bz = std::abs(bdz), cz = std::abs(cdz);
-  const double permanent = (std::abs(bdxcdy) + std::abs(cdxbdy)) * az +
-                           (std::abs(cdxady) + std::abs(adxcdy)) * bz +
-                           (std::abs(adxbdy) + std::abs(bdxady)) * cz;
-  const double underflow = (az + bz + cz + 1.0) * kUnderflowUnit;
-  if (std::abs(det) > kOrient3dBoundA * permanent + underflow) [[likely]]
-    return det;
-  return orient3d_slow(a, b, c, d, permanent);
-}
-
-double incircle(const double* a, const double* b, const double* c, const double* d) {
-  const double adx = a[0] - d[0], ady = a[1] - d[1];
-  const double bdx = b[0] - d[0], bdy = b[1] - d[1];
-  const double cdx = c[0] - d[0], cdy = c[1] - d[1];
-  const double bdxcdy = bdx * cdy, cdxbdy = cdx * bdy;
-  const double cdxady = cdx * ady, adxcdy = adx * cdy;
-  const double adxbdy = adx * bdy, bdxady = bdx * ady;
-  const double alift = adx * adx + ady * ady;
-  const double blift = bdx * bdx + bdy * bdy;
-  const double clift = cdx * cdx + cdy * cdy;
-  const double det = alift * (bdxcdy - cdxbdy) + blift * (cdxady - adxcdy) + clift * (adxbdy - bdxady);
-  const double bc = std::abs(bdxcdy) + std::abs(cdxbdy);
-  const double ca = std::abs(cdxady) + std::abs(adxcdy);
-  const double ab = std::abs(adxbdy) + std::abs(bdxady);
-  const double permanent = bc * alift + ca * blift + ab * clift;
-  const double underflow = ((bc + ca + ab) + (alift + blift + clift) + 1.0) * kUnderflowUnit;
-  if (std::abs(det) > kIncircleBoundA * permanent + underflow) [[likely]]
-    return det;
-  return incircle_slow(a, b, c, d, permanent);
-}
-
-double insphere(const double* a, const double* b, const double* c, const double* d, const double* e) {
-  const double aex = a[0] - e[0], aey = a[1] - e[1], aez = a[2] - e[2];
-  const double bex = b[0] - e[0], bey = b[1] - e[1], bez = b[2] - e[2];
-  const double cex = c[0] - e[0], cey = c[1] - e[1], cez = c[2] - e[2];
-  const double dex = d[0] - e[0], dey = d[1] - e[1], dez = d[2] - e[2];
-  const double aexbey = aex * bey, bexaey = bex * aey;
-  const double bexcey = bex * cey, cexbey = cex * bey;
-  const double cexdey = cex * dey, dexcey = dex * cey;
-  const double dexaey = dex * aey, aexdey = aex * dey;
-  const double aexcey = aex * cey, cexaey = cex * aey;
-  const double bexdey = bex * dey, dexbey = dex * bey;
-  const double ab = aexbey - bexaey, bc = bexcey - cexbey, cd = cexdey - dexcey;
-  const double da = dexaey - aexdey, ac = aexcey - cexaey, bd = bexdey - dexbey;
-  const double abc = aez * bc - bez * ac + cez * ab;
-  const double bcd = bez * cd - cez * bd + dez * bc;
-  const double cda = cez * da + dez * ac + aez * cd;
-  const double dab = dez * ab + aez * bd + bez * da;
-  const double alift = aex * aex + aey * aey + aez * aez;
-  const double blift = bex * bex + bey * bey + bez * bez;
-  const double clift = cex * cex + cey * cey + cez * cez;
-  const double dlift = dex * dex + dey * dey + dez * dez;
-  const double det = (dlift * abc - clift * dab) + (blift * cda - alift * bcd);
-
-  const double az = std::abs(aez), bz = std::abs(bez), cz = std::abs(cez), dz = std::abs(dez);
-  const double ab_plus = std::abs(aexbey) + std::abs(bexaey), bc_plus = std::abs(bexcey) + std::abs(cexbey);
-  const double cd_plus = std::abs(cexdey) + std::abs(dexcey), da_plus = std::abs(dexaey) + std::abs(aexdey);
-  const double ac_plus = std::abs(aexcey) + std::abs(cexaey), bd_plus = std::abs(bexdey) + std::abs(dexbey);
-  const double abc_plus = bc_plus * az + ac_plus * bz + ab_plus * cz;
-  const double bcd_plus = cd_plus * bz + bd_plus * cz + bc_plus * dz;
-  const double cda_plus = da_plus * cz + ac_plus * dz + cd_plus * az;
-  const double dab_plus = ab_plus * dz + bd_plus * az + da_plus * bz;
-  const double permanent = bcd_plus * alift + cda_plus * blift + dab_plus * clift + abc_plus * dlift;
-  const double lifts = (alift + blift) + (clift + dlift);
-  const double underflow = (((az + bz) + (cz + dz) + 1.0) * lifts + ((abc_plus + bcd_plus) + (cda_plus + dab_plus)) + 1.0) *
-                           kUnderflowUnit;
-  if (std::abs(det) > kInsphereBoundA * permanent + underflow) [[likely]]
-    return det;
-  return insphere_slow(a, b, c, d, e, permanent);
-}
+}  // namespace detail
 
 double orient2d_fast(const double* a, const double* b, const double* c) { return orient2d_formula(a, b, c); }
 
