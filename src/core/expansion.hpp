@@ -56,14 +56,18 @@ inline TwoTerm split(double a) {
   return {hi, a - hi};
 }
 
-inline TwoTerm two_product(double a, double b) {
+// a * b with b already split (b == bs.head + bs.tail): scaling an expansion
+// splits its factor once.
+inline TwoTerm two_product_presplit(double a, double b, TwoTerm bs) {
   const double p = a * b;
-  const TwoTerm as = split(a), bs = split(b);
+  const TwoTerm as = split(a);
   const double err1 = p - as.head * bs.head;
   const double err2 = err1 - as.tail * bs.head;
   const double err3 = err2 - as.head * bs.tail;
   return {p, as.tail * bs.tail - err3};
 }
+
+inline TwoTerm two_product(double a, double b) { return two_product_presplit(a, b, split(b)); }
 #endif
 
 template <int N>
@@ -127,17 +131,30 @@ namespace detail {
 // Two_sum instead of the first fast_two_sum: same result, no precondition.
 inline int sum(const double* e, int ne, const double* f, int nf, double f_sign, double* h) {
   int i = 0, j = 0, n = 0;
-  auto next = [&]() {
-    if (j == nf || (i < ne && std::abs(e[i]) < std::abs(f[j]))) return e[i++];
-    return f_sign * f[j++];
-  };
-  if (ne + nf == 0) return 0;
-  double q = next();
-  while (i < ne || j < nf) {
-    const TwoTerm t = two_sum(q, next());
+  double q;
+  if (ne == 0 && nf == 0) return 0;
+  if (j == nf || (i < ne && std::abs(e[i]) < std::abs(f[j]))) {
+    q = e[i++];
+  } else {
+    q = f_sign * f[j++];
+  }
+  const auto add = [&](double x) {
+    const TwoTerm t = two_sum(q, x);
     if (t.tail != 0.0) h[n++] = t.tail;
     q = t.head;
+  };
+  while (i < ne && j < nf) {
+    const double x = e[i], y = f_sign * f[j];
+    if (std::abs(x) < std::abs(y)) {
+      add(x);
+      ++i;
+    } else {
+      add(y);
+      ++j;
+    }
   }
+  for (; i < ne; ++i) add(e[i]);
+  for (; j < nf; ++j) add(f_sign * f[j]);
   if (q != 0.0) h[n++] = q;
   return n;
 }
@@ -145,12 +162,17 @@ inline int sum(const double* e, int ne, const double* f, int nf, double f_sign, 
 // Shewchuk's SCALE-EXPANSION-ZEROELIM: e * b.
 inline int scale(const double* e, int ne, double b, double* h) {
   if (ne == 0 || b == 0.0) return 0;
+#ifdef __FMA__
+  const auto times_b = [b](double a) { return two_product(a, b); };
+#else
+  const auto times_b = [b, bs = split(b)](double a) { return two_product_presplit(a, b, bs); };
+#endif
   int n = 0;
-  TwoTerm p = two_product(e[0], b);
+  TwoTerm p = times_b(e[0]);
   if (p.tail != 0.0) h[n++] = p.tail;
   double q = p.head;
   for (int i = 1; i < ne; ++i) {
-    p = two_product(e[i], b);
+    p = times_b(e[i]);
     const TwoTerm s = two_sum(q, p.tail);
     if (s.tail != 0.0) h[n++] = s.tail;
     const TwoTerm r = fast_two_sum(p.head, s.head);
