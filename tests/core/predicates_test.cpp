@@ -562,6 +562,45 @@ TEST(Predicates, InsphereExactOnLatticeSpheres) {
   }
 }
 
+// Exactly degenerate points whose coordinate differences are not exact:
+// components x, y, z of very different magnitudes, permuted and negated, lie
+// on one line / plane through the origin or on one circle / sphere around it.
+// Nothing short of the last exact stage can call these 0; nudged by an ulp,
+// they exercise the stage with the first-order tail terms (C) and the last.
+Points inexact_differences(Rng& rng, int dim, bool round, bool nudged) {
+  const double x = 1.0 + rng.uniform(0, 1), y = std::ldexp(rng.uniform(1, 2), -int(rng.below(40)) - 1);
+  const double z = std::ldexp(rng.uniform(1, 2), -int(rng.below(40)) - 1);
+  Points p{};
+  const int count = dim + (round ? 2 : 1);
+  for (int i = 0; i < count; ++i) {
+    double v[3] = {x, y, z};
+    if (round) {
+      const int shift = int(rng.below(std::uint64_t(dim)));  // cyclic permutations keep |v|
+      for (int k = 0; k < dim; ++k) p[i][k] = random_sign(rng) * v[(k + shift) % dim];
+    } else {
+      // On the line y = x (2D) or the plane z = x (3D), scaled by a power of two.
+      const double s = random_sign(rng) * std::ldexp(1.0, int(rng.below(7)) - 3);
+      const int pick = int(rng.below(3));
+      const double u = v[pick] * s, w = v[(pick + 1) % 3] * s;
+      p[i] = dim == 2 ? Point{u, u, 0} : Point{u, w, u};
+    }
+  }
+  if (nudged) nudge_point(p[count - 1], rng, 1);
+  if (dim == 2)
+    for (auto& q : p) q[2] = 0.0;
+  return p;
+}
+
+TEST(Predicates, ExactlyDegenerateWithInexactDifferences) {
+  for (const Predicate* pred : {&kOrient2d, &kOrient3d, &kIncircle, &kInsphere}) {
+    const bool round = pred->lifted;
+    expect_exact_signs(*pred, 7, kCases, [&](Rng& rng) { return inexact_differences(rng, pred->dim, round, false); },
+                       "inexact_differences");
+    expect_exact_signs(*pred, 8, kCases, [&](Rng& rng) { return inexact_differences(rng, pred->dim, round, true); },
+                       "inexact_differences_nudged");
+  }
+}
+
 TEST(Predicates, FastDeterminantsAgreeAwayFromDegeneracy) {
   Rng rng(99);
   for (const Predicate* pred : {&kOrient2d, &kOrient3d, &kIncircle, &kInsphere}) {
