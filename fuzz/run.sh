@@ -26,6 +26,10 @@ for f in jacksboro_dem.npy land_points.npy land_segments.npy; do copy npy "$f"; 
 prefixed points 00 land_points.npy
 prefixed segments 00 land_segments.npy
 
+# A small ASan quarantine: Assimp's large transient allocations would otherwise
+# count against libFuzzer's RSS limit.
+export ASAN_OPTIONS=${ASAN_OPTIONS:-quarantine_size_mb=64:detect_leaks=1}
+
 failed=()
 for target in ply obj stl off gltf image npy nrrd nifti points segments; do
   exe=$bin/fuzz_$target

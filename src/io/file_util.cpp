@@ -24,14 +24,17 @@ std::vector<std::uint8_t> read_file(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) fail(path, "cannot open for reading");
   std::vector<std::uint8_t> bytes;
-  // Read in chunks rather than trusting the reported size (it may change, /proc reports 0).
-  constexpr std::size_t chunk = 1 << 20;
+  // The reported size is only a hint (the file may change, /proc reports 0):
+  // read until the end, growing as needed.
+  const std::uintmax_t hint = fs::file_size(path, ec);
+  std::size_t chunk = ec ? 4096 : std::size_t(hint) + 1;
   for (;;) {
     const std::size_t old = bytes.size();
     bytes.resize(old + chunk);
     in.read(reinterpret_cast<char*>(bytes.data() + old), std::streamsize(chunk));
     bytes.resize(old + std::size_t(in.gcount()));
     if (!in) break;
+    chunk = std::max<std::size_t>(bytes.size(), 1 << 16);
   }
   if (in.bad()) fail(path, "read error");
   return bytes;

@@ -59,9 +59,9 @@ TriMesh mesh_from_ply(const fs::path& path, std::span<const std::uint8_t> bytes)
   }
   for (std::size_t i = 0; i + 2 < ply.normals.size(); i += 3)
     mesh.normals.emplace_back(ply.normals[i], ply.normals[i + 1], ply.normals[i + 2]);
+  if (ply.triangles.empty()) fail(path, "no triangles (no face element with vertex_indices)");
   mesh.triangles.resize(ply.triangles.size() / 3);
   std::memcpy(mesh.triangles.data(), ply.triangles.data(), ply.triangles.size() * sizeof(std::uint32_t));
-  if (mesh.triangles.empty()) fail(path, "no triangles");
   return mesh;
 }
 

@@ -6,10 +6,10 @@
 
 namespace geods::io {
 
-/// Reads PLY (ascii/binary) and OFF with our own strict parsers (vertex order
-/// kept), OBJ, STL and glTF/GLB through Assimp (coincident vertices merged,
-/// node transforms applied); also any of them gzip-compressed (.ply.gz,
-/// .off.gz, ...). Polygons are fan-triangulated; points and lines are skipped.
+/// Reads PLY (ascii/binary), OFF and STL (ascii/binary; coincident corners
+/// merged) with our own strict parsers that keep the file's vertex order, and
+/// OBJ and glTF/GLB through Assimp (identical vertices merged, node transforms
+/// applied); also any of them gzip-compressed (.ply.gz, .off.gz, ...). Polygons are fan-triangulated; points and lines are skipped.
 /// Throws geods::Error naming the file and the problem (missing, unreadable,
 /// malformed, truncated, no triangles, out-of-range indices, non-finite
 /// coordinates); counts are checked against the file size before allocating.
