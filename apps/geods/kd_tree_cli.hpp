@@ -1,9 +1,13 @@
 #pragma once
 // What the knn and range commands share: reading an n x d table of numbers and
 // building the k-d tree of the right dimension over it.
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -20,11 +24,49 @@ struct Table {
   std::size_t rows = 0, cols = 0;
 };
 
-/// .npy: any 2-D numeric array (any number of columns); other point formats
-/// through io::read_points (2 or 3 columns). Throws geods::Error naming the file.
+/// A .csv/.txt table: rows of numbers separated by commas or blanks; blank
+/// lines and '#' comments are skipped, and so is a first line that is a header.
+inline Table read_text_table(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  if (!in) throw Error(path.string() + ": cannot open");
+  Table t;
+  std::string line;
+  for (std::size_t number = 1; std::getline(in, line); ++number) {
+    if (const auto hash = line.find('#'); hash != std::string::npos) line.erase(hash);
+    std::replace(line.begin(), line.end(), ',', ' ');
+    std::istringstream fields(line);
+    std::vector<double> row;
+    std::string field;
+    bool numeric = true;
+    while (fields >> field) {
+      char* end = nullptr;
+      row.push_back(std::strtod(field.c_str(), &end));
+      numeric = numeric && end == field.c_str() + field.size();
+    }
+    if (row.empty()) continue;
+    if (!numeric) {
+      if (t.rows == 0 && number == 1) continue;  // a header
+      throw Error(path.string() + ":" + std::to_string(number) + ": not a number");
+    }
+    if (t.rows > 0 && row.size() != t.cols)
+      throw Error(path.string() + ":" + std::to_string(number) + ": " + std::to_string(row.size()) +
+                  " values, the rows above have " + std::to_string(t.cols));
+    t.cols = row.size();
+    t.values.insert(t.values.end(), row.begin(), row.end());
+    ++t.rows;
+  }
+  if (t.rows == 0) throw Error(path.string() + ": no rows");
+  return t;
+}
+
+/// .npy: any 2-D numeric array; .csv/.txt: rows of numbers (any number of
+/// columns); other point formats through io::read_points (2 or 3 columns).
+/// Throws geods::Error naming the file.
 inline Table read_table(const std::filesystem::path& path) {
   Table t;
-  if (path.extension() == ".npy") {
+  if (path.extension() == ".csv" || path.extension() == ".txt") {
+    t = read_text_table(path);
+  } else if (path.extension() == ".npy") {
     const io::NpyArray array = io::read_npy(path);
     if (array.shape.size() != 2 || array.shape[1] == 0)
       throw Error(path.string() + ": expected a 2-D array of shape (n, d), got " + std::to_string(array.shape.size()) +
