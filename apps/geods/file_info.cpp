@@ -111,7 +111,7 @@ void describe_grid(const Grid3<T>& grid, Report& report) {
 }
 
 void describe_volume(const fs::path& path, const io::AnyGrid3& volume, Report& report) {
-  const DType dtype = io::dtype_of(volume);
+  const DType dtype = io::grid_dtype(volume);
   report.json["kind"] = "volume";
   report.json["dtype"] = std::string(dtype_name(dtype));
   report.lines.push_back(fmt::format("{}: volume of {}", path.filename().string(), dtype_name(dtype)));

@@ -146,7 +146,7 @@ void write_nifti(const fs::path& path, const AnyGrid3& grid) {
   for (std::size_t d : dims)
     if (d > 32767) fail(path, "NIfTI-1 dimensions are limited to 32767, volume has " + std::to_string(d));
   int datatype = DT_FLOAT64;
-  switch (dtype_of(grid)) {
+  switch (grid_dtype(grid)) {
     case DType::u8: datatype = DT_UINT8; break;
     case DType::u16: datatype = DT_UINT16; break;
     case DType::i16: datatype = DT_INT16; break;

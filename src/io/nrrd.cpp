@@ -240,12 +240,12 @@ void write_nrrd(const fs::path& path, const AnyGrid3& grid) {
       "NRRD0004\n# written by geods\ntype: {}\ndimension: 3\nspace dimension: 3\nsizes: {} {} {}\n"
       "space directions: ({},0,0) (0,{},0) (0,0,{})\nspace origin: ({},{},{})\nkinds: domain domain domain\n"
       "endian: little\nencoding: raw\n\n",
-      nrrd_type_name(dtype_of(grid)), d[0], d[1], d[2], s.x(), s.y(), s.z(), o.x(), o.y(), o.z());
+      nrrd_type_name(grid_dtype(grid)), d[0], d[1], d[2], s.x(), s.y(), s.z(), o.x(), o.y(), o.z());
   std::vector<std::uint8_t> out(header.begin(), header.end());
   const auto bytes = grid_bytes(grid);
   out.insert(out.end(), bytes.begin(), bytes.end());
   if constexpr (std::endian::native == std::endian::big)
-    swap_bytes(std::span(out).subspan(header.size()), dtype_size(dtype_of(grid)));
+    swap_bytes(std::span(out).subspan(header.size()), dtype_size(grid_dtype(grid)));
   write_file(path, out);
 }
 

@@ -93,7 +93,7 @@ void set_geometry(AnyGrid3& grid, const Vec3f& origin, const Vec3f& spacing) {
 
 }  // namespace detail
 
-DType dtype_of(const AnyGrid3& grid) {
+DType grid_dtype(const AnyGrid3& grid) {
   return std::visit([](const auto& g) { return geods::dtype_of<typename std::decay_t<decltype(g)>::value_type>(); },
                     grid);
 }
@@ -130,7 +130,7 @@ AnyGrid3 read_npy_volume(const fs::path& path) {
 void write_npy_volume(const fs::path& path, const AnyGrid3& grid) {
   const auto dims = detail::grid_dims(grid);
   NpyArray a;
-  a.dtype = dtype_of(grid);
+  a.dtype = grid_dtype(grid);
   a.shape = {dims[2], dims[1], dims[0]};
   const auto bytes = detail::grid_bytes(grid);
   a.bytes.assign(bytes.begin(), bytes.end());
@@ -169,7 +169,7 @@ AnyGrid3 read_raw_volume(const fs::path& path, std::array<std::size_t, 3> dims, 
 
 void write_volume(const fs::path& path, const AnyGrid3& grid) {
   const auto dims = detail::grid_dims(grid);
-  if (dims[0] * dims[1] * dims[2] == 0 || detail::grid_bytes(grid).size() != dims[0] * dims[1] * dims[2] * dtype_size(dtype_of(grid)))
+  if (dims[0] * dims[1] * dims[2] == 0 || detail::grid_bytes(grid).size() != dims[0] * dims[1] * dims[2] * dtype_size(grid_dtype(grid)))
     fail(path, "cannot write a volume whose data does not match its dimensions " + std::to_string(dims[0]) + "x" +
                    std::to_string(dims[1]) + "x" + std::to_string(dims[2]));
   std::string ext = detail::extension(path);

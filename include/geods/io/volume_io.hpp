@@ -14,7 +14,7 @@ namespace geods::io {
 using AnyGrid3 = std::variant<Grid3<std::uint8_t>, Grid3<std::uint16_t>, Grid3<std::int16_t>,
                               Grid3<float>, Grid3<double>>;
 
-DType dtype_of(const AnyGrid3& grid);
+DType grid_dtype(const AnyGrid3& grid);
 /// Converts any volume to float samples (same dims, origin, spacing).
 Grid3<float> to_float(const AnyGrid3& grid);
 
