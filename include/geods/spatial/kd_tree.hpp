@@ -138,7 +138,7 @@ class KdTree {
       const T approx = slack / T((1 + request.eps) * (1 + request.eps));
       Scratch<T> dists(dim());
       const T mindist = initial_distances(query.data(), dists.data());
-      search_knn(0, query.data(), mindist, dists.data(), result, slack, approx);
+      KnnSearch{*this, query.data(), dists.data(), result, slack, approx}.visit(0, mindist);
     }
     result.finish();
     return result.size();
@@ -566,38 +566,46 @@ class KdTree {
     return sum;
   }
 
-  // mindist is a lower bound of the squared distance from q to the cell of node v;
-  // dists holds its per-axis terms. A subtree is entered when mindist <= worst * factor.
-  void search_knn(std::uint32_t v, const T* q, T mindist, T* dists, KnnResultSet<T>& result, T slack,
-                  T approx) const {
-    const Node& node = nodes_[v];
-    if (node.leaf()) {
-      for (std::uint32_t i = node.begin; i < node.end; ++i) {
-        const std::uint32_t j = perm_[i];
-        result.insert(j, squared_distance(q, point(j)));
+  // One k-NN search: the query state in one place, so the recursion passes only (node, mindist).
+  struct KnnSearch {
+    const KdTree& tree;
+    const T* q;
+    T* dists;  // per-axis terms of mindist
+    KnnResultSet<T>& result;
+    T slack, approx;
+
+    // mindist is a lower bound of the squared distance from q to the cell of node v.
+    // A subtree is entered when mindist <= worst * factor.
+    void visit(std::uint32_t v, T mindist) const {
+      const Node& node = tree.nodes_[v];
+      if (node.leaf()) {
+        for (std::uint32_t i = node.begin; i < node.end; ++i) {
+          const std::uint32_t j = tree.perm_[i];
+          result.insert(j, tree.squared_distance(q, tree.point(j)));
+        }
+        return;
       }
-      return;
+      const std::uint32_t axis = node.axis;
+      const T x = q[axis];
+      const T to_low = x - node.low, to_high = node.high - x;
+      std::uint32_t near = v + 1, far = node.right;
+      T cut = to_high * to_high;  // distance term of the far cell on this axis
+      if (to_low > to_high) {
+        std::swap(near, far);
+        cut = to_low * to_low;
+      }
+      visit(near, mindist);
+      const T old = dists[axis];
+      mindist += cut - old;
+      // While fewer than k are found, the limit is the max distance and eps must not shrink it.
+      const T bound = result.worst() * (result.full() ? approx : slack);
+      if (mindist <= bound) {
+        dists[axis] = cut;
+        visit(far, mindist);
+        dists[axis] = old;
+      }
     }
-    const std::uint32_t axis = node.axis;
-    const T x = q[axis];
-    const T to_low = x - node.low, to_high = node.high - x;
-    std::uint32_t near = v + 1, far = node.right;
-    T cut = to_high * to_high;  // distance term of the far cell on this axis
-    if (to_low > to_high) {
-      std::swap(near, far);
-      cut = to_low * to_low;
-    }
-    search_knn(near, q, mindist, dists, result, slack, approx);
-    const T old = dists[axis];
-    mindist += cut - old;
-    // While fewer than k are found, the limit is the max distance and eps must not shrink it.
-    const T bound = result.full() ? result.worst() * approx : result.worst() * slack;
-    if (mindist <= bound) {
-      dists[axis] = cut;
-      search_knn(far, q, mindist, dists, result, slack, approx);
-      dists[axis] = old;
-    }
-  }
+  };
 
   void search_radius(std::uint32_t v, const T* q, T mindist, T* dists, T r2, T bound,
                      std::vector<Neighbor<T>>& out) const {

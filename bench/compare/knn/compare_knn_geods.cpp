@@ -1,0 +1,22 @@
+// geods::spatial::KdTree<float, 3> on the knn comparison inputs (zero-copy over the points).
+#include "geods/spatial/kd_tree.hpp"
+#include "knn_driver.hpp"
+
+namespace {
+
+struct Geods {
+  static constexpr const char* anchor = "geods";
+  using Index = geods::spatial::KdTree<float, 3>;
+  static std::unique_ptr<Index> build(const float* points, std::size_t n, std::size_t leaf_size) {
+    return std::make_unique<Index>(geods::spatial::PointView<float>(points, n, 3), leaf_size);
+  }
+  static void knn(const Index& tree, const float* q, std::size_t k, std::uint32_t* indices, float* distances) {
+    std::array<geods::spatial::Neighbor<float>, 64> out;
+    tree.query_into(std::span<const float>(q, 3), geods::spatial::KnnRequest{k}, out.data());
+    for (std::size_t i = 0; i < k; ++i) indices[i] = out[i].index, distances[i] = out[i].squared_distance;
+  }
+};
+
+}  // namespace
+
+int main(int argc, char** argv) { return compare::knn::run<Geods>(argc, argv); }

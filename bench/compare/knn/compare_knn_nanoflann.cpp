@@ -1,0 +1,39 @@
+// nanoflann's KDTreeSingleIndexAdaptor (L2, dimension 3 at compile time) on the knn comparison inputs.
+#include <nanoflann.hpp>
+
+#include "knn_driver.hpp"
+
+namespace {
+
+struct Cloud {
+  const float* points;
+  std::size_t n;
+  std::size_t kdtree_get_point_count() const { return n; }
+  float kdtree_get_pt(std::size_t i, std::size_t d) const { return points[3 * i + d]; }
+  template <class Box>
+  bool kdtree_get_bbox(Box&) const { return false; }
+};
+
+struct Nanoflann {
+  static constexpr const char* anchor = "nanoflann";
+  using Tree =
+      nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, Cloud>, Cloud, 3, std::uint32_t>;
+  struct Index {
+    Cloud cloud;
+    Tree tree;
+    Index(const float* points, std::size_t n, std::size_t leaf_size)
+        : cloud{points, n}, tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(leaf_size)) {}
+  };
+  static std::unique_ptr<Index> build(const float* points, std::size_t n, std::size_t leaf_size) {
+    return std::make_unique<Index>(points, n, leaf_size);  // the constructor builds the tree
+  }
+  static void knn(const Index& index, const float* q, std::size_t k, std::uint32_t* indices, float* distances) {
+    nanoflann::KNNResultSet<float, std::uint32_t> result(k);
+    result.init(indices, distances);
+    index.tree.findNeighbors(result, q, nanoflann::SearchParams());
+  }
+};
+
+}  // namespace
+
+int main(int argc, char** argv) { return compare::knn::run<Nanoflann>(argc, argv); }
