@@ -11,7 +11,8 @@ struct Geods {
     return std::make_unique<Index>(geods::spatial::PointView<float>(points, n, 3), leaf_size);
   }
   static void knn(const Index& tree, const float* q, std::size_t k, std::uint32_t* indices, float* distances) {
-    std::array<geods::spatial::Neighbor<float>, 64> out;
+    thread_local std::vector<geods::spatial::Neighbor<float>> out;  // allocated once per thread
+    out.resize(k);
     tree.query_into(std::span<const float>(q, 3), geods::spatial::KnnRequest{k}, out.data());
     for (std::size_t i = 0; i < k; ++i) indices[i] = out[i].index, distances[i] = out[i].squared_distance;
   }

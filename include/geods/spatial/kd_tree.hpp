@@ -579,9 +579,14 @@ class KdTree {
     void visit(std::uint32_t v, T mindist) const {
       const Node& node = tree.nodes_[v];
       if (node.leaf()) {
+        T worst = result.worst();  // cheap rejection first; insert() breaks exact ties by index
         for (std::uint32_t i = node.begin; i < node.end; ++i) {
           const std::uint32_t j = tree.perm_[i];
-          result.insert(j, tree.squared_distance(q, tree.point(j)));
+          const T d = tree.squared_distance(q, tree.point(j));
+          if (d <= worst) {
+            result.insert(j, d);
+            worst = result.worst();
+          }
         }
         return;
       }
