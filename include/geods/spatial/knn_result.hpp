@@ -1,5 +1,6 @@
 #pragma once
 // What nearest-neighbour queries ask for and return.
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <limits>
@@ -44,7 +45,7 @@ class KnnResultSet {
   std::size_t size() const { return size_; }
   bool full() const { return size_ == k_; }
   /// The squared distance a new point must not exceed to be kept.
-  T worst() const { return full() ? slots_[k_ - 1].squared_distance : limit_; }
+  T worst() const { return full() && k_ > 0 ? slots_[k_ - 1].squared_distance : limit_; }
 
   void insert(std::uint32_t index, T squared_distance) {
     const Neighbor<T> candidate{index, squared_distance};
@@ -56,8 +57,9 @@ class KnnResultSet {
       if (!(candidate < slots_[k_ - 1])) return;
       pos = k_ - 1;
     }
-    for (; pos > 0 && candidate < slots_[pos - 1]; --pos) slots_[pos] = slots_[pos - 1];
-    slots_[pos] = candidate;
+    Neighbor<T>* at = std::upper_bound(slots_, slots_ + pos, candidate);
+    std::move_backward(at, slots_ + pos, slots_ + pos + 1);
+    *at = candidate;
   }
 
   /// Marks the unused slots as "none" (kNoIndex, +inf).
