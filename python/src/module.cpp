@@ -9,4 +9,5 @@ PYBIND11_MODULE(_geods, m) {
   geods::python::bind_core(m);
   geods::python::bind_io(m);
   geods::python::bind_spatial(m);
+  geods::python::bind_quadtree(m);
 }
