@@ -1,0 +1,250 @@
+// Dyn(k-d) against a brute-force set: long seeded insert/delete/query
+// sequences for both variants, with validate() after every step.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <vector>
+
+#include "geods/core/error.hpp"
+#include "geods/core/rng.hpp"
+#include "geods/dynamic/dynamic_kd_tree.hpp"
+
+namespace geods::dynamic {
+namespace {
+
+using Tree = DynamicKdTree<double, 2>;
+using P = Tree::Point;
+
+// The oracle: every live id and its point.
+struct Oracle {
+  std::map<Id, P> items;
+
+  std::vector<Tree::Neighbor> nearest(const P& q, std::size_t k) const {
+    std::vector<Tree::Neighbor> all;
+    for (const auto& [id, p] : items) all.push_back({id, squared_distance(q, p)});
+    std::sort(all.begin(), all.end());
+    if (all.size() > k) all.resize(k);
+    return all;
+  }
+  std::vector<Tree::Neighbor> within(const P& q, double r) const {
+    std::vector<Tree::Neighbor> out;
+    for (const auto& [id, p] : items)
+      if (squared_distance(q, p) <= r * r) out.push_back({id, squared_distance(q, p)});
+    std::sort(out.begin(), out.end());
+    return out;
+  }
+  std::vector<Id> in_box(const P& lo, const P& hi) const {
+    std::vector<Id> out;
+    for (const auto& [id, p] : items)
+      if (lo[0] <= p[0] && p[0] <= hi[0] && lo[1] <= p[1] && p[1] <= hi[1]) out.push_back(id);
+    return out;
+  }
+  // The same sum in the same order as KdBlock, so distances compare exactly.
+  static double squared_distance(const P& q, const P& p) {
+    double d = 0;
+    for (int a = 0; a < 2; ++a) d += (q[a] - p[a]) * (q[a] - p[a]);
+    return d;
+  }
+};
+
+// Coordinates on a coarse grid half of the time, so exact duplicates and distance ties are common.
+P random_point(Rng& rng) {
+  if (rng.below(2)) return {double(rng.below(20)), double(rng.below(20))};
+  return {rng.uniform(0, 20), rng.uniform(0, 20)};
+}
+
+void run_sequence(Variant variant, std::uint64_t seed, int steps) {
+  Rng rng(seed);
+  Tree tree(DynamizeOptions{variant});
+  Oracle oracle;
+  std::vector<P> removed_points;
+  for (int step = 0; step < steps; ++step) {
+    const std::uint64_t op = rng.below(10);
+    if (op < 5 || oracle.items.empty()) {
+      // Insert a batch; sometimes re-insert points removed earlier, sometimes a big batch (bulk build).
+      std::vector<double> coords;
+      const std::size_t count = rng.below(8) == 0 ? 1 + rng.below(200) : 1 + rng.below(6);
+      for (std::size_t i = 0; i < count; ++i) {
+        const P p = !removed_points.empty() && rng.below(4) == 0 ? removed_points[rng.below(removed_points.size())]
+                                                                 : random_point(rng);
+        coords.insert(coords.end(), p.begin(), p.end());
+      }
+      const std::vector<Id> ids = tree.insert(spatial::PointView<double>(coords.data(), count, 2));
+      ASSERT_EQ(ids.size(), count);
+      for (std::size_t i = 0; i < count; ++i) {
+        ASSERT_EQ(oracle.items.count(ids[i]), 0u) << "ids are never reused";
+        oracle.items[ids[i]] = {coords[2 * i], coords[2 * i + 1]};
+      }
+    } else if (op < 8) {
+      // Remove a few random live ids (sometimes many, to trigger reconstructions).
+      std::vector<Id> live;
+      for (const auto& [id, p] : oracle.items) live.push_back(id);
+      std::shuffle(live.begin(), live.end(), rng);
+      const std::size_t count = std::min(live.size(), rng.below(10) == 0 ? live.size() / 2 + 1 : 1 + rng.below(4));
+      live.resize(count);
+      tree.remove(live);
+      for (Id id : live) {
+        removed_points.push_back(oracle.items.at(id));
+        oracle.items.erase(id);
+      }
+    } else {
+      const P q = random_point(rng);
+      const std::size_t k = 1 + rng.below(12);
+      ASSERT_EQ(tree.query(q, k), oracle.nearest(q, k)) << "step " << step;
+      const double r = rng.uniform(0, 4);
+      ASSERT_EQ(tree.query_radius(q, r), oracle.within(q, r)) << "step " << step;
+      const P lo = random_point(rng), hi{lo[0] + rng.uniform(0, 8), lo[1] + rng.uniform(0, 8)};
+      ASSERT_EQ(tree.query_box(lo, hi), oracle.in_box(lo, hi)) << "step " << step;
+    }
+    ASSERT_EQ(tree.size(), oracle.items.size());
+    ASSERT_NO_THROW(tree.validate()) << "step " << step;
+  }
+  for (const auto& [id, p] : oracle.items) ASSERT_EQ(tree.point(id), p);
+  EXPECT_GE(tree.stats().structure.rebuilds, 2u) << "the sequence reaches the reconstruction threshold";
+}
+
+TEST(DynamicKdTree, RandomSequenceAmortized) {
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) run_sequence(Variant::amortized, seed, 3000);
+}
+
+TEST(DynamicKdTree, RandomSequenceWorstCase) {
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) run_sequence(Variant::worst_case, seed, 3000);
+}
+
+TEST(DynamicKdTree, AmortizedDecompositionFollowsTheBinaryRepresentation) {
+  Tree tree;
+  Rng rng(7);
+  for (std::size_t n = 1; n <= 300; ++n) {
+    tree.insert(random_point(rng));
+    const DynamizedStats s = tree.stats().structure;
+    for (std::size_t i = 0; i < 12; ++i)
+      ASSERT_EQ(i < s.per_level.size() ? s.per_level[i] : 0, (n >> i) & 1) << "n = " << n << ", level " << i;
+    tree.validate();
+  }
+}
+
+TEST(DynamicKdTree, WorstCaseSpreadsBuildsOverInserts) {
+  Tree tree(DynamizeOptions{Variant::worst_case});
+  Rng rng(8);
+  std::size_t max_building = 0;
+  for (int n = 0; n < 20000; ++n) {
+    tree.insert(random_point(rng));
+    max_building = std::max(max_building, tree.stats().structure.building);
+    if (n % 997 == 0) tree.validate();
+  }
+  tree.validate();
+  const DynamizedStats s = tree.stats().structure;
+  EXPECT_GE(max_building, 3u) << "builds on several levels run at the same time";
+  EXPECT_EQ(s.forced_builds, 0u) << "every build finished within its schedule";
+  std::size_t slots = 0;
+  for (std::size_t i = 0; i < s.per_level.size(); ++i) {
+    EXPECT_LE(s.per_level[i], 3u);
+    slots += s.per_level[i] << i;
+  }
+  EXPECT_EQ(slots, 20000u);
+}
+
+TEST(DynamicKdTree, MemoryReturnsAfterMassDeletion) {
+  for (Variant variant : {Variant::amortized, Variant::worst_case}) {
+    Tree tree(DynamizeOptions{variant});
+    Rng rng(3);
+    std::vector<Id> ids;
+    for (int i = 0; i < 20000; ++i) ids.push_back(tree.insert(random_point(rng)));
+    const std::size_t full = tree.stats().bytes;
+    // Delete 95 % in small batches: reconstructions happen on the way, at the latest
+    // when more than half of the slots are dead.
+    for (std::size_t i = 0; i < 19000; i += 100) tree.remove(std::span<const Id>(ids.data() + i, 100));
+    tree.validate();
+    const DynamicKdTreeStats after = tree.stats();
+    EXPECT_EQ(tree.size(), 1000u);
+    EXPECT_GE(after.structure.rebuilds, 1u);
+    EXPECT_LE(after.structure.dead, tree.size());
+    EXPECT_LT(after.bytes, full / 5) << "full " << full << " bytes, after " << after.bytes;
+    tree.rebuild();
+    EXPECT_EQ(tree.stats().structure.dead, 0u);
+    EXPECT_LT(tree.stats().bytes, full / 10);
+    tree.validate();
+    for (std::size_t i = 19000; i < ids.size(); ++i) EXPECT_TRUE(tree.contains(ids[i]));
+  }
+}
+
+TEST(DynamicKdTree, ReinsertingARemovedPointDoesNotDuplicateIt) {
+  for (Variant variant : {Variant::amortized, Variant::worst_case}) {
+    Tree tree(DynamizeOptions{variant});
+    Rng rng(4);
+    for (int i = 0; i < 100; ++i) tree.insert(random_point(rng));
+    const P p{100.5, -3.25};
+    const Id a = tree.insert(p);
+    tree.remove(a);
+    const Id b = tree.insert(p);
+    EXPECT_NE(a, b);
+    EXPECT_FALSE(tree.contains(a));
+    const auto at_p = tree.query_radius(p, 0.0);
+    ASSERT_EQ(at_p.size(), 1u);
+    EXPECT_EQ(at_p[0].id, b);
+    EXPECT_THROW(tree.remove(a), Error);
+    // After a reconstruction, still one copy.
+    tree.rebuild();
+    EXPECT_EQ(tree.query_radius(p, 0.0).size(), 1u);
+    EXPECT_EQ(tree.size(), 101u);
+    tree.validate();
+  }
+}
+
+TEST(DynamicKdTree, BadInputThrowsAndChangesNothing) {
+  Tree tree;
+  const std::vector<Id> ids = tree.insert(spatial::PointView<double>(std::vector<double>{0, 0, 1, 1}.data(), 2, 2));
+  const double nan = std::nan("");
+  const std::vector<double> bad{0, 0, nan, 1};
+  EXPECT_THROW(tree.insert(spatial::PointView<double>(bad.data(), 2, 2)), Error);
+  const std::vector<double> three{0, 0, 0};
+  EXPECT_THROW(tree.insert(spatial::PointView<double>(three.data(), 1, 3)), Error);
+  EXPECT_EQ(tree.size(), 2u);
+  const std::vector<Id> unknown{ids[0], 12345};
+  EXPECT_THROW(tree.remove(unknown), Error);
+  const std::vector<Id> twice{ids[1], ids[1]};
+  EXPECT_THROW(tree.remove(twice), Error);
+  EXPECT_EQ(tree.size(), 2u) << "a failed batch removes nothing";
+  EXPECT_THROW(tree.query(P{0, 0}, 0), Error);
+  EXPECT_THROW(tree.query(std::span<const double>(three), 1), Error);
+  const double inf = INFINITY;
+  EXPECT_THROW(tree.query(P{inf, 0}, 1), Error);
+  EXPECT_THROW(tree.query_radius(P{0, 0}, -1), Error);
+  EXPECT_THROW(tree.point(999), Error);
+  EXPECT_THROW(Tree(DynamizeOptions{Variant::amortized, 1.5}), Error);
+  tree.validate();
+}
+
+TEST(DynamicKdTree, EmptyTreeAnswersNothing) {
+  Tree tree(DynamizeOptions{Variant::worst_case});
+  EXPECT_TRUE(tree.query(P{1, 2}, 3).empty());
+  EXPECT_TRUE(tree.query_radius(P{1, 2}, 10).empty());
+  tree.validate();
+  const Id id = tree.insert(P{1, 2});
+  tree.remove(id);
+  EXPECT_TRUE(tree.query(P{1, 2}, 3).empty());
+  EXPECT_EQ(tree.stats().structure.structures, 0u) << "removing the only item rebuilds to nothing";
+  tree.validate();
+}
+
+TEST(DynamicKdTree, BatchQueriesMatchSingleOnes) {
+  DynamicKdTree<float, 3> tree(DynamizeOptions{Variant::worst_case});
+  Rng rng(5);
+  std::vector<float> coords(3 * 3000);
+  for (float& x : coords) x = float(rng.uniform());
+  tree.insert(spatial::PointView<float>(coords.data(), 1000, 3));
+  for (std::size_t i = 1000; i < 3000; ++i) tree.insert({coords[3 * i], coords[3 * i + 1], coords[3 * i + 2]});
+  std::vector<float> queries(3 * 50);
+  for (float& x : queries) x = float(rng.uniform());
+  const auto batch = tree.query_batch(spatial::PointView<float>(queries.data(), 50, 3), 4);
+  for (std::size_t i = 0; i < 50; ++i) {
+    const auto single = tree.query(std::span<const float>(queries.data() + 3 * i, 3), 4);
+    ASSERT_EQ(single.size(), 4u);
+    for (std::size_t j = 0; j < 4; ++j) EXPECT_EQ(batch[4 * i + j], single[j]);
+  }
+}
+
+}  // namespace
+}  // namespace geods::dynamic

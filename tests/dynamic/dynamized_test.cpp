@@ -1,0 +1,103 @@
+// The generic wrapper with other static structures, and the k-d block on its own.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <set>
+#include <vector>
+
+#include "geods/core/error.hpp"
+#include "geods/core/rng.hpp"
+#include "geods/dynamic/dynamized.hpp"
+#include "geods/dynamic/kd_block.hpp"
+
+namespace geods::dynamic {
+namespace {
+
+// The smallest static structure: a sorted copy of the items for membership
+// queries, with neither weak delete nor a stepped build.
+struct SortedArray {
+  using Item = int;
+  std::vector<int> items;   // slot order
+  std::vector<int> sorted;  // for queries
+
+  static SortedArray build(std::vector<int> items) {
+    SortedArray s{std::move(items), {}};
+    s.sorted = s.items;
+    std::sort(s.sorted.begin(), s.sorted.end());
+    return s;
+  }
+  std::size_t size() const { return items.size(); }
+  std::vector<int> extract() const { return items; }
+  bool contains(int x) const { return std::binary_search(sorted.begin(), sorted.end(), x); }
+};
+
+static_assert(StaticStructure<SortedArray>);
+static_assert(!WeakDeletable<SortedArray>);
+static_assert(WeakDeletable<KdBlock<float, 3>> && SteppedBuild<KdBlock<float, 3>>);
+
+TEST(Dynamized, InsertOnlyStructureAnswersDecomposedQueries) {
+  Dynamized<SortedArray> set;
+  std::vector<Id> ids;
+  for (int x = 0; x < 1000; ++x) ids.push_back(set.insert(3 * x));
+  set.validate();
+  auto member = [&](int x) {
+    bool found = false;
+    set.for_each([&](const SortedArray& s, std::span<const Id>) { found = found || s.contains(x); });
+    return found;
+  };
+  EXPECT_TRUE(member(2997));
+  EXPECT_FALSE(member(2998));
+  EXPECT_EQ(set.stats().structures, 6u);  // 1000 = 0b1111101000
+  EXPECT_THROW(Dynamized<SortedArray>(DynamizeOptions{Variant::worst_case}), Error);
+  const auto [items, item_ids] = set.live_items();
+  EXPECT_EQ(std::set<int>(items.begin(), items.end()).size(), 1000u);
+  EXPECT_EQ(std::set<Id>(item_ids.begin(), item_ids.end()), std::set<Id>(ids.begin(), ids.end()));
+}
+
+TEST(KdBlock, SteppedBuildGivesTheSameTree) {
+  Rng rng(11);
+  std::vector<KdBlock<double, 3>::Item> items(5000);
+  for (auto& p : items) p = {rng.uniform(), double(rng.below(4)), rng.normal()};
+  const KdBlock<double, 3> whole = KdBlock<double, 3>::build(items);
+  KdBlock<double, 3>::Builder builder(items);
+  std::size_t steps = 0;
+  while (!builder.step(97)) ++steps;
+  EXPECT_GT(steps, builder.estimated_work() / 97 / 4) << "the build really runs in many small steps";
+  const KdBlock<double, 3> stepped = builder.finish();
+  whole.validate();
+  stepped.validate();
+  EXPECT_EQ(stepped.extract(), items);
+  const double q[3] = {0.5, 1, 0};
+  const double lo[3] = {0.2, 0, -1}, hi[3] = {0.6, 2, 1};
+  std::vector<std::size_t> a, b;
+  whole.in_box(lo, hi, [&](std::size_t slot) { a.push_back(slot); });
+  stepped.in_box(lo, hi, [&](std::size_t slot) { b.push_back(slot); });
+  EXPECT_EQ(a, b);
+  std::vector<std::size_t> near;
+  stepped.within(q, 0.01, [&](std::size_t slot, double) { near.push_back(slot); });
+  std::size_t expected = 0;
+  for (const auto& p : items)
+    expected += (p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) + (p[2] - q[2]) * (p[2] - q[2]) <= 0.01;
+  EXPECT_EQ(near.size(), expected);
+}
+
+TEST(KdBlock, WeakDeleteHidesSlots) {
+  std::vector<KdBlock<float, 2>::Item> items;
+  for (int i = 0; i < 100; ++i) items.push_back({float(i % 10), float(i / 10)});
+  KdBlock<float, 2> block = KdBlock<float, 2>::build(items);
+  for (std::size_t slot = 0; slot < 100; slot += 2) block.weak_delete(slot);
+  EXPECT_THROW(block.weak_delete(0), Error);
+  EXPECT_EQ(block.dead(), 50u);
+  block.validate();
+  const float lo[2] = {0, 0}, hi[2] = {9, 9};
+  std::size_t count = 0;
+  block.in_box(lo, hi, [&](std::size_t slot) {
+    EXPECT_EQ(slot % 2, 1u);
+    ++count;
+  });
+  EXPECT_EQ(count, 50u);
+  EXPECT_EQ(block.extract().size(), 100u) << "dead slots stay until a rebuild";
+}
+
+}  // namespace
+}  // namespace geods::dynamic
