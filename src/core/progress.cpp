@@ -10,7 +10,7 @@ namespace geods {
 void Progress::report(double done) {
   if (!callback_) return;
   if (!callback_(stage_, std::clamp(done / total_, 0.0, 1.0))) {
-    throw Error(std::string(stage_) + ": cancelled");
+    throw Error(stage_ + ": cancelled");
   }
 }
 

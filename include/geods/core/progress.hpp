@@ -1,7 +1,9 @@
 #pragma once
 // Progress reporting for long operations.
 #include <functional>
+#include <string>
 #include <string_view>
+#include <utility>
 
 namespace geods {
 
@@ -13,8 +15,9 @@ using ProgressCallback = std::function<bool(std::string_view stage, double fract
 /// most about 200 updates so that calling step() in a hot loop stays cheap.
 class Progress {
  public:
-  Progress(const ProgressCallback& callback, std::string_view stage, double total)
-      : callback_(callback), stage_(stage), total_(total > 0 ? total : 1) {
+  // Holds copies of the callback and the stage name, so temporaries are fine.
+  Progress(ProgressCallback callback, std::string_view stage, double total)
+      : callback_(std::move(callback)), stage_(stage), total_(total > 0 ? total : 1) {
     report(0);
   }
 
@@ -30,8 +33,8 @@ class Progress {
  private:
   void report(double done);
 
-  const ProgressCallback& callback_;
-  std::string_view stage_;
+  ProgressCallback callback_;
+  std::string stage_;
   double total_;
   double next_ = 0;
 };
