@@ -7,6 +7,8 @@ JOBS ?= $(shell nproc)
 FUZZ_SECONDS ?= 60
 DEMO_OUT ?= out/demo
 PYTHON := /usr/bin/python3
+# Paths under the checkout are hashed relative to it, so a fresh clone reuses ccache.
+export CCACHE_BASEDIR := $(CURDIR)
 
 .PHONY: all setup release demo test bench fuzz clean
 
