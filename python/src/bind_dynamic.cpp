@@ -1,0 +1,219 @@
+// Python bindings of the dynamic module: geods.DynamicKdTree.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <cmath>
+#include <limits>
+#include <string>
+#include <variant>
+
+#include "bindings.hpp"
+#include "geods/core/error.hpp"
+#include "geods/dynamic/dynamic_kd_tree.hpp"
+
+namespace py = pybind11;
+
+namespace geods::python {
+namespace {
+
+using dynamic::DynamicKdTree;
+using dynamic::Id;
+using Rows = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+class PyDynamicKdTree {
+ public:
+  PyDynamicKdTree(std::size_t dim, const std::string& variant, double max_dead_fraction) {
+    dynamic::DynamizeOptions options;
+    if (variant == "amortized") {
+      options.variant = dynamic::Variant::amortized;
+    } else if (variant == "worst_case") {
+      options.variant = dynamic::Variant::worst_case;
+    } else {
+      throw Error("DynamicKdTree: variant must be \"amortized\" or \"worst_case\", got \"" + variant + "\"");
+    }
+    options.max_dead_fraction = max_dead_fraction;
+    if (dim == 2) {
+      tree_.emplace<DynamicKdTree<double, 2>>(options);
+    } else if (dim == 3) {
+      tree_.emplace<DynamicKdTree<double, 3>>(options);
+    } else {
+      throw Error("DynamicKdTree: dim must be 2 or 3, got " + std::to_string(dim));
+    }
+    variant_ = variant;
+  }
+
+  std::size_t dim() const { return tree_.index() == 0 ? 2 : 3; }
+  const std::string& variant() const { return variant_; }
+  std::size_t size() const {
+    return std::visit([](const auto& t) { return t.size(); }, tree_);
+  }
+  bool contains(std::int64_t id) const {
+    return id >= 0 && std::visit([&](const auto& t) { return t.contains(Id(id)); }, tree_);
+  }
+
+  py::array_t<std::int64_t> insert(const py::handle& points) {
+    const auto [rows, single] = as_rows(points, "DynamicKdTree.insert");
+    std::vector<Id> ids;
+    {
+      py::gil_scoped_release release;
+      ids = std::visit([&](auto& t) { return t.insert(spatial::PointView<double>(rows.data(), count(rows), dim())); },
+                       tree_);
+    }
+    py::array_t<std::int64_t> out(py::ssize_t(ids.size()));
+    std::int64_t* p = out.mutable_data();
+    for (std::size_t i = 0; i < ids.size(); ++i) p[i] = std::int64_t(ids[i]);
+    if (single) return out.reshape(std::vector<py::ssize_t>{});
+    return out;
+  }
+
+  void remove(const py::handle& ids) {
+    auto array = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>::ensure(ids);
+    if (!array || array.ndim() > 1) throw Error("DynamicKdTree.remove: ids must be an integer or a 1-d array of them");
+    std::vector<Id> list(std::size_t(array.size()));
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      const std::int64_t id = array.data()[i];
+      if (id < 0) throw Error("DynamicKdTree.remove: id " + std::to_string(id) + " is not stored");
+      list[i] = Id(id);
+    }
+    py::gil_scoped_release release;
+    std::visit([&](auto& t) { t.remove(list); }, tree_);
+  }
+
+  py::tuple query(const py::handle& q, std::size_t k) const {
+    const auto [rows, single] = as_rows(q, "DynamicKdTree.query");
+    const std::size_t m = count(rows);
+    py::array_t<double> distances(std::vector<py::ssize_t>{py::ssize_t(m), py::ssize_t(k)});
+    py::array_t<std::int64_t> ids(std::vector<py::ssize_t>{py::ssize_t(m), py::ssize_t(k)});
+    double* d = distances.mutable_data();
+    std::int64_t* idx = ids.mutable_data();
+    {
+      py::gil_scoped_release release;
+      std::visit(
+          [&](const auto& t) {
+            const auto result = t.query_batch(spatial::PointView<double>(rows.data(), m, dim()), k);
+            for (std::size_t i = 0; i < result.size(); ++i) {
+              const bool missing = result[i].id == dynamic::kNoId;
+              d[i] = missing ? std::numeric_limits<double>::infinity() : std::sqrt(result[i].squared_distance);
+              idx[i] = missing ? -1 : std::int64_t(result[i].id);
+            }
+          },
+          tree_);
+    }
+    if (single) return py::make_tuple(distances.reshape({py::ssize_t(k)}), ids.reshape({py::ssize_t(k)}));
+    return py::make_tuple(distances, ids);
+  }
+
+  py::array_t<std::int64_t> query_radius(const py::handle& q, double r) const {
+    const auto [rows, single] = as_rows(q, "DynamicKdTree.query_radius");
+    if (!single) throw Error("DynamicKdTree.query_radius: q is one point");
+    std::vector<std::int64_t> out;
+    {
+      py::gil_scoped_release release;
+      std::visit(
+          [&](const auto& t) {
+            for (const auto& nb : t.query_radius(std::span<const double>(rows.data(), dim()), r))
+              out.push_back(std::int64_t(nb.id));
+          },
+          tree_);
+    }
+    return py::array_t<std::int64_t>(py::ssize_t(out.size()), out.data());
+  }
+
+  py::array_t<std::int64_t> query_box(const py::handle& lo, const py::handle& hi) const {
+    const auto [l, l_single] = as_rows(lo, "DynamicKdTree.query_box lo");
+    const auto [h, h_single] = as_rows(hi, "DynamicKdTree.query_box hi");
+    if (!l_single || !h_single) throw Error("DynamicKdTree.query_box: lo and hi are single points");
+    std::vector<std::int64_t> out;
+    {
+      py::gil_scoped_release release;
+      std::visit(
+          [&](const auto& t) {
+            for (Id id : t.query_box(std::span<const double>(l.data(), dim()), std::span<const double>(h.data(), dim())))
+              out.push_back(std::int64_t(id));
+          },
+          tree_);
+    }
+    return py::array_t<std::int64_t>(py::ssize_t(out.size()), out.data());
+  }
+
+  void validate() const {
+    std::visit([](const auto& t) { t.validate(); }, tree_);
+  }
+  void rebuild() {
+    std::visit([](auto& t) { t.rebuild(); }, tree_);
+  }
+
+  py::dict stats() const {
+    const dynamic::DynamicKdTreeStats s = std::visit([](const auto& t) { return t.stats(); }, tree_);
+    py::dict d;
+    d["live"] = s.structure.live;
+    d["dead"] = s.structure.dead;
+    d["structures"] = s.structure.structures;
+    d["building"] = s.structure.building;
+    d["per_level"] = s.structure.per_level;
+    d["rebuilds"] = s.structure.rebuilds;
+    d["forced_builds"] = s.structure.forced_builds;
+    d["bytes"] = s.bytes;
+    return d;
+  }
+
+ private:
+  struct RowsOf {
+    Rows array;
+    bool single;
+  };
+  static std::size_t count(const Rows& rows) { return rows.ndim() == 1 ? 1 : std::size_t(rows.shape(0)); }
+
+  // One point (d,) or rows (m, d) as C-order float64.
+  RowsOf as_rows(const py::handle& x, const char* what) const {
+    auto a = Rows::ensure(x);
+    if (!a) throw Error(std::string(what) + ": expected an array of numbers");
+    if (a.ndim() == 1 && std::size_t(a.shape(0)) == dim()) return {a, true};
+    if (a.ndim() == 2 && std::size_t(a.shape(1)) == dim()) return {a, false};
+    throw Error(std::string(what) + ": expected shape (" + std::to_string(dim()) + ",) or (m, " +
+                std::to_string(dim()) + ") for a tree of dimension " + std::to_string(dim()));
+  }
+
+  std::variant<DynamicKdTree<double, 2>, DynamicKdTree<double, 3>> tree_;
+  std::string variant_;
+};
+
+}  // namespace
+
+void bind_dynamic(py::module_& m) {
+  py::class_<PyDynamicKdTree>(m, "DynamicKdTree", R"doc(
+A k-d tree with insert and delete (seed §7.4, Dyn(k-d)) over float64 points of dimension 2 or 3.
+
+Made of static k-d trees of 2^i slots (the binary structure). variant="amortized" rebuilds
+merged trees at once (Theorem 11); variant="worst_case" builds them in small steps spread
+over later inserts, so no single insert pays for a large rebuild (Theorem 14). Deleted
+points are hidden at once and dropped (memory freed) when more than max_dead_fraction of
+the stored slots are dead. insert returns new int64 ids, never reused; removing an id that
+is not stored raises ValueError and removes nothing.
+)doc")
+      .def(py::init<std::size_t, const std::string&, double>(), py::arg("dim") = 3, py::arg("variant") = "amortized",
+           py::arg("max_dead_fraction") = 0.5)
+      .def("insert", &PyDynamicKdTree::insert, py::arg("points"),
+           "Inserts one point (d,) or rows (n, d); returns their ids (int64 array, or one int64 for one point).")
+      .def("remove", &PyDynamicKdTree::remove, py::arg("ids"), "Removes the items with these ids (int or 1-d array).")
+      .def("query", &PyDynamicKdTree::query, py::arg("q"), py::arg("k") = 1,
+           "k nearest stored points of one point (d,) or m points (m, d): (distances float64, ids int64), each (k,) "
+           "or (m, k), ascending by distance, ties by id; -1 / inf where fewer than k are stored.")
+      .def("query_radius", &PyDynamicKdTree::query_radius, py::arg("q"), py::arg("r"),
+           "Ids within distance r of q (inclusive), sorted by distance.")
+      .def("query_box", &PyDynamicKdTree::query_box, py::arg("lo"), py::arg("hi"),
+           "Ids (ascending) of the stored points p with lo <= p <= hi.")
+      .def("validate", &PyDynamicKdTree::validate,
+           "Checks the decomposition into trees of 2^i slots, the id locator and every tree; raises if one fails.")
+      .def("rebuild", &PyDynamicKdTree::rebuild, "Rebuilds from the live points now, freeing deleted ones.")
+      .def("stats", &PyDynamicKdTree::stats,
+           "dict: live, dead, structures, building, per_level (trees of 2^i slots on level i), rebuilds, "
+           "forced_builds, bytes")
+      .def("__len__", &PyDynamicKdTree::size)
+      .def("__contains__", &PyDynamicKdTree::contains)
+      .def_property_readonly("dim", &PyDynamicKdTree::dim)
+      .def_property_readonly("variant", &PyDynamicKdTree::variant);
+}
+
+}  // namespace geods::python
