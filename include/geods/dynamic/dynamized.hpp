@@ -166,12 +166,14 @@ class Dynamized {
     ++rebuilds_;
   }
 
-  /// Calls f(structure, ids) for every complete structure, where ids[slot] is
-  /// the id in that slot (kNoId if deleted). Queries combine the answers.
+  /// Calls f(structure, ids) for every complete structure, largest first, where
+  /// ids[slot] is the id in that slot (kNoId if deleted). Queries combine the
+  /// answers; largest first, a k-nearest search finds good candidates early and
+  /// then prunes most small structures at their root.
   template <typename F>
   void for_each(const F& f) const {
-    for (const auto& level : levels_)
-      for (const Part& p : level) f(p.structure, std::span<const Id>(p.ids));
+    for (auto level = levels_.rbegin(); level != levels_.rend(); ++level)
+      for (const Part& p : *level) f(p.structure, std::span<const Id>(p.ids));
   }
 
   /// Every live item with its id (Extract(W, D)).

@@ -24,31 +24,56 @@ struct Location {
   std::uint32_t slot = 0;
 };
 
+// Two generations of hash maps, so that growing never rehashes every entry in
+// one call (a std::unordered_map rehash would be the slowest single insert of
+// the worst-case variant): when `current_` is full it becomes `old_`, a map
+// reserved for twice as many starts, and every set() moves two entries over.
 class Locator {
  public:
   Locator() = default;
-  explicit Locator(std::size_t expected) { map_.reserve(expected); }
+  explicit Locator(std::size_t expected) { current_.reserve(expected); }
 
-  std::size_t size() const { return map_.size(); }
+  std::size_t size() const { return current_.size() + old_.size(); }
   const Location* find(Id id) const {
-    const auto it = map_.find(id);
-    return it == map_.end() ? nullptr : &it->second;
+    if (const auto it = current_.find(id); it != current_.end()) return &it->second;
+    if (const auto it = old_.find(id); it != old_.end()) return &it->second;
+    return nullptr;
   }
-  void set(Id id, Location location) { map_.insert_or_assign(id, location); }
-  void erase(Id id) { map_.erase(id); }
+  void set(Id id, Location location) {
+    if (!old_.empty()) old_.erase(id);
+    if (current_.find(id) == current_.end() && double(current_.size() + 1) > capacity()) grow();
+    current_.insert_or_assign(id, location);
+    for (int i = 0; i < 2 && !old_.empty(); ++i) current_.insert(old_.extract(old_.begin()));
+  }
+  void erase(Id id) {
+    if (current_.erase(id) == 0) old_.erase(id);
+  }
 
   template <typename F>
   void for_each(const F& f) const {
-    for (const auto& [id, location] : map_) f(id, location);
+    for (const auto& [id, location] : current_) f(id, location);
+    for (const auto& [id, location] : old_) f(id, location);
   }
 
   /// Heap bytes, about: buckets and one node per entry.
   std::size_t bytes() const {
-    return map_.bucket_count() * sizeof(void*) + map_.size() * (sizeof(std::pair<const Id, Location>) + 2 * sizeof(void*));
+    return (current_.bucket_count() + old_.bucket_count()) * sizeof(void*) +
+           size() * (sizeof(std::pair<const Id, Location>) + 2 * sizeof(void*));
   }
 
  private:
-  std::unordered_map<Id, Location> map_;
+  using Map = std::unordered_map<Id, Location>;
+
+  double capacity() const { return double(current_.bucket_count()) * double(current_.max_load_factor()); }
+
+  void grow() {
+    while (!old_.empty()) current_.insert(old_.extract(old_.begin()));  // only if set() was outpaced
+    old_ = std::move(current_);
+    current_ = Map();
+    current_.reserve(2 * (old_.size() + 1));
+  }
+
+  Map current_, old_;
 };
 
 }  // namespace geods::dynamic
