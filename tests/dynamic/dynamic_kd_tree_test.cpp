@@ -146,6 +146,34 @@ TEST(DynamicKdTree, WorstCaseSpreadsBuildsOverInserts) {
   EXPECT_EQ(slots, 20000u);
 }
 
+// Deletions while builds are under way and while their items are relocated:
+// each removal hits a source, a structure being relocated, or a finished one.
+TEST(DynamicKdTree, WorstCaseDeletesDuringBuilds) {
+  Tree tree(DynamizeOptions{Variant::worst_case});
+  Rng rng(9);
+  std::vector<Id> live;
+  std::size_t max_building = 0;
+  for (int step = 0; step < 6000; ++step) {
+    live.push_back(tree.insert(random_point(rng)));
+    if (step % 3 == 2) {
+      const std::size_t i = rng.below(live.size());
+      tree.remove(live[i]);
+      live[i] = live.back();
+      live.pop_back();
+    }
+    max_building = std::max(max_building, tree.stats().structure.building);
+    if (step % 7 == 0 || step > 5900) {
+      ASSERT_NO_THROW(tree.validate()) << "step " << step;
+    }
+  }
+  EXPECT_GE(max_building, 3u);
+  EXPECT_EQ(tree.size(), live.size());
+  for (Id id : live) ASSERT_TRUE(tree.contains(id));
+  const P q{10, 10};
+  const auto all = tree.query_radius(q, 100);
+  EXPECT_EQ(all.size(), live.size());
+}
+
 TEST(DynamicKdTree, MemoryReturnsAfterMassDeletion) {
   for (Variant variant : {Variant::amortized, Variant::worst_case}) {
     Tree tree(DynamizeOptions{variant});

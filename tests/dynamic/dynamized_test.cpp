@@ -9,6 +9,7 @@
 #include "geods/core/rng.hpp"
 #include "geods/dynamic/dynamized.hpp"
 #include "geods/dynamic/kd_block.hpp"
+#include "geods/dynamic/locator.hpp"
 
 namespace geods::dynamic {
 namespace {
@@ -97,6 +98,30 @@ TEST(KdBlock, WeakDeleteHidesSlots) {
   });
   EXPECT_EQ(count, 50u);
   EXPECT_EQ(block.extract().size(), 100u) << "dead slots stay until a rebuild";
+}
+
+TEST(Locator, FindsEveryEntryAcrossGenerations) {
+  Locator locator;
+  for (Id id = 0; id < 50000; ++id) {
+    locator.set(id, {1, std::uint32_t(id % 7), std::uint32_t(id)});
+    if (id % 3 == 0) locator.erase(id / 3);
+    if (id % 5 == 0 && locator.find(id / 5)) locator.set(id / 5, {2, 0, 0});  // moves an entry
+  }
+  std::size_t count = 0;
+  for (Id id = 0; id < 50000; ++id) {
+    const Location* at = locator.find(id);
+    const bool erased = id <= 49999 / 3;
+    ASSERT_EQ(at == nullptr, erased) << id;
+    if (at) {
+      ++count;
+      EXPECT_EQ(at->slot, at->level == 2 ? 0u : std::uint32_t(id));
+    }
+  }
+  EXPECT_EQ(count, locator.size());
+  std::size_t visited = 0;
+  locator.for_each([&](Id, const Location&) { ++visited; });
+  EXPECT_EQ(visited, count);
+  EXPECT_EQ(locator.find(50000), nullptr);
 }
 
 }  // namespace
