@@ -2,9 +2,11 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <limits>
 #include <string>
 #include <variant>
@@ -111,6 +113,23 @@ class PyOrthtree {
   void validate() const {
     py::gil_scoped_release release;
     visit([](const auto& t) { t.validate(); });
+  }
+
+  void save(const std::filesystem::path& path) const {
+    py::gil_scoped_release release;
+    visit([&](const auto& t) { t.save(path); });
+  }
+  // The scalar size sits after the 8-byte magic and the version word.
+  static PyOrthtree load(const std::filesystem::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw Error(path.string() + ": cannot open");
+    std::uint32_t words[3] = {0, 0, 0};
+    in.seekg(8);
+    in.read(reinterpret_cast<char*>(words), sizeof words);
+    in.close();
+    py::gil_scoped_release release;
+    if (words[1] == 4) return PyOrthtree(AnyTree(Orthtree<float, Dim>::load(path)));
+    return PyOrthtree(AnyTree(Orthtree<double, Dim>::load(path)));
   }
 
   py::dict stats() const {
@@ -288,6 +307,8 @@ void bind_orthtree(py::module_& m, const char* doc) {
       .def("balanced", &Py::balanced, "A new, 2:1-balanced tree: face-adjacent leaves differ by at most one in depth.")
       .def("validate", &Py::validate, "Checks every invariant (and the 2:1 balance of balanced trees); raises if one fails.")
       .def("stats", &Py::stats, "dict: points, nodes, leaves, empty_leaves, depth, bytes")
+      .def("save", &Py::save, py::arg("path"), "Writes the tree and its points to a binary file.")
+      .def_static("load", &Py::load, py::arg("path"), "Reads a tree written by save().")
       .def("locate", &Py::locate, py::arg("p"), "The leaf whose cell contains p, or -1 outside the root cell.")
       .def("query_box", &Py::query_box, py::arg("lo"), py::arg("hi"),
            "Indices (ascending) of the points p with lo <= p <= hi.")

@@ -167,3 +167,14 @@ def test_bad_input():
         tree.neighbor(tree.num_nodes, "N")
     with pytest.raises(geods.Error):
         tree.query([0.0, 0.0], k=0)
+
+
+def test_save_load(tmp_path):
+    pts = np.random.default_rng(5).random((500, 2)).astype(np.float32)
+    tree = geods.Quadtree(pts, bucket=2).balanced()
+    tree.save(tmp_path / "t.ort")
+    loaded = geods.Quadtree.load(tmp_path / "t.ort")
+    assert loaded.stats() == tree.stats() and loaded.is_balanced and loaded.dtype == np.float32
+    np.testing.assert_array_equal(loaded.query(pts[:3], 4)[1], tree.query(pts[:3], 4)[1])
+    with pytest.raises(geods.Error):
+        geods.Octree.load(tmp_path / "t.ort")

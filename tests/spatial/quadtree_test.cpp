@@ -3,8 +3,12 @@
 // 2:1 balancing against an all-pairs oracle, queries against brute force, bad input.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <limits>
 #include <map>
 #include <string>
@@ -183,9 +187,11 @@ void check_queries(const Tree<T, D>& tree, const std::vector<Vec<T, D>>& points,
   }
 }
 
+// Every node of small trees, a sample of about 1000 of large ones (the oracle is O(m) per call).
 template <typename T, int D>
 void check_neighbors(const Tree<T, D>& tree) {
-  for (std::uint32_t v = 0; v < tree.nodes().size(); ++v)
+  const std::size_t step = tree.nodes().size() / 1000 + 1;
+  for (std::uint32_t v = 0; v < tree.nodes().size(); v += std::uint32_t(step))
     for (int dir = 0; dir < 2 * D; ++dir)
       ASSERT_EQ(tree.neighbor(v, Direction(dir)), neighbor_oracle(tree, v, dir)) << "node " << v << " dir " << dir;
 }
@@ -333,6 +339,45 @@ TEST(Octree, BalancingLargeClusteredTree) {
   balanced.validate();
   EXPECT_GT(balanced.nodes().size(), tree.nodes().size());
   EXPECT_LE(balanced.nodes().size(), 16 * tree.nodes().size());  // O(m) nodes
+}
+
+TEST(Orthtree, SaveLoad) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("geods_qt_" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir);
+  const auto points = make_points<float, 3>(Shape::clustered, 500, 3);
+  const Octree<float> tree(points, {.bucket = 2, .max_depth = 12});
+  const Octree<float> balanced = tree.balanced();
+  for (const Octree<float>* t : {&tree, &balanced}) {
+    t->save(dir / "t.ort");
+    const Octree<float> loaded = Octree<float>::load(dir / "t.ort");
+    EXPECT_EQ(loaded.nodes(), t->nodes());
+    EXPECT_EQ(loaded.permutation(), t->permutation());
+    EXPECT_EQ(loaded.is_balanced(), t->is_balanced());
+    EXPECT_EQ(loaded.bucket(), 2u);
+    EXPECT_EQ(loaded.query(points[7], 4), t->query(points[7], 4));
+  }
+  EXPECT_THROW(Octree<double>::load(dir / "t.ort"), Error);    // other scalar type
+  EXPECT_THROW(Quadtree<float>::load(dir / "t.ort"), Error);   // other dimension
+  EXPECT_THROW(Octree<float>::load(dir / "missing.ort"), Error);
+  // Truncated, and single corrupted bytes: an Error or a tree that validates, never a crash.
+  std::ifstream in(dir / "t.ort", std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::ofstream(dir / "short.ort", std::ios::binary) << bytes.substr(0, bytes.size() - 5);
+  EXPECT_THROW(Octree<float>::load(dir / "short.ort"), Error);
+  Rng rng(1);
+  for (int t = 0; t < 200; ++t) {
+    std::string bad = bytes;
+    bad[rng.below(bad.size())] ^= char(1 + rng.below(255));
+    std::ofstream(dir / "bad.ort", std::ios::binary) << bad;
+    try {
+      Octree<float>::load(dir / "bad.ort").validate();
+    } catch (const Error&) {
+    }
+  }
+  const Quadtree<> empty(std::vector<Vec2d>{});
+  empty.save(dir / "empty.ort");
+  EXPECT_TRUE(Quadtree<>::load(dir / "empty.ort").empty());
+  std::filesystem::remove_all(dir);
 }
 
 TEST(Orthtree, EmptyTree) {

@@ -30,10 +30,13 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <filesystem>
+#include <fstream>
 #include <limits>
 #include <memory>
 #include <numeric>
 #include <string>
+#include <string_view>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -276,6 +279,7 @@ class Orthtree {
     }
     if (nodes_.empty()) fail("points without nodes");
     if (bucket_ == 0 || max_depth_ < 0 || max_depth_ > kMaxDepth) fail("bad bucket or max_depth");
+    if (!lo_.allFinite() || !std::isfinite(side_) || side_ < 0) fail("bad root square");
     const Node& root = nodes_[0];
     if (root.parent != kNoNode || root.depth != 0 || root.begin != 0 || root.end != n ||
         root.cell != std::array<std::uint32_t, Dim>{})
@@ -295,10 +299,8 @@ class Orthtree {
       if (int(node.depth) > max_depth_) fail(where + "deeper than max_depth");
       if (node.leaf()) {
         if (must_split(node)) fail(where + "leaf that has to be split");
-        for (std::uint32_t i = node.begin; i < node.end; ++i) {
-          if (i > node.begin && perm_[i - 1] >= perm_[i]) fail(where + "leaf indices not ascending");
-          if (locate(point(perm_[i])) != v) fail(where + "point " + std::to_string(perm_[i]) + " is located elsewhere");
-        }
+        for (std::uint32_t i = node.begin + 1; i < node.end; ++i)
+          if (perm_[i - 1] >= perm_[i]) fail(where + "leaf indices not ascending");
         continue;
       }
       if (!balanced_ && !must_split(node)) fail(where + "inner node that did not have to split");
@@ -317,12 +319,98 @@ class Orthtree {
       if (at != node.end) fail(where + "children do not cover the point range");
     }
     if (visited != nodes_.size()) fail("unreachable nodes");
+    // Now that the links are sound, follow them: each point must descend to its own leaf.
+    for (std::uint32_t v = 0; v < nodes_.size(); ++v) {
+      if (!nodes_[v].leaf()) continue;
+      for (std::uint32_t i = nodes_[v].begin; i < nodes_[v].end; ++i)
+        if (locate(point(perm_[i])) != v)
+          fail("node " + std::to_string(v) + ": point " + std::to_string(perm_[i]) + " is located elsewhere");
+    }
     if (!balanced_) return;
     for (std::uint32_t v = 0; v < nodes_.size(); ++v)
       if (nodes_[v].leaf() && must_refine(v)) fail("node " + std::to_string(v) + ": not 2:1 balanced");
   }
 
+  // ---------------------------------------------------------------- files
+  /// Writes the tree and its points. Layout (little-endian): "GEODSORT", then
+  /// uint32 version, scalar bytes, Dim, max_depth, balanced, 0; uint64 bucket,
+  /// points, nodes; the root corner (Dim doubles) and side (double); the nodes
+  /// as in memory; the permutation (uint32 each); the points (Dim scalars each).
+  void save(const std::filesystem::path& path) const {
+    std::ofstream out(path, std::ios::binary);
+    if (!out) throw Error(path.string() + ": cannot open for writing");
+    const std::uint32_t words[6] = {kFileVersion, sizeof(T), Dim, std::uint32_t(max_depth_), balanced_, 0};
+    const std::uint64_t counts[3] = {bucket_, size(), nodes_.size()};
+    out.write(kMagic, sizeof kMagic);
+    out.write(reinterpret_cast<const char*>(words), sizeof words);
+    out.write(reinterpret_cast<const char*>(counts), sizeof counts);
+    out.write(reinterpret_cast<const char*>(lo_.data()), Dim * sizeof(double));
+    out.write(reinterpret_cast<const char*>(&side_), sizeof side_);
+    out.write(reinterpret_cast<const char*>(nodes_.data()), std::streamsize(nodes_.size() * sizeof(Node)));
+    out.write(reinterpret_cast<const char*>(perm_.data()), std::streamsize(perm_.size() * sizeof(std::uint32_t)));
+    if (points_) out.write(reinterpret_cast<const char*>(points_->data()), std::streamsize(size() * sizeof(VecT)));
+    out.flush();
+    if (!out) throw Error(path.string() + ": cannot write");
+  }
+
+  /// Reads a tree written by save(). Throws geods::Error for another scalar type
+  /// or dimension, a bad header, a wrong file size or contents that fail validate().
+  static Orthtree load(const std::filesystem::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw Error(path.string() + ": cannot open");
+    auto fail = [&](const std::string& what) { return Error(path.string() + ": " + what); };
+    char magic[sizeof kMagic];
+    std::uint32_t words[6];
+    std::uint64_t counts[3];
+    in.read(magic, sizeof magic);
+    in.read(reinterpret_cast<char*>(words), sizeof words);
+    in.read(reinterpret_cast<char*>(counts), sizeof counts);
+    if (!in || std::string_view(magic, sizeof magic) != std::string_view(kMagic, sizeof kMagic))
+      throw fail("not a geods quadtree/octree file");
+    if (words[0] != kFileVersion) throw fail("quadtree/octree file version " + std::to_string(words[0]) +
+                                             ", this geods reads version " + std::to_string(kFileVersion));
+    if (words[1] != sizeof(T) || words[2] != std::uint32_t(Dim))
+      throw fail("a tree of " + std::to_string(words[1] * 8) + "-bit scalars in dimension " + std::to_string(words[2]) +
+                 ", expected " + std::to_string(sizeof(T) * 8) + "-bit scalars in dimension " + std::to_string(Dim));
+    if (words[3] > std::uint32_t(kMaxDepth) || words[4] > 1 || counts[0] == 0 || counts[1] >= kNoNode ||
+        counts[2] >= kNoNode)
+      throw fail("bad quadtree/octree header");
+    const std::uint64_t body = Dim * sizeof(double) + sizeof(double) + counts[2] * sizeof(Node) +
+                               counts[1] * (sizeof(std::uint32_t) + sizeof(VecT));
+    const auto here = in.tellg();
+    in.seekg(0, std::ios::end);
+    const auto end = in.tellg();
+    in.seekg(here);
+    if (here < 0 || end < 0 || std::uint64_t(end - here) != body) throw fail("truncated or oversized tree file");
+    Orthtree tree;
+    tree.max_depth_ = int(words[3]);
+    tree.balanced_ = words[4] == 1;
+    tree.bucket_ = counts[0];
+    tree.nodes_.resize(counts[2]);
+    tree.perm_.resize(counts[1]);
+    auto points = std::make_shared<std::vector<VecT>>(counts[1]);
+    in.read(reinterpret_cast<char*>(tree.lo_.data()), Dim * sizeof(double));
+    in.read(reinterpret_cast<char*>(&tree.side_), sizeof tree.side_);
+    in.read(reinterpret_cast<char*>(tree.nodes_.data()), std::streamsize(counts[2] * sizeof(Node)));
+    in.read(reinterpret_cast<char*>(tree.perm_.data()), std::streamsize(counts[1] * sizeof(std::uint32_t)));
+    in.read(reinterpret_cast<char*>(points->data()), std::streamsize(counts[1] * sizeof(VecT)));
+    if (!in) throw fail("cannot read");
+    for (const VecT& p : *points)
+      if (!p.allFinite()) throw fail("corrupted tree: non-finite point");
+    tree.points_ = std::move(points);
+    try {
+      tree.validate();
+    } catch (const Error& e) {
+      throw fail(std::string("corrupted tree: ") + e.what());
+    }
+    return tree;
+  }
+
  private:
+  static constexpr char kMagic[8] = {'G', 'E', 'O', 'D', 'S', 'O', 'R', 'T'};
+  static constexpr std::uint32_t kFileVersion = 1;
+  static_assert(sizeof(Node) == 4 * (5 + Dim), "Node is written to files as is");
+
   // ---------------------------------------------------------------- geometry
   // Coordinate k / 2^depth of the root along axis a (k may be a half-integer).
   double coordinate(double k, std::uint32_t depth, int a) const { return lo_[a] + side_ * std::ldexp(k, -int(depth)); }
