@@ -10,10 +10,10 @@
 //  - Variant::worst_case (Theorem 14): a level may hold up to three V_i;
 //    when it holds two, their union starts being built as a V_{i+1} in steps
 //    (S::Builder) spread over the next 2^i inserts, while the two keep
-//    answering queries. Each insert advances every such build by about
-//    estimated_work / 2^(i-1) units; once built, the locator entries of its
-//    2^(i+1) items are rewritten 8 per insert (deletions meanwhile go to both
-//    copies), and only then does it replace the two. So no insert pays for a
+//    answering queries. Each insert advances every such build: 8 of its
+//    items are gathered, or about estimated_work / 2^(i-1) units of the
+//    build are done, or 8 locator entries of its items are rewritten
+//    (deletions meanwhile go to both copies); then it replaces the two. So no insert pays for a
 //    whole build or a whole relocation: O(log^2 n) per insert for the k-d
 //    tree. If a level fills up anyway (the estimate was short) the build is
 //    finished on the spot, and counted in stats().forced_builds.
@@ -272,18 +272,19 @@ class Dynamized {
     std::size_t dead;
   };
 
-  // A V_{i+1} under construction from the first two structures of level i:
-  // first built in steps, then its items' locator entries are rewritten in steps.
+  // A V_{i+1} under construction from the first two structures of level i, in
+  // three phases spread over 2^i inserts: its items are gathered from the two
+  // (2^(i-2) inserts), built (2^(i-1)), and their locator entries rewritten (2^(i-2)).
   struct Pending {
-    typename detail::BuilderOf<S>::type builder;
-    std::size_t work_per_insert;
+    std::vector<Item> items;                                     // being gathered
+    std::optional<typename detail::BuilderOf<S>::type> builder;  // once gathered
+    std::size_t work_per_insert = 0;
     std::optional<Part> result;  // once built; ids filled up to `relocated`
     std::size_t relocated = 0;
   };
 
-  // Locator entries rewritten per insert: a V_{i+1} holds 2^(i+1) slots and has
-  // 2^(i-2) inserts left after its build, so 8 per insert.
-  static constexpr std::size_t kRelocatePerInsert = 8;
+  // Items gathered, and locator entries rewritten, per insert: 2^(i+1) slots in 2^(i-2) inserts.
+  static constexpr std::size_t kSlotsPerInsert = 8;
 
   // Sizes, dead counts and the structure's own checks.
   template <typename Fail>
@@ -405,33 +406,39 @@ class Dynamized {
   }
 
   void start_build(std::size_t level) {
-    if constexpr (SteppedBuild<S>) {
-      std::vector<Item> items;
-      items.reserve(std::size_t(2) << level);
-      append(levels_[level][0], items, nullptr);
-      append(levels_[level][1], items, nullptr);
-      typename S::Builder builder(std::move(items));
-      // Built within about 2^(level-1) inserts; relocated in the next 2^(level-2): before the level can fill up.
-      const std::size_t work =
-          std::size_t(builder.estimated_work()) / std::max<std::size_t>(1, (std::size_t(1) << level) / 2) + 1;
-      if (building_.size() <= level) building_.resize(level + 1);
-      building_[level].emplace(Pending{std::move(builder), work, std::nullopt, 0});
+    if (building_.size() <= level) building_.resize(level + 1);
+    Pending& p = building_[level].emplace();
+    p.items.reserve(std::size_t(2) << level);
+    if constexpr (!requires(const S& s) { s.item(std::size_t{}); }) {
+      append(levels_[level][0], p.items, nullptr);  // no item access: gathered at once
+      append(levels_[level][1], p.items, nullptr);
     }
   }
 
-  // One insert's share of the work on level's build (all of it if `all`); true once relocated.
+  // One insert's share of the work on level's build (all of it if `all`); a
+  // phase that ends leaves the rest of the share to the next. True once relocated.
   bool advance(std::size_t level, bool all) {
     if constexpr (SteppedBuild<S>) {
       Pending& p = *building_[level];
+      const std::size_t half = std::size_t(1) << level;
+      if (!p.builder) {
+        if constexpr (requires(const S& s) { s.item(std::size_t{}); }) {
+          const std::size_t end = all ? 2 * half : std::min(2 * half, p.items.size() + kSlotsPerInsert);
+          for (std::size_t slot = p.items.size(); slot < end; ++slot)
+            p.items.push_back(levels_[level][slot < half ? 0 : 1].structure.item(slot % half));
+          if (p.items.size() < 2 * half) return false;
+        }
+        p.builder.emplace(std::move(p.items));
+        // Built within about 2^(level-1) inserts.
+        p.work_per_insert = std::size_t(p.builder->estimated_work()) / std::max<std::size_t>(1, half / 2) + 1;
+      }
       if (!p.result) {
-        if (!p.builder.step(all ? std::numeric_limits<std::size_t>::max() : p.work_per_insert)) return false;
-        p.result.emplace(Part{p.builder.finish(), {}, next_serial_++, 0});
-        p.result->ids.reserve(p.result->structure.size());
-        if (!all) return false;
+        if (!p.builder->step(all ? std::numeric_limits<std::size_t>::max() : p.work_per_insert)) return false;
+        p.result.emplace(Part{p.builder->finish(), {}, next_serial_++, 0});
+        p.result->ids.reserve(2 * half);
       }
       Part& copy = *p.result;
-      const std::size_t half = copy.structure.size() / 2;
-      const std::size_t end = all ? 2 * half : std::min(2 * half, p.relocated + kRelocatePerInsert);
+      const std::size_t end = all ? 2 * half : std::min(2 * half, p.relocated + kSlotsPerInsert);
       for (; p.relocated < end; ++p.relocated) {
         const std::size_t slot = p.relocated;
         const Id id = levels_[level][slot < half ? 0 : 1].ids[slot % half];
