@@ -222,7 +222,7 @@ class Orthtree {
     std::vector<Neighbor<T>> out(std::min(k, size()));
     if (out.empty()) return out;
     KnnResultSet<T> result(out.data(), out.size(), std::numeric_limits<T>::infinity());
-    search_knn(0, q, result);
+    search_knn(0, root_bounds(), q, q.template cast<double>(), result);
     result.finish();
     return out;
   }
@@ -412,15 +412,29 @@ class Orthtree {
   static_assert(sizeof(Node) == 4 * (5 + Dim), "Node is written to files as is");
 
   // ---------------------------------------------------------------- geometry
-  // Coordinate k / 2^depth of the root along axis a (k may be a half-integer).
-  double coordinate(double k, std::uint32_t depth, int a) const { return lo_[a] + side_ * std::ldexp(k, -int(depth)); }
+  // 2^-d for every depth: k * 2^-d is exact, so every caller gets the same rounding.
+  static constexpr std::array<double, kMaxDepth + 2> kScale = [] {
+    std::array<double, kMaxDepth + 2> s{};
+    double x = 1;
+    for (double& v : s) v = x, x /= 2;
+    return s;
+  }();
 
-  std::uint32_t child_slot(const Node& node, const VecT& p) const {
+  // Coordinate k / 2^depth of the root along axis a (k may be a half-integer).
+  double coordinate(double k, std::uint32_t depth, int a) const { return lo_[a] + side_ * (k * kScale[depth]); }
+
+  Vec<double, Dim> middle(const Node& node) const {
+    Vec<double, Dim> mid;
+    for (int a = 0; a < Dim; ++a) mid[a] = coordinate(node.cell[a] + 0.5, node.depth, a);
+    return mid;
+  }
+  static std::uint32_t slot_of(const Vec<double, Dim>& mid, const VecT& p) {
     std::uint32_t slot = 0;
     for (int a = 0; a < Dim; ++a)
-      if (double(p[a]) > coordinate(node.cell[a] + 0.5, node.depth, a)) slot |= 1u << a;
+      if (double(p[a]) > mid[a]) slot |= 1u << a;
     return slot;
   }
+  std::uint32_t child_slot(const Node& node, const VecT& p) const { return slot_of(middle(node), p); }
 
   bool coincident(const Node& node) const {
     if (node.end - node.begin < 2) return true;
@@ -539,16 +553,17 @@ class Orthtree {
   // Top-down: a counting sort of v's points by child slot (scratch: n entries).
   void split_points(std::uint32_t v, std::uint32_t* scratch) {
     const Node node = nodes_[v];
+    const Vec<double, Dim> mid = middle(node);
     std::array<std::uint32_t, kChildren + 1> bounds{};
     for (std::uint32_t i = node.begin; i < node.end; ++i) {
       scratch[i] = perm_[i];
-      ++bounds[child_slot(node, point(perm_[i])) + 1];
+      ++bounds[slot_of(mid, point(perm_[i])) + 1];
     }
     bounds[0] = node.begin;
     for (std::uint32_t c = 0; c < kChildren; ++c) bounds[c + 1] += bounds[c];
     std::array<std::uint32_t, kChildren> at;
     std::copy(bounds.begin(), bounds.end() - 1, at.begin());
-    for (std::uint32_t i = node.begin; i < node.end; ++i) perm_[at[child_slot(node, point(scratch[i]))]++] = scratch[i];
+    for (std::uint32_t i = node.begin; i < node.end; ++i) perm_[at[slot_of(mid, point(scratch[i]))]++] = scratch[i];
     make_children(v, bounds);
   }
 
@@ -625,25 +640,34 @@ class Orthtree {
   // Rounding slack: a cell's distance is compared with point distances computed in T.
   static constexpr double kSlack = 1 + 4.0 * (Dim + 2) * std::numeric_limits<T>::epsilon();
 
-  void search_knn(std::uint32_t v, const VecT& q, KnnResultSet<T>& result) const {
+  // The cell of child `slot` of a node with cell `box` and middle `mid` (the same
+  // doubles node_bounds() gives: the middle is the children's shared corner).
+  static Box child_box(const Box& box, const Vec<double, Dim>& mid, std::uint32_t slot) {
+    Box child = box;
+    for (int a = 0; a < Dim; ++a) ((slot >> a) & 1 ? child.lo[a] : child.hi[a]) = mid[a];
+    return child;
+  }
+
+  void search_knn(std::uint32_t v, const Box& box, const VecT& q, const Vec<double, Dim>& qd,
+                  KnnResultSet<T>& result) const {
     const Node& node = nodes_[v];
     if (node.leaf()) {
       for (std::uint32_t i = node.begin; i < node.end; ++i) result.insert(perm_[i], squared_distance(q, point(perm_[i])));
       return;
     }
     // Nearest child first, so the k-th distance shrinks early.
+    const Vec<double, Dim> mid = middle(node);
     std::array<std::pair<double, std::uint32_t>, kChildren> order;
-    const Vec<double, Dim> qd = q.template cast<double>();
     for (std::uint32_t c = 0; c < kChildren; ++c) {
-      const std::uint32_t child = node.first_child + c;
-      order[c] = {nodes_[child].begin == nodes_[child].end ? std::numeric_limits<double>::infinity()
-                                                           : node_bounds(child).squared_distance(qd),
-                  child};
+      const Node& child = nodes_[node.first_child + c];
+      order[c] = {child.begin == child.end ? std::numeric_limits<double>::infinity()
+                                           : child_box(box, mid, c).squared_distance(qd),
+                  c};
     }
     std::sort(order.begin(), order.end());
-    for (const auto& [d2, child] : order) {
+    for (const auto& [d2, c] : order) {
       if (!(d2 <= double(result.worst()) * kSlack)) break;
-      search_knn(child, q, result);
+      search_knn(node.first_child + c, child_box(box, mid, c), q, qd, result);
     }
   }
 
