@@ -13,9 +13,9 @@
 //    answering queries. Each insert advances every such build: 8 of its
 //    items are gathered, or about estimated_work / 2^(i-1) units of the
 //    build are done, or 8 locator entries of its items are rewritten
-//    (deletions meanwhile go to both copies); then it replaces the two. So no insert pays for a
-//    whole build or a whole relocation: O(log^2 n) per insert for the k-d
-//    tree. If a level fills up anyway (the estimate was short) the build is
+//    (deletions meanwhile go to both copies); then it replaces the two. So
+//    no insert pays for a whole build or a whole relocation: O(log^2 n) per
+//    insert for the k-d tree. If a level fills up anyway (the estimate was short) the build is
 //    finished on the spot, and counted in stats().forced_builds.
 //  - Delete (Theorems 12, 13): the locator (locator.hpp) finds the V_i and
 //    slot of an id, weak_delete hides it. Dead slots stay in their structure

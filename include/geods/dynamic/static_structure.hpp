@@ -33,6 +33,7 @@ template <typename S>
 concept WeakDeletable = StaticStructure<S> && requires(S& s, std::size_t slot) { s.weak_delete(slot); };
 
 /// A structure whose build can run in bounded steps (for the worst-case variant,
+/// which also gathers a build's items in steps when S offers item(slot);
 /// seed §7.3): S::Builder(items) starts it, step(work) does about `work` units
 /// and returns true once done, finish() completes it and hands it over;
 /// estimated_work() says about how many units a whole build takes, so the
