@@ -374,6 +374,19 @@ TEST(Orthtree, SaveLoad) {
     } catch (const Error&) {
     }
   }
+  // validate() checks the 2:1 condition of trees that claim it: mark an unbalanced tree balanced.
+  ASSERT_FALSE(balanced_oracle(tree));
+  tree.save(dir / "t.ort");
+  std::ifstream again(dir / "t.ort", std::ios::binary);
+  std::string claim((std::istreambuf_iterator<char>(again)), std::istreambuf_iterator<char>());
+  claim[8 + 4 * 4] = 1;  // the `balanced` word of the header
+  std::ofstream(dir / "claim.ort", std::ios::binary) << claim;
+  try {
+    Octree<float>::load(dir / "claim.ort");
+    FAIL() << "an unbalanced tree passed as balanced";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("not 2:1 balanced"), std::string::npos) << e.what();
+  }
   const Quadtree<> empty(std::vector<Vec2d>{});
   empty.save(dir / "empty.ort");
   EXPECT_TRUE(Quadtree<>::load(dir / "empty.ort").empty());
