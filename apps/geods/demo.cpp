@@ -9,6 +9,7 @@
 #include <string_view>
 
 #include "geods/core/error.hpp"
+#include "geods/io/svg.hpp"
 
 namespace geods::cli {
 
@@ -26,20 +27,6 @@ std::size_t module_rank(const std::string& module) {
 std::vector<std::unique_ptr<DemoStep>>& steps() {
   static std::vector<std::unique_ptr<DemoStep>> all;
   return all;
-}
-
-std::string escape(std::string_view text) {
-  std::string out;
-  for (char c : text) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
-    }
-  }
-  return out;
 }
 
 constexpr std::string_view kStyle = R"(
@@ -81,34 +68,34 @@ void write_demo_gallery(const std::filesystem::path& out_dir, const std::vector<
       "Timings exclude file I/O unless stated.</p>\n<nav>",
       kStyle);
   for (const DemoOutcome& o : outcomes) {
-    html += fmt::format("<a href=\"#{0}-{1}\">{0}/{1}</a>", escape(o.step->module), escape(o.step->name));
+    html += fmt::format("<a href=\"#{0}-{1}\">{0}/{1}</a>", io::xml_escape(o.step->module), io::xml_escape(o.step->name));
   }
   html += "</nav>\n";
   for (const DemoOutcome& o : outcomes) {
     const DemoResult& r = o.result;
     html += fmt::format("<section id=\"{0}-{1}\"><h2>{2} <span class=\"module\">{0}/{1}</span></h2>\n",
-                        escape(o.step->module), escape(o.step->name), escape(o.step->title));
-    if (!o.error.empty()) html += fmt::format("<p class=\"error\">failed: {}</p>\n", escape(o.error));
-    if (!r.text.empty()) html += fmt::format("<p>{}</p>\n", escape(r.text));
+                        io::xml_escape(o.step->module), io::xml_escape(o.step->name), io::xml_escape(o.step->title));
+    if (!o.error.empty()) html += fmt::format("<p class=\"error\">failed: {}</p>\n", io::xml_escape(o.error));
+    if (!r.text.empty()) html += fmt::format("<p>{}</p>\n", io::xml_escape(r.text));
     for (const auto& f : r.figures) {
       html += fmt::format("<figure><a href=\"{0}\"><img src=\"{0}\" alt=\"{1}\"></a><figcaption>{1}</figcaption></figure>\n",
-                          escape(f.file), escape(f.caption));
+                          io::xml_escape(f.file), io::xml_escape(f.caption));
     }
     if (!r.files.empty()) {
       html += "<p>Files: ";
-      for (const auto& f : r.files) html += fmt::format("<a href=\"{}\">{}</a> ", escape(f.file), escape(f.caption));
+      for (const auto& f : r.files) html += fmt::format("<a href=\"{}\">{}</a> ", io::xml_escape(f.file), io::xml_escape(f.caption));
       html += "</p>\n";
     }
     if (!r.stats.empty()) {
       html += "<table>\n";
       for (const auto& [name, value] : r.stats) {
-        html += fmt::format("<tr><th>{}</th><td>{}</td></tr>\n", escape(name), escape(value));
+        html += fmt::format("<tr><th>{}</th><td>{}</td></tr>\n", io::xml_escape(name), io::xml_escape(value));
       }
       html += "</table>\n";
     }
     html += "<table>\n";
     for (const auto& [name, seconds] : r.timings) {
-      html += fmt::format("<tr><th>{}</th><td class=\"num\">{:.4f} s</td></tr>\n", escape(name), seconds);
+      html += fmt::format("<tr><th>{}</th><td class=\"num\">{:.4f} s</td></tr>\n", io::xml_escape(name), seconds);
     }
     html += fmt::format("<tr><th>step total</th><td class=\"num\">{:.4f} s</td></tr>\n</table>\n</section>\n", o.seconds);
   }

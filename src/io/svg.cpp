@@ -10,10 +10,16 @@ namespace geods::io {
 
 namespace {
 
-std::string escape(std::string_view s) {
+void require_finite(const Vec2d& p) {
+  if (!p.allFinite()) throw Error("svg: non-finite coordinate");
+}
+
+}  // namespace
+
+std::string xml_escape(std::string_view text) {
   std::string out;
-  out.reserve(s.size());
-  for (char c : s) {
+  out.reserve(text.size());
+  for (char c : text) {
     switch (c) {
       case '&': out += "&amp;"; break;
       case '<': out += "&lt;"; break;
@@ -25,12 +31,6 @@ std::string escape(std::string_view s) {
   }
   return out;
 }
-
-void require_finite(const Vec2d& p) {
-  if (!p.allFinite()) throw Error("svg: non-finite coordinate");
-}
-
-}  // namespace
 
 SvgWriter::SvgWriter(const AABB2d& view, double width, double margin) : view_(view), width_(width), margin_(margin) {
   if (view.empty() || !view.lo.allFinite() || !view.hi.allFinite()) throw Error("svg: the view box is empty or not finite");
@@ -50,8 +50,8 @@ Vec2d SvgWriter::map(const Vec2d& p) const {
 }
 
 std::string SvgWriter::attributes(const SvgStyle& style, bool filled) {
-  std::string a = fmt::format(R"( stroke="{}" stroke-width="{}")", escape(style.stroke), style.stroke_width);
-  a += fmt::format(R"( fill="{}")", filled ? escape(style.fill) : "none");
+  std::string a = fmt::format(R"( stroke="{}" stroke-width="{}")", xml_escape(style.stroke), style.stroke_width);
+  a += fmt::format(R"( fill="{}")", filled ? xml_escape(style.fill) : "none");
   if (style.opacity != 1.0) a += fmt::format(R"( opacity="{}")", style.opacity);
   return a;
 }
@@ -59,7 +59,7 @@ std::string SvgWriter::attributes(const SvgStyle& style, bool filled) {
 void SvgWriter::point(const Vec2d& p, const SvgStyle& style) {
   const Vec2d q = map(p);
   // A point is a dot: filled with its fill colour, or its stroke colour if it has none.
-  const std::string colour = escape(style.fill != "none" ? style.fill : style.stroke);
+  const std::string colour = xml_escape(style.fill != "none" ? style.fill : style.stroke);
   body_ += fmt::format(R"(<circle cx="{:.2f}" cy="{:.2f}" r="{}" fill="{}" stroke="none")", q.x(), q.y(), style.radius, colour);
   if (style.opacity != 1.0) body_ += fmt::format(R"( opacity="{}")", style.opacity);
   body_ += "/>\n";
@@ -109,9 +109,9 @@ void SvgWriter::rect(const AABB2d& box, const SvgStyle& style) {
 void SvgWriter::label(const Vec2d& p, const std::string& text, const SvgStyle& style) {
   const Vec2d q = map(p);
   // Text is drawn in its fill colour, or its stroke colour if it has none.
-  const std::string colour = escape(style.fill != "none" ? style.fill : style.stroke);
+  const std::string colour = xml_escape(style.fill != "none" ? style.fill : style.stroke);
   body_ += fmt::format(R"(<text x="{:.2f}" y="{:.2f}" font-family="sans-serif" font-size="{}" fill="{}">{}</text>)",
-                       q.x(), q.y(), style.font_size, colour, escape(text)) + "\n";
+                       q.x(), q.y(), style.font_size, colour, xml_escape(text)) + "\n";
 }
 
 void SvgWriter::title(const std::string& text) { title_ = text; }
@@ -121,7 +121,7 @@ std::string SvgWriter::str() const {
       "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
       "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{0:.0f}\" height=\"{1:.0f}\" viewBox=\"0 0 {0:.2f} {1:.2f}\">\n",
       width_, height_);
-  if (!title_.empty()) s += "<title>" + escape(title_) + "</title>\n";
+  if (!title_.empty()) s += "<title>" + xml_escape(title_) + "</title>\n";
   s += "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
   s += body_;
   s += "</svg>\n";

@@ -4,6 +4,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 
 #include "geods/core/aabb.hpp"
 
@@ -17,6 +18,9 @@ struct SvgStyle {
   double radius = 2.0;           // in pixels, for points
   double font_size = 12.0;       // in pixels, for labels
 };
+
+/// Escapes & < > " ' for XML and HTML text and attribute values.
+std::string xml_escape(std::string_view text);
 
 /// Collects shapes given in world coordinates and maps `view` onto a picture
 /// `width` pixels wide (height by the aspect ratio), flipping y so up is up.
