@@ -29,6 +29,7 @@ prefixed segments 00 land_segments.npy
 # A small ASan quarantine: Assimp's large transient allocations would otherwise
 # count against libFuzzer's RSS limit.
 export ASAN_OPTIONS=${ASAN_OPTIONS:-quarantine_size_mb=64:detect_leaks=1}
+export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$root/fuzz/lsan.supp:print_suppressions=0}
 
 failed=()
 for target in ply obj stl off gltf image npy nrrd nifti points segments; do
