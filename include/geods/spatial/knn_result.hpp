@@ -40,12 +40,12 @@ template <typename T>
 class KnnResultSet {
  public:
   /// Accepts points with squared distance <= limit until k are found.
-  KnnResultSet(Neighbor<T>* slots, std::size_t k, T limit) : slots_(slots), k_(k), limit_(limit) {}
+  KnnResultSet(Neighbor<T>* slots, std::size_t k, T limit) : slots_(slots), k_(k), limit_(limit), worst_(limit) {}
 
   std::size_t size() const { return size_; }
   bool full() const { return size_ == k_; }
   /// The squared distance a new point must not exceed to be kept.
-  T worst() const { return full() && k_ > 0 ? slots_[k_ - 1].squared_distance : limit_; }
+  T worst() const { return worst_; }
 
   void insert(std::uint32_t index, T squared_distance) {
     const Neighbor<T> candidate{index, squared_distance};
@@ -57,9 +57,13 @@ class KnnResultSet {
       if (!(candidate < slots_[k_ - 1])) return;
       pos = k_ - 1;
     }
-    Neighbor<T>* at = std::upper_bound(slots_, slots_ + pos, candidate);
-    std::move_backward(at, slots_ + pos, slots_ + pos + 1);
-    *at = candidate;
+    // Linear insertion from the back (k is small): lands after equal entries, like upper_bound.
+    while (pos > 0 && candidate < slots_[pos - 1]) {
+      slots_[pos] = slots_[pos - 1];
+      --pos;
+    }
+    slots_[pos] = candidate;
+    if (size_ == k_) worst_ = slots_[k_ - 1].squared_distance;
   }
 
   /// Marks the unused slots as "none" (kNoIndex, +inf).
@@ -72,6 +76,7 @@ class KnnResultSet {
   std::size_t k_;
   std::size_t size_ = 0;
   T limit_;
+  T worst_;  // limit_ until k are found, then the k-th distance (kept by insert)
 };
 
 }  // namespace geods::spatial
