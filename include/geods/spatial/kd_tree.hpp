@@ -101,6 +101,19 @@ class KdTree {
   const std::vector<Node>& nodes() const { return nodes_; }
   /// Point indices in tree order: node v owns permutation()[v.begin, v.end).
   const std::vector<std::uint32_t>& permutation() const { return perm_; }
+
+  /// Opt-in speed-up for large inputs: keeps a copy of the points in tree order
+  /// (size() * dim() values, shared by copies of the tree) so that k-NN and radius
+  /// queries read each leaf's points contiguously instead of through the
+  /// permutation. Results are identical. The default stays zero-copy; a loaded
+  /// tree has no copy until this is called.
+  void store_points_in_tree_order() {
+    auto ordered = std::make_shared<std::vector<T>>(perm_.size() * dim());
+    T* out = ordered->data();
+    for (std::size_t i = 0; i < perm_.size(); ++i, out += dim()) std::copy_n(point(perm_[i]), dim(), out);
+    ordered_ = std::move(ordered);
+  }
+  bool stores_points_in_tree_order() const { return ordered_ != nullptr; }
   /// Bounding box of all points (empty vectors for an empty tree).
   const std::vector<T>& bounds_lo() const { return root_lo_; }
   const std::vector<T>& bounds_hi() const { return root_hi_; }
@@ -138,7 +151,10 @@ class KdTree {
       const T approx = slack / T((1 + request.eps) * (1 + request.eps));
       Scratch<T> dists(dim());
       const T mindist = initial_distances(query.data(), dists.data());
-      KnnSearch{*this, query.data(), dists.data(), result, slack, approx}.visit(0, mindist);
+      if (ordered_)
+        KnnSearch<true>{*this, query.data(), dists.data(), result, slack, approx}.visit(0, mindist);
+      else
+        KnnSearch<false>{*this, query.data(), dists.data(), result, slack, approx}.visit(0, mindist);
     }
     result.finish();
     return result.size();
@@ -567,6 +583,8 @@ class KdTree {
   }
 
   // One k-NN search: the query state in one place, so the recursion passes only (node, mindist).
+  // Ordered: read the leaf points from ordered_ (store_points_in_tree_order) instead of via perm_.
+  template <bool Ordered>
   struct KnnSearch {
     const KdTree& tree;
     const T* q;
@@ -580,6 +598,18 @@ class KdTree {
       const Node& node = tree.nodes_[v];
       if (node.leaf()) {
         T worst = result.worst();  // cheap rejection first; insert() breaks exact ties by index
+        if constexpr (Ordered) {
+          const std::size_t dim = tree.dim();
+          const T* p = tree.ordered_->data() + std::size_t(node.begin) * dim;
+          for (std::uint32_t i = node.begin; i < node.end; ++i, p += dim) {
+            const T d = tree.squared_distance(q, p);
+            if (d <= worst) {
+              result.insert(tree.perm_[i], d);
+              worst = result.worst();
+            }
+          }
+          return;
+        }
         for (std::uint32_t i = node.begin; i < node.end; ++i) {
           const std::uint32_t j = tree.perm_[i];
           const T d = tree.squared_distance(q, tree.point(j));
@@ -618,7 +648,7 @@ class KdTree {
     if (node.leaf()) {
       for (std::uint32_t i = node.begin; i < node.end; ++i) {
         const std::uint32_t j = perm_[i];
-        const T d = squared_distance(q, point(j));
+        const T d = squared_distance(q, ordered_ ? ordered_->data() + std::size_t(i) * dim() : point(j));
         if (d <= r2) out.push_back({j, d});
       }
       return;
@@ -698,6 +728,7 @@ class KdTree {
 
   PointView<T> view_;
   std::shared_ptr<const std::vector<T>> owned_;  // the points, when the tree owns them (shared by copies)
+  std::shared_ptr<const std::vector<T>> ordered_;  // opt-in copy in tree order (store_points_in_tree_order)
   std::size_t leaf_size_ = kDefaultLeafSize;
   std::vector<Node> nodes_;
   std::vector<std::uint32_t> perm_;
