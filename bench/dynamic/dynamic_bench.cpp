@@ -1,7 +1,9 @@
 // Dyn(k-d) micro benchmarks: insert / delete / query throughput of both
 // variants against rebuilding a static k-d tree from scratch, and the worst
-// single-insert latency of each variant (counters max_insert_us, mean_insert_us,
-// in thread CPU time, so that being preempted by other processes does not count).
+// single-insert and single-delete latency of each variant (counters
+// max_insert_us, mean_insert_us, max_delete_us, mean_delete_us, in thread CPU
+// time, so that being preempted by other processes does not count), with the
+// largest work count (DynamizedStats::work, element visits) one delete paid.
 //   geods_dynamic_bench --benchmark_counters_tabular=true
 #include <benchmark/benchmark.h>
 
@@ -68,20 +70,36 @@ void BM_StaticRebuild(benchmark::State& state) {
 }
 BENCHMARK(BM_StaticRebuild)->Arg(1 << 16)->Arg(1 << 18)->ArgName("n")->Unit(benchmark::kMillisecond);
 
-// Deletes one at a time, in random order, of all n points (reconstructions included).
+// Deletes one at a time, in random order, of all n points (reconstructions
+// included); the slowest single delete is the worst-case delete latency.
 void BM_Delete(benchmark::State& state) {
   const std::size_t n = std::size_t(state.range(0));
   const auto points = uniform_points(n, 2);
   std::vector<dynamic::Id> order;
+  double worst = 0, total = 0;
+  std::size_t worst_work = 0, rebuilds = 0;
   for (auto _ : state) {
     state.PauseTiming();
     Tree tree(dynamic::DynamizeOptions{variant_of(state)});
     order = tree.insert(spatial::PointView<float>(points.front().data(), n, 3));
     std::shuffle(order.begin(), order.end(), Rng(3));
     state.ResumeTiming();
-    for (dynamic::Id id : order) tree.remove(id);
+    for (dynamic::Id id : order) {
+      const std::size_t work = tree.structure().work();
+      const double start = thread_seconds();
+      tree.remove(id);
+      const double seconds = thread_seconds() - start;
+      worst = std::max(worst, seconds);
+      total += seconds;
+      worst_work = std::max(worst_work, tree.structure().work() - work);
+    }
+    rebuilds = tree.structure().stats().rebuilds;
   }
   state.SetItemsProcessed(std::int64_t(state.iterations() * n));
+  state.counters["max_delete_us"] = worst * 1e6;
+  state.counters["mean_delete_us"] = total / double(state.iterations() * n) * 1e6;
+  state.counters["max_delete_work"] = double(worst_work);
+  state.counters["rebuilds"] = double(rebuilds);
 }
 BENCHMARK(BM_Delete)->ArgsProduct({{1 << 18}, {0, 1}})->ArgNames({"n", "worst_case"})->Unit(benchmark::kMillisecond);
 

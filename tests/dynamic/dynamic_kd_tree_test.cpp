@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <vector>
 
@@ -55,17 +56,31 @@ P random_point(Rng& rng) {
   return {rng.uniform(0, 20), rng.uniform(0, 20)};
 }
 
-void run_sequence(Variant variant, std::uint64_t seed, int steps) {
+// heavy_deletion: as many deletes as inserts, mostly of single ids and no
+// big batches, so that the worst-case variant's global reconstructions run in
+// steps across many operations (while they are under way, items are inserted,
+// deleted before and after being copied, and queried).
+struct SequenceResult {
+  std::size_t steps_reconstructing = 0;
+};
+
+void run_sequence(Variant variant, std::uint64_t seed, int steps, bool heavy_deletion = false,
+                  SequenceResult* out = nullptr) {
   Rng rng(seed);
   Tree tree(DynamizeOptions{variant});
   Oracle oracle;
   std::vector<P> removed_points;
+  SequenceResult result;
+  if (out) *out = result;
   for (int step = 0; step < steps; ++step) {
     const std::uint64_t op = rng.below(10);
-    if (op < 5 || oracle.items.empty()) {
+    const bool insert = heavy_deletion ? op < 4 || (op < 6 && step % 800 < 400) : op < 5;
+    if (insert || oracle.items.empty()) {
       // Insert a batch; sometimes re-insert points removed earlier, sometimes a big batch (bulk build).
       std::vector<double> coords;
-      const std::size_t count = rng.below(8) == 0 ? 1 + rng.below(200) : 1 + rng.below(6);
+      const std::size_t count = heavy_deletion ? (rng.below(20) == 0 ? 1 + rng.below(30) : 1)
+                                : rng.below(8) == 0 ? 1 + rng.below(200)
+                                                    : 1 + rng.below(6);
       for (std::size_t i = 0; i < count; ++i) {
         const P p = !removed_points.empty() && rng.below(4) == 0 ? removed_points[rng.below(removed_points.size())]
                                                                  : random_point(rng);
@@ -82,7 +97,9 @@ void run_sequence(Variant variant, std::uint64_t seed, int steps) {
       std::vector<Id> live;
       for (const auto& [id, p] : oracle.items) live.push_back(id);
       std::shuffle(live.begin(), live.end(), rng);
-      const std::size_t count = std::min(live.size(), rng.below(10) == 0 ? live.size() / 2 + 1 : 1 + rng.below(4));
+      const std::size_t count = std::min(live.size(), heavy_deletion         ? 1 + rng.below(3)
+                                                      : rng.below(10) == 0 ? live.size() / 2 + 1
+                                                                           : 1 + rng.below(4));
       live.resize(count);
       tree.remove(live);
       for (Id id : live) {
@@ -100,9 +117,16 @@ void run_sequence(Variant variant, std::uint64_t seed, int steps) {
     }
     ASSERT_EQ(tree.size(), oracle.items.size());
     ASSERT_NO_THROW(tree.validate()) << "step " << step;
+    result.steps_reconstructing += tree.stats().structure.reconstructing;
+    if (heavy_deletion && step % 50 == 0) {
+      for (const auto& [id, p] : oracle.items) ASSERT_EQ(tree.point(id), p) << "step " << step;
+    }
   }
-  for (const auto& [id, p] : oracle.items) ASSERT_EQ(tree.point(id), p);
-  EXPECT_GE(tree.stats().structure.rebuilds, 2u) << "the sequence reaches the reconstruction threshold";
+  for (const auto& [id, p] : oracle.items) EXPECT_EQ(tree.point(id), p);
+  const DynamizedStats s = tree.stats().structure;
+  EXPECT_GE(s.rebuilds, 2u) << "the sequence reaches the reconstruction threshold";
+  EXPECT_EQ(s.forced_rebuilds, 0u) << "every reconstruction finished within its schedule";
+  if (out) *out = result;
 }
 
 TEST(DynamicKdTree, RandomSequenceAmortized) {
@@ -111,6 +135,65 @@ TEST(DynamicKdTree, RandomSequenceAmortized) {
 
 TEST(DynamicKdTree, RandomSequenceWorstCase) {
   for (std::uint64_t seed = 1; seed <= 3; ++seed) run_sequence(Variant::worst_case, seed, 3000);
+}
+
+TEST(DynamicKdTree, HeavyDeletionSequenceWorstCase) {
+  for (std::uint64_t seed = 11; seed <= 14; ++seed) {
+    SequenceResult r;
+    run_sequence(Variant::worst_case, seed, 4000, true, &r);
+    EXPECT_GE(r.steps_reconstructing, 100u) << "reconstructions run across many operations";
+  }
+}
+
+TEST(DynamicKdTree, HeavyDeletionSequenceAmortized) {
+  for (std::uint64_t seed = 11; seed <= 12; ++seed) run_sequence(Variant::amortized, seed, 4000, true);
+}
+
+// The work a single operation pays (DynamizedStats::work: element visits of
+// gathering, building and relocating, a deterministic count) in a
+// deletion-heavy sequence: the worst case stays within O(log^2 n) per
+// operation, far below n, where the amortized variant's reconstruction costs
+// Theta(n log n) in one delete.
+std::pair<std::size_t, std::size_t> max_work(Variant variant, std::size_t n) {
+  Tree tree(DynamizeOptions{variant});
+  Rng rng(21);
+  std::vector<Id> live;
+  std::size_t worst_insert = 0, worst_delete = 0;
+  auto measure = [&](std::size_t& worst, const auto& op) {
+    const std::size_t before = tree.stats().structure.work;
+    op();
+    worst = std::max(worst, tree.stats().structure.work - before);
+  };
+  for (std::size_t i = 0; i < n; ++i) measure(worst_insert, [&] { live.push_back(tree.insert(random_point(rng))); });
+  // Two deletes per insert until a sixteenth is left: several reconstructions.
+  while (live.size() > n / 16) {
+    for (int d = 0; d < 2; ++d) {
+      const std::size_t i = rng.below(live.size());
+      measure(worst_delete, [&] { tree.remove(live[i]); });
+      live[i] = live.back();
+      live.pop_back();
+    }
+    measure(worst_insert, [&] { live.push_back(tree.insert(random_point(rng))); });
+  }
+  tree.validate();
+  const DynamizedStats s = tree.stats().structure;
+  EXPECT_GE(s.rebuilds, 3u);
+  EXPECT_EQ(s.forced_rebuilds, 0u);
+  EXPECT_EQ(s.forced_builds, 0u);
+  return {worst_insert, worst_delete};
+}
+
+TEST(DynamicKdTree, WorstCaseBoundsTheWorkOfEveryOperation) {
+  constexpr std::size_t n = 1 << 15;
+  const double log_n = std::log2(double(n));
+  const auto [worst_insert, worst_delete] = max_work(Variant::worst_case, n);
+  const auto [amortized_insert, amortized_delete] = max_work(Variant::amortized, n);
+  std::printf("max work per operation, n = %zu: worst case insert %zu, delete %zu; amortized insert %zu, delete %zu\n",
+              n, worst_insert, worst_delete, amortized_insert, amortized_delete);
+  EXPECT_LE(double(worst_delete), 64 * log_n) << "a delete's share of a reconstruction is O(B(n) / n)";
+  EXPECT_LE(double(worst_insert), 8 * log_n * log_n) << "an insert's share of the merges is O(log n B(n) / n)";
+  EXPECT_LT(worst_delete, n / 8);
+  EXPECT_GE(amortized_delete, n) << "the amortized variant rebuilds in one delete";
 }
 
 TEST(DynamicKdTree, AmortizedDecompositionFollowsTheBinaryRepresentation) {
@@ -185,7 +268,12 @@ TEST(DynamicKdTree, MemoryReturnsAfterMassDeletion) {
     // when more than half of the slots are dead.
     for (std::size_t i = 0; i < 19000; i += 100) tree.remove(std::span<const Id>(ids.data() + i, 100));
     tree.validate();
+    EXPECT_LE(tree.stats().structure.dead, 3 * tree.size()) << "at most 3/4 dead while a reconstruction runs";
+    // The worst case reconstructs in steps: a few more operations let it finish.
+    for (int i = 0; i < 10000 && tree.stats().structure.reconstructing; ++i) tree.remove(tree.insert(random_point(rng)));
+    tree.validate();
     const DynamicKdTreeStats after = tree.stats();
+    EXPECT_FALSE(after.structure.reconstructing);
     EXPECT_EQ(tree.size(), 1000u);
     EXPECT_GE(after.structure.rebuilds, 1u);
     EXPECT_LE(after.structure.dead, tree.size());

@@ -124,5 +124,22 @@ TEST(Locator, FindsEveryEntryAcrossGenerations) {
   EXPECT_EQ(locator.find(50000), nullptr);
 }
 
+TEST(Locator, ShrinksInStepsAfterMassDeletion) {
+  Locator locator;
+  for (Id id = 0; id < 20000; ++id) locator.set(id, {0, 0, std::uint32_t(id)});
+  for (Id id = 0; id < 19800; ++id) locator.erase(id);
+  const std::size_t before = locator.bytes();
+  locator.shrink();
+  EXPECT_EQ(locator.migrating(), 200u) << "entries move over in steps";
+  std::size_t steps = 0;
+  while (locator.migrate(16) > 0) ++steps;
+  EXPECT_EQ(steps, 200u / 16 + 1);
+  EXPECT_LT(locator.bytes(), before / 10);
+  for (Id id = 0; id < 20000; ++id) ASSERT_EQ(locator.find(id) != nullptr, id >= 19800) << id;
+  EXPECT_EQ(locator.find(19900)->slot, 19900u);
+  locator.shrink();
+  EXPECT_EQ(locator.migrating(), 0u) << "a table of the right size stays";
+}
+
 }  // namespace
 }  // namespace geods::dynamic

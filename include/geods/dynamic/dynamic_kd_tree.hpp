@@ -3,15 +3,17 @@
 // k-d blocks (kd_block.hpp) by the generic dynamization (dynamized.hpp).
 // With the worst-case variant (Theorem 14): build O(n log n), query
 // O(sqrt(n) log n + a) for ranges in 2D, insert O(log^2 n), delete O(log n)
-// amortized (weak delete plus occasional global reconstruction), space O(n).
+// (weak delete plus a share of a global reconstruction that runs in steps),
+// all worst case, space O(n). The amortized variant rebuilds in one delete.
 //
 // Semantics: insert hands out new ids (0, 1, 2, ...), never reused. The same
 // coordinates inserted twice are two items; a removed id is gone for good and
 // re-inserting its point gives one item with a new id. Removing an id that is
 // not stored is an error (geods::Error), and a batch with such an id removes
 // nothing. Deleted points leave the blocks, and their memory is returned, at
-// the next global reconstruction (when more than half of the stored slots are
-// dead, or on rebuild()).
+// the end of the next global reconstruction (which starts when more than half
+// of the stored slots are dead, and in the worst-case variant ends within a
+// bounded number of later operations), or on rebuild().
 #include <algorithm>
 #include <array>
 #include <cmath>

@@ -5,9 +5,11 @@
 // a hash map plays the same role in O(1) expected. Rebuilding moves items to
 // a new structure, and their entries are rewritten then, which the build's
 // own O(B_V(2^j)) cost already covers (seed §7.2.3).
+#include <cstddef>
 #include <cstdint>
 #include <limits>
 #include <unordered_map>
+#include <utility>
 
 namespace geods::dynamic {
 
@@ -43,8 +45,28 @@ class Locator {
     if (!old_.empty()) old_.erase(id);
     if (current_.find(id) == current_.end() && double(current_.size() + 1) > capacity()) grow();
     current_.insert_or_assign(id, location);
-    for (int i = 0; i < 2 && !old_.empty(); ++i) current_.insert(old_.extract(old_.begin()));
+    migrate(2);
   }
+  /// After mass deletion: if the table is more than four times larger than its
+  /// entries need, starts moving them to one of the right size (a generation
+  /// change like growing); set() and migrate() move them over, and the old
+  /// table's memory is returned once it is empty.
+  void shrink() {
+    if (!old_.empty() || capacity() <= 4.0 * double(size() + 16)) return;
+    old_ = std::move(current_);
+    current_ = Map();
+    current_.reserve(2 * (old_.size() + 1));
+    migrate(0);
+  }
+  /// Moves up to `count` entries of the old generation over; returns how many.
+  std::size_t migrate(std::size_t count) {
+    std::size_t moved = 0;
+    for (; moved < count && !old_.empty(); ++moved) current_.insert(old_.extract(old_.begin()));
+    if (old_.empty() && old_.bucket_count() > 1) old_ = Map();  // frees the old bucket array
+    return moved;
+  }
+  /// Entries still in the old generation.
+  std::size_t migrating() const { return old_.size(); }
   void erase(Id id) {
     if (current_.erase(id) == 0) old_.erase(id);
   }
