@@ -218,6 +218,38 @@ TEST(KdTree, OwnedPointsAndEigenViews) {
   EXPECT_EQ(copy.count_box(AABB3f({-0.5f, -0.5f, -0.5f}, {0.5f, 1.5f, 1.5f})), 3u);
 }
 
+// store_points_in_tree_order() only changes where leaves read their points:
+// every k-NN (exact, approximate, limited) and radius result must be identical.
+template <typename T, int Dim>
+void check_tree_order_copy(Shape shape, std::size_t d) {
+  SCOPED_TRACE(name(shape) + " d=" + std::to_string(d) + (sizeof(T) == 4 ? " float" : " double"));
+  constexpr std::size_t n = 3000;
+  const std::vector<T> pts = make_points<T>(shape, n, d, 29 + d);
+  const KdTree<T, Dim> plain(PointView<T>(pts.data(), n, d), 8);
+  KdTree<T, Dim> ordered = plain;
+  ordered.store_points_in_tree_order();
+  ASSERT_TRUE(ordered.stores_points_in_tree_order());
+  ASSERT_FALSE(plain.stores_points_in_tree_order());
+  const std::vector<T> qs = make_queries(pts, n, d, 60, 31);
+  for (std::size_t i = 0; i < 60; ++i) {
+    const std::span<const T> q(&qs[i * d], d);
+    for (std::size_t k : {1u, 10u, 37u}) {
+      EXPECT_EQ(plain.query(q, k), ordered.query(q, k));
+      EXPECT_EQ(plain.query(q, k, 0.5), ordered.query(q, k, 0.5));
+      EXPECT_EQ(plain.query(q, KnnRequest{k, 0, 0.3}), ordered.query(q, KnnRequest{k, 0, 0.3}));
+    }
+    EXPECT_EQ(plain.query_radius(q, 0.2), ordered.query_radius(q, 0.2));
+  }
+}
+
+TEST(KdTree, TreeOrderCopyGivesIdenticalResults) {
+  for (Shape shape : {Shape::uniform, Shape::clustered, Shape::duplicated, Shape::identical}) {
+    check_tree_order_copy<float, 3>(shape, 3);
+    check_tree_order_copy<double, 2>(shape, 2);
+    check_tree_order_copy<double, Dynamic>(shape, 5);
+  }
+}
+
 TEST(KdTree, BalancedAndStats) {
   const std::size_t n = 100000;
   const auto pts = make_points<float>(Shape::clustered, n, 3, 3);
