@@ -38,6 +38,7 @@
 #include "geods/core/vec.hpp"
 #include "geods/spatial/kd_tree_file.hpp"
 #include "geods/spatial/knn_result.hpp"
+#include "geods/spatial/permutation.hpp"
 #include "geods/spatial/point_view.hpp"
 
 namespace geods::spatial {
@@ -268,13 +269,7 @@ class KdTree {
   void validate() const {
     const std::size_t n = size();
     auto fail = [](const std::string& what) { throw Error("KdTree::validate: " + what); };
-    if (perm_.size() != n) fail("permutation has " + std::to_string(perm_.size()) + " entries for " +
-                                std::to_string(n) + " points");
-    std::vector<bool> seen(n, false);
-    for (std::uint32_t i : perm_) {
-      if (i >= n || seen[i]) fail("permutation is not a permutation (entry " + std::to_string(i) + ")");
-      seen[i] = true;
-    }
+    require_permutation(perm_, n, "KdTree::validate");
     if (n == 0) {
       if (!nodes_.empty()) fail("nodes without points");
       return;

@@ -48,6 +48,7 @@
 #include "geods/core/parallel.hpp"
 #include "geods/core/vec.hpp"
 #include "geods/spatial/knn_result.hpp"
+#include "geods/spatial/permutation.hpp"
 #include "geods/spatial/point_view.hpp"
 
 namespace geods::spatial {
@@ -267,13 +268,7 @@ class Orthtree {
   void validate() const {
     const std::size_t n = size();
     auto fail = [](const std::string& what) { throw Error("Orthtree::validate: " + what); };
-    if (perm_.size() != n) fail("permutation has " + std::to_string(perm_.size()) + " entries for " +
-                                std::to_string(n) + " points");
-    std::vector<bool> seen(n, false);
-    for (std::uint32_t i : perm_) {
-      if (i >= n || seen[i]) fail("permutation is not a permutation (entry " + std::to_string(i) + ")");
-      seen[i] = true;
-    }
+    require_permutation(perm_, n, "Orthtree::validate");
     if (n == 0) {
       if (!nodes_.empty()) fail("nodes without points");
       return;
