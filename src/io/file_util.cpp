@@ -64,6 +64,17 @@ bool is_gzip_name(const fs::path& path, std::string* inner) {
   return true;
 }
 
+namespace {
+// zlib counts in 32-bit units: hands it the next chunk of at most 1 GiB once it used up the last.
+void feed_input(z_stream& zs, std::span<const std::uint8_t> data, std::size_t& consumed) {
+  if (zs.avail_in != 0 || consumed == data.size()) return;
+  const std::size_t n = std::min<std::size_t>(data.size() - consumed, 1u << 30);
+  zs.next_in = const_cast<Bytef*>(data.data() + consumed);
+  zs.avail_in = uInt(n);
+  consumed += n;
+}
+}  // namespace
+
 std::vector<std::uint8_t> gunzip(const fs::path& path, std::span<const std::uint8_t> data, std::size_t max_bytes,
                                  bool prefix) {
   z_stream zs{};
@@ -73,13 +84,7 @@ std::vector<std::uint8_t> gunzip(const fs::path& path, std::span<const std::uint
   int rc = Z_OK;
   std::uint8_t buffer[1 << 16];
   for (;;) {
-    // zlib counts in 32-bit units: feed at most 1 GiB at a time.
-    if (zs.avail_in == 0 && consumed < data.size()) {
-      const std::size_t n = std::min<std::size_t>(data.size() - consumed, 1u << 30);
-      zs.next_in = const_cast<Bytef*>(data.data() + consumed);
-      zs.avail_in = uInt(n);
-      consumed += n;
-    }
+    feed_input(zs, data, consumed);
     zs.next_out = buffer;
     zs.avail_out = sizeof(buffer);
     rc = inflate(&zs, Z_NO_FLUSH);
@@ -123,12 +128,7 @@ std::vector<std::uint8_t> gzip(std::span<const std::uint8_t> data) {
   std::uint8_t buffer[1 << 16];
   int rc = Z_OK;
   while (rc != Z_STREAM_END) {
-    if (zs.avail_in == 0 && consumed < data.size()) {
-      const std::size_t n = std::min<std::size_t>(data.size() - consumed, 1u << 30);
-      zs.next_in = const_cast<Bytef*>(data.data() + consumed);
-      zs.avail_in = uInt(n);
-      consumed += n;
-    }
+    feed_input(zs, data, consumed);
     zs.next_out = buffer;
     zs.avail_out = sizeof(buffer);
     rc = deflate(&zs, consumed == data.size() ? Z_FINISH : Z_NO_FLUSH);
