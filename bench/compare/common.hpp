@@ -19,6 +19,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <array>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -214,6 +215,20 @@ struct SplitMix64 {
 inline std::uint64_t fnv1a(const void* data, std::size_t bytes, std::uint64_t h = 0xcbf29ce484222325ULL) {
   auto* p = static_cast<const unsigned char*>(data);
   for (std::size_t i = 0; i < bytes; ++i) h = (h ^ p[i]) * 0x100000001b3ULL;
+  return h;
+}
+
+/// Fingerprint of m k-NN answers (k ids per query): FNV-1a of each query's ids sorted,
+/// so libraries that order equal distances differently still agree.
+template <std::size_t K>
+std::uint64_t neighbour_checksum(const std::uint32_t* ids, std::size_t m) {
+  std::uint64_t h = 0xcbf29ce484222325ULL;
+  for (std::size_t i = 0; i < m; ++i) {
+    std::array<std::uint32_t, K> sorted;
+    std::copy_n(ids + i * K, K, sorted.begin());
+    std::sort(sorted.begin(), sorted.end());
+    h = fnv1a(sorted.data(), sizeof sorted, h);
+  }
   return h;
 }
 

@@ -133,13 +133,7 @@ void run_uniform(const Args& args) {
       if (std::abs(std::sqrt(s) - std::sqrt(brute[r])) > 1e-5 * std::max(1.0, std::sqrt(brute[r]))) ok = false;
     }
   }
-  std::uint64_t checksum = 0xcbf29ce484222325ULL;
-  for (std::size_t i = 0; i < m; ++i) {
-    std::array<std::uint32_t, kK> sorted;
-    std::copy_n(&ids[i * kK], kK, sorted.begin());
-    std::sort(sorted.begin(), sorted.end());
-    checksum = fnv1a(sorted.data(), sizeof sorted, checksum);
-  }
+  const std::uint64_t checksum = neighbour_checksum<kK>(ids.data(), m);
   state.reset();
 
   Record rec("dynamic", Lib::anchor, "uniform", args.threads);

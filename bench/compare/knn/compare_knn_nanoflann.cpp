@@ -2,17 +2,9 @@
 #include <nanoflann.hpp>
 
 #include "knn_driver.hpp"
+#include "nanoflann_cloud.hpp"
 
 namespace {
-
-struct Cloud {
-  const float* points;
-  std::size_t n;
-  std::size_t kdtree_get_point_count() const { return n; }
-  float kdtree_get_pt(std::size_t i, std::size_t d) const { return points[3 * i + d]; }
-  template <class Box>
-  bool kdtree_get_bbox(Box&) const { return false; }
-};
 
 struct Nanoflann {
   static constexpr const char* anchor = "nanoflann";
