@@ -1,0 +1,91 @@
+#pragma once
+// Watertight ray-triangle intersection (Woop, Benthin and Wald, "Watertight
+// Ray/Triangle Intersection", JCGT 2013). The ray is sheared so that it points
+// along +z; the three edge functions of the projected triangle are then
+// evaluated in the same way for every triangle that shares an edge, so a ray
+// through a shared edge or vertex of a closed mesh hits at least one of the
+// triangles around it: it never slips through a crack.
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <utility>
+
+#include "geods/core/ray.hpp"
+
+namespace geods {
+
+/// The closest hit found so far along a ray. prim is the triangle index
+/// (no_hit when the ray missed); (u, v) are the barycentric weights of the
+/// triangle's second and third corner: p = (1-u-v) a + u b + v c.
+struct RayHit {
+  static constexpr std::uint32_t no_hit = std::numeric_limits<std::uint32_t>::max();
+  float t = std::numeric_limits<float>::infinity();
+  std::uint32_t prim = no_hit;
+  float u = 0.0f;
+  float v = 0.0f;
+
+  bool hit() const { return prim != no_hit; }
+};
+
+/// Per-ray precomputation of the watertight test; build once per ray, then
+/// call intersect() on every candidate triangle. Triangles are two-sided.
+template <typename T>
+class RayTriangleTest {
+ public:
+  explicit RayTriangleTest(const Ray<T>& ray) : origin_(ray.origin) {
+    const Vec<T, 3>& d = ray.direction;
+    kz_ = 0;
+    if (std::abs(d[1]) > std::abs(d[kz_])) kz_ = 1;
+    if (std::abs(d[2]) > std::abs(d[kz_])) kz_ = 2;
+    kx_ = (kz_ + 1) % 3;
+    ky_ = (kx_ + 1) % 3;
+    // Swapping x and y for a negative z keeps the winding, so the sign of the
+    // edge functions does not depend on the ray's direction.
+    if (d[kz_] < T(0)) std::swap(kx_, ky_);
+    shear_x_ = d[kx_] / d[kz_];
+    shear_y_ = d[ky_] / d[kz_];
+    shear_z_ = T(1) / d[kz_];
+  }
+
+  /// Parameter t and barycentrics (u, v) of the hit with triangle (a, b, c)
+  /// if t lies in [tmin, tmax]; false otherwise (also for degenerate triangles
+  /// and a zero direction).
+  bool intersect(const Vec<T, 3>& a, const Vec<T, 3>& b, const Vec<T, 3>& c, T tmin, T tmax, T& t,
+                 T& u, T& v) const {
+    const Vec<T, 3> pa = a - origin_, pb = b - origin_, pc = c - origin_;
+    const T ax = pa[kx_] - shear_x_ * pa[kz_], ay = pa[ky_] - shear_y_ * pa[kz_];
+    const T bx = pb[kx_] - shear_x_ * pb[kz_], by = pb[ky_] - shear_y_ * pb[kz_];
+    const T cx = pc[kx_] - shear_x_ * pc[kz_], cy = pc[ky_] - shear_y_ * pc[kz_];
+    T eu = cx * by - cy * bx;
+    T ev = ax * cy - ay * cx;
+    T ew = bx * ay - by * ax;
+    // An edge function that rounds to zero is recomputed in double, so the
+    // ray-on-edge decision is the same for both triangles of that edge.
+    if constexpr (sizeof(T) < sizeof(double)) {
+      if (eu == T(0) || ev == T(0) || ew == T(0)) {
+        eu = T(double(cx) * double(by) - double(cy) * double(bx));
+        ev = T(double(ax) * double(cy) - double(ay) * double(cx));
+        ew = T(double(bx) * double(ay) - double(by) * double(ax));
+      }
+    }
+    if ((eu < T(0) || ev < T(0) || ew < T(0)) && (eu > T(0) || ev > T(0) || ew > T(0))) return false;
+    const T det = eu + ev + ew;
+    if (det == T(0) || !std::isfinite(det)) return false;
+    const T az = shear_z_ * pa[kz_], bz = shear_z_ * pb[kz_], cz = shear_z_ * pc[kz_];
+    const T scaled_t = eu * az + ev * bz + ew * cz;
+    const T inv_det = T(1) / det;
+    const T hit_t = scaled_t * inv_det;
+    if (!(hit_t >= tmin && hit_t <= tmax)) return false;
+    t = hit_t;
+    u = ev * inv_det;
+    v = ew * inv_det;
+    return true;
+  }
+
+ private:
+  Vec<T, 3> origin_;
+  int kx_, ky_, kz_;
+  T shear_x_, shear_y_, shear_z_;
+};
+
+}  // namespace geods
