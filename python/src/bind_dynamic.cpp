@@ -154,6 +154,10 @@ class PyDynamicKdTree {
     d["per_level"] = s.structure.per_level;
     d["rebuilds"] = s.structure.rebuilds;
     d["forced_builds"] = s.structure.forced_builds;
+    d["reconstructing"] = s.structure.reconstructing;
+    d["forced_rebuilds"] = s.structure.forced_rebuilds;
+    d["work"] = s.structure.work;
+    d["locator_bytes"] = s.structure.locator_bytes;
     d["bytes"] = s.bytes;
     return d;
   }

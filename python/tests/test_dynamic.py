@@ -72,9 +72,13 @@ def test_memory_returns_after_mass_deletion():
     tree = geods.DynamicKdTree(dim=3, variant="worst_case")
     ids = np.concatenate([tree.insert(rng.uniform(size=(100, 3))) for _ in range(100)])
     full = tree.stats()["bytes"]
+    work_before = tree.stats()["work"]
     tree.remove(ids[:9500])
     s = tree.stats()
     assert s["live"] == 500 and s["rebuilds"] >= 1
+    # The reconstructions were paid for (work counts element visits) and are finished or under way.
+    assert s["work"] > work_before and isinstance(s["reconstructing"], bool)
+    assert 0 < s["locator_bytes"] <= s["bytes"]
     assert s["bytes"] < full / 5
     tree.validate()
 
