@@ -1,0 +1,180 @@
+#pragma once
+// Delaunay triangulation of points in the plane (seed §5.1.2, §5.2): incremental
+// insertion with Lawson flips, exact predicates for every decision.
+//
+// Representation (as Delaunator): flat arrays of half-edges, three per triangle.
+// Half-edge e runs from triangles()[e] to triangles()[next(e)] with
+// next(e) = e % 3 == 2 ? e - 2 : e + 1; halfedges()[e] is the opposite half-edge
+// or no_edge on the convex hull. Triangles are counter-clockwise.
+//
+// Internally the triangulation is closed by a "ghost" vertex at infinity: every
+// hull edge has a ghost triangle on its outer side (seed §5.2's infinite
+// triangles), so insertion outside the hull, on the hull and inside are the same
+// two operations (split a triangle or an edge, then flip). The public arrays are
+// the finite triangles only, renumbered densely after each construction,
+// insert() and remove().
+//
+// Order of insertion: BRIO (biased randomized insertion order: random rounds of
+// doubling size, each sorted along a Hilbert curve); each point is located by a
+// visibility walk from the triangle of the previous point. Expected O(n log n),
+// near linear in practice.
+//
+// Degenerate input: duplicates are merged (representative(i) is the first
+// occurrence, which is the vertex used in triangles()); co-circular points give
+// one of the valid Delaunay triangulations; if all distinct points are collinear
+// (or fewer than 3) there are no triangles, degenerate() is true and hull() is
+// the distinct points sorted by (x, y). NaN or infinite coordinates raise
+// geods::Error.
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "geods/core/vec.hpp"
+
+namespace geods::voronoi {
+
+struct Delaunay2Stats {
+  std::size_t points = 0;      // input points, including inserted ones
+  std::size_t vertices = 0;    // distinct points present in the triangulation
+  std::size_t duplicates = 0;  // points merged into an earlier equal point
+  std::size_t removed = 0;     // points removed by remove()
+  std::size_t triangles = 0;   // finite triangles
+  std::size_t hull = 0;        // hull vertices
+  std::size_t flips = 0;       // Lawson flips since construction
+  std::size_t walk_steps = 0;  // triangles visited by point location while inserting
+  std::size_t bytes = 0;       // memory of all arrays
+};
+
+struct Delaunay2Options {
+  std::uint64_t seed = 0x5eed;  // of the randomized insertion order (results are deterministic)
+};
+
+class Delaunay2 {
+ public:
+  static constexpr std::uint32_t no_edge = std::uint32_t(-1);
+
+  using Options = Delaunay2Options;
+
+  /// An empty triangulation.
+  Delaunay2() = default;
+  /// Triangulates the points; throws geods::Error for NaN/inf coordinates or
+  /// 2^30 points or more.
+  explicit Delaunay2(std::span<const Vec2d> points, Options options = {});
+
+  /// The input points (and inserted ones), indexed as given.
+  std::span<const Vec2d> points() const { return points_; }
+  /// Finite triangles, three counter-clockwise vertex indices each.
+  const std::vector<std::uint32_t>& triangles() const { return triangles_; }
+  /// The opposite half-edge of each half-edge, no_edge on the hull.
+  const std::vector<std::uint32_t>& halfedges() const { return halfedges_; }
+  /// Hull vertices counter-clockwise, collinear hull points included; for a
+  /// degenerate set the distinct points sorted by (x, y).
+  const std::vector<std::uint32_t>& hull() const { return hull_; }
+  std::size_t triangle_count() const { return triangles_.size() / 3; }
+  /// True when there are no triangles (fewer than 3 distinct points, or all collinear).
+  bool degenerate() const { return triangles_.empty(); }
+
+  static std::uint32_t next(std::uint32_t e) { return e % 3 == 2 ? e - 2 : e + 1; }
+  static std::uint32_t prev(std::uint32_t e) { return e % 3 == 0 ? e + 2 : e - 1; }
+
+  /// The vertex that stands for point i: i itself, the first occurrence of an
+  /// equal point, or no_edge for a removed point.
+  std::uint32_t representative(std::uint32_t i) const;
+  /// Number of input points merged into an earlier one.
+  std::size_t duplicate_count() const;
+
+  /// A finite triangle (index into triangles() / 3) whose closed area contains q,
+  /// or no_edge if q lies outside the hull (or the triangulation is degenerate).
+  /// A visibility walk from `hint` (a triangle index, or no_edge for a fixed
+  /// start): O(sqrt n) expected for a far hint, O(1) for a close one.
+  /// Thread-safe.
+  std::uint32_t locate(const Vec2d& q, std::uint32_t hint = no_edge) const;
+  /// The nearest vertex to q (a representative; ties broken arbitrarily), by a
+  /// greedy walk along Delaunay edges; no_edge if the triangulation is empty.
+  /// Thread-safe.
+  std::uint32_t nearest(const Vec2d& q) const;
+  /// The Delaunay neighbours of vertex v counter-clockwise (empty for a point
+  /// that is not a vertex); for a hull vertex from the next hull vertex to the
+  /// previous one; for a degenerate set, v's neighbours in hull().
+  std::vector<std::uint32_t> neighbors(std::uint32_t v) const;
+
+  /// Inserts a point, returns its index (points().size() - 1 before the call).
+  /// A duplicate is merged into the existing point. Keeps the triangulation
+  /// Delaunay; O(expected degree) flips plus O(n) to renumber the public arrays.
+  std::uint32_t insert(const Vec2d& p);
+  /// Removes vertex v (a representative; removing a duplicate only drops the
+  /// alias, removing a vertex that has aliases promotes the next alias). The hole
+  /// is retriangulated by flipping v's edges away (Delaunay ears, Devillers),
+  /// then v is cut out at degree 3. O(d^2) for degree d plus O(n) renumbering.
+  void remove(std::uint32_t v);
+
+  Delaunay2Stats stats() const;
+  /// Checks every invariant; throws geods::Error naming the first violation:
+  /// twins consistent, triangles counter-clockwise, every edge locally Delaunay
+  /// (exact incircle), the hull convex, Euler's formula (t = 2n - h - 2), every
+  /// representative in a triangle, and the public arrays match the internal ones.
+  void validate() const;
+
+ private:
+  static constexpr std::uint32_t kGhost = std::uint32_t(-2);  // the vertex at infinity
+  static constexpr std::uint32_t kGhostBit = 1u << 31;         // set in kGhost, never in a vertex
+
+  enum class Where { inside, on_edge, on_vertex, outside };
+  struct Location {
+    Where where;
+    std::uint32_t edge;  // inside: any half-edge of the triangle; on_edge: the edge;
+                         // on_vertex: a half-edge leaving the vertex; outside: the ghost triangle's hull half-edge
+  };
+
+  void build(Options options);
+  void build_degenerate();
+  std::vector<std::uint32_t> insertion_order(std::uint64_t seed) const;
+  bool make_first_triangle();
+  void insert_vertex(std::uint32_t i, std::uint32_t start_tri);
+  Location walk(const Vec2d& p, std::uint32_t start_tri, std::size_t* steps) const;
+  bool in_conflict(std::uint32_t tri, const Vec2d& p) const;
+  std::uint32_t new_triangle();
+  void link(std::uint32_t a, std::uint32_t b) {
+    twin_[a] = b;
+    twin_[b] = a;
+  }
+  void split_triangle(std::uint32_t e, std::uint32_t p);
+  void split_edge(std::uint32_t e, std::uint32_t p);
+  void legalize(std::uint32_t p);
+  void flip(std::uint32_t e);
+  bool remove_by_flips(std::uint32_t v);
+  void publish();
+  std::uint32_t finite_triangle_near(std::uint32_t tri) const;
+  bool is_ghost_triangle(std::uint32_t t) const {
+    return ((vert_[3 * t] | vert_[3 * t + 1] | vert_[3 * t + 2]) & kGhostBit) != 0;
+  }
+  const Vec2d& at(std::uint32_t v) const { return coords_[v]; }
+
+  Options options_;
+  std::vector<Vec2d> points_;
+  std::vector<std::uint32_t> rep_;  // representative per point, no_edge when removed
+
+  // Vertices are numbered internally in insertion order, their coordinates
+  // copied in that order, so that the spatially sorted insertion reads memory
+  // sequentially.
+  std::vector<Vec2d> coords_;              // per internal vertex
+  std::vector<std::uint32_t> original_of_;  // internal vertex -> the point it stands for
+  std::vector<std::uint32_t> internal_of_;  // point -> its internal vertex, no_edge if removed
+
+  // The closed triangulation with ghost triangles: 3 vertices and 3 twins per triangle.
+  std::vector<std::uint32_t> vert_, twin_;
+  std::vector<std::uint32_t> free_triangles_;  // slots freed by remove(); their vert_ are no_edge
+  std::vector<std::uint32_t> vertex_edge_;     // per internal vertex: a half-edge leaving it, or no_edge
+  std::vector<std::uint32_t> flip_stack_;
+  std::uint32_t last_triangle_ = 0;  // where the next walk starts
+  std::uint32_t walk_seed_ = 1;
+
+  // The public, finite-only view.
+  std::vector<std::uint32_t> triangles_, halfedges_, hull_;
+  std::vector<std::uint32_t> public_triangle_;  // internal triangle -> public index or no_edge
+  std::vector<std::uint32_t> internal_triangle_;  // public -> internal
+  std::size_t flips_ = 0, walk_steps_ = 0;
+};
+
+}  // namespace geods::voronoi

@@ -1,0 +1,398 @@
+// Delaunay2 against independent oracles: the empty-circle property by brute
+// force with exact incircle, Euler's formula, the convex hull by Andrew's
+// monotone chain, point location and nearest points by brute force; on seeded
+// uniform, clustered and degenerate sets (duplicates, collinear, integer grids,
+// exactly co-circular points, tiny/huge/mixed magnitudes); insert and remove.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "geods/core/error.hpp"
+#include "geods/core/predicates.hpp"
+#include "geods/core/rng.hpp"
+#include "geods/voronoi/delaunay2.hpp"
+
+namespace geods::voronoi {
+namespace {
+
+constexpr std::uint32_t kNone = Delaunay2::no_edge;
+
+bool lex_less(const Vec2d& a, const Vec2d& b) { return a[0] < b[0] || (a[0] == b[0] && a[1] < b[1]); }
+
+// Strictly convex hull vertices, counter-clockwise from the lexicographically smallest.
+std::vector<Vec2d> monotone_chain(std::vector<Vec2d> p) {
+  std::sort(p.begin(), p.end(), lex_less);
+  p.erase(std::unique(p.begin(), p.end()), p.end());
+  if (p.size() < 3) return p;
+  std::vector<Vec2d> hull(2 * p.size());
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    while (k >= 2 && orient2d(hull[k - 2], hull[k - 1], p[i]) <= 0) --k;
+    hull[k++] = p[i];
+  }
+  for (std::size_t i = p.size() - 1, t = k + 1; i-- > 0;) {
+    while (k >= t && orient2d(hull[k - 2], hull[k - 1], p[i]) <= 0) --k;
+    hull[k++] = p[i];
+  }
+  hull.resize(k - 1);
+  return hull;
+}
+
+// The strictly convex corners of the triangulation's hull, from the smallest.
+std::vector<Vec2d> hull_corners(const Delaunay2& dt) {
+  const auto& h = dt.hull();
+  std::vector<Vec2d> corners;
+  for (std::size_t i = 0; i < h.size(); ++i) {
+    const Vec2d& a = dt.points()[h[(i + h.size() - 1) % h.size()]];
+    const Vec2d& b = dt.points()[h[i]];
+    const Vec2d& c = dt.points()[h[(i + 1) % h.size()]];
+    if (orient2d(a, b, c) > 0) corners.push_back(b);
+  }
+  if (corners.empty()) return corners;
+  std::rotate(corners.begin(), std::min_element(corners.begin(), corners.end(), lex_less), corners.end());
+  return corners;
+}
+
+// Everything a Delaunay triangulation of `points` must satisfy, checked
+// without trusting the structure (besides its own validate()).
+void check_delaunay(const Delaunay2& dt, std::span<const Vec2d> points, bool brute_force_circles = true) {
+  ASSERT_NO_THROW(dt.validate());
+  const auto& tri = dt.triangles();
+  std::vector<std::uint32_t> distinct;
+  std::map<std::pair<double, double>, std::uint32_t> first;
+  for (std::uint32_t i = 0; i < points.size(); ++i) {
+    const std::uint32_t r = dt.representative(i);
+    const auto [it, is_first] = first.insert({{points[i][0], points[i][1]}, i});
+    ASSERT_EQ(r, it->second) << "first occurrence";
+    if (is_first) distinct.push_back(i);
+  }
+  // Collinear or fewer than 3 distinct points: no triangles.
+  const std::vector<Vec2d> chain = monotone_chain(std::vector<Vec2d>(points.begin(), points.end()));
+  if (chain.size() < 3) {
+    EXPECT_TRUE(dt.degenerate());
+    EXPECT_EQ(dt.hull().size(), distinct.size());
+    return;
+  }
+  const std::size_t n = distinct.size(), h = dt.hull().size();
+  ASSERT_EQ(tri.size() / 3, 2 * n - h - 2) << "Euler";
+  std::vector<char> used(points.size(), 0);
+  for (std::size_t t = 0; t < tri.size(); t += 3) {
+    const Vec2d &a = points[tri[t]], &b = points[tri[t + 1]], &c = points[tri[t + 2]];
+    ASSERT_GT(orient2d(a, b, c), 0) << "counter-clockwise";
+    for (int s = 0; s < 3; ++s) used[tri[t + s]] = 1;
+    if (brute_force_circles) {
+      for (std::uint32_t v : distinct) ASSERT_LE(incircle(a, b, c, points[v]), 0) << "empty circle";
+    }
+  }
+  for (std::uint32_t v : distinct) ASSERT_TRUE(used[v]) << "vertex " << v << " missing";
+  for (std::size_t e = 0; e < tri.size(); ++e) {
+    const std::uint32_t f = dt.halfedges()[e];
+    if (f == kNone) continue;
+    ASSERT_EQ(dt.halfedges()[f], e);
+    ASSERT_EQ(tri[f], tri[Delaunay2::next(std::uint32_t(e))]);
+  }
+  EXPECT_EQ(hull_corners(dt), chain);
+  // Every hull vertex is on the boundary of the independent hull.
+  for (std::uint32_t v : dt.hull()) {
+    bool on_boundary = false;
+    for (std::size_t i = 0; i < chain.size() && !on_boundary; ++i)
+      on_boundary = orient2d(chain[i], chain[(i + 1) % chain.size()], points[v]) == 0;
+    EXPECT_TRUE(on_boundary);
+  }
+}
+
+enum class Shape { uniform, clustered, duplicates, grid, circle, line, tiny, huge, mixed };
+
+std::vector<Vec2d> make_points(Shape shape, std::size_t n, std::uint64_t seed) {
+  Rng rng(seed);
+  std::vector<Vec2d> p;
+  switch (shape) {
+    case Shape::uniform:
+      for (std::size_t i = 0; i < n; ++i) p.emplace_back(rng.uniform(), rng.uniform());
+      break;
+    case Shape::clustered:
+      for (std::size_t i = 0; i < n; ++i) {
+        const double cx = double(rng.below(4)), cy = double(rng.below(3));
+        p.emplace_back(cx + 1e-3 * rng.normal(), cy + 1e-3 * rng.normal());
+      }
+      break;
+    case Shape::duplicates:
+      for (std::size_t i = 0; i < n / 4; ++i) p.emplace_back(rng.uniform(), rng.uniform());
+      while (p.size() < n) p.push_back(p[rng.below(p.size())]);
+      break;
+    case Shape::grid: {
+      const std::size_t side = std::size_t(std::sqrt(double(n)));
+      for (std::size_t i = 0; i < side * side; ++i) p.emplace_back(double(i % side), double(i / side));
+      break;
+    }
+    case Shape::circle: {
+      // Every integer point on x^2 + y^2 = 5^2 * 13^2 * 17^2: exactly co-circular, plus the centre.
+      const long r2 = 5L * 5 * 13 * 13 * 17 * 17;
+      const long r = long(std::sqrt(double(r2)));
+      for (long x = -r; x <= r; ++x) {
+        const long y = long(std::llround(std::sqrt(double(r2 - x * x))));
+        if (x * x + y * y != r2) continue;
+        p.emplace_back(double(x), double(y));
+        if (y != 0) p.emplace_back(double(x), double(-y));
+      }
+      p.emplace_back(0.0, 0.0);
+      break;
+    }
+    case Shape::line:
+      for (std::size_t i = 0; i < n; ++i) {
+        const double t = double(rng.below(n));
+        p.emplace_back(3 + 2 * t, -1 + 5 * t);
+      }
+      break;
+    case Shape::tiny:
+      for (std::size_t i = 0; i < n; ++i) p.emplace_back(1e-300 * rng.uniform(), 1e-300 * rng.uniform());
+      break;
+    case Shape::huge:
+      for (std::size_t i = 0; i < n; ++i) p.emplace_back(1e300 * rng.uniform(-1, 1), 1e300 * rng.uniform(-1, 1));
+      break;
+    case Shape::mixed:
+      for (std::size_t i = 0; i < n; ++i) {
+        const double scale = std::ldexp(1.0, int(rng.below(200)) - 100);
+        p.emplace_back(scale * rng.uniform(-1, 1), scale * rng.uniform(-1, 1));
+      }
+      break;
+  }
+  return p;
+}
+
+const Shape kShapes[] = {Shape::uniform, Shape::clustered, Shape::duplicates, Shape::grid, Shape::circle,
+                         Shape::line,    Shape::tiny,      Shape::huge,       Shape::mixed};
+
+TEST(Delaunay2, EmptyCircleOnEveryShape) {
+  for (Shape shape : kShapes)
+    for (std::uint64_t seed : {1, 2, 3}) {
+      SCOPED_TRACE("shape " + std::to_string(int(shape)) + " seed " + std::to_string(seed));
+      // Tiny and huge coordinates take the predicates' slow exact path: fewer points.
+      const bool slow = shape == Shape::tiny || shape == Shape::huge || shape == Shape::mixed;
+      const std::vector<Vec2d> p = make_points(shape, slow ? 120 : 400, seed);
+      const Delaunay2 dt(p);
+      check_delaunay(dt, p);
+    }
+}
+
+TEST(Delaunay2, LargerSetsAreValid) {
+  for (Shape shape : {Shape::uniform, Shape::clustered, Shape::grid, Shape::duplicates}) {
+    const std::vector<Vec2d> p = make_points(shape, 40000, 7);
+    const Delaunay2 dt(p);
+    check_delaunay(dt, p, false);
+  }
+}
+
+TEST(Delaunay2, SmallAndDegenerateSets) {
+  const std::vector<std::vector<Vec2d>> sets = {
+      {},
+      {{1, 2}},
+      {{1, 2}, {1, 2}},
+      {{0, 0}, {1, 1}, {2, 2}, {1, 1}},
+      {{0, 0}, {1, 0}, {0, 1}},
+      {{0, 0}, {0, 1}, {1, 0}},
+      {{0, 0}, {1, 0}, {1, 1}, {0, 1}},  // co-circular square
+      {{0, 0}, {2, 0}, {1, 0}, {3, 0}, {1, 1}},  // collinear points then one off the line
+      {{5, 5}, {5, 5}, {0, 0}, {0, 0}, {1, 0}, {0, 1}},
+  };
+  for (const auto& p : sets) {
+    const Delaunay2 dt(p);
+    check_delaunay(dt, p);
+  }
+  const Delaunay2 line(std::vector<Vec2d>{{2, 2}, {0, 0}, {1, 1}, {0, 0}, {3, 3}});
+  EXPECT_TRUE(line.degenerate());
+  EXPECT_EQ(line.hull(), (std::vector<std::uint32_t>{1, 2, 0, 4}));
+  EXPECT_EQ(line.representative(3), 1u);
+  EXPECT_EQ(line.duplicate_count(), 1u);
+  EXPECT_EQ(line.locate({1, 1}), kNone);
+  EXPECT_EQ(line.nearest({2.9, 3}), 4u);
+}
+
+TEST(Delaunay2, DuplicatesMapToFirstOccurrence) {
+  std::vector<Vec2d> p = make_points(Shape::uniform, 300, 11);
+  const std::size_t n = p.size();
+  for (std::size_t i = 0; i < n; i += 3) p.push_back(p[i]);
+  std::reverse(p.begin(), p.end());  // the copies come first now
+  const Delaunay2 dt(p);
+  check_delaunay(dt, p);
+  EXPECT_EQ(dt.duplicate_count(), p.size() - n);
+  for (std::uint32_t i = 0; i < p.size(); ++i)
+    for (std::uint32_t j = 0; j < i; ++j)
+      if (p[j] == p[i]) {
+        EXPECT_EQ(dt.representative(i), dt.representative(j));
+        break;
+      }
+}
+
+TEST(Delaunay2, DifferentInsertionOrdersAreValid) {
+  const std::vector<Vec2d> p = make_points(Shape::grid, 900, 1);
+  for (std::uint64_t seed : {1, 2, 99}) {
+    const Delaunay2 dt(p, {seed});
+    check_delaunay(dt, p);
+  }
+}
+
+TEST(Delaunay2, RejectsNonFinitePoints) {
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(Delaunay2(std::vector<Vec2d>{{0, 0}, {nan, 1}, {1, 1}}), Error);
+  EXPECT_THROW(Delaunay2(std::vector<Vec2d>{{0, 0}, {1, -inf}, {1, 1}}), Error);
+  Delaunay2 dt(std::vector<Vec2d>{{0, 0}, {1, 0}, {0, 1}});
+  EXPECT_THROW(dt.insert({nan, 0}), Error);
+  EXPECT_THROW(dt.locate({inf, 0}), Error);
+  EXPECT_THROW(dt.remove(7), Error);
+}
+
+// Is q in the closed triangle t?
+bool in_triangle(const Delaunay2& dt, std::uint32_t t, const Vec2d& q) {
+  const auto& tri = dt.triangles();
+  const auto p = dt.points();
+  for (int s = 0; s < 3; ++s)
+    if (orient2d(p[tri[3 * t + s]], p[tri[3 * t + (s + 1) % 3]], q) < 0) return false;
+  return true;
+}
+
+bool inside_hull(const std::vector<Vec2d>& hull, const Vec2d& q) {
+  for (std::size_t i = 0; i < hull.size(); ++i)
+    if (orient2d(hull[i], hull[(i + 1) % hull.size()], q) < 0) return false;
+  return true;
+}
+
+TEST(Delaunay2, LocateAndNearestAgreeWithBruteForce) {
+  for (Shape shape : {Shape::uniform, Shape::clustered, Shape::grid, Shape::duplicates}) {
+    const std::vector<Vec2d> p = make_points(shape, 2000, 5);
+    const Delaunay2 dt(p);
+    const std::vector<Vec2d> hull = monotone_chain(p);
+    Rng rng(9);
+    std::vector<Vec2d> queries;
+    for (int i = 0; i < 300; ++i) queries.emplace_back(rng.uniform(-0.5, 4.5), rng.uniform(-0.5, 3.5));
+    for (int i = 0; i < 100; ++i) queries.push_back(p[rng.below(p.size())]);  // on vertices
+    for (const Vec2d& q : queries) {
+      const std::uint32_t t = dt.locate(q);
+      if (inside_hull(hull, q)) {
+        ASSERT_NE(t, kNone);
+        ASSERT_TRUE(in_triangle(dt, t, q));
+        ASSERT_TRUE(in_triangle(dt, dt.locate(q, 0), q));
+      } else {
+        ASSERT_EQ(t, kNone);
+      }
+      double best = INFINITY;
+      for (const Vec2d& x : p) best = std::min(best, (x - q).squaredNorm());
+      const std::uint32_t v = dt.nearest(q);
+      ASSERT_EQ((p[v] - q).squaredNorm(), best);
+      ASSERT_EQ(dt.representative(v), v);
+    }
+  }
+}
+
+TEST(Delaunay2, NeighborsAreTheEdges) {
+  const std::vector<Vec2d> p = make_points(Shape::uniform, 500, 3);
+  const Delaunay2 dt(p);
+  std::set<std::pair<std::uint32_t, std::uint32_t>> edges;
+  for (std::size_t e = 0; e < dt.triangles().size(); ++e)
+    edges.insert({dt.triangles()[e], dt.triangles()[Delaunay2::next(std::uint32_t(e))]});
+  std::size_t total = 0;
+  for (std::uint32_t v = 0; v < p.size(); ++v) {
+    const auto nb = dt.neighbors(v);
+    total += nb.size();
+    for (std::uint32_t w : nb) EXPECT_TRUE(edges.count({v, w}) || edges.count({w, v}));
+    for (std::size_t k = 0; k + 1 < nb.size(); ++k) EXPECT_GE(orient2d(p[v], p[nb[k]], p[nb[k + 1]]), 0) << "ccw";
+  }
+  // Each undirected edge counted from both ends.
+  std::set<std::pair<std::uint32_t, std::uint32_t>> undirected;
+  for (auto [a, b] : edges) undirected.insert({std::min(a, b), std::max(a, b)});
+  EXPECT_EQ(total, 2 * undirected.size());
+}
+
+TEST(Delaunay2, InsertKeepsDelaunay) {
+  for (Shape shape : {Shape::uniform, Shape::grid, Shape::circle, Shape::line}) {
+    std::vector<Vec2d> all = make_points(shape, 300, 4);
+    Delaunay2 dt(std::span<const Vec2d>(all.data(), all.size() / 2));
+    for (std::size_t i = all.size() / 2; i < all.size(); ++i) {
+      EXPECT_EQ(dt.insert(all[i]), i);
+      if (i % 17 == 0) check_delaunay(dt, std::span<const Vec2d>(all.data(), i + 1));
+    }
+    check_delaunay(dt, all);
+    // Outside the hull, on the hull, a duplicate.
+    all.push_back({-10, 7});
+    all.push_back(all[0]);
+    for (std::size_t i = all.size() - 2; i < all.size(); ++i) dt.insert(all[i]);
+    check_delaunay(dt, all);
+    EXPECT_EQ(dt.representative(std::uint32_t(all.size() - 1)), dt.representative(0));
+  }
+}
+
+// After removals: a Delaunay triangulation of the points still present.
+void check_after_removal(const Delaunay2& dt, const std::vector<char>& removed) {
+  ASSERT_NO_THROW(dt.validate());
+  std::vector<Vec2d> left;
+  for (std::uint32_t i = 0; i < removed.size(); ++i) {
+    if (removed[i]) {
+      ASSERT_EQ(dt.representative(i), kNone);
+    } else {
+      left.push_back(dt.points()[i]);
+      ASSERT_NE(dt.representative(i), kNone);
+    }
+  }
+  const Delaunay2 fresh(left);
+  ASSERT_EQ(dt.triangle_count(), fresh.triangle_count());
+  ASSERT_EQ(hull_corners(dt), hull_corners(fresh));
+  const auto p = dt.points();
+  for (std::size_t t = 0; t < dt.triangles().size(); t += 3)
+    for (const Vec2d& x : left)
+      ASSERT_LE(incircle(p[dt.triangles()[t]], p[dt.triangles()[t + 1]], p[dt.triangles()[t + 2]], x), 0);
+}
+
+TEST(Delaunay2, RemoveKeepsDelaunay) {
+  for (Shape shape : {Shape::uniform, Shape::grid, Shape::circle, Shape::duplicates, Shape::clustered}) {
+    SCOPED_TRACE("shape " + std::to_string(int(shape)));
+    const std::vector<Vec2d> p = make_points(shape, 300, 8);
+    Delaunay2 dt(p);
+    std::vector<char> removed(p.size(), 0);
+    Rng rng(3);
+    // Remove all but two points, in random order, hull vertices included.
+    std::vector<std::uint32_t> order(p.size());
+    for (std::uint32_t i = 0; i < p.size(); ++i) order[i] = i;
+    for (std::size_t i = order.size(); i > 1; --i) std::swap(order[i - 1], order[rng.below(i)]);
+    for (std::size_t k = 0; k + 2 < order.size(); ++k) {
+      dt.remove(order[k]);
+      removed[order[k]] = 1;
+      if (k % 13 == 0 || k + 10 > order.size()) check_after_removal(dt, removed);
+    }
+    EXPECT_THROW(dt.remove(order[0]), Error);
+  }
+}
+
+TEST(Delaunay2, RemoveHullVerticesOnly) {
+  const std::vector<Vec2d> p = make_points(Shape::uniform, 200, 12);
+  Delaunay2 dt(p);
+  std::vector<char> removed(p.size(), 0);
+  for (int k = 0; k < 150; ++k) {
+    const std::uint32_t v = dt.hull()[std::size_t(k) % dt.hull().size()];
+    dt.remove(v);
+    removed[v] = 1;
+    check_after_removal(dt, removed);
+  }
+}
+
+TEST(Delaunay2, StatsCountWhatIsThere) {
+  std::vector<Vec2d> p = make_points(Shape::uniform, 1000, 2);
+  p.push_back(p[3]);
+  const Delaunay2 dt(p);
+  const Delaunay2Stats s = dt.stats();
+  EXPECT_EQ(s.points, p.size());
+  EXPECT_EQ(s.vertices, p.size() - 1);
+  EXPECT_EQ(s.duplicates, 1u);
+  EXPECT_EQ(s.triangles, dt.triangle_count());
+  EXPECT_EQ(s.hull, dt.hull().size());
+  EXPECT_GT(s.flips, 0u);
+  EXPECT_GT(s.bytes, p.size() * sizeof(Vec2d));
+}
+
+}  // namespace
+}  // namespace geods::voronoi
