@@ -1,0 +1,45 @@
+#pragma once
+// How a bounding volume hierarchy is built: the builder (§4.1 of the seed),
+// the bounding volume stored at the nodes, leaf size and node arity.
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+#include "geods/core/progress.hpp"
+
+namespace geods::bvh {
+
+enum class Builder {
+  sah,        // top-down, binned surface area heuristic (equation 7, the sweep of §4.1.4)
+  median,     // top-down, object median along the longest axis of the centroids
+  pca,        // top-down, plane through the barycenter orthogonal to the principal axis
+  bottom_up,  // bottom-up, pairing nearest neighbours level by level (§4.1.1)
+  tiling,     // bottom-up, grouping the nodes of a level into tiles (§4.1.1)
+  insertion,  // one primitive at a time into the child of least area increase (§4.1.2)
+  boxtree,    // top-down, Zachmann's restricted boxtree criterion (least total volume, §4.1.5)
+};
+
+enum class BoundingVolume { aabb, sphere, kdop6, kdop14, kdop18, kdop26, obb };
+
+struct BuildOptions {
+  Builder builder = Builder::sah;
+  BoundingVolume bv = BoundingVolume::aabb;
+  /// Most primitives in a leaf (1..255); the SAH builder may stop earlier.
+  int leaf_size = 4;
+  /// Children per inner node: 2, 4 or 8. Wider trees come from collapsing the binary one.
+  int arity = 4;
+  /// Bins per axis of the SAH builder.
+  int sah_bins = 32;
+  ProgressCallback progress;
+};
+
+/// "sah", "median", "pca", "bottomup", "tiling", "insertion", "boxtree"; throws geods::Error otherwise.
+Builder parse_builder(std::string_view name);
+/// "aabb", "sphere", "kdop6", "kdop14", "kdop18", "kdop26", "obb"; throws geods::Error otherwise.
+BoundingVolume parse_bounding_volume(std::string_view name);
+std::string_view to_string(Builder builder);
+std::string_view to_string(BoundingVolume bv);
+/// Throws geods::Error naming the bad field.
+void check_options(const BuildOptions& options);
+
+}  // namespace geods::bvh

@@ -1,0 +1,37 @@
+#pragma once
+// Private to the builders: the binary tree every builder produces, before it
+// is renumbered depth first and collapsed to the requested arity (finalize).
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "geods/bvh/topology.hpp"
+
+namespace geods::bvh::detail {
+
+inline constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+
+struct BinaryNode {
+  AABB3f box;
+  std::uint32_t left = kNone, right = kNone;  // kNone: a leaf
+  std::uint32_t prim_first = 0;              // leaf: its primitives are prims[prim_first, +prim_count)
+  std::uint32_t prim_count = 0;              // leaf: its primitives; inner node: all below it
+
+  bool leaf() const { return left == kNone; }
+};
+
+struct BinaryTree {
+  std::vector<BinaryNode> nodes;
+  std::uint32_t root = kNone;
+  std::vector<std::uint32_t> prims;
+  /// Bottom-up builders make single-primitive leaves: subtrees of at most
+  /// leaf_size primitives then become one leaf.
+  bool merge_small_subtrees = false;
+};
+
+BinaryTree build_top_down(std::span<const AABB3f> boxes, const BuildOptions& options);
+BinaryTree build_bottom_up(std::span<const AABB3f> boxes, const BuildOptions& options);
+BinaryTree build_tiling(std::span<const AABB3f> boxes, const BuildOptions& options);
+BinaryTree build_insertion(std::span<const AABB3f> boxes, const BuildOptions& options);
+
+}  // namespace geods::bvh::detail

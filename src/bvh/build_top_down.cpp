@@ -1,0 +1,321 @@
+// Top-down builders (§4.1.3): binned SAH, object median, PCA plane and
+// Zachmann's restricted boxtree criterion. Each recursion step splits a range
+// of the primitive array in place; large ranges recurse in parallel. Node ids
+// depend on scheduling, but finalize() renumbers depth first and every split
+// decision depends only on the range's contents, so the tree is deterministic.
+#include <tbb/parallel_invoke.h>
+#include <tbb/parallel_reduce.h>
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cmath>
+#include <vector>
+
+#include "binary_tree.hpp"
+#include "geods/core/parallel.hpp"
+
+namespace geods::bvh::detail {
+namespace {
+
+constexpr std::size_t kParallelThreshold = 4096;  // ranges below this recurse sequentially
+constexpr std::size_t kParallelScan = 65536;      // ranges above this are scanned in parallel
+constexpr int kMaxBins = 256;
+
+struct RangeBounds {
+  AABB3f box;       // of the primitive boxes
+  AABB3f centroid;  // of their centers
+  void join(const RangeBounds& o) {
+    box.extend(o.box);
+    centroid.extend(o.centroid);
+  }
+};
+
+struct Bins {
+  int count = 0;
+  std::array<std::array<AABB3f, kMaxBins>, 3> box;
+  std::array<std::array<std::uint32_t, kMaxBins>, 3> n{};
+  void join(const Bins& o) {
+    for (int a = 0; a < 3; ++a)
+      for (int i = 0; i < count; ++i) {
+        box[a][i].extend(o.box[a][i]);
+        n[a][i] += o.n[a][i];
+      }
+  }
+};
+
+class TopDown {
+ public:
+  TopDown(std::span<const AABB3f> boxes, const BuildOptions& options)
+      : boxes_(boxes), options_(options), centers_(boxes.size()) {
+    tree_.prims.resize(boxes.size());
+    for (std::size_t i = 0; i < boxes.size(); ++i) {
+      tree_.prims[i] = std::uint32_t(i);
+      centers_[i] = boxes[i].center();
+    }
+    tree_.nodes.resize(2 * boxes.size());
+  }
+
+  BinaryTree run() {
+    tree_.root = build(0, std::uint32_t(boxes_.size()), bounds(0, std::uint32_t(boxes_.size())), 0);
+    tree_.nodes.resize(next_.load());
+    return std::move(tree_);
+  }
+
+ private:
+  RangeBounds bounds(std::uint32_t begin, std::uint32_t end) const {
+    auto scan = [&](std::uint32_t b, std::uint32_t e, RangeBounds r) {
+      for (std::uint32_t i = b; i < e; ++i) {
+        r.box.extend(boxes_[tree_.prims[i]]);
+        r.centroid.extend(centers_[tree_.prims[i]]);
+      }
+      return r;
+    };
+    if (end - begin < kParallelScan) return scan(begin, end, {});
+    // min/max are exact, so the chunking does not change the result.
+    return tbb::parallel_reduce(
+        tbb::blocked_range<std::uint32_t>(begin, end, 16384), RangeBounds{},
+        [&](const tbb::blocked_range<std::uint32_t>& r, RangeBounds acc) { return scan(r.begin(), r.end(), acc); },
+        [](RangeBounds a, const RangeBounds& b) {
+          a.join(b);
+          return a;
+        });
+  }
+
+  std::uint32_t make_leaf(std::uint32_t id, std::uint32_t begin, std::uint32_t end) {
+    tree_.nodes[id].prim_first = begin;
+    tree_.nodes[id].prim_count = end - begin;
+    return id;
+  }
+
+  std::uint32_t build(std::uint32_t begin, std::uint32_t end, const RangeBounds& rb, int depth) {
+    const std::uint32_t id = next_.fetch_add(1);
+    BinaryNode& node = tree_.nodes[id];
+    node.box = rb.box;
+    node.prim_count = end - begin;
+    const std::uint32_t count = end - begin;
+    if (count == 1) return make_leaf(id, begin, end);
+    std::uint32_t mid = begin;
+    bool leaf = options_.builder != Builder::sah && count <= std::uint32_t(options_.leaf_size);
+    if (leaf) return make_leaf(id, begin, end);
+    switch (options_.builder) {
+      case Builder::sah: mid = split_sah(begin, end, rb, leaf); break;
+      case Builder::pca: mid = split_pca(begin, end); break;
+      case Builder::boxtree: mid = depth < 48 ? split_boxtree(begin, end, rb.box) : begin; break;
+      default: break;
+    }
+    if (leaf) return make_leaf(id, begin, end);
+    if (mid <= begin || mid >= end) mid = split_median(begin, end, rb.centroid);
+    std::uint32_t left = 0, right = 0;
+    if (count >= kParallelThreshold && num_threads() > 1) {
+      RangeBounds lb, rbb;
+      tbb::parallel_invoke([&] { lb = bounds(begin, mid); }, [&] { rbb = bounds(mid, end); });
+      tbb::parallel_invoke([&] { left = build(begin, mid, lb, depth + 1); },
+                           [&] { right = build(mid, end, rbb, depth + 1); });
+    } else {
+      left = build(begin, mid, bounds(begin, mid), depth + 1);
+      right = build(mid, end, bounds(mid, end), depth + 1);
+    }
+    tree_.nodes[id].left = left;
+    tree_.nodes[id].right = right;
+    return id;
+  }
+
+  // Object median along the longest axis of the centroids, ties by id.
+  std::uint32_t split_median(std::uint32_t begin, std::uint32_t end, const AABB3f& centroid) {
+    const int axis = centroid.longest_axis();
+    const std::uint32_t mid = begin + (end - begin) / 2;
+    auto* p = tree_.prims.data();
+    std::nth_element(p + begin, p + mid, p + end, [&](std::uint32_t a, std::uint32_t b) {
+      const float ca = centers_[a][axis], cb = centers_[b][axis];
+      return ca < cb || (ca == cb && a < b);
+    });
+    return mid;
+  }
+
+  // Binned SAH: bins on all three axes, the sweep of §4.1.4 over bin
+  // boundaries, cost (7) with unit traversal and intersection costs.
+  std::uint32_t split_sah(std::uint32_t begin, std::uint32_t end, const RangeBounds& rb, bool& leaf) {
+    const std::uint32_t count = end - begin;
+    const int nbins = std::min<int>(options_.sah_bins, kMaxBins);
+    const Vec3f extent = rb.centroid.extent();
+    Vec3f scale;
+    for (int a = 0; a < 3; ++a) scale[a] = extent[a] > 0 ? float(nbins) * (1.0f - 1e-6f) / extent[a] : 0.0f;
+    auto bin_of = [&](std::uint32_t prim, int a) {
+      const int b = int((centers_[prim][a] - rb.centroid.lo[a]) * scale[a]);
+      return std::clamp(b, 0, nbins - 1);
+    };
+    auto fill = [&](std::uint32_t b, std::uint32_t e, Bins& bins) {
+      for (std::uint32_t i = b; i < e; ++i) {
+        const std::uint32_t prim = tree_.prims[i];
+        for (int a = 0; a < 3; ++a) {
+          const int k = bin_of(prim, a);
+          bins.box[a][k].extend(boxes_[prim]);
+          ++bins.n[a][k];
+        }
+      }
+    };
+    Bins bins;
+    bins.count = nbins;
+    if (count < kParallelScan) {
+      fill(begin, end, bins);
+    } else {
+      bins = tbb::parallel_reduce(
+          tbb::blocked_range<std::uint32_t>(begin, end, 16384), bins,
+          [&](const tbb::blocked_range<std::uint32_t>& r, Bins acc) {
+            fill(r.begin(), r.end(), acc);
+            return acc;
+          },
+          [](Bins a, const Bins& b) {
+            a.join(b);
+            return a;
+          });
+    }
+    const float parent_area = rb.box.surface_area();
+    float best_cost = std::numeric_limits<float>::infinity();
+    int best_axis = -1, best_bin = -1;
+    std::array<float, kMaxBins> right_cost;
+    for (int a = 0; a < 3; ++a) {
+      if (scale[a] == 0) continue;
+      AABB3f acc;
+      std::uint32_t n = 0;
+      for (int k = nbins - 1; k > 0; --k) {
+        acc.extend(bins.box[a][k]);
+        n += bins.n[a][k];
+        right_cost[k] = n ? acc.surface_area() * float(n) : 0.0f;
+      }
+      acc = AABB3f();
+      n = 0;
+      for (int k = 0; k < nbins - 1; ++k) {
+        acc.extend(bins.box[a][k]);
+        n += bins.n[a][k];
+        if (n == 0 || n == count) continue;
+        const float cost = acc.surface_area() * float(n) + right_cost[k + 1];
+        if (cost < best_cost) best_cost = cost, best_axis = a, best_bin = k;
+      }
+    }
+    const float leaf_cost = float(count);
+    const float split_cost =
+        best_axis < 0 ? std::numeric_limits<float>::infinity() : 1.0f + best_cost / std::max(parent_area, 1e-30f);
+    if (count <= std::uint32_t(options_.leaf_size) && leaf_cost <= split_cost) {
+      leaf = true;
+      return begin;
+    }
+    if (best_axis < 0) return begin;  // all centroids equal: median split by id
+    auto* p = tree_.prims.data();
+    return std::uint32_t(std::partition(p + begin, p + end, [&](std::uint32_t prim) {
+                           return bin_of(prim, best_axis) <= best_bin;
+                         }) - p);
+  }
+
+  // Plane through the barycenter of the centroids, orthogonal to their
+  // principal axis (§4.1.4, after Gottschalk et al.).
+  std::uint32_t split_pca(std::uint32_t begin, std::uint32_t end) {
+    Vec3d mean = Vec3d::Zero();
+    for (std::uint32_t i = begin; i < end; ++i) mean += centers_[tree_.prims[i]].cast<double>();
+    mean /= double(end - begin);
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    for (std::uint32_t i = begin; i < end; ++i) {
+      const Vec3d d = centers_[tree_.prims[i]].cast<double>() - mean;
+      cov += d * d.transpose();
+    }
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(cov);
+    if (solver.info() != Eigen::Success) return begin;
+    const Vec3d axis = solver.eigenvectors().col(2);
+    auto* p = tree_.prims.data();
+    return std::uint32_t(std::partition(p + begin, p + end, [&](std::uint32_t prim) {
+                           return (centers_[prim].cast<double>() - mean).dot(axis) < 0;
+                         }) - p);
+  }
+
+  // Area of the box's section orthogonal to `axis`; flat sides count as a
+  // tiny fraction of the largest extent so that flat boxes still compare.
+  static double cross_section(const AABB3f& box, int axis) {
+    const Vec3d e = box.extent().cast<double>();
+    const double floor = 1e-6 * std::max(e.maxCoeff(), 1e-30);
+    return std::max(e[(axis + 1) % 3], floor) * std::max(e[(axis + 2) % 3], floor);
+  }
+
+  // Restricted boxtree (§4.1.5): each child is the parent box cut by one
+  // plane, a "lower" box [lo, m] or an "upper" box [m, hi] along the axis, so
+  // a child's volume is proportional to its length along the axis. For each
+  // axis and each pairing (lower+upper, lower+lower, upper+upper) two seeds
+  // nearest the outer borders start the subsets; every other primitive joins
+  // the subset whose volume grows least, visiting the array alternately from
+  // the front and the back. The split with the least total volume wins.
+  std::uint32_t split_boxtree(std::uint32_t begin, std::uint32_t end, const AABB3f& parent) {
+    const std::uint32_t count = end - begin;
+    std::vector<std::uint8_t> side(count), best_side;
+    double best_total = std::numeric_limits<double>::infinity();
+    const std::uint32_t* p = tree_.prims.data() + begin;
+    for (int a = 0; a < 3; ++a) {
+      const double plo = parent.lo[a], phi = parent.hi[a];
+      if (!(phi > plo)) continue;
+      for (int pairing = 0; pairing < 3; ++pairing) {
+        // upper[s]: subset s forms an upper box.
+        const bool upper[2] = {pairing == 2, pairing >= 1};
+        // Seeds: a lower box is seeded by the primitive reaching least far up,
+        // an upper box by the one reaching least far down.
+        std::uint32_t seed[2] = {count, count};
+        for (int s = 0; s < 2; ++s) {
+          double best = std::numeric_limits<double>::infinity();
+          for (std::uint32_t i = 0; i < count; ++i) {
+            if (s == 1 && i == seed[0]) continue;
+            const double key = upper[s] ? -double(boxes_[p[i]].lo[a]) : double(boxes_[p[i]].hi[a]);
+            if (key < best) best = key, seed[s] = i;
+          }
+        }
+        double reach[2];  // lower box: its top; upper box: its bottom
+        for (int s = 0; s < 2; ++s) {
+          const AABB3f& b = boxes_[p[seed[s]]];
+          reach[s] = upper[s] ? b.lo[a] : b.hi[a];
+          side[seed[s]] = std::uint8_t(s);
+        }
+        std::uint32_t size[2] = {1, 1};
+        auto length = [&](int s, double r) { return upper[s] ? phi - r : r - plo; };
+        for (std::uint32_t k = 0; k < count; ++k) {
+          const std::uint32_t i = (k % 2 == 0) ? k / 2 : count - 1 - k / 2;
+          if (i == seed[0] || i == seed[1]) continue;
+          const AABB3f& b = boxes_[p[i]];
+          double grown[2], increase[2];
+          for (int s = 0; s < 2; ++s) {
+            grown[s] = upper[s] ? std::min(reach[s], double(b.lo[a])) : std::max(reach[s], double(b.hi[a]));
+            increase[s] = length(s, grown[s]) - length(s, reach[s]);
+          }
+          const int s = increase[0] < increase[1] ? 0 : increase[1] < increase[0] ? 1 : (size[0] <= size[1] ? 0 : 1);
+          reach[s] = grown[s];
+          side[i] = std::uint8_t(s);
+          ++size[s];
+        }
+        const double total = (length(0, reach[0]) + length(1, reach[1])) * cross_section(parent, a);
+        if (total < best_total) best_total = total, best_side = side;
+      }
+    }
+    if (best_side.empty()) return begin;
+    // Stable partition of the ids by the chosen sides.
+    std::vector<std::uint32_t> ids(p, p + count);
+    std::uint32_t* out = tree_.prims.data() + begin;
+    std::uint32_t n0 = 0;
+    for (std::uint32_t i = 0; i < count; ++i)
+      if (best_side[i] == 0) out[n0++] = ids[i];
+    std::uint32_t n1 = n0;
+    for (std::uint32_t i = 0; i < count; ++i)
+      if (best_side[i] == 1) out[n1++] = ids[i];
+    return begin + n0;
+  }
+
+  std::span<const AABB3f> boxes_;
+  const BuildOptions& options_;
+  std::vector<Vec3f> centers_;
+  BinaryTree tree_;
+  std::atomic<std::uint32_t> next_{0};
+};
+
+}  // namespace
+
+BinaryTree build_top_down(std::span<const AABB3f> boxes, const BuildOptions& options) {
+  return TopDown(boxes, options).run();
+}
+
+}  // namespace geods::bvh::detail

@@ -1,0 +1,691 @@
+// TriangleBvh: build (topology, volumes, wide nodes) and the queries.
+#include "geods/bvh/triangle_bvh.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <string>
+#include <type_traits>
+
+#include "geods/bvh/triangle_box.hpp"
+#include "geods/core/error.hpp"
+#include "geods/core/parallel.hpp"
+#include "geods/core/triangle.hpp"
+
+namespace geods::bvh {
+namespace {
+
+// A traversal stack: an inline buffer for the usual depths, the heap for the
+// deep trees the insertion builder can make.
+template <typename Entry>
+class TraversalStack {
+ public:
+  explicit TraversalStack(std::size_t capacity) {
+    if (capacity > inline_.size()) {
+      heap_.resize(capacity);
+      data_ = heap_.data();
+    }
+  }
+  void push(const Entry& e) { data_[size_++] = e; }
+  Entry pop() { return data_[--size_]; }
+  bool empty() const { return size_ == 0; }
+
+ private:
+  std::array<Entry, 256> inline_;
+  std::vector<Entry> heap_;
+  Entry* data_ = inline_.data();
+  std::size_t size_ = 0;
+};
+
+struct NodeEntry {
+  std::uint32_t node;
+  float t;
+};
+
+template <typename BV>
+BV fit_points(std::span<const Vec3f> points) {
+  if constexpr (std::is_same_v<BV, AABB3f>) {
+    return fit_aabb<float>(points);
+  } else if constexpr (std::is_same_v<BV, Sphere3f>) {
+    return fit_sphere<float>(points);
+  } else if constexpr (std::is_same_v<BV, Obb3f>) {
+    return fit_obb<float>(points);
+  } else {
+    return fit_kdop<float, BV::num_axes * 2>(points);
+  }
+}
+
+template <typename BV>
+std::pair<double, double> measures(const BV& bv) {
+  if constexpr (std::is_same_v<BV, AABB3f> || std::is_same_v<BV, Sphere3f> || std::is_same_v<BV, Obb3f>) {
+    return {double(volume(bv)), double(surface_area(bv))};
+  } else {
+    return kdop_measures(bv);
+  }
+}
+
+// A bounding-volume interval test must never reject a box the exact
+// triangle test would hit: widen the far end by a few ulps (Ize 2013).
+inline bool interval_hit(std::pair<float, float> iv) {
+  return iv.first <= iv.second + std::abs(iv.second) * 4e-7f;
+}
+
+// Directions whose components are far from any simple ratio, so that rays
+// from a point rarely pass exactly through edges or vertices.
+const std::array<Vec3f, 7> kContainDirections = {
+    Vec3f(0.5377f, 1.8339f, -2.2588f).normalized(), Vec3f(0.8622f, 0.3188f, -1.3077f).normalized(),
+    Vec3f(-0.4336f, 0.3426f, 3.5784f).normalized(), Vec3f(2.7694f, -1.3499f, 3.0349f).normalized(),
+    Vec3f(0.7254f, -0.0631f, 0.7147f).normalized(), Vec3f(-0.2050f, -0.1241f, 1.4897f).normalized(),
+    Vec3f(1.4090f, 1.4172f, 0.6715f).normalized()};
+
+}  // namespace
+
+// ------------------------------------------------------------------ build
+
+TriangleBvh TriangleBvh::build(const TriMesh& mesh, const BuildOptions& options) {
+  check_options(options);
+  mesh.require_valid("bvh");
+  Progress progress(options.progress, "bvh build", 3);
+  TriangleBvh bvh;
+  bvh.options_ = options;
+  bvh.options_.progress = nullptr;
+  const std::size_t n = mesh.num_triangles();
+  std::vector<AABB3f> boxes(n);
+  parallel_for_each_index(0, n, [&](std::size_t i) {
+    const auto& t = mesh.triangles[i];
+    boxes[i] = triangle_bounds(mesh.vertices[t[0]], mesh.vertices[t[1]], mesh.vertices[t[2]]);
+  });
+  bvh.topology_ = build_topology(boxes, options);
+  progress.update(1);
+  bvh.triangles_.resize(n);
+  parallel_for_each_index(0, n, [&](std::size_t i) {
+    const auto& t = mesh.triangles[bvh.topology_.prim_order[i]];
+    bvh.triangles_[i] = {mesh.vertices[t[0]], mesh.vertices[t[1]], mesh.vertices[t[2]]};
+  });
+  switch (options.bv) {
+    case BoundingVolume::aabb: bvh.fit_volumes<AABB3f>(); break;
+    case BoundingVolume::sphere: bvh.fit_volumes<Sphere3f>(); break;
+    case BoundingVolume::kdop6: bvh.fit_volumes<Kdop<float, 6>>(); break;
+    case BoundingVolume::kdop14: bvh.fit_volumes<Kdop<float, 14>>(); break;
+    case BoundingVolume::kdop18: bvh.fit_volumes<Kdop<float, 18>>(); break;
+    case BoundingVolume::kdop26: bvh.fit_volumes<Kdop<float, 26>>(); break;
+    case BoundingVolume::obb: bvh.fit_volumes<Obb3f>(); break;
+  }
+  progress.update(2);
+  if (options.bv == BoundingVolume::aabb && options.arity >= 4 && n > 0) bvh.build_wide();
+  progress.finish();
+  return bvh;
+}
+
+template <typename BV>
+void TriangleBvh::fit_volumes() {
+  const auto& nodes = topology_.nodes;
+  std::vector<BV> vols(nodes.size());
+  auto points_of = [&](const TopoNode& node, std::vector<Vec3f>& pts) {
+    pts.clear();
+    for (std::uint32_t i = node.prim_first; i < node.prim_first + node.prim_count; ++i) {
+      pts.push_back(triangles_[i].a);
+      pts.push_back(triangles_[i].b);
+      pts.push_back(triangles_[i].c);
+    }
+  };
+  constexpr bool mergeable = std::is_same_v<BV, AABB3f> || !(std::is_same_v<BV, Sphere3f> || std::is_same_v<BV, Obb3f>);
+  if constexpr (mergeable) {
+    // Boxes and k-DOPs merge exactly: fit the leaves, merge upwards (children follow parents).
+    parallel_for(0, nodes.size(), 1024, [&](std::size_t b, std::size_t e) {
+      std::vector<Vec3f> pts;
+      for (std::size_t i = b; i < e; ++i)
+        if (nodes[i].leaf()) {
+          points_of(nodes[i], pts);
+          vols[i] = fit_points<BV>(pts);
+        }
+    });
+    for (std::size_t i = nodes.size(); i-- > 0;) {
+      if (nodes[i].leaf()) continue;
+      BV v = vols[nodes[i].first_child];
+      for (std::uint32_t c = 1; c < nodes[i].num_children; ++c) v = merge(v, vols[nodes[i].first_child + c]);
+      vols[i] = v;
+    }
+  } else {
+    // Spheres and OBBs are fitted to all vertices below the node: much tighter than merging.
+    parallel_for(0, nodes.size(), 16, [&](std::size_t b, std::size_t e) {
+      std::vector<Vec3f> pts;
+      for (std::size_t i = b; i < e; ++i) {
+        points_of(nodes[i], pts);
+        vols[i] = fit_points<BV>(pts);
+      }
+    });
+  }
+  volumes_ = std::move(vols);
+}
+
+void TriangleBvh::build_wide() {
+  const auto& nodes = topology_.nodes;
+  const auto& boxes = std::get<std::vector<AABB3f>>(volumes_);
+  std::vector<std::uint32_t> wide_index(nodes.size(), 0);
+  std::uint32_t inner = 0;
+  for (std::size_t i = 0; i < nodes.size(); ++i)
+    if (!nodes[i].leaf()) wide_index[i] = inner++;
+  auto fill = [&](auto& out) {
+    using Node = typename std::decay_t<decltype(out)>::value_type;
+    constexpr int W = sizeof(Node::child) / sizeof(std::uint32_t);
+    auto set_child = [&](Node& w, int slot, std::uint32_t c) {
+      for (int a = 0; a < 3; ++a) {
+        w.bounds[2 * a][slot] = boxes[c].lo[a];
+        w.bounds[2 * a + 1][slot] = boxes[c].hi[a];
+      }
+      w.child[slot] = nodes[c].leaf() ? nodes[c].prim_first : wide_index[c];
+      w.count[slot] = nodes[c].leaf() ? nodes[c].prim_count : 0;
+    };
+    auto empty_node = [] {
+      Node w;
+      for (int a = 0; a < 3; ++a)
+        for (int i = 0; i < W; ++i) {
+          w.bounds[2 * a][i] = std::numeric_limits<float>::infinity();
+          w.bounds[2 * a + 1][i] = -std::numeric_limits<float>::infinity();
+        }
+      for (int i = 0; i < W; ++i) w.child[i] = Node::kEmpty, w.count[i] = 0;
+      return w;
+    };
+    out.assign(std::max<std::uint32_t>(inner, 1), empty_node());
+    if (nodes[0].leaf()) {  // a single leaf: one wide node holding it
+      set_child(out[0], 0, 0);
+      return;
+    }
+    for (std::size_t i = 0; i < nodes.size(); ++i) {
+      if (nodes[i].leaf()) continue;
+      for (std::uint32_t c = 0; c < nodes[i].num_children; ++c)
+        set_child(out[wide_index[i]], int(c), nodes[i].first_child + c);
+    }
+  };
+  if (options_.arity == 8) {
+    fill(wide8_);
+  } else {
+    fill(wide4_);
+  }
+}
+
+// ------------------------------------------------------------------ rays
+
+namespace {
+
+template <int W>
+struct SimdTypes;
+template <>
+struct SimdTypes<4> {
+  typedef float vf __attribute__((vector_size(16)));
+};
+template <>
+struct SimdTypes<8> {
+  typedef float vf __attribute__((vector_size(32)));
+};
+
+}  // namespace
+
+template <int W>
+RayHit TriangleBvh::intersect_wide(const std::vector<WideNode<W>>& nodes, const Ray3f& ray, bool any) const {
+  using vf = typename SimdTypes<W>::vf;
+  RayHit hit;
+  if (nodes.empty()) return hit;
+  const RayTriangleTest<float> test(ray);
+  // Tiny direction components are replaced by +-1e-30 so that no 0 * inf
+  // NaN appears; the near bound of each axis is chosen by the sign.
+  float org[3], inv[3];
+  int near_row[3];
+  for (int a = 0; a < 3; ++a) {
+    const float d = ray.direction[a];
+    const float safe = std::abs(d) < 1e-30f ? std::copysign(1e-30f, d) : d;
+    inv[a] = 1.0f / safe;
+    org[a] = ray.origin[a];
+    near_row[a] = 2 * a + (inv[a] < 0 ? 1 : 0);
+  }
+  float tmax = ray.tmax;
+  const float tmin = ray.tmin;
+  struct Entry {
+    std::uint32_t child, count;
+    float t;
+  };
+  TraversalStack<Entry> stack(std::size_t(topology_.depth() + 2) * W);
+  stack.push({0, 0, tmin});
+  while (!stack.empty()) {
+    const Entry e = stack.pop();
+    if (e.t > tmax) continue;
+    if (e.count > 0) {
+      for (std::uint32_t i = e.child; i < e.child + e.count; ++i) {
+        const Triangle& tri = triangles_[i];
+        float t, u, v;
+        if (test.intersect(tri.a, tri.b, tri.c, tmin, tmax, t, u, v)) {
+          tmax = t;
+          hit.t = t;
+          hit.u = u;
+          hit.v = v;
+          hit.prim = i;  // mapped to the mesh index at the end
+          if (any) {
+            hit.prim = topology_.prim_order[i];
+            return hit;
+          }
+        }
+      }
+      continue;
+    }
+    const WideNode<W>& node = nodes[e.child];
+    vf tn, tf;
+    for (int i = 0; i < W; ++i) tn[i] = tmin, tf[i] = tmax;
+    for (int a = 0; a < 3; ++a) {
+      vf lo, hi;
+      std::memcpy(&lo, node.bounds[near_row[a]], sizeof(vf));
+      std::memcpy(&hi, node.bounds[near_row[a] ^ 1], sizeof(vf));
+      const vf t0 = (lo - org[a]) * inv[a];
+      const vf t1 = (hi - org[a]) * inv[a];
+      tn = t0 > tn ? t0 : tn;
+      tf = t1 < tf ? t1 : tf;
+    }
+    // Widened far bound: a box hit that rounding would lose is kept (Ize 2013).
+    const auto mask = tn <= tf * (1.0f + 4e-7f);
+    Entry hits[W];
+    int nh = 0;
+    for (int i = 0; i < W; ++i) {
+      if (!mask[i]) continue;
+      Entry h{node.child[i], node.count[i], tn[i]};
+      // Insertion sort, farthest first, so the nearest child is popped first.
+      int k = nh++;
+      while (k > 0 && hits[k - 1].t < h.t) {
+        hits[k] = hits[k - 1];
+        --k;
+      }
+      hits[k] = h;
+    }
+    for (int i = 0; i < nh; ++i) stack.push(hits[i]);
+  }
+  if (hit.hit()) hit.prim = topology_.prim_order[hit.prim];
+  return hit;
+}
+
+template <typename BV>
+RayHit TriangleBvh::intersect_generic(const std::vector<BV>& volumes, const Ray3f& ray, bool any) const {
+  RayHit hit;
+  if (volumes.empty()) return hit;
+  const RayTriangleTest<float> test(ray);
+  const Vec3f inv = ray.direction.cwiseInverse();
+  Ray3f clipped = ray;
+  const auto& nodes = topology_.nodes;
+  TraversalStack<NodeEntry> stack(std::size_t(topology_.depth() + 2) * std::size_t(options_.arity));
+  const auto root = ray_interval(volumes[0], clipped, inv);
+  if (!interval_hit(root)) return hit;
+  stack.push({0, root.first});
+  while (!stack.empty()) {
+    const NodeEntry e = stack.pop();
+    if (e.t > clipped.tmax) continue;
+    const TopoNode& node = nodes[e.node];
+    if (node.leaf()) {
+      for (std::uint32_t i = node.prim_first; i < node.prim_first + node.prim_count; ++i) {
+        const Triangle& tri = triangles_[i];
+        float t, u, v;
+        if (test.intersect(tri.a, tri.b, tri.c, ray.tmin, clipped.tmax, t, u, v)) {
+          clipped.tmax = t;
+          hit = {t, topology_.prim_order[i], u, v};
+          if (any) return hit;
+        }
+      }
+      continue;
+    }
+    NodeEntry hits[8];
+    int nh = 0;
+    for (std::uint32_t c = 0; c < node.num_children; ++c) {
+      const auto iv = ray_interval(volumes[node.first_child + c], clipped, inv);
+      if (!interval_hit(iv)) continue;
+      NodeEntry h{node.first_child + c, iv.first};
+      int k = nh++;
+      while (k > 0 && hits[k - 1].t < h.t) {
+        hits[k] = hits[k - 1];
+        --k;
+      }
+      hits[k] = h;
+    }
+    for (int i = 0; i < nh; ++i) stack.push(hits[i]);
+  }
+  return hit;
+}
+
+RayHit TriangleBvh::intersect(const Ray3f& ray) const {
+  if (!wide4_.empty()) return intersect_wide(wide4_, ray, false);
+  if (!wide8_.empty()) return intersect_wide(wide8_, ray, false);
+  return std::visit([&](const auto& vols) { return intersect_generic(vols, ray, false); }, volumes_);
+}
+
+bool TriangleBvh::occluded(const Ray3f& ray) const {
+  if (!wide4_.empty()) return intersect_wide(wide4_, ray, true).hit();
+  if (!wide8_.empty()) return intersect_wide(wide8_, ray, true).hit();
+  return std::visit([&](const auto& vols) { return intersect_generic(vols, ray, true).hit(); }, volumes_);
+}
+
+// ------------------------------------------------------------------ closest point, containment
+
+template <typename BV>
+ClosestPoint TriangleBvh::closest_generic(const std::vector<BV>& volumes, std::uint32_t start, const Vec3f& p,
+                                          float max_distance) const {
+  ClosestPoint best;
+  if (volumes.empty()) return best;
+  float best_d2 = max_distance * max_distance;
+  const auto& nodes = topology_.nodes;
+  TraversalStack<NodeEntry> stack(std::size_t(topology_.depth() + 2) * std::size_t(options_.arity));
+  stack.push({start, squared_distance(volumes[start], p)});
+  while (!stack.empty()) {
+    const NodeEntry e = stack.pop();
+    if (e.t > best_d2) continue;
+    const TopoNode& node = nodes[e.node];
+    if (node.leaf()) {
+      for (std::uint32_t i = node.prim_first; i < node.prim_first + node.prim_count; ++i) {
+        const Triangle& tri = triangles_[i];
+        const Vec3f q = closest_point_on_triangle(p, tri.a, tri.b, tri.c);
+        const float d2 = (q - p).squaredNorm();
+        if (d2 < best_d2 || (d2 == best_d2 && best.prim == RayHit::no_hit)) {
+          best_d2 = d2;
+          best.point = q;
+          best.prim = topology_.prim_order[i];
+        }
+      }
+      continue;
+    }
+    NodeEntry hits[8];
+    int nh = 0;
+    for (std::uint32_t c = 0; c < node.num_children; ++c) {
+      const float d2 = squared_distance(volumes[node.first_child + c], p);
+      if (d2 > best_d2) continue;
+      NodeEntry h{node.first_child + c, d2};
+      int k = nh++;
+      while (k > 0 && hits[k - 1].t < h.t) {
+        hits[k] = hits[k - 1];
+        --k;
+      }
+      hits[k] = h;
+    }
+    for (int i = 0; i < nh; ++i) stack.push(hits[i]);
+  }
+  if (best.prim != RayHit::no_hit) best.distance = std::sqrt(best_d2);
+  return best;
+}
+
+ClosestPoint TriangleBvh::closest_point(const Vec3f& p, float max_distance) const {
+  if (!p.allFinite()) throw Error("bvh closest_point: the query point is not finite");
+  return std::visit([&](const auto& vols) { return closest_generic(vols, 0, p, max_distance); }, volumes_);
+}
+
+template <typename Fn>
+void TriangleBvh::for_each_crossing(const Ray3f& ray, Fn&& fn) const {
+  std::visit(
+      [&](const auto& volumes) {
+        if (volumes.empty()) return;
+        const RayTriangleTest<float> test(ray);
+        const Vec3f inv = ray.direction.cwiseInverse();
+        const auto& nodes = topology_.nodes;
+        TraversalStack<std::uint32_t> stack(std::size_t(topology_.depth() + 2) * std::size_t(options_.arity));
+        if (interval_hit(ray_interval(volumes[0], ray, inv))) stack.push(0);
+        while (!stack.empty()) {
+          const TopoNode& node = nodes[stack.pop()];
+          if (node.leaf()) {
+            for (std::uint32_t i = node.prim_first; i < node.prim_first + node.prim_count; ++i) {
+              float t, u, v;
+              if (test.intersect(triangles_[i].a, triangles_[i].b, triangles_[i].c, ray.tmin, ray.tmax, t, u, v))
+                fn(t, u, v);
+            }
+            continue;
+          }
+          for (std::uint32_t c = 0; c < node.num_children; ++c)
+            if (interval_hit(ray_interval(volumes[node.first_child + c], ray, inv))) stack.push(node.first_child + c);
+        }
+      },
+      volumes_);
+}
+
+bool TriangleBvh::contains(const Vec3f& p) const {
+  if (!p.allFinite()) throw Error("bvh contains: the query point is not finite");
+  if (triangles_.empty()) return false;
+  // On the surface (up to 1e-6 of the mesh size): inside.
+  const float size = std::visit([](const auto& v) { return bounds(v[0]).extent().maxCoeff(); }, volumes_);
+  if (closest_point(p, std::max(size, 1e-30f) * 1e-6f).prim != RayHit::no_hit) return true;
+  constexpr float kEdge = 1e-5f;  // a crossing this close to an edge makes the ray untrusted
+  int votes_in = 0, trusted = 0, first_parity = -1;
+  for (const Vec3f& d : kContainDirections) {
+    Ray3f ray;
+    ray.origin = p;
+    ray.direction = d;
+    int crossings = 0;
+    bool on_surface = false, near_edge = false;
+    for_each_crossing(ray, [&](float t, float u, float v) {
+      ++crossings;
+      if (t == 0.0f) on_surface = true;
+      if (u < kEdge || v < kEdge || 1.0f - u - v < kEdge) near_edge = true;
+    });
+    if (on_surface) return true;
+    if (first_parity < 0) first_parity = crossings % 2;
+    if (near_edge) continue;
+    votes_in += crossings % 2;
+    if (++trusted == 3) break;
+  }
+  if (trusted == 0) return first_parity == 1;
+  return 2 * votes_in > trusted;
+}
+
+// ------------------------------------------------------------------ culling
+
+std::vector<std::uint32_t> TriangleBvh::cull_box(const AABB3f& box) const {
+  std::vector<std::uint32_t> out;
+  std::visit(
+      [&](const auto& volumes) {
+        if (volumes.empty() || box.empty()) return;
+        std::vector<std::uint32_t> stack{0};
+        while (!stack.empty()) {
+          const std::uint32_t id = stack.back();
+          stack.pop_back();
+          if (!bounds(volumes[id]).overlaps(box)) continue;
+          const TopoNode& node = topology_.nodes[id];
+          if (node.leaf()) {
+            for (std::uint32_t i = node.prim_first; i < node.prim_first + node.prim_count; ++i)
+              if (triangle_box_overlap(triangles_[i].a, triangles_[i].b, triangles_[i].c, box))
+                out.push_back(topology_.prim_order[i]);
+            continue;
+          }
+          for (std::uint32_t c = 0; c < node.num_children; ++c) stack.push_back(node.first_child + c);
+        }
+      },
+      volumes_);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+std::vector<std::uint32_t> TriangleBvh::cull_frustum(std::span<const Plane3f> planes) const {
+  std::vector<std::uint32_t> out;
+  std::vector<Plane3f> outward;
+  for (const Plane3f& p : planes) outward.push_back(p.flipped());
+  std::visit(
+      [&](const auto& volumes) {
+        if (volumes.empty()) return;
+        std::vector<std::uint32_t> stack{0};
+        while (!stack.empty()) {
+          const std::uint32_t id = stack.back();
+          stack.pop_back();
+          bool culled = false;
+          for (const Plane3f& p : outward) culled = culled || above(volumes[id], p);
+          if (culled) continue;
+          const TopoNode& node = topology_.nodes[id];
+          if (node.leaf()) {
+            for (std::uint32_t i = node.prim_first; i < node.prim_first + node.prim_count; ++i) {
+              const Triangle& t = triangles_[i];
+              bool outside = false;
+              for (const Plane3f& p : planes)
+                outside = outside || (p.signed_distance(t.a) < 0 && p.signed_distance(t.b) < 0 &&
+                                      p.signed_distance(t.c) < 0);
+              if (!outside) out.push_back(topology_.prim_order[i]);
+            }
+            continue;
+          }
+          for (std::uint32_t c = 0; c < node.num_children; ++c) stack.push_back(node.first_child + c);
+        }
+      },
+      volumes_);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+// ------------------------------------------------------------------ stats, validate
+
+BvhStats TriangleBvh::stats() const {
+  BvhStats s;
+  const auto& nodes = topology_.nodes;
+  s.triangles = triangles_.size();
+  s.nodes = nodes.size();
+  for (const auto& n : nodes) s.leaves += n.leaf();
+  s.depth = topology_.depth();
+  s.bytes = nodes.size() * sizeof(TopoNode) + topology_.prim_order.size() * sizeof(std::uint32_t) +
+            triangles_.size() * sizeof(Triangle) + wide4_.size() * sizeof(WideNode<4>) +
+            wide8_.size() * sizeof(WideNode<8>);
+  if (nodes.empty()) return s;
+  std::visit(
+      [&](const auto& volumes) {
+        using BV = typename std::decay_t<decltype(volumes)>::value_type;
+        s.bytes += volumes.size() * sizeof(BV);
+        std::vector<std::pair<double, double>> m(nodes.size());
+        parallel_for_each_index(0, nodes.size(), [&](std::size_t i) { m[i] = measures(volumes[i]); }, 256);
+        double cost = 0, tight = 0;
+        std::size_t inner = 0;
+        for (std::size_t i = 0; i < nodes.size(); ++i) {
+          if (nodes[i].leaf()) {
+            cost += m[i].second * nodes[i].prim_count;
+            continue;
+          }
+          cost += m[i].second;
+          double children = 0;
+          for (std::uint32_t c = 0; c < nodes[i].num_children; ++c) children += m[nodes[i].first_child + c].first;
+          if (children > 0) {
+            tight += m[i].first / children;
+            ++inner;
+          }
+        }
+        s.sah_cost = m[0].second > 0 ? cost / m[0].second : 0;
+        s.tightness_volume = inner ? tight / double(inner) : 0;
+        // Definition 3 on the top three levels.
+        std::vector<int> level(nodes.size(), 0);
+        std::vector<std::uint32_t> top;
+        for (std::size_t i = 0; i < nodes.size(); ++i) {
+          if (level[i] <= 2) top.push_back(std::uint32_t(i));
+          for (std::uint32_t c = 0; c < nodes[i].num_children; ++c) level[nodes[i].first_child + c] = level[i] + 1;
+        }
+        std::vector<double> ratio(top.size(), -1);
+        parallel_for_each_index(0, top.size(), [&](std::size_t k) {
+          const std::uint32_t id = top[k];
+          const TopoNode& node = nodes[id];
+          double diam = 0;
+          for (const auto& dir : kdop_all_directions) {
+            const Vec3f d{float(dir[0]), float(dir[1]), float(dir[2])};
+            float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+            for (std::uint32_t i = node.prim_first; i < node.prim_first + node.prim_count; ++i)
+              for (const Vec3f* v : {&triangles_[i].a, &triangles_[i].b, &triangles_[i].c}) {
+                lo = std::min(lo, d.dot(*v));
+                hi = std::max(hi, d.dot(*v));
+              }
+            diam = std::max(diam, double(hi - lo) / double(d.norm()));
+          }
+          const AABB3f box = bounds(volumes[id]);
+          double h = -1;
+          for (int x = 0; x < 5; ++x)
+            for (int y = 0; y < 5; ++y)
+              for (int z = 0; z < 5; ++z) {
+                const Vec3f q = box.lo + Vec3f((x + 0.5f) / 5, (y + 0.5f) / 5, (z + 0.5f) / 5).cwiseProduct(box.extent());
+                if (!bvh::contains(volumes[id], q)) continue;
+                h = std::max(h, double(closest_generic(volumes, id, q, std::numeric_limits<float>::infinity()).distance));
+              }
+          if (h >= 0 && diam > 0) ratio[k] = h / diam;
+        }, 1);
+        double sum = 0;
+        int counted = 0;
+        for (double r : ratio)
+          if (r >= 0) sum += r, ++counted;
+        s.tightness_hausdorff = counted ? sum / counted : 0;
+      },
+      volumes_);
+  return s;
+}
+
+void TriangleBvh::validate() const {
+  const auto& nodes = topology_.nodes;
+  const std::size_t n = triangles_.size();
+  auto fail = [](const std::string& what) { throw Error("bvh validate: " + what); };
+  if (topology_.prim_order.size() != n) fail("triangle id count differs from the triangle count");
+  if (n == 0) {
+    if (!nodes.empty()) fail("nodes without triangles");
+    return;
+  }
+  std::vector<char> seen(n, 0);
+  for (std::uint32_t id : topology_.prim_order) {
+    if (id >= n || seen[id]) fail("triangle ids are not a permutation");
+    seen[id] = 1;
+  }
+  if (nodes[0].prim_first != 0 || nodes[0].prim_count != n) fail("the root does not cover every triangle");
+  std::vector<char> reached(nodes.size(), 0);
+  reached[0] = 1;
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    const TopoNode& node = nodes[i];
+    const std::string at = "node " + std::to_string(i) + ": ";
+    if (!reached[i]) fail(at + "not reachable from the root");
+    if (node.prim_count == 0) fail(at + "covers no triangle");
+    if (node.leaf()) {
+      if (node.prim_count > std::uint32_t(options_.leaf_size)) fail(at + "leaf larger than leaf_size");
+      continue;
+    }
+    if (node.num_children < 2 || node.num_children > std::uint32_t(options_.arity)) fail(at + "bad child count");
+    if (node.first_child <= i || node.first_child + node.num_children > nodes.size()) fail(at + "bad child index");
+    std::uint32_t next = node.prim_first;
+    for (std::uint32_t c = 0; c < node.num_children; ++c) {
+      const TopoNode& child = nodes[node.first_child + c];
+      if (reached[node.first_child + c]) fail(at + "child with two parents");
+      reached[node.first_child + c] = 1;
+      if (child.prim_first != next) fail(at + "children do not partition its triangle range");
+      next += child.prim_count;
+    }
+    if (next != node.prim_first + node.prim_count) fail(at + "children do not partition its triangle range");
+  }
+  std::visit(
+      [&](const auto& volumes) {
+        if (volumes.size() != nodes.size()) fail("one bounding volume per node expected");
+        for (std::size_t i = 0; i < nodes.size(); ++i)
+          for (std::uint32_t t = nodes[i].prim_first; t < nodes[i].prim_first + nodes[i].prim_count; ++t)
+            for (const Vec3f* v : {&triangles_[t].a, &triangles_[t].b, &triangles_[t].c})
+              if (!bvh::contains(volumes[i], *v))
+                fail("node " + std::to_string(i) + ": a vertex of triangle " + std::to_string(topology_.prim_order[t]) +
+                     " lies outside its bounding volume");
+      },
+      volumes_);
+  const bool wide = options_.bv == BoundingVolume::aabb && options_.arity >= 4 && n > 0;
+  if (wide != (!wide4_.empty() || !wide8_.empty())) fail("wide nodes missing or unexpected");
+  auto check_wide = [&](const auto& wnodes) {
+    // Every triangle must be reachable exactly once through the wide nodes.
+    std::vector<char> covered(n, 0);
+    std::vector<std::uint32_t> stack{0};
+    while (!stack.empty()) {
+      const auto& w = wnodes[stack.back()];
+      stack.pop_back();
+      for (std::size_t s = 0; s < std::size(w.child); ++s) {
+        if (w.child[s] == std::decay_t<decltype(w)>::kEmpty) continue;
+        const AABB3f box({w.bounds[0][s], w.bounds[2][s], w.bounds[4][s]}, {w.bounds[1][s], w.bounds[3][s], w.bounds[5][s]});
+        if (w.count[s] == 0) {
+          if (w.child[s] >= wnodes.size()) fail("wide node child out of range");
+          stack.push_back(w.child[s]);
+          continue;
+        }
+        for (std::uint32_t t = w.child[s]; t < w.child[s] + w.count[s]; ++t) {
+          if (t >= n || covered[t]) fail("wide leaves do not cover each triangle once");
+          covered[t] = 1;
+          if (!box.contains(triangles_[t].a) || !box.contains(triangles_[t].b) || !box.contains(triangles_[t].c))
+            fail("a wide leaf box does not hold its triangle");
+        }
+      }
+    }
+    if (std::count(covered.begin(), covered.end(), 1) != std::ptrdiff_t(n)) fail("wide leaves miss triangles");
+  };
+  if (!wide4_.empty()) check_wide(wide4_);
+  if (!wide8_.empty()) check_wide(wide8_);
+}
+
+}  // namespace geods::bvh

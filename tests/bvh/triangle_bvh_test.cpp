@@ -1,0 +1,340 @@
+// TriangleBvh queries against brute force, for every builder and bounding volume.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <tuple>
+
+#include "bvh_test_util.hpp"
+#include "geods/bvh/triangle_box.hpp"
+#include "geods/core/error.hpp"
+#include "geods/core/parallel.hpp"
+
+namespace geods::bvh {
+namespace {
+
+using test::brute_intersect;
+
+constexpr Builder kBuilders[] = {Builder::sah,    Builder::median,    Builder::pca,    Builder::bottom_up,
+                                 Builder::tiling, Builder::insertion, Builder::boxtree};
+constexpr BoundingVolume kVolumes[] = {BoundingVolume::aabb,   BoundingVolume::sphere, BoundingVolume::kdop6,
+                                       BoundingVolume::kdop14, BoundingVolume::kdop18, BoundingVolume::kdop26,
+                                       BoundingVolume::obb};
+
+// The closest hit must have the brute-force t, and its triangle must be hit
+// there. Where several triangles meet the ray at the same exact point (a ray
+// through a vertex), their float t differ in the last bits and a traversal may
+// prune the one that rounded lowest: t agrees up to 1e-6 relative.
+void expect_same_hit(const TriMesh& mesh, const Ray3f& ray, const RayHit& got, const RayHit& want, const std::string& what) {
+  ASSERT_EQ(got.hit(), want.hit()) << what;
+  if (!want.hit()) return;
+  ASSERT_NEAR(got.t, want.t, 1e-6f * std::max(1.0f, want.t)) << what;
+  ASSERT_TRUE(test::hits_at(mesh, got.prim, ray, got.t)) << what;
+}
+
+void check_rays(const TriMesh& mesh, const TriangleBvh& bvh, const std::vector<Ray3f>& rays,
+                const std::vector<RayHit>& expected, const std::string& what) {
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    expect_same_hit(mesh, rays[i], bvh.intersect(rays[i]), expected[i], what + " ray " + std::to_string(i));
+    ASSERT_EQ(bvh.occluded(rays[i]), expected[i].hit()) << what << " ray " << i;
+  }
+}
+
+TEST(TriangleBvh, EveryBuilderAndVolumeMatchesBruteForceOnTheBunny) {
+  const TriMesh bunny = test::data_mesh("bunny.ply");
+  const auto rays = test::test_rays(bunny, 120, 1);
+  std::vector<RayHit> expected;
+  for (const auto& r : rays) expected.push_back(brute_intersect(bunny, r));
+  Rng rng(2);
+  std::vector<Vec3f> points;
+  for (int i = 0; i < 20; ++i) points.push_back(test::random_point(rng, -1.2f, 1.2f));
+  std::vector<float> distances;
+  for (const auto& p : points) distances.push_back(test::brute_distance(bunny, p));
+  for (Builder builder : kBuilders)
+    for (BoundingVolume bv : kVolumes) {
+      BuildOptions options;
+      options.builder = builder;
+      options.bv = bv;
+      options.arity = bv == BoundingVolume::aabb ? 4 : 2;
+      const std::string what = std::string(to_string(builder)) + "/" + std::string(to_string(bv));
+      const TriangleBvh bvh = TriangleBvh::build(bunny, options);
+      ASSERT_NO_THROW(bvh.validate()) << what;
+      check_rays(bunny, bvh, rays, expected, what);
+      for (std::size_t i = 0; i < points.size(); ++i) {
+        const ClosestPoint cp = bvh.closest_point(points[i]);
+        ASSERT_EQ(cp.distance, distances[i]) << what;
+        ASSERT_LT((cp.point - points[i]).norm() - cp.distance, 1e-6f) << what;
+      }
+      const BvhStats s = bvh.stats();
+      EXPECT_EQ(s.triangles, bunny.num_triangles());
+      EXPECT_GE(s.sah_cost, 1.0) << what;
+      EXPECT_GT(s.tightness_volume, 0.0) << what;
+      EXPECT_GT(s.tightness_hausdorff, 0.0) << what;
+    }
+}
+
+TEST(TriangleBvh, ArityAndLeafSizeVariantsMatchBruteForceOnTheTeapot) {
+  const TriMesh teapot = test::data_mesh("teapot.obj");
+  const auto rays = test::test_rays(teapot, 300, 3);
+  std::vector<RayHit> expected;
+  for (const auto& r : rays) expected.push_back(brute_intersect(teapot, r));
+  for (int arity : {2, 4, 8})
+    for (int leaf : {1, 4, 16}) {
+      for (BoundingVolume bv : {BoundingVolume::aabb, BoundingVolume::obb}) {
+        BuildOptions options;
+        options.arity = arity;
+        options.leaf_size = leaf;
+        options.bv = bv;
+        const TriangleBvh bvh = TriangleBvh::build(teapot, options);
+        const std::string what = "arity " + std::to_string(arity) + " leaf " + std::to_string(leaf);
+        ASSERT_NO_THROW(bvh.validate()) << what;
+        check_rays(teapot, bvh, rays, expected, what);
+        EXPECT_LE(bvh.stats().depth, 64);
+      }
+    }
+}
+
+TEST(TriangleBvh, RandomSoupsWithDegenerateTinyHugeAndAxisAlignedTriangles) {
+  for (std::uint64_t seed : {11u, 12u}) {
+    const TriMesh soup = test::random_soup(1500, seed);
+    const auto rays = test::test_rays(soup, 300, seed + 100);
+    std::vector<RayHit> expected;
+    for (const auto& r : rays) expected.push_back(brute_intersect(soup, r));
+    for (Builder builder : kBuilders)
+      for (BoundingVolume bv : {BoundingVolume::aabb, BoundingVolume::sphere, BoundingVolume::kdop18, BoundingVolume::obb}) {
+        BuildOptions options;
+        options.builder = builder;
+        options.bv = bv;
+        const TriangleBvh bvh = TriangleBvh::build(soup, options);
+        const std::string what = std::string(to_string(builder)) + "/" + std::string(to_string(bv));
+        ASSERT_NO_THROW(bvh.validate()) << what;
+        check_rays(soup, bvh, rays, expected, what);
+      }
+  }
+}
+
+TEST(TriangleBvh, RaysFromInsideAClosedMeshThroughEveryVertexNeverSlipThrough) {
+  // From a point inside a closed mesh every ray must hit, also the rays
+  // aimed exactly at vertices (where up to a dozen triangles meet).
+  const TriMesh bunny = test::data_mesh("bunny.ply");
+  // The grid point deepest inside (winding number as the oracle).
+  const TriangleBvh probe = TriangleBvh::build(bunny);
+  Vec3f inside = Vec3f::Zero();
+  float depth = 0;
+  const AABB3f box = bunny.bounds();
+  for (int i = 1; i < 8; ++i)
+    for (int j = 1; j < 8; ++j)
+      for (int k = 1; k < 8; ++k) {
+        const Vec3f p = box.lo + Vec3f(i / 8.0f, j / 8.0f, k / 8.0f).cwiseProduct(box.extent());
+        const float d = probe.closest_point(p).distance;
+        if (d > depth && test::winding_number(bunny, p) > 0.99) depth = d, inside = p;
+      }
+  ASSERT_GT(depth, 0.05f);
+  for (int arity : {2, 4, 8}) {
+    BuildOptions options;
+    options.arity = arity;
+    const TriangleBvh bvh = TriangleBvh::build(bunny, options);
+    for (const Vec3f& v : bunny.vertices) {
+      Ray3f ray;
+      ray.origin = inside;
+      ray.direction = v - inside;
+      ASSERT_TRUE(bvh.intersect(ray).hit()) << v.transpose();
+      ASSERT_TRUE(bvh.occluded(ray));
+    }
+  }
+}
+
+TEST(TriangleBvh, TmaxAndTminBoundTheHits) {
+  const TriMesh bunny = test::data_mesh("bunny.ply");
+  const TriangleBvh bvh = TriangleBvh::build(bunny);
+  for (const auto& ray : test::test_rays(bunny, 60, 5)) {
+    const RayHit full = bvh.intersect(ray);
+    if (!full.hit()) continue;
+    Ray3f shorter = ray;
+    shorter.tmax = std::nextafter(full.t, 0.0f);
+    EXPECT_EQ(bvh.intersect(shorter).t, brute_intersect(bunny, shorter).t);
+    Ray3f later = ray;
+    later.tmin = std::nextafter(full.t, INFINITY);
+    expect_same_hit(bunny, later, bvh.intersect(later), brute_intersect(bunny, later), "tmin");
+  }
+}
+
+TEST(TriangleBvh, ContainsAgreesWithTheWindingNumber) {
+  const TriMesh bunny = test::data_mesh("bunny.ply");
+  Rng rng(7);
+  for (BoundingVolume bv : {BoundingVolume::aabb, BoundingVolume::sphere}) {
+    BuildOptions options;
+    options.bv = bv;
+    const TriangleBvh bvh = TriangleBvh::build(bunny, options);
+    int inside = 0, checked = 0;
+    for (int i = 0; i < 400; ++i) {
+      const Vec3f p = test::random_point(rng, -1.1f, 1.1f);
+      if (bvh.closest_point(p).distance < 1e-4f) continue;
+      const bool expected = test::winding_number(bunny, p) > 0.5;
+      ASSERT_EQ(bvh.contains(p), expected) << p.transpose();
+      inside += expected;
+      ++checked;
+    }
+    EXPECT_GT(inside, 20);
+    EXPECT_GT(checked - inside, 20);
+  }
+  // Vertices lie on the surface: inside.
+  const TriangleBvh bvh = TriangleBvh::build(bunny);
+  for (std::size_t i = 0; i < bunny.num_vertices(); i += 37) EXPECT_TRUE(bvh.contains(bunny.vertices[i]));
+}
+
+TEST(TriangleBvh, ContainsOnAClosedAxisAlignedCubeWithPointsOnItsGrid) {
+  // A unit cube as 12 triangles: query points share coordinates with its
+  // vertices and edges, so many rays would pass through edges.
+  TriMesh cube;
+  for (int i = 0; i < 8; ++i) cube.vertices.push_back(Vec3f(float(i & 1), float((i >> 1) & 1), float((i >> 2) & 1)));
+  cube.triangles = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
+                    {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
+  ASSERT_TRUE(cube.validate().closed_manifold());
+  const TriangleBvh bvh = TriangleBvh::build(cube);
+  for (int x = -1; x <= 5; ++x)
+    for (int y = -1; y <= 5; ++y)
+      for (int z = -1; z <= 5; ++z) {
+        const Vec3f p(x * 0.25f, y * 0.25f, z * 0.25f);
+        const bool expected = (p.array() >= 0).all() && (p.array() <= 1).all();
+        ASSERT_EQ(bvh.contains(p), expected) << p.transpose();
+      }
+}
+
+TEST(TriangleBvh, BoxAndFrustumCullingMatchBruteForce) {
+  const TriMesh soup = test::random_soup(2000, 21);
+  Rng rng(22);
+  for (BoundingVolume bv : kVolumes) {
+    BuildOptions options;
+    options.bv = bv;
+    const TriangleBvh bvh = TriangleBvh::build(soup, options);
+    for (int q = 0; q < 20; ++q) {
+      const Vec3f a = test::random_point(rng, -1.2f, 1.2f), b = test::random_point(rng, -1.2f, 1.2f);
+      const AABB3f box(a.cwiseMin(b), a.cwiseMax(b));
+      std::vector<std::uint32_t> expected;
+      for (std::size_t i = 0; i < soup.num_triangles(); ++i)
+        if (triangle_box_overlap(test::corner(soup, i, 0), test::corner(soup, i, 1), test::corner(soup, i, 2), box))
+          expected.push_back(std::uint32_t(i));
+      ASSERT_EQ(bvh.cull_box(box), expected);
+      std::vector<Plane3f> planes;
+      for (int k = 0; k < 5; ++k) planes.push_back(Plane3f::from_point_normal(test::random_point(rng, -0.5f, 0.5f), test::random_direction(rng)));
+      expected.clear();
+      for (std::size_t i = 0; i < soup.num_triangles(); ++i) {
+        bool outside = false;
+        for (const auto& p : planes) {
+          bool all = true;
+          for (int k = 0; k < 3; ++k) all = all && p.signed_distance(test::corner(soup, i, k)) < 0;
+          outside = outside || all;
+        }
+        if (!outside) expected.push_back(std::uint32_t(i));
+      }
+      ASSERT_EQ(bvh.cull_frustum(planes), expected);
+    }
+  }
+}
+
+// An independent oracle for the triangle-box test: clip the triangle by the
+// six box planes; it overlaps iff something is left.
+bool clipped_nonempty(const Vec3f& a, const Vec3f& b, const Vec3f& c, const AABB3f& box) {
+  std::vector<Vec3d> poly = {a.cast<double>(), b.cast<double>(), c.cast<double>()};
+  for (int axis = 0; axis < 3; ++axis)
+    for (int side = 0; side < 2; ++side) {
+      std::vector<Vec3d> out;
+      auto inside = [&](const Vec3d& p) { return side ? p[axis] <= box.hi[axis] : p[axis] >= box.lo[axis]; };
+      const double plane = side ? box.hi[axis] : box.lo[axis];
+      for (std::size_t i = 0; i < poly.size(); ++i) {
+        const Vec3d& p = poly[i];
+        const Vec3d& q = poly[(i + 1) % poly.size()];
+        if (inside(p)) out.push_back(p);
+        if (inside(p) != inside(q)) {
+          Vec3d x = p + (plane - p[axis]) / (q[axis] - p[axis]) * (q - p);
+          x[axis] = plane;
+          out.push_back(x);
+        }
+      }
+      poly = out;
+      if (poly.empty()) return false;
+    }
+  return true;
+}
+
+TEST(TriangleBox, AgreesWithPolygonClipping) {
+  Rng rng(31);
+  int overlapping = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const Vec3f a = test::random_point(rng, -1, 1), b = test::random_point(rng, -1, 1), c = test::random_point(rng, -1, 1);
+    const Vec3f lo = test::random_point(rng, -1, 0.5f);
+    const AABB3f box(lo, lo + test::random_point(rng, 0.01f, 0.5f));
+    const bool expected = clipped_nonempty(a, b, c, box);
+    ASSERT_EQ(triangle_box_overlap(a, b, c, box), expected) << i;
+    overlapping += expected;
+  }
+  EXPECT_GT(overlapping, 1000);
+}
+
+TEST(TriangleBvh, ParallelBuildIsDeterministic) {
+  const TriMesh soup = test::random_soup(70000, 41);
+  for (Builder builder : {Builder::sah, Builder::median, Builder::pca, Builder::boxtree, Builder::bottom_up,
+                          Builder::tiling}) {
+    BuildOptions options;
+    options.builder = builder;
+    set_num_threads(1);
+    const TriangleBvh serial = TriangleBvh::build(soup, options);
+    set_num_threads(0);
+    const TriangleBvh parallel = TriangleBvh::build(soup, options);
+    ASSERT_EQ(serial.triangle_ids(), parallel.triangle_ids()) << to_string(builder);
+    const auto& a = serial.topology().nodes;
+    const auto& b = parallel.topology().nodes;
+    ASSERT_EQ(a.size(), b.size());
+    for (std::size_t i = 0; i < a.size(); ++i)
+      ASSERT_TRUE(std::tie(a[i].first_child, a[i].num_children, a[i].prim_first, a[i].prim_count) ==
+                  std::tie(b[i].first_child, b[i].num_children, b[i].prim_first, b[i].prim_count));
+    ASSERT_NO_THROW(parallel.validate());
+  }
+}
+
+TEST(TriangleBvh, BadInputRaisesErrors) {
+  TriMesh mesh = test::random_soup(10, 1);
+  BuildOptions options;
+  options.arity = 3;
+  EXPECT_THROW(TriangleBvh::build(mesh, options), Error);
+  options = {};
+  options.leaf_size = 0;
+  EXPECT_THROW(TriangleBvh::build(mesh, options), Error);
+  mesh.vertices[0][1] = std::nanf("");
+  EXPECT_THROW(TriangleBvh::build(mesh), Error);
+  mesh = test::random_soup(10, 1);
+  mesh.triangles[3][2] = 1000;
+  EXPECT_THROW(TriangleBvh::build(mesh), Error);
+  EXPECT_THROW(parse_builder("octree"), Error);
+  EXPECT_THROW(parse_bounding_volume("cone"), Error);
+  const TriangleBvh bvh = TriangleBvh::build(test::random_soup(10, 1));
+  EXPECT_THROW(bvh.closest_point(Vec3f(0, INFINITY, 0)), Error);
+}
+
+TEST(TriangleBvh, EmptyAndSingleTriangleMeshes) {
+  const TriangleBvh empty = TriangleBvh::build(TriMesh{});
+  Ray3f ray;
+  ray.origin = {0.2f, 0.2f, -1};
+  EXPECT_FALSE(empty.intersect(ray).hit());
+  EXPECT_FALSE(empty.occluded(ray));
+  EXPECT_FALSE(empty.contains(Vec3f::Zero()));
+  EXPECT_EQ(empty.closest_point(Vec3f::Zero()).prim, RayHit::no_hit);
+  EXPECT_NO_THROW(empty.validate());
+  EXPECT_EQ(empty.stats().nodes, 0u);
+  TriMesh one;
+  one.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  one.triangles = {{0, 1, 2}};
+  for (int arity : {2, 4, 8}) {
+    BuildOptions options;
+    options.arity = arity;
+    const TriangleBvh bvh = TriangleBvh::build(one, options);
+    EXPECT_NO_THROW(bvh.validate());
+    const RayHit hit = bvh.intersect(ray);
+    ASSERT_TRUE(hit.hit());
+    EXPECT_EQ(hit.t, 1.0f);
+    EXPECT_EQ(hit.prim, 0u);
+  }
+}
+
+}  // namespace
+}  // namespace geods::bvh
