@@ -83,11 +83,38 @@ bool strictly_between(const Vec2d& a, const Vec2d& b, const Vec2d& p) {
 
 }  // namespace
 
-Delaunay2::Delaunay2(std::span<const Vec2d> points, Options options) {
+Delaunay2::Delaunay2(std::span<const Vec2d> points, Options options) { init(points, {}, options); }
+
+Delaunay2::Delaunay2(std::span<const Vec2d> points, std::span<const Segment> segments, Options options) {
+  init(points, segments, options);
+}
+
+Delaunay2 Delaunay2::from_segment_ends(std::span<const Vec2d> points, std::span<const std::array<Vec2d, 2>> segments,
+                                       Options options) {
+  std::vector<Vec2d> all(points.begin(), points.end());
+  std::vector<Segment> indices;
+  for (const auto& [a, b] : segments) {
+    indices.push_back({std::uint32_t(all.size()), std::uint32_t(all.size() + 1)});
+    all.push_back(a);
+    all.push_back(b);
+  }
+  return Delaunay2(all, indices, options);
+}
+
+void Delaunay2::init(std::span<const Vec2d> points, std::span<const Segment> segments, Options options) {
   if (points.size() >= (std::size_t(1) << 30))
     throw Error("Delaunay2: " + std::to_string(points.size()) + " points, at most 2^30 - 1 are supported");
   for (std::size_t i = 0; i < points.size(); ++i) require_finite(points[i], i, "Delaunay2");
+  for (std::size_t k = 0; k < segments.size(); ++k) {
+    const Segment& s = segments[k];
+    if (s[0] >= points.size() || s[1] >= points.size())
+      throw Error("Delaunay2: segment " + std::to_string(k) + " refers to point " +
+                  std::to_string(std::max(s[0], s[1])) + ", but there are " + std::to_string(points.size()) + " points");
+    if (s[0] == s[1])
+      throw Error("Delaunay2: segment " + std::to_string(k) + " joins point " + std::to_string(s[0]) + " to itself");
+  }
   points_.assign(points.begin(), points.end());
+  segments_.assign(segments.begin(), segments.end());
   rep_.resize(points_.size());
   std::iota(rep_.begin(), rep_.end(), 0u);
   options_ = options;
@@ -143,6 +170,8 @@ void Delaunay2::build(Options options) {
   vert_.clear();
   twin_.clear();
   free_triangles_.clear();
+  has_constraints_ = false;
+  fixed_.clear();
   for (std::uint32_t i = 0; i < points_.size(); ++i)
     if (rep_[i] != kNone) rep_[i] = i;
   original_of_ = insertion_order(options.seed);
@@ -170,6 +199,7 @@ void Delaunay2::build(Options options) {
     rep_[i] = r;
   }
   publish();
+  if (!segments_.empty()) insert_constraints();
 }
 
 bool Delaunay2::make_first_triangle() {
@@ -253,6 +283,7 @@ std::uint32_t Delaunay2::new_triangle() {
   const std::uint32_t t = std::uint32_t(vert_.size() / 3);
   vert_.resize(vert_.size() + 3);
   twin_.resize(twin_.size() + 3);
+  if (has_constraints_) fixed_.resize(vert_.size(), 0);
   return t;
 }
 
@@ -343,6 +374,11 @@ void Delaunay2::split_triangle(std::uint32_t t, std::uint32_t p) {
   link(s1, u0 + 2);
   link(u0 + 1, w0 + 2);
   link(w0 + 1, s2);
+  if (has_constraints_) {
+    fixed_[u0] = fixed_[o1], fixed_[w0] = fixed_[o2];
+    for (std::uint32_t h : {s1, s2, u0 + 1, u0 + 2, w0 + 1, w0 + 2}) fixed_[h] = 0;
+    note_vertex_edges({s0, s1, s2, u0, u0 + 1, u0 + 2, w0, w0 + 1, w0 + 2});
+  }
   flip_stack_.push_back(s0);
   flip_stack_.push_back(u0);
   flip_stack_.push_back(w0);
@@ -367,6 +403,13 @@ void Delaunay2::split_edge(std::uint32_t e, std::uint32_t p) {
   link(t1, m0 + 2);
   link(n0 + 1, o_e1);
   link(m0 + 1, o_t1);
+  if (has_constraints_) {  // the two halves of a constrained edge stay constrained
+    const std::uint8_t halves = fixed_[e];
+    fixed_[m0] = fixed_[n0] = fixed_[t] = halves;
+    fixed_[n0 + 1] = fixed_[o_e1], fixed_[m0 + 1] = fixed_[o_t1];
+    for (std::uint32_t h : {e1, n0 + 2, t1, m0 + 2}) fixed_[h] = 0;
+    note_vertex_edges({e, e1, e2, n0, n0 + 1, n0 + 2, t, t1, t2, m0, m0 + 1, m0 + 2});
+  }
   flip_stack_.push_back(e2);
   flip_stack_.push_back(n0 + 1);
   flip_stack_.push_back(t2);
@@ -384,6 +427,11 @@ void Delaunay2::flip(std::uint32_t e) {
   link(e, outer_f1);
   link(f, outer_e1);
   link(e1, f1);
+  if (has_constraints_) {
+    fixed_[e] = fixed_[outer_f1], fixed_[f] = fixed_[outer_e1];
+    fixed_[e1] = fixed_[f1] = 0;
+    note_vertex_edges({e, e1, f, f1});
+  }
   ++flips_;
 }
 
@@ -393,12 +441,179 @@ void Delaunay2::legalize(std::uint32_t p) {
     const std::uint32_t e = flip_stack_.back();  // opposite p in its triangle
     flip_stack_.pop_back();
     const std::uint32_t f = twin_[e];
-    if (!in_conflict(f / 3, point)) continue;
+    if ((has_constraints_ && fixed_[e]) || !in_conflict(f / 3, point)) continue;
     const std::uint32_t f2 = prev(f);
     flip(e);
     flip_stack_.push_back(e);
     flip_stack_.push_back(f2);
   }
+}
+
+// ------------------------------------------------------------------ constraints
+
+void Delaunay2::note_vertex_edges(std::initializer_list<std::uint32_t> half_edges) {
+  for (std::uint32_t h : half_edges)
+    if (vert_[h] != kGhost) vertex_edge_[vert_[h]] = h;
+}
+
+void Delaunay2::insert_constraints() {
+  has_constraints_ = true;
+  fixed_.assign(vert_.size(), 0);
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> pending;
+  for (auto it = segments_.rbegin(); it != segments_.rend(); ++it)
+    pending.push_back({internal_of_[rep_[(*it)[0]]], internal_of_[rep_[(*it)[1]]]});
+  while (!pending.empty()) {
+    const auto [a, b] = pending.back();
+    pending.pop_back();
+    if (a != b) insert_segment(a, b, pending);
+  }
+  publish();
+}
+
+void Delaunay2::mark_fixed(std::uint32_t e) {
+  fixed_[e] = fixed_[twin_[e]] = 1;
+}
+
+void Delaunay2::insert_segment(std::uint32_t a, std::uint32_t b,
+                               std::vector<std::pair<std::uint32_t, std::uint32_t>>& pending) {
+  const Vec2d pa = at(a), pb = at(b);
+  // The triangle at a that the segment leaves a through (b lies strictly inside
+  // its angle), or an edge or vertex on the segment.
+  const std::uint32_t start = vertex_edge_[a];
+  std::uint32_t h = start, crossing = kNone;
+  do {
+    const std::uint32_t u = vert_[next(h)], w = vert_[prev(h)];
+    if (u == b) {
+      mark_fixed(h);
+      return;
+    }
+    if (u != kGhost && orient2d(pa, pb, at(u)) == 0 && strictly_between(pa, pb, at(u))) {
+      mark_fixed(h);  // a vertex on the segment splits it
+      pending.push_back({u, b});
+      return;
+    }
+    if (u != kGhost && w != kGhost && orient2d(pa, at(u), pb) > 0 && orient2d(pa, at(w), pb) < 0) {
+      crossing = next(h);
+      break;
+    }
+    h = twin_[prev(h)];
+  } while (h != start);
+  if (crossing == kNone) throw Error("Delaunay2: internal error, segment leaves no triangle");
+
+  // Walk along the segment, collecting the triangles it crosses and the
+  // vertices left and right of it.
+  std::vector<std::uint32_t> cavity{crossing / 3}, left{vert_[next(crossing)]}, right{vert_[crossing]};
+  for (;;) {
+    if (fixed_[crossing]) {
+      split_crossing(a, b, crossing, pending);
+      return;
+    }
+    const std::uint32_t t = twin_[crossing], x = vert_[prev(t)];
+    cavity.push_back(t / 3);
+    if (x == b) break;
+    const double side = orient2d(pa, pb, at(x));
+    if (side == 0) {  // a vertex on the segment: two segments
+      pending.push_back({x, b});
+      pending.push_back({a, x});
+      return;
+    }
+    if (side > 0) {
+      crossing = next(t);
+      left.push_back(x);
+    } else {
+      crossing = prev(t);
+      right.push_back(x);
+    }
+  }
+
+  // Remember the edges around the cavity, free its triangles, fill each side
+  // with its constrained Delaunay triangulation (Anglada's algorithm).
+  std::sort(cavity.begin(), cavity.end());
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> outer, open;
+  std::uint32_t segment_edge = kNone;
+  const auto key = [](std::uint32_t from, std::uint32_t to) { return (std::uint64_t(from) << 32) | to; };
+  for (std::uint32_t t : cavity)
+    for (std::uint32_t e = 3 * t; e < 3 * t + 3; ++e)
+      if (!std::binary_search(cavity.begin(), cavity.end(), twin_[e] / 3))
+        outer.push_back({key(vert_[e], vert_[next(e)]), twin_[e]});
+  for (std::uint32_t t : cavity) {
+    vert_[3 * t] = vert_[3 * t + 1] = vert_[3 * t + 2] = kNone;
+    free_triangles_.push_back(t);
+  }
+  const auto emit = [&](std::uint32_t p, std::uint32_t q, std::uint32_t r) {
+    const std::uint32_t t = new_triangle();
+    vert_[3 * t] = p, vert_[3 * t + 1] = q, vert_[3 * t + 2] = r;
+    for (std::uint32_t e = 3 * t; e < 3 * t + 3; ++e) {
+      const std::uint32_t from = vert_[e], to = vert_[next(e)];
+      fixed_[e] = 0;
+      const auto is_outer = std::find_if(outer.begin(), outer.end(), [&](const auto& o) { return o.first == key(from, to); });
+      if (is_outer != outer.end()) {
+        link(e, is_outer->second);
+        fixed_[e] = fixed_[is_outer->second];
+        continue;
+      }
+      const auto is_open = std::find_if(open.begin(), open.end(), [&](const auto& o) { return o.first == key(to, from); });
+      if (is_open != open.end()) {
+        link(e, is_open->second);
+        open.erase(is_open);
+        if ((from == a && to == b) || (from == b && to == a)) segment_edge = e;
+      } else {
+        open.push_back({key(from, to), e});
+      }
+    }
+    note_vertex_edges({3 * t, 3 * t + 1, 3 * t + 2});
+    last_triangle_ = t;
+  };
+  // Polygon p, q, chain... counter-clockwise: the triangle (p, q, c) with the
+  // chain vertex c whose circle holds no other, then the two sub-polygons.
+  struct Polygon {
+    std::uint32_t p, q;
+    std::vector<std::uint32_t> chain;
+  };
+  std::reverse(left.begin(), left.end());
+  std::vector<Polygon> stack;
+  stack.push_back({a, b, std::move(left)});
+  stack.push_back({b, a, std::move(right)});
+  while (!stack.empty()) {
+    Polygon poly = std::move(stack.back());
+    stack.pop_back();
+    if (poly.chain.empty()) continue;
+    std::size_t c = 0;
+    for (std::size_t d = 1; d < poly.chain.size(); ++d)
+      if (incircle(at(poly.p), at(poly.q), at(poly.chain[c]), at(poly.chain[d])) > 0) c = d;
+    const std::uint32_t vc = poly.chain[c];
+    emit(poly.p, poly.q, vc);
+    stack.push_back({vc, poly.q, std::vector<std::uint32_t>(poly.chain.begin(), poly.chain.begin() + std::ptrdiff_t(c))});
+    stack.push_back({poly.p, vc, std::vector<std::uint32_t>(poly.chain.begin() + std::ptrdiff_t(c) + 1, poly.chain.end())});
+  }
+  if (!open.empty() || segment_edge == kNone) throw Error("Delaunay2: internal error, cavity not closed");
+  mark_fixed(segment_edge);
+}
+
+void Delaunay2::split_crossing(std::uint32_t a, std::uint32_t b, std::uint32_t crossing,
+                               std::vector<std::pair<std::uint32_t, std::uint32_t>>& pending) {
+  // Segment a-b crosses the constrained edge u-w: both are split at their
+  // intersection point, a new vertex (rounded to doubles; the four pieces are
+  // then inserted as segments of their own).
+  const std::uint32_t u = vert_[crossing], w = vert_[next(crossing)];
+  const Vec2d &pu = at(u), &pw = at(w);
+  const double du = orient2d(at(a), at(b), pu), dw = orient2d(at(a), at(b), pw);
+  Vec2d x = (pu * dw - pw * du) / (dw - du);
+  for (int k = 0; k < 2; ++k) x[k] = std::clamp(x[k], std::min(pu[k], pw[k]), std::max(pu[k], pw[k]));
+  fixed_[crossing] = fixed_[twin_[crossing]] = 0;
+  const std::uint32_t i = std::uint32_t(points_.size());
+  if (i + 1 >= (std::uint32_t(1) << 30)) throw Error("Delaunay2: too many points");
+  points_.push_back(x);
+  rep_.push_back(i);
+  const std::uint32_t k = std::uint32_t(coords_.size());
+  coords_.push_back(x);
+  original_of_.push_back(i);
+  internal_of_.push_back(k);
+  vertex_edge_.push_back(kNone);
+  insert_vertex(k, crossing / 3);
+  intersections_.push_back(i);
+  const std::uint32_t vx = internal_of_[i];
+  for (auto piece : {std::pair{u, vx}, std::pair{vx, w}, std::pair{vx, b}, std::pair{a, vx}}) pending.push_back(piece);
 }
 
 // ------------------------------------------------------------------ public view
@@ -423,6 +638,10 @@ void Delaunay2::publish() {
       halfedges_[3 * k + s] = other == kNone ? kNone : 3 * other + f % 3;
     }
   }
+  constrained_.assign(has_constraints_ ? 3 * m : 0, 0);
+  if (has_constraints_)
+    for (std::size_t k = 0; k < m; ++k)
+      for (std::uint32_t s = 0; s < 3; ++s) constrained_[3 * k + s] = fixed_[3 * internal_triangle_[k] + s];
   vertex_edge_.assign(coords_.size(), kNone);
   for (std::uint32_t h = 0; h < vert_.size(); ++h)
     if (vert_[h] != kGhost && vert_[h] != kNone) vertex_edge_[vert_[h]] = h;
@@ -540,6 +759,7 @@ std::uint32_t Delaunay2::insert(const Vec2d& p) {
     coords_.push_back(p);
     original_of_.push_back(i);
     internal_of_.push_back(k);
+    vertex_edge_.push_back(kNone);
     insert_vertex(k, last_triangle_);
     publish();
   }
@@ -613,6 +833,7 @@ bool Delaunay2::remove_by_flips(std::uint32_t v) {
 void Delaunay2::remove(std::uint32_t v) {
   if (v >= points_.size() || rep_[v] == kNone)
     throw Error("Delaunay2::remove: point " + std::to_string(v) + " is not in the triangulation");
+  if (!segments_.empty()) throw Error("Delaunay2::remove: not supported on a constrained triangulation");
   if (rep_[v] != v) {  // an alias: the triangulation does not change
     rep_[v] = kNone;
     return;
@@ -642,6 +863,37 @@ void Delaunay2::remove(std::uint32_t v) {
   }
   publish();
   if (internal_triangle_.empty()) build(options_);  // what is left is collinear
+}
+
+std::vector<std::uint8_t> Delaunay2::inside() const {
+  // Even-odd: a breadth-first search from the hull, the parity flipping across
+  // each constrained edge.
+  const std::size_t m = triangle_count();
+  std::vector<std::uint8_t> parity(m, 2);
+  std::vector<std::uint32_t> queue;
+  for (std::uint32_t e = 0; e < 3 * m; ++e)
+    if (halfedges_[e] == kNone && parity[e / 3] == 2) {
+      parity[e / 3] = constrained_.empty() ? 0 : constrained_[e];
+      queue.push_back(e / 3);
+    }
+  for (std::size_t k = 0; k < queue.size(); ++k) {
+    const std::uint32_t t = queue[k];
+    for (std::uint32_t e = 3 * t; e < 3 * t + 3; ++e) {
+      const std::uint32_t f = halfedges_[e];
+      if (f == kNone || parity[f / 3] != 2) continue;
+      parity[f / 3] = std::uint8_t(parity[t] ^ (constrained_.empty() ? 0 : constrained_[e]));
+      queue.push_back(f / 3);
+    }
+  }
+  return parity;
+}
+
+std::vector<Delaunay2::Segment> Delaunay2::constrained_edges() const {
+  std::vector<Segment> edges;
+  for (std::uint32_t e = 0; e < constrained_.size(); ++e)
+    if (constrained_[e] && (halfedges_[e] == kNone || e < halfedges_[e]))
+      edges.push_back({triangles_[e], triangles_[next(e)]});
+  return edges;
 }
 
 // ------------------------------------------------------------------ inspection
@@ -724,9 +976,40 @@ void Delaunay2::validate() const {
   for (std::uint32_t e = 0; e < half_edges; ++e) {
     if (vert_[e] == kNone) continue;
     const std::uint32_t opposite = vert_[prev(twin_[e])];
-    if (opposite == kGhost) continue;
+    if (opposite == kGhost || (has_constraints_ && fixed_[e])) continue;
     if (in_conflict(e / 3, at(opposite)))
       fail("edge " + std::to_string(vert_[e]) + "-" + std::to_string(vert_[next(e)]) + " is not locally Delaunay");
+  }
+  if (has_constraints_) {
+    if (fixed_.size() != half_edges) fail("constraint flags have the wrong size");
+    for (std::uint32_t e = 0; e < half_edges; ++e)
+      if (vert_[e] != kNone && fixed_[e] != fixed_[twin_[e]]) fail("constraint flags of twins differ");
+    // Every input segment is a path of constrained edges through vertices on
+    // it or through intersection points (rounded, so slightly off it).
+    std::vector<std::uint32_t> crossings = intersections_;
+    std::sort(crossings.begin(), crossings.end());
+    for (const Segment& seg : segments_) {
+      const std::uint32_t a = internal_of_[rep_[seg[0]]], b = internal_of_[rep_[seg[1]]];
+      if (a == kNone || b == kNone) fail("a segment end point is not a vertex");
+      std::vector<std::uint32_t> queue{a};
+      std::vector<char> seen(coords_.size(), 0);
+      seen[a] = 1;
+      for (std::size_t k = 0; k < queue.size() && !seen[b]; ++k) {
+        const std::uint32_t start = vertex_edge_[queue[k]];
+        std::uint32_t h = start;
+        do {
+          const std::uint32_t w = vert_[next(h)];
+          if (fixed_[h] && w != kGhost && !seen[w] &&
+              (w == b || std::binary_search(crossings.begin(), crossings.end(), original_of_[w]) ||
+               (orient2d(at(a), at(b), at(w)) == 0 && strictly_between(at(a), at(b), at(w))))) {
+            seen[w] = 1;
+            queue.push_back(w);
+          }
+          h = twin_[prev(h)];
+        } while (h != start);
+      }
+      if (!seen[b]) fail("segment " + std::to_string(seg[0]) + "-" + std::to_string(seg[1]) + " is not present");
+    }
   }
   // Euler on the sphere (ghost vertex included): t = 2 (n + 1) - 4; hull size = ghost triangles.
   const std::size_t finite = live - ghosts;

@@ -394,5 +394,157 @@ TEST(Delaunay2, StatsCountWhatIsThere) {
   EXPECT_GT(s.bytes, p.size() * sizeof(Vec2d));
 }
 
+// ------------------------------------------------------------------ constrained
+
+// Do segments pq and rs cross at a point interior to both?
+bool properly_cross(const Vec2d& p, const Vec2d& q, const Vec2d& r, const Vec2d& s) {
+  const double a = orient2d(p, q, r), b = orient2d(p, q, s), c = orient2d(r, s, p), d = orient2d(r, s, q);
+  return ((a > 0 && b < 0) || (a < 0 && b > 0)) && ((c > 0 && d < 0) || (c < 0 && d > 0));
+}
+
+// The constrained Delaunay property by brute force: a vertex inside a
+// triangle's circle is hidden from the triangle's centroid by a constrained edge.
+void check_constrained(const Delaunay2& dt) {
+  ASSERT_NO_THROW(dt.validate());
+  const auto p = dt.points();
+  const auto& tri = dt.triangles();
+  const std::vector<Delaunay2::Segment> fixed = dt.constrained_edges();
+  std::vector<std::uint32_t> vertices;
+  for (std::uint32_t i = 0; i < p.size(); ++i)
+    if (dt.representative(i) == i) vertices.push_back(i);
+  for (std::size_t t = 0; t < tri.size(); t += 3) {
+    const Vec2d &a = p[tri[t]], &b = p[tri[t + 1]], &c = p[tri[t + 2]];
+    ASSERT_GT(orient2d(a, b, c), 0);
+    const Vec2d centroid = (a + b + c) / 3;
+    for (std::uint32_t v : vertices) {
+      if (incircle(a, b, c, p[v]) <= 0) continue;
+      bool hidden = false;
+      for (const auto& s : fixed) hidden = hidden || properly_cross(centroid, p[v], p[s[0]], p[s[1]]);
+      ASSERT_TRUE(hidden) << "vertex " << v << " visible inside the circle of triangle " << t / 3;
+    }
+  }
+  // No constrained edge is crossed by any edge.
+  for (const auto& s : fixed)
+    for (std::size_t e = 0; e < tri.size(); ++e)
+      ASSERT_FALSE(properly_cross(p[s[0]], p[s[1]], p[tri[e]], p[tri[Delaunay2::next(std::uint32_t(e))]]));
+}
+
+// Is the edge (a, b) in the triangulation, constrained?
+bool has_constrained_edge(const Delaunay2& dt, std::uint32_t a, std::uint32_t b) {
+  for (const auto& s : dt.constrained_edges())
+    if ((s[0] == a && s[1] == b) || (s[0] == b && s[1] == a)) return true;
+  return false;
+}
+
+TEST(Delaunay2Constrained, RandomNonCrossingSegmentsArePresent) {
+  for (std::uint64_t seed : {1, 2, 3, 4}) {
+    Rng rng(seed);
+    std::vector<Vec2d> p;
+    for (int i = 0; i < 300; ++i) p.emplace_back(rng.uniform(), rng.uniform());
+    // Long segments that do not cross each other: chords of horizontal strips.
+    std::vector<Delaunay2::Segment> segments;
+    for (int k = 0; k < 8; ++k) {
+      const double y = (k + 0.5) / 8;
+      p.emplace_back(rng.uniform(0, 0.3), y + rng.uniform(-0.04, 0.04));
+      p.emplace_back(rng.uniform(0.7, 1), y + rng.uniform(-0.04, 0.04));
+      segments.push_back({std::uint32_t(p.size() - 2), std::uint32_t(p.size() - 1)});
+    }
+    const Delaunay2 dt(p, segments);
+    check_constrained(dt);
+    EXPECT_TRUE(dt.intersection_points().empty());
+    EXPECT_EQ(dt.points().size(), p.size());
+    for (const auto& s : segments) {
+      // Present as one edge or as a chain through vertices exactly on it; here none are.
+      EXPECT_TRUE(has_constrained_edge(dt, s[0], s[1]));
+    }
+    EXPECT_EQ(dt.constrained_edges().size(), segments.size());
+  }
+}
+
+TEST(Delaunay2Constrained, CrossingSegmentsAreSplit) {
+  const std::vector<Vec2d> p = {{0, 0}, {4, 4}, {0, 4}, {4, 0}, {2, 7}, {-3, 1}, {6, 2}};
+  const std::vector<Delaunay2::Segment> segments = {{0, 1}, {2, 3}};
+  const Delaunay2 dt(p, segments);
+  check_constrained(dt);
+  ASSERT_EQ(dt.intersection_points().size(), 1u);
+  const std::uint32_t x = dt.intersection_points()[0];
+  EXPECT_EQ(x, p.size());
+  EXPECT_EQ(dt.points()[x], Vec2d(2, 2));
+  for (std::uint32_t v : {0u, 1u, 2u, 3u}) EXPECT_TRUE(has_constrained_edge(dt, v, x));
+  EXPECT_EQ(dt.constrained_edges().size(), 4u);
+}
+
+TEST(Delaunay2Constrained, ManyRandomCrossingSegments) {
+  Rng rng(5);
+  std::vector<Vec2d> p;
+  for (int i = 0; i < 200; ++i) p.emplace_back(rng.uniform(), rng.uniform());
+  std::vector<Delaunay2::Segment> segments;
+  for (int k = 0; k < 15; ++k) segments.push_back({std::uint32_t(rng.below(200)), std::uint32_t(rng.below(200))});
+  segments.erase(std::remove_if(segments.begin(), segments.end(), [](const auto& s) { return s[0] == s[1]; }),
+                 segments.end());
+  const Delaunay2 dt(p, segments);
+  check_constrained(dt);
+  EXPECT_GT(dt.intersection_points().size(), 0u);
+}
+
+TEST(Delaunay2Constrained, SegmentThroughVerticesIsSplit) {
+  std::vector<Vec2d> p = {{0, 0}, {4, 0}, {1, 0}, {3, 0}, {2, 3}, {2, -3}, {2, 0.5}, {2, -0.5}};
+  const std::vector<Delaunay2::Segment> segments = {{0, 1}};
+  const Delaunay2 dt(p, segments);
+  check_constrained(dt);
+  EXPECT_TRUE(has_constrained_edge(dt, 0, 2));
+  EXPECT_TRUE(has_constrained_edge(dt, 2, 3));
+  EXPECT_TRUE(has_constrained_edge(dt, 3, 1));
+  EXPECT_TRUE(dt.intersection_points().empty());
+}
+
+TEST(Delaunay2Constrained, PolygonWithHoleInsideOutside) {
+  // Outer square 0..10, hole 3..7 (a diamond, so it is not aligned with the grid of points).
+  std::vector<Vec2d> p = {{0, 0}, {10, 0}, {10, 10}, {0, 10}, {5, 3}, {7, 5}, {5, 7}, {3, 5}};
+  std::vector<Delaunay2::Segment> segments = {{0, 1}, {1, 2}, {2, 3}, {3, 0}, {4, 5}, {5, 6}, {6, 7}, {7, 4}};
+  Rng rng(2);
+  for (int i = 0; i < 200; ++i) p.emplace_back(rng.uniform(-2, 12), rng.uniform(-2, 12));
+  const Delaunay2 dt(p, segments);
+  check_constrained(dt);
+  const std::vector<std::uint8_t> inside = dt.inside();
+  ASSERT_EQ(inside.size(), dt.triangle_count());
+  const auto in_polygon = [](const Vec2d& c) {
+    const bool in_outer = c[0] > 0 && c[0] < 10 && c[1] > 0 && c[1] < 10;
+    const bool in_hole = std::abs(c[0] - 5) + std::abs(c[1] - 5) < 2;
+    return in_outer && !in_hole;
+  };
+  double area = 0;
+  for (std::size_t t = 0; t < inside.size(); ++t) {
+    const auto& tri = dt.triangles();
+    const Vec2d &a = dt.points()[tri[3 * t]], &b = dt.points()[tri[3 * t + 1]], &c = dt.points()[tri[3 * t + 2]];
+    EXPECT_EQ(bool(inside[t]), in_polygon((a + b + c) / 3));
+    if (inside[t]) area += orient2d(a, b, c) / 2;
+  }
+  EXPECT_DOUBLE_EQ(area, 100.0 - 8.0);
+}
+
+TEST(Delaunay2Constrained, InsertKeepsConstraints) {
+  std::vector<Vec2d> p = {{0, 0}, {10, 0}, {10, 10}, {0, 10}};
+  const std::vector<Delaunay2::Segment> segments = {{0, 2}};
+  Delaunay2 dt(p, segments);
+  Rng rng(4);
+  for (int i = 0; i < 100; ++i) dt.insert({rng.uniform(0, 10), rng.uniform(0, 10)});
+  for (int i = 1; i < 10; ++i) dt.insert({double(i), double(i)});  // on the segment
+  check_constrained(dt);
+  EXPECT_TRUE(has_constrained_edge(dt, 0, std::uint32_t(dt.points().size() - 9)));
+  EXPECT_EQ(dt.constrained_edges().size(), 10u);
+  EXPECT_THROW(dt.remove(5), Error);
+}
+
+TEST(Delaunay2Constrained, RejectsBadSegments) {
+  const std::vector<Vec2d> p = {{0, 0}, {1, 0}, {0, 1}};
+  EXPECT_THROW(Delaunay2(p, std::vector<Delaunay2::Segment>{{0, 3}}), Error);
+  EXPECT_THROW(Delaunay2(p, std::vector<Delaunay2::Segment>{{1, 1}}), Error);
+  // Equal end points (duplicates) are fine: nothing to constrain.
+  const std::vector<Vec2d> q = {{0, 0}, {1, 0}, {0, 1}, {1, 0}};
+  const Delaunay2 dt(q, std::vector<Delaunay2::Segment>{{1, 3}, {0, 1}});
+  check_constrained(dt);
+}
+
 }  // namespace
 }  // namespace geods::voronoi

@@ -25,7 +25,9 @@
 // (or fewer than 3) there are no triangles, degenerate() is true and hull() is
 // the distinct points sorted by (x, y). NaN or infinite coordinates raise
 // geods::Error.
+#include <array>
 #include <cstdint>
+#include <initializer_list>
 #include <span>
 #include <string>
 #include <vector>
@@ -56,11 +58,25 @@ class Delaunay2 {
 
   using Options = Delaunay2Options;
 
+  using Segment = std::array<std::uint32_t, 2>;
+
   /// An empty triangulation.
   Delaunay2() = default;
   /// Triangulates the points; throws geods::Error for NaN/inf coordinates or
   /// 2^30 points or more.
   explicit Delaunay2(std::span<const Vec2d> points, Options options = {});
+  /// Constrained Delaunay triangulation (seed §5.3.2): every segment (a pair of
+  /// point indices) is a union of edges, every other edge is locally Delaunay,
+  /// so no triangle's circle holds a point visible from inside it. Segments that cross are split at their intersection,
+  /// a new point (rounded to doubles) appended to points() and listed in
+  /// intersection_points(); a segment through a vertex is split there.
+  /// Throws geods::Error for an index out of range or a segment (i, i).
+  Delaunay2(std::span<const Vec2d> points, std::span<const Segment> segments, Options options = {});
+  /// The same with segments given by their end points' coordinates: the end
+  /// points are appended to `points` (points().size() grows by 2 per segment;
+  /// equal points merge as duplicates), segment k joins points n + 2k and n + 2k + 1.
+  static Delaunay2 from_segment_ends(std::span<const Vec2d> points, std::span<const std::array<Vec2d, 2>> segments,
+                                     Options options = {});
 
   /// The input points (and inserted ones), indexed as given.
   std::span<const Vec2d> points() const { return points_; }
@@ -72,6 +88,20 @@ class Delaunay2 {
   /// degenerate set the distinct points sorted by (x, y).
   const std::vector<std::uint32_t>& hull() const { return hull_; }
   std::size_t triangle_count() const { return triangles_.size() / 3; }
+
+  /// Constrained triangulations: per half-edge of triangles(), 1 if it lies on
+  /// a segment (empty without segments).
+  const std::vector<std::uint8_t>& constrained() const { return constrained_; }
+  /// The constrained edges, each once, as point index pairs.
+  std::vector<Segment> constrained_edges() const;
+  /// The input segments as given.
+  const std::vector<Segment>& segments() const { return segments_; }
+  /// Points added where segments cross (indices into points()).
+  const std::vector<std::uint32_t>& intersection_points() const { return intersections_; }
+  /// Per triangle: 1 if it lies inside the segments (reached from outside the
+  /// hull by crossing an odd number of constrained edges), else 0. For polygons
+  /// with holes: the triangles of the polygon minus its holes.
+  std::vector<std::uint8_t> inside() const;
   /// True when there are no triangles (fewer than 3 distinct points, or all collinear).
   bool degenerate() const { return triangles_.empty(); }
 
@@ -103,7 +133,7 @@ class Delaunay2 {
   /// A duplicate is merged into the existing point. Keeps the triangulation
   /// Delaunay; O(expected degree) flips plus O(n) to renumber the public arrays.
   std::uint32_t insert(const Vec2d& p);
-  /// Removes vertex v (a representative; removing a duplicate only drops the
+  /// Removes vertex v (a representative; not supported with segments; removing a duplicate only drops the
   /// alias, removing a vertex that has aliases promotes the next alias). The hole
   /// is retriangulated by flipping v's edges away (Delaunay ears, Devillers),
   /// then v is cut out at degree 3. O(d^2) for degree d plus O(n) renumbering.
@@ -127,7 +157,14 @@ class Delaunay2 {
                          // on_vertex: a half-edge leaving the vertex; outside: the ghost triangle's hull half-edge
   };
 
+  void init(std::span<const Vec2d> points, std::span<const Segment> segments, Options options);
   void build(Options options);
+  void insert_constraints();
+  void insert_segment(std::uint32_t a, std::uint32_t b, std::vector<std::pair<std::uint32_t, std::uint32_t>>& pending);
+  void split_crossing(std::uint32_t a, std::uint32_t b, std::uint32_t crossing,
+                      std::vector<std::pair<std::uint32_t, std::uint32_t>>& pending);
+  void mark_fixed(std::uint32_t e);
+  void note_vertex_edges(std::initializer_list<std::uint32_t> half_edges);
   void build_degenerate();
   std::vector<std::uint32_t> insertion_order(std::uint64_t seed) const;
   bool make_first_triangle();
@@ -153,6 +190,8 @@ class Delaunay2 {
 
   Options options_;
   std::vector<Vec2d> points_;
+  std::vector<Segment> segments_;
+  std::vector<std::uint32_t> intersections_;
   std::vector<std::uint32_t> rep_;  // representative per point, no_edge when removed
 
   // Vertices are numbered internally in insertion order, their coordinates
@@ -167,11 +206,14 @@ class Delaunay2 {
   std::vector<std::uint32_t> free_triangles_;  // slots freed by remove(); their vert_ are no_edge
   std::vector<std::uint32_t> vertex_edge_;     // per internal vertex: a half-edge leaving it, or no_edge
   std::vector<std::uint32_t> flip_stack_;
+  bool has_constraints_ = false;
+  std::vector<std::uint8_t> fixed_;  // per internal half-edge: on a segment (only with segments)
   std::uint32_t last_triangle_ = 0;  // where the next walk starts
   std::uint32_t walk_seed_ = 1;
 
   // The public, finite-only view.
   std::vector<std::uint32_t> triangles_, halfedges_, hull_;
+  std::vector<std::uint8_t> constrained_;
   std::vector<std::uint32_t> public_triangle_;  // internal triangle -> public index or no_edge
   std::vector<std::uint32_t> internal_triangle_;  // public -> internal
   std::size_t flips_ = 0, walk_steps_ = 0;
