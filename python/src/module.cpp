@@ -11,4 +11,5 @@ PYBIND11_MODULE(_geods, m) {
   geods::python::bind_spatial(m);
   geods::python::bind_dynamic(m);
   geods::python::bind_quadtree(m);
+  geods::python::bind_delaunay(m);
 }

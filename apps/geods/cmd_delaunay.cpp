@@ -1,0 +1,145 @@
+// geods delaunay: Delaunay triangulation of 2D points, optionally constrained by segments.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <vector>
+
+#include "command.hpp"
+#include "geods/core/aabb.hpp"
+#include "geods/core/error.hpp"
+#include "geods/io/npy.hpp"
+#include "geods/io/point_io.hpp"
+#include "geods/io/svg.hpp"
+#include "geods/voronoi/delaunay2.hpp"
+#include "stopwatch.hpp"
+
+namespace geods::cli {
+namespace {
+
+using voronoi::Delaunay2;
+
+class DelaunayCommand : public Command {
+ public:
+  std::string name() const override { return "delaunay"; }
+  std::string summary() const override {
+    return "Delaunay triangulation of 2D points (constrained by --segments): triangles as int64 .npy";
+  }
+  void add_options(CLI::App& app) override {
+    app.add_option("points", points_, "Points, n x 2 (.npy, .xyz, .csv)")->required();
+    app.add_option("--segments", segments_,
+                   "Constraints: int m x 2 point indices (.npy), or m x 4 end coordinates x0 y0 x1 y1 "
+                   "(.npy/.edg/.cin; the end points are appended to the points)");
+    app.add_option("-o,--output", output_,
+                   "Output: int64 m x 3 counter-clockwise triangles, indices into the points (duplicates map to "
+                   "their first occurrence)");
+    app.add_option("--svg", svg_, "Output: a picture of the triangulation");
+  }
+
+  void run(const RunContext&, Report& report) override {
+    const io::PointMatrix matrix = io::read_points(points_);
+    if (matrix.cols() != 2)
+      throw Error(fmt::format("{}: expected 2D points, got {} columns", points_, matrix.cols()));
+    std::vector<Vec2d> points(std::size_t(matrix.rows()));
+    for (std::size_t i = 0; i < points.size(); ++i) points[i] = Vec2d(matrix(long(i), 0), matrix(long(i), 1));
+
+    std::vector<Delaunay2::Segment> index_segments;
+    std::vector<std::array<Vec2d, 2>> end_segments;
+    if (!segments_.empty()) read_segments(points.size(), index_segments, end_segments);
+
+    Stopwatch watch;
+    Delaunay2 dt = !end_segments.empty()   ? Delaunay2::from_segment_ends(points, end_segments)
+                   : !segments_.empty() ? Delaunay2(points, index_segments)
+                                          : Delaunay2(points);
+    const double build_s = watch.seconds();
+    const voronoi::Delaunay2Stats stats = dt.stats();
+
+    if (!output_.empty()) {
+      std::vector<std::int64_t> tri(dt.triangles().begin(), dt.triangles().end());
+      io::write_npy<std::int64_t>(output_, tri, {dt.triangle_count(), 3});
+    }
+    if (!svg_.empty()) write_svg(dt);
+
+    Json& j = report.json;
+    j["points"] = points.size();
+    j["all_points"] = dt.points().size();  // with appended segment ends and intersection points
+    j["vertices"] = stats.vertices;
+    j["duplicates"] = stats.duplicates;
+    j["triangles"] = stats.triangles;
+    j["hull"] = stats.hull;
+    j["degenerate"] = dt.degenerate();
+    j["segments"] = index_segments.size() + end_segments.size();
+    j["constrained_edges"] = dt.constrained_edges().size();
+    j["intersection_points"] = dt.intersection_points().size();
+    j["flips"] = stats.flips;
+    j["build_s"] = build_s;
+    j["compute_s"] = build_s;
+    const std::string added =
+        dt.points().size() > points.size()
+            ? fmt::format(" + {} segment end and intersection points", dt.points().size() - points.size())
+            : "";
+    report.lines.push_back(fmt::format("delaunay: {} points{} ({} distinct, {} duplicates) -> {} triangles, {} on the hull{}",
+                                       points.size(), added, stats.vertices, stats.duplicates, stats.triangles, stats.hull,
+                                       dt.degenerate() ? " (degenerate: fewer than 3 points or all collinear)" : ""));
+    if (!segments_.empty())
+      report.lines.push_back(fmt::format("  {} segments: {} constrained edges, {} intersection points added",
+                                         index_segments.size() + end_segments.size(), dt.constrained_edges().size(),
+                                         dt.intersection_points().size()));
+    report.lines.push_back(fmt::format("  built in {:.3f} s ({} flips)", build_s, stats.flips));
+    if (!output_.empty()) report.lines.push_back("  wrote " + output_);
+    if (!svg_.empty()) report.lines.push_back("  wrote " + svg_);
+  }
+
+ private:
+  void read_segments(std::size_t n, std::vector<Delaunay2::Segment>& indices, std::vector<std::array<Vec2d, 2>>& ends) {
+    // Integer .npy m x 2: point indices; anything else: end coordinates.
+    const bool npy = segments_.size() > 4 && segments_.substr(segments_.size() - 4) == ".npy";
+    if (npy) {
+      const io::NpyArray a = io::read_npy(segments_);
+      const bool integer = a.dtype != DType::f32 && a.dtype != DType::f64;
+      if (integer) {
+        if (a.shape.size() != 2 || a.shape[1] != 2)
+          throw Error(fmt::format("{}: integer segments must be m x 2 point indices", segments_));
+        const std::vector<std::int64_t> v = a.to_vector<std::int64_t>();
+        for (std::size_t k = 0; k < a.shape[0]; ++k) {
+          for (int s = 0; s < 2; ++s)
+            if (v[2 * k + s] < 0 || std::size_t(v[2 * k + s]) >= n)
+              throw Error(fmt::format("{}: segment {} refers to point {}, but there are {} points", segments_, k,
+                                      v[2 * k + s], n));
+          indices.push_back({std::uint32_t(v[2 * k]), std::uint32_t(v[2 * k + 1])});
+        }
+        return;
+      }
+    }
+    const io::SegmentMatrix m = io::read_segments(segments_);
+    for (long k = 0; k < m.rows(); ++k) ends.push_back({Vec2d(m(k, 0), m(k, 1)), Vec2d(m(k, 2), m(k, 3))});
+  }
+
+  void write_svg(const Delaunay2& dt) const {
+    const auto p = dt.points();
+    AABB2d box = bounds_of<double, 2>(p);
+    if (p.empty()) box = AABB2d(Vec2d(0, 0), Vec2d(1, 1));
+    const Vec2d pad = ((box.hi - box.lo) * 0.02).cwiseMax(Vec2d(1e-9, 1e-9).cwiseMax(box.hi.cwiseAbs() * 1e-9));
+    io::SvgWriter svg(AABB2d(box.lo - pad, box.hi + pad));
+    svg.title(fmt::format("Delaunay triangulation of {} points", p.size()));
+    const auto& tri = dt.triangles();
+    const std::vector<std::uint8_t> inside = dt.segments().empty() ? std::vector<std::uint8_t>() : dt.inside();
+    for (std::size_t t = 0; t < dt.triangle_count(); ++t) {
+      const std::vector<Vec2d> corners = {p[tri[3 * t]], p[tri[3 * t + 1]], p[tri[3 * t + 2]]};
+      svg.polygon(corners, {.stroke = "#4a6fa5", .fill = !inside.empty() && inside[t] ? "#dde8f5" : "none",
+                            .stroke_width = 0.5});
+    }
+    for (const auto& e : dt.constrained_edges()) svg.segment(p[e[0]], p[e[1]], {.stroke = "#c0392b", .stroke_width = 1.5});
+    if (dt.degenerate())
+      for (std::size_t k = 1; k < dt.hull().size(); ++k) svg.segment(p[dt.hull()[k - 1]], p[dt.hull()[k]], {.stroke = "#4a6fa5"});
+    if (p.size() <= 20000) svg.points(p, {.fill = "black", .radius = 1.2});
+    svg.save(svg_);
+  }
+
+  std::string points_, segments_, output_, svg_;
+};
+
+const bool registered = register_command<DelaunayCommand>();
+
+}  // namespace
+}  // namespace geods::cli

@@ -1,0 +1,193 @@
+// Python bindings of the Delaunay triangulation: geods.Delaunay2.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "bindings.hpp"
+#include "geods/core/error.hpp"
+#include "geods/voronoi/delaunay2.hpp"
+
+namespace py = pybind11;
+
+namespace geods::python {
+namespace {
+
+using voronoi::Delaunay2;
+using Rows = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+std::vector<Vec2d> as_points(const py::handle& h, const char* what) {
+  const auto a = Rows::ensure(h);
+  if (!a || a.ndim() != 2 || a.shape(1) != 2) throw Error(std::string(what) + ": expected an (n, 2) array of numbers");
+  std::vector<Vec2d> points(std::size_t(a.shape(0)));
+  for (std::size_t i = 0; i < points.size(); ++i) points[i] = Vec2d(a.at(i, 0), a.at(i, 1));
+  return points;
+}
+
+Vec2d as_point(const py::handle& h, const char* what) {
+  const auto a = Rows::ensure(h);
+  if (!a || a.ndim() != 1 || a.shape(0) != 2) throw Error(std::string(what) + ": expected a point (x, y)");
+  return {a.at(0), a.at(1)};
+}
+
+// -1 for no_edge, as numpy users expect of a missing index.
+py::array_t<std::int64_t> as_int64(const std::vector<std::uint32_t>& v, std::vector<py::ssize_t> shape) {
+  py::array_t<std::int64_t> out(shape);
+  std::int64_t* o = out.mutable_data();
+  for (std::size_t i = 0; i < v.size(); ++i) o[i] = v[i] == Delaunay2::no_edge ? -1 : std::int64_t(v[i]);
+  return out;
+}
+
+std::int64_t as_index(std::uint32_t i) { return i == Delaunay2::no_edge ? -1 : std::int64_t(i); }
+
+std::uint32_t vertex_index(std::int64_t i, const Delaunay2& dt, const char* what) {
+  if (i < 0 || std::size_t(i) >= dt.points().size())
+    throw Error(std::string(what) + ": point " + std::to_string(i) + " does not exist");
+  return std::uint32_t(i);
+}
+
+Delaunay2 make(const py::handle& points_in, const py::object& segments_in, std::uint64_t seed) {
+  const std::vector<Vec2d> points = as_points(points_in, "Delaunay2");
+  Delaunay2::Options options;
+  options.seed = seed;
+  if (segments_in.is_none()) {
+    py::gil_scoped_release release;
+    return Delaunay2(points, options);
+  }
+  const py::array seg = py::array::ensure(segments_in);
+  if (!seg || seg.ndim() != 2 || (seg.shape(1) != 2 && seg.shape(1) != 4))
+    throw Error("Delaunay2: segments must be (m, 2) point indices or (m, 4) end coordinates x0, y0, x1, y1");
+  if (seg.shape(1) == 4) {
+    const auto ends = Rows::ensure(seg);
+    std::vector<std::array<Vec2d, 2>> segments(std::size_t(ends.shape(0)));
+    for (std::size_t k = 0; k < segments.size(); ++k)
+      segments[k] = {Vec2d(ends.at(k, 0), ends.at(k, 1)), Vec2d(ends.at(k, 2), ends.at(k, 3))};
+    py::gil_scoped_release release;
+    return Delaunay2::from_segment_ends(points, segments, options);
+  }
+  if (seg.dtype().kind() != 'i' && seg.dtype().kind() != 'u')
+    throw Error("Delaunay2: (m, 2) segments must be integer point indices");
+  const auto idx = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>::ensure(seg);
+  std::vector<Delaunay2::Segment> segments(std::size_t(idx.shape(0)));
+  for (std::size_t k = 0; k < segments.size(); ++k)
+    for (int s = 0; s < 2; ++s) {
+      const std::int64_t v = idx.at(k, s);
+      if (v < 0 || std::size_t(v) >= points.size())
+        throw Error("Delaunay2: segment " + std::to_string(k) + " refers to point " + std::to_string(v) +
+                    ", but there are " + std::to_string(points.size()) + " points");
+      segments[k][s] = std::uint32_t(v);
+    }
+  py::gil_scoped_release release;
+  return Delaunay2(points, segments, options);
+}
+
+}  // namespace
+
+void bind_delaunay(py::module_& m) {
+  py::class_<Delaunay2>(m, "Delaunay2", R"doc(
+Delaunay triangulation of 2D points (incremental, Lawson flips, exact predicates),
+optionally constrained by segments.
+
+Delaunay2(points, segments=None, seed=...) -- points (n, 2); segments either (m, 2)
+integer point indices or (m, 4) end coordinates x0, y0, x1, y1 (then the end points
+are appended to the points). Duplicates merge into their first occurrence; all
+collinear points give no triangles (degenerate). Crossing segments are split at a
+new appended point (intersection_points). NaN/inf raise geods.Error (ValueError).
+)doc")
+      .def(py::init(&make), py::arg("points"), py::arg("segments") = py::none(),
+           py::arg("seed") = Delaunay2::Options{}.seed)
+      .def_property_readonly(
+          "points",
+          [](const Delaunay2& dt) {
+            py::array_t<double> out({py::ssize_t(dt.points().size()), py::ssize_t(2)});
+            double* o = out.mutable_data();
+            for (const Vec2d& p : dt.points()) *o++ = p[0], *o++ = p[1];
+            return out;
+          },
+          "(n, 2) float64: the input points, then intersection and inserted points")
+      .def_property_readonly(
+          "triangles",
+          [](const Delaunay2& dt) { return as_int64(dt.triangles(), {py::ssize_t(dt.triangle_count()), 3}); },
+          "(m, 3) int64: counter-clockwise vertex indices (first occurrences of duplicates)")
+      .def_property_readonly(
+          "halfedges", [](const Delaunay2& dt) { return as_int64(dt.halfedges(), {py::ssize_t(dt.halfedges().size())}); },
+          "(3m,) int64: the opposite half-edge of half-edge e (from triangles.flat[e] to the next vertex "
+          "of its triangle), -1 on the hull")
+      .def_property_readonly(
+          "hull", [](const Delaunay2& dt) { return as_int64(dt.hull(), {py::ssize_t(dt.hull().size())}); },
+          "hull vertices counter-clockwise (for a degenerate set: the distinct points sorted by x, y)")
+      .def_property_readonly("degenerate", &Delaunay2::degenerate, "True when there are no triangles")
+      .def_property_readonly(
+          "constrained",
+          [](const Delaunay2& dt) {
+            py::array_t<bool> out(py::ssize_t(dt.halfedges().size()));
+            bool* o = out.mutable_data();
+            for (std::size_t e = 0; e < dt.halfedges().size(); ++e) o[e] = !dt.constrained().empty() && dt.constrained()[e];
+            return out;
+          },
+          "(3m,) bool: half-edges on a segment")
+      .def_property_readonly(
+          "constrained_edges",
+          [](const Delaunay2& dt) {
+            const auto edges = dt.constrained_edges();
+            std::vector<std::uint32_t> flat;
+            for (const auto& e : edges) flat.insert(flat.end(), e.begin(), e.end());
+            return as_int64(flat, {py::ssize_t(edges.size()), 2});
+          },
+          "(k, 2) int64: the constrained edges, each once")
+      .def_property_readonly(
+          "intersection_points",
+          [](const Delaunay2& dt) {
+            return as_int64(dt.intersection_points(), {py::ssize_t(dt.intersection_points().size())});
+          },
+          "indices of the points added where segments cross")
+      .def_property_readonly(
+          "inside",
+          [](const Delaunay2& dt) {
+            const auto in = dt.inside();
+            py::array_t<bool> out(py::ssize_t(in.size()));
+            for (std::size_t t = 0; t < in.size(); ++t) out.mutable_data()[t] = in[t];
+            return out;
+          },
+          "(m,) bool: triangles inside the segments (even-odd from outside the hull): a polygon minus its holes")
+      .def(
+          "representative", [](const Delaunay2& dt, std::int64_t i) {
+            return as_index(dt.representative(vertex_index(i, dt, "Delaunay2.representative")));
+          },
+          py::arg("i"), "the first occurrence of point i, -1 if it was removed")
+      .def(
+          "locate",
+          [](const Delaunay2& dt, const py::handle& q) { return as_index(dt.locate(as_point(q, "Delaunay2.locate"))); },
+          py::arg("q"), "index of a triangle containing q (closed), -1 outside the hull")
+      .def(
+          "nearest",
+          [](const Delaunay2& dt, const py::handle& q) { return as_index(dt.nearest(as_point(q, "Delaunay2.nearest"))); },
+          py::arg("q"), "index of the nearest point (a first occurrence), -1 if empty")
+      .def(
+          "neighbors",
+          [](const Delaunay2& dt, std::int64_t v) {
+            const auto nb = dt.neighbors(vertex_index(v, dt, "Delaunay2.neighbors"));
+            return as_int64(nb, {py::ssize_t(nb.size())});
+          },
+          py::arg("v"), "Delaunay neighbours of vertex v, counter-clockwise")
+      .def(
+          "insert", [](Delaunay2& dt, const py::handle& p) { return std::int64_t(dt.insert(as_point(p, "Delaunay2.insert"))); },
+          py::arg("p"), "inserts a point, returns its index")
+      .def(
+          "remove", [](Delaunay2& dt, std::int64_t v) { dt.remove(vertex_index(v, dt, "Delaunay2.remove")); },
+          py::arg("i"), "removes point i (not with segments)")
+      .def("validate", &Delaunay2::validate, "checks every invariant; raises geods.Error on a violation")
+      .def("stats", [](const Delaunay2& dt) {
+        const auto s = dt.stats();
+        py::dict d;
+        d["points"] = s.points, d["vertices"] = s.vertices, d["duplicates"] = s.duplicates, d["removed"] = s.removed;
+        d["triangles"] = s.triangles, d["hull"] = s.hull, d["flips"] = s.flips, d["walk_steps"] = s.walk_steps;
+        d["bytes"] = s.bytes;
+        return d;
+      });
+}
+
+}  // namespace geods::python
