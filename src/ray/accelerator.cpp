@@ -1,0 +1,105 @@
+#include "geods/ray/accelerator.hpp"
+
+#include <array>
+#include <cmath>
+
+#include "geods/core/error.hpp"
+#include "geods/ray/ray_classifier.hpp"
+#include "geods/ray/ray_octree.hpp"
+#include "geods/ray/uniform_grid.hpp"
+
+namespace geods::ray {
+
+namespace {
+constexpr std::array<AcceleratorKind, 3> kKinds = {AcceleratorKind::grid, AcceleratorKind::octree,
+                                                   AcceleratorKind::rays5d};
+}  // namespace
+
+std::string_view to_string(AcceleratorKind kind) {
+  switch (kind) {
+    case AcceleratorKind::grid: return "grid";
+    case AcceleratorKind::octree: return "octree";
+    case AcceleratorKind::rays5d: return "rays5d";
+  }
+  return "?";
+}
+
+AcceleratorKind parse_accelerator_kind(std::string_view name) {
+  for (AcceleratorKind kind : kKinds)
+    if (to_string(kind) == name) return kind;
+  std::string valid;
+  for (AcceleratorKind kind : kKinds) valid += (valid.empty() ? "" : ", ") + std::string(to_string(kind));
+  throw Error("unknown accelerator '" + std::string(name) + "' (valid: " + valid + ")");
+}
+
+std::span<const AcceleratorKind> all_accelerator_kinds() { return kKinds; }
+
+Accelerator::Accelerator(const TriMesh& mesh) {
+  mesh.require_valid("ray accelerator");
+  if (mesh.num_triangles() >= std::size_t(RayHit::no_hit))
+    throw Error("ray accelerator: more than 2^32 - 2 triangles");
+  corners_.resize(mesh.num_triangles() * 3);
+  for (std::size_t i = 0; i < mesh.num_triangles(); ++i)
+    for (int k = 0; k < 3; ++k) {
+      corners_[3 * i + k] = mesh.vertices[mesh.triangles[i][k]];
+      bounds_.extend(corners_[3 * i + k]);
+    }
+  // Float rounding of the traversal is relative to the coordinates (about 1e-7
+  // of them); 1e-5 of the scene's size and largest coordinate covers rays
+  // starting up to a hundred scene sizes away.
+  if (!bounds_.empty()) {
+    const float scale = std::max(bounds_.extent().norm(), std::max(bounds_.lo.cwiseAbs().maxCoeff(),
+                                                                   bounds_.hi.cwiseAbs().maxCoeff()));
+    margin_ = std::max(scale * 1e-5f, 1e-30f);
+  }
+}
+
+bool Accelerator::shootable(const Ray3f& ray) {
+  return ray.origin.allFinite() && ray.direction.allFinite() && !ray.direction.isZero(0) &&
+         !std::isnan(ray.tmin) && !std::isnan(ray.tmax) && ray.tmin <= ray.tmax;
+}
+
+RayHit Accelerator::intersect(const Ray3f& ray) const {
+  RayCache cache;
+  return intersect(ray, cache);
+}
+
+RayHit Accelerator::intersect(const Ray3f& ray, RayCache& cache) const {
+  if (!shootable(ray) || corners_.empty()) return {};
+  if (cache.owner != this) cache = RayCache{this};
+  const RayHit hit = closest_hit(ray, cache);
+  return hit.hit() ? hit : RayHit{};
+}
+
+bool Accelerator::occluded(const Ray3f& ray) const {
+  RayCache cache;
+  return occluded(ray, cache);
+}
+
+bool Accelerator::occluded(const Ray3f& ray, RayCache& cache) const {
+  if (!shootable(ray) || corners_.empty()) return false;
+  if (cache.owner != this) cache = RayCache{this};
+  // The occluder cache (seed §2.5.2): any occluder will do, and the one that
+  // blocked the previous shadow ray towards the same light often blocks this one.
+  if (cache.occluder != RayHit::no_hit &&
+      test_any(RayTriangleTest<float>(ray), cache.occluder, ray.tmin, ray.tmax)) {
+    ++cache.occluder_hits;
+    return true;
+  }
+  const std::uint32_t prim = any_hit(ray, cache);
+  if (prim == RayHit::no_hit) return false;
+  cache.occluder = prim;
+  return true;
+}
+
+std::unique_ptr<Accelerator> make_accelerator(const TriMesh& mesh, AcceleratorKind kind,
+                                              const AcceleratorOptions& options) {
+  switch (kind) {
+    case AcceleratorKind::grid: return UniformGrid::build(mesh, options);
+    case AcceleratorKind::octree: return RayOctree::build(mesh, options);
+    case AcceleratorKind::rays5d: return RayClassifier::build(mesh, options);
+  }
+  throw Error("make_accelerator: unknown kind");
+}
+
+}  // namespace geods::ray

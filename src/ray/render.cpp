@@ -1,0 +1,124 @@
+#include "geods/ray/render.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+
+#include "geods/core/error.hpp"
+#include "geods/core/parallel.hpp"
+
+namespace geods::ray {
+
+namespace {
+
+constexpr int kTile = 16;
+
+// Area-weighted vertex normals for smooth shading when the mesh has none.
+std::vector<Vec3f> vertex_normals(const TriMesh& mesh) {
+  if (mesh.normals.size() == mesh.vertices.size()) return mesh.normals;
+  std::vector<Vec3f> normals(mesh.vertices.size(), Vec3f::Zero());
+  for (const auto& t : mesh.triangles) {
+    const Vec3f n = (mesh.vertices[t[1]] - mesh.vertices[t[0]]).cross(mesh.vertices[t[2]] - mesh.vertices[t[0]]);
+    for (std::uint32_t v : t) normals[v] += n;
+  }
+  return normals;
+}
+
+std::uint8_t to_byte(float linear) {
+  return std::uint8_t(std::lround(255.0f * std::pow(std::clamp(linear, 0.0f, 1.0f), 1.0f / 2.2f)));
+}
+
+}  // namespace
+
+RenderResult render(const TriMesh& mesh, const RenderOptions& options) {
+  const auto accel = make_accelerator(mesh, options.accel, options.accel_options);
+  RenderResult result = render(mesh, *accel, options);
+  result.build_s = accel->build_s();
+  return result;
+}
+
+RenderResult render(const TriMesh& mesh, const Accelerator& accel, const RenderOptions& options) {
+  if (options.width < 1 || options.height < 1 || options.width > 32768 || options.height > 32768)
+    throw Error("render: width and height must be in [1, 32768]");
+  if (accel.num_triangles() != mesh.num_triangles())
+    throw Error("render: the accelerator was built over a different mesh");
+  const Camera camera = options.camera.value_or(Camera::framing(mesh.bounds()));
+  camera.check();
+  const auto start = std::chrono::steady_clock::now();
+  const std::vector<Vec3f> normals = vertex_normals(mesh);
+  const int width = options.width, height = options.height;
+  RenderResult result;
+  result.image = Image<std::uint8_t>(std::size_t(width), std::size_t(height), 3);
+
+  // A directional light above, left of and behind the camera.
+  const Vec3f forward = (camera.target - camera.eye).normalized();
+  const Vec3f right = forward.cross(camera.up).normalized();
+  const Vec3f true_up = right.cross(forward);
+  const Vec3f light = (0.6f * true_up - 0.45f * right - 0.65f * forward).normalized();
+  const AABB3f bounds = mesh.bounds();
+  const float offset = 1e-4f * (bounds.empty() ? 1.0f : std::max(bounds.extent().norm(), 1e-30f));
+  const Vec3f albedo(0.90f, 0.72f, 0.50f);
+
+  const int tiles_x = (width + kTile - 1) / kTile, tiles_y = (height + kTile - 1) / kTile;
+  const std::size_t tiles = std::size_t(tiles_x) * std::size_t(tiles_y);
+  std::atomic<std::uint64_t> rays{0}, hits{0}, occluder_hits{0};
+  auto render_tile = [&](std::size_t tile) {
+    // Per tile: one cache for primary rays, one for the shadow rays of the light.
+    RayCache primary_cache, shadow_cache;
+    std::uint64_t tile_rays = 0, tile_hits = 0;
+    const int x0 = int(tile % std::size_t(tiles_x)) * kTile, y0 = int(tile / std::size_t(tiles_x)) * kTile;
+    for (int y = y0; y < std::min(y0 + kTile, height); ++y)
+      for (int x = x0; x < std::min(x0 + kTile, width); ++x) {
+        const Ray3f ray = camera.primary_ray(float(x) + 0.5f, float(y) + 0.5f, width, height);
+        ++tile_rays;
+        const RayHit hit = accel.intersect(ray, primary_cache);
+        Vec3f color;
+        if (!hit.hit()) {
+          const float s = float(y) / float(height);
+          color = (1 - s) * Vec3f(0.93f, 0.95f, 0.98f) + s * Vec3f(0.70f, 0.76f, 0.84f);
+        } else {
+          ++tile_hits;
+          const auto& tri = mesh.triangles[hit.prim];
+          const Vec3f &a = mesh.vertices[tri[0]], &b = mesh.vertices[tri[1]], &c = mesh.vertices[tri[2]];
+          Vec3f geometric = (b - a).cross(c - a).normalized();
+          // Two-sided: turn the normals towards the viewer.
+          const float facing = geometric.dot(ray.direction) > 0 ? -1.0f : 1.0f;
+          geometric *= facing;
+          Vec3f n = (1 - hit.u - hit.v) * normals[tri[0]] + hit.u * normals[tri[1]] + hit.v * normals[tri[2]];
+          n = n.squaredNorm() > 0 ? Vec3f(facing * n.normalized()) : geometric;
+          if (n.dot(ray.direction) > 0) n = geometric;
+          float key = std::max(0.0f, n.dot(light));
+          if (options.shadows && key > 0 && geometric.dot(light) > 0) {
+            Ray3f shadow;
+            shadow.origin = ray.at(hit.t) + offset * geometric;
+            shadow.direction = light;
+            ++tile_rays;
+            if (accel.occluded(shadow, shadow_cache)) key = 0;
+          }
+          const float fill = std::abs(n.dot(ray.direction));
+          color = albedo * (0.10f + 0.75f * key + 0.20f * fill);
+        }
+        for (int ch = 0; ch < 3; ++ch) result.image(std::size_t(x), std::size_t(y), std::size_t(ch)) = to_byte(color[ch]);
+      }
+    rays.fetch_add(tile_rays, std::memory_order_relaxed);
+    hits.fetch_add(tile_hits, std::memory_order_relaxed);
+    occluder_hits.fetch_add(shadow_cache.occluder_hits, std::memory_order_relaxed);
+  };
+  // Tiles in batches, so that progress is reported from this thread.
+  Progress progress(options.progress, "render", double(tiles));
+  const std::size_t batch = std::max<std::size_t>(1, tiles / 32);
+  for (std::size_t first = 0; first < tiles; first += batch) {
+    parallel_for_each_index(first, std::min(tiles, first + batch), render_tile, 1);
+    progress.update(double(std::min(tiles, first + batch)));
+  }
+  progress.finish();
+  result.render_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.rays = rays.load();
+  result.hits = hits.load();
+  result.occluder_hits = occluder_hits.load();
+  result.accel_stats = accel.stats();
+  return result;
+}
+
+}  // namespace geods::ray

@@ -1,0 +1,419 @@
+// Every accelerator against brute force (all triangles with the watertight
+// RayTriangleTest): the same closest t and triangle (ties: the smallest index,
+// which brute force in index order also keeps), the same any-hit answer, on the
+// meshes of data/ and on random soups with degenerate, tiny, huge and
+// axis-aligned triangles, for random, axis-parallel, grazing and on-surface rays.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "geods/core/error.hpp"
+#include "geods/core/parallel.hpp"
+#include "geods/core/rng.hpp"
+#include "geods/io/mesh_io.hpp"
+#include "geods/ray/accelerator.hpp"
+#include "geods/ray/ray_classifier.hpp"
+#include "geods/ray/ray_octree.hpp"
+#include "geods/ray/uniform_grid.hpp"
+
+namespace geods::ray {
+namespace {
+
+RayHit brute_closest(const TriMesh& mesh, const Ray3f& ray) {
+  RayHit best;
+  best.t = ray.tmax;
+  const RayTriangleTest<float> test(ray);
+  for (std::uint32_t i = 0; i < mesh.num_triangles(); ++i) {
+    const auto& t = mesh.triangles[i];
+    float th, u, v;
+    if (test.intersect(mesh.vertices[t[0]], mesh.vertices[t[1]], mesh.vertices[t[2]], ray.tmin, best.t, th, u, v) &&
+        (th < best.t || !best.hit()))
+      best = {th, i, u, v};
+  }
+  return best.hit() ? best : RayHit{};
+}
+
+bool brute_any(const TriMesh& mesh, const Ray3f& ray) {
+  const RayTriangleTest<float> test(ray);
+  for (const auto& t : mesh.triangles) {
+    float th, u, v;
+    if (test.intersect(mesh.vertices[t[0]], mesh.vertices[t[1]], mesh.vertices[t[2]], ray.tmin, ray.tmax, th, u, v))
+      return true;
+  }
+  return false;
+}
+
+Vec3f random_vec(Rng& rng, const Vec3f& lo, const Vec3f& hi) {
+  Vec3f p;
+  for (int a = 0; a < 3; ++a) p[a] = float(rng.uniform(lo[a], hi[a]));
+  return p;
+}
+
+Vec3f random_direction(Rng& rng) {
+  for (;;) {
+    const Vec3f d = random_vec(rng, Vec3f::Constant(-1), Vec3f::Constant(1));
+    if (d.squaredNorm() > 1e-4f && d.squaredNorm() <= 1) return d.normalized();
+  }
+}
+
+// Rays of many kinds around the mesh's bounds.
+std::vector<Ray3f> test_rays(const TriMesh& mesh, std::uint64_t seed, int count) {
+  Rng rng(seed);
+  const AABB3f box = mesh.bounds();
+  const Vec3f c = box.center(), e = box.extent().cwiseMax(Vec3f::Constant(1e-3f));
+  const Vec3f lo = c - e, hi = c + e;
+  std::vector<Ray3f> rays;
+  auto vertex = [&]() {
+    return mesh.vertices[mesh.triangles[rng() % mesh.num_triangles()][rng() % 3]];
+  };
+  for (int i = 0; i < count; ++i) {
+    Ray3f r;
+    switch (i % 9) {
+      case 0:  // from outside towards a random point inside
+        r.origin = random_vec(rng, lo, hi);
+        r.direction = random_vec(rng, box.lo, box.hi) - r.origin;
+        break;
+      case 1:  // through a vertex
+        r.origin = random_vec(rng, lo, hi);
+        r.direction = vertex() - r.origin;
+        break;
+      case 2: {  // through the middle of an edge
+        const auto& t = mesh.triangles[rng() % mesh.num_triangles()];
+        r.origin = random_vec(rng, lo, hi);
+        r.direction = 0.5f * (mesh.vertices[t[0]] + mesh.vertices[t[1]]) - r.origin;
+        break;
+      }
+      case 3: {  // parallel to an axis (zero components), either sign
+        r.origin = random_vec(rng, lo, hi);
+        r.direction = Vec3f::Zero();
+        r.direction[int(rng() % 3)] = rng() % 2 ? 1.0f : -1.0f;
+        break;
+      }
+      case 4: {  // starting on the surface, leaving in a random direction
+        const auto& t = mesh.triangles[rng() % mesh.num_triangles()];
+        const float u = float(rng.uniform()), v = float(rng.uniform()) * (1 - u);
+        r.origin = (1 - u - v) * mesh.vertices[t[0]] + u * mesh.vertices[t[1]] + v * mesh.vertices[t[2]];
+        r.direction = random_direction(rng);
+        break;
+      }
+      case 5: {  // in the plane of an axis through a vertex: one zero component
+        const Vec3f p = vertex();
+        r.origin = random_vec(rng, lo, hi);
+        const int a = int(rng() % 3);
+        r.origin[a] = p[a];
+        r.direction = p - r.origin;
+        r.direction[a] = 0;
+        break;
+      }
+      case 6:  // from inside, random direction, bounded interval
+        r.origin = random_vec(rng, box.lo, box.hi);
+        r.direction = random_direction(rng);
+        r.tmin = float(rng.uniform(0, 0.3)) * e.norm();
+        r.tmax = r.tmin + float(rng.uniform(0, 1)) * e.norm();
+        break;
+      case 7:  // far away, unnormalized direction
+        r.origin = c + 20 * e.norm() * random_direction(rng);
+        r.direction = (random_vec(rng, box.lo, box.hi) - r.origin) * float(rng.uniform(0.01, 100));
+        break;
+      default:  // from a vertex along an axis: exactly on the mesh
+        r.origin = vertex();
+        r.direction = Vec3f::Zero();
+        r.direction[int(rng() % 3)] = rng() % 2 ? 1.0f : -1.0f;
+        break;
+    }
+    if (r.direction.isZero(0)) r.direction = Vec3f::UnitX();
+    rays.push_back(r);
+  }
+  return rays;
+}
+
+void expect_same_as_brute_force(const TriMesh& mesh, const std::vector<Ray3f>& rays, const std::string& what,
+                                const AcceleratorOptions& options = {}) {
+  for (AcceleratorKind kind : all_accelerator_kinds()) {
+    SCOPED_TRACE(what + " / " + std::string(to_string(kind)));
+    const auto accel = make_accelerator(mesh, kind, options);
+    ASSERT_EQ(accel->kind(), kind);
+    std::size_t hits = 0, mismatches = 0;
+    RayCache cache;  // shared by all rays: must not change any answer
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+      const RayHit expected = brute_closest(mesh, rays[i]);
+      const RayHit got = accel->intersect(rays[i]);
+      const RayHit cached = accel->intersect(rays[i], cache);
+      hits += expected.hit();
+      if (got.prim != expected.prim || got.t != expected.t || cached.prim != expected.prim || cached.t != expected.t) {
+        if (++mismatches <= 5)
+          ADD_FAILURE() << "ray " << i << " o=" << rays[i].origin.transpose() << " d=" << rays[i].direction.transpose()
+                        << ": expected prim " << expected.prim << " t " << expected.t << ", got " << got.prim << " t "
+                        << got.t << " (cached " << cached.prim << ")";
+        continue;
+      }
+      EXPECT_EQ(got.u, expected.u);
+      EXPECT_EQ(got.v, expected.v);
+      const bool any = brute_any(mesh, rays[i]);
+      EXPECT_EQ(accel->occluded(rays[i]), any) << "ray " << i;
+      EXPECT_EQ(accel->occluded(rays[i], cache), any) << "ray " << i << " with the occluder cache";
+    }
+    EXPECT_EQ(mismatches, 0u);
+    EXPECT_GT(hits, rays.size() / 10) << "the rays should hit the mesh often";
+    EXPECT_NO_THROW(accel->validate());
+  }
+}
+
+TriMesh load(const char* name) { return io::read_mesh(std::string(GEODS_DATA_DIR) + "/" + name); }
+
+TEST(Accelerators, BunnyMatchesBruteForce) {
+  const TriMesh mesh = load("bunny.ply");
+  expect_same_as_brute_force(mesh, test_rays(mesh, 1, 1800), "bunny");
+}
+
+TEST(Accelerators, TeapotMatchesBruteForce) {
+  const TriMesh mesh = load("teapot.obj");
+  expect_same_as_brute_force(mesh, test_rays(mesh, 2, 1800), "teapot");
+}
+
+// A soup of random triangles mixed with degenerate (repeated corner, collinear),
+// tiny, huge and axis-aligned ones, and exact duplicates (ties in t).
+TriMesh ugly_soup(std::uint64_t seed, int count) {
+  Rng rng(seed);
+  TriMesh mesh;
+  auto add = [&](const Vec3f& a, const Vec3f& b, const Vec3f& c) {
+    const auto base = std::uint32_t(mesh.vertices.size());
+    mesh.vertices.insert(mesh.vertices.end(), {a, b, c});
+    mesh.triangles.push_back({base, base + 1, base + 2});
+  };
+  const Vec3f lo = Vec3f::Constant(-1), hi = Vec3f::Constant(1);
+  for (int i = 0; i < count; ++i) {
+    const Vec3f p = random_vec(rng, lo, hi);
+    switch (i % 8) {
+      case 0: add(p, random_vec(rng, lo, hi), random_vec(rng, lo, hi)); break;  // large random
+      case 1: add(p, p + 0.1f * random_direction(rng), p + 0.1f * random_direction(rng)); break;
+      case 2: add(p, p + 1e-5f * random_direction(rng), p + 1e-5f * random_direction(rng)); break;  // tiny
+      case 3: add(p, p, p + 0.2f * random_direction(rng)); break;                                  // degenerate
+      case 4: add(p, p + Vec3f(0.1f, 0.1f, 0.1f), p + Vec3f(0.2f, 0.2f, 0.2f)); break;            // collinear
+      case 5: {  // axis-aligned
+        const int a = int(rng() % 3);
+        Vec3f q = p + 0.3f * random_direction(rng), r = p + 0.3f * random_direction(rng);
+        q[a] = r[a] = p[a];
+        add(p, q, r);
+        break;
+      }
+      case 6: add(10 * p, 10 * random_vec(rng, lo, hi), -10 * p); break;  // huge, crosses everything
+      default: {  // a duplicate of an earlier triangle, corners rotated: the same t
+        const auto& t = mesh.triangles[rng() % mesh.triangles.size()];
+        add(mesh.vertices[t[1]], mesh.vertices[t[2]], mesh.vertices[t[0]]);
+        break;
+      }
+    }
+  }
+  return mesh;
+}
+
+TEST(Accelerators, UglySoupMatchesBruteForce) {
+  for (std::uint64_t seed : {3u, 4u}) {
+    const TriMesh mesh = ugly_soup(seed, 600);
+    expect_same_as_brute_force(mesh, test_rays(mesh, seed + 10, 1800), "soup " + std::to_string(seed));
+  }
+}
+
+// A closed cube of 2 x 2 quads per face on a grid, shot through its shared edges
+// and vertices along the axes and diagonals: watertight, so every ray from
+// outside through the cube's interior hits.
+TEST(Accelerators, ClosedGridCubeNeverLeaks) {
+  TriMesh mesh;
+  auto vertex = [&](Vec3f p) {
+    mesh.vertices.push_back(p);
+    return std::uint32_t(mesh.vertices.size() - 1);
+  };
+  for (int axis = 0; axis < 3; ++axis)
+    for (float side : {0.0f, 2.0f})
+      for (int i = 0; i < 2; ++i)
+        for (int j = 0; j < 2; ++j) {
+          auto at = [&](int a, int b) {
+            Vec3f p;
+            p[axis] = side;
+            p[(axis + 1) % 3] = float(i + a);
+            p[(axis + 2) % 3] = float(j + b);
+            return vertex(p);
+          };
+          const std::uint32_t v00 = at(0, 0), v10 = at(1, 0), v01 = at(0, 1), v11 = at(1, 1);
+          mesh.triangles.push_back({v00, v10, v11});
+          mesh.triangles.push_back({v00, v11, v01});
+        }
+  std::vector<Ray3f> rays;
+  for (int a = 0; a < 3; ++a)
+    for (float x : {0.5f, 1.0f, 1.5f})
+      for (float y : {0.5f, 1.0f, 1.5f})
+        for (float sign : {1.0f, -1.0f}) {
+          Ray3f r;
+          r.origin[a] = sign > 0 ? -1.0f : 3.0f;
+          r.origin[(a + 1) % 3] = x;
+          r.origin[(a + 2) % 3] = y;
+          r.direction = Vec3f::Zero();
+          r.direction[a] = sign;
+          rays.push_back(r);
+          Ray3f diagonal = r;  // through the same point of the near face, at 45 degrees
+          diagonal.direction[(a + 1) % 3] = 0.5f;
+          diagonal.origin[(a + 1) % 3] -= 0.5f * (sign > 0 ? 1.0f : 3.0f);
+          rays.push_back(diagonal);
+        }
+  for (AcceleratorKind kind : all_accelerator_kinds()) {
+    const auto accel = make_accelerator(mesh, kind);
+    for (const Ray3f& r : rays) {
+      EXPECT_TRUE(accel->intersect(r).hit()) << to_string(kind) << " o=" << r.origin.transpose();
+      EXPECT_EQ(accel->intersect(r).t, brute_closest(mesh, r).t) << to_string(kind);
+    }
+  }
+  expect_same_as_brute_force(mesh, rays, "grid cube");
+}
+
+TEST(Accelerators, SmallLeavesDeepTreesAndCutoffMatchBruteForce) {
+  const TriMesh mesh = load("bunny.ply");
+  AcceleratorOptions options;
+  options.grid_density = 0.3f;  // coarse grid: many triangles per cell
+  options.octree_leaf_size = 1;
+  options.octree_max_depth = 10;
+  options.rays5d_leaf_size = 1;
+  options.rays5d_max_depth = 6;
+  options.rays5d_max_references = 4000000;
+  options.rays5d_cutoff = 0.01f;  // restarts often
+  expect_same_as_brute_force(mesh, test_rays(mesh, 5, 900), "bunny, extreme options", options);
+  options.rays5d_cutoff = 0;  // no cut-off
+  options.rays5d_max_references = 20000;  // the budget runs out early
+  options.grid_max_resolution = 3;
+  expect_same_as_brute_force(mesh, test_rays(mesh, 6, 900), "bunny, small budgets", options);
+}
+
+TEST(Accelerators, EmptyFlatAndBadInput) {
+  TriMesh empty;
+  for (AcceleratorKind kind : all_accelerator_kinds()) {
+    const auto accel = make_accelerator(empty, kind);
+    Ray3f r;
+    EXPECT_FALSE(accel->intersect(r).hit());
+    EXPECT_FALSE(accel->occluded(r));
+    EXPECT_NO_THROW(accel->validate());
+    EXPECT_EQ(accel->stats().triangles, 0u);
+  }
+  // All triangles in the plane z = 0: a flat scene box.
+  TriMesh flat;
+  Rng rng(9);
+  for (int i = 0; i < 200; ++i) {
+    const auto base = std::uint32_t(flat.vertices.size());
+    for (int k = 0; k < 3; ++k) flat.vertices.push_back({float(rng.uniform(-1, 1)), float(rng.uniform(-1, 1)), 0.0f});
+    flat.triangles.push_back({base, base + 1, base + 2});
+  }
+  expect_same_as_brute_force(flat, test_rays(flat, 11, 900), "flat");
+
+  TriMesh bad = flat;
+  bad.vertices[3][1] = std::numeric_limits<float>::quiet_NaN();
+  TriMesh out_of_range = flat;
+  out_of_range.triangles[5][2] = 100000;
+  for (AcceleratorKind kind : all_accelerator_kinds()) {
+    EXPECT_THROW(make_accelerator(bad, kind), Error);
+    EXPECT_THROW(make_accelerator(out_of_range, kind), Error);
+  }
+  EXPECT_THROW(parse_accelerator_kind("kdtree"), Error);
+  for (AcceleratorKind kind : all_accelerator_kinds()) EXPECT_EQ(parse_accelerator_kind(to_string(kind)), kind);
+  AcceleratorOptions options;
+  options.grid_density = 0;
+  EXPECT_THROW(make_accelerator(flat, AcceleratorKind::grid, options), Error);
+  options = {};
+  options.octree_leaf_size = 0;
+  EXPECT_THROW(make_accelerator(flat, AcceleratorKind::octree, options), Error);
+
+  // Rays that cannot hit: zero or NaN direction, empty interval.
+  const auto grid = make_accelerator(flat, AcceleratorKind::rays5d);
+  Ray3f r;
+  r.origin = {0, 0, 1};
+  r.direction = Vec3f::Zero();
+  EXPECT_FALSE(grid->intersect(r).hit());
+  r.direction = {0, std::numeric_limits<float>::quiet_NaN(), -1};
+  EXPECT_FALSE(grid->intersect(r).hit());
+  r.direction = {0, 0, -1};
+  r.tmin = 2;
+  r.tmax = 1;
+  EXPECT_FALSE(grid->occluded(r));
+}
+
+TEST(Accelerators, ParallelQueriesGiveTheSameAnswers) {
+  const TriMesh mesh = load("bunny.ply");
+  const std::vector<Ray3f> rays = test_rays(mesh, 21, 4000);
+  for (AcceleratorKind kind : all_accelerator_kinds()) {
+    const auto accel = make_accelerator(mesh, kind);
+    std::vector<RayHit> serial(rays.size()), parallel(rays.size());
+    std::vector<char> blocked(rays.size()), parallel_blocked(rays.size());
+    // In parallel first, so the 5D classifier subdivides concurrently.
+    parallel_for(0, rays.size(), 64, [&](std::size_t b, std::size_t e) {
+      RayCache cache;
+      for (std::size_t i = b; i < e; ++i) {
+        parallel[i] = accel->intersect(rays[i], cache);
+        parallel_blocked[i] = accel->occluded(rays[i], cache);
+      }
+    });
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+      serial[i] = brute_closest(mesh, rays[i]);
+      blocked[i] = brute_any(mesh, rays[i]);
+      EXPECT_EQ(parallel[i].prim, serial[i].prim) << to_string(kind) << " ray " << i;
+      EXPECT_EQ(parallel[i].t, serial[i].t) << to_string(kind) << " ray " << i;
+      EXPECT_EQ(parallel_blocked[i], blocked[i]) << to_string(kind) << " ray " << i;
+    }
+    EXPECT_NO_THROW(accel->validate());
+  }
+}
+
+TEST(Accelerators, CachesHelpCoherentRays) {
+  const TriMesh mesh = load("bunny.ply");
+  const auto accel = make_accelerator(mesh, AcceleratorKind::rays5d);
+  const AABB3f box = mesh.bounds();
+  // A fan of coherent rays from one eye, then shadow rays towards one light.
+  RayCache primary, shadow;
+  const Vec3f eye = box.center() + Vec3f(0, 0, 3 * box.extent().norm());
+  std::size_t blocked = 0;
+  for (int y = 0; y < 40; ++y)
+    for (int x = 0; x < 40; ++x) {
+      Ray3f r;
+      r.origin = eye;
+      // A window of a tenth of the bunny: about a pixel per 1/1000 of the direction cube's face.
+      const Vec3f target = box.center() + 0.1f * Vec3f(box.extent()[0] * ((x + 0.5f) / 40 - 0.5f),
+                                                        box.extent()[1] * ((y + 0.5f) / 40 - 0.5f), 0);
+      r.direction = (target - eye).normalized();
+      const RayHit hit = accel->intersect(r, primary);
+      ASSERT_EQ(hit.prim, brute_closest(mesh, r).prim);
+      if (!hit.hit()) continue;
+      Ray3f s;
+      s.origin = r.at(hit.t) - 1e-4f * r.direction;
+      s.direction = Vec3f(0.2f, 0.1f, -1.0f).normalized();  // into the bunny: blocked by its back
+      const bool occluded = accel->occluded(s, shadow);
+      ASSERT_EQ(occluded, brute_any(mesh, s));
+      blocked += occluded;
+    }
+  EXPECT_GT(primary.cell_hits, 800u) << "coherent rays should mostly start in the cached leaf";
+  EXPECT_GT(blocked, 0u);
+  EXPECT_GT(shadow.occluder_hits, 0u) << "neighbouring shadow rays should share occluders";
+  const AcceleratorStats stats = accel->stats();
+  EXPECT_GT(stats.nodes, 6u) << "rays should have subdivided the 5D octrees";
+  EXPECT_EQ(stats.references, static_cast<const RayClassifier&>(*accel).references());
+}
+
+TEST(Accelerators, StatsDescribeTheStructures) {
+  const TriMesh mesh = load("bunny.ply");
+  const auto grid = UniformGrid::build(mesh);
+  const AcceleratorStats g = grid->stats();
+  EXPECT_EQ(g.kind, "grid");
+  EXPECT_EQ(g.triangles, mesh.num_triangles());
+  EXPECT_EQ(g.nodes, std::size_t(g.resolution[0]) * g.resolution[1] * g.resolution[2]);
+  // About density * n cells.
+  EXPECT_GT(g.nodes, mesh.num_triangles());
+  EXPECT_LT(g.nodes, 12 * mesh.num_triangles());
+  EXPECT_GE(g.references, mesh.num_triangles());
+  const auto octree = RayOctree::build(mesh);
+  const AcceleratorStats o = octree->stats();
+  EXPECT_EQ((o.nodes - 1) % 8, 0u);
+  EXPECT_GE(o.references, mesh.num_triangles());
+  EXPECT_GT(o.depth, 2u);
+  EXPECT_LE(o.depth, 12u);
+}
+
+}  // namespace
+}  // namespace geods::ray
