@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <atomic>
+#include <array>
 #include <chrono>
+#include <numbers>
 #include <cmath>
 
 #include "geods/core/error.hpp"
@@ -25,9 +27,41 @@ std::vector<Vec3f> vertex_normals(const TriMesh& mesh) {
   return normals;
 }
 
-std::uint8_t to_byte(float linear) {
-  return std::uint8_t(std::lround(255.0f * std::pow(std::clamp(linear, 0.0f, 1.0f), 1.0f / 2.2f)));
-}
+// Linear intensity to 8-bit sRGB-like values (gamma 2.2), by a table of 4096 entries.
+class GammaTable {
+ public:
+  GammaTable() {
+    for (int i = 0; i < kSize; ++i)
+      table_[std::size_t(i)] = std::uint8_t(std::lround(255.0 * std::pow(double(i) / (kSize - 1), 1.0 / 2.2)));
+  }
+  std::uint8_t operator()(float linear) const {
+    return table_[std::size_t(std::lround(std::clamp(linear, 0.0f, 1.0f) * (kSize - 1)))];
+  }
+
+ private:
+  static constexpr int kSize = 4096;
+  std::array<std::uint8_t, kSize> table_;
+};
+
+// The camera's frame, computed once per image (Camera::primary_ray recomputes it per ray).
+struct CameraFrame {
+  explicit CameraFrame(const Camera& camera, int width, int height) : eye(camera.eye) {
+    forward = (camera.target - camera.eye).normalized();
+    right = forward.cross(camera.up).normalized();
+    up = right.cross(forward);
+    const float h = std::tan(0.5f * camera.vertical_fov_deg * std::numbers::pi_v<float> / 180.0f);
+    right *= 2 * h * float(width) / float(height) / float(width);
+    up *= 2 * h / float(height);
+    corner = forward - 0.5f * float(width) * right + 0.5f * float(height) * up;
+  }
+  Ray3f ray(float x, float y) const {
+    Ray3f r;
+    r.origin = eye;
+    r.direction = (corner + x * right - y * up).normalized();
+    return r;
+  }
+  Vec3f eye, forward, right, up, corner;
+};
 
 }  // namespace
 
@@ -51,11 +85,10 @@ RenderResult render(const TriMesh& mesh, const Accelerator& accel, const RenderO
   RenderResult result;
   result.image = Image<std::uint8_t>(std::size_t(width), std::size_t(height), 3);
 
-  // A directional light above, left of and behind the camera.
-  const Vec3f forward = (camera.target - camera.eye).normalized();
-  const Vec3f right = forward.cross(camera.up).normalized();
-  const Vec3f true_up = right.cross(forward);
-  const Vec3f light = (0.6f * true_up - 0.45f * right - 0.65f * forward).normalized();
+  // A directional light above and to the left, a little behind the camera.
+  const CameraFrame frame(camera, width, height);
+  const Vec3f light = (0.55f * frame.up.normalized() - 0.75f * frame.right.normalized() - 0.35f * frame.forward).normalized();
+  const GammaTable to_byte;
   const AABB3f bounds = mesh.bounds();
   const float offset = 1e-4f * (bounds.empty() ? 1.0f : std::max(bounds.extent().norm(), 1e-30f));
   const Vec3f albedo(0.90f, 0.72f, 0.50f);
@@ -70,7 +103,7 @@ RenderResult render(const TriMesh& mesh, const Accelerator& accel, const RenderO
     const int x0 = int(tile % std::size_t(tiles_x)) * kTile, y0 = int(tile / std::size_t(tiles_x)) * kTile;
     for (int y = y0; y < std::min(y0 + kTile, height); ++y)
       for (int x = x0; x < std::min(x0 + kTile, width); ++x) {
-        const Ray3f ray = camera.primary_ray(float(x) + 0.5f, float(y) + 0.5f, width, height);
+        const Ray3f ray = frame.ray(float(x) + 0.5f, float(y) + 0.5f);
         ++tile_rays;
         const RayHit hit = accel.intersect(ray, primary_cache);
         Vec3f color;

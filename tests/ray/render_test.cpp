@@ -1,0 +1,118 @@
+// The renderer: the same picture with every accelerator and any thread count,
+// the framing camera fits the mesh, shadows darken, bad options raise.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "geods/core/error.hpp"
+#include "geods/core/parallel.hpp"
+#include "geods/io/mesh_io.hpp"
+#include "geods/ray/render.hpp"
+
+namespace geods::ray {
+namespace {
+
+TriMesh bunny() { return io::read_mesh(std::string(GEODS_DATA_DIR) + "/bunny.ply"); }
+
+bool is_background(const Image<std::uint8_t>& image, std::size_t x, std::size_t y) {
+  // The background is a bluish-grey gradient: blue above red; the surface is warm: red above blue.
+  return image(x, y, 2) > image(x, y, 0);
+}
+
+TEST(Render, EveryAcceleratorAndThreadCountGivesTheSamePicture) {
+  const TriMesh mesh = bunny();
+  RenderOptions options;
+  options.width = 96;
+  options.height = 64;
+  options.shadows = true;
+  options.accel = AcceleratorKind::grid;
+  const RenderResult reference = render(mesh, options);
+  ASSERT_EQ(reference.image.width, 96u);
+  ASSERT_EQ(reference.image.height, 64u);
+  ASSERT_EQ(reference.image.channels, 3u);
+  EXPECT_GT(reference.hits, 96u * 64u / 10);
+  EXPECT_GT(reference.rays, 96u * 64u);  // primary plus shadow rays
+  EXPECT_GT(reference.mrays_per_s(), 0.0);
+  for (AcceleratorKind kind : all_accelerator_kinds()) {
+    options.accel = kind;
+    const RenderResult result = render(mesh, options);
+    EXPECT_EQ(result.image.data, reference.image.data) << to_string(kind);
+    EXPECT_EQ(result.rays, reference.rays) << to_string(kind);
+    EXPECT_EQ(result.accel_stats.kind, to_string(kind));
+  }
+  set_num_threads(1);
+  options.accel = AcceleratorKind::rays5d;
+  const RenderResult serial = render(mesh, options);
+  set_num_threads(0);
+  EXPECT_EQ(serial.image.data, reference.image.data);
+}
+
+TEST(Render, FramingShowsTheWholeMesh) {
+  const TriMesh mesh = bunny();
+  RenderOptions options;
+  options.width = options.height = 80;
+  const RenderResult result = render(mesh, options);
+  std::size_t surface = 0;
+  for (std::size_t y = 0; y < 80; ++y)
+    for (std::size_t x = 0; x < 80; ++x) {
+      const bool border = x == 0 || y == 0 || x == 79 || y == 79;
+      if (border) {
+        EXPECT_TRUE(is_background(result.image, x, y)) << x << ", " << y;
+      }
+      surface += !is_background(result.image, x, y);
+    }
+  EXPECT_EQ(surface, result.hits);
+  EXPECT_GT(surface, 80u * 80u / 8);
+  // Every corner of the bounds projects inside the field of view.
+  const Camera camera = Camera::framing(mesh.bounds());
+  const Vec3f forward = (camera.target - camera.eye).normalized();
+  const AABB3f box = mesh.bounds();
+  for (int c = 0; c < 8; ++c) {
+    const Vec3f corner(c & 1 ? box.hi[0] : box.lo[0], c & 2 ? box.hi[1] : box.lo[1], c & 4 ? box.hi[2] : box.lo[2]);
+    const float angle = std::acos((corner - camera.eye).normalized().dot(forward)) * 180.0f / 3.14159265f;
+    EXPECT_LT(angle, camera.vertical_fov_deg / 2);
+  }
+}
+
+TEST(Render, ShadowsDarkenAndUseTheOccluderCache) {
+  const TriMesh mesh = bunny();
+  RenderOptions options;
+  options.width = options.height = 160;  // neighbouring shadow rays often meet the same triangle
+  const RenderResult lit = render(mesh, options);
+  options.shadows = true;
+  const RenderResult shadowed = render(mesh, options);
+  EXPECT_EQ(lit.hits, shadowed.hits);
+  long darker = 0, brighter = 0;
+  for (std::size_t i = 0; i < lit.image.size(); ++i) {
+    darker += shadowed.image.data[i] < lit.image.data[i];
+    brighter += shadowed.image.data[i] > lit.image.data[i];
+  }
+  EXPECT_GT(darker, 0);
+  EXPECT_EQ(brighter, 0);
+  EXPECT_GT(shadowed.occluder_hits, 0u);
+}
+
+TEST(Render, BadOptionsRaise) {
+  const TriMesh mesh = bunny();
+  RenderOptions options;
+  options.width = 0;
+  EXPECT_THROW(render(mesh, options), Error);
+  options.width = 16;
+  options.height = 16;
+  options.camera = Camera{Vec3f::Zero(), Vec3f::Zero()};
+  EXPECT_THROW(render(mesh, options), Error);
+  options.camera = Camera{Vec3f(0, 5, 0), Vec3f::Zero(), Vec3f::UnitY()};
+  EXPECT_THROW(render(mesh, options), Error);  // up parallel to the view direction
+  options.camera = Camera{Vec3f(0, 0, 5), Vec3f::Zero(), Vec3f::UnitY(), 180};
+  EXPECT_THROW(render(mesh, options), Error);
+  // A camera inside the mesh's bounds looking out works.
+  options.camera = Camera{mesh.bounds().center(), mesh.bounds().center() + Vec3f::UnitZ()};
+  EXPECT_NO_THROW(render(mesh, options));
+  TriMesh other = mesh;
+  other.triangles.pop_back();
+  const auto accel = make_accelerator(other, AcceleratorKind::grid);
+  EXPECT_THROW(render(mesh, *accel, RenderOptions{}), Error);
+}
+
+}  // namespace
+}  // namespace geods::ray
