@@ -44,7 +44,7 @@ class RenderCommand : public Command {
   void add_options(CLI::App& app) override {
     app.add_option("mesh", mesh_, "Mesh (PLY, OBJ, OFF, STL, glTF)")->required();
     app.add_option("-o,--output", output_, "Output image (.png)")->required();
-    app.add_option("--accel", accel_, "Accelerator: grid, octree or rays5d")->default_val(accel_);
+    app.add_option("--accel", accel_, "Accelerator: bvh, grid, octree or rays5d")->default_val(accel_);
     app.add_option("--width", width_, "Image width in pixels")->default_val(width_);
     app.add_option("--height", height_, "Image height in pixels")->default_val(height_);
     app.add_option("--camera", camera_, "ex,ey,ez,tx,ty,tz,ux,uy,uz,fov (default: a three-quarter view of the mesh)");
@@ -92,7 +92,7 @@ class RenderCommand : public Command {
   }
 
  private:
-  std::string mesh_, output_, accel_ = "grid", camera_;
+  std::string mesh_, output_, accel_ = "bvh", camera_;
   int width_ = 512, height_ = 512;
   bool shadows_ = false;
 };

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "geods/core/error.hpp"
+#include "geods/ray/bvh_accelerator.hpp"
 #include "geods/ray/ray_classifier.hpp"
 #include "geods/ray/ray_octree.hpp"
 #include "geods/ray/uniform_grid.hpp"
@@ -11,12 +12,13 @@
 namespace geods::ray {
 
 namespace {
-constexpr std::array<AcceleratorKind, 3> kKinds = {AcceleratorKind::grid, AcceleratorKind::octree,
-                                                   AcceleratorKind::rays5d};
+constexpr std::array<AcceleratorKind, 4> kKinds = {AcceleratorKind::bvh, AcceleratorKind::grid,
+                                                   AcceleratorKind::octree, AcceleratorKind::rays5d};
 }  // namespace
 
 std::string_view to_string(AcceleratorKind kind) {
   switch (kind) {
+    case AcceleratorKind::bvh: return "bvh";
     case AcceleratorKind::grid: return "grid";
     case AcceleratorKind::octree: return "octree";
     case AcceleratorKind::rays5d: return "rays5d";
@@ -95,6 +97,7 @@ bool Accelerator::occluded(const Ray3f& ray, RayCache& cache) const {
 std::unique_ptr<Accelerator> make_accelerator(const TriMesh& mesh, AcceleratorKind kind,
                                               const AcceleratorOptions& options) {
   switch (kind) {
+    case AcceleratorKind::bvh: return BvhAccelerator::build(mesh, options);
     case AcceleratorKind::grid: return UniformGrid::build(mesh, options);
     case AcceleratorKind::octree: return RayOctree::build(mesh, options);
     case AcceleratorKind::rays5d: return RayClassifier::build(mesh, options);

@@ -18,12 +18,13 @@
 #include "geods/core/ray.hpp"
 #include "geods/core/ray_triangle.hpp"
 #include "geods/core/tri_mesh.hpp"
+#include "geods/bvh/build_options.hpp"
 
 namespace geods::ray {
 
-enum class AcceleratorKind { grid, octree, rays5d };
+enum class AcceleratorKind { bvh, grid, octree, rays5d };
 
-/// "grid", "octree", "rays5d".
+/// "bvh", "grid", "octree", "rays5d".
 std::string_view to_string(AcceleratorKind kind);
 /// The inverse of to_string; throws geods::Error naming the valid kinds.
 AcceleratorKind parse_accelerator_kind(std::string_view name);
@@ -31,6 +32,8 @@ AcceleratorKind parse_accelerator_kind(std::string_view name);
 std::span<const AcceleratorKind> all_accelerator_kinds();
 
 struct AcceleratorOptions {
+  // BVH (geods::bvh::TriangleBvh): its builder, bounding volume, leaf size, arity.
+  bvh::BuildOptions bvh;
   // Uniform grid: about grid_density * n cells for n triangles (each axis gets
   // cells proportional to its extent), at most grid_max_resolution per axis.
   float grid_density = 4.0f;

@@ -18,7 +18,7 @@ struct RenderOptions {
   int width = 512, height = 512;
   std::optional<Camera> camera;  // default: Camera::framing(mesh bounds)
   bool shadows = false;
-  AcceleratorKind accel = AcceleratorKind::grid;
+  AcceleratorKind accel = AcceleratorKind::bvh;
   AcceleratorOptions accel_options;
   ProgressCallback progress;
 };

@@ -1,0 +1,31 @@
+#pragma once
+// The bounding volume hierarchy of the bvh module (seed §4.1) behind the
+// Accelerator interface, so that it can be compared with the grid, the octree
+// and 5D ray classification on the same scene and the same rays.
+#include "geods/bvh/triangle_bvh.hpp"
+#include "geods/ray/accelerator.hpp"
+
+namespace geods::ray {
+
+class BvhAccelerator final : public Accelerator {
+ public:
+  /// Builds a bvh::TriangleBvh with options.bvh.
+  static std::unique_ptr<BvhAccelerator> build(const TriMesh& mesh, const AcceleratorOptions& options = {});
+
+  AcceleratorKind kind() const override { return AcceleratorKind::bvh; }
+  AcceleratorStats stats() const override;
+  void validate() const override { bvh_.validate(); }
+  const bvh::TriangleBvh& hierarchy() const { return bvh_; }
+
+ protected:
+  RayHit closest_hit(const Ray3f& ray, RayCache& cache) const override;
+  /// TriangleBvh::occluded does not say which triangle blocks the ray, so a
+  /// blocked ray is shot again for its closest hit to refresh the occluder cache.
+  std::uint32_t any_hit(const Ray3f& ray, RayCache& cache) const override;
+
+ private:
+  explicit BvhAccelerator(const TriMesh& mesh) : Accelerator(mesh) {}
+  bvh::TriangleBvh bvh_;
+};
+
+}  // namespace geods::ray

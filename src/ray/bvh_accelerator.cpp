@@ -1,0 +1,36 @@
+#include "geods/ray/bvh_accelerator.hpp"
+
+#include <chrono>
+
+namespace geods::ray {
+
+std::unique_ptr<BvhAccelerator> BvhAccelerator::build(const TriMesh& mesh, const AcceleratorOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  std::unique_ptr<BvhAccelerator> accel(new BvhAccelerator(mesh));
+  accel->bvh_ = bvh::TriangleBvh::build(mesh, options.bvh);
+  accel->build_s_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return accel;
+}
+
+RayHit BvhAccelerator::closest_hit(const Ray3f& ray, RayCache&) const { return bvh_.intersect(ray); }
+
+std::uint32_t BvhAccelerator::any_hit(const Ray3f& ray, RayCache&) const {
+  if (!bvh_.occluded(ray)) return RayHit::no_hit;
+  return bvh_.intersect(ray).prim;
+}
+
+AcceleratorStats BvhAccelerator::stats() const {
+  const bvh::BvhStats b = bvh_.stats();
+  AcceleratorStats s;
+  s.kind = "bvh";
+  s.triangles = b.triangles;
+  s.nodes = b.nodes;
+  s.leaves = b.leaves;
+  s.references = b.triangles;
+  s.depth = std::size_t(b.depth);
+  s.bytes = b.bytes + corners_.size() * sizeof(Vec3f);
+  s.build_s = build_s_;
+  return s;
+}
+
+}  // namespace geods::ray
