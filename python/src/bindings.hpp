@@ -10,5 +10,6 @@ void bind_spatial(pybind11::module_& m);  // bind_spatial.cpp: k-d tree
 void bind_dynamic(pybind11::module_& m);  // bind_dynamic.cpp: dynamic k-d tree
 void bind_quadtree(pybind11::module_& m);  // bind_quadtree.cpp: quadtree, octree
 void bind_delaunay(pybind11::module_& m);  // bind_delaunay.cpp: Delaunay triangulation
+void bind_ray(pybind11::module_& m);  // bind_ray.cpp: ray accelerators, render
 
 }  // namespace geods::python
