@@ -1,0 +1,26 @@
+#pragma once
+// Small polygon helpers for the voronoi module: clipping to a box, point in polygon.
+#include <optional>
+#include <utility>
+#include <vector>
+
+#include "geods/core/aabb.hpp"
+#include "geods/core/vec.hpp"
+
+namespace geods::voronoi {
+
+/// Sutherland-Hodgman: the part of `polygon` inside `box`, counter-clockwise if
+/// `polygon` is. Exact for convex polygons; a non-convex one whose clipped part
+/// falls apart comes back as one polygon joined by zero-width bridges along the box.
+std::vector<Vec2d> clip_polygon_to_box(const std::vector<Vec2d>& polygon, const AABB2d& box);
+
+/// Liang-Barsky: the part of segment ab inside `box`, if any.
+std::optional<std::pair<Vec2d, Vec2d>> clip_segment_to_box(const Vec2d& a, const Vec2d& b, const AABB2d& box);
+
+/// Whether p lies inside the simple polygon (even-odd rule; points on the boundary may go either way).
+bool point_in_polygon(const Vec2d& p, const std::vector<Vec2d>& polygon);
+
+/// Signed area, positive for counter-clockwise polygons.
+double polygon_area(const std::vector<Vec2d>& polygon);
+
+}  // namespace geods::voronoi

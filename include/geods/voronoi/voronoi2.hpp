@@ -1,0 +1,112 @@
+#pragma once
+// The Voronoi diagram of points in the plane (seed §5.1) as the dual of their
+// Delaunay triangulation, in a half-edge representation.
+//
+// Vertices are the circumcentres of the Delaunay triangles. Triangles whose
+// circumcircles coincide (co-circular sites, decided with the exact incircle
+// predicate) share one Voronoi vertex, so a vertex may have degree > 3 and no
+// edge has zero length. Every Voronoi edge is a pair of twin half-edges, one
+// per side; a half-edge has its cell (`site`) on its left, so the half-edges of
+// a cell, followed by `next`, run counter-clockwise around it. Unbounded edges
+// have origin and/or target kInfinity: a ray from the circumcentre of a hull
+// triangle, or, when all sites are collinear, a whole line (parallel bisectors;
+// then every cell is unbounded). The `next` of an edge that runs off to
+// infinity is the cell's edge that comes back from infinity, so every cell is
+// one cycle. Each half-edge lies on the line line_point(e) + t * direction(e).
+//
+// Duplicate points share the cell of their first occurrence (representative()).
+//
+// Cells are convex polygons; cell_polygon(i, box) clips one to a box.
+// Size: at most 2n - 5 vertices and 3n - 6 edges for n distinct sites.
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "geods/core/aabb.hpp"
+#include "geods/core/vec.hpp"
+
+namespace geods::voronoi {
+
+struct Voronoi2Stats {
+  std::size_t sites = 0;     // input points
+  std::size_t distinct = 0;  // sites without duplicates
+  std::size_t vertices = 0;
+  std::size_t edges = 0;     // undirected (half-edge pairs)
+  std::size_t unbounded_cells = 0;
+  std::size_t bytes = 0;
+};
+
+class Voronoi2 {
+ public:
+  static constexpr std::uint32_t kInfinity = 0xffffffffu;  // origin/target of an unbounded end
+  static constexpr std::uint32_t kNoEdge = 0xffffffffu;
+
+  struct Edge {
+    std::uint32_t site;    // the cell on the left (a representative site)
+    std::uint32_t twin;    // the same edge seen from the neighbouring cell
+    std::uint32_t next;    // the next half-edge counter-clockwise around `site`
+    std::uint32_t origin;  // vertex index or kInfinity
+    std::uint32_t target;  // vertex index or kInfinity
+  };
+
+  /// The dual of any Delaunay triangulation of `points` in the flat half-edge
+  /// form: counter-clockwise `triangles` (3 indices each), `halfedges[e]` the
+  /// opposite half-edge or kNoEdge on the hull, and `representative[i]` the
+  /// first occurrence of point i (i itself if it is not a duplicate). No
+  /// triangles means the distinct points are collinear (or fewer than 3).
+  Voronoi2(std::span<const Vec2d> points, std::span<const std::uint32_t> triangles,
+           std::span<const std::uint32_t> halfedges, std::span<const std::uint32_t> representative);
+
+  std::span<const Vec2d> points() const { return points_; }
+  std::size_t size() const { return points_.size(); }
+  const std::vector<Vec2d>& vertices() const { return vertices_; }
+  const std::vector<Edge>& edges() const { return edges_; }
+  std::uint32_t representative(std::uint32_t i) const { return representative_[i]; }
+
+  /// One half-edge of the cell of point i (of its representative), or kNoEdge
+  /// if there is only one distinct site (its cell is the whole plane).
+  std::uint32_t cell_edge(std::uint32_t i) const { return cell_edge_[representative_[i]]; }
+  /// Whether the cell of point i is bounded (its site is not on the convex hull).
+  bool bounded(std::uint32_t i) const;
+  /// The Delaunay neighbours of a representative site (sites whose cells share
+  /// an edge or, for co-circular sites, only a vertex), each once.
+  std::span<const std::uint32_t> neighbors(std::uint32_t site) const {
+    return {neighbors_.data() + neighbor_offsets_[site], neighbors_.data() + neighbor_offsets_[site + 1]};
+  }
+
+  /// Unit vector along half-edge e, from its origin towards its target.
+  Vec2d direction(std::uint32_t e) const;
+  /// A point of the line of half-edge e: the midpoint of its two sites.
+  Vec2d line_point(std::uint32_t e) const;
+  /// The site on the other side of half-edge e.
+  std::uint32_t opposite_site(std::uint32_t e) const { return edges_[edges_[e].twin].site; }
+
+  /// The cell of point i clipped to `box`, counter-clockwise (empty if the
+  /// cell misses the box).
+  std::vector<Vec2d> cell_polygon(std::uint32_t i, const AABB2d& box) const;
+  /// cell_polygon of every point, in parallel.
+  std::vector<std::vector<Vec2d>> cell_polygons(const AABB2d& box) const;
+  /// The bounding box of the sites, grown by `margin` times its larger side on
+  /// every side (a frame like the curve Gamma of the seed's Figure 42).
+  AABB2d default_box(double margin = 0.25) const;
+
+  Voronoi2Stats stats() const;
+  /// Checks twins, next cycles, that each cell's cycle holds only its site,
+  /// that every finite vertex is equidistant from the sites of its edges, and
+  /// that the cell of every site contains the site. Throws geods::Error.
+  void validate() const;
+
+ private:
+  void build_dual(std::span<const std::uint32_t> triangles, std::span<const std::uint32_t> halfedges);
+  void build_collinear();
+  void build_neighbors(std::span<const std::uint32_t> triangles);
+
+  std::vector<Vec2d> points_;
+  std::vector<std::uint32_t> representative_;
+  std::vector<Vec2d> vertices_;
+  std::vector<Edge> edges_;
+  std::vector<std::uint32_t> cell_edge_;  // per point; only representatives are set
+  std::vector<std::uint32_t> neighbor_offsets_, neighbors_;
+};
+
+}  // namespace geods::voronoi

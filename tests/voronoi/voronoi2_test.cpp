@@ -1,0 +1,166 @@
+// Voronoi2: the dual structure against brute force (cells hold exactly the
+// points nearest to their site) on random, co-circular, collinear and
+// duplicated sites; clipping; bad input.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "brute_delaunay.hpp"
+#include "geods/core/error.hpp"
+#include "geods/voronoi/polygon_clip.hpp"
+#include "geods/voronoi/voronoi2.hpp"
+
+namespace geods::voronoi {
+namespace {
+
+using testing::brute_delaunay;
+using testing::grid_delaunay;
+using testing::nearest_squared_distance;
+using testing::uniform_points;
+
+// Every sampled point of the box lies in the clipped cell of a nearest site, and
+// the clipped cells tile the box.
+void expect_cells_match_brute_force(const Voronoi2& v, const AABB2d& box, std::uint64_t seed) {
+  const std::vector<std::vector<Vec2d>> cells = v.cell_polygons(box);
+  const std::vector<Vec2d> points(v.points().begin(), v.points().end());
+  double area = 0;
+  for (std::uint32_t i = 0; i < cells.size(); ++i)
+    if (v.representative(i) == i) area += polygon_area(cells[i]);
+  const double box_area = (box.hi[0] - box.lo[0]) * (box.hi[1] - box.lo[1]);
+  EXPECT_NEAR(area, box_area, 1e-9 * box_area);
+  Rng rng(seed);
+  for (int s = 0; s < 500; ++s) {
+    const Vec2d q(rng.uniform(box.lo[0], box.hi[0]), rng.uniform(box.lo[1], box.hi[1]));
+    const double best = nearest_squared_distance(points, q);
+    int containing = 0;
+    for (std::uint32_t i = 0; i < cells.size(); ++i) {
+      if (v.representative(i) != i || !point_in_polygon(q, cells[i])) continue;
+      ++containing;
+      EXPECT_NEAR((points[i] - q).squaredNorm(), best, 1e-9 * (1 + best)) << "sample " << q.transpose();
+    }
+    EXPECT_GE(containing, 1) << "sample " << q.transpose() << " is in no cell";
+  }
+}
+
+TEST(Voronoi2, RandomSitesAgainstBruteForce) {
+  for (std::uint64_t seed : {1, 2, 3}) {
+    const auto t = brute_delaunay(uniform_points(40, seed));
+    const Voronoi2 v = t.voronoi();
+    v.validate();
+    const Voronoi2Stats s = v.stats();
+    EXPECT_EQ(s.vertices, t.triangles.size() / 3);  // no co-circular sites
+    std::size_t hull = 0;
+    for (std::uint32_t h : t.halfedges) hull += h == Voronoi2::kNoEdge;
+    EXPECT_EQ(s.edges, (t.triangles.size() + hull) / 2);
+    EXPECT_EQ(s.unbounded_cells, hull);
+    // Euler: V - E + F = 1 with the unbounded edges ending at one vertex at infinity (V + 1 - E + n = 2).
+    EXPECT_EQ(long(s.vertices) + 1 - long(s.edges) + long(s.distinct), 2);
+    expect_cells_match_brute_force(v, v.default_box(), seed);
+    expect_cells_match_brute_force(v, AABB2d({0.3, 0.2}, {0.6, 0.9}), seed + 10);
+  }
+}
+
+TEST(Voronoi2, CellsAreCounterClockwiseAndContainTheirSites) {
+  const auto t = brute_delaunay(uniform_points(30, 7));
+  const Voronoi2 v = t.voronoi();
+  const AABB2d box = v.default_box();
+  for (std::uint32_t i = 0; i < v.size(); ++i) {
+    const auto cell = v.cell_polygon(i, box);
+    EXPECT_GT(polygon_area(cell), 0);
+    EXPECT_TRUE(point_in_polygon(v.points()[i], cell));
+    // The half-edges of the cell go round it counter-clockwise, ending where the next one starts.
+    std::uint32_t e = v.cell_edge(i);
+    do {
+      EXPECT_EQ(v.edges()[e].site, i);
+      e = v.edges()[e].next;
+    } while (e != v.cell_edge(i));
+  }
+}
+
+TEST(Voronoi2, CoCircularGridMergesCircumcentres) {
+  const auto t = grid_delaunay(6);
+  const Voronoi2 v = t.voronoi();
+  v.validate();
+  // One vertex per square (its centre), each of degree 4; no zero-length edges.
+  ASSERT_EQ(v.vertices().size(), 25u);
+  for (const Vec2d& c : v.vertices()) {
+    EXPECT_EQ(c[0] - std::floor(c[0]), 0.5);
+    EXPECT_EQ(c[1] - std::floor(c[1]), 0.5);
+  }
+  std::vector<int> degree(v.vertices().size(), 0);
+  for (const auto& e : v.edges())
+    if (e.origin != Voronoi2::kInfinity) ++degree[e.origin];
+  for (int d : degree) EXPECT_EQ(d, 4);
+  EXPECT_EQ(v.stats().edges, 2u * 5 * 4 + 4u * 5);  // 40 inner segments + 20 rays
+  // The diagonal neighbours meet only at a vertex but stay Delaunay neighbours.
+  EXPECT_EQ(v.neighbors(0).size(), 3u);
+  expect_cells_match_brute_force(v, AABB2d({-1.3, -0.7}, {6.1, 5.4}), 5);
+}
+
+TEST(Voronoi2, CollinearSitesHaveParallelLines) {
+  std::vector<Vec2d> p = {{0, 0}, {3, 1.5}, {1, 0.5}, {2, 1}, {1, 0.5}, {-2, -1}};
+  const auto t = brute_delaunay(p);
+  ASSERT_TRUE(t.triangles.empty());
+  const Voronoi2 v = t.voronoi();
+  v.validate();
+  EXPECT_TRUE(v.vertices().empty());
+  EXPECT_EQ(v.stats().edges, 4u);
+  EXPECT_EQ(v.stats().unbounded_cells, 5u);
+  EXPECT_EQ(v.representative(4), 2u);
+  for (const auto& e : v.edges()) {
+    EXPECT_EQ(e.origin, Voronoi2::kInfinity);
+    EXPECT_EQ(e.target, Voronoi2::kInfinity);
+    EXPECT_NEAR(std::abs(v.direction(std::uint32_t(&e - v.edges().data())).dot(Vec2d(2, 1).normalized())), 0, 1e-12);
+  }
+  expect_cells_match_brute_force(v, AABB2d({-3, -2}, {4, 3}), 9);
+  // Horizontal sites give vertical lines.
+  const auto h = brute_delaunay({{0, 1}, {2, 1}, {5, 1}});
+  expect_cells_match_brute_force(h.voronoi(), AABB2d({-1, -1}, {6, 3}), 10);
+}
+
+TEST(Voronoi2, DuplicatesShareTheCellOfTheirFirstOccurrence) {
+  std::vector<Vec2d> p = uniform_points(25, 11);
+  p.push_back(p[3]);
+  p.push_back(p[7]);
+  p.push_back(p[3]);
+  const auto t = brute_delaunay(p);
+  const Voronoi2 v = t.voronoi();
+  v.validate();
+  EXPECT_EQ(v.representative(25), 3u);
+  EXPECT_EQ(v.representative(27), 3u);
+  EXPECT_EQ(v.cell_edge(27), v.cell_edge(3));
+  const AABB2d box = v.default_box();
+  EXPECT_EQ(v.cell_polygon(26, box), v.cell_polygon(7, box));
+  EXPECT_EQ(v.stats().distinct, 25u);
+  expect_cells_match_brute_force(v, box, 12);
+}
+
+TEST(Voronoi2, OneOrTwoSites) {
+  const auto one = brute_delaunay({{1, 2}, {1, 2}});
+  const Voronoi2 v1 = one.voronoi();
+  v1.validate();
+  EXPECT_EQ(v1.cell_edge(1), Voronoi2::kNoEdge);
+  EXPECT_NEAR(polygon_area(v1.cell_polygon(0, AABB2d({0, 0}, {3, 4}))), 12, 1e-12);
+  const auto two = brute_delaunay({{0, 0}, {1, 1}});
+  const Voronoi2 v2 = two.voronoi();
+  v2.validate();
+  expect_cells_match_brute_force(v2, AABB2d({-2, -1}, {2, 3}), 13);
+}
+
+TEST(Voronoi2, BadInput) {
+  const std::vector<Vec2d> p = {{0, 0}, {1, 0}, {0, 1}};
+  const std::vector<std::uint32_t> rep = {0, 1, 2}, tri = {0, 1, 2}, he = {Voronoi2::kNoEdge, Voronoi2::kNoEdge, Voronoi2::kNoEdge};
+  EXPECT_THROW(Voronoi2({}, {}, {}, {}), Error);
+  EXPECT_THROW(Voronoi2(p, tri, he, std::vector<std::uint32_t>{0, 1}), Error);
+  EXPECT_THROW(Voronoi2(p, std::vector<std::uint32_t>{0, 1}, std::vector<std::uint32_t>{0, 1}, rep), Error);
+  EXPECT_THROW(Voronoi2(p, std::vector<std::uint32_t>{0, 1, 5}, he, rep), Error);
+  EXPECT_THROW(Voronoi2(p, tri, std::vector<std::uint32_t>{1, 1, Voronoi2::kNoEdge}, rep), Error);
+  const std::vector<Vec2d> nan = {{0, 0}, {std::nan(""), 0}};
+  EXPECT_THROW(Voronoi2(nan, {}, {}, std::vector<std::uint32_t>{0, 1}), Error);
+  const Voronoi2 v(p, tri, he, rep);
+  v.validate();
+  EXPECT_THROW(v.cell_polygon(0, AABB2d()), Error);
+}
+
+}  // namespace
+}  // namespace geods::voronoi
