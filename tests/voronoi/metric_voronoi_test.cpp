@@ -1,0 +1,127 @@
+// L1, L-infinity and L2 Voronoi diagrams: sampled points lie in the cell of a
+// nearest site in that metric (brute force), cells tile the box, edges lie on
+// bisectors; degenerate |dx| = |dy| pairs, duplicates, bad input.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "brute_delaunay.hpp"
+#include "geods/core/error.hpp"
+#include "geods/voronoi/metric_voronoi.hpp"
+#include "geods/voronoi/polygon_clip.hpp"
+
+namespace geods::voronoi {
+namespace {
+
+using testing::uniform_points;
+
+void expect_cells_match_brute_force(const MetricVoronoi& v, std::uint64_t seed, int samples = 1500) {
+  v.validate();
+  const AABB2d& box = v.box();
+  const auto& cells = v.cells();
+  double area = 0;
+  for (std::uint32_t i = 0; i < cells.size(); ++i)
+    if (v.representative(i) == i && !cells[i].empty()) area += polygon_area(cells[i]);
+  const double box_area = (box.hi[0] - box.lo[0]) * (box.hi[1] - box.lo[1]);
+  EXPECT_NEAR(area, box_area, 1e-6 * box_area) << metric_name(v.metric());
+  Rng rng(seed);
+  int outside = 0;
+  for (int s = 0; s < samples; ++s) {
+    const Vec2d q(rng.uniform(box.lo[0], box.hi[0]), rng.uniform(box.lo[1], box.hi[1]));
+    double best = std::numeric_limits<double>::infinity();
+    for (const Vec2d& p : v.points()) best = std::min(best, metric_distance(v.metric(), q, p));
+    int containing = 0;
+    for (std::uint32_t i = 0; i < cells.size(); ++i) {
+      if (v.representative(i) != i || cells[i].empty() || !point_in_polygon(q, cells[i])) continue;
+      ++containing;
+      EXPECT_NEAR(metric_distance(v.metric(), q, v.points()[i]), best, 1e-6 * (1 + best))
+          << metric_name(v.metric()) << ": sample " << q.transpose() << " in the cell of " << i;
+    }
+    outside += containing == 0;
+  }
+  EXPECT_EQ(outside, 0) << metric_name(v.metric());
+}
+
+TEST(MetricVoronoi, RandomSitesAllMetrics) {
+  for (Metric m : {Metric::l1, Metric::linf, Metric::l2})
+    for (std::uint64_t seed : {1, 2}) {
+      const auto p = uniform_points(60, seed);
+      const MetricVoronoi v(p, m, AABB2d({-0.2, -0.1}, {1.1, 1.3}));
+      expect_cells_match_brute_force(v, seed);
+      EXPECT_GT(v.edges().size(), 60u);
+    }
+}
+
+TEST(MetricVoronoi, BoxInsideTheSites) {
+  const auto p = uniform_points(80, 3, -5, 5);
+  for (Metric m : {Metric::l1, Metric::linf})
+    expect_cells_match_brute_force(MetricVoronoi(p, m, AABB2d({-1, -2}, {2, 1})), 4);
+}
+
+TEST(MetricVoronoi, DegenerateDiagonalPairsAndDuplicates) {
+  // Integer grids: many pairs with |dx| = |dy| (two-dimensional L1 bisector
+  // quadrants), equal coordinates and exact ties.
+  std::vector<Vec2d> grid;
+  for (int x = 0; x < 5; ++x)
+    for (int y = 0; y < 4; ++y) grid.push_back(Vec2d(x, y));
+  grid.push_back(grid[6]);
+  for (Metric m : {Metric::l1, Metric::linf, Metric::l2}) {
+    const MetricVoronoi v(grid, m, AABB2d({-1.5, -1.25}, {5.5, 4.75}));
+    EXPECT_EQ(v.representative(20), 6u);
+    EXPECT_EQ(v.cells()[20], v.cells()[6]);
+    expect_cells_match_brute_force(v, 5);
+  }
+  // Two sites on a diagonal: the quadrants go to the site nearer in x (the documented convention).
+  const std::vector<Vec2d> two = {{0, 0}, {1, 1}};
+  const MetricVoronoi v(two, Metric::l1, AABB2d({-3, -3}, {4, 4}));
+  expect_cells_match_brute_force(v, 6);
+  EXPECT_TRUE(point_in_polygon({-2, 3}, v.cells()[0]));
+  EXPECT_TRUE(point_in_polygon({3, -2}, v.cells()[1]));
+}
+
+TEST(MetricVoronoi, L1AndL2DifferAsInFigure46) {
+  // Three sites where L1 and L2 disagree on the owner of a point.
+  const std::vector<Vec2d> p = {{0, 0}, {4, 1}, {1, 5}};
+  const MetricVoronoi l1(p, Metric::l1, AABB2d({-2, -2}, {6, 7}));
+  const MetricVoronoi l2(p, Metric::l2, AABB2d({-2, -2}, {6, 7}));
+  // Points owned by different sites under the two metrics lie in the matching cells.
+  const auto owner = [&](Metric m, const Vec2d& q) {
+    std::uint32_t best = 0;
+    for (std::uint32_t i = 1; i < p.size(); ++i)
+      if (metric_distance(m, q, p[i]) < metric_distance(m, q, p[best])) best = i;
+    return best;
+  };
+  int differ = 0;
+  for (double x = -1.95; x < 6; x += 0.1)
+    for (double y = -1.95; y < 7; y += 0.1) {
+      const Vec2d q(x, y);
+      const std::uint32_t a = owner(Metric::l1, q), b = owner(Metric::l2, q);
+      if (a == b) continue;
+      ++differ;
+      EXPECT_TRUE(point_in_polygon(q, l1.cells()[a]));
+      EXPECT_TRUE(point_in_polygon(q, l2.cells()[b]));
+    }
+  EXPECT_GT(differ, 100);
+  // L1 edges are axis-parallel or diagonal; L2 edges are not in general.
+  for (const auto& e : l1.edges()) {
+    const Vec2d d = (e.p1 - e.p0).cwiseAbs();
+    EXPECT_TRUE(d[0] < 1e-9 || d[1] < 1e-9 || std::abs(d[0] - d[1]) < 1e-9) << d.transpose();
+  }
+}
+
+TEST(MetricVoronoi, BadInput) {
+  const std::vector<Vec2d> p = {{0, 0}, {1, 1}};
+  EXPECT_THROW(MetricVoronoi({}, Metric::l1, AABB2d({0, 0}, {1, 1})), Error);
+  EXPECT_THROW(MetricVoronoi(p, Metric::l1, AABB2d()), Error);
+  EXPECT_THROW(MetricVoronoi(p, Metric::l1, AABB2d({0, 0}, {0, 1})), Error);
+  EXPECT_THROW(MetricVoronoi(std::vector<Vec2d>{{0, std::nan("")}}, Metric::l1, AABB2d({0, 0}, {1, 1})), Error);
+  EXPECT_THROW(parse_metric("l3"), Error);
+  EXPECT_EQ(parse_metric("linf"), Metric::linf);
+  EXPECT_EQ(metric_name(Metric::l1), "l1");
+  const MetricVoronoi one(std::vector<Vec2d>{{0.5, 0.5}}, Metric::linf, AABB2d({0, 0}, {1, 1}));
+  EXPECT_NEAR(polygon_area(one.cells()[0]), 1, 1e-12);
+  EXPECT_TRUE(one.edges().empty());
+}
+
+}  // namespace
+}  // namespace geods::voronoi
