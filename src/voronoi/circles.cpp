@@ -187,4 +187,6 @@ Circle largest_empty_circle(const Voronoi2& diagram) {
   return best;
 }
 
+Circle largest_empty_circle(std::span<const Vec2d> points) { return largest_empty_circle(Voronoi2(points)); }
+
 }  // namespace geods::voronoi

@@ -107,6 +107,12 @@ SpanningTree emst(const Voronoi2& diagram) {
   return tree;
 }
 
+ClosestPair closest_pair(std::span<const Vec2d> points) { return closest_pair(Voronoi2(points)); }
+std::vector<std::uint32_t> all_nearest_neighbors(std::span<const Vec2d> points) {
+  return all_nearest_neighbors(Voronoi2(points));
+}
+SpanningTree emst(std::span<const Vec2d> points) { return emst(Voronoi2(points)); }
+
 std::vector<std::uint32_t> k_nearest_sites(const WalkLocator& locator, const Vec2d& q, std::size_t k) {
   const Voronoi2& diagram = locator.diagram();
   std::vector<std::uint32_t> out;

@@ -9,6 +9,7 @@
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"
 #include "geods/core/predicates.hpp"
+#include "geods/voronoi/delaunay2.hpp"
 #include "geods/voronoi/polygon_clip.hpp"
 #include "exact_compare.hpp"
 
@@ -60,6 +61,26 @@ Vec2d box_corner(const AABB2d& box, int k) {
 }
 
 }  // namespace
+
+namespace {
+
+std::vector<std::uint32_t> representatives(const Delaunay2& triangulation) {
+  std::vector<std::uint32_t> rep(triangulation.points().size());
+  for (std::uint32_t i = 0; i < rep.size(); ++i) {
+    rep[i] = triangulation.representative(i);
+    if (rep[i] == Delaunay2::no_edge)
+      throw Error("Voronoi2: point " + std::to_string(i) + " was removed from the triangulation");
+  }
+  return rep;
+}
+
+}  // namespace
+
+Voronoi2::Voronoi2(std::span<const Vec2d> points) : Voronoi2(Delaunay2(points)) {}
+
+Voronoi2::Voronoi2(const Delaunay2& triangulation)
+    : Voronoi2(triangulation.points(), triangulation.triangles(), triangulation.halfedges(),
+               representatives(triangulation)) {}
 
 Voronoi2::Voronoi2(std::span<const Vec2d> points, std::span<const std::uint32_t> triangles,
                    std::span<const std::uint32_t> halfedges, std::span<const std::uint32_t> representative)

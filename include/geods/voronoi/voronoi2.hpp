@@ -27,6 +27,8 @@
 
 namespace geods::voronoi {
 
+class Delaunay2;
+
 struct Voronoi2Stats {
   std::size_t sites = 0;     // input points
   std::size_t distinct = 0;  // sites without duplicates
@@ -49,6 +51,12 @@ class Voronoi2 {
     std::uint32_t target;  // vertex index or kInfinity
   };
 
+  /// The Voronoi diagram of `points` (triangulates them with Delaunay2).
+  /// Throws geods::Error for no points or non-finite coordinates.
+  explicit Voronoi2(std::span<const Vec2d> points);
+  /// The dual of a Delaunay2 (copied: the diagram does not refer to it).
+  /// Throws geods::Error if points were removed from it.
+  explicit Voronoi2(const Delaunay2& triangulation);
   /// The dual of any Delaunay triangulation of `points` in the flat half-edge
   /// form: counter-clockwise `triangles` (3 indices each), `halfedges[e]` the
   /// opposite half-edge or kNoEdge on the hull, and `representative[i]` the
