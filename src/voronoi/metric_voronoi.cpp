@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <numeric>
 
 #include "geods/core/error.hpp"
@@ -21,6 +22,33 @@ struct Piece {
   Vec2d a, b;
   std::uint32_t neighbor;
 };
+
+// Disjoint increasing parameter intervals of a piece, without allocation.
+struct Intervals {
+  static constexpr int kCapacity = 32;
+  std::array<std::array<double, 2>, kCapacity> v;
+  int size = 0;
+
+  void add(double t0, double t1) {
+    if (size > 0 && v[size - 1][1] >= t0) {
+      v[size - 1][1] = std::max(v[size - 1][1], t1);
+      return;
+    }
+    if (size == kCapacity) throw Error("MetricVoronoi: a bisector piece split into more than 32 parts");
+    v[size++] = {t0, t1};
+  }
+  bool whole() const { return size == 1 && v[0][0] <= 0 && v[0][1] >= 1; }
+};
+
+Intervals intersect(const Intervals& a, const Intervals& b) {
+  Intervals out;
+  for (int i = 0, j = 0; i < a.size && j < b.size;) {
+    const double lo = std::max(a.v[i][0], b.v[j][0]), hi = std::min(a.v[i][1], b.v[j][1]);
+    if (lo < hi) out.add(lo, hi);
+    (a.v[i][1] < b.v[j][1] ? i : j)++;
+  }
+  return out;
+}
 
 // (x, y) -> (x + y, x - y): L-infinity distances become half the L1 distances of the images.
 Vec2d turn(const Vec2d& v) { return {v[0] + v[1], v[0] - v[1]}; }
@@ -52,29 +80,39 @@ class CellBuilder {
       : points_(points), metric_(metric), frame_(frame),
         far_(4 * (frame.hi - frame.lo).norm()), scale_((frame.hi - frame.lo).norm()) {}
 
-  // The cell of site p against the candidate sites, and its pieces with their neighbours.
-  std::vector<Piece> pieces(std::uint32_t p, std::span<const std::uint32_t> candidates) const {
-    std::vector<Piece> raw;
-    for (std::uint32_t q : candidates)
-      for (const auto& [a, b] : bisector(points_[p], points_[q]))
-        if (const auto clipped = clip_segment_to_box(a, b, frame_); clipped && clipped->first != clipped->second)
-          raw.push_back({clipped->first, clipped->second, q});
-    for (int k = 0; k < 4; ++k) raw.push_back({corner(k), corner(k + 1), kFrameSide});
+  // The whole frame: the cell of a site before any other site is considered.
+  std::vector<Piece> frame_pieces() const {
+    std::vector<Piece> out;
+    for (int k = 0; k < 4; ++k) out.push_back({corner(k), corner(k + 1), kFrameSide});
+    return out;
+  }
 
+  // Cuts site q's part out of the cell of p given by its boundary pieces and the
+  // sites that made it (`active`): the pieces keep what is not nearer to q, and
+  // the bisector of p and q adds what is not nearer to an active site.
+  void cut(std::uint32_t p, std::uint32_t q, std::span<const std::uint32_t> active, std::vector<Piece>& pieces) const {
     std::vector<Piece> kept;
-    for (const Piece& piece : raw) {
-      std::vector<std::array<double, 2>> intervals{{0.0, 1.0}};
-      for (std::uint32_t r : candidates) {
-        if (r == piece.neighbor) continue;
-        intervals = intersect(intervals, allowed(piece, points_[p], points_[r]));
-        if (intervals.empty()) break;
-      }
-      for (const auto& [t0, t1] : intervals) {
-        const Vec2d a = piece.a + t0 * (piece.b - piece.a), b = piece.a + t1 * (piece.b - piece.a);
+    const auto keep = [&](const Piece& piece, const Intervals& intervals) {
+      for (int k = 0; k < intervals.size; ++k) {
+        const Vec2d d = piece.b - piece.a;
+        const Vec2d a = piece.a + intervals.v[k][0] * d, b = piece.a + intervals.v[k][1] * d;
         if ((b - a).norm() > 1e-12 * scale_) kept.push_back({a, b, piece.neighbor});
       }
+    };
+    for (const Piece& piece : pieces) keep(piece, allowed(piece, points_[p], points_[q]));
+    for (const auto& [a, b] : bisector(points_[p], points_[q])) {
+      const auto clipped = clip_segment_to_box(a, b, frame_);
+      if (!clipped || clipped->first == clipped->second) continue;
+      const Piece piece{clipped->first, clipped->second, q};
+      Intervals intervals;
+      intervals.add(0, 1);
+      for (std::uint32_t r : active) {
+        intervals = intersect(intervals, allowed(piece, points_[p], points_[r]));
+        if (intervals.size == 0) break;
+      }
+      keep(piece, intervals);
     }
-    return kept;
+    pieces = std::move(kept);
   }
 
   // Joins the pieces around the site into a counter-clockwise polygon.
@@ -99,6 +137,15 @@ class CellBuilder {
   }
 
   double distance(const Vec2d& x, const Vec2d& p) const { return metric_distance(metric_, x, p); }
+
+  // Whether site r takes part of the cell `polygon` of site p.
+  bool takes_part(const std::vector<Vec2d>& polygon, const Vec2d& p, const Vec2d& r) const {
+    if (point_in_polygon(r, polygon)) return true;
+    for (std::size_t k = 0; k < polygon.size(); ++k) {
+      if (!allowed({polygon[k], polygon[(k + 1) % polygon.size()], kFrameSide}, p, r).whole()) return true;
+    }
+    return false;
+  }
 
  private:
   Vec2d corner(int k) const {
@@ -138,7 +185,7 @@ class CellBuilder {
   }
 
   // The parameters t in [0, 1] where piece.a + t (piece.b - piece.a) is not nearer to r than to p.
-  std::vector<std::array<double, 2>> allowed(const Piece& piece, const Vec2d& p, const Vec2d& r) const {
+  Intervals allowed(const Piece& piece, const Vec2d& p, const Vec2d& r) const {
     // Both distances are linear between the crossings with the axis-parallel and
     // diagonal lines through p and r.
     std::array<double, 10> ts;
@@ -156,18 +203,12 @@ class CellBuilder {
     }
     for (std::size_t i = 1; i < count; ++i)  // insertion sort of at most 10 values
       for (std::size_t j = i; j > 0 && ts[j] < ts[j - 1]; --j) std::swap(ts[j], ts[j - 1]);
-    std::vector<std::array<double, 2>> out;
+    Intervals out;
     const auto f = [&](double t) {
       const Vec2d x = piece.a + t * d;
       return biased(x, p) - biased(x, r);
     };
-    const auto add = [&](double t0, double t1) {
-      if (!out.empty() && out.back()[1] >= t0) {
-        out.back()[1] = std::max(out.back()[1], t1);
-      } else {
-        out.push_back({t0, t1});
-      }
-    };
+    const auto add = [&](double t0, double t1) { out.add(t0, t1); };
     double f0 = f(ts[0]);
     for (std::size_t k = 0; k + 1 < count; ++k) {
       const double t0 = ts[k], t1 = ts[k + 1];
@@ -180,17 +221,6 @@ class CellBuilder {
         f0 <= 0 ? add(t0, root) : add(root, t1);
       }
       f0 = f1;
-    }
-    return out;
-  }
-
-  static std::vector<std::array<double, 2>> intersect(const std::vector<std::array<double, 2>>& a,
-                                                      const std::vector<std::array<double, 2>>& b) {
-    std::vector<std::array<double, 2>> out;
-    for (std::size_t i = 0, j = 0; i < a.size() && j < b.size();) {
-      const double lo = std::max(a[i][0], b[j][0]), hi = std::min(a[i][1], b[j][1]);
-      if (lo < hi) out.push_back({lo, hi});
-      (a[i][1] < b[j][1] ? i : j)++;
     }
     return out;
   }
@@ -240,7 +270,7 @@ MetricVoronoi::MetricVoronoi(std::span<const Vec2d> points, Metric metric, const
     frame.extend(points[i]);
   }
   // The frame holds every site strictly inside, so every cell is star-shaped within it.
-  const double margin = std::max(frame.hi[0] - frame.lo[0], frame.hi[1] - frame.lo[1]);
+  const double margin = 0.05 * std::max(frame.hi[0] - frame.lo[0], frame.hi[1] - frame.lo[1]);
   frame.lo.array() -= margin;
   frame.hi.array() += margin;
 
@@ -260,31 +290,53 @@ MetricVoronoi::MetricVoronoi(std::span<const Vec2d> points, Metric metric, const
 
   const spatial::KdTree<double, 2> tree{spatial::PointView<double>(std::span<const Vec2d>(site_points))};
   const CellBuilder builder(site_points, metric, frame);
-  // L2 distance <= factor * metric distance: the radius that finds every site that can matter.
-  const double factor = metric == Metric::linf ? std::sqrt(2.0) : 1.0;
 
   std::vector<std::vector<Vec2d>> site_cells(sites.size());
   std::vector<std::vector<Piece>> site_pieces(sites.size());
   std::vector<std::size_t> consulted(sites.size());
   parallel_for_each_index(0, sites.size(), [&](std::size_t s) {
     const Vec2d& p = site_points[s];
-    std::size_t k = std::min<std::size_t>(24, sites.size());
-    std::vector<std::uint32_t> candidates;
-    std::vector<Piece> pieces;
-    std::vector<Vec2d> polygon;
-    for (;;) {
-      candidates.clear();
-      for (const auto& nb : tree.query(p, k))
-        if (nb.index != s) candidates.push_back(nb.index);
-      pieces = builder.pieces(std::uint32_t(s), candidates);
+    // Start from the nearest sites, then offer the others nearest first: a site
+    // joins only if it takes part of the current cell (it lies in it, or some
+    // boundary point is nearer to it, which catches every site whose region meets
+    // the cell because that region is star-shaped around its site). Sites beyond
+    // twice the cell's reach cannot take anything.
+    std::vector<std::uint32_t> active;
+    std::vector<Piece> pieces = builder.frame_pieces();
+    std::vector<Vec2d> polygon = builder.polygon(p, pieces);
+    double reach = std::numeric_limits<double>::infinity();
+    AABB2d bounds = frame;
+    // A site farther from the cell's bounding box than the cell's reach cannot take any of it.
+    const auto near_cell = [&](std::uint32_t q) {
+      const Vec2d gap = (bounds.lo - site_points[q]).cwiseMax(site_points[q] - bounds.hi).cwiseMax(0.0);
+      return metric_distance(metric, gap, Vec2d::Zero()) < reach;
+    };
+    const auto offer = [&](std::uint32_t q) {
+      if (!near_cell(q) || !builder.takes_part(polygon, p, site_points[q])) return;
+      builder.cut(std::uint32_t(s), q, active, pieces);
+      active.push_back(q);
       polygon = builder.polygon(p, pieces);
-      double reach = 0;
-      for (const Vec2d& v : polygon) reach = std::max(reach, builder.distance(v, p));
-      const std::size_t within = tree.query_radius(p, 2 * reach * factor * (1 + 1e-9)).size();
-      if (within <= k || k == sites.size()) break;
-      k = std::min(sites.size(), std::max(within, 2 * k));
+      reach = 0;
+      bounds = AABB2d();
+      for (const Vec2d& v : polygon) reach = std::max(reach, builder.distance(v, p)), bounds.extend(v);
+    };
+    // The nearest few first; then, if the cell still reaches far, every site
+    // within its reach of the cell's bounding box, nearest first.
+    const auto nearest = tree.query(p, std::min<std::size_t>(17, sites.size()));
+    for (const auto& nb : nearest)
+      if (nb.index != s) offer(nb.index);
+    if (nearest.size() < sites.size()) {
+      AABB2d around = bounds;
+      around.lo.array() -= reach;
+      around.hi.array() += reach;
+      std::vector<std::pair<double, std::uint32_t>> more;  // squared distance, site
+      for (std::uint32_t q : tree.query_box(around))
+        if (q != s && near_cell(q)) more.push_back({(site_points[q] - p).squaredNorm(), q});
+      std::sort(more.begin(), more.end());
+      for (const auto& [d, q] : more)
+        if (std::find(active.begin(), active.end(), q) == active.end()) offer(q);
     }
-    consulted[s] = candidates.size();
+    consulted[s] = active.size();
     site_pieces[s] = std::move(pieces);
     site_cells[s] = clip_polygon_to_box(polygon, box);
   });

@@ -24,11 +24,14 @@ std::uint32_t find_root(std::vector<std::uint32_t>& parent, std::uint32_t x) {
   return x;
 }
 
-// The parameter interval of the line p + t d inside `box` (d a unit vector, p inside the box).
+// The parameter interval of the line p + t d inside `box` (d a unit vector); empty when lo > hi.
 std::pair<double, double> line_box_interval(const Vec2d& p, const Vec2d& d, const AABB2d& box) {
   double lo = -std::numeric_limits<double>::infinity(), hi = std::numeric_limits<double>::infinity();
   for (int k = 0; k < 2; ++k) {
-    if (d[k] == 0) continue;
+    if (d[k] == 0) {
+      if (p[k] < box.lo[k] || p[k] > box.hi[k]) return {hi, lo};  // parallel to the side and outside: empty
+      continue;
+    }
     const double t1 = (box.lo[k] - p[k]) / d[k], t2 = (box.hi[k] - p[k]) / d[k];
     lo = std::max(lo, std::min(t1, t2));
     hi = std::min(hi, std::max(t1, t2));
@@ -253,13 +256,27 @@ Vec2d Voronoi2::line_point(std::uint32_t e) const {
   return (points_[edges_[e].site] + points_[opposite_site(e)]) / 2;
 }
 
-AABB2d Voronoi2::default_box(double margin) const {
+AABB2d frame_around(std::span<const Vec2d> points, double margin) {
+  if (points.empty()) throw Error("frame_around: no points");
   AABB2d box;
-  for (const Vec2d& p : points_) box.extend(p);
-  const double side = std::max({box.hi[0] - box.lo[0], box.hi[1] - box.lo[1], 1e-300});
-  box.lo.array() -= margin * side;
-  box.hi.array() += margin * side;
+  for (const Vec2d& p : points) box.extend(p);
+  const double side = std::max(box.hi[0] - box.lo[0], box.hi[1] - box.lo[1]);
+  const double grow = side > 0 ? margin * side : 0.5;
+  box.lo.array() -= grow;
+  box.hi.array() += grow;
   return box;
+}
+
+std::optional<std::pair<Vec2d, Vec2d>> Voronoi2::clipped_edge(std::uint32_t e, const AABB2d& box) const {
+  const Edge& edge = edges_[e];
+  const Vec2d p = line_point(e), d = direction(e);
+  auto [t0, t1] = line_box_interval(p, d, box);
+  if (edge.origin != kInfinity) t0 = std::max(t0, (vertices_[edge.origin] - p).dot(d));
+  if (edge.target != kInfinity) t1 = std::min(t1, (vertices_[edge.target] - p).dot(d));
+  if (!(t0 < t1)) return std::nullopt;
+  const Vec2d a = edge.origin != kInfinity && t0 == (vertices_[edge.origin] - p).dot(d) ? vertices_[edge.origin] : Vec2d(p + t0 * d);
+  const Vec2d b = edge.target != kInfinity && t1 == (vertices_[edge.target] - p).dot(d) ? vertices_[edge.target] : Vec2d(p + t1 * d);
+  return std::pair(a, b);
 }
 
 std::vector<Vec2d> Voronoi2::cell_polygon(std::uint32_t i, const AABB2d& box) const {

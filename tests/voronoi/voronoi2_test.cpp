@@ -77,6 +77,29 @@ TEST(Voronoi2, CellsAreCounterClockwiseAndContainTheirSites) {
   }
 }
 
+TEST(Voronoi2, ClippedEdgesLieOnBisectorsInsideTheBox) {
+  const Voronoi2 v = brute_delaunay(uniform_points(40, 8)).voronoi();
+  const AABB2d box({0.2, 0.1}, {0.7, 0.8});
+  std::size_t inside = 0;
+  for (std::uint32_t e = 0; e < v.edges().size(); ++e) {
+    const auto segment = v.clipped_edge(e, box);
+    const auto twin = v.clipped_edge(v.edges()[e].twin, box);
+    ASSERT_EQ(segment.has_value(), twin.has_value());
+    if (!segment) continue;
+    ++inside;
+    EXPECT_EQ(segment->first, twin->second);
+    for (const Vec2d& x : {segment->first, segment->second}) {
+      EXPECT_TRUE(box.contains(x + (x - (box.lo + box.hi) / 2) * -1e-12));
+      EXPECT_NEAR((x - v.points()[v.edges()[e].site]).norm(), (x - v.points()[v.opposite_site(e)]).norm(), 1e-12);
+    }
+    // Going along the edge, its site is on the left.
+    const Vec2d d = segment->second - segment->first, s = v.points()[v.edges()[e].site] - segment->first;
+    EXPECT_GT(d[0] * s[1] - d[1] * s[0], 0);
+  }
+  EXPECT_GT(inside, 20u);
+  EXPECT_FALSE(v.clipped_edge(0, AABB2d({5, 5}, {6, 6})).has_value());
+}
+
 TEST(Voronoi2, CoCircularGridMergesCircumcentres) {
   const auto t = grid_delaunay(6);
   const Voronoi2 v = t.voronoi();

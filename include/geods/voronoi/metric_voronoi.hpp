@@ -17,13 +17,17 @@
 // 1e-9 * |x - site_x| (L1; |(x - site_x) + (y - site_y)| for L-infinity) to the
 // distances, which moves no boundary by more than 1e-9 of its distance to the sites.
 //
-// Construction: each cell is cut out of a frame around the box by the
-// bisectors of its site and the sites near it (nearest first, until no farther
-// site can reach the cell: a site q matters only if d(p, q) <= 2 max_{x in cell} d(p, x));
-// each bisector piece keeps the parts not nearer to another site, decided on
-// the piecewise-linear distance functions along it, and the pieces are joined
-// around the site. About O(n k^2) for k ~ 20 neighbours per site on spread-out
-// sites, in parallel; floating point, not exact predicates.
+// Construction: each cell is cut out of a frame around the box and the sites
+// by the bisectors of its site and its 16 nearest sites; farther sites are then
+// offered nearest first and join only if they take part of the current cell
+// (some point of its boundary is nearer to them; a site's region is star-shaped
+// around it, so that catches every one that matters), until they are farther
+// than twice the cell's reach (d(p, q) > 2 max_{x in cell} d(p, x)). Each
+// bisector piece keeps the parts not nearer to another site, decided on the
+// piecewise-linear distance functions along it, and the pieces are joined
+// around the site. About O(n k^2) for k ~ 20 sites per cell on spread-out
+// sites, more for cells that reach far (sites on the hull); in parallel;
+// floating point, not exact predicates.
 #include <cstdint>
 #include <span>
 #include <string>

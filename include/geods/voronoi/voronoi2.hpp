@@ -19,6 +19,8 @@
 // Cells are convex polygons; cell_polygon(i, box) clips one to a box.
 // Size: at most 2n - 5 vertices and 3n - 6 edges for n distinct sites.
 #include <cstdint>
+#include <optional>
+#include <utility>
 #include <span>
 #include <vector>
 
@@ -28,6 +30,11 @@
 namespace geods::voronoi {
 
 class Delaunay2;
+
+/// The bounding box of `points` grown by `margin` times its larger side on
+/// every side (a frame like the curve Gamma of the seed's Figure 42); a unit
+/// square around a single point. Throws geods::Error for no points.
+AABB2d frame_around(std::span<const Vec2d> points, double margin = 0.25);
 
 struct Voronoi2Stats {
   std::size_t sites = 0;     // input points
@@ -94,9 +101,10 @@ class Voronoi2 {
   std::vector<Vec2d> cell_polygon(std::uint32_t i, const AABB2d& box) const;
   /// cell_polygon of every point, in parallel.
   std::vector<std::vector<Vec2d>> cell_polygons(const AABB2d& box) const;
-  /// The bounding box of the sites, grown by `margin` times its larger side on
-  /// every side (a frame like the curve Gamma of the seed's Figure 42).
-  AABB2d default_box(double margin = 0.25) const;
+  /// frame_around(points(), margin).
+  AABB2d default_box(double margin = 0.25) const { return frame_around(points_, margin); }
+  /// The part of half-edge e inside `box` (from its origin side to its target side), if any.
+  std::optional<std::pair<Vec2d, Vec2d>> clipped_edge(std::uint32_t e, const AABB2d& box) const;
 
   Voronoi2Stats stats() const;
   /// Checks twins, next cycles, that each cell's cycle holds only its site,

@@ -1,0 +1,122 @@
+// geods voronoi: the Voronoi diagram of 2D points under L2, L1 or L-infinity, as an SVG and/or cells in JSON.
+#include <fmt/format.h>
+
+#include <fstream>
+#include <optional>
+
+#include "command.hpp"
+#include "geods/voronoi/metric_voronoi.hpp"
+#include "geods/voronoi/voronoi2.hpp"
+#include "stopwatch.hpp"
+#include "voronoi_cli.hpp"
+
+namespace geods::cli {
+namespace {
+
+class VoronoiCommand : public Command {
+ public:
+  std::string name() const override { return "voronoi"; }
+  std::string summary() const override {
+    return "Voronoi diagram of 2D points (L2 from the Delaunay triangulation, or L1 / L-infinity): SVG and cells as JSON";
+  }
+  void add_options(CLI::App& app) override {
+    app.add_option("points", points_, "Points, n x 2 (.npy, .csv, .xyz...)")->required();
+    app.add_option("--metric", metric_, "l2 (default), l1 or linf");
+    app.add_option("--box", box_, "Clip cells to x0,y0,x1,y1 (default: the points' bounding box grown by 25%)");
+    app.add_option("--svg", svg_, "Output: a figure of the cells, edges and sites");
+    app.add_option("-o,--output", output_, "Output: JSON with the box, each point's cell polygon and the edges");
+  }
+
+  void run(const RunContext&, Report& report) override {
+    const voronoi::Metric metric = voronoi::parse_metric(metric_);
+    const std::vector<Vec2d> points = read_points_2d(points_);
+    const AABB2d box = box_.empty() ? voronoi::frame_around(points) : parse_box(box_);
+
+    std::vector<std::vector<Vec2d>> cells;
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> edge_sites;
+    std::vector<std::pair<Vec2d, Vec2d>> edges;
+    std::size_t distinct = 0, vertices = 0;
+    double build_s = 0, cells_s = 0;
+    if (metric == voronoi::Metric::l2) {
+      Stopwatch build_watch;
+      const voronoi::Voronoi2 diagram(points);
+      build_s = build_watch.seconds();
+      Stopwatch cells_watch;
+      cells = diagram.cell_polygons(box);
+      for (std::uint32_t e = 0; e < diagram.edges().size(); ++e) {
+        if (diagram.edges()[e].twin < e) continue;
+        if (const auto segment = diagram.clipped_edge(e, box)) {
+          edges.push_back(*segment);
+          edge_sites.push_back({diagram.edges()[e].site, diagram.opposite_site(e)});
+        }
+      }
+      cells_s = cells_watch.seconds();
+      distinct = diagram.stats().distinct;
+      vertices = diagram.vertices().size();
+    } else {
+      Stopwatch build_watch;
+      const voronoi::MetricVoronoi diagram(points, metric, box);
+      build_s = build_watch.seconds();
+      cells = diagram.cells();
+      for (const auto& e : diagram.edges()) {
+        edges.push_back({e.p0, e.p1});
+        edge_sites.push_back({e.a, e.b});
+      }
+      distinct = diagram.stats().distinct;
+    }
+
+    if (!svg_.empty()) {
+      io::SvgWriter svg(box, 900);
+      svg.title(fmt::format("{} Voronoi diagram of {} points", voronoi::metric_name(metric), points.size()));
+      draw_diagram(svg, cells, edges, points, "#1f4e79", points.size() > 2000 ? 0.8 : 2.0);
+      svg.save(svg_);
+    }
+    if (!output_.empty()) {
+      Json out;
+      out["metric"] = voronoi::metric_name(metric);
+      out["box"] = {box.lo[0], box.lo[1], box.hi[0], box.hi[1]};
+      Json cell_list = Json::array();
+      for (const auto& cell : cells) {
+        Json polygon = Json::array();
+        for (const Vec2d& v : cell) polygon.push_back({v[0], v[1]});
+        cell_list.push_back(std::move(polygon));
+      }
+      out["cells"] = std::move(cell_list);
+      Json edge_list = Json::array();
+      for (std::size_t k = 0; k < edges.size(); ++k)
+        edge_list.push_back({{"sites", {edge_sites[k].first, edge_sites[k].second}},
+                             {"from", {edges[k].first[0], edges[k].first[1]}},
+                             {"to", {edges[k].second[0], edges[k].second[1]}}});
+      out["edges"] = std::move(edge_list);
+      std::ofstream file(output_);
+      if (!file) throw Error(output_ + ": cannot write");
+      file << out.dump() << '\n';
+      if (!file) throw Error(output_ + ": write failed");
+    }
+
+    Json& j = report.json;
+    j["points"] = points.size();
+    j["distinct"] = distinct;
+    j["metric"] = voronoi::metric_name(metric);
+    j["box"] = {box.lo[0], box.lo[1], box.hi[0], box.hi[1]};
+    if (metric == voronoi::Metric::l2) j["vertices"] = vertices;
+    j["edges_in_box"] = edges.size();
+    j["build_s"] = build_s;
+    j["cells_s"] = cells_s;
+    j["compute_s"] = build_s + cells_s;
+    report.lines.push_back(fmt::format("voronoi ({}): {} points ({} distinct), {} edges in the box{}",
+                                       voronoi::metric_name(metric), points.size(), distinct, edges.size(),
+                                       metric == voronoi::Metric::l2 ? fmt::format(", {} vertices", vertices) : ""));
+    report.lines.push_back(fmt::format("  built in {:.3f} s, cells clipped in {:.3f} s", build_s, cells_s));
+    if (!svg_.empty()) report.lines.push_back("  wrote " + svg_);
+    if (!output_.empty()) report.lines.push_back("  wrote " + output_);
+  }
+
+ private:
+  std::string points_, metric_ = "l2", box_, svg_, output_;
+};
+
+const bool registered = register_command<VoronoiCommand>();
+
+}  // namespace
+}  // namespace geods::cli
