@@ -229,6 +229,26 @@ Expansion<96> lifted_orient3d(const double* a, const double* b, const double* c,
   return (minor3(a, c, d) - minor3(b, c, d)) + (minor3(a, b, c) - minor3(a, b, d));
 }
 
+// Integer grids (the common exactly degenerate input) need no expansions: when
+// every coordinate is an integer of magnitude below 2^52, their differences are
+// computed exactly, and when those differences are below 2^bits the plain
+// double determinant is exact too (bits = 26 for orient2d: products < 2^52;
+// bits = 12 for incircle: lifts and 2x2 minors < 2^25, their products < 2^50,
+// the sum of three < 2^52). As CGAL's static filters, this answers the
+// degenerate calls of such inputs at the cost of the filter.
+template <std::size_t N>
+bool small_integer_differences(const std::array<const double*, N>& points, int bits) {
+  const double limit = std::ldexp(1.0, bits);
+  for (const double* p : points)
+    for (int k = 0; k < 2; ++k)
+      if (!(std::abs(p[k]) < 0x1p52) || p[k] != std::trunc(p[k])) return false;
+  const double* last = points[N - 1];
+  for (std::size_t i = 0; i + 1 < N; ++i)
+    for (int k = 0; k < 2; ++k)
+      if (!(std::abs(points[i][k] - last[k]) < limit)) return false;
+  return true;
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------
@@ -244,6 +264,7 @@ namespace detail {
 
 double orient2d_adapt(const double* a, const double* b, const double* c, double permanent) {
   const std::array<const double*, 3> points{a, b, c};
+  if (small_integer_differences(points, 26)) return orient2d_formula(a, b, c);
   if (!fits_expansions<2, 2>(points))
     return with_big_integers<2, 2>(points, [](const auto& p) { return orient2d_formula(p[0], p[1], p[2]); });
 
@@ -302,6 +323,7 @@ double orient3d_adapt(const double* a, const double* b, const double* c, const d
 
 double incircle_adapt(const double* a, const double* b, const double* c, const double* d, double permanent) {
   const std::array<const double*, 4> points{a, b, c, d};
+  if (small_integer_differences(points, 12)) return incircle_formula(a, b, c, d);
   if (!fits_expansions<4, 2>(points))
     return with_big_integers<4, 2>(points,
                                    [](const auto& p) { return incircle_formula(p[0], p[1], p[2], p[3]); });

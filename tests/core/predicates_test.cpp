@@ -554,6 +554,45 @@ TEST(Predicates, IncircleExactOnLatticeCircles) {
   }
 }
 
+// Unscaled integer coordinates far from the origin whose differences reach the
+// limits of the plain-double path for integers (2^26 for orient2d, 2^12 for
+// incircle) and up to 8 times beyond (where the adaptive stages take over):
+// random, collinear or co-circular (lattice circles of radius 1105 and 5525,
+// scaled by up to 2), or those moved by one unit.
+Points integer_differences_near_limit(Rng& rng, int bits, const std::vector<std::vector<Point>>& circles) {
+  Points p{};
+  const double origin = double(std::int64_t(rng.below(std::uint64_t(1) << 50)) - (std::int64_t(1) << 49));
+  const double limit = std::ldexp(1.0, bits + int(rng.below(4)));
+  const auto coordinate = [&] { return std::floor(rng.uniform(-limit, limit)); };
+  const std::uint64_t kind = rng.below(3);
+  if (kind == 0) {
+    for (auto& q : p) q = {origin + coordinate(), origin + coordinate(), 0};
+    return p;
+  }
+  if (bits == 26) {  // collinear: a + t v with t in -2..2
+    const Point a{origin + coordinate(), origin + coordinate(), 0};
+    const double vx = std::floor(coordinate() / 2), vy = std::floor(coordinate() / 2);
+    for (int i = 0; i < 5; ++i) p[i] = {a[0] + double(i - 2) * vx, a[1] + double(i - 2) * vy, 0};
+  } else {
+    const auto& circle = circles[rng.below(circles.size())];
+    const double scale = double(1 + rng.below(2));
+    for (int i = 0; i < 5; ++i) {
+      const Point& q = circle[rng.below(circle.size())];
+      p[i] = {origin + scale * q[0], origin + scale * q[1], 0};
+    }
+  }
+  if (kind == 2) p[rng.below(3)][rng.below(2)] += rng.below(2) ? 1.0 : -1.0;  // nearly degenerate
+  return p;
+}
+
+TEST(Predicates, ExactOnIntegerDifferencesNearTheLimit) {
+  const std::vector<std::vector<Point>> circles = {lattice_sphere(1105, 2), lattice_sphere(5525, 2)};
+  expect_exact_signs(kOrient2d, 71, 4 * kCases,
+                     [&](Rng& rng) { return integer_differences_near_limit(rng, 26, circles); }, "orient2d_integers");
+  expect_exact_signs(kIncircle, 72, 4 * kCases,
+                     [&](Rng& rng) { return integer_differences_near_limit(rng, 12, circles); }, "incircle_integers");
+}
+
 TEST(Predicates, InsphereExactOnLatticeSpheres) {
   for (const int r : {3, 9, 21}) {
     const auto sphere = lattice_sphere(r, 3);
