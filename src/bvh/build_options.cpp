@@ -61,8 +61,8 @@ void check_options(const BuildOptions& options) {
     throw Error("bvh: leaf_size must be in 1..255, got " + std::to_string(options.leaf_size));
   if (options.arity != 2 && options.arity != 4 && options.arity != 8)
     throw Error("bvh: arity must be 2, 4 or 8, got " + std::to_string(options.arity));
-  if (options.sah_bins < 2 || options.sah_bins > 256)
-    throw Error("bvh: sah_bins must be in 2..256, got " + std::to_string(options.sah_bins));
+  if (options.sah_bins < 2 || options.sah_bins > 64)
+    throw Error("bvh: sah_bins must be in 2..64, got " + std::to_string(options.sah_bins));
   bool known_builder = false, known_bv = false;
   for (const auto& entry : kBuilders) known_builder |= entry.second == options.builder;
   for (const auto& entry : kVolumes) known_bv |= entry.second == options.bv;

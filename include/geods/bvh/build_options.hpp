@@ -28,7 +28,7 @@ struct BuildOptions {
   int leaf_size = 4;
   /// Children per inner node: 2, 4 or 8. Wider trees come from collapsing the binary one.
   int arity = 4;
-  /// Bins per axis of the SAH builder.
+  /// Bins per axis of the SAH builder (2..64).
   int sah_bins = 32;
   ProgressCallback progress;
 };

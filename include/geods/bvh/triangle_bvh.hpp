@@ -115,6 +115,7 @@ class TriangleBvh {
 
   BuildOptions options_;
   Topology topology_;
+  int depth_ = 0;  // of topology_, sizes the traversal stacks
   VolumeArray volumes_;
   std::vector<Triangle> triangles_;
   std::vector<WideNode<4>> wide4_;

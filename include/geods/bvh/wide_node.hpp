@@ -10,7 +10,7 @@
 namespace geods::bvh {
 
 template <int W>
-struct alignas(W * 4) WideNode {
+struct alignas(64) WideNode {  // whole cache lines: 128 bytes (4 wide), 256 (8 wide)
   static_assert(W == 4 || W == 8, "wide nodes hold 4 or 8 children");
   static constexpr std::uint32_t kEmpty = std::numeric_limits<std::uint32_t>::max();
   /// bounds[2 a][i] = lo of child i on axis a, bounds[2 a + 1][i] = hi.

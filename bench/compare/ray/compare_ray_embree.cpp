@@ -1,0 +1,64 @@
+// Embree 3 (RTC_BUILD_QUALITY_MEDIUM, rtcIntersect1 one ray at a time) on the ray comparison.
+#include <embree3/rtcore.h>
+
+#include "ray_driver.hpp"
+
+namespace {
+
+struct Embree {
+  static constexpr const char* anchor = "embree";
+  struct Index {
+    RTCDevice device = nullptr;
+    RTCScene scene = nullptr;
+    ~Index() {
+      if (scene) rtcReleaseScene(scene);
+      if (device) rtcReleaseDevice(device);
+    }
+  };
+  static inline int threads = 1;
+  static std::unique_ptr<Index> build(const compare::PlyMesh& mesh) {
+    auto index = std::make_unique<Index>();
+    const std::string config = "threads=" + std::to_string(threads);
+    index->device = rtcNewDevice(config.c_str());
+    index->scene = rtcNewScene(index->device);
+    rtcSetSceneBuildQuality(index->scene, RTC_BUILD_QUALITY_MEDIUM);
+    RTCGeometry geom = rtcNewGeometry(index->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    auto* v = static_cast<float*>(
+        rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), mesh.vertices()));
+    std::copy(mesh.xyz.begin(), mesh.xyz.end(), v);
+    auto* f = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                             3 * sizeof(unsigned), mesh.triangles()));
+    std::copy(mesh.tris.begin(), mesh.tris.end(), f);
+    rtcSetGeometryBuildQuality(geom, RTC_BUILD_QUALITY_MEDIUM);
+    rtcCommitGeometry(geom);
+    rtcAttachGeometry(index->scene, geom);
+    rtcReleaseGeometry(geom);
+    rtcCommitScene(index->scene);
+    return index;
+  }
+  static compare::ray::Hit intersect(const Index& index, const float* r) {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    RTCRayHit rh;
+    rh.ray.org_x = r[0], rh.ray.org_y = r[1], rh.ray.org_z = r[2];
+    rh.ray.dir_x = r[3], rh.ray.dir_y = r[4], rh.ray.dir_z = r[5];
+    rh.ray.tnear = 0.0f;
+    rh.ray.tfar = std::numeric_limits<float>::infinity();
+    rh.ray.mask = ~0u;
+    rh.ray.flags = 0;
+    rh.ray.time = 0.0f;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(index.scene, &context, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return {};
+    return {rh.ray.tfar, rh.hit.primID};
+  }
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const compare::Args args = compare::parse_args(argc, argv);
+  Embree::threads = args.threads;
+  return compare::ray::run<Embree>(argc, argv);
+}
