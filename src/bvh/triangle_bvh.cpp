@@ -239,14 +239,14 @@ RayHit TriangleBvh::intersect_wide(const std::vector<WideNode<W>>& nodes, const 
   RayHit hit;
   if (nodes.empty()) return hit;
   const RayTriangleTest<float> test(ray);
-  // Tiny direction components are replaced by +-1e-30 so that no 0 * inf
-  // NaN appears; the near bound of each axis is chosen by the sign.
+  // A zero direction component gives an infinite inverse; the 0 * inf NaN of
+  // an origin on a slab plane is then skipped by the NaN-ignoring min/max
+  // below, so a ray inside a (possibly flat) slab keeps the whole line. The
+  // near bound of each axis is chosen by the sign.
   float org[3], inv[3];
   int near_row[3];
   for (int a = 0; a < 3; ++a) {
-    const float d = ray.direction[a];
-    const float safe = std::abs(d) < 1e-30f ? std::copysign(1e-30f, d) : d;
-    inv[a] = 1.0f / safe;
+    inv[a] = 1.0f / ray.direction[a];
     org[a] = ray.origin[a];
     near_row[a] = 2 * a + (inv[a] < 0 ? 1 : 0);
   }
@@ -288,6 +288,7 @@ RayHit TriangleBvh::intersect_wide(const std::vector<WideNode<W>>& nodes, const 
       std::memcpy(&hi, node.bounds[near_row[a] ^ 1], sizeof(vf));
       const vf t0 = (lo - org[a]) * inv[a];
       const vf t1 = (hi - org[a]) * inv[a];
+      // Written so that a NaN t0 or t1 leaves the interval unchanged.
       tn = t0 > tn ? t0 : tn;
       tf = t1 < tf ? t1 : tf;
     }

@@ -129,7 +129,7 @@ inline std::vector<Ray3f> test_rays(const TriMesh& mesh, std::size_t n, std::uin
     const std::size_t tri = rng.below(mesh.num_triangles());
     const Vec3f a = corner(mesh, tri, 0), b = corner(mesh, tri, 1), c = corner(mesh, tri, 2);
     const Vec3f outside = center + radius * random_direction(rng);
-    switch (i % 6) {
+    switch (i % 7) {
       case 0:  // random through the box
         r.origin = outside;
         r.direction = (center + 0.5f * box.extent().cwiseProduct(random_point(rng, -1, 1)) - outside).normalized();
@@ -154,6 +154,15 @@ inline std::vector<Ray3f> test_rays(const TriMesh& mesh, std::size_t n, std::uin
         r.origin[axis] = rng.below(2) ? box.lo[axis] - 1 : box.hi[axis] + 1;
         r.direction = Vec3f::Zero();
         r.direction[axis] = r.origin[axis] < center[axis] ? 1.0f : -1.0f;
+        break;
+      }
+      case 5: {  // in an axis plane through a vertex (a zero direction component), or from the vertex
+        const int axis = int(rng.below(3));
+        r.origin = rng.below(2) ? a : Vec3f(outside);
+        r.origin[axis] = a[axis];
+        r.direction = rng.below(2) ? Vec3f(a - r.origin) : random_direction(rng);
+        if (r.direction.isZero(0)) r.direction = random_direction(rng);
+        r.direction[axis] = 0;
         break;
       }
       default:  // in the plane of a triangle (parallel to it), through its centroid
