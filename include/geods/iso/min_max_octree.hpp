@@ -1,0 +1,81 @@
+#pragma once
+// The min/max octree of seed §2.4: built once over the cells of a volume,
+// queried for many iso-values, visiting only the nodes the surface can cross.
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "geods/core/grid3.hpp"
+#include "geods/core/tri_mesh.hpp"
+#include "geods/iso/marching_cubes.hpp"
+
+namespace geods::iso {
+
+struct MinMaxOctreeStats {
+  std::size_t nodes = 0;       // all levels, leaves included
+  std::size_t levels = 0;      // leaves to root
+  std::size_t leaf_cells = 0;  // cells per leaf along each axis
+  std::size_t cells = 0;       // cells of the volume
+  std::size_t bytes = 0;       // min/max arrays and level table (the volume not counted)
+};
+
+struct OctreeIsoResult {
+  TriMesh mesh;
+  std::size_t cells_visited = 0;  // cells whose corners were examined
+  std::size_t nodes_visited = 0;  // octree nodes whose min/max was tested
+};
+
+/// A complete octree over the cells of a volume (any size: the levels are
+/// ceil-halved, children beyond the border do not exist), stored as one flat
+/// min array and one max array level by level, each node holding the min and
+/// max of the samples of its cells. A leaf covers leaf_cells^3 cells (1 gives
+/// the textbook octree with one cell per leaf; larger leaves save memory and
+/// node tests). The octree owns its volume.
+///
+/// isosurface(iso) descends from the root into the children with
+/// min < iso <= max (a cell is crossed iff some corner is >= iso and some is
+/// not), runs the cell cases of marching_cubes.hpp at the leaves, and shares
+/// vertices through a hash table keyed by grid edge from which an edge is
+/// removed after its last visit (the fourth for an interior edge). The result
+/// has exactly the vertices and triangles of iso::isosurface() on the same
+/// volume (in traversal order); with several threads subtrees are extracted in
+/// parallel and merged into the same output as the sequential traversal.
+template <typename T>
+class MinMaxOctree {
+ public:
+  static constexpr std::size_t kDefaultLeafCells = 4;
+
+  /// Throws geods::Error for a NaN sample or leaf_cells == 0. O(samples), parallel.
+  explicit MinMaxOctree(Grid3<T> volume, std::size_t leaf_cells = kDefaultLeafCells);
+
+  /// Thread-safe. Throws geods::Error for a non-finite iso or bad positions.
+  OctreeIsoResult isosurface(double iso, const IsoOptions& options = {}) const;
+
+  const Grid3<T>& volume() const { return volume_; }
+  MinMaxOctreeStats stats() const;
+  /// Checks that every node's min/max is that of its cells' samples
+  /// (leaves) or of its children; throws geods::Error naming the first bad node.
+  void validate() const;
+
+ private:
+  struct Level {
+    std::array<std::size_t, 3> dims;
+    std::size_t offset;
+  };
+  struct Query;
+
+  std::size_t node_index(std::size_t level, std::size_t x, std::size_t y, std::size_t z) const {
+    const Level& l = levels_[level];
+    return l.offset + x + l.dims[0] * (y + l.dims[1] * z);
+  }
+  std::array<T, 2> leaf_range(std::size_t x, std::size_t y, std::size_t z) const;
+
+  Grid3<T> volume_;
+  std::size_t leaf_cells_;
+  std::array<std::size_t, 3> cells_{0, 0, 0};
+  std::vector<Level> levels_;  // levels_[0]: leaves, back(): the root
+  std::vector<T> min_, max_;
+};
+
+}  // namespace geods::iso

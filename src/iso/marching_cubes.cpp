@@ -1,0 +1,301 @@
+// The exhaustive scan: slab by slab in z, with the trimmed row ranges of
+// flying edges (Schroeder et al. 2015) so that only the cells next to a side
+// change are looked at, and the vertex ids of two planes kept in flat arrays.
+#include "geods/iso/marching_cubes.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <memory>
+#include <cstdint>
+#include <vector>
+
+#include "cell.hpp"
+#include "geods/core/parallel.hpp"
+
+namespace geods::iso {
+namespace {
+
+// The range of x edges of one row where the side changes: samples [0, xl] are
+// all on the side of sample 0 and samples [xr, nx) on the side of sample nx-1;
+// a row on one side only has xl = nx, xr = 0.
+struct RowTrim {
+  std::uint32_t xl, xr;
+  bool uniform() const { return xl > xr; }
+};
+
+// Which of the five id arrays (x edges of planes k and k+1, y edges of planes
+// k and k+1, z edges of the layer) holds cube edge e, and its offset from the
+// cell's (i, j) entry.
+constexpr std::uint8_t kEdgeArray[12] = {0, 0, 1, 1, 2, 2, 3, 3, 4, 4, 4, 4};
+
+template <typename T>
+class SlabScan {
+ public:
+  SlabScan(const Grid3<T>& g, double iso, const IsoOptions& options, bool flip)
+      : g_(g), iso_(iso), thr_(iso), placer_(g, iso, options.positions, options.normals), flip_(flip),
+        table_(detail::case_table_view()), nx_(g.dims[0]), ny_(g.dims[1]) {
+    const std::size_t plane = nx_ * ny_;
+    for (auto& ids : xid_) ids.resize(plane);
+    for (auto& ids : yid_) ids.resize(plane);
+    zid_.resize(plane);
+    for (auto& t : trims_) t.resize(ny_);
+    const std::ptrdiff_t nx = std::ptrdiff_t(nx_);
+    const std::ptrdiff_t delta[12] = {0, nx, 0, nx, 0, 1, 0, 1, 0, 1, nx, nx + 1};
+    std::copy(delta, delta + 12, edge_delta_);
+  }
+
+  // Triangle corners with this bit refer to centre_positions.
+  static constexpr std::uint32_t kCentreFlag = 0x80000000u;
+
+  // Edge vertices: the bottom plane's x/y edges first (bottom_count of them),
+  // the top plane's x/y edges last (from top_begin on). Cell-centre vertices
+  // apart, so that the top plane stays last.
+  std::vector<Vec3f> positions, normals, centre_positions, centre_normals;
+  std::vector<TriMesh::Triangle> triangles;
+  std::size_t bottom_count = 0, top_begin = 0;
+
+  void run(std::size_t k0, std::size_t k1) {
+    compute_trims(k0);
+    create_xy_vertices(k0);
+    bottom_count = positions.size();
+    for (std::size_t k = k0; k < k1; ++k) {
+      compute_trims(k + 1);
+      create_z_vertices(k);
+      top_begin = positions.size();
+      create_xy_vertices(k + 1);
+      march_layer(k);
+    }
+  }
+
+ private:
+  bool inside(std::size_t i) const { return thr_.inside(g_.data[i]); }
+  const T* row(std::size_t j, std::size_t k) const { return g_.data.data() + g_.index(0, j, k); }
+  std::vector<RowTrim>& trims(std::size_t k) { return trims_[k & 1]; }
+
+  void compute_trims(std::size_t k) {
+    std::vector<RowTrim>& out = trims(k);
+    const std::size_t nx = nx_;
+    for (std::size_t j = 0; j < ny_; ++j) {
+      const T* r = row(j, k);
+      std::size_t count = 0;
+      bool nan = false;
+      for (std::size_t i = 0; i < nx; ++i) {
+        count += thr_.inside(r[i]);
+        if constexpr (std::is_floating_point_v<T>) nan |= (r[i] != r[i]);
+      }
+      if (nan) throw Error("isosurface: the volume has a NaN sample in row y = " + std::to_string(j) +
+                           ", z = " + std::to_string(k));
+      if (count == 0 || count == nx) {
+        out[j] = {std::uint32_t(nx), 0};
+        continue;
+      }
+      const bool first = thr_.inside(r[0]), last = thr_.inside(r[nx - 1]);
+      std::size_t xl = 0, xr = nx - 1;
+      while (thr_.inside(r[xl + 1]) == first) ++xl;
+      while (thr_.inside(r[xr - 1]) == last) --xr;
+      out[j] = {std::uint32_t(xl), std::uint32_t(xr)};
+    }
+  }
+
+  // Samples [a, b] of two rows outside of which the two rows keep their sides
+  // and agree; false if they agree everywhere.
+  template <std::size_t N>
+  bool active_range(const T* const (&rows)[N], const RowTrim* const (&trim)[N], std::size_t& a,
+                    std::size_t& b) const {
+    std::size_t lo = nx_, hi = 0;
+    for (std::size_t r = 0; r < N; ++r) lo = std::min<std::size_t>(lo, trim[r]->xl), hi = std::max<std::size_t>(hi, trim[r]->xr);
+    auto differ_at = [&](std::size_t x) {
+      const bool s = thr_.inside(rows[0][x]);
+      for (std::size_t r = 1; r < N; ++r)
+        if (thr_.inside(rows[r][x]) != s) return true;
+      return false;
+    };
+    if (lo > hi) {  // every row on one side
+      if (!differ_at(0)) return false;
+      a = 0, b = nx_ - 1;
+      return true;
+    }
+    a = differ_at(lo) ? 0 : lo;
+    b = differ_at(hi) ? nx_ - 1 : hi;
+    return true;
+  }
+
+  void create_xy_vertices(std::size_t k) {
+    std::uint32_t* xid = xid_[k & 1].data();
+    std::uint32_t* yid = yid_[k & 1].data();
+    const std::vector<RowTrim>& t = trims(k);
+    for (std::size_t j = 0; j < ny_; ++j) {
+      if (t[j].uniform()) continue;
+      const T* r = row(j, k);
+      for (std::size_t i = t[j].xl; i < t[j].xr; ++i)
+        if (thr_.inside(r[i]) != thr_.inside(r[i + 1])) xid[j * nx_ + i] = add_vertex(i, j, k, 0);
+    }
+    for (std::size_t j = 0; j + 1 < ny_; ++j) {
+      const T* const rows[2] = {row(j, k), row(j + 1, k)};
+      const RowTrim* const rt[2] = {&t[j], &t[j + 1]};
+      std::size_t a, b;
+      if (!active_range(rows, rt, a, b)) continue;
+      for (std::size_t i = a; i <= b; ++i)
+        if (thr_.inside(rows[0][i]) != thr_.inside(rows[1][i])) yid[j * nx_ + i] = add_vertex(i, j, k, 1);
+    }
+  }
+
+  void create_z_vertices(std::size_t k) {
+    const std::vector<RowTrim>& t0 = trims(k);
+    const std::vector<RowTrim>& t1 = trims(k + 1);
+    for (std::size_t j = 0; j < ny_; ++j) {
+      const T* const rows[2] = {row(j, k), row(j, k + 1)};
+      const RowTrim* const rt[2] = {&t0[j], &t1[j]};
+      std::size_t a, b;
+      if (!active_range(rows, rt, a, b)) continue;
+      for (std::size_t i = a; i <= b; ++i)
+        if (thr_.inside(rows[0][i]) != thr_.inside(rows[1][i])) zid_[j * nx_ + i] = add_vertex(i, j, k, 2);
+    }
+  }
+
+  std::uint32_t add_vertex(std::size_t i, std::size_t j, std::size_t k, int axis) {
+    const std::size_t id = positions.size();
+    if (id >= std::size_t(kCentreFlag)) throw Error("isosurface: more than 2^32 - 1 vertices");
+    placer_.place(i, j, k, axis, positions, normals);
+    return std::uint32_t(id);
+  }
+
+  void march_layer(std::size_t k) {
+    const std::vector<RowTrim>& t0 = trims(k);
+    const std::vector<RowTrim>& t1 = trims(k + 1);
+    const std::uint32_t* arrays[5] = {xid_[k & 1].data(), xid_[(k + 1) & 1].data(), yid_[k & 1].data(),
+                                      yid_[(k + 1) & 1].data(), zid_.data()};
+    for (std::size_t j = 0; j + 1 < ny_; ++j) {
+      // Corner bit c = x + 2y + 4z: rows (y, z) = (0,0), (1,0), (0,1), (1,1).
+      const T* const rows[4] = {row(j, k), row(j + 1, k), row(j, k + 1), row(j + 1, k + 1)};
+      const RowTrim* const rt[4] = {&t0[j], &t0[j + 1], &t1[j], &t1[j + 1]};
+      std::size_t a, b;
+      if (!active_range(rows, rt, a, b)) continue;
+      auto column = [&](std::size_t x) {
+        return unsigned(thr_.inside(rows[0][x])) | unsigned(thr_.inside(rows[1][x])) << 2 |
+               unsigned(thr_.inside(rows[2][x])) << 4 | unsigned(thr_.inside(rows[3][x])) << 6;
+      };
+      unsigned left = column(a);
+      for (std::size_t i = a; i < b; ++i) {
+        const unsigned right = column(i + 1);
+        const unsigned c = left | right << 1;
+        left = right;
+        if (c == 0 || c == 255) continue;
+        std::uint8_t joined = 0;
+        if (const std::uint8_t amb = table_.ambiguous[c]) {
+          joined = detail::decide_faces(amb, iso_, [&](int corner) {
+            return rows[corner >> 1][i + (corner & 1)];
+          });
+        }
+        const std::size_t entry = std::size_t(c) * 64 + joined;
+        const std::ptrdiff_t base = std::ptrdiff_t(j * nx_ + i);
+        std::uint32_t ids[12 + kMaxCentres];
+        for (unsigned crossed = detail::kCrossedEdges[c]; crossed != 0; crossed &= crossed - 1) {
+          const int e = std::countr_zero(crossed);
+          ids[e] = arrays[kEdgeArray[e]][base + edge_delta_[e]];
+        }
+        for (std::size_t n = 0; n < kMaxCentres && table_.centres[entry * kMaxCentres + n] != 0; ++n) {
+          ids[12 + n] = kCentreFlag | std::uint32_t(centre_positions.size());
+          detail::place_centre(table_.centres[entry * kMaxCentres + n], ids, positions, normals, centre_positions,
+                               centre_normals);
+        }
+        const std::uint8_t* e = table_.edges + table_.offsets[entry];
+        const std::uint8_t* end = table_.edges + table_.offsets[entry + 1];
+        for (; e != end; e += 3)
+          triangles.push_back(flip_ ? TriMesh::Triangle{ids[e[0]], ids[e[2]], ids[e[1]]}
+                                    : TriMesh::Triangle{ids[e[0]], ids[e[1]], ids[e[2]]});
+      }
+    }
+  }
+
+  const Grid3<T>& g_;
+  double iso_;
+  detail::Threshold<T> thr_;
+  detail::VertexPlacer<T> placer_;
+  bool flip_;
+  detail::CaseTableView table_;
+  std::size_t nx_, ny_;
+  std::ptrdiff_t edge_delta_[12];
+  std::vector<std::uint32_t> xid_[2], yid_[2], zid_;
+  std::vector<RowTrim> trims_[2];
+};
+
+}  // namespace
+
+template <typename T>
+TriMesh isosurface(const Grid3<T>& volume, double iso, const IsoOptions& options) {
+  const detail::Threshold<T> check_iso(iso);  // throws for a non-finite iso-value
+  detail::check_positions(volume, options.positions);
+  TriMesh mesh;
+  const std::size_t nz = volume.dims[2];
+  if (volume.dims[0] < 2 || volume.dims[1] < 2 || nz < 2) {
+    detail::check_samples(volume);
+    return mesh;
+  }
+  const bool flip = detail::mirrored(volume, options.positions);
+  const std::size_t layers = nz - 1;
+  // Several slabs per thread for balance, but not so thin that the plane
+  // each slab recomputes at its bottom costs much.
+  const std::size_t slabs = num_threads() == 1 ? 1 : std::min<std::size_t>(layers, 4 * std::size_t(num_threads()));
+  std::vector<std::unique_ptr<SlabScan<T>>> scans(slabs);
+  parallel_for_each_index(0, slabs, [&](std::size_t s) {
+    scans[s] = std::make_unique<SlabScan<T>>(volume, iso, options, flip);
+    scans[s]->run(layers * s / slabs, layers * (s + 1) / slabs);
+  }, 1);
+
+  // Slab s's top plane is slab s+1's bottom plane, made in the same order:
+  // keep the latter, so that the result equals one slab over everything.
+  // Edge vertices of all slabs first, then the centre vertices of all slabs.
+  std::vector<std::size_t> base(slabs + 1, 0), centre_base(slabs + 1, 0);
+  for (std::size_t s = 0; s < slabs; ++s) {
+    const SlabScan<T>& scan = *scans[s];
+    const bool last = s + 1 == slabs;
+    if (!last && scan.positions.size() - scan.top_begin != scans[s + 1]->bottom_count)
+      throw Error("isosurface: internal error: slab planes disagree");
+    base[s + 1] = base[s] + (last ? scan.positions.size() : scan.top_begin);
+  }
+  centre_base[0] = base[slabs];
+  for (std::size_t s = 0; s < slabs; ++s) centre_base[s + 1] = centre_base[s] + scans[s]->centre_positions.size();
+  const std::size_t vertices = centre_base[slabs];
+  if (vertices >= std::size_t(UINT32_MAX)) throw Error("isosurface: more than 2^32 - 1 vertices");
+  std::vector<std::size_t> tri_base(slabs + 1, 0);
+  for (std::size_t s = 0; s < slabs; ++s) tri_base[s + 1] = tri_base[s] + scans[s]->triangles.size();
+  mesh.vertices.resize(vertices);
+  if (options.normals) mesh.normals.resize(vertices);
+  mesh.triangles.resize(tri_base[slabs]);
+  parallel_for_each_index(0, slabs, [&](std::size_t s) {
+    SlabScan<T>& scan = *scans[s];
+    const std::size_t keep = base[s + 1] - base[s];
+    std::copy_n(scan.positions.begin(), keep, mesh.vertices.begin() + std::ptrdiff_t(base[s]));
+    if (options.normals) std::copy_n(scan.normals.begin(), keep, mesh.normals.begin() + std::ptrdiff_t(base[s]));
+    std::copy(scan.centre_positions.begin(), scan.centre_positions.end(),
+              mesh.vertices.begin() + std::ptrdiff_t(centre_base[s]));
+    if (options.normals)
+      std::copy(scan.centre_normals.begin(), scan.centre_normals.end(),
+                mesh.normals.begin() + std::ptrdiff_t(centre_base[s]));
+    const std::uint32_t own = std::uint32_t(base[s]);
+    const std::uint32_t centres = std::uint32_t(centre_base[s]);
+    const std::uint32_t next = std::uint32_t(base[s + 1]);
+    const std::uint32_t top = std::uint32_t(scan.top_begin);
+    const bool last = s + 1 == slabs;
+    TriMesh::Triangle* out = mesh.triangles.data() + tri_base[s];
+    for (const TriMesh::Triangle& t : scan.triangles) {
+      TriMesh::Triangle r;
+      for (int c = 0; c < 3; ++c) {
+        if (t[c] & SlabScan<T>::kCentreFlag) r[c] = centres + (t[c] & ~SlabScan<T>::kCentreFlag);
+        else r[c] = (last || t[c] < top) ? own + t[c] : next + (t[c] - top);
+      }
+      *out++ = r;
+    }
+    scans[s].reset();
+  }, 1);
+  return mesh;
+}
+
+template TriMesh isosurface(const Grid3<std::uint8_t>&, double, const IsoOptions&);
+template TriMesh isosurface(const Grid3<std::uint16_t>&, double, const IsoOptions&);
+template TriMesh isosurface(const Grid3<std::int16_t>&, double, const IsoOptions&);
+template TriMesh isosurface(const Grid3<float>&, double, const IsoOptions&);
+template TriMesh isosurface(const Grid3<double>&, double, const IsoOptions&);
+
+}  // namespace geods::iso

@@ -1,0 +1,370 @@
+// Min/max octree: build, validation, and extraction by recursive descent with
+// the edge-vertex hash table of seed §2.4.
+#include "geods/iso/min_max_octree.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <memory>
+#include <string>
+
+#include "cell.hpp"
+#include "geods/core/parallel.hpp"
+
+namespace geods::iso {
+namespace {
+
+// Open addressing with linear probing and backward-shift deletion, keyed by
+// grid edge (3 * sample index + axis).
+class EdgeTable {
+ public:
+  struct Slot {
+    std::uint64_t key;
+    std::uint32_t vertex;
+    std::uint8_t visits, needed;
+  };
+  static constexpr std::uint64_t kEmpty = ~std::uint64_t(0);
+
+  EdgeTable() { rehash(1024); }
+
+  std::size_t size() const { return size_; }
+
+  // The slot of key, or nullptr.
+  Slot* find(std::uint64_t key) {
+    for (std::size_t i = home(key);; i = (i + 1) & mask_) {
+      if (slots_[i].key == key) return &slots_[i];
+      if (slots_[i].key == kEmpty) return nullptr;
+    }
+  }
+
+  void insert(const Slot& slot) {
+    if (2 * (size_ + 1) > slots_.size()) rehash(2 * slots_.size());
+    std::size_t i = home(slot.key);
+    while (slots_[i].key != kEmpty) i = (i + 1) & mask_;
+    slots_[i] = slot;
+    ++size_;
+  }
+
+  void erase(Slot* slot) {
+    std::size_t i = std::size_t(slot - slots_.data());
+    for (std::size_t j = (i + 1) & mask_; slots_[j].key != kEmpty; j = (j + 1) & mask_) {
+      const std::size_t h = home(slots_[j].key);
+      // Move slot j back into the hole at i unless its home lies in (i, j].
+      const bool stays = i <= j ? (h > i && h <= j) : (h > i || h <= j);
+      if (!stays) slots_[i] = slots_[j], i = j;
+    }
+    slots_[i].key = kEmpty;
+    --size_;
+  }
+
+ private:
+  std::size_t home(std::uint64_t key) const { return std::size_t((key * 0x9E3779B97F4A7C15ull) >> shift_); }
+
+  void rehash(std::size_t capacity) {
+    std::vector<Slot> old = std::move(slots_);
+    slots_.assign(capacity, Slot{kEmpty, 0, 0, 0});
+    mask_ = capacity - 1;
+    shift_ = 64 - std::countr_zero(capacity);
+    size_ = 0;
+    for (const Slot& s : old)
+      if (s.key != kEmpty) insert(s);
+  }
+
+  std::vector<Slot> slots_;
+  std::size_t mask_ = 0, size_ = 0;
+  int shift_ = 0;
+};
+
+
+}  // namespace
+
+// One extraction over one subtree (or the whole tree): its own hash table and output.
+template <typename T>
+struct MinMaxOctree<T>::Query {
+  const MinMaxOctree& tree;
+  double iso;
+  detail::Threshold<T> thr;
+  detail::VertexPlacer<T> placer;
+  bool flip;
+  detail::CaseTableView table = detail::case_table_view();
+  EdgeTable edges;
+  std::vector<Vec3f> positions, normals;
+  static constexpr std::uint64_t kNoEdge = EdgeTable::kEmpty;  // key of a cell-centre vertex
+  std::vector<std::uint64_t> keys;  // the grid edge of each vertex
+  std::vector<TriMesh::Triangle> triangles;
+  std::size_t cells_visited = 0, nodes_visited = 0;
+
+  Query(const MinMaxOctree& t, double iso_value, const IsoOptions& options, bool flip_triangles)
+      : tree(t), iso(iso_value), thr(iso_value), placer(t.volume_, iso_value, options.positions, options.normals),
+        flip(flip_triangles) {}
+
+  bool active(std::size_t node) const { return thr.inside(tree.max_[node]) && !thr.inside(tree.min_[node]); }
+
+  // Tests the existing children of node (level, x, y, z) and descends into the crossed ones.
+  void descend(std::size_t level, std::size_t x, std::size_t y, std::size_t z) {
+    if (level == 0) {
+      march_leaf(x, y, z);
+      return;
+    }
+    const auto& dims = tree.levels_[level - 1].dims;
+    for (std::size_t dz = 0; dz < 2; ++dz)
+      for (std::size_t dy = 0; dy < 2; ++dy)
+        for (std::size_t dx = 0; dx < 2; ++dx) {
+          const std::size_t cx = 2 * x + dx, cy = 2 * y + dy, cz = 2 * z + dz;
+          if (cx >= dims[0] || cy >= dims[1] || cz >= dims[2]) continue;
+          ++nodes_visited;
+          if (active(tree.node_index(level - 1, cx, cy, cz))) descend(level - 1, cx, cy, cz);
+        }
+  }
+
+  void march_leaf(std::size_t bx, std::size_t by, std::size_t bz) {
+    const Grid3<T>& g = tree.volume_;
+    const std::size_t L = tree.leaf_cells_;
+    const std::size_t x0 = bx * L, y0 = by * L, z0 = bz * L;
+    const std::size_t x1 = std::min(x0 + L, tree.cells_[0]), y1 = std::min(y0 + L, tree.cells_[1]),
+                      z1 = std::min(z0 + L, tree.cells_[2]);
+    const std::size_t sy = g.dims[0], sz = g.dims[0] * g.dims[1];
+    const std::size_t corner_offset[8] = {0, 1, sy, sy + 1, sz, sz + 1, sz + sy, sz + sy + 1};
+    cells_visited += (x1 - x0) * (y1 - y0) * (z1 - z0);
+    for (std::size_t k = z0; k < z1; ++k)
+      for (std::size_t j = y0; j < y1; ++j)
+        for (std::size_t i = x0; i < x1; ++i) {
+          const T* s = g.data.data() + g.index(i, j, k);
+          unsigned c = 0;
+          for (int q = 0; q < 8; ++q) c |= unsigned(thr.inside(s[corner_offset[q]])) << q;
+          if (c == 0 || c == 255) continue;
+          march_cell(i, j, k, c, s, corner_offset);
+        }
+  }
+
+  void march_cell(std::size_t i, std::size_t j, std::size_t k, unsigned c, const T* s,
+                  const std::size_t (&corner_offset)[8]) {
+    std::uint8_t joined = 0;
+    if (const std::uint8_t amb = table.ambiguous[c])
+      joined = detail::decide_faces(amb, iso, [&](int q) { return s[corner_offset[q]]; });
+    std::uint32_t ids[12 + kMaxCentres];
+    for (unsigned crossed = detail::kCrossedEdges[c]; crossed != 0; crossed &= crossed - 1) {
+      const int e = std::countr_zero(crossed);
+      ids[e] = edge_vertex(i, j, k, e);
+    }
+    const std::size_t entry = std::size_t(c) * 64 + joined;
+    for (std::size_t n = 0; n < kMaxCentres && table.centres[entry * kMaxCentres + n] != 0; ++n) {
+      ids[12 + n] = std::uint32_t(positions.size());
+      detail::place_centre(table.centres[entry * kMaxCentres + n], ids, positions, normals, positions, normals);
+      keys.push_back(kNoEdge);
+    }
+    const std::uint8_t* e = table.edges + table.offsets[entry];
+    const std::uint8_t* end = table.edges + table.offsets[entry + 1];
+    for (; e != end; e += 3)
+      triangles.push_back(flip ? TriMesh::Triangle{ids[e[0]], ids[e[2]], ids[e[1]]}
+                               : TriMesh::Triangle{ids[e[0]], ids[e[1]], ids[e[2]]});
+  }
+
+  // The vertex on cube edge e of cell (i, j, k): from the table if an earlier
+  // cell made it (removed at its last visit), else new.
+  std::uint32_t edge_vertex(std::size_t i, std::size_t j, std::size_t k, int e) {
+    const Grid3<T>& g = tree.volume_;
+    const int lo = detail::kEdgeCorners[e][0], axis = e / 4;
+    const std::size_t p[3] = {i + (lo & 1), j + ((lo >> 1) & 1), k + ((lo >> 2) & 1)};
+    const std::uint64_t key = 3 * std::uint64_t(g.index(p[0], p[1], p[2])) + std::uint64_t(axis);
+    if (EdgeTable::Slot* slot = edges.find(key)) {
+      const std::uint32_t v = slot->vertex;
+      if (++slot->visits == slot->needed) edges.erase(slot);
+      return v;
+    }
+    // Cells around the edge: along each other axis, the cells before and after it that exist.
+    std::uint8_t needed = 1;
+    for (int d = 0; d < 3; ++d)
+      if (d != axis) needed = std::uint8_t(needed * ((p[d] > 0) + (p[d] + 1 < g.dims[d])));
+    const std::size_t id = positions.size();
+    if (id >= std::size_t(UINT32_MAX)) throw Error("isosurface: more than 2^32 - 1 vertices");
+    placer.place(p[0], p[1], p[2], axis, positions, normals);
+    keys.push_back(key);
+    if (needed > 1) edges.insert({key, std::uint32_t(id), 1, needed});
+    return std::uint32_t(id);
+  }
+};
+
+template <typename T>
+MinMaxOctree<T>::MinMaxOctree(Grid3<T> volume, std::size_t leaf_cells)
+    : volume_(std::move(volume)), leaf_cells_(leaf_cells) {
+  if (leaf_cells_ == 0) throw Error("MinMaxOctree: leaf_cells must be >= 1");
+  detail::check_samples(volume_);
+  for (int d = 0; d < 3; ++d) {
+    if (volume_.dims[d] < 2) return;  // no cells
+    cells_[d] = volume_.dims[d] - 1;
+  }
+  std::array<std::size_t, 3> dims;
+  for (int d = 0; d < 3; ++d) dims[d] = (cells_[d] + leaf_cells_ - 1) / leaf_cells_;
+  std::size_t total = 0;
+  for (;;) {
+    levels_.push_back({dims, total});
+    total += dims[0] * dims[1] * dims[2];
+    if (dims[0] == 1 && dims[1] == 1 && dims[2] == 1) break;
+    for (int d = 0; d < 3; ++d) dims[d] = (dims[d] + 1) / 2;
+  }
+  min_.resize(total);
+  max_.resize(total);
+  const auto& leaves = levels_[0].dims;
+  parallel_for_each_index(0, leaves[2], [&](std::size_t z) {
+    for (std::size_t y = 0; y < leaves[1]; ++y)
+      for (std::size_t x = 0; x < leaves[0]; ++x) {
+        const std::array<T, 2> r = leaf_range(x, y, z);
+        min_[node_index(0, x, y, z)] = r[0];
+        max_[node_index(0, x, y, z)] = r[1];
+      }
+  }, 1);
+  for (std::size_t level = 1; level < levels_.size(); ++level) {
+    const auto& d = levels_[level].dims;
+    const auto& cd = levels_[level - 1].dims;
+    parallel_for_each_index(0, d[2], [&](std::size_t z) {
+      for (std::size_t y = 0; y < d[1]; ++y)
+        for (std::size_t x = 0; x < d[0]; ++x) {
+          const std::size_t first = node_index(level - 1, 2 * x, 2 * y, 2 * z);
+          T lo = min_[first], hi = max_[first];
+          for (std::size_t cz = 2 * z; cz < std::min(2 * z + 2, cd[2]); ++cz)
+            for (std::size_t cy = 2 * y; cy < std::min(2 * y + 2, cd[1]); ++cy)
+              for (std::size_t cx = 2 * x; cx < std::min(2 * x + 2, cd[0]); ++cx) {
+                const std::size_t c = node_index(level - 1, cx, cy, cz);
+                lo = std::min(lo, min_[c]);
+                hi = std::max(hi, max_[c]);
+              }
+          min_[node_index(level, x, y, z)] = lo;
+          max_[node_index(level, x, y, z)] = hi;
+        }
+    }, 1);
+  }
+}
+
+template <typename T>
+std::array<T, 2> MinMaxOctree<T>::leaf_range(std::size_t x, std::size_t y, std::size_t z) const {
+  const std::size_t L = leaf_cells_;
+  const std::size_t x0 = x * L, y0 = y * L, z0 = z * L;
+  const std::size_t x1 = std::min(x0 + L, cells_[0]), y1 = std::min(y0 + L, cells_[1]),
+                    z1 = std::min(z0 + L, cells_[2]);
+  T lo = volume_(x0, y0, z0), hi = lo;
+  for (std::size_t k = z0; k <= z1; ++k)
+    for (std::size_t j = y0; j <= y1; ++j) {
+      const T* row = volume_.data.data() + volume_.index(0, j, k);
+      for (std::size_t i = x0; i <= x1; ++i) lo = std::min(lo, row[i]), hi = std::max(hi, row[i]);
+    }
+  return {lo, hi};
+}
+
+template <typename T>
+OctreeIsoResult MinMaxOctree<T>::isosurface(double iso, const IsoOptions& options) const {
+  const detail::Threshold<T> thr(iso);  // throws for a non-finite iso-value
+  detail::check_positions(volume_, options.positions);
+  OctreeIsoResult result;
+  if (levels_.empty()) return result;
+  const bool flip = detail::mirrored(volume_, options.positions);
+  const std::size_t root = levels_.back().offset;
+  result.nodes_visited = 1;
+  if (!(thr.inside(max_[root]) && !thr.inside(min_[root]))) return result;
+
+  // Subtree roots: the crossed nodes of the highest level with enough nodes
+  // for the threads, in the order the sequential descent reaches them.
+  struct Node {
+    std::size_t level, x, y, z;
+  };
+  std::vector<Node> roots = {{levels_.size() - 1, 0, 0, 0}};
+  const std::size_t wanted = num_threads() == 1 ? 1 : 8 * std::size_t(num_threads());
+  while (roots.size() < wanted && roots.front().level > 0) {
+    std::vector<Node> next;
+    for (const Node& n : roots) {
+      const auto& dims = levels_[n.level - 1].dims;
+      for (std::size_t dz = 0; dz < 2; ++dz)
+        for (std::size_t dy = 0; dy < 2; ++dy)
+          for (std::size_t dx = 0; dx < 2; ++dx) {
+            const Node c{n.level - 1, 2 * n.x + dx, 2 * n.y + dy, 2 * n.z + dz};
+            if (c.x >= dims[0] || c.y >= dims[1] || c.z >= dims[2]) continue;
+            ++result.nodes_visited;
+            const std::size_t i = node_index(c.level, c.x, c.y, c.z);
+            if (thr.inside(max_[i]) && !thr.inside(min_[i])) next.push_back(c);
+          }
+    }
+    roots = std::move(next);
+  }
+
+  std::vector<std::unique_ptr<Query>> queries(roots.size());
+  parallel_for_each_index(0, roots.size(), [&](std::size_t r) {
+    queries[r] = std::make_unique<Query>(*this, iso, options, flip);
+    queries[r]->descend(roots[r].level, roots[r].x, roots[r].y, roots[r].z);
+  }, 1);
+
+  // Merge in traversal order: a vertex already made by an earlier subtree
+  // (on a shared border) keeps its first id, as in the sequential descent.
+  TriMesh& mesh = result.mesh;
+  EdgeTable first_id;
+  std::vector<std::uint32_t> remap;
+  for (auto& q : queries) {
+    result.cells_visited += q->cells_visited;
+    result.nodes_visited += q->nodes_visited;
+    remap.resize(q->positions.size());
+    for (std::size_t v = 0; v < q->positions.size(); ++v) {
+      if (queries.size() > 1 && q->keys[v] != Query::kNoEdge) {
+        if (const EdgeTable::Slot* s = first_id.find(q->keys[v])) {
+          remap[v] = s->vertex;
+          continue;
+        }
+        first_id.insert({q->keys[v], std::uint32_t(mesh.vertices.size()), 0, 0});
+      }
+      remap[v] = std::uint32_t(mesh.vertices.size());
+      mesh.vertices.push_back(q->positions[v]);
+      if (options.normals) mesh.normals.push_back(q->normals[v]);
+    }
+    for (const TriMesh::Triangle& t : q->triangles) mesh.triangles.push_back({remap[t[0]], remap[t[1]], remap[t[2]]});
+    q.reset();
+  }
+  return result;
+}
+
+template <typename T>
+MinMaxOctreeStats MinMaxOctree<T>::stats() const {
+  MinMaxOctreeStats s;
+  s.nodes = min_.size();
+  s.levels = levels_.size();
+  s.leaf_cells = leaf_cells_;
+  s.cells = cells_[0] * cells_[1] * cells_[2];
+  s.bytes = 2 * min_.size() * sizeof(T) + levels_.size() * sizeof(Level);
+  return s;
+}
+
+template <typename T>
+void MinMaxOctree<T>::validate() const {
+  auto fail = [](std::size_t level, std::size_t x, std::size_t y, std::size_t z) {
+    throw Error("MinMaxOctree: node (" + std::to_string(x) + ", " + std::to_string(y) + ", " + std::to_string(z) +
+                ") of level " + std::to_string(level) + " has a wrong min/max");
+  };
+  for (std::size_t level = 0; level < levels_.size(); ++level) {
+    const auto& d = levels_[level].dims;
+    for (std::size_t z = 0; z < d[2]; ++z)
+      for (std::size_t y = 0; y < d[1]; ++y)
+        for (std::size_t x = 0; x < d[0]; ++x) {
+          std::array<T, 2> want;
+          if (level == 0) {
+            want = leaf_range(x, y, z);
+          } else {
+            const auto& cd = levels_[level - 1].dims;
+            want = {min_[node_index(level - 1, 2 * x, 2 * y, 2 * z)], max_[node_index(level - 1, 2 * x, 2 * y, 2 * z)]};
+            for (std::size_t cz = 2 * z; cz < std::min(2 * z + 2, cd[2]); ++cz)
+              for (std::size_t cy = 2 * y; cy < std::min(2 * y + 2, cd[1]); ++cy)
+                for (std::size_t cx = 2 * x; cx < std::min(2 * x + 2, cd[0]); ++cx) {
+                  want[0] = std::min(want[0], min_[node_index(level - 1, cx, cy, cz)]);
+                  want[1] = std::max(want[1], max_[node_index(level - 1, cx, cy, cz)]);
+                }
+          }
+          const std::size_t n = node_index(level, x, y, z);
+          if (min_[n] != want[0] || max_[n] != want[1]) fail(level, x, y, z);
+        }
+  }
+  const auto& root = levels_.empty() ? std::array<std::size_t, 3>{1, 1, 1} : levels_.back().dims;
+  if (root[0] != 1 || root[1] != 1 || root[2] != 1) throw Error("MinMaxOctree: the top level is not a single root");
+}
+
+template class MinMaxOctree<std::uint8_t>;
+template class MinMaxOctree<std::uint16_t>;
+template class MinMaxOctree<std::int16_t>;
+template class MinMaxOctree<float>;
+template class MinMaxOctree<double>;
+
+}  // namespace geods::iso

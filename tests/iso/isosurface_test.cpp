@@ -1,0 +1,403 @@
+// Marching cubes and the min/max octree: closed, oriented 2-manifolds on
+// analytic fields, random noise and integer volumes at sample values; Euler
+// characteristics; the octree against the exhaustive scan; threads against
+// one thread; normals, spacing, curvilinear grids; bad input.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <functional>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "geods/core/error.hpp"
+#include "geods/core/parallel.hpp"
+#include "geods/core/rng.hpp"
+#include "geods/io/volume_io.hpp"
+#include "geods/iso/marching_cubes.hpp"
+#include "geods/iso/min_max_octree.hpp"
+
+namespace geods::iso {
+namespace {
+
+using Field = std::function<double(double, double, double)>;
+
+// Samples f at (i, j, k) * spacing + origin.
+template <typename T = float>
+Grid3<T> sample(std::size_t nx, std::size_t ny, std::size_t nz, const Field& f, Vec3f spacing = Vec3f::Ones(),
+                Vec3f origin = Vec3f::Zero()) {
+  Grid3<T> g(nx, ny, nz);
+  g.spacing = spacing;
+  g.origin = origin;
+  for (std::size_t k = 0; k < nz; ++k)
+    for (std::size_t j = 0; j < ny; ++j)
+      for (std::size_t i = 0; i < nx; ++i) {
+        const Vec3f p = g.position(i, j, k);
+        g(i, j, k) = T(f(p.x(), p.y(), p.z()));
+      }
+  return g;
+}
+
+Field sphere(double cx, double cy, double cz, double r) {
+  return [=](double x, double y, double z) { return r - std::sqrt((x - cx) * (x - cx) + (y - cy) * (y - cy) + (z - cz) * (z - cz)); };
+}
+// Torus around the z axis through (cx, cy, cz): positive inside.
+Field torus(double cx, double cy, double cz, double major, double minor) {
+  return [=](double x, double y, double z) {
+    const double q = std::hypot(x - cx, y - cy) - major;
+    return minor - std::hypot(q, z - cz);
+  };
+}
+
+// Everything the issue asks of an isosurface that avoids the border.
+void expect_closed_surface(const TriMesh& mesh, const std::string& what) {
+  const MeshReport report = mesh.validate();
+  EXPECT_TRUE(report.closed_manifold()) << what << ": " << ::testing::PrintToString(report.problems());
+  // One vertex per position: shared edge vertices, never two on one spot.
+  std::vector<std::array<float, 3>> p;
+  for (const Vec3f& v : mesh.vertices) p.push_back({v.x(), v.y(), v.z()});
+  std::sort(p.begin(), p.end());
+  EXPECT_EQ(std::adjacent_find(p.begin(), p.end()), p.end()) << what << ": coincident vertices";
+  // Every vertex is used.
+  std::vector<char> used(mesh.num_vertices(), 0);
+  for (const auto& t : mesh.triangles)
+    for (auto v : t) used[v] = 1;
+  EXPECT_EQ(std::count(used.begin(), used.end(), 0), 0) << what << ": unused vertices";
+  if (!mesh.triangles.empty()) {
+    EXPECT_GT(mesh.signed_volume(), 0) << what << ": not oriented outwards";
+  }
+}
+
+long euler(const TriMesh& mesh) { return long(mesh.num_vertices()) - long(mesh.num_triangles()) / 2; }
+
+// Triangles as position triples, each rotated to start at its smallest
+// corner (orientation kept), sorted: equal iff the same oriented triangles.
+std::vector<std::array<float, 9>> canonical(const TriMesh& mesh) {
+  std::vector<std::array<float, 9>> out;
+  for (const auto& t : mesh.triangles) {
+    std::array<std::array<float, 3>, 3> c;
+    for (int k = 0; k < 3; ++k) c[k] = {mesh.vertices[t[k]].x(), mesh.vertices[t[k]].y(), mesh.vertices[t[k]].z()};
+    const int first = int(std::min_element(c.begin(), c.end()) - c.begin());
+    std::array<float, 9> r;
+    for (int k = 0; k < 3; ++k)
+      for (int d = 0; d < 3; ++d) r[3 * k + d] = c[(first + k) % 3][d];
+    out.push_back(r);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+void expect_same_mesh(const TriMesh& a, const TriMesh& b, const std::string& what) {
+  EXPECT_EQ(a.vertices, b.vertices) << what;
+  EXPECT_EQ(a.normals, b.normals) << what;
+  EXPECT_EQ(a.triangles, b.triangles) << what;
+}
+
+// Random samples in [0, levels) inside, `outside` on the border.
+template <typename T>
+Grid3<T> noise(std::size_t n, int levels, std::uint64_t seed, T outside = T(0)) {
+  Rng rng(seed);
+  Grid3<T> g(n, n + 1, n + 2, outside);
+  for (std::size_t k = 1; k + 1 < g.dims[2]; ++k)
+    for (std::size_t j = 1; j + 1 < g.dims[1]; ++j)
+      for (std::size_t i = 1; i + 1 < g.dims[0]; ++i) g(i, j, k) = T(rng.below(std::uint64_t(levels)));
+  return g;
+}
+
+struct ThreadGuard {
+  ~ThreadGuard() { set_num_threads(0); }
+};
+
+TEST(Isosurface, SphereIsClosedWithEulerTwoAndRadialNormals) {
+  const auto g = sample(40, 41, 42, sphere(19.3, 20.1, 20.7, 12.4));
+  const TriMesh mesh = isosurface(g, 0.0);
+  expect_closed_surface(mesh, "sphere");
+  EXPECT_EQ(euler(mesh), 2);
+  ASSERT_EQ(mesh.normals.size(), mesh.vertices.size());
+  const Vec3f c(19.3f, 20.1f, 20.7f);
+  for (std::size_t v = 0; v < mesh.num_vertices(); ++v) {
+    EXPECT_NEAR((mesh.vertices[v] - c).norm(), 12.4, 0.05);
+    EXPECT_GT(mesh.normals[v].dot((mesh.vertices[v] - c).normalized()), 0.99f);
+    EXPECT_NEAR(mesh.normals[v].norm(), 1.0f, 1e-5f);
+  }
+  EXPECT_NEAR(mesh.signed_volume(), 4.0 / 3.0 * M_PI * std::pow(12.4, 3), 0.02 * 4.0 / 3.0 * M_PI * std::pow(12.4, 3));
+}
+
+TEST(Isosurface, TorusAndGenusTwoHaveTheirEulerCharacteristics) {
+  const auto t = sample(50, 40, 24, torus(24.5, 19.6, 11.3, 13, 5));
+  const TriMesh torus_mesh = isosurface(t, 0.0);
+  expect_closed_surface(torus_mesh, "torus");
+  EXPECT_EQ(euler(torus_mesh), 0);
+  // Two tori side by side, fused where they overlap: genus 2.
+  const Field a = torus(20, 20, 12, 10, 4), b = torus(42, 20, 12, 10, 4);
+  const auto g2 = sample(64, 40, 24, [&](double x, double y, double z) { return std::max(a(x, y, z), b(x, y, z)); });
+  const TriMesh genus2 = isosurface(g2, 0.0);
+  expect_closed_surface(genus2, "genus 2");
+  EXPECT_EQ(euler(genus2), -2);
+}
+
+TEST(Isosurface, ThinSheetsAndSharpCreasesStayClosed) {
+  // A disk thinner than a voxel, tilted: many ambiguous faces.
+  const auto sheet = sample(48, 48, 48, [](double x, double y, double z) {
+    const double h = (x - 24) * 0.3 + (y - 24) * 0.2 + (z - 24);
+    return std::min(0.35 - std::abs(h), 18 - std::hypot(x - 24, y - 24));
+  });
+  expect_closed_surface(isosurface(sheet, 0.0), "thin sheet");
+  // A cube and an octahedron: creases and corners through samples.
+  const auto cube = sample(32, 32, 32, [](double x, double y, double z) {
+    return 10 - std::max({std::abs(x - 15.5), std::abs(y - 15.5), std::abs(z - 15.5)});
+  });
+  const TriMesh cube_mesh = isosurface(cube, 0.0);
+  expect_closed_surface(cube_mesh, "cube");
+  EXPECT_EQ(euler(cube_mesh), 2);
+  const auto octa = sample(32, 32, 32, [](double x, double y, double z) {
+    return 12 - (std::abs(x - 16) + std::abs(y - 16) + std::abs(z - 16));  // vertices exactly on samples
+  });
+  for (double iso : {0.0, 1.0, 0.5}) expect_closed_surface(isosurface(octa, iso), "octahedron " + std::to_string(iso));
+}
+
+TEST(Isosurface, RandomNoiseIsAlwaysClosed) {
+  for (std::uint64_t seed = 1; seed <= 40; ++seed) {
+    Rng rng(seed);
+    Grid3<float> g(14, 13, 12, -1.0f);
+    for (std::size_t k = 1; k + 1 < 12; ++k)
+      for (std::size_t j = 1; j + 1 < 13; ++j)
+        for (std::size_t i = 1; i + 1 < 14; ++i) g(i, j, k) = float(rng.uniform(-1, 1));
+    for (double iso : {-0.5, 0.0, 0.3}) {
+      const TriMesh mesh = isosurface(g, iso);
+      expect_closed_surface(mesh, "noise seed " + std::to_string(seed) + " iso " + std::to_string(iso));
+    }
+  }
+}
+
+TEST(Isosurface, IntegerVolumesAtSampleValues) {
+  // Many samples exactly at the iso-value: one rule (>= is inside), no
+  // coincident vertices, no zero-area or duplicate faces.
+  for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+    const auto u8 = noise<std::uint8_t>(12, 4, seed);
+    const auto u16 = noise<std::uint16_t>(11, 3, seed + 100);
+    auto i16 = noise<std::int16_t>(10, 5, seed + 200, std::int16_t(-3));
+    for (auto& v : i16.data) v = std::int16_t(v == -3 ? -3 : v - 2);
+    for (double iso : {1.0, 2.0, 3.0}) {
+      expect_closed_surface(isosurface(u8, iso), "u8 seed " + std::to_string(seed) + " iso " + std::to_string(iso));
+      expect_closed_surface(isosurface(u16, iso - 1), "u16 seed " + std::to_string(seed));
+      expect_closed_surface(isosurface(i16, iso - 2), "i16 seed " + std::to_string(seed));
+    }
+    // Non-integer iso-values on integer volumes.
+    expect_closed_surface(isosurface(u8, 1.5), "u8 1.5");
+    expect_closed_surface(isosurface(u8, 0.25), "u8 0.25");
+  }
+  // Two values only: the saddles of ambiguous faces are exactly at the iso-value.
+  for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+    auto g = noise<std::uint8_t>(12, 2, seed);
+    for (auto& v : g.data) v = std::uint8_t(v * 2);  // 0 or 2, iso 1: every saddle is 1
+    expect_closed_surface(isosurface(g, 1.0), "binary seed " + std::to_string(seed));
+    expect_closed_surface(isosurface(g, 2.0), "binary at the sample value, seed " + std::to_string(seed));
+  }
+}
+
+TEST(Isosurface, IsoValueOutsideTheRangeGivesNothing) {
+  const auto g = noise<std::uint8_t>(8, 4, 7);
+  EXPECT_EQ(isosurface(g, 10.0).num_triangles(), 0u);
+  EXPECT_EQ(isosurface(g, -1.0).num_triangles(), 0u);  // everything inside: no crossing
+  EXPECT_EQ(isosurface(Grid3<float>(1, 5, 5, 1.0f), 0.5).num_triangles(), 0u);  // no cells
+}
+
+TEST(Isosurface, SpacingAndOriginArePositionsInWorld) {
+  const Vec3f spacing(0.5f, 1.0f, 2.0f), origin(-3.0f, 4.0f, 1.0f);
+  const auto g = sample(50, 26, 14, sphere(9.2, 16.8, 13.9, 9.5), spacing, origin);
+  const TriMesh mesh = isosurface(g, 0.0);
+  expect_closed_surface(mesh, "anisotropic sphere");
+  const Vec3f c(9.2f, 16.8f, 13.9f);
+  for (std::size_t v = 0; v < mesh.num_vertices(); ++v) {
+    EXPECT_NEAR((mesh.vertices[v] - c).norm(), 9.5, 0.15);
+    EXPECT_GT(mesh.normals[v].dot((mesh.vertices[v] - c).normalized()), 0.97f);
+  }
+  // Negative spacing mirrors the grid; triangles stay oriented outwards.
+  auto mirrored = g;
+  mirrored.spacing.x() = -0.5f;
+  expect_closed_surface(isosurface(mirrored, 0.0), "mirrored");
+}
+
+TEST(Isosurface, ThreadsGiveTheSameOutputAsOneThread) {
+  ThreadGuard guard;
+  const Field a = sphere(20, 22, 18, 9), b = torus(30, 25, 30, 10, 3);
+  const auto g = sample(48, 47, 49, [&](double x, double y, double z) { return std::max(a(x, y, z), b(x, y, z)); });
+  set_num_threads(1);
+  const TriMesh one = isosurface(g, 0.0);
+  for (int threads : {2, 3, 8}) {
+    set_num_threads(threads);
+    expect_same_mesh(isosurface(g, 0.0), one, std::to_string(threads) + " threads");
+  }
+  expect_closed_surface(one, "sphere and torus");
+}
+
+TEST(Isosurface, CurvilinearGridPlacesVerticesInPhysicalSpace) {
+  // A bent and sheared grid; the field is a sphere in physical space.
+  const std::size_t n = 40;
+  Grid3<float> g(n, n, n);
+  std::vector<Vec3f> positions(g.size());
+  const Vec3d c(24, 20, 20);
+  for (std::size_t k = 0; k < n; ++k)
+    for (std::size_t j = 0; j < n; ++j)
+      for (std::size_t i = 0; i < n; ++i) {
+        const Vec3d p(i + 0.3 * j + 0.005 * double(k * k), 1.1 * j + 2 * std::sin(0.1 * double(i)), 0.9 * k + 0.1 * i);
+        positions[g.index(i, j, k)] = p.cast<float>();
+        g(i, j, k) = float(8.0 - (p - c).norm());
+      }
+  IsoOptions options;
+  options.positions = positions;
+  const TriMesh mesh = isosurface(g, 0.0, options);
+  expect_closed_surface(mesh, "curvilinear sphere");
+  EXPECT_EQ(euler(mesh), 2);
+  for (std::size_t v = 0; v < mesh.num_vertices(); ++v) {
+    const Vec3d p = mesh.vertices[v].cast<double>();
+    EXPECT_NEAR((p - c).norm(), 8.0, 0.1);
+    EXPECT_GT(mesh.normals[v].cast<double>().dot((p - c).normalized()), 0.95);
+  }
+  // Mirror the physical space: still outward.
+  for (Vec3f& p : positions) p.x() = -p.x();
+  expect_closed_surface(isosurface(g, 0.0, options), "mirrored curvilinear");
+  // The regular grid's own positions give the regular result.
+  const auto regular = sample(20, 21, 22, sphere(9.5, 10.2, 10.9, 7), Vec3f(0.5f, 1.5f, 1.0f), Vec3f(1, 2, 3));
+  std::vector<Vec3f> same(regular.size());
+  for (std::size_t k = 0; k < 22; ++k)
+    for (std::size_t j = 0; j < 21; ++j)
+      for (std::size_t i = 0; i < 20; ++i) same[regular.index(i, j, k)] = regular.position(i, j, k);
+  IsoOptions as_curvilinear;
+  as_curvilinear.positions = same;
+  const TriMesh a = isosurface(regular, 0.0), b = isosurface(regular, 0.0, as_curvilinear);
+  ASSERT_EQ(a.triangles, b.triangles);
+  for (std::size_t v = 0; v < a.num_vertices(); ++v) {
+    EXPECT_LT((a.vertices[v] - b.vertices[v]).norm(), 1e-4f);
+    EXPECT_GT(a.normals[v].dot(b.normals[v]), 0.999f);
+  }
+}
+
+TEST(Isosurface, BadInputThrows) {
+  Grid3<float> g(4, 4, 4, 0.0f);
+  EXPECT_THROW(isosurface(g, std::nan("")), Error);
+  EXPECT_THROW(isosurface(g, INFINITY), Error);
+  g(2, 1, 3) = std::nanf("");
+  EXPECT_THROW(isosurface(g, 0.5), Error);
+  EXPECT_THROW(MinMaxOctree<float>{g}, Error);
+  g(2, 1, 3) = 1;
+  std::vector<Vec3f> few(10);
+  IsoOptions options;
+  options.positions = few;
+  EXPECT_THROW(isosurface(g, 0.5, options), Error);
+  std::vector<Vec3f> bad(g.size(), Vec3f::Zero());
+  bad[5].y() = INFINITY;
+  options.positions = bad;
+  EXPECT_THROW(isosurface(g, 0.5, options), Error);
+  EXPECT_THROW((MinMaxOctree<float>{g, 0}), Error);
+  EXPECT_THROW(MinMaxOctree<float>{g}.isosurface(std::nan("")), Error);
+}
+
+TEST(MinMaxOctree, NodesHoldTheRangeOfTheirCells) {
+  for (std::size_t leaf : {1, 2, 3, 4}) {
+    const auto g = noise<std::uint16_t>(13, 1000, leaf);  // 13 x 14 x 15: not powers of two
+    const MinMaxOctree<std::uint16_t> tree(g, leaf);
+    EXPECT_NO_THROW(tree.validate());
+    const MinMaxOctreeStats s = tree.stats();
+    EXPECT_EQ(s.cells, 12u * 13 * 14);
+    EXPECT_EQ(s.leaf_cells, leaf);
+    EXPECT_GT(s.nodes, s.cells / (leaf * leaf * leaf));
+  }
+  const MinMaxOctree<float> empty(Grid3<float>(1, 1, 1, 0.0f));
+  EXPECT_EQ(empty.isosurface(0.5).mesh.num_triangles(), 0u);
+}
+
+TEST(MinMaxOctree, GivesExactlyTheTrianglesOfTheScan) {
+  ThreadGuard guard;
+  const auto blobs = sample(45, 38, 51, [](double x, double y, double z) {
+    return std::max({sphere(15, 16, 20, 9)(x, y, z), torus(28, 20, 30, 9, 3)(x, y, z), sphere(35, 30, 12, 2.5)(x, y, z)});
+  });
+  for (int threads : {1, 2}) {
+    set_num_threads(threads);
+    for (std::size_t leaf : {1, 3, 4}) {
+      const MinMaxOctree<float> tree(blobs, leaf);
+      for (double iso : {-3.0, 0.0, 1.5, 2.4}) {
+        const TriMesh scan = isosurface(blobs, iso);
+        const OctreeIsoResult r = tree.isosurface(iso);
+        EXPECT_EQ(r.mesh.num_vertices(), scan.num_vertices());
+        EXPECT_EQ(canonical(r.mesh), canonical(scan)) << "leaf " << leaf << " iso " << iso;
+        expect_closed_surface(r.mesh, "octree");
+      }
+    }
+  }
+  for (std::uint64_t seed = 1; seed <= 10; ++seed) {
+    const auto g = noise<std::uint8_t>(15, 5, seed);
+    const MinMaxOctree<std::uint8_t> tree(g, 1 + seed % 3);
+    for (double iso : {1.0, 2.0, 2.5, 4.0}) {
+      EXPECT_EQ(canonical(tree.isosurface(iso).mesh), canonical(isosurface(g, iso))) << seed << " " << iso;
+    }
+  }
+}
+
+TEST(MinMaxOctree, ParallelSubtreesMergeIntoTheSequentialOutput) {
+  ThreadGuard guard;
+  const auto g = noise<float>(30, 100, 3);
+  for (std::size_t leaf : {1, 4}) {
+    const MinMaxOctree<float> tree(g, leaf);
+    set_num_threads(1);
+    const OctreeIsoResult one = tree.isosurface(49.5);
+    for (int threads : {2, 5}) {
+      set_num_threads(threads);
+      const OctreeIsoResult many = tree.isosurface(49.5);
+      expect_same_mesh(many.mesh, one.mesh, "octree with " + std::to_string(threads) + " threads");
+      EXPECT_EQ(many.cells_visited, one.cells_visited);
+      EXPECT_EQ(many.nodes_visited, one.nodes_visited);
+    }
+  }
+}
+
+TEST(MinMaxOctree, SmallSurfacesVisitFewCells) {
+  const auto g = sample(96, 90, 100, sphere(40.3, 50.2, 60.1, 3.2));
+  for (std::size_t leaf : {1, 4}) {
+    const MinMaxOctree<float> tree(g, leaf);
+    const OctreeIsoResult r = tree.isosurface(0.0);
+    expect_closed_surface(r.mesh, "tiny sphere");
+    const double cells = 95.0 * 89 * 99;
+    EXPECT_LT(double(r.cells_visited), 0.01 * cells) << "leaf " << leaf;
+    EXPECT_GT(r.cells_visited, r.mesh.num_triangles() / 4);  // it did look at the crossed cells
+  }
+  // One cell per leaf: only crossed cells are visited.
+  const MinMaxOctree<float> fine(g, 1);
+  const OctreeIsoResult r = fine.isosurface(0.0);
+  std::size_t crossed = 0;
+  for (std::size_t k = 0; k + 1 < g.dims[2]; ++k)
+    for (std::size_t j = 0; j + 1 < g.dims[1]; ++j)
+      for (std::size_t i = 0; i + 1 < g.dims[0]; ++i) {
+        int in = 0;
+        for (int c = 0; c < 8; ++c) in += g(i + (c & 1), j + ((c >> 1) & 1), k + (c >> 2)) >= 0.0f;
+        crossed += in != 0 && in != 8;
+      }
+  EXPECT_EQ(r.cells_visited, crossed);
+}
+
+TEST(Isosurface, DemoHeadVolumePaddedIsClosed) {
+  const Grid3<float> head = io::to_float(io::read_volume(std::string(GEODS_DATA_DIR) + "/t1_head.nii.gz"));
+  // Pad with the minimum so that the surface closes at the border.
+  const float low = *std::min_element(head.data.begin(), head.data.end());
+  const float high = *std::max_element(head.data.begin(), head.data.end());
+  Grid3<float> padded(head.dims[0] + 2, head.dims[1] + 2, head.dims[2] + 2, low);
+  padded.spacing = head.spacing;
+  padded.origin = head.origin - head.spacing;
+  for (std::size_t k = 0; k < head.dims[2]; ++k)
+    for (std::size_t j = 0; j < head.dims[1]; ++j)
+      for (std::size_t i = 0; i < head.dims[0]; ++i) padded(i + 1, j + 1, k + 1) = head(i, j, k);
+  const MinMaxOctree<float> tree(padded);
+  for (double fraction : {0.1, 0.3}) {
+    const double iso = low + fraction * (high - low);
+    const TriMesh mesh = isosurface(padded, iso);
+    EXPECT_GT(mesh.num_triangles(), 1000u);
+    expect_closed_surface(mesh, "head at " + std::to_string(iso));
+    EXPECT_EQ(canonical(tree.isosurface(iso).mesh), canonical(mesh));
+  }
+}
+
+}  // namespace
+}  // namespace geods::iso
