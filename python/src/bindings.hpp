@@ -11,5 +11,6 @@ void bind_dynamic(pybind11::module_& m);  // bind_dynamic.cpp: dynamic k-d tree
 void bind_quadtree(pybind11::module_& m);  // bind_quadtree.cpp: quadtree, octree
 void bind_delaunay(pybind11::module_& m);  // bind_delaunay.cpp: Delaunay triangulation
 void bind_ray(pybind11::module_& m);  // bind_ray.cpp: ray accelerators, render
+void bind_iso(pybind11::module_& m);       // bind_iso.cpp: isosurfaces, min/max octree
 
 }  // namespace geods::python

@@ -13,4 +13,5 @@ PYBIND11_MODULE(_geods, m) {
   geods::python::bind_quadtree(m);
   geods::python::bind_delaunay(m);
   geods::python::bind_ray(m);
+  geods::python::bind_iso(m);
 }

@@ -177,9 +177,12 @@ struct Table {
       }
     }
     for (int c = 0; c < 256; ++c) {
+      std::vector<CaseEntry> derived(64);  // by the decisions of the ambiguous faces only
       for (int joined = 0; joined < 64; ++joined) {
         offsets.push_back(std::uint32_t(edges.size()));
-        const CaseEntry e = derive_case(c, joined & ambiguous[c]);
+        const int key = joined & ambiguous[c];
+        if (key == joined) derived[key] = derive_case(c, key);
+        const CaseEntry& e = derived[key];
         edges.insert(edges.end(), e.triangles.begin(), e.triangles.end());
         max_triangles = std::max(max_triangles, int(e.triangles.size() / 3));
         for (std::size_t i = 0; i < kMaxCentres; ++i) centres.push_back(i < e.centres.size() ? e.centres[i] : 0);

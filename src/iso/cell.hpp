@@ -61,10 +61,13 @@ inline void place_centre(std::uint16_t mask, const std::uint32_t* ids, const std
   out_normals.push_back(normal);
 }
 
-/// `inside(v)` is exactly double(v) >= iso, with the comparison done in T.
+/// `inside(v)` is exactly double(v) >= iso, with the comparison done in T
+/// (floating point) or int32 (the 8- and 16-bit integer types), so that loops
+/// over samples vectorize.
 template <typename T>
 struct Threshold {
-  using Compare = std::conditional_t<std::is_floating_point_v<T>, T, long long>;
+  static_assert(std::is_floating_point_v<T> || sizeof(T) <= 2, "integer samples of at most 16 bits");
+  using Compare = std::conditional_t<std::is_floating_point_v<T>, T, std::int32_t>;
   Compare value;
 
   explicit Threshold(double iso) {
@@ -74,10 +77,21 @@ struct Threshold {
       if (double(t) < iso) t = std::nextafter(t, std::numeric_limits<T>::infinity());
       value = t;
     } else {
-      value = (long long)std::clamp(std::ceil(iso), -1e15, 1e15);
+      value = std::int32_t(std::clamp(std::ceil(iso), -1e9, 1e9));
     }
   }
   bool inside(T v) const { return Compare(v) >= value; }
+
+  /// How many of the n samples are inside; throws for a NaN among them.
+  std::uint32_t count_inside(const T* v, std::size_t n) const {
+    std::uint32_t count = 0, nan = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      count += std::uint32_t(Compare(v[i]) >= value);
+      if constexpr (std::is_floating_point_v<T>) nan += std::uint32_t(v[i] != v[i]);
+    }
+    if (nan) throw Error("isosurface: the volume has a NaN sample");
+    return count;
+  }
 };
 
 /// Bit f set for every ambiguous face f of the cell whose inside corners are

@@ -53,6 +53,7 @@ class SlabScan {
   std::vector<Vec3f> positions, normals, centre_positions, centre_normals;
   std::vector<TriMesh::Triangle> triangles;
   std::size_t bottom_count = 0, top_begin = 0;
+  std::size_t cells_visited = 0;
 
   void run(std::size_t k0, std::size_t k1) {
     compute_trims(k0);
@@ -77,14 +78,7 @@ class SlabScan {
     const std::size_t nx = nx_;
     for (std::size_t j = 0; j < ny_; ++j) {
       const T* r = row(j, k);
-      std::size_t count = 0;
-      bool nan = false;
-      for (std::size_t i = 0; i < nx; ++i) {
-        count += thr_.inside(r[i]);
-        if constexpr (std::is_floating_point_v<T>) nan |= (r[i] != r[i]);
-      }
-      if (nan) throw Error("isosurface: the volume has a NaN sample in row y = " + std::to_string(j) +
-                           ", z = " + std::to_string(k));
+      const std::size_t count = thr_.count_inside(r, nx);
       if (count == 0 || count == nx) {
         out[j] = {std::uint32_t(nx), 0};
         continue;
@@ -171,6 +165,7 @@ class SlabScan {
       const RowTrim* const rt[4] = {&t0[j], &t0[j + 1], &t1[j], &t1[j + 1]};
       std::size_t a, b;
       if (!active_range(rows, rt, a, b)) continue;
+      cells_visited += b - a;
       auto column = [&](std::size_t x) {
         return unsigned(thr_.inside(rows[0][x])) | unsigned(thr_.inside(rows[1][x])) << 2 |
                unsigned(thr_.inside(rows[2][x])) << 4 | unsigned(thr_.inside(rows[3][x])) << 6;
@@ -223,7 +218,8 @@ class SlabScan {
 }  // namespace
 
 template <typename T>
-TriMesh isosurface(const Grid3<T>& volume, double iso, const IsoOptions& options) {
+TriMesh isosurface(const Grid3<T>& volume, double iso, const IsoOptions& options, std::size_t* cells_visited) {
+  if (cells_visited) *cells_visited = 0;
   const detail::Threshold<T> check_iso(iso);  // throws for a non-finite iso-value
   detail::check_positions(volume, options.positions);
   TriMesh mesh;
@@ -258,6 +254,8 @@ TriMesh isosurface(const Grid3<T>& volume, double iso, const IsoOptions& options
   for (std::size_t s = 0; s < slabs; ++s) centre_base[s + 1] = centre_base[s] + scans[s]->centre_positions.size();
   const std::size_t vertices = centre_base[slabs];
   if (vertices >= std::size_t(UINT32_MAX)) throw Error("isosurface: more than 2^32 - 1 vertices");
+  if (cells_visited)
+    for (const auto& scan : scans) *cells_visited += scan->cells_visited;
   std::vector<std::size_t> tri_base(slabs + 1, 0);
   for (std::size_t s = 0; s < slabs; ++s) tri_base[s + 1] = tri_base[s] + scans[s]->triangles.size();
   mesh.vertices.resize(vertices);
@@ -292,10 +290,10 @@ TriMesh isosurface(const Grid3<T>& volume, double iso, const IsoOptions& options
   return mesh;
 }
 
-template TriMesh isosurface(const Grid3<std::uint8_t>&, double, const IsoOptions&);
-template TriMesh isosurface(const Grid3<std::uint16_t>&, double, const IsoOptions&);
-template TriMesh isosurface(const Grid3<std::int16_t>&, double, const IsoOptions&);
-template TriMesh isosurface(const Grid3<float>&, double, const IsoOptions&);
-template TriMesh isosurface(const Grid3<double>&, double, const IsoOptions&);
+template TriMesh isosurface(const Grid3<std::uint8_t>&, double, const IsoOptions&, std::size_t*);
+template TriMesh isosurface(const Grid3<std::uint16_t>&, double, const IsoOptions&, std::size_t*);
+template TriMesh isosurface(const Grid3<std::int16_t>&, double, const IsoOptions&, std::size_t*);
+template TriMesh isosurface(const Grid3<float>&, double, const IsoOptions&, std::size_t*);
+template TriMesh isosurface(const Grid3<double>&, double, const IsoOptions&, std::size_t*);
 
 }  // namespace geods::iso

@@ -34,7 +34,10 @@ struct IsoOptions {
 /// included) is the same for any number of threads. O(samples + output).
 /// Throws geods::Error for a non-finite iso-value, a NaN sample, or positions
 /// of the wrong count or not finite. T: uint8, uint16, int16, float, double.
+/// If `cells_visited` is given, it receives the number of cells whose corners
+/// were examined (those in the trimmed row ranges).
 template <typename T>
-TriMesh isosurface(const Grid3<T>& volume, double iso, const IsoOptions& options = {});
+TriMesh isosurface(const Grid3<T>& volume, double iso, const IsoOptions& options = {},
+                   std::size_t* cells_visited = nullptr);
 
 }  // namespace geods::iso
