@@ -12,5 +12,6 @@ void bind_quadtree(pybind11::module_& m);  // bind_quadtree.cpp: quadtree, octre
 void bind_delaunay(pybind11::module_& m);  // bind_delaunay.cpp: Delaunay triangulation
 void bind_ray(pybind11::module_& m);  // bind_ray.cpp: ray accelerators, render
 void bind_iso(pybind11::module_& m);       // bind_iso.cpp: isosurfaces, min/max octree
+void bind_voronoi(pybind11::module_& m);  // bind_voronoi.cpp: Voronoi2, MetricVoronoi, emst, circles
 
 }  // namespace geods::python

@@ -1,0 +1,319 @@
+// Python bindings of the Voronoi side of the voronoi module: geods.Voronoi2,
+// geods.MetricVoronoi, and the applications (emst, closest_pair, circles...).
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "bindings.hpp"
+#include "geods/core/error.hpp"
+#include "geods/voronoi/circles.hpp"
+#include "geods/voronoi/metric_voronoi.hpp"
+#include "geods/voronoi/post_office.hpp"
+#include "geods/voronoi/proximity.hpp"
+#include "geods/voronoi/voronoi2.hpp"
+
+namespace py = pybind11;
+
+namespace geods::python {
+namespace {
+
+using voronoi::Voronoi2;
+using Rows = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+// An (n, 2) array (or a single point (2,) when `single` is allowed) as points.
+std::vector<Vec2d> to_points(const py::handle& object, const char* what, bool* single = nullptr) {
+  const Rows a = Rows::ensure(object);
+  if (!a) throw Error(std::string(what) + ": expected an array of numbers");
+  if (single && a.ndim() == 1 && a.shape(0) == 2) {
+    *single = true;
+    return {Vec2d(a.at(0), a.at(1))};
+  }
+  if (a.ndim() != 2 || a.shape(1) != 2)
+    throw Error(std::string(what) + ": expected an (n, 2) array" + (single ? " or one point (2,)" : ""));
+  if (single) *single = false;
+  std::vector<Vec2d> p(std::size_t(a.shape(0)));
+  for (std::size_t i = 0; i < p.size(); ++i) p[i] = {a.at(py::ssize_t(i), 0), a.at(py::ssize_t(i), 1)};
+  return p;
+}
+
+AABB2d to_box(const py::object& box, const char* what) {
+  const std::vector<double> v = box.cast<std::vector<double>>();
+  if (v.size() != 4 || !(v[0] < v[2]) || !(v[1] < v[3]))
+    throw Error(std::string(what) + ": box must be (x0, y0, x1, y1) with x0 < x1 and y0 < y1");
+  return AABB2d({v[0], v[1]}, {v[2], v[3]});
+}
+
+py::array_t<double> to_array(const std::vector<Vec2d>& p) {
+  py::array_t<double> out(std::vector<py::ssize_t>{py::ssize_t(p.size()), 2});
+  double* d = out.mutable_data();
+  for (std::size_t i = 0; i < p.size(); ++i) d[2 * i] = p[i][0], d[2 * i + 1] = p[i][1];
+  return out;
+}
+
+template <typename T>
+py::array_t<std::int64_t> to_int_array(const std::vector<T>& v) {
+  py::array_t<std::int64_t> out(py::ssize_t(v.size()));
+  std::int64_t* d = out.mutable_data();
+  for (std::size_t i = 0; i < v.size(); ++i) d[i] = std::int64_t(v[i]);
+  return out;
+}
+
+py::list to_polygons(const std::vector<std::vector<Vec2d>>& cells) {
+  py::list out;
+  for (const auto& cell : cells) out.append(to_array(cell));
+  return out;
+}
+
+std::int64_t index_or_minus_one(std::uint32_t v) { return v == Voronoi2::kInfinity ? -1 : std::int64_t(v); }
+
+class PyVoronoi2 {
+ public:
+  PyVoronoi2(const py::handle& points, const py::object& box) {
+    const std::vector<Vec2d> p = to_points(points, "Voronoi2");
+    {
+      py::gil_scoped_release release;
+      diagram_ = std::make_unique<Voronoi2>(p);
+    }
+    box_ = box.is_none() ? diagram_->default_box() : to_box(box, "Voronoi2");
+  }
+
+  py::tuple box() const { return py::make_tuple(box_.lo[0], box_.lo[1], box_.hi[0], box_.hi[1]); }
+  py::array_t<double> points() const { return to_array({diagram_->points().begin(), diagram_->points().end()}); }
+  py::array_t<double> vertices() const { return to_array(diagram_->vertices()); }
+
+  py::list cells() const {
+    std::vector<std::vector<Vec2d>> cells;
+    {
+      py::gil_scoped_release release;
+      cells = diagram_->cell_polygons(box_);
+    }
+    return to_polygons(cells);
+  }
+
+  // One row per edge (a pair of twin half-edges): left site, right site, origin, target (-1: infinity).
+  py::array_t<std::int64_t> edges() const {
+    const auto& e = diagram_->edges();
+    std::vector<std::int64_t> rows;
+    for (std::uint32_t k = 0; k < e.size(); ++k)
+      if (e[k].twin > k)
+        rows.insert(rows.end(), {std::int64_t(e[k].site), std::int64_t(diagram_->opposite_site(k)),
+                                 index_or_minus_one(e[k].origin), index_or_minus_one(e[k].target)});
+    py::array_t<std::int64_t> out(std::vector<py::ssize_t>{py::ssize_t(rows.size() / 4), 4});
+    std::copy(rows.begin(), rows.end(), out.mutable_data());
+    return out;
+  }
+
+  // Unit direction from origin to target of each row of edges().
+  py::array_t<double> edge_directions() const {
+    std::vector<Vec2d> d;
+    for (std::uint32_t k = 0; k < diagram_->edges().size(); ++k)
+      if (diagram_->edges()[k].twin > k) d.push_back(diagram_->direction(k));
+    return to_array(d);
+  }
+
+  // Each row of edges() clipped to the box: x0, y0, x1, y1 (NaN when outside).
+  py::array_t<double> edge_segments() const {
+    std::vector<double> rows;
+    const double nan = std::nan("");
+    for (std::uint32_t k = 0; k < diagram_->edges().size(); ++k) {
+      if (diagram_->edges()[k].twin < k) continue;
+      const auto s = diagram_->clipped_edge(k, box_);
+      rows.insert(rows.end(), s ? std::initializer_list<double>{s->first[0], s->first[1], s->second[0], s->second[1]}
+                                : std::initializer_list<double>{nan, nan, nan, nan});
+    }
+    py::array_t<double> out(std::vector<py::ssize_t>{py::ssize_t(rows.size() / 4), 4});
+    std::copy(rows.begin(), rows.end(), out.mutable_data());
+    return out;
+  }
+
+  py::array_t<std::int64_t> representatives() const {
+    std::vector<std::uint32_t> r(diagram_->size());
+    for (std::uint32_t i = 0; i < r.size(); ++i) r[i] = diagram_->representative(i);
+    return to_int_array(r);
+  }
+
+  py::array_t<std::int64_t> neighbors(std::uint32_t site) const {
+    check_index(site);
+    const auto n = diagram_->neighbors(diagram_->representative(site));
+    return to_int_array(std::vector<std::uint32_t>(n.begin(), n.end()));
+  }
+
+  py::object nearest(const py::handle& queries, const std::string& method) {
+    bool single = false;
+    const std::vector<Vec2d> q = to_points(queries, "Voronoi2.nearest", &single);
+    std::vector<std::uint32_t> result;
+    if (method == "slab") {
+      if (!slab_) slab_ = std::make_unique<voronoi::SlabLocator>(*diagram_);
+      py::gil_scoped_release release;
+      result = slab_->nearest_batch(q);
+    } else if (method == "walk") {
+      py::gil_scoped_release release;
+      result = walk().nearest_batch(q);
+    } else {
+      throw Error("Voronoi2.nearest: method must be 'slab' or 'walk', got '" + method + "'");
+    }
+    if (single) return py::int_(result[0]);
+    return to_int_array(result);
+  }
+
+  py::array_t<std::int64_t> k_nearest(const py::handle& query, std::size_t k) {
+    bool single = false;
+    const std::vector<Vec2d> q = to_points(query, "Voronoi2.k_nearest", &single);
+    if (!single) throw Error("Voronoi2.k_nearest: expected one query point (2,)");
+    return to_int_array(voronoi::k_nearest_sites(walk(), q[0], k));
+  }
+
+  py::dict stats() const {
+    const voronoi::Voronoi2Stats s = diagram_->stats();
+    py::dict d;
+    d["sites"] = s.sites;
+    d["distinct"] = s.distinct;
+    d["vertices"] = s.vertices;
+    d["edges"] = s.edges;
+    d["unbounded_cells"] = s.unbounded_cells;
+    d["bytes"] = s.bytes;
+    return d;
+  }
+
+  void validate() const { diagram_->validate(); }
+  std::size_t size() const { return diagram_->size(); }
+  const Voronoi2& diagram() const { return *diagram_; }
+
+ private:
+  void check_index(std::uint32_t i) const {
+    if (i >= diagram_->size()) throw Error("Voronoi2: point index " + std::to_string(i) + " out of range");
+  }
+  const voronoi::WalkLocator& walk() {
+    if (!walk_) walk_ = std::make_unique<voronoi::WalkLocator>(*diagram_);
+    return *walk_;
+  }
+
+  std::unique_ptr<Voronoi2> diagram_;
+  AABB2d box_;
+  std::unique_ptr<voronoi::SlabLocator> slab_;
+  std::unique_ptr<voronoi::WalkLocator> walk_;
+};
+
+class PyMetricVoronoi {
+ public:
+  PyMetricVoronoi(const py::handle& points, const std::string& metric, const py::object& box) {
+    const std::vector<Vec2d> p = to_points(points, "MetricVoronoi");
+    const voronoi::Metric m = voronoi::parse_metric(metric);
+    const AABB2d b = box.is_none() ? voronoi::frame_around(p) : to_box(box, "MetricVoronoi");
+    py::gil_scoped_release release;
+    diagram_ = std::make_unique<voronoi::MetricVoronoi>(p, m, b);
+  }
+  std::string metric() const { return voronoi::metric_name(diagram_->metric()); }
+  py::tuple box() const {
+    const AABB2d& b = diagram_->box();
+    return py::make_tuple(b.lo[0], b.lo[1], b.hi[0], b.hi[1]);
+  }
+  py::list cells() const { return to_polygons(diagram_->cells()); }
+  // One row per piece of the diagram: site a, site b (integer columns) ...
+  py::tuple edges() const {
+    std::vector<std::uint32_t> sites;
+    std::vector<double> segments;
+    for (const auto& e : diagram_->edges()) {
+      sites.insert(sites.end(), {e.a, e.b});
+      segments.insert(segments.end(), {e.p0[0], e.p0[1], e.p1[0], e.p1[1]});
+    }
+    py::array_t<std::int64_t> s(std::vector<py::ssize_t>{py::ssize_t(sites.size() / 2), 2});
+    std::copy(sites.begin(), sites.end(), s.mutable_data());
+    py::array_t<double> g(std::vector<py::ssize_t>{py::ssize_t(segments.size() / 4), 4});
+    std::copy(segments.begin(), segments.end(), g.mutable_data());
+    return py::make_tuple(s, g);
+  }
+  void validate() const { diagram_->validate(); }
+
+ private:
+  std::unique_ptr<voronoi::MetricVoronoi> diagram_;
+};
+
+}  // namespace
+
+void bind_voronoi(py::module_& m) {
+  py::class_<PyVoronoi2>(m, "Voronoi2",
+                         "Voronoi diagram of 2D points, the dual of their Delaunay triangulation (seed §5.1).\n"
+                         "box = (x0, y0, x1, y1) clips the cells (default: the points' bounding box grown by 25%).")
+      .def(py::init<const py::handle&, const py::object&>(), py::arg("points"), py::arg("box") = py::none())
+      .def("__len__", &PyVoronoi2::size)
+      .def_property_readonly("box", &PyVoronoi2::box)
+      .def_property_readonly("points", &PyVoronoi2::points)
+      .def_property_readonly("cells", &PyVoronoi2::cells,
+                             "One counter-clockwise (k, 2) polygon per input point, clipped to box "
+                             "(duplicates repeat their first occurrence's cell).")
+      .def_property_readonly("vertices", &PyVoronoi2::vertices, "(v, 2) Voronoi vertices (circumcentres; co-circular ones merged).")
+      .def_property_readonly("edges", &PyVoronoi2::edges,
+                             "(m, 4) int64 per edge: the site on its left, the site on its right, origin and "
+                             "target vertex (-1: the edge runs to infinity).")
+      .def_property_readonly("edge_directions", &PyVoronoi2::edge_directions, "(m, 2) unit direction origin -> target.")
+      .def_property_readonly("edge_segments", &PyVoronoi2::edge_segments,
+                             "(m, 4) each edge clipped to box: x0, y0, x1, y1 (NaN if outside).")
+      .def_property_readonly("representatives", &PyVoronoi2::representatives, "First occurrence of each point.")
+      .def("neighbors", &PyVoronoi2::neighbors, py::arg("i"), "Delaunay neighbours of point i's site.")
+      .def("nearest", &PyVoronoi2::nearest, py::arg("queries"), py::arg("method") = "slab",
+           "Index of a nearest site of each query ((m, 2) -> (m,), or (2,) -> int): 'slab' (Theorem 8) or 'walk'.")
+      .def("k_nearest", &PyVoronoi2::k_nearest, py::arg("query"), py::arg("k"),
+           "The k nearest distinct sites of one query point, nearest first.")
+      .def("stats", &PyVoronoi2::stats)
+      .def("validate", &PyVoronoi2::validate);
+
+  py::class_<PyMetricVoronoi>(m, "MetricVoronoi",
+                              "Voronoi diagram under metric 'l1', 'linf' or 'l2', clipped to box (seed §5.3.3).")
+      .def(py::init<const py::handle&, const std::string&, const py::object&>(), py::arg("points"),
+           py::arg("metric") = "l1", py::arg("box") = py::none())
+      .def_property_readonly("metric", &PyMetricVoronoi::metric)
+      .def_property_readonly("box", &PyMetricVoronoi::box)
+      .def_property_readonly("cells", &PyMetricVoronoi::cells, "One counter-clockwise (k, 2) polygon per input point.")
+      .def_property_readonly("edges", &PyMetricVoronoi::edges,
+                             "(sites (m, 2) int64, segments (m, 4) float64): bisector pieces inside the box.")
+      .def("validate", &PyMetricVoronoi::validate);
+
+  m.def(
+      "emst",
+      [](const py::handle& points) {
+        const std::vector<Vec2d> p = to_points(points, "emst");
+        voronoi::SpanningTree tree;
+        {
+          py::gil_scoped_release release;
+          tree = voronoi::emst(p);
+        }
+        py::array_t<std::int64_t> edges(std::vector<py::ssize_t>{py::ssize_t(tree.edges.size()), 2});
+        std::int64_t* d = edges.mutable_data();
+        for (std::size_t k = 0; k < tree.edges.size(); ++k) d[2 * k] = tree.edges[k].first, d[2 * k + 1] = tree.edges[k].second;
+        return py::make_tuple(edges, tree.length);
+      },
+      py::arg("points"), "Euclidean minimum spanning tree: ((n - 1, 2) int64 edges by increasing length, total length).");
+  m.def(
+      "closest_pair",
+      [](const py::handle& points) {
+        const voronoi::ClosestPair c = voronoi::closest_pair(to_points(points, "closest_pair"));
+        return py::make_tuple(c.i, c.j, c.distance);
+      },
+      py::arg("points"), "The two nearest points: (i, j, distance) with i < j.");
+  m.def(
+      "all_nearest_neighbors",
+      [](const py::handle& points) { return to_int_array(voronoi::all_nearest_neighbors(to_points(points, "all_nearest_neighbors"))); },
+      py::arg("points"), "For each point the index of its nearest other point.");
+  m.def(
+      "largest_empty_circle",
+      [](const py::handle& points) {
+        const voronoi::Circle c = voronoi::largest_empty_circle(to_points(points, "largest_empty_circle"));
+        return py::make_tuple(to_array({c.center}).reshape({2}), c.radius);
+      },
+      py::arg("points"), "Largest circle centred in the convex hull with no point inside: (center, radius).");
+  m.def(
+      "smallest_enclosing_circle",
+      [](const py::handle& points, std::uint64_t seed) {
+        const voronoi::Circle c = voronoi::smallest_enclosing_circle(to_points(points, "smallest_enclosing_circle"), seed);
+        return py::make_tuple(to_array({c.center}).reshape({2}), c.radius);
+      },
+      py::arg("points"), py::arg("seed") = 0, "Smallest circle containing every point (Welzl): (center, radius).");
+}
+
+}  // namespace geods::python
