@@ -1,6 +1,7 @@
 #include "geods/ray/accelerator.hpp"
 
 #include <array>
+#include <atomic>
 #include <cmath>
 
 #include "geods/core/error.hpp"
@@ -37,7 +38,15 @@ AcceleratorKind parse_accelerator_kind(std::string_view name) {
 std::span<const AcceleratorKind> all_accelerator_kinds() { return kKinds; }
 
 Accelerator::Accelerator(const TriMesh& mesh) {
-  mesh.require_valid("ray accelerator");
+  static std::atomic<std::uint64_t> next_id{1};
+  id_ = next_id.fetch_add(1, std::memory_order_relaxed);
+  // The O(n) checks first; the full validation (which sorts the edges) only
+  // to word the error message.
+  bool usable = true;
+  for (const Vec3f& p : mesh.vertices) usable = usable && p.allFinite();
+  for (const auto& t : mesh.triangles)
+    for (std::uint32_t v : t) usable = usable && v < mesh.num_vertices();
+  if (!usable) mesh.require_valid("ray accelerator");
   if (mesh.num_triangles() >= std::size_t(RayHit::no_hit))
     throw Error("ray accelerator: more than 2^32 - 2 triangles");
   corners_.resize(mesh.num_triangles() * 3);
@@ -68,7 +77,7 @@ RayHit Accelerator::intersect(const Ray3f& ray) const {
 
 RayHit Accelerator::intersect(const Ray3f& ray, RayCache& cache) const {
   if (!shootable(ray) || corners_.empty()) return {};
-  if (cache.owner != this) cache = RayCache{this};
+  if (cache.owner != id_) cache = RayCache{id_};
   const RayHit hit = closest_hit(ray, cache);
   return hit.hit() ? hit : RayHit{};
 }
@@ -80,7 +89,7 @@ bool Accelerator::occluded(const Ray3f& ray) const {
 
 bool Accelerator::occluded(const Ray3f& ray, RayCache& cache) const {
   if (!shootable(ray) || corners_.empty()) return false;
-  if (cache.owner != this) cache = RayCache{this};
+  if (cache.owner != id_) cache = RayCache{id_};
   // The occluder cache (seed §2.5.2): any occluder will do, and the one that
   // blocked the previous shadow ray towards the same light often blocks this one.
   if (cache.occluder != RayHit::no_hit &&

@@ -26,6 +26,10 @@ struct RayClassifier::Node {
   // Set once under a lock while queries read the node through const pointers.
   mutable std::atomic<Node*> children{nullptr};  // 32 children, published once
   mutable std::unique_ptr<Node[]> owned_children;
+  // Candidates tested by the rays that ended here, and children built: the
+  // rent-or-buy rule of locate() pays for building with the queries' work.
+  mutable std::atomic<std::uint64_t> work{0};
+  mutable std::atomic<std::uint32_t> built{0};
 
   int axis() const { return face / 2; }
   bool negative() const { return face & 1; }
@@ -82,12 +86,11 @@ std::unique_ptr<RayClassifier> RayClassifier::build(const TriMesh& mesh, const A
     root->face = std::uint8_t(face);
     const int axis = root->axis();
     const bool negative = root->negative();
+    std::vector<std::pair<float, std::uint32_t>> keys(n);
+    for (std::uint32_t i = 0; i < n; ++i) keys[i] = {start_along(c.boxes_[i], axis, negative), i};
+    tbb::parallel_sort(keys.begin(), keys.end());
     root->candidates.resize(n);
-    std::iota(root->candidates.begin(), root->candidates.end(), 0u);
-    tbb::parallel_sort(root->candidates.begin(), root->candidates.end(), [&](std::uint32_t x, std::uint32_t y) {
-      const float sx = start_along(c.boxes_[x], axis, negative), sy = start_along(c.boxes_[y], axis, negative);
-      return sx < sy || (sx == sy && x < y);
-    });
+    for (std::size_t i = 0; i < n; ++i) root->candidates[i] = keys[i].second;
     root->ready.store(true, std::memory_order_release);
     c.roots_[face] = std::move(root);
   }, 1);
@@ -144,9 +147,10 @@ const RayClassifier::Node& RayClassifier::locate(const Ray5& r, RayCache& cache)
   const std::size_t max_refs = options_.rays5d_max_references;
   for (;;) {
     Node* kids = node->children.load(std::memory_order_acquire);
+    const std::uint64_t size = node->candidates.size();
     if (!kids) {
-      if (node->candidates.size() <= options_.rays5d_leaf_size || node->depth >= options_.rays5d_max_depth ||
-          references() >= max_refs)
+      if (size <= options_.rays5d_leaf_size || node->depth >= options_.rays5d_max_depth ||
+          references() >= max_refs || node->work.load(std::memory_order_relaxed) < size)
         break;
       std::lock_guard lock(locks_[std::hash<const void*>{}(node) % locks_.size()]);
       kids = node->children.load(std::memory_order_acquire);
@@ -176,11 +180,18 @@ const RayClassifier::Node& RayClassifier::locate(const Ray5& r, RayCache& cache)
     for (int i = 0; i < 2; ++i) c |= (r.uv[i] >= 0.5f * (node->uv_lo[i] + node->uv_hi[i])) << (3 + i);
     Node& child = kids[c];
     if (!child.ready.load(std::memory_order_acquire)) {
-      // Over the budget the parent answers: its list holds the child's.
-      if (references() >= max_refs) break;
+      // Building a child costs a pass over the parent's list; it is built once
+      // the rays that stopped at the parent have tested as many candidates as
+      // all children built so far and this one cost (so building never costs
+      // more than the queries it serves). Until then, or over the budget, the
+      // parent answers: its list holds the child's.
+      if (references() >= max_refs ||
+          node->work.load(std::memory_order_relaxed) < (node->built.load(std::memory_order_relaxed) + 1) * size)
+        break;
       std::lock_guard lock(locks_[std::hash<const void*>{}(&child) % locks_.size()]);
       if (!child.ready.load(std::memory_order_relaxed)) {
         build_child(*node, child);
+        node->built.fetch_add(1, std::memory_order_relaxed);
         child.ready.store(true, std::memory_order_release);
       }
     }
@@ -208,15 +219,21 @@ std::uint32_t RayClassifier::shoot(const Ray3f& ray, RayCache& cache, RayHit& be
   for (;;) {
     r.origin = ray.at(t_start).cwiseMax(scene_.lo).cwiseMin(scene_.hi);
     const Node& leaf = locate(r, cache);
+    std::uint64_t tested = 0;
     for (std::uint32_t prim : leaf.candidates) {
       // Sorted along the axis: this candidate and all later ones start beyond the closest hit.
       if (start_along(boxes_[prim], k, neg) > origin_along + best.t * dk) break;
+      ++tested;
       if constexpr (AnyHit) {
-        if (test_any(test, prim, ray.tmin, ray.tmax)) return prim;
+        if (test_any(test, prim, ray.tmin, ray.tmax)) {
+          leaf.work.fetch_add(tested, std::memory_order_relaxed);
+          return prim;
+        }
       } else {
         test_closest(test, prim, ray.tmin, best);
       }
     }
+    leaf.work.fetch_add(tested, std::memory_order_relaxed);
     // The leaf lists every triangle starting before its far side + cut-off; a
     // hit before that is final, otherwise start again from there.
     const float cut = end_along(leaf.box, k, neg) + cutoff_[k];

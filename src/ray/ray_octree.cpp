@@ -65,7 +65,9 @@ std::unique_ptr<RayOctree> RayOctree::build(const TriMesh& mesh, const Accelerat
         const Vec3f* corners = &o.corners_[3 * std::size_t(t)];
         const AABB3f tri_box = detail::triangle_bounds(corners);
         for (int c = 0; c < 8; ++c)
-          if (tri_box.overlaps(boxes[c]) && detail::triangle_overlaps_box(corners[0], corners[1], corners[2], boxes[c]))
+          if (boxes[c].contains(tri_box) ||
+              (tri_box.overlaps(boxes[c]) &&
+               detail::triangle_overlaps_box(corners[0], corners[1], corners[2], boxes[c])))
             children[k][c].push_back(t);
       }
       // A child is hit by about a quarter of the rays that hit its parent (the

@@ -71,7 +71,7 @@ struct AcceleratorStats {
 /// level (primary rays, shadow rays of each light source...). It never changes
 /// an answer; counts of how often it helped are kept for statistics.
 struct RayCache {
-  const void* owner = nullptr;        // the accelerator the entries below belong to
+  std::uint64_t owner = 0;            // Accelerator::id() of the accelerator the entries belong to
   const void* cell = nullptr;         // rays5d: the leaf the previous ray ended in
   std::uint32_t occluder = RayHit::no_hit;  // the triangle that blocked the previous shadow ray
   std::uint64_t cell_hits = 0;        // queries that started in the cached leaf
@@ -99,6 +99,9 @@ class Accelerator {
   /// could hit it, ranges in bounds...); throws geods::Error on a violation.
   virtual void validate() const = 0;
   double build_s() const { return build_s_; }
+  /// A number no other accelerator of this process has (caches are tied to it,
+  /// not to an address that a later accelerator may reuse).
+  std::uint64_t id() const { return id_; }
   std::size_t num_triangles() const { return corners_.size() / 3; }
 
  protected:
@@ -133,6 +136,9 @@ class Accelerator {
   // them, so that float rounding in the traversal never loses a triangle.
   float margin_ = 0;
   double build_s_ = 0;
+
+ private:
+  std::uint64_t id_;
 };
 
 /// Builds the accelerator of the given kind over the mesh's triangles (which

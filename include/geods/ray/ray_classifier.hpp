@@ -13,7 +13,11 @@
 // face to the leaf containing its 5D point; a node with more than leaf_size
 // candidates, above max_depth, is split into 2^5 = 32 children (all five
 // coordinates halved), and a child's list is filtered from its parent's, so
-// candidate lists shrink while subdividing. Children are built one at a time
+// candidate lists shrink while subdividing. Building is paid for by the
+// queries (rent or buy): a child is built only once the rays that stopped at
+// its parent have tested as many candidates as the parent's children built so
+// far cost (one pass over the parent's list each), so incoherent rays do not
+// build a deep tree that only one ray uses, and coherent rays get one quickly. Children are built one at a time
 // under a lock and published atomically, so concurrent queries are safe; the
 // tree's shape may depend on the order rays arrive, the answers never do.
 // Once the lists of all nodes hold max_references entries, nodes stop splitting.
