@@ -48,10 +48,10 @@ bool brute_any(const TriMesh& mesh, const Ray3f& ray) {
 // The same closest hit: the same t and the same triangle (grid, octree and 5D
 // classification keep the smallest index on ties, as brute force does).
 //
-// The BVH (bvh::TriangleBvh, another module) is held to less: it may report
-// another triangle at a shared vertex or edge whose t is a few ulps larger, and
-// it is only shot with rays without zero direction components — on those it
-// misses hits (reported to its owner); see bvh_may_check().
+// The BVH (bvh::TriangleBvh, another module) is held to less: on rays through
+// a vertex it may report another triangle of that vertex whose t is an ulp or
+// two larger (its box pruning is not conservative by that much), so its t is
+// checked to 1e-6 relative and its triangle to be hit at the t it reports.
 bool same_hit(const TriMesh& mesh, const Ray3f& ray, const RayHit& expected, const RayHit& got, AcceleratorKind kind) {
   if (kind != AcceleratorKind::bvh)
     return got.t == expected.t && got.prim == expected.prim && got.u == expected.u && got.v == expected.v;
@@ -65,8 +65,6 @@ bool same_hit(const TriMesh& mesh, const Ray3f& ray, const RayHit& expected, con
                                                ray.tmax, th, u, v) &&
          th == got.t;
 }
-
-bool bvh_may_check(const Ray3f& ray) { return (ray.direction.array() != 0.0f).all(); }
 
 Vec3f random_vec(Rng& rng, const Vec3f& lo, const Vec3f& hi) {
   Vec3f p;
@@ -158,11 +156,9 @@ void expect_same_as_brute_force(const TriMesh& mesh, const std::vector<Ray3f>& r
     SCOPED_TRACE(what + " / " + std::string(to_string(kind)));
     const auto accel = make_accelerator(mesh, kind, options);
     ASSERT_EQ(accel->kind(), kind);
-    std::size_t hits = 0, mismatches = 0, checked = 0;
+    std::size_t hits = 0, mismatches = 0;
     RayCache cache;  // shared by all rays: must not change any answer
     for (std::size_t i = 0; i < rays.size(); ++i) {
-      if (kind == AcceleratorKind::bvh && !bvh_may_check(rays[i])) continue;
-      ++checked;
       const RayHit expected = brute_closest(mesh, rays[i]);
       const RayHit got = accel->intersect(rays[i]);
       const RayHit cached = accel->intersect(rays[i], cache);
@@ -179,9 +175,7 @@ void expect_same_as_brute_force(const TriMesh& mesh, const std::vector<Ray3f>& r
       EXPECT_EQ(accel->occluded(rays[i], cache), any) << "ray " << i << " with the occluder cache";
     }
     EXPECT_EQ(mismatches, 0u);
-    if (checked > 0) {
-      EXPECT_GT(hits, checked / 10) << "the rays should hit the mesh often";
-    }
+    EXPECT_GT(hits, rays.size() / 10) << "the rays should hit the mesh often";
     EXPECT_NO_THROW(accel->validate());
   }
 }
@@ -377,7 +371,6 @@ TEST(Accelerators, ParallelQueriesGiveTheSameAnswers) {
       }
     });
     for (std::size_t i = 0; i < rays.size(); ++i) {
-      if (kind == AcceleratorKind::bvh && !bvh_may_check(rays[i])) continue;
       serial[i] = brute_closest(mesh, rays[i]);
       blocked[i] = brute_any(mesh, rays[i]);
       EXPECT_TRUE(same_hit(mesh, rays[i], serial[i], parallel[i], kind)) << to_string(kind) << " ray " << i;
