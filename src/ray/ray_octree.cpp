@@ -61,14 +61,24 @@ std::unique_ptr<RayOctree> RayOctree::build(const TriMesh& mesh, const Accelerat
       if (p.triangles.size() <= options.octree_leaf_size || depth >= options.octree_max_depth) return;
       std::array<AABB3f, 8> boxes;
       for (int c = 0; c < 8; ++c) boxes[c] = detail::widened(child_box(p.box, c), o.margin_);
+      const Vec3f mid = p.box.center();
       for (std::uint32_t t : p.triangles) {
         const Vec3f* corners = &o.corners_[3 * std::size_t(t)];
         const AABB3f tri_box = detail::triangle_bounds(corners);
-        for (int c = 0; c < 8; ++c)
-          if (boxes[c].contains(tri_box) ||
-              (tri_box.overlaps(boxes[c]) &&
-               detail::triangle_overlaps_box(corners[0], corners[1], corners[2], boxes[c])))
+        // The halves of each axis the (widened) triangle box reaches: a
+        // triangle inside one child needs no triangle-box test.
+        int lo_bits = 0, hi_bits = 0;
+        for (int a = 0; a < 3; ++a) {
+          if (tri_box.lo[a] <= mid[a] + o.margin_) lo_bits |= 4 >> a;
+          if (tri_box.hi[a] >= mid[a] - o.margin_) hi_bits |= 4 >> a;
+        }
+        const bool single = (lo_bits ^ hi_bits) == 7;
+        for (int c = 0; c < 8; ++c) {
+          // Child c takes the upper half of the axes whose bit is set in c.
+          if ((c & ~hi_bits & 7) != 0 || (~c & ~lo_bits & 7) != 0) continue;
+          if (single || detail::triangle_overlaps_box(corners[0], corners[1], corners[2], boxes[c]))
             children[k][c].push_back(t);
+        }
       }
       // A child is hit by about a quarter of the rays that hit its parent (the
       // ratio of their surface areas), so splitting pays only while the
