@@ -11,7 +11,12 @@ their hashes), (c) configures and builds the separate CMake project bench/compar
 build/compare (ccache), (d) runs each comparison's programs interleaved (geods, anchor, ...,
 geods, anchor, ... for --rounds rounds) with one thread and with all threads, collecting their
 JSON lines, (e) runs the Google Benchmark programs build/release/bin/geods_*_bench if present,
-(f) writes the report (--out) and the raw JSON lines beside it (performance.jsonl).
+(f) writes the report (--out), the raw JSON lines beside it (performance.jsonl) and when and how
+each workload was measured (performance-runs.json).
+
+With --only W --update, only W is re-run; the other workloads (and, with --no-micro, the micro
+benchmarks) keep their earlier results from performance.jsonl / performance-runs.json, and each
+section of the report says which run measured it. Ratios are still taken within one run.
 
 A comparison is a folder bench/compare/<workload>/ holding its programs, a CMakeLists.txt that
 declares them with geods_compare_program(), and a compare.json read here:
@@ -397,8 +402,36 @@ def micro_table(micro):
     return "\n".join(lines)
 
 
+def run_record(cmdline, info, started):
+    """When and how one workload (or the micro benchmarks) was measured."""
+    return {"date": started.strftime("%Y-%m-%d %H:%M UTC"), "git": info["git"],
+            "load": [round(x, 2) for x in info["load"]], "command": cmdline}
+
+
+def load_previous(jsonl, comps):
+    """Records, raw lines and run records of an earlier report, by workload (for --update)."""
+    runs_path = os.path.join(os.path.dirname(jsonl), "performance-runs.json")
+    runs = {}
+    if os.path.exists(runs_path):
+        with open(runs_path) as f:
+            runs = json.load(f)
+    by_workload = {}
+    if os.path.exists(jsonl):
+        with open(jsonl) as f:
+            for line in f:
+                line = line.strip()
+                if line.startswith("{"):
+                    by_workload.setdefault(json.loads(line).get("workload"), []).append(line)
+    results = {}
+    for c in comps:
+        raw = by_workload.get(c["workload"], [])
+        if raw:
+            results[c["workload"]] = ([json.loads(line) for line in raw], raw, [])
+    return results, runs
+
+
 def write_report(out, jsonl, cmdline, info, versions, verify, comps, results, status, micro, data_dir,
-                 rounds, reps, threads_list, started, early_problems=()):
+                 rounds, reps, threads_list, started, runs, early_problems=()):
     L = []
     L.append("# geods performance\n")
     L.append("Written by `bench/compare/run.py` (`make bench`); do not edit by hand. Every ratio is "
@@ -430,6 +463,8 @@ def write_report(out, jsonl, cmdline, info, versions, verify, comps, results, st
                 f"reference hashes; differing: {', '.join(verify.get('mismatched', []) + verify.get('missing', []))}")
     L.append(f"- Workloads: `{data_dir}`; {vtxt}")
     L.append("- Anchor packages (Debian): " + ", ".join(f"{p} {v}" for p, v in versions))
+    L.append("- Each section below names the run that measured it; sections from earlier runs were kept "
+             "by `--update` (this run re-measured only the sections dated as above).")
     L.append("")
 
     # summary
@@ -451,6 +486,10 @@ def write_report(out, jsonl, cmdline, info, versions, verify, comps, results, st
         for (a, t), g in sorted(summary.items(), key=lambda kv: (kv[0][1], kv[0][0])):
             L.append(f"| {c['workload']} | {labels.get(a, a)} | {t} | **{g:.2f}** |")
         s = [f"## {c['workload']} — {c['title']}\n", c["about"] + "\n"]
+        run = runs.get(c["workload"])
+        if run:
+            s.append(f"Measured {run['date']} on geods `{run['git']}`, load average "
+                     f"{' / '.join(f'{x:.2f}' for x in run['load'])}: `{run['command']}`\n")
         progs = []
         for p in c["programs"]:
             pname = p.get("program") or " ".join(p["command"]).replace("{python} ", "").replace("{dir}/", "")
@@ -472,6 +511,8 @@ def write_report(out, jsonl, cmdline, info, versions, verify, comps, results, st
     L.append("## Micro benchmarks (Google Benchmark)\n")
     if micro:
         L.append("`build/release/bin/geods_*_bench --benchmark_format=json` (geods only, no anchor).\n")
+        if runs.get("micro"):
+            L.append(f"Measured {runs['micro']['date']} on geods `{runs['micro']['git']}`.\n")
         L.append(micro_table(micro))
     else:
         L.append("None found (`build/release/bin/geods_*_bench`; `make release` builds them).\n")
@@ -488,6 +529,10 @@ def write_report(out, jsonl, cmdline, info, versions, verify, comps, results, st
         f.write("\n".join(L))
     with open(jsonl, "w") as f:
         f.write("\n".join(raw_all) + ("\n" if raw_all else ""))
+    with open(os.path.join(os.path.dirname(jsonl), "performance-runs.json"), "w") as f:
+        json.dump({k: v for k, v in runs.items() if k in results or k == "micro"} | {"micro_results": micro},
+                  f, indent=1)
+        f.write("\n")
     log("wrote", out, "and", jsonl)
     return problems_all
 
@@ -510,6 +555,8 @@ def main():
     ap.add_argument("--build-dir", default=os.path.join(REPO, "build", "compare"))
     ap.add_argument("--no-setup", action="store_true", help="skip scripts/setup.sh --bench")
     ap.add_argument("--no-micro", action="store_true", help="skip the Google Benchmark programs")
+    ap.add_argument("--update", action="store_true", help="with --only: keep the other workloads' "
+                    "earlier results (and the micro benchmarks with --no-micro) in the report")
     args = ap.parse_args()
 
     started = datetime.datetime.now(datetime.timezone.utc)
@@ -522,7 +569,9 @@ def main():
     threads_list = ([int(t) for t in args.threads.split(",")] if args.threads
                     else sorted({1, ncpu}))
 
-    comps = discover()
+    all_comps = comps = discover()
+    if args.update and not args.only:
+        raise SystemExit("--update needs --only (the workloads to re-run)")
     if args.only:
         want = {w.strip() for w in args.only.split(",") if w.strip()}
         unknown = want - {c["workload"] for c in comps}
@@ -548,9 +597,25 @@ def main():
                                                 args.rounds or c["rounds"], args.reps, args.scale, status,
                                                 log_dir)
     micro = [] if args.no_micro else run_micro()  # (e)
-    problems = write_report(out, jsonl, cmdline, machine_info(build_dir), anchor_versions(), verify,  # (f)
+    info = machine_info(build_dir)
+    runs = {c["workload"]: run_record(cmdline, info, started) for c in comps}
+    if micro:
+        runs["micro"] = run_record(cmdline, info, started)
+    if args.update:
+        previous, previous_runs = load_previous(jsonl, all_comps)
+        for c in all_comps:
+            w = c["workload"]
+            if w not in results and w in previous:
+                results[w] = previous[w]
+                runs[w] = previous_runs.get(w, {"date": "an earlier run", "git": "unknown", "load": [0, 0, 0],
+                                               "command": "unknown"})
+        if not micro and previous_runs.get("micro_results"):
+            micro = previous_runs["micro_results"]
+            runs["micro"] = previous_runs.get("micro", {"date": "an earlier run", "git": "unknown"})
+        comps = [c for c in all_comps if c["workload"] in results]
+    problems = write_report(out, jsonl, cmdline, info, anchor_versions(), verify,  # (f)
                             comps, results, status, micro, rel(data_dir) if data_dir.startswith(REPO) else data_dir,
-                            args.rounds, args.reps, threads_list, started,
+                            args.rounds, args.reps, threads_list, started, runs,
                             [setup_problem] if setup_problem else [])
     for p in problems:
         log("PROBLEM:", p)
