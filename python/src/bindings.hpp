@@ -7,6 +7,7 @@ namespace geods::python {
 void bind_core(pybind11::module_& m);  // bind_core.cpp: predicates, threads
 void bind_io(pybind11::module_& m);    // bind_io.cpp: meshes, volumes, points
 void bind_spatial(pybind11::module_& m);  // bind_spatial.cpp: k-d tree
+void bind_bvh(pybind11::module_& m);  // bind_bvh.cpp: bounding volume hierarchy
 void bind_dynamic(pybind11::module_& m);  // bind_dynamic.cpp: dynamic k-d tree
 void bind_quadtree(pybind11::module_& m);  // bind_quadtree.cpp: quadtree, octree
 void bind_delaunay(pybind11::module_& m);  // bind_delaunay.cpp: Delaunay triangulation

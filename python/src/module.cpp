@@ -9,6 +9,7 @@ PYBIND11_MODULE(_geods, m) {
   geods::python::bind_core(m);
   geods::python::bind_io(m);
   geods::python::bind_spatial(m);
+  geods::python::bind_bvh(m);
   geods::python::bind_dynamic(m);
   geods::python::bind_quadtree(m);
   geods::python::bind_voronoi(m);
