@@ -175,6 +175,10 @@ void Delaunay2::build(Options options) {
   for (std::uint32_t i = 0; i < points_.size(); ++i)
     if (rep_[i] != kNone) rep_[i] = i;
   original_of_ = insertion_order(options.seed);
+  if (options.location == Delaunay2Location::history_dag) {  // a random order instead: the DAG needs no locality
+    Rng rng(options.seed);
+    for (std::size_t k = original_of_.size(); k > 1; --k) std::swap(original_of_[k - 1], original_of_[rng.below(k)]);
+  }
   const std::uint32_t m = std::uint32_t(original_of_.size());
   coords_.resize(m);
   internal_of_.assign(points_.size(), kNone);
@@ -189,8 +193,20 @@ void Delaunay2::build(Options options) {
   vert_.reserve(6 * std::size_t(m) + 12);
   twin_.reserve(6 * std::size_t(m) + 12);
   const std::uint32_t a = vert_[0], b = vert_[1], c = vert_[2];
+  history_center_ = (at(a) + at(b) + at(c)) / 3;
+  history_ = options.location == Delaunay2Location::history_dag && orient2d(at(a), at(b), history_center_) > 0 &&
+             orient2d(at(b), at(c), history_center_) > 0 && orient2d(at(c), at(a), history_center_) > 0;
+  if (history_) {
+    history_nodes_.reserve(9 * std::size_t(m) + 4);
+    for (std::uint32_t t = 0; t < 4; ++t) add_history_node(t);
+  }
   for (std::uint32_t k = 0; k < m; ++k)
-    if (k != a && k != b && k != c) insert_vertex(k, last_triangle_);
+    if (k != a && k != b && k != c) insert_vertex(k, history_ ? history_locate(at(k)) : last_triangle_);
+  // The DAG serves construction only (updates may shrink the hull, which its cones assume never happens).
+  dag_nodes_ = history_nodes_.size();
+  history_ = false;
+  history_nodes_ = {};
+  triangle_node_ = {};
   // A point renamed to an earlier duplicate leaves a chain of representatives.
   for (std::uint32_t i = 0; i < rep_.size(); ++i) {
     std::uint32_t r = rep_[i];
@@ -284,6 +300,7 @@ std::uint32_t Delaunay2::new_triangle() {
   vert_.resize(vert_.size() + 3);
   twin_.resize(twin_.size() + 3);
   if (has_constraints_) fixed_.resize(vert_.size(), 0);
+  if (history_) triangle_node_.resize(t + 1, kNone);
   return t;
 }
 
@@ -365,6 +382,7 @@ void Delaunay2::split_triangle(std::uint32_t t, std::uint32_t p) {
   const std::uint32_t s0 = 3 * t, s1 = s0 + 1, s2 = s0 + 2, u0 = 3 * t1, w0 = 3 * t2;
   const std::uint32_t a = vert_[s0], b = vert_[s1], c = vert_[s2];
   const std::uint32_t o1 = twin_[s1], o2 = twin_[s2];
+  const std::uint32_t parent = history_ ? triangle_node_[t] : kNone;
   // t = (a, b, p), t1 = (b, c, p), t2 = (c, a, p)
   vert_[s2] = p;
   vert_[u0] = b, vert_[u0 + 1] = c, vert_[u0 + 2] = p;
@@ -379,6 +397,10 @@ void Delaunay2::split_triangle(std::uint32_t t, std::uint32_t p) {
     for (std::uint32_t h : {s1, s2, u0 + 1, u0 + 2, w0 + 1, w0 + 2}) fixed_[h] = 0;
     note_vertex_edges({s0, s1, s2, u0, u0 + 1, u0 + 2, w0, w0 + 1, w0 + 2});
   }
+  if (history_) {
+    const std::uint32_t children[3] = {add_history_node(t), add_history_node(t1), add_history_node(t2)};
+    std::copy(children, children + 3, history_nodes_[parent].child);
+  }
   flip_stack_.push_back(s0);
   flip_stack_.push_back(u0);
   flip_stack_.push_back(w0);
@@ -392,6 +414,7 @@ void Delaunay2::split_edge(std::uint32_t e, std::uint32_t p) {
   const std::uint32_t a = vert_[e], b = vert_[e1], c = vert_[e2], d = vert_[t2];
   const std::uint32_t o_e1 = twin_[e1], o_t1 = twin_[t1];
   const std::uint32_t n0 = 3 * n1t, m0 = 3 * n2t;
+  const std::uint32_t parent_e = history_ ? triangle_node_[e / 3] : kNone, parent_t = history_ ? triangle_node_[t / 3] : kNone;
   // (a, b, c) -> (a, p, c) + (p, b, c); (b, a, d) -> (b, p, d) + (p, a, d)
   vert_[e1] = p;
   vert_[t1] = p;
@@ -410,6 +433,12 @@ void Delaunay2::split_edge(std::uint32_t e, std::uint32_t p) {
     for (std::uint32_t h : {e1, n0 + 2, t1, m0 + 2}) fixed_[h] = 0;
     note_vertex_edges({e, e1, e2, n0, n0 + 1, n0 + 2, t, t1, t2, m0, m0 + 1, m0 + 2});
   }
+  if (history_) {
+    const std::uint32_t c0 = add_history_node(e / 3), c1 = add_history_node(n1t);
+    history_nodes_[parent_e].child[0] = c0, history_nodes_[parent_e].child[1] = c1;
+    const std::uint32_t c2 = add_history_node(t / 3), c3 = add_history_node(n2t);
+    history_nodes_[parent_t].child[0] = c2, history_nodes_[parent_t].child[1] = c3;
+  }
   flip_stack_.push_back(e2);
   flip_stack_.push_back(n0 + 1);
   flip_stack_.push_back(t2);
@@ -422,8 +451,14 @@ void Delaunay2::flip(std::uint32_t e) {
   const std::uint32_t e1 = next(e), f = twin_[e], f1 = next(f), f2 = prev(f);
   const std::uint32_t outer_e1 = twin_[e1], outer_f1 = twin_[f1];
   const std::uint32_t p = vert_[prev(e)], x = vert_[f2];
+  const std::uint32_t parent_e = history_ ? triangle_node_[e / 3] : kNone, parent_f = history_ ? triangle_node_[f / 3] : kNone;
   vert_[e1] = x;
   vert_[f1] = p;
+  if (history_) {
+    const std::uint32_t c0 = add_history_node(e / 3), c1 = add_history_node(f / 3);
+    for (std::uint32_t parent : {parent_e, parent_f})
+      history_nodes_[parent].child[0] = c0, history_nodes_[parent].child[1] = c1;
+  }
   link(e, outer_f1);
   link(f, outer_e1);
   link(e1, f1);
@@ -446,6 +481,47 @@ void Delaunay2::legalize(std::uint32_t p) {
     flip(e);
     flip_stack_.push_back(e);
     flip_stack_.push_back(f2);
+  }
+}
+
+// ------------------------------------------------------------------ history DAG
+
+std::uint32_t Delaunay2::add_history_node(std::uint32_t t) {
+  const std::uint32_t id = std::uint32_t(history_nodes_.size());
+  history_nodes_.push_back({{vert_[3 * t], vert_[3 * t + 1], vert_[3 * t + 2]}, {kNone, kNone, kNone}, t});
+  if (triangle_node_.size() <= t) triangle_node_.resize(t + 1, kNone);
+  triangle_node_[t] = id;
+  return id;
+}
+
+bool Delaunay2::history_contains(std::uint32_t node, const Vec2d& q) const {
+  const std::uint32_t* v = history_nodes_[node].vertex;
+  if (((v[0] | v[1] | v[2]) & kGhostBit) == 0)
+    return orient2d(at(v[0]), at(v[1]), q) >= 0 && orient2d(at(v[1]), at(v[2]), q) >= 0 &&
+           orient2d(at(v[2]), at(v[0]), q) >= 0;
+  // Ghost triangle (x, y, ghost), hull edge y -> x: the part of the cone from
+  // the centre between the rays through y and x that lies beyond the edge.
+  const int g = v[0] == kGhost ? 0 : v[1] == kGhost ? 1 : 2;
+  const Vec2d &x = at(v[(g + 1) % 3]), &y = at(v[(g + 2) % 3]);
+  return orient2d(x, y, q) >= 0 && orient2d(history_center_, y, q) >= 0 && orient2d(history_center_, x, q) <= 0;
+}
+
+std::uint32_t Delaunay2::history_locate(const Vec2d& q) const {
+  std::uint32_t node = kNone;
+  for (std::uint32_t root = 0; root < 4 && node == kNone; ++root)
+    if (history_contains(root, q)) node = root;
+  if (node == kNone) return last_triangle_;
+  for (;;) {
+    const HistoryNode& h = history_nodes_[node];
+    if (h.child[0] == kNone) return h.triangle;  // a leaf: the walk finishes from here in O(1)
+    std::uint32_t next_node = kNone;
+    for (std::uint32_t c : h.child)
+      if (c != kNone && history_contains(c, q)) {
+        next_node = c;
+        break;
+      }
+    if (next_node == kNone) return last_triangle_;  // not reached: the children cover their parent
+    node = next_node;
   }
 }
 
@@ -910,6 +986,7 @@ Delaunay2Stats Delaunay2::stats() const {
   s.hull = hull_.size();
   s.flips = flips_;
   s.walk_steps = walk_steps_;
+  s.dag_nodes = dag_nodes_;
   s.bytes = (points_.capacity() + coords_.capacity()) * sizeof(Vec2d) +
             sizeof(std::uint32_t) * (rep_.capacity() + original_of_.capacity() + internal_of_.capacity() + vert_.capacity() + twin_.capacity() +
                                      free_triangles_.capacity() + vertex_edge_.capacity() + triangles_.capacity() +

@@ -238,6 +238,42 @@ TEST(Delaunay2, DifferentInsertionOrdersAreValid) {
   }
 }
 
+// Sorted triangles with their smallest vertex first: equal for equal triangulations.
+std::vector<std::array<std::uint32_t, 3>> canonical(const Delaunay2& dt) {
+  std::vector<std::array<std::uint32_t, 3>> out;
+  const auto& t = dt.triangles();
+  for (std::size_t k = 0; k < t.size(); k += 3) {
+    std::array<std::uint32_t, 3> tri{t[k], t[k + 1], t[k + 2]};
+    std::rotate(tri.begin(), std::min_element(tri.begin(), tri.end()), tri.end());
+    out.push_back(tri);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+TEST(Delaunay2, HistoryDagLocationGivesTheSameTriangulation) {
+  for (Shape shape : kShapes) {
+    SCOPED_TRACE("shape " + std::to_string(int(shape)));
+    const bool slow = shape == Shape::tiny || shape == Shape::huge || shape == Shape::mixed;
+    const std::vector<Vec2d> p = make_points(shape, slow ? 120 : 3000, 21);
+    Delaunay2::Options options;
+    options.location = Delaunay2Location::history_dag;
+    const Delaunay2 dag(p, options);
+    check_delaunay(dag, p, p.size() <= 500);
+    const Delaunay2 walk(p);
+    // No DAG for collinear sets (no triangles), nor for mixed magnitudes whose
+    // first triangle's rounded centroid is not inside it (then the walk locates).
+    if (shape != Shape::line && shape != Shape::mixed) {
+      EXPECT_GT(dag.stats().dag_nodes, p.size() / 2);
+    }
+    EXPECT_EQ(walk.stats().dag_nodes, 0u);
+    // Without four co-circular points the Delaunay triangulation is unique.
+    if (shape == Shape::uniform || shape == Shape::clustered || shape == Shape::duplicates) {
+      EXPECT_EQ(canonical(dag), canonical(walk));
+    }
+  }
+}
+
 TEST(Delaunay2, RejectsNonFinitePoints) {
   const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
   EXPECT_THROW(Delaunay2(std::vector<Vec2d>{{0, 0}, {nan, 1}, {1, 1}}), Error);

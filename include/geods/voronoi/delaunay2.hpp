@@ -45,11 +45,29 @@ struct Delaunay2Stats {
   std::size_t hull = 0;        // hull vertices
   std::size_t flips = 0;       // Lawson flips since construction
   std::size_t walk_steps = 0;  // triangles visited by point location while inserting
+  std::size_t dag_nodes = 0;   // history DAG nodes created by the construction (history_dag location)
   std::size_t bytes = 0;       // memory of all arrays
+};
+
+/// How construction finds the triangle of each new point.
+enum class Delaunay2Location {
+  /// BRIO order (random rounds, Hilbert order in each), visibility walk from the
+  /// previous point: a few steps per point. The fast default.
+  walk,
+  /// Random order, descent in the history DAG of all triangles ever created
+  /// (seed §5.2; Guibas-Knuth-Sharir, the Delaunay tree of Boissonnat-Teillaud
+  /// without its conflict lists): O(log i) expected per point whatever the
+  /// order. Outside the hull the DAG's regions are the cones from a fixed
+  /// interior point through the hull edges (the centroid of the first
+  /// triangle; if rounding puts it outside, as with wildly mixed magnitudes,
+  /// construction walks instead). The DAG (about 9 nodes of 28 bytes per
+  /// point) lives during construction only; stats().dag_nodes counts it.
+  history_dag,
 };
 
 struct Delaunay2Options {
   std::uint64_t seed = 0x5eed;  // of the randomized insertion order (results are deterministic)
+  Delaunay2Location location = Delaunay2Location::walk;
 };
 
 class Delaunay2 {
@@ -164,6 +182,9 @@ class Delaunay2 {
   void split_crossing(std::uint32_t a, std::uint32_t b, std::uint32_t crossing,
                       std::vector<std::pair<std::uint32_t, std::uint32_t>>& pending);
   void mark_fixed(std::uint32_t e);
+  std::uint32_t add_history_node(std::uint32_t tri);
+  bool history_contains(std::uint32_t node, const Vec2d& q) const;
+  std::uint32_t history_locate(const Vec2d& q) const;
   void note_vertex_edges(std::initializer_list<std::uint32_t> half_edges);
   void build_degenerate();
   std::vector<std::uint32_t> insertion_order(std::uint64_t seed) const;
@@ -207,6 +228,18 @@ class Delaunay2 {
   std::vector<std::uint32_t> vertex_edge_;     // per internal vertex: a half-edge leaving it, or no_edge
   std::vector<std::uint32_t> flip_stack_;
   bool has_constraints_ = false;
+  // History DAG (construction with history_dag only): a node per triangle ever
+  // created, its children the triangles that replaced it.
+  struct HistoryNode {
+    std::uint32_t vertex[3];
+    std::uint32_t child[3];
+    std::uint32_t triangle;  // the triangle slot while the node is a leaf
+  };
+  bool history_ = false;
+  std::vector<HistoryNode> history_nodes_;
+  std::vector<std::uint32_t> triangle_node_;  // per triangle slot: its leaf node
+  Vec2d history_center_{0, 0};                // a point strictly inside the first triangle
+  std::size_t dag_nodes_ = 0;
   std::vector<std::uint8_t> fixed_;  // per internal half-edge: on a segment (only with segments)
   std::uint32_t last_triangle_ = 0;  // where the next walk starts
   std::uint32_t walk_seed_ = 1;
