@@ -74,6 +74,20 @@ TEST(Render, FramingShowsTheWholeMesh) {
   }
 }
 
+TEST(Render, PrimaryRaysSpanTheFieldOfView) {
+  const Camera camera{Vec3f(1, 2, 3), Vec3f(1, 2, -1), Vec3f::UnitY(), 60};
+  const Ray3f centre = camera.primary_ray(50, 25, 100, 50);
+  EXPECT_EQ(centre.origin, camera.eye);
+  EXPECT_NEAR((centre.direction - Vec3f(0, 0, -1)).norm(), 0.0f, 1e-6f);
+  // The top edge's middle is half the vertical field of view above the axis; the
+  // right edge's middle is further out by the aspect ratio (2) in tan units.
+  const Ray3f top = camera.primary_ray(50, 0, 100, 50);
+  EXPECT_NEAR(std::atan2(top.direction[1], -top.direction[2]), 30.0f * 3.14159265f / 180, 1e-5f);
+  const Ray3f right = camera.primary_ray(100, 25, 100, 50);
+  EXPECT_NEAR(right.direction[0] / -right.direction[2], 2 * std::tan(30.0f * 3.14159265f / 180), 1e-5f);
+  EXPECT_NEAR(right.direction.norm(), 1.0f, 1e-6f);
+}
+
 TEST(Render, ShadowsDarkenAndUseTheOccluderCache) {
   const TriMesh mesh = bunny();
   RenderOptions options;
