@@ -34,10 +34,11 @@ class SlabScan {
   SlabScan(const Grid3<T>& g, double iso, const IsoOptions& options, bool flip)
       : g_(g), iso_(iso), thr_(iso), placer_(g, iso, options.positions, options.normals), flip_(flip),
         table_(detail::case_table_view()), nx_(g.dims[0]), ny_(g.dims[1]) {
+    // Left uninitialized: an id is read only for a crossed edge, which was written first.
     const std::size_t plane = nx_ * ny_;
-    for (auto& ids : xid_) ids.resize(plane);
-    for (auto& ids : yid_) ids.resize(plane);
-    zid_.resize(plane);
+    for (auto& ids : xid_) ids = std::make_unique_for_overwrite<std::uint32_t[]>(plane);
+    for (auto& ids : yid_) ids = std::make_unique_for_overwrite<std::uint32_t[]>(plane);
+    zid_ = std::make_unique_for_overwrite<std::uint32_t[]>(plane);
     for (auto& t : trims_) t.resize(ny_);
     const std::ptrdiff_t nx = std::ptrdiff_t(nx_);
     const std::ptrdiff_t delta[12] = {0, nx, 0, nx, 0, 1, 0, 1, 0, 1, nx, nx + 1};
@@ -115,8 +116,8 @@ class SlabScan {
   }
 
   void create_xy_vertices(std::size_t k) {
-    std::uint32_t* xid = xid_[k & 1].data();
-    std::uint32_t* yid = yid_[k & 1].data();
+    std::uint32_t* xid = xid_[k & 1].get();
+    std::uint32_t* yid = yid_[k & 1].get();
     const std::vector<RowTrim>& t = trims(k);
     for (std::size_t j = 0; j < ny_; ++j) {
       if (t[j].uniform()) continue;
@@ -157,8 +158,8 @@ class SlabScan {
   void march_layer(std::size_t k) {
     const std::vector<RowTrim>& t0 = trims(k);
     const std::vector<RowTrim>& t1 = trims(k + 1);
-    const std::uint32_t* arrays[5] = {xid_[k & 1].data(), xid_[(k + 1) & 1].data(), yid_[k & 1].data(),
-                                      yid_[(k + 1) & 1].data(), zid_.data()};
+    const std::uint32_t* arrays[5] = {xid_[k & 1].get(), xid_[(k + 1) & 1].get(), yid_[k & 1].get(),
+                                      yid_[(k + 1) & 1].get(), zid_.get()};
     for (std::size_t j = 0; j + 1 < ny_; ++j) {
       // Corner bit c = x + 2y + 4z: rows (y, z) = (0,0), (1,0), (0,1), (1,1).
       const T* const rows[4] = {row(j, k), row(j + 1, k), row(j, k + 1), row(j + 1, k + 1)};
@@ -211,7 +212,7 @@ class SlabScan {
   detail::CaseTableView table_;
   std::size_t nx_, ny_;
   std::ptrdiff_t edge_delta_[12];
-  std::vector<std::uint32_t> xid_[2], yid_[2], zid_;
+  std::unique_ptr<std::uint32_t[]> xid_[2], yid_[2], zid_;
   std::vector<RowTrim> trims_[2];
 };
 
@@ -238,6 +239,15 @@ TriMesh isosurface(const Grid3<T>& volume, double iso, const IsoOptions& options
     scans[s] = std::make_unique<SlabScan<T>>(volume, iso, options, flip);
     scans[s]->run(layers * s / slabs, layers * (s + 1) / slabs);
   }, 1);
+
+  if (slabs == 1 && scans[0]->centre_positions.empty()) {  // nothing to merge
+    SlabScan<T>& scan = *scans[0];
+    if (cells_visited) *cells_visited = scan.cells_visited;
+    mesh.vertices = std::move(scan.positions);
+    mesh.normals = std::move(scan.normals);
+    mesh.triangles = std::move(scan.triangles);
+    return mesh;
+  }
 
   // Slab s's top plane is slab s+1's bottom plane, made in the same order:
   // keep the latter, so that the result equals one slab over everything.
