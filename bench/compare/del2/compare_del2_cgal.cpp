@@ -11,6 +11,7 @@ using Triangulation = CGAL::Delaunay_triangulation_2<Kernel>;
 
 struct Cgal {
   static constexpr const char* workload = "del2";
+  static constexpr int max_reps = 100;
   static constexpr const char* anchor = "cgal";
   static del2::Result triangulate(const std::vector<double>& xy, std::size_t n) {
     std::vector<Kernel::Point_2> points;

@@ -8,6 +8,7 @@
 
 struct Geods {
   static constexpr const char* workload = "del2";
+  static constexpr int max_reps = 100;
   static constexpr const char* anchor = "geods";
   static del2::Result triangulate(const std::vector<double>& xy, std::size_t n) {
     std::vector<geods::Vec2d> points(n);

@@ -13,6 +13,7 @@ extern "C" {
 
 struct Qhull {
   static constexpr const char* workload = "del2";
+  static constexpr int max_reps = 1;  // about 20-50 s per run on 1M points: one run
   static constexpr const char* anchor = "qhull";
   static del2::Result triangulate(const std::vector<double>& xy, std::size_t n) {
     qhT qh_storage;

@@ -2,10 +2,11 @@
 // anchors/WORKLOADS.md, the first n * --scale points), the timing loop and the checks.
 //
 // A library provides   static Result triangulate(const std::vector<double>& xy, std::size_t n)
-// returning the counts of its triangulation; the driver times it (median of --reps, a fresh
-// triangulation each time) and checks Euler's formula t = 2n - h - 2 with every input point a
-// vertex (the workloads have no duplicates).
+// returning the counts of its triangulation, and max_reps; the driver times it (median of
+// min(--reps, max_reps), a fresh triangulation each time) and checks Euler's formula
+// t = 2n - h - 2 with every input point a vertex (the workloads have no duplicates).
 #pragma once
+#include <algorithm>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -30,11 +31,12 @@ int run(int argc, char** argv) {
     const std::size_t n = std::min(xy.size() / 2, args.scaled(xy.size() / 2));
     xy.resize(2 * n);
     Result result;
-    const double build_s = compare::median_time_s(args.reps, [&] { result = Library::triangulate(xy, n); });
+    const int reps = std::min(args.reps, Library::max_reps);
+    const double build_s = compare::median_time_s(reps, [&] { result = Library::triangulate(xy, n); });
     const bool euler = result.triangles == 2 * result.vertices - result.hull - 2;
     const bool all_vertices = result.vertices == n;
     compare::Record(Library::workload, Library::anchor, variant, args.threads)
-        .timing(build_s, 0.0, n, args.reps)
+        .timing(build_s, 0.0, n, reps)
         .set("triangles", static_cast<unsigned long long>(result.triangles))
         .set("hull", static_cast<unsigned long long>(result.hull))
         .set("vertices", static_cast<unsigned long long>(result.vertices))
