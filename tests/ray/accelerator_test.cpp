@@ -297,11 +297,11 @@ TEST(Accelerators, SmallLeavesDeepTreesAndCutoffMatchBruteForce) {
   options.rays5d_max_depth = 6;
   options.rays5d_max_references = 4000000;
   options.rays5d_cutoff = 0.01f;  // restarts often
-  expect_same_as_brute_force(mesh, test_rays(mesh, 5, 900), "bunny, extreme options", options);
+  expect_same_as_brute_force(mesh, test_rays(mesh, 5, 450), "bunny, extreme options", options);
   options.rays5d_cutoff = 0;  // no cut-off
   options.rays5d_max_references = 20000;  // the budget runs out early
   options.grid_max_resolution = 3;
-  expect_same_as_brute_force(mesh, test_rays(mesh, 6, 900), "bunny, small budgets", options);
+  expect_same_as_brute_force(mesh, test_rays(mesh, 6, 450), "bunny, small budgets", options);
 }
 
 TEST(Accelerators, EmptyFlatAndBadInput) {
@@ -357,7 +357,7 @@ TEST(Accelerators, EmptyFlatAndBadInput) {
 
 TEST(Accelerators, ParallelQueriesGiveTheSameAnswers) {
   const TriMesh mesh = load("bunny.ply");
-  const std::vector<Ray3f> rays = test_rays(mesh, 21, 4000);
+  const std::vector<Ray3f> rays = test_rays(mesh, 21, 2000);
   for (AcceleratorKind kind : all_accelerator_kinds()) {
     const auto accel = make_accelerator(mesh, kind);
     std::vector<RayHit> serial(rays.size()), parallel(rays.size());
