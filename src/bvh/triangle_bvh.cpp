@@ -71,6 +71,9 @@ std::pair<double, double> measures(const BV& bv) {
 inline bool interval_hit(std::pair<float, float> iv) {
   return iv.first <= iv.second + std::abs(iv.second) * 4e-7f;
 }
+// A node entered at t_near may still hold a hit at tmax: the same slack as
+// interval_hit, since t_near carries the same rounding as the far bound.
+inline bool may_hit_before(float t_near, float tmax) { return t_near <= tmax + std::abs(tmax) * 4e-7f; }
 
 // Directions whose components are far from any simple ratio, so that rays
 // from a point rarely pass exactly through edges or vertices.
@@ -260,7 +263,7 @@ RayHit TriangleBvh::intersect_wide(const std::vector<WideNode<W>>& nodes, const 
   stack.push({0, 0, tmin});
   while (!stack.empty()) {
     const Entry e = stack.pop();
-    if (e.t > tmax) continue;
+    if (!may_hit_before(e.t, tmax)) continue;
     if (e.count > 0) {
       for (std::uint32_t i = e.child; i < e.child + e.count; ++i) {
         const Triangle& tri = triangles_[i];
@@ -335,7 +338,7 @@ RayHit TriangleBvh::intersect_generic(const std::vector<BV>& volumes, const Ray3
   stack.push({0, root.first});
   while (!stack.empty()) {
     const NodeEntry e = stack.pop();
-    if (e.t > clipped.tmax) continue;
+    if (!may_hit_before(e.t, clipped.tmax)) continue;
     const TopoNode& node = nodes[e.node];
     if (node.leaf()) {
       for (std::uint32_t i = node.prim_first; i < node.prim_first + node.prim_count; ++i) {

@@ -48,10 +48,11 @@ bool brute_any(const TriMesh& mesh, const Ray3f& ray) {
 // The same closest hit: the same t and the same triangle (grid, octree and 5D
 // classification keep the smallest index on ties, as brute force does).
 //
-// The BVH (bvh::TriangleBvh, another module) is held to less: on rays through
-// a vertex it may report another triangle of that vertex whose t is an ulp or
-// two larger (its box pruning is not conservative by that much), so its t is
-// checked to 1e-6 relative and its triangle to be hit at the t it reports.
+// The BVH (bvh::TriangleBvh) is held to less: it prunes boxes in float with a
+// slack of a few ulps, and on grazing rays through a shared vertex (the flat
+// mesh) the float t of the triangles there differ by more than that, so it may
+// report another of them: its t is checked to 1e-6 relative and its triangle
+// to be hit at the t it reports.
 bool same_hit(const TriMesh& mesh, const Ray3f& ray, const RayHit& expected, const RayHit& got, AcceleratorKind kind) {
   if (kind != AcceleratorKind::bvh)
     return got.t == expected.t && got.prim == expected.prim && got.u == expected.u && got.v == expected.v;
