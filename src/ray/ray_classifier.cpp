@@ -11,7 +11,8 @@
 
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"
-#include "triangle_box.hpp"
+#include "box_margin.hpp"
+#include "geods/core/triangle.hpp"
 
 namespace geods::ray {
 
@@ -76,7 +77,8 @@ std::unique_ptr<RayClassifier> RayClassifier::build(const TriMesh& mesh, const A
   }
   c.boxes_.resize(n);
   parallel_for_each_index(0, n, [&](std::size_t i) {
-    c.boxes_[i] = detail::widened(detail::triangle_bounds(&c.corners_[3 * i]), c.margin_);
+    const Vec3f* t = &c.corners_[3 * i];
+    c.boxes_[i] = detail::widened(triangle_bounds(t[0], t[1], t[2]), c.margin_);
   });
   // The six roots hold every triangle, sorted along their axis (ties by index,
   // a total order: the parallel sort is deterministic).

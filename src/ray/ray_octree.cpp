@@ -10,7 +10,9 @@
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"
 #include "mailbox.hpp"
-#include "triangle_box.hpp"
+#include "box_margin.hpp"
+#include "geods/bvh/triangle_box.hpp"
+#include "geods/core/triangle.hpp"
 
 namespace geods::ray {
 
@@ -64,7 +66,7 @@ std::unique_ptr<RayOctree> RayOctree::build(const TriMesh& mesh, const Accelerat
       const Vec3f mid = p.box.center();
       for (std::uint32_t t : p.triangles) {
         const Vec3f* corners = &o.corners_[3 * std::size_t(t)];
-        const AABB3f tri_box = detail::triangle_bounds(corners);
+        const AABB3f tri_box = triangle_bounds(corners[0], corners[1], corners[2]);
         // The halves of each axis the (widened) triangle box reaches: a
         // triangle inside one child needs no triangle-box test.
         int lo_bits = 0, hi_bits = 0;
@@ -76,7 +78,7 @@ std::unique_ptr<RayOctree> RayOctree::build(const TriMesh& mesh, const Accelerat
         for (int c = 0; c < 8; ++c) {
           // Child c takes the upper half of the axes whose bit is set in c.
           if ((c & ~hi_bits & 7) != 0 || (~c & ~lo_bits & 7) != 0) continue;
-          if (single || detail::triangle_overlaps_box(corners[0], corners[1], corners[2], boxes[c]))
+          if (single || bvh::triangle_box_overlap(corners[0], corners[1], corners[2], boxes[c]))
             children[k][c].push_back(t);
         }
       }

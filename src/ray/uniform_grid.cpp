@@ -11,7 +11,9 @@
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"
 #include "mailbox.hpp"
-#include "triangle_box.hpp"
+#include "box_margin.hpp"
+#include "geods/bvh/triangle_box.hpp"
+#include "geods/core/triangle.hpp"
 
 namespace geods::ray {
 
@@ -68,7 +70,7 @@ std::unique_ptr<UniformGrid> UniformGrid::build(const TriMesh& mesh, const Accel
     auto& out = pairs[c];
     for (std::size_t i = c * kChunk; i < std::min(n, (c + 1) * kChunk); ++i) {
       const Vec3f* corners = &g.corners_[3 * i];
-      const AABB3f box = detail::widened(detail::triangle_bounds(corners), g.margin_);
+      const AABB3f box = detail::widened(triangle_bounds(corners[0], corners[1], corners[2]), g.margin_);
       Vec3i lo, hi;
       for (int a = 0; a < 3; ++a) {
         lo[a] = std::clamp(int(std::floor((box.lo[a] - g.grid_bounds_.lo[a]) * g.inv_cell_size_[a])), 0,
@@ -83,7 +85,7 @@ std::unique_ptr<UniformGrid> UniformGrid::build(const TriMesh& mesh, const Accel
             if (!single) {
               const Vec3f cell_lo = g.grid_bounds_.lo + Vec3f(float(x), float(y), float(z)).cwiseProduct(g.cell_size_);
               const AABB3f cell_box(cell_lo, cell_lo + g.cell_size_);
-              if (!detail::triangle_overlaps_box(corners[0], corners[1], corners[2],
+              if (!bvh::triangle_box_overlap(corners[0], corners[1], corners[2],
                                                  detail::widened(cell_box, g.margin_)))
                 continue;
             }
