@@ -12,6 +12,7 @@
 #include <string_view>
 
 #include "geods/ray/accelerator.hpp"
+#include "geods_mesh.hpp"
 #include "ray_driver.hpp"
 
 #ifndef GEODS_RAY_ACCEL
@@ -26,17 +27,7 @@ struct Accel {
   static constexpr const char* anchor = "geods_" GEODS_STRINGIFY(GEODS_RAY_ACCEL);
   using Index = geods::ray::Accelerator;
   static std::unique_ptr<Index> build(const compare::PlyMesh& ply) {
-    // As for the BVH program: the TriMesh is the input, copying the triangles is part of the build.
-    static thread_local geods::TriMesh mesh;
-    if (mesh.num_triangles() != ply.triangles()) {
-      mesh.vertices.resize(ply.vertices());
-      for (std::size_t i = 0; i < ply.vertices(); ++i)
-        mesh.vertices[i] = {ply.xyz[3 * i], ply.xyz[3 * i + 1], ply.xyz[3 * i + 2]};
-      mesh.triangles.resize(ply.triangles());
-      for (std::size_t i = 0; i < ply.triangles(); ++i)
-        mesh.triangles[i] = {std::uint32_t(ply.tris[3 * i]), std::uint32_t(ply.tris[3 * i + 1]),
-                             std::uint32_t(ply.tris[3 * i + 2])};
-    }
+    const geods::TriMesh& mesh = compare::ray::geods_mesh(ply);
     return geods::ray::make_accelerator(mesh, geods::ray::parse_accelerator_kind(GEODS_STRINGIFY(GEODS_RAY_ACCEL)));
   }
   static compare::ray::Hit intersect(const Index& accel, const float* r) {

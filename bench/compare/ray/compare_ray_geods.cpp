@@ -1,5 +1,6 @@
 // geods::bvh::TriangleBvh (binned SAH, AABB, 4 wide: the defaults) on the ray comparison.
 #include "geods/bvh/triangle_bvh.hpp"
+#include "geods_mesh.hpp"
 #include "ray_driver.hpp"
 
 namespace {
@@ -8,17 +9,7 @@ struct Geods {
   static constexpr const char* anchor = "geods";
   using Index = geods::bvh::TriangleBvh;
   static std::unique_ptr<Index> build(const compare::PlyMesh& ply) {
-    // The TriMesh is the input, as a PLY reader would give it; copying it is part of the build.
-    static thread_local geods::TriMesh mesh;
-    if (mesh.num_triangles() != ply.triangles()) {
-      mesh.vertices.resize(ply.vertices());
-      for (std::size_t i = 0; i < ply.vertices(); ++i)
-        mesh.vertices[i] = {ply.xyz[3 * i], ply.xyz[3 * i + 1], ply.xyz[3 * i + 2]};
-      mesh.triangles.resize(ply.triangles());
-      for (std::size_t i = 0; i < ply.triangles(); ++i)
-        mesh.triangles[i] = {std::uint32_t(ply.tris[3 * i]), std::uint32_t(ply.tris[3 * i + 1]),
-                             std::uint32_t(ply.tris[3 * i + 2])};
-    }
+    const geods::TriMesh& mesh = compare::ray::geods_mesh(ply);
     return std::make_unique<Index>(Index::build(mesh));
   }
   static compare::ray::Hit intersect(const Index& bvh, const float* r) {
