@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "bindings.hpp"
+#include "mesh_arrays.hpp"
 #include "geods/bvh/triangle_bvh.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"
@@ -31,22 +32,7 @@ class PyBvh {
  public:
   PyBvh(const CArray<float>& v, const CArray<std::int64_t>& f, const std::string& builder, const std::string& bv,
         int leaf_size, int arity) {
-    std::size_t nv = 0;
-    const float* pv = rows3(v, "V", nv);
-    if (f.ndim() != 2 || f.shape(1) != 3) throw Error("Bvh: F must be an (m, 3) array");
-    TriMesh mesh;
-    mesh.vertices.resize(nv);
-    for (std::size_t i = 0; i < nv; ++i) mesh.vertices[i] = Vec3f(pv[3 * i], pv[3 * i + 1], pv[3 * i + 2]);
-    mesh.triangles.resize(std::size_t(f.shape(0)));
-    const std::int64_t* idx = f.data();
-    for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
-      for (int c = 0; c < 3; ++c) {
-        const std::int64_t i = idx[3 * t + std::size_t(c)];
-        if (i < 0 || std::size_t(i) >= nv)
-          throw Error("Bvh: F[" + std::to_string(t) + "] has vertex index " + std::to_string(i) + " out of range (" +
-                      std::to_string(nv) + " vertices)");
-        mesh.triangles[t][std::size_t(c)] = std::uint32_t(i);
-      }
+    const TriMesh mesh = mesh_from_arrays(v, f, "Bvh");
     bvh::BuildOptions options;
     options.builder = bvh::parse_builder(builder);
     options.bv = bvh::parse_bounding_volume(bv);

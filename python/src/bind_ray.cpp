@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "bindings.hpp"
+#include "mesh_arrays.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"
 #include "geods/ray/accelerator.hpp"
@@ -22,26 +23,6 @@ namespace {
 
 template <typename T>
 using CArray = py::array_t<T, py::array::c_style | py::array::forcecast>;
-
-TriMesh mesh_from_arrays(const CArray<float>& v, const CArray<std::int64_t>& f, const char* what) {
-  if (v.ndim() != 2 || v.shape(1) != 3) throw Error(std::string(what) + ": V must be an (n, 3) array");
-  if (f.ndim() != 2 || f.shape(1) != 3) throw Error(std::string(what) + ": F must be an (m, 3) array");
-  TriMesh mesh;
-  mesh.vertices.resize(std::size_t(v.shape(0)));
-  const float* pv = v.data();
-  for (std::size_t i = 0; i < mesh.vertices.size(); ++i) mesh.vertices[i] = Vec3f(pv[3 * i], pv[3 * i + 1], pv[3 * i + 2]);
-  mesh.triangles.resize(std::size_t(f.shape(0)));
-  const std::int64_t* idx = f.data();
-  for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
-    for (int c = 0; c < 3; ++c) {
-      const std::int64_t i = idx[3 * t + std::size_t(c)];
-      if (i < 0 || i >= v.shape(0))
-        throw Error(std::string(what) + ": F[" + std::to_string(t) + "] has vertex index " + std::to_string(i) +
-                    " out of range (" + std::to_string(v.shape(0)) + " vertices)");
-      mesh.triangles[t][std::size_t(c)] = std::uint32_t(i);
-    }
-  return mesh;
-}
 
 // Rays from (n, 3) origins and directions and a tmax that is one value or n.
 std::vector<Ray3f> rays_from_arrays(const CArray<float>& origins, const CArray<float>& directions,
