@@ -102,4 +102,22 @@ inline double nearest_squared_distance(const std::vector<Vec2d>& points, const V
   return best;
 }
 
+/// Length of a minimum spanning tree of the complete graph (Prim, O(n^2)).
+inline double prim_mst_length(const std::vector<Vec2d>& p) {
+  std::vector<double> key(p.size(), std::numeric_limits<double>::infinity());
+  std::vector<char> in(p.size(), 0);
+  if (!p.empty()) key[0] = 0;
+  double length = 0;
+  for (std::size_t step = 0; step < p.size(); ++step) {
+    std::size_t u = p.size();
+    for (std::size_t i = 0; i < p.size(); ++i)
+      if (!in[i] && (u == p.size() || key[i] < key[u])) u = i;
+    in[u] = 1;
+    length += key[u];
+    for (std::size_t i = 0; i < p.size(); ++i)
+      if (!in[i]) key[i] = std::min(key[i], (p[u] - p[i]).norm());
+  }
+  return length;
+}
+
 }  // namespace geods::voronoi::testing

@@ -18,6 +18,7 @@ namespace {
 using testing::brute_delaunay;
 using testing::grid_delaunay;
 using testing::Triangulation;
+using testing::prim_mst_length;
 using testing::uniform_points;
 
 std::vector<Triangulation> test_sets() {
@@ -73,19 +74,7 @@ TEST(Proximity, EmstAgainstPrim) {
       parent[root(i)] = root(j);
     }
     // Its length equals Prim's on the complete graph.
-    std::vector<double> key(p.size(), std::numeric_limits<double>::infinity());
-    std::vector<char> in(p.size(), 0);
-    key[0] = 0;
-    double prim = 0;
-    for (std::size_t step = 0; step < p.size(); ++step) {
-      std::size_t u = p.size();
-      for (std::size_t i = 0; i < p.size(); ++i)
-        if (!in[i] && (u == p.size() || key[i] < key[u])) u = i;
-      in[u] = 1;
-      prim += key[u];
-      for (std::size_t i = 0; i < p.size(); ++i)
-        if (!in[i]) key[i] = std::min(key[i], distance(p, std::uint32_t(u), std::uint32_t(i)));
-    }
+    const double prim = prim_mst_length(p);
     EXPECT_NEAR(tree.length, prim, 1e-12 * (1 + prim));
   }
 }

@@ -16,6 +16,7 @@
 namespace geods::voronoi {
 namespace {
 
+using testing::prim_mst_length;
 using testing::uniform_points;
 
 std::vector<Vec2d> clustered(std::size_t n, std::uint64_t seed) {
@@ -139,19 +140,7 @@ TEST(VoronoiFromDelaunay, ApplicationsOnLargerSets) {
       EXPECT_EQ((p[i] - p[nn[i]]).norm(), nearest);
     }
     // Prim on the complete graph.
-    std::vector<double> key(p.size(), std::numeric_limits<double>::infinity());
-    std::vector<char> in(p.size(), 0);
-    key[0] = 0;
-    double prim = 0;
-    for (std::size_t step = 0; step < p.size(); ++step) {
-      std::size_t u = p.size();
-      for (std::size_t i = 0; i < p.size(); ++i)
-        if (!in[i] && (u == p.size() || key[i] < key[u])) u = i;
-      in[u] = 1;
-      prim += key[u];
-      for (std::size_t i = 0; i < p.size(); ++i)
-        if (!in[i]) key[i] = std::min(key[i], (p[u] - p[i]).norm());
-    }
+    const double prim = prim_mst_length(p);
     const SpanningTree tree = emst(p);
     EXPECT_EQ(tree.edges.size(), p.size() - 1);
     EXPECT_NEAR(tree.length, prim, 1e-9 * prim);
