@@ -41,24 +41,32 @@ inline constexpr auto kCrossedEdges = [] {
   return mask;
 }();
 
-/// Appends the centre vertex of a cell (see case_triangles()): the mean of the
-/// vertices ids[e] of the edges e in `mask`, and the mean of their normals.
-inline void place_centre(std::uint16_t mask, const std::uint32_t* ids, const std::vector<Vec3f>& positions,
-                         const std::vector<Vec3f>& normals, std::vector<Vec3f>& out_positions,
-                         std::vector<Vec3f>& out_normals) {
+/// The centre vertex of a cell (see case_triangles()): the mean of the
+/// vertices ids[e] of the edges e in `mask`, and (if `normals` is not null)
+/// the mean of their normals.
+inline void centre_vertex(std::uint16_t mask, const std::uint32_t* ids, const Vec3f* positions, const Vec3f* normals,
+                          Vec3f& position, Vec3f& normal) {
   Vec3d p = Vec3d::Zero(), n = Vec3d::Zero();
   int count = 0;
   for (int e = 0; e < 12; ++e) {
     if (!((mask >> e) & 1)) continue;
     p += positions[ids[e]].cast<double>();
-    if (!normals.empty()) n += normals[ids[e]].cast<double>();
+    if (normals) n += normals[ids[e]].cast<double>();
     ++count;
   }
-  const Vec3f centre = (p / count).cast<float>();
-  out_positions.push_back(centre);
-  if (normals.empty()) return;
-  const Vec3f normal = n.squaredNorm() > 0 ? n.normalized().cast<float>() : normals[ids[std::countr_zero(mask)]];
-  out_normals.push_back(normal);
+  position = (p / count).cast<float>();
+  if (normals) normal = n.squaredNorm() > 0 ? n.normalized().cast<float>() : normals[ids[std::countr_zero(mask)]];
+}
+
+/// Appends the centre vertex of a cell (centre_vertex()) to the output arrays;
+/// `normals` empty: no normals.
+inline void place_centre(std::uint16_t mask, const std::uint32_t* ids, const std::vector<Vec3f>& positions,
+                         const std::vector<Vec3f>& normals, std::vector<Vec3f>& out_positions,
+                         std::vector<Vec3f>& out_normals) {
+  Vec3f position, normal;
+  centre_vertex(mask, ids, positions.data(), normals.empty() ? nullptr : normals.data(), position, normal);
+  out_positions.push_back(position);
+  if (!normals.empty()) out_normals.push_back(normal);
 }
 
 /// `inside(v)` is exactly double(v) >= iso, with the comparison done in T
@@ -130,17 +138,23 @@ class VertexPlacer {
   /// Appends the vertex on the edge from sample (i, j, k) one step along `axis`.
   void place(std::size_t i, std::size_t j, std::size_t k, int axis, std::vector<Vec3f>& out_positions,
              std::vector<Vec3f>& out_normals) const {
+    Vec3f position, normal;
+    place(i, j, k, axis, position, normal);
+    out_positions.push_back(position);
+    if (normals_) out_normals.push_back(normal);
+  }
+
+  /// The vertex on that edge, written in place (`normal` only if normals() is true).
+  void place(std::size_t i, std::size_t j, std::size_t k, int axis, Vec3f& position, Vec3f& normal) const {
     const std::size_t a = g_.index(i, j, k), b = a + stride_[axis];
     const double va = double(g_.data[a]), vb = double(g_.data[b]);
     const double s = std::clamp((iso_ - va) / (vb - va), kEdgeMargin, 1.0 - kEdgeMargin);
     if (positions_.empty()) {
       double idx[3] = {double(i), double(j), double(k)};
       idx[axis] += s;
-      Vec3f p;
-      for (int d = 0; d < 3; ++d) p[d] = float(double(g_.origin[d]) + idx[d] * double(g_.spacing[d]));
-      out_positions.push_back(p);
+      for (int d = 0; d < 3; ++d) position[d] = float(double(g_.origin[d]) + idx[d] * double(g_.spacing[d]));
     } else {
-      out_positions.push_back(((1 - s) * positions_[a].cast<double>() + s * positions_[b].cast<double>()).cast<float>());
+      position = ((1 - s) * positions_[a].cast<double>() + s * positions_[b].cast<double>()).cast<float>();
     }
     if (!normals_) return;
     const std::size_t ijk_b[3] = {i + (axis == 0), j + (axis == 1), k + (axis == 2)};
@@ -151,7 +165,7 @@ class VertexPlacer {
       n = edge_direction(a, b, axis);
       if (va < iso_) n = -n;
     }
-    out_normals.push_back(n.normalized().cast<float>());
+    normal = n.normalized().cast<float>();
   }
 
  private:

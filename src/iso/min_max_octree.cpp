@@ -9,6 +9,7 @@
 
 #include "cell.hpp"
 #include "geods/core/parallel.hpp"
+#include "geods/core/progress.hpp"
 
 namespace geods::iso {
 namespace {
@@ -74,6 +75,20 @@ class EdgeTable {
   int shift_ = 0;
 };
 
+
+// Calls fn(i) for every i in [0, n) in parallel. With a progress callback
+// (`batched`) the range runs in about 32 batches, and after each the calling
+// thread reports done_before + (indices done) steps.
+template <typename Fn>
+void for_each_in_batches(std::size_t n, bool batched, Progress& progress, double done_before, std::size_t grain,
+                         const Fn& fn) {
+  const std::size_t batch = batched ? std::max<std::size_t>(1, (n + 31) / 32) : std::max<std::size_t>(n, 1);
+  for (std::size_t first = 0; first < n; first += batch) {
+    const std::size_t last = std::min(n, first + batch);
+    parallel_for_each_index(first, last, fn, grain);
+    progress.update(done_before + double(last));
+  }
+}
 
 }  // namespace
 
@@ -187,7 +202,9 @@ struct MinMaxOctree<T>::Query {
 template <typename T>
 MinMaxOctree<T>::MinMaxOctree(Grid3<T> volume, std::size_t leaf_cells)
     : volume_(std::move(volume)), leaf_cells_(leaf_cells) {
-  if (leaf_cells_ == 0) throw Error("MinMaxOctree: leaf_cells must be >= 1");
+  if (leaf_cells_ == 0 || leaf_cells_ > kMaxLeafCells)
+    throw Error("MinMaxOctree: leaf_cells must be in [1, " + std::to_string(kMaxLeafCells) + "], not " +
+                std::to_string(leaf_cells_));
   detail::check_samples(volume_);
   for (int d = 0; d < 3; ++d) {
     if (volume_.dims[d] < 2) return;  // no cells
@@ -251,45 +268,62 @@ std::array<T, 2> MinMaxOctree<T>::leaf_range(std::size_t x, std::size_t y, std::
 }
 
 template <typename T>
-OctreeIsoResult MinMaxOctree<T>::isosurface(double iso, const IsoOptions& options) const {
-  const detail::Threshold<T> thr(iso);  // throws for a non-finite iso-value
-  detail::check_positions(volume_, options.positions);
-  OctreeIsoResult result;
-  if (levels_.empty()) return result;
-  const bool flip = detail::mirrored(volume_, options.positions);
+template <typename Threshold>
+std::vector<typename MinMaxOctree<T>::SubtreeRoot> MinMaxOctree<T>::subtree_roots(const Threshold& thr,
+                                                                                   std::size_t wanted,
+                                                                                   std::size_t& nodes_visited) const {
   const std::size_t root = levels_.back().offset;
-  result.nodes_visited = 1;
-  if (!(thr.inside(max_[root]) && !thr.inside(min_[root]))) return result;
-
-  // Subtree roots: the crossed nodes of the highest level with enough nodes
-  // for the threads, in the order the sequential descent reaches them.
-  struct Node {
-    std::size_t level, x, y, z;
-  };
-  std::vector<Node> roots = {{levels_.size() - 1, 0, 0, 0}};
-  const std::size_t wanted = num_threads() == 1 ? 1 : 8 * std::size_t(num_threads());
+  ++nodes_visited;
+  if (!(thr.inside(max_[root]) && !thr.inside(min_[root]))) return {};
+  std::vector<SubtreeRoot> roots = {{levels_.size() - 1, 0, 0, 0}};
+  // A crossed node always has a crossed child, so `roots` never runs empty.
   while (roots.size() < wanted && roots.front().level > 0) {
-    std::vector<Node> next;
-    for (const Node& n : roots) {
+    std::vector<SubtreeRoot> next;
+    for (const SubtreeRoot& n : roots) {
       const auto& dims = levels_[n.level - 1].dims;
       for (std::size_t dz = 0; dz < 2; ++dz)
         for (std::size_t dy = 0; dy < 2; ++dy)
           for (std::size_t dx = 0; dx < 2; ++dx) {
-            const Node c{n.level - 1, 2 * n.x + dx, 2 * n.y + dy, 2 * n.z + dz};
+            const SubtreeRoot c{n.level - 1, 2 * n.x + dx, 2 * n.y + dy, 2 * n.z + dz};
             if (c.x >= dims[0] || c.y >= dims[1] || c.z >= dims[2]) continue;
-            ++result.nodes_visited;
+            ++nodes_visited;
             const std::size_t i = node_index(c.level, c.x, c.y, c.z);
             if (thr.inside(max_[i]) && !thr.inside(min_[i])) next.push_back(c);
           }
     }
     roots = std::move(next);
   }
+  return roots;
+}
+
+template <typename T>
+OctreeIsoResult MinMaxOctree<T>::isosurface(double iso, const IsoOptions& options, VertexSharing sharing) const {
+  const detail::Threshold<T> thr(iso);  // throws for a non-finite iso-value
+  detail::check_positions(volume_, options.positions);
+  if (levels_.empty()) {
+    Progress(options.progress, "isosurface", 1).finish();
+    return {};
+  }
+  const bool flip = detail::mirrored(volume_, options.positions);
+  return sharing == VertexSharing::hash_table ? hash_table_isosurface(iso, options, flip)
+                                              : block_isosurface(iso, options, flip);
+}
+
+template <typename T>
+OctreeIsoResult MinMaxOctree<T>::hash_table_isosurface(double iso, const IsoOptions& options, bool flip) const {
+  OctreeIsoResult result;
+  // Subtree roots: enough for the threads, and with a progress callback enough
+  // for about 32 batches between the reports.
+  std::size_t wanted = num_threads() == 1 ? 1 : 8 * std::size_t(num_threads());
+  if (options.progress) wanted = std::max<std::size_t>(wanted, 64);
+  const std::vector<SubtreeRoot> roots = subtree_roots(detail::Threshold<T>(iso), wanted, result.nodes_visited);
+  Progress progress(options.progress, "isosurface", double(roots.size()));
 
   std::vector<std::unique_ptr<Query>> queries(roots.size());
-  parallel_for_each_index(0, roots.size(), [&](std::size_t r) {
+  for_each_in_batches(roots.size(), bool(options.progress), progress, 0, 1, [&](std::size_t r) {
     queries[r] = std::make_unique<Query>(*this, iso, options, flip);
     queries[r]->descend(roots[r].level, roots[r].x, roots[r].y, roots[r].z);
-  }, 1);
+  });
 
   // Merge in traversal order: a vertex already made by an earlier subtree
   // (on a shared border) keeps its first id, as in the sequential descent.
@@ -315,6 +349,281 @@ OctreeIsoResult MinMaxOctree<T>::isosurface(double iso, const IsoOptions& option
     for (const TriMesh::Triangle& t : q->triangles) mesh.triangles.push_back({remap[t[0]], remap[t[1]], remap[t[2]]});
     q.reset();
   }
+  progress.finish();
+  return result;
+}
+
+// The block extraction (VertexSharing::block_masks) over the crossed leaves.
+//
+// Leaf b covers the cells [b * L, b * L + cells) along each axis and owns the
+// samples [b * L, b * L + L), the last leaf also the last sample plane, and
+// with them the grid edges that start at these samples. The owner of a crossed
+// edge contains a cell around it, which is crossed, so the owner is a crossed
+// leaf too. Bit ((axis * S + z) * S + y) * S + x (S = L + 1, local sample
+// coordinates) of a leaf's masks is set for each crossed edge it owns; its
+// vertices are numbered in bit order after those of the earlier leaves.
+template <typename T>
+struct MinMaxOctree<T>::BlockQuery {
+  // One crossed leaf: its first cell and sample, cells and owned samples per axis.
+  struct Box {
+    std::size_t leaf_xyz[3];
+    std::size_t origin[3];
+    std::size_t cells[3], owned[3];
+  };
+  static constexpr std::uint32_t kUnknown = ~std::uint32_t(0);
+
+  const MinMaxOctree& tree;
+  double iso;
+  detail::Threshold<T> thr;
+  detail::VertexPlacer<T> placer;
+  bool flip;
+  detail::CaseTableView table = detail::case_table_view();
+  std::size_t L, S, words;
+  std::array<std::size_t, 3> leaf_dims;
+  std::size_t corner_offset[8];
+
+  std::vector<std::uint32_t> leaves;        // crossed leaves (leaf-grid index), in descent order
+  std::unique_ptr<std::uint32_t[]> slot;    // leaf-grid index -> place in `leaves`, set for crossed leaves only
+  std::vector<std::uint64_t> masks;         // `words` per crossed leaf
+  std::vector<std::uint32_t> ranks;         // per word: bits set in the leaf's earlier words
+  std::vector<std::size_t> vertex_first;    // per crossed leaf: its edge vertices, then its centre vertices
+  std::vector<std::size_t> centre_first, triangle_first;
+
+  BlockQuery(const MinMaxOctree& t, double iso_value, const IsoOptions& options, bool flip_triangles)
+      : tree(t), iso(iso_value), thr(iso_value), placer(t.volume_, iso_value, options.positions, options.normals),
+        flip(flip_triangles), L(t.leaf_cells_), S(t.leaf_cells_ + 1), words((3 * S * S * S + 63) / 64),
+        leaf_dims(t.levels_[0].dims) {
+    const std::size_t sy = t.volume_.dims[0], sz = t.volume_.dims[0] * t.volume_.dims[1];
+    const std::size_t offsets[8] = {0, 1, sy, sy + 1, sz, sz + 1, sz + sy, sz + sy + 1};
+    std::copy(offsets, offsets + 8, corner_offset);
+  }
+
+  void collect(std::size_t level, std::size_t x, std::size_t y, std::size_t z, std::vector<std::uint32_t>& out,
+               std::size_t& nodes_visited) const {
+    if (level == 0) {
+      out.push_back(std::uint32_t(x + leaf_dims[0] * (y + leaf_dims[1] * z)));
+      return;
+    }
+    const auto& dims = tree.levels_[level - 1].dims;
+    for (std::size_t cz = 2 * z; cz < std::min(2 * z + 2, dims[2]); ++cz)
+      for (std::size_t cy = 2 * y; cy < std::min(2 * y + 2, dims[1]); ++cy)
+        for (std::size_t cx = 2 * x; cx < std::min(2 * x + 2, dims[0]); ++cx) {
+          ++nodes_visited;
+          const std::size_t n = tree.node_index(level - 1, cx, cy, cz);
+          if (thr.inside(tree.max_[n]) && !thr.inside(tree.min_[n])) collect(level - 1, cx, cy, cz, out, nodes_visited);
+        }
+  }
+
+  Box box(std::uint32_t leaf) const {
+    Box b;
+    b.leaf_xyz[0] = leaf % leaf_dims[0];
+    b.leaf_xyz[1] = (leaf / leaf_dims[0]) % leaf_dims[1];
+    b.leaf_xyz[2] = leaf / (leaf_dims[0] * leaf_dims[1]);
+    for (int d = 0; d < 3; ++d) {
+      b.origin[d] = b.leaf_xyz[d] * L;
+      b.cells[d] = std::min(L, tree.cells_[d] - b.origin[d]);
+      b.owned[d] = b.leaf_xyz[d] + 1 < leaf_dims[d] ? L : b.cells[d] + 1;
+    }
+    return b;
+  }
+
+  static std::uint64_t low_bits(std::size_t n) { return n >= 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << n) - 1; }
+
+  // rows[z * S + y], bit x: sample (x, y, z) of the box is inside.
+  void inside_rows(const Box& b, std::uint64_t* rows) const {
+    const Grid3<T>& g = tree.volume_;
+    for (std::size_t z = 0; z <= b.cells[2]; ++z)
+      for (std::size_t y = 0; y <= b.cells[1]; ++y) {
+        const T* r = g.data.data() + g.index(b.origin[0], b.origin[1] + y, b.origin[2] + z);
+        std::uint64_t bits = 0;
+        for (std::size_t x = 0; x <= b.cells[0]; ++x) bits |= std::uint64_t(thr.inside(r[x])) << x;
+        rows[z * S + y] = bits;
+      }
+  }
+
+  // fn(x, y, z, case) for every crossed cell of the box, in z, y, x order.
+  template <typename Fn>
+  void for_each_crossed_cell(const Box& b, const std::uint64_t* rows, const Fn& fn) const {
+    const std::uint64_t cells_x = low_bits(b.cells[0]);
+    for (std::size_t z = 0; z < b.cells[2]; ++z)
+      for (std::size_t y = 0; y < b.cells[1]; ++y) {
+        const std::uint64_t r00 = rows[z * S + y], r10 = rows[z * S + y + 1], r01 = rows[(z + 1) * S + y],
+                            r11 = rows[(z + 1) * S + y + 1];
+        const std::uint64_t any = r00 | r10 | r01 | r11, all = r00 & r10 & r01 & r11;
+        for (std::uint64_t crossed = (any | any >> 1) & ~(all & all >> 1) & cells_x; crossed != 0;
+             crossed &= crossed - 1) {
+          const int x = std::countr_zero(crossed);
+          const unsigned c = unsigned((r00 >> x) & 3) | unsigned((r10 >> x) & 3) << 2 | unsigned((r01 >> x) & 3) << 4 |
+                             unsigned((r11 >> x) & 3) << 6;
+          fn(std::size_t(x), y, z, c);
+        }
+      }
+  }
+
+  // The table entry of crossed cell (x, y, z) of the box with case c.
+  std::size_t entry(const Box& b, std::size_t x, std::size_t y, std::size_t z, unsigned c) const {
+    std::uint8_t joined = 0;
+    if (const std::uint8_t amb = table.ambiguous[c]) {
+      const T* s = tree.volume_.data.data() + tree.volume_.index(b.origin[0] + x, b.origin[1] + y, b.origin[2] + z);
+      joined = detail::decide_faces(amb, iso, [&](int q) { return s[corner_offset[q]]; });
+    }
+    return std::size_t(c) * 64 + joined;
+  }
+
+  // Pass 1 for crossed leaf s: its edge masks and counts; returns its cells.
+  std::size_t count(std::size_t s, std::size_t& edge_vertices, std::size_t& centres, std::size_t& triangles) {
+    const Box b = box(leaves[s]);
+    std::uint64_t rows[(kMaxLeafCells + 1) * (kMaxLeafCells + 1)];
+    inside_rows(b, rows);
+    std::uint64_t* w = masks.data() + s * words;
+    std::fill(w, w + words, std::uint64_t(0));
+    auto put = [&](std::size_t axis, std::size_t y, std::size_t z, std::uint64_t bits) {
+      if (bits == 0) return;
+      const std::size_t bit = ((axis * S + z) * S + y) * S, word = bit >> 6, shift = bit & 63;
+      w[word] |= bits << shift;
+      if (shift + S > 64) w[word + 1] |= bits >> (64 - shift);
+    };
+    const std::uint64_t owned_x = low_bits(b.owned[0]), cells_x = low_bits(b.cells[0]);
+    for (std::size_t z = 0; z <= b.cells[2] && z < b.owned[2]; ++z)
+      for (std::size_t y = 0; y <= b.cells[1] && y < b.owned[1]; ++y) {
+        const std::uint64_t r = rows[z * S + y];
+        put(0, y, z, (r ^ (r >> 1)) & cells_x);
+        if (y < b.cells[1]) put(1, y, z, (r ^ rows[z * S + y + 1]) & owned_x);
+        if (z < b.cells[2]) put(2, y, z, (r ^ rows[(z + 1) * S + y]) & owned_x);
+      }
+    std::uint32_t running = 0;
+    for (std::size_t i = 0; i < words; ++i) {
+      ranks[s * words + i] = running;
+      running += std::uint32_t(std::popcount(w[i]));
+    }
+    edge_vertices = running;
+    centres = triangles = 0;
+    for_each_crossed_cell(b, rows, [&](std::size_t x, std::size_t y, std::size_t z, unsigned c) {
+      const std::size_t e = entry(b, x, y, z, c);
+      triangles += (table.offsets[e + 1] - table.offsets[e]) / 3;
+      for (std::size_t n = 0; n < kMaxCentres && table.centres[e * kMaxCentres + n] != 0; ++n) ++centres;
+    });
+    return b.cells[0] * b.cells[1] * b.cells[2];
+  }
+
+  // Pass 2: the edge vertices owned by crossed leaf s, in bit order.
+  void place_edge_vertices(std::size_t s, TriMesh& mesh) const {
+    const Box b = box(leaves[s]);
+    const std::uint64_t* w = masks.data() + s * words;
+    Vec3f unused_normal;
+    std::size_t v = vertex_first[s];
+    for (std::size_t i = 0; i < words; ++i)
+      for (std::uint64_t bits = w[i]; bits != 0; bits &= bits - 1, ++v) {
+        const std::size_t bit = i * 64 + std::size_t(std::countr_zero(bits));
+        const std::size_t x = bit % S, y = bit / S % S, z = bit / (S * S) % S, axis = bit / (S * S * S);
+        placer.place(b.origin[0] + x, b.origin[1] + y, b.origin[2] + z, int(axis), mesh.vertices[v],
+                     placer.normals() ? mesh.normals[v] : unused_normal);
+      }
+  }
+
+  // Pass 3: the centre vertices and triangles of the cells of crossed leaf s.
+  void march(std::size_t s, TriMesh& mesh) const {
+    const Box b = box(leaves[s]);
+    std::uint64_t rows[(kMaxLeafCells + 1) * (kMaxLeafCells + 1)];
+    inside_rows(b, rows);
+    // The owner of an edge: this leaf or its neighbour +x, +y, +z (bits 0-2), looked up once.
+    std::uint32_t owner[8];
+    std::fill(owner, owner + 8, kUnknown);
+    owner[0] = std::uint32_t(s);
+    const std::size_t leaf = leaves[s];
+    std::size_t centre = centre_first[s];
+    TriMesh::Triangle* out = mesh.triangles.data() + triangle_first[s];
+    const Vec3f* normals = placer.normals() ? mesh.normals.data() : nullptr;
+    for_each_crossed_cell(b, rows, [&](std::size_t x, std::size_t y, std::size_t z, unsigned c) {
+      const std::size_t e = entry(b, x, y, z, c);
+      std::uint32_t ids[12 + kMaxCentres];
+      for (unsigned crossed = detail::kCrossedEdges[c]; crossed != 0; crossed &= crossed - 1) {
+        const int edge = std::countr_zero(crossed);
+        const int lo = detail::kEdgeCorners[edge][0];
+        std::size_t p[3] = {x + (lo & 1), y + ((lo >> 1) & 1), z + ((lo >> 2) & 1)};
+        unsigned neighbour = 0;
+        for (int d = 0; d < 3; ++d)
+          if (p[d] == L && b.leaf_xyz[d] + 1 < leaf_dims[d]) p[d] = 0, neighbour |= 1u << d;
+        if (owner[neighbour] == kUnknown)
+          owner[neighbour] = slot[leaf + (neighbour & 1) + leaf_dims[0] * (((neighbour >> 1) & 1) +
+                                                                           leaf_dims[1] * ((neighbour >> 2) & 1))];
+        const std::size_t o = owner[neighbour];
+        const std::size_t bit = ((std::size_t(edge >> 2) * S + p[2]) * S + p[1]) * S + p[0];
+        const std::size_t word = o * words + (bit >> 6);
+        ids[edge] = std::uint32_t(vertex_first[o] + ranks[word] +
+                                  std::size_t(std::popcount(masks[word] & ((std::uint64_t(1) << (bit & 63)) - 1))));
+      }
+      for (std::size_t n = 0; n < kMaxCentres && table.centres[e * kMaxCentres + n] != 0; ++n, ++centre) {
+        ids[12 + n] = std::uint32_t(centre);
+        Vec3f unused_normal;
+        detail::centre_vertex(table.centres[e * kMaxCentres + n], ids, mesh.vertices.data(), normals,
+                              mesh.vertices[centre], normals ? mesh.normals[centre] : unused_normal);
+      }
+      const std::uint8_t* t = table.edges + table.offsets[e];
+      const std::uint8_t* end = table.edges + table.offsets[e + 1];
+      for (; t != end; t += 3)
+        *out++ = flip ? TriMesh::Triangle{ids[t[0]], ids[t[2]], ids[t[1]]}
+                      : TriMesh::Triangle{ids[t[0]], ids[t[1]], ids[t[2]]};
+    });
+  }
+};
+
+template <typename T>
+OctreeIsoResult MinMaxOctree<T>::block_isosurface(double iso, const IsoOptions& options, bool flip) const {
+  OctreeIsoResult result;
+  BlockQuery q(*this, iso, options, flip);
+  // The crossed leaves, subtree by subtree in parallel, in the order of the sequential descent.
+  const std::size_t wanted = num_threads() == 1 ? 1 : 8 * std::size_t(num_threads());
+  const std::vector<SubtreeRoot> roots = subtree_roots(q.thr, wanted, result.nodes_visited);
+  std::vector<std::vector<std::uint32_t>> found(roots.size());
+  std::vector<std::size_t> nodes(roots.size(), 0);
+  parallel_for_each_index(0, roots.size(), [&](std::size_t r) {
+    q.collect(roots[r].level, roots[r].x, roots[r].y, roots[r].z, found[r], nodes[r]);
+  }, 1);
+  for (std::size_t r = 0; r < roots.size(); ++r) {
+    result.nodes_visited += nodes[r];
+    q.leaves.insert(q.leaves.end(), found[r].begin(), found[r].end());
+  }
+  found.clear();
+  const std::size_t n = q.leaves.size();
+  Progress progress(options.progress, "isosurface", double(3 * n));
+  if (n == 0) {
+    progress.finish();
+    return result;
+  }
+  const auto& dims = levels_[0].dims;
+  q.slot = std::make_unique_for_overwrite<std::uint32_t[]>(dims[0] * dims[1] * dims[2]);
+  for (std::size_t s = 0; s < n; ++s) q.slot[q.leaves[s]] = std::uint32_t(s);
+  q.masks.resize(n * q.words);
+  q.ranks.resize(n * q.words);
+
+  // Pass 1: masks and counts, then every leaf's first vertex, centre and triangle.
+  std::vector<std::size_t> edge_vertices(n), centres(n), triangles(n), cells(n);
+  constexpr std::size_t kGrain = 16;
+  for_each_in_batches(n, bool(options.progress), progress, 0, kGrain, [&](std::size_t s) {
+    cells[s] = q.count(s, edge_vertices[s], centres[s], triangles[s]);
+  });
+  q.vertex_first.resize(n + 1);
+  q.centre_first.resize(n);
+  q.triangle_first.resize(n + 1);
+  q.vertex_first[0] = q.triangle_first[0] = 0;
+  for (std::size_t s = 0; s < n; ++s) {
+    q.centre_first[s] = q.vertex_first[s] + edge_vertices[s];
+    q.vertex_first[s + 1] = q.centre_first[s] + centres[s];
+    q.triangle_first[s + 1] = q.triangle_first[s] + triangles[s];
+    result.cells_visited += cells[s];
+  }
+  if (q.vertex_first[n] >= std::size_t(UINT32_MAX)) throw Error("isosurface: more than 2^32 - 1 vertices");
+
+  // Pass 2 writes the edge vertices, pass 3 (which averages some of them into
+  // centre vertices) the centres and triangles, all in place.
+  TriMesh& mesh = result.mesh;
+  mesh.vertices.resize(q.vertex_first[n]);
+  if (options.normals) mesh.normals.resize(q.vertex_first[n]);
+  mesh.triangles.resize(q.triangle_first[n]);
+  for_each_in_batches(n, bool(options.progress), progress, double(n), kGrain, [&](std::size_t s) { q.place_edge_vertices(s, mesh); });
+  for_each_in_batches(n, bool(options.progress), progress, double(2 * n), kGrain, [&](std::size_t s) { q.march(s, mesh); });
+  progress.finish();
   return result;
 }
 

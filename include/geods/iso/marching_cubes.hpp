@@ -4,6 +4,7 @@
 #include <span>
 
 #include "geods/core/grid3.hpp"
+#include "geods/core/progress.hpp"
 #include "geods/core/tri_mesh.hpp"
 
 namespace geods::iso {
@@ -17,6 +18,12 @@ struct IsoOptions {
   /// vertices placed between these positions; origin and spacing are then
   /// unused. Empty: the regular grid origin + (i, j, k) * spacing.
   std::span<const Vec3f> positions;
+  /// Called from the calling thread with stage "isosurface" and the fraction
+  /// done (throttled); returning false stops the extraction with
+  /// geods::Error("isosurface: cancelled"). With a callback the work runs in
+  /// batches between the reports (the scan in at least 32 slabs, some planes
+  /// made twice); the output is the same.
+  ProgressCallback progress;
 };
 
 /// The isosurface {value = iso} of a volume by marching cubes. A sample is

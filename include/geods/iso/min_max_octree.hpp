@@ -20,6 +20,24 @@ struct MinMaxOctreeStats {
   std::size_t bytes = 0;       // min/max arrays and level table (the volume not counted)
 };
 
+/// How an octree extraction gives the cells around a crossed grid edge its one vertex.
+enum class VertexSharing {
+  /// The crossed leaves as blocks (the default): a first parallel pass makes,
+  /// per leaf, bit masks of the crossed grid edges it owns (those starting at
+  /// its samples; the last sample plane belongs to the last leaf) and counts
+  /// its vertices and triangles; prefix sums give every leaf its place in the
+  /// output; a second pass writes the vertices and triangles in place, finding
+  /// an edge owned by a neighbour leaf by the rank of its bit in that leaf's
+  /// masks. No hash table and no merge: the output (order included) is the
+  /// same for any number of threads.
+  block_masks,
+  /// The textbook method of seed §2.4: a recursive descent that shares edge
+  /// vertices through a hash table keyed by grid edge, from which an edge is
+  /// removed after its last visit (the fourth for an interior edge). Subtrees
+  /// run in parallel and are merged into the output of the sequential descent.
+  hash_table,
+};
+
 struct OctreeIsoResult {
   TriMesh mesh;
   std::size_t cells_visited = 0;  // cells whose corners were examined
@@ -35,22 +53,23 @@ struct OctreeIsoResult {
 ///
 /// isosurface(iso) descends from the root into the children with
 /// min < iso <= max (a cell is crossed iff some corner is >= iso and some is
-/// not), runs the cell cases of marching_cubes.hpp at the leaves, and shares
-/// vertices through a hash table keyed by grid edge from which an edge is
-/// removed after its last visit (the fourth for an interior edge). The result
-/// has exactly the vertices and triangles of iso::isosurface() on the same
-/// volume (in traversal order); with several threads subtrees are extracted in
-/// parallel and merged into the same output as the sequential traversal.
+/// not) and runs the cell cases of marching_cubes.hpp in the leaves it
+/// reaches, sharing edge vertices as `sharing` says (see VertexSharing). The
+/// result has exactly the vertices and triangles of iso::isosurface() on the
+/// same volume, in another order; for a given sharing mode the output is the
+/// same for any number of threads.
 template <typename T>
 class MinMaxOctree {
  public:
   static constexpr std::size_t kDefaultLeafCells = 4;
+  static constexpr std::size_t kMaxLeafCells = 32;
 
-  /// Throws geods::Error for a NaN sample or leaf_cells == 0. O(samples), parallel.
+  /// Throws geods::Error for a NaN sample or leaf_cells outside [1, 32]. O(samples), parallel.
   explicit MinMaxOctree(Grid3<T> volume, std::size_t leaf_cells = kDefaultLeafCells);
 
   /// Thread-safe. Throws geods::Error for a non-finite iso or bad positions.
-  OctreeIsoResult isosurface(double iso, const IsoOptions& options = {}) const;
+  OctreeIsoResult isosurface(double iso, const IsoOptions& options = {},
+                             VertexSharing sharing = VertexSharing::block_masks) const;
 
   const Grid3<T>& volume() const { return volume_; }
   MinMaxOctreeStats stats() const;
@@ -64,6 +83,18 @@ class MinMaxOctree {
     std::size_t offset;
   };
   struct Query;
+  struct BlockQuery;
+  struct SubtreeRoot {
+    std::size_t level, x, y, z;
+  };
+
+  // The crossed nodes of the highest level with at least `wanted` of them (or
+  // the crossed leaves), in the order of the sequential descent; adds the
+  // nodes tested to nodes_visited. Empty if the root is not crossed.
+  template <typename Threshold>
+  std::vector<SubtreeRoot> subtree_roots(const Threshold& thr, std::size_t wanted, std::size_t& nodes_visited) const;
+  OctreeIsoResult hash_table_isosurface(double iso, const IsoOptions& options, bool flip) const;
+  OctreeIsoResult block_isosurface(double iso, const IsoOptions& options, bool flip) const;
 
   std::size_t node_index(std::size_t level, std::size_t x, std::size_t y, std::size_t z) const {
     const Level& l = levels_[level];
