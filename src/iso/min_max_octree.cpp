@@ -386,8 +386,10 @@ struct MinMaxOctree<T>::BlockQuery {
   std::unique_ptr<std::uint32_t[]> slot;    // leaf-grid index -> place in `leaves`, set for crossed leaves only
   std::vector<std::uint64_t> masks;         // `words` per crossed leaf
   std::vector<std::uint32_t> ranks;         // per word: bits set in the leaf's earlier words
+  std::vector<std::uint32_t> crossed_cells;  // L^3 per crossed leaf: its crossed cells (pass 1), then unused
+  std::vector<std::uint32_t> crossed_count, centre_count;  // per crossed leaf
   std::vector<std::size_t> vertex_first;    // per crossed leaf: its edge vertices, then its centre vertices
-  std::vector<std::size_t> centre_first, triangle_first;
+  std::vector<std::size_t> triangle_first;
 
   BlockQuery(const MinMaxOctree& t, double iso_value, const IsoOptions& options, bool flip_triangles)
       : tree(t), iso(iso_value), thr(iso_value), placer(t.volume_, iso_value, options.positions, options.normals),
@@ -470,8 +472,28 @@ struct MinMaxOctree<T>::BlockQuery {
     return std::size_t(c) * 64 + joined;
   }
 
-  // Pass 1 for crossed leaf s: its edge masks and counts; returns its cells.
-  std::size_t count(std::size_t s, std::size_t& edge_vertices, std::size_t& centres, std::size_t& triangles) {
+  // Bits set in w, without the libgcc call std::popcount becomes when the
+  // target has no popcnt instruction.
+  static std::uint32_t bit_count(std::uint64_t w) {
+    w = w - ((w >> 1) & 0x5555555555555555ull);
+    w = (w & 0x3333333333333333ull) + ((w >> 2) & 0x3333333333333333ull);
+    w = (w + (w >> 4)) & 0x0F0F0F0F0F0F0F0Full;
+    return std::uint32_t((w * 0x0101010101010101ull) >> 56);
+  }
+
+  // The S bits of row (axis, y, z) of a leaf's masks.
+  std::uint64_t row_bits(const std::uint64_t* w, std::size_t axis, std::size_t y, std::size_t z) const {
+    const std::size_t bit = ((axis * S + z) * S + y) * S, word = bit >> 6, shift = bit & 63;
+    std::uint64_t bits = w[word] >> shift;
+    if (shift + S > 64) bits |= w[word + 1] << (64 - shift);
+    return bits & low_bits(S);
+  }
+
+  // A crossed cell as stored by pass 1: table entry << 15 | z << 10 | y << 5 | x.
+  static constexpr int kEntryShift = 15;
+
+  // Pass 1 for crossed leaf s: its edge masks, its crossed cells and counts; returns its cells.
+  std::size_t count(std::size_t s, std::size_t& triangles) {
     const Box b = box(leaves[s]);
     std::uint64_t rows[(kMaxLeafCells + 1) * (kMaxLeafCells + 1)];
     inside_rows(b, rows);
@@ -494,48 +516,53 @@ struct MinMaxOctree<T>::BlockQuery {
     std::uint32_t running = 0;
     for (std::size_t i = 0; i < words; ++i) {
       ranks[s * words + i] = running;
-      running += std::uint32_t(std::popcount(w[i]));
+      running += bit_count(w[i]);
     }
-    edge_vertices = running;
-    centres = triangles = 0;
+    std::size_t centres = 0;
+    triangles = 0;
+    std::uint32_t* cells = crossed_cells.data() + s * L * L * L;
+    std::uint32_t crossed = 0;
     for_each_crossed_cell(b, rows, [&](std::size_t x, std::size_t y, std::size_t z, unsigned c) {
       const std::size_t e = entry(b, x, y, z, c);
       triangles += (table.offsets[e + 1] - table.offsets[e]) / 3;
       for (std::size_t n = 0; n < kMaxCentres && table.centres[e * kMaxCentres + n] != 0; ++n) ++centres;
+      cells[crossed++] = std::uint32_t(e << kEntryShift | z << 10 | y << 5 | x);
     });
+    crossed_count[s] = crossed;
+    centre_count[s] = std::uint32_t(centres);
     return b.cells[0] * b.cells[1] * b.cells[2];
   }
 
-  // Pass 2: the edge vertices owned by crossed leaf s, in bit order.
-  void place_edge_vertices(std::size_t s, TriMesh& mesh) const {
+  // Appends the edge vertices owned by crossed leaf s, in bit order, then
+  // room for its centre vertices.
+  void place_edge_vertices(std::size_t s, std::vector<Vec3f>& positions, std::vector<Vec3f>& normals) const {
     const Box b = box(leaves[s]);
     const std::uint64_t* w = masks.data() + s * words;
-    Vec3f unused_normal;
-    std::size_t v = vertex_first[s];
-    for (std::size_t i = 0; i < words; ++i)
-      for (std::uint64_t bits = w[i]; bits != 0; bits &= bits - 1, ++v) {
-        const std::size_t bit = i * 64 + std::size_t(std::countr_zero(bits));
-        const std::size_t x = bit % S, y = bit / S % S, z = bit / (S * S) % S, axis = bit / (S * S * S);
-        placer.place(b.origin[0] + x, b.origin[1] + y, b.origin[2] + z, int(axis), mesh.vertices[v],
-                     placer.normals() ? mesh.normals[v] : unused_normal);
-      }
+    for (std::size_t axis = 0; axis < 3; ++axis)
+      for (std::size_t z = 0; z < S; ++z)
+        for (std::size_t y = 0; y < S; ++y)
+          for (std::uint64_t bits = row_bits(w, axis, y, z); bits != 0; bits &= bits - 1)
+            placer.place(b.origin[0] + std::size_t(std::countr_zero(bits)), b.origin[1] + y, b.origin[2] + z,
+                         int(axis), positions, normals);
+    positions.resize(positions.size() + centre_count[s]);
+    if (placer.normals()) normals.resize(positions.size());
   }
 
-  // Pass 3: the centre vertices and triangles of the cells of crossed leaf s.
+  // Pass 2: the centre vertices and triangles of the crossed cells of leaf s.
   void march(std::size_t s, TriMesh& mesh) const {
     const Box b = box(leaves[s]);
-    std::uint64_t rows[(kMaxLeafCells + 1) * (kMaxLeafCells + 1)];
-    inside_rows(b, rows);
     // The owner of an edge: this leaf or its neighbour +x, +y, +z (bits 0-2), looked up once.
     std::uint32_t owner[8];
     std::fill(owner, owner + 8, kUnknown);
     owner[0] = std::uint32_t(s);
     const std::size_t leaf = leaves[s];
-    std::size_t centre = centre_first[s];
+    std::size_t centre = vertex_first[s + 1] - centre_count[s];
     TriMesh::Triangle* out = mesh.triangles.data() + triangle_first[s];
     const Vec3f* normals = placer.normals() ? mesh.normals.data() : nullptr;
-    for_each_crossed_cell(b, rows, [&](std::size_t x, std::size_t y, std::size_t z, unsigned c) {
-      const std::size_t e = entry(b, x, y, z, c);
+    const std::uint32_t* cells = crossed_cells.data() + s * L * L * L;
+    for (std::uint32_t i = 0; i < crossed_count[s]; ++i) {
+      const std::size_t e = cells[i] >> kEntryShift, c = e >> 6;
+      const std::size_t x = cells[i] & 31, y = (cells[i] >> 5) & 31, z = (cells[i] >> 10) & 31;
       std::uint32_t ids[12 + kMaxCentres];
       for (unsigned crossed = detail::kCrossedEdges[c]; crossed != 0; crossed &= crossed - 1) {
         const int edge = std::countr_zero(crossed);
@@ -551,7 +578,7 @@ struct MinMaxOctree<T>::BlockQuery {
         const std::size_t bit = ((std::size_t(edge >> 2) * S + p[2]) * S + p[1]) * S + p[0];
         const std::size_t word = o * words + (bit >> 6);
         ids[edge] = std::uint32_t(vertex_first[o] + ranks[word] +
-                                  std::size_t(std::popcount(masks[word] & ((std::uint64_t(1) << (bit & 63)) - 1))));
+                                  bit_count(masks[word] & ((std::uint64_t(1) << (bit & 63)) - 1)));
       }
       for (std::size_t n = 0; n < kMaxCentres && table.centres[e * kMaxCentres + n] != 0; ++n, ++centre) {
         ids[12 + n] = std::uint32_t(centre);
@@ -564,7 +591,7 @@ struct MinMaxOctree<T>::BlockQuery {
       for (; t != end; t += 3)
         *out++ = flip ? TriMesh::Triangle{ids[t[0]], ids[t[2]], ids[t[1]]}
                       : TriMesh::Triangle{ids[t[0]], ids[t[1]], ids[t[2]]};
-    });
+    }
   }
 };
 
@@ -586,9 +613,8 @@ OctreeIsoResult MinMaxOctree<T>::block_isosurface(double iso, const IsoOptions& 
   }
   found.clear();
   const std::size_t n = q.leaves.size();
-  Progress progress(options.progress, "isosurface", double(3 * n));
   if (n == 0) {
-    progress.finish();
+    Progress(options.progress, "isosurface", 1).finish();
     return result;
   }
   const auto& dims = levels_[0].dims;
@@ -597,32 +623,60 @@ OctreeIsoResult MinMaxOctree<T>::block_isosurface(double iso, const IsoOptions& 
   q.masks.resize(n * q.words);
   q.ranks.resize(n * q.words);
 
-  // Pass 1: masks and counts, then every leaf's first vertex, centre and triangle.
-  std::vector<std::size_t> edge_vertices(n), centres(n), triangles(n), cells(n);
-  constexpr std::size_t kGrain = 16;
-  for_each_in_batches(n, bool(options.progress), progress, 0, kGrain, [&](std::size_t s) {
-    cells[s] = q.count(s, edge_vertices[s], centres[s], triangles[s]);
-  });
+  // Pass 1, over chunks of consecutive leaves: a leaf's masks, crossed cells
+  // and counts, then its edge vertices while its samples are in cache, into
+  // the chunk's arrays (with room for its centre vertices).
+  const std::size_t threads = std::size_t(num_threads());
+  const std::size_t chunks = std::min(n, std::max<std::size_t>(threads == 1 ? 1 : 8 * threads, options.progress ? 32 : 1));
+  // Progress steps: the chunks of pass 1, then the leaves of pass 2.
+  Progress progress(options.progress, "isosurface", double(chunks + n));
+  struct Chunk {
+    std::vector<Vec3f> positions, normals;
+  };
+  std::vector<Chunk> chunk(chunks);
+  q.crossed_cells.resize(n * leaf_cells_ * leaf_cells_ * leaf_cells_);
+  q.crossed_count.resize(n);
+  q.centre_count.resize(n);
   q.vertex_first.resize(n + 1);
-  q.centre_first.resize(n);
   q.triangle_first.resize(n + 1);
-  q.vertex_first[0] = q.triangle_first[0] = 0;
+  std::vector<std::size_t> triangles(n), cells(n);
+  for_each_in_batches(chunks, bool(options.progress), progress, 0, 1, [&](std::size_t c) {
+    for (std::size_t s = n * c / chunks; s < n * (c + 1) / chunks; ++s) {
+      cells[s] = q.count(s, triangles[s]);
+      q.vertex_first[s] = chunk[c].positions.size();  // within the chunk for now
+      q.place_edge_vertices(s, chunk[c].positions, chunk[c].normals);
+    }
+  });
+  std::vector<std::size_t> chunk_first(chunks + 1, 0);
+  for (std::size_t c = 0; c < chunks; ++c) {
+    chunk_first[c + 1] = chunk_first[c] + chunk[c].positions.size();
+    for (std::size_t s = n * c / chunks; s < n * (c + 1) / chunks; ++s) q.vertex_first[s] += chunk_first[c];
+  }
+  q.vertex_first[n] = chunk_first[chunks];
+  q.triangle_first[0] = 0;
   for (std::size_t s = 0; s < n; ++s) {
-    q.centre_first[s] = q.vertex_first[s] + edge_vertices[s];
-    q.vertex_first[s + 1] = q.centre_first[s] + centres[s];
     q.triangle_first[s + 1] = q.triangle_first[s] + triangles[s];
     result.cells_visited += cells[s];
   }
   if (q.vertex_first[n] >= std::size_t(UINT32_MAX)) throw Error("isosurface: more than 2^32 - 1 vertices");
 
-  // Pass 2 writes the edge vertices, pass 3 (which averages some of them into
-  // centre vertices) the centres and triangles, all in place.
+  // The chunks' vertices in order, then pass 2 (which averages some of them
+  // into centre vertices) writes the centres and triangles in place.
   TriMesh& mesh = result.mesh;
-  mesh.vertices.resize(q.vertex_first[n]);
-  if (options.normals) mesh.normals.resize(q.vertex_first[n]);
+  if (chunks == 1) {
+    mesh.vertices = std::move(chunk[0].positions);
+    mesh.normals = std::move(chunk[0].normals);
+  } else {
+    mesh.vertices.resize(q.vertex_first[n]);
+    if (options.normals) mesh.normals.resize(q.vertex_first[n]);
+    parallel_for_each_index(0, chunks, [&](std::size_t c) {
+      std::copy(chunk[c].positions.begin(), chunk[c].positions.end(), mesh.vertices.begin() + std::ptrdiff_t(chunk_first[c]));
+      std::copy(chunk[c].normals.begin(), chunk[c].normals.end(), mesh.normals.begin() + std::ptrdiff_t(chunk_first[c]));
+    }, 1);
+  }
+  chunk.clear();
   mesh.triangles.resize(q.triangle_first[n]);
-  for_each_in_batches(n, bool(options.progress), progress, double(n), kGrain, [&](std::size_t s) { q.place_edge_vertices(s, mesh); });
-  for_each_in_batches(n, bool(options.progress), progress, double(2 * n), kGrain, [&](std::size_t s) { q.march(s, mesh); });
+  for_each_in_batches(n, bool(options.progress), progress, double(chunks), 16, [&](std::size_t s) { q.march(s, mesh); });
   progress.finish();
   return result;
 }
