@@ -11,6 +11,7 @@
 
 #include "cell.hpp"
 #include "geods/core/parallel.hpp"
+#include "geods/core/progress.hpp"
 
 namespace geods::iso {
 namespace {
@@ -227,18 +228,28 @@ TriMesh isosurface(const Grid3<T>& volume, double iso, const IsoOptions& options
   const std::size_t nz = volume.dims[2];
   if (volume.dims[0] < 2 || volume.dims[1] < 2 || nz < 2) {
     detail::check_samples(volume);
+    Progress(options.progress, "isosurface", 1).finish();
     return mesh;
   }
   const bool flip = detail::mirrored(volume, options.positions);
   const std::size_t layers = nz - 1;
   // Several slabs per thread for balance, but not so thin that the plane
-  // each slab recomputes at its bottom costs much.
-  const std::size_t slabs = num_threads() == 1 ? 1 : std::min<std::size_t>(layers, 4 * std::size_t(num_threads()));
+  // each slab recomputes at its bottom costs much. With a progress callback,
+  // at least 32 slabs, run a thread's worth at a time between the reports.
+  const std::size_t threads = std::size_t(num_threads());
+  std::size_t slabs = threads == 1 ? 1 : std::min(layers, 4 * threads);
+  if (options.progress) slabs = std::max(slabs, std::min<std::size_t>(layers, 32));
+  const std::size_t batch = options.progress ? threads : slabs;
+  Progress progress(options.progress, "isosurface", double(slabs));
   std::vector<std::unique_ptr<SlabScan<T>>> scans(slabs);
-  parallel_for_each_index(0, slabs, [&](std::size_t s) {
-    scans[s] = std::make_unique<SlabScan<T>>(volume, iso, options, flip);
-    scans[s]->run(layers * s / slabs, layers * (s + 1) / slabs);
-  }, 1);
+  for (std::size_t first = 0; first < slabs; first += batch) {
+    const std::size_t last = std::min(slabs, first + batch);
+    parallel_for_each_index(first, last, [&](std::size_t s) {
+      scans[s] = std::make_unique<SlabScan<T>>(volume, iso, options, flip);
+      scans[s]->run(layers * s / slabs, layers * (s + 1) / slabs);
+    }, 1);
+    progress.update(double(last));
+  }
 
   if (slabs == 1 && scans[0]->centre_positions.empty()) {  // nothing to merge
     SlabScan<T>& scan = *scans[0];
@@ -246,6 +257,7 @@ TriMesh isosurface(const Grid3<T>& volume, double iso, const IsoOptions& options
     mesh.vertices = std::move(scan.positions);
     mesh.normals = std::move(scan.normals);
     mesh.triangles = std::move(scan.triangles);
+    progress.finish();
     return mesh;
   }
 
@@ -297,6 +309,7 @@ TriMesh isosurface(const Grid3<T>& volume, double iso, const IsoOptions& options
     }
     scans[s].reset();
   }, 1);
+  progress.finish();
   return mesh;
 }
 

@@ -10,6 +10,7 @@
 #include <functional>
 #include <string>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include "geods/core/error.hpp"
@@ -88,6 +89,27 @@ std::vector<std::array<float, 9>> canonical(const TriMesh& mesh) {
   std::sort(out.begin(), out.end());
   return out;
 }
+
+// Vertices with their normals, sorted: equal iff the same vertex set.
+std::vector<std::array<float, 6>> canonical_vertices(const TriMesh& mesh) {
+  std::vector<std::array<float, 6>> out;
+  for (std::size_t v = 0; v < mesh.num_vertices(); ++v) {
+    const Vec3f n = mesh.normals.empty() ? Vec3f::Zero() : mesh.normals[v];
+    out.push_back({mesh.vertices[v].x(), mesh.vertices[v].y(), mesh.vertices[v].z(), n.x(), n.y(), n.z()});
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+// Same oriented triangles on the same vertices (positions and normals) as the scan.
+void expect_same_surface(const TriMesh& octree, const TriMesh& scan, const std::string& what) {
+  EXPECT_EQ(octree.normals.size(), scan.normals.size()) << what;
+  EXPECT_EQ(canonical_vertices(octree), canonical_vertices(scan)) << what;
+  EXPECT_EQ(canonical(octree), canonical(scan)) << what;
+}
+
+constexpr VertexSharing kSharings[] = {VertexSharing::block_masks, VertexSharing::hash_table};
+std::string name(VertexSharing s) { return s == VertexSharing::block_masks ? "block_masks" : "hash_table"; }
 
 void expect_same_mesh(const TriMesh& a, const TriMesh& b, const std::string& what) {
   EXPECT_EQ(a.vertices, b.vertices) << what;
@@ -293,6 +315,7 @@ TEST(Isosurface, BadInputThrows) {
   options.positions = bad;
   EXPECT_THROW(isosurface(g, 0.5, options), Error);
   EXPECT_THROW((MinMaxOctree<float>{g, 0}), Error);
+  EXPECT_THROW((MinMaxOctree<float>{g, MinMaxOctree<float>::kMaxLeafCells + 1}), Error);
   EXPECT_THROW(MinMaxOctree<float>{g}.isosurface(std::nan("")), Error);
 }
 
@@ -321,35 +344,148 @@ TEST(MinMaxOctree, GivesExactlyTheTrianglesOfTheScan) {
       const MinMaxOctree<float> tree(blobs, leaf);
       for (double iso : {-3.0, 0.0, 1.5, 2.4}) {
         const TriMesh scan = isosurface(blobs, iso);
-        const OctreeIsoResult r = tree.isosurface(iso);
-        EXPECT_EQ(r.mesh.num_vertices(), scan.num_vertices());
-        EXPECT_EQ(canonical(r.mesh), canonical(scan)) << "leaf " << leaf << " iso " << iso;
-        expect_closed_surface(r.mesh, "octree");
+        for (VertexSharing sharing : kSharings) {
+          const OctreeIsoResult r = tree.isosurface(iso, {}, sharing);
+          const std::string what = name(sharing) + " leaf " + std::to_string(leaf) + " iso " + std::to_string(iso);
+          EXPECT_EQ(r.mesh.num_vertices(), scan.num_vertices()) << what;
+          expect_same_surface(r.mesh, scan, what);
+          expect_closed_surface(r.mesh, what);
+        }
       }
     }
   }
+  // Noise with samples equal to the iso-value, leaves of 1 to 5 cells.
   for (std::uint64_t seed = 1; seed <= 10; ++seed) {
     const auto g = noise<std::uint8_t>(15, 5, seed);
-    const MinMaxOctree<std::uint8_t> tree(g, 1 + seed % 3);
-    for (double iso : {1.0, 2.0, 2.5, 4.0}) {
-      EXPECT_EQ(canonical(tree.isosurface(iso).mesh), canonical(isosurface(g, iso))) << seed << " " << iso;
+    const MinMaxOctree<std::uint8_t> tree(g, 1 + seed % 5);
+    for (double iso : {1.0, 2.0, 2.5, 4.0})
+      for (VertexSharing sharing : kSharings)
+        expect_same_surface(tree.isosurface(iso, {}, sharing).mesh, isosurface(g, iso),
+                            name(sharing) + " seed " + std::to_string(seed) + " iso " + std::to_string(iso));
+  }
+}
+
+TEST(MinMaxOctree, BothSharingModesOnBordersThinVolumesAndCurvilinearGrids) {
+  // Sizes that are not multiples of the leaf (border leaves of 1 to 3 cells),
+  // volumes one cell thick along each axis, and a surface that reaches the border.
+  const std::array<std::array<std::size_t, 3>, 6> sizes = {
+      {{18, 11, 14}, {2, 13, 12}, {13, 2, 12}, {13, 12, 2}, {5, 6, 7}, {9, 9, 9}}};
+  std::uint64_t seed = 50;
+  for (const auto& d : sizes) {
+    Rng rng(++seed);
+    Grid3<float> g(d[0], d[1], d[2]);
+    for (float& v : g.data) v = float(rng.uniform(-1, 1));
+    const Field ball = sphere(0.4 * double(d[0]), 0.5 * double(d[1]), 0.45 * double(d[2]), 4.5);
+    Grid3<std::int16_t> ints(d[0], d[1], d[2]);
+    for (std::size_t k = 0; k < d[2]; ++k)
+      for (std::size_t j = 0; j < d[1]; ++j)
+        for (std::size_t i = 0; i < d[0]; ++i) ints(i, j, k) = std::int16_t(std::lround(2 * ball(double(i), double(j), double(k))));
+    for (std::size_t leaf : {1, 3, 4}) {
+      const MinMaxOctree<float> tree(g, leaf);
+      const MinMaxOctree<std::int16_t> int_tree(ints, leaf);
+      for (bool normals : {true, false}) {
+        IsoOptions options;
+        options.normals = normals;
+        const std::string what = std::to_string(d[0]) + "x" + std::to_string(d[1]) + "x" + std::to_string(d[2]) +
+                                 " leaf " + std::to_string(leaf) + (normals ? " normals" : "");
+        for (VertexSharing sharing : kSharings) {
+          expect_same_surface(tree.isosurface(0.1, options, sharing).mesh, isosurface(g, 0.1, options),
+                              name(sharing) + " noise " + what);
+          for (double iso : {0.0, 2.0})  // many samples equal to the iso-value
+            expect_same_surface(int_tree.isosurface(iso, options, sharing).mesh, isosurface(ints, iso, options),
+                                name(sharing) + " int16 " + what);
+        }
+      }
+    }
+  }
+  // A curvilinear (bent) grid, and a mirrored one: same surface as the scan.
+  const std::size_t n = 17;
+  Grid3<float> g(n, n + 2, n - 3);
+  std::vector<Vec3f> positions(g.size());
+  for (std::size_t k = 0; k < g.dims[2]; ++k)
+    for (std::size_t j = 0; j < g.dims[1]; ++j)
+      for (std::size_t i = 0; i < g.dims[0]; ++i) {
+        const Vec3d p(i + 0.2 * j, 1.1 * j + std::sin(0.3 * double(i)), 0.9 * k + 0.1 * i);
+        positions[g.index(i, j, k)] = p.cast<float>();
+        g(i, j, k) = float(5.0 - (p - Vec3d(9, 10, 7)).norm());
+      }
+  IsoOptions curvilinear;
+  curvilinear.positions = positions;
+  for (int mirror = 0; mirror < 2; ++mirror) {
+    if (mirror)
+      for (Vec3f& p : positions) p.x() = -p.x();
+    for (std::size_t leaf : {1, 3, 4}) {
+      const MinMaxOctree<float> tree(g, leaf);
+      for (VertexSharing sharing : kSharings) {
+        const TriMesh mesh = tree.isosurface(0.0, curvilinear, sharing).mesh;
+        expect_same_surface(mesh, isosurface(g, 0.0, curvilinear), name(sharing) + " curvilinear");
+        expect_closed_surface(mesh, name(sharing) + " curvilinear");
+      }
     }
   }
 }
 
-TEST(MinMaxOctree, ParallelSubtreesMergeIntoTheSequentialOutput) {
+
+TEST(MinMaxOctree, ThreadsGiveTheSequentialOutput) {
   ThreadGuard guard;
   const auto g = noise<float>(30, 100, 3);
   for (std::size_t leaf : {1, 4}) {
     const MinMaxOctree<float> tree(g, leaf);
-    set_num_threads(1);
-    const OctreeIsoResult one = tree.isosurface(49.5);
-    for (int threads : {2, 5}) {
-      set_num_threads(threads);
-      const OctreeIsoResult many = tree.isosurface(49.5);
-      expect_same_mesh(many.mesh, one.mesh, "octree with " + std::to_string(threads) + " threads");
-      EXPECT_EQ(many.cells_visited, one.cells_visited);
-      EXPECT_EQ(many.nodes_visited, one.nodes_visited);
+    for (VertexSharing sharing : kSharings) {
+      set_num_threads(1);
+      const OctreeIsoResult one = tree.isosurface(49.5, {}, sharing);
+      for (int threads : {2, 5}) {
+        set_num_threads(threads);
+        const OctreeIsoResult many = tree.isosurface(49.5, {}, sharing);
+        expect_same_mesh(many.mesh, one.mesh, name(sharing) + " with " + std::to_string(threads) + " threads");
+        EXPECT_EQ(many.cells_visited, one.cells_visited);
+        EXPECT_EQ(many.nodes_visited, one.nodes_visited);
+      }
+    }
+  }
+}
+
+TEST(MinMaxOctree, BothSharingModesVisitTheSameCells) {
+  const auto g = sample(40, 33, 37, sphere(17, 15, 19, 8.3));
+  const MinMaxOctree<float> tree(g);
+  const OctreeIsoResult blocks = tree.isosurface(0.0, {}, VertexSharing::block_masks);
+  const OctreeIsoResult hash = tree.isosurface(0.0, {}, VertexSharing::hash_table);
+  EXPECT_EQ(blocks.cells_visited, hash.cells_visited);
+  EXPECT_EQ(blocks.nodes_visited, hash.nodes_visited);
+  EXPECT_GT(blocks.cells_visited, 0u);
+}
+
+// Progress: fractions from 0 to 1, never decreasing; returning false cancels.
+TEST(Isosurface, ProgressReachesOneAndCancellationThrows) {
+  ThreadGuard guard;
+  const auto g = sample(40, 41, 42, sphere(19.3, 20.1, 20.7, 12.4));
+  const MinMaxOctree<float> tree(g);
+  using Extract = std::function<TriMesh(const IsoOptions&)>;
+  const std::vector<std::pair<std::string, Extract>> extractions = {
+      {"scan", [&](const IsoOptions& o) { return isosurface(g, 0.0, o); }},
+      {"block_masks", [&](const IsoOptions& o) { return tree.isosurface(0.0, o, VertexSharing::block_masks).mesh; }},
+      {"hash_table", [&](const IsoOptions& o) { return tree.isosurface(0.0, o, VertexSharing::hash_table).mesh; }}};
+  for (int threads : {1, 2}) {
+    set_num_threads(threads);
+    for (const auto& [what, extract] : extractions) {
+      std::vector<double> seen;
+      IsoOptions options;
+      options.progress = [&](std::string_view stage, double fraction) {
+        EXPECT_EQ(stage, "isosurface");
+        seen.push_back(fraction);
+        return true;
+      };
+      const TriMesh with_progress = extract(options);
+      ASSERT_GE(seen.size(), 3u) << what;
+      EXPECT_EQ(seen.front(), 0.0) << what;
+      EXPECT_EQ(seen.back(), 1.0) << what;
+      EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end())) << what;
+      expect_same_mesh(with_progress, extract({}), what + ": a callback does not change the output");
+
+      int calls = 0;
+      options.progress = [&](std::string_view, double) { return ++calls < 2; };  // stop at the second report
+      EXPECT_THROW(extract(options), Error) << what;
+      EXPECT_EQ(calls, 2) << what;
     }
   }
 }
@@ -395,7 +531,7 @@ TEST(Isosurface, DemoHeadVolumePaddedIsClosed) {
     const TriMesh mesh = isosurface(padded, iso);
     EXPECT_GT(mesh.num_triangles(), 1000u);
     expect_closed_surface(mesh, "head at " + std::to_string(iso));
-    EXPECT_EQ(canonical(tree.isosurface(iso).mesh), canonical(mesh));
+    for (VertexSharing sharing : kSharings) expect_same_surface(tree.isosurface(iso, {}, sharing).mesh, mesh, name(sharing));
   }
 }
 
