@@ -32,11 +32,16 @@ class IsoCommand : public Command {
     app.add_option("--coords", coords_,
                    "Curvilinear grid: float .npy of shape (z, y, x, 3), the x, y, z position of every sample");
     app.add_flag("--octree", octree_, "Build a min/max octree and extract through it (reports build_s, query_s)");
-    app.add_option("--leaf-cells", leaf_cells_, "Octree: cells per leaf along each axis")->check(CLI::PositiveNumber);
+    app.add_option("--leaf-cells", leaf_cells_, "Octree: cells per leaf along each axis (1 to 32)")
+        ->check(CLI::Range(std::size_t(1), iso::MinMaxOctree<float>::kMaxLeafCells));
+    app.add_option("--sharing", sharing_,
+                   "Octree: how cells share edge vertices: blocks (bit masks per leaf, the default) or hash "
+                   "(the hash table of seed 2.4)")
+        ->check(CLI::IsMember({"blocks", "hash"}));
     app.add_flag("--no-normals", no_normals_, "Do not compute vertex normals");
   }
 
-  void run(const RunContext&, Report& report) override {
+  void run(const RunContext& context, Report& report) override {
     io::AnyGrid3 volume = read_input();
     const auto dims = std::visit([](const auto& g) { return g.dims; }, volume);
     std::vector<Vec3f> positions;
@@ -44,6 +49,8 @@ class IsoCommand : public Command {
     iso::IsoOptions options;
     options.normals = !no_normals_;
     options.positions = positions;
+    options.progress = context.progress;
+    const iso::VertexSharing sharing = sharing_ == "hash" ? iso::VertexSharing::hash_table : iso::VertexSharing::block_masks;
 
     TriMesh mesh;
     std::size_t cells_visited = 0, nodes_visited = 0;
@@ -56,7 +63,7 @@ class IsoCommand : public Command {
             const iso::MinMaxOctree<T> tree(std::move(grid), leaf_cells_);
             build_s = build_watch.seconds();
             Stopwatch query_watch;
-            iso::OctreeIsoResult r = tree.isosurface(iso_, options);
+            iso::OctreeIsoResult r = tree.isosurface(iso_, options, sharing);
             query_s = query_watch.seconds();
             mesh = std::move(r.mesh);
             cells_visited = r.cells_visited;
@@ -83,6 +90,7 @@ class IsoCommand : public Command {
     j["cells_visited"] = cells_visited;
     if (octree_) {
       j["leaf_cells"] = leaf_cells_;
+      j["sharing"] = sharing_;
       j["nodes_visited"] = nodes_visited;
       j["build_s"] = build_s;
     }
@@ -95,8 +103,8 @@ class IsoCommand : public Command {
                                        mesh.num_vertices(), mesh.num_triangles(), cells_visited, cells,
                                        cells ? 100.0 * double(cells_visited) / double(cells) : 0.0));
     if (octree_)
-      report.lines.push_back(fmt::format("  min/max octree built in {:.3f} s, queried in {:.3f} s ({} nodes tested)",
-                                         build_s, query_s, nodes_visited));
+      report.lines.push_back(fmt::format("  min/max octree built in {:.3f} s, queried in {:.3f} s ({} nodes tested, {} sharing)",
+                                         build_s, query_s, nodes_visited, sharing_));
     else
       report.lines.push_back(fmt::format("  extracted in {:.3f} s", query_s));
     if (!output_.empty()) report.lines.push_back("  wrote " + output_);
@@ -124,7 +132,7 @@ class IsoCommand : public Command {
     return positions;
   }
 
-  std::string volume_, output_, dtype_, coords_;
+  std::string volume_, output_, dtype_, coords_, sharing_ = "blocks";
   double iso_ = 0;
   std::vector<std::size_t> dims_;
   bool octree_ = false, no_normals_ = false;

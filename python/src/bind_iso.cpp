@@ -8,6 +8,7 @@
 #include <limits>
 #include <memory>
 #include <optional>
+#include <string>
 #include <variant>
 
 #include "bindings.hpp"
@@ -119,7 +120,10 @@ class PyOctree {
         grid);
   }
 
-  py::tuple isosurface(double iso, bool normals, const py::object& coords) {
+  py::tuple isosurface(double iso, bool normals, const py::object& coords, const std::string& sharing) {
+    if (sharing != "blocks" && sharing != "hash")
+      throw Error("MinMaxOctree.isosurface: sharing must be 'blocks' or 'hash', not '" + sharing + "'");
+    const iso::VertexSharing mode = sharing == "hash" ? iso::VertexSharing::hash_table : iso::VertexSharing::block_masks;
     const auto dims = std::visit([](const auto& t) { return t->volume().dims; }, tree_);
     const std::vector<Vec3f> positions = positions_from(coords, dims);
     iso::OctreeIsoResult r;
@@ -128,7 +132,7 @@ class PyOctree {
       iso::IsoOptions options;
       options.normals = normals;
       options.positions = positions;
-      r = std::visit([&](const auto& t) { return t->isosurface(iso, options); }, tree_);
+      r = std::visit([&](const auto& t) { return t->isosurface(iso, options, mode); }, tree_);
     }
     cells_visited_ = r.cells_visited;
     nodes_visited_ = r.nodes_visited;
@@ -184,14 +188,16 @@ Raises geods.Error for a non-finite t, NaN samples or mismatched coords.)doc");
 
 Built once, then isosurface(t) for many t visits only the nodes whose
 min < t <= max. The volume is copied; axis order, spacing and origin as for
-geods.isosurface. leaf_cells: cells per leaf along each axis (1: one cell per
-leaf, the textbook octree).)doc")
+geods.isosurface. leaf_cells: cells per leaf along each axis, 1 to 32 (1: one
+cell per leaf, the textbook octree).)doc")
       .def(py::init<const py::array&, std::size_t, const std::array<double, 3>&, const std::array<double, 3>&>(),
            py::arg("volume"), py::arg("leaf_cells") = iso::MinMaxOctree<float>::kDefaultLeafCells,
            py::arg("spacing") = ones, py::arg("origin") = zeros)
       .def("isosurface", &PyOctree::isosurface, py::arg("t"), py::arg("normals") = true,
-           py::arg("coords") = py::none(),
-           "(V, F, N) exactly as geods.isosurface(volume, t) gives them (possibly in another order).")
+           py::arg("coords") = py::none(), py::arg("sharing") = "blocks",
+           "(V, F, N) exactly as geods.isosurface(volume, t) gives them (in another order). sharing: how the\n"
+           "cells around a grid edge share its vertex, 'blocks' (bit masks per crossed leaf, the default) or\n"
+           "'hash' (the edge hash table of seed 2.4).")
       .def_property_readonly("cells_visited", &PyOctree::cells_visited,
                              "Cells examined by the last isosurface() call (None before the first).")
       .def_property_readonly("nodes_visited", &PyOctree::nodes_visited,

@@ -116,6 +116,22 @@ def test_octree_gives_the_scan_triangles_and_visits_few_cells():
         assert canonical(V, F) == canonical(Vs, Fs)
 
 
+def test_octree_sharing_modes_give_the_same_surface():
+    rng = np.random.default_rng(4)
+    vol = rng.integers(0, 5, size=(13, 17, 19)).astype(np.uint8)  # samples equal to the iso-value
+    tree = geods.MinMaxOctree(vol, leaf_cells=3)
+    for t in (1.0, 2.0, 2.5):
+        Vs, Fs, Ns = geods.isosurface(vol, t)
+        for sharing in ("blocks", "hash"):
+            V, F, N = tree.isosurface(t, sharing=sharing)
+            assert len(V) == len(Vs) and canonical(V, F) == canonical(Vs, Fs)
+            assert sorted(map(tuple, np.hstack([V, N]))) == sorted(map(tuple, np.hstack([Vs, Ns])))
+    with pytest.raises(ERRORS):
+        tree.isosurface(1.0, sharing="octree")
+    with pytest.raises(ERRORS):
+        geods.MinMaxOctree(vol, leaf_cells=33)
+
+
 def test_curvilinear_coords():
     vol = sphere((20, 21, 22), (10.1, 9.8, 10.4), 6.0)
     z, y, x = grid(vol.shape)
