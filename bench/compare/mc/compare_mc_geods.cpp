@@ -1,5 +1,6 @@
 // geods::iso on the mc comparison: the exhaustive scan (iso::isosurface), or with
-// GEODS_COMPARE_OCTREE the min/max octree (built once, build_s) queried per iso-value.
+// GEODS_COMPARE_OCTREE the min/max octree (built once, build_s) queried per iso-value with its
+// default vertex sharing (VertexSharing::block_masks).
 #include <memory>
 
 #include "geods/iso/marching_cubes.hpp"
@@ -22,7 +23,7 @@ int main(int argc, char** argv) {
         return compare::time_s([&] { tree = std::make_unique<geods::iso::MinMaxOctree<float>>(volume); });
       },
       [&](double iso) {
-        const geods::iso::OctreeIsoResult r = tree->isosurface(iso, options);
+        const geods::iso::OctreeIsoResult r = tree->isosurface(iso, options, geods::iso::VertexSharing::block_masks);
         return compare::mc::Extracted{r.mesh.num_vertices(), r.mesh.num_triangles(), r.cells_visited};
       });
 #else
