@@ -9,6 +9,7 @@
 #include <string>
 #include <type_traits>
 
+#include "geods/bvh/ray_triangle4.hpp"
 #include "geods/bvh/triangle_box.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"
@@ -176,10 +177,36 @@ void TriangleBvh::fit_volumes() {
 void TriangleBvh::build_wide() {
   const auto& nodes = topology_.nodes;
   const auto& boxes = std::get<std::vector<AABB3f>>(volumes_);
+  // Inner nodes: their wide node; leaves: their first triangle group.
   std::vector<std::uint32_t> wide_index(nodes.size(), 0);
-  std::uint32_t inner = 0;
-  for (std::size_t i = 0; i < nodes.size(); ++i)
-    if (!nodes[i].leaf()) wide_index[i] = inner++;
+  std::uint32_t inner = 0, groups = 0;
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    if (nodes[i].leaf()) {
+      wide_index[i] = groups;
+      groups += (nodes[i].prim_count + 3) / 4;
+    } else {
+      wide_index[i] = inner++;
+    }
+  }
+  groups_.resize(groups);
+  parallel_for(0, nodes.size(), 1024, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) {
+      if (!nodes[i].leaf()) continue;
+      for (std::uint32_t k = 0; k < nodes[i].prim_count; k += 4) {
+        TriangleGroup& g = groups_[wide_index[i] + k / 4];
+        for (std::uint32_t lane = 0; lane < 4; ++lane) {
+          const std::uint32_t t = nodes[i].prim_first + std::min(k + lane, nodes[i].prim_count - 1);
+          const Triangle& tri = triangles_[t];
+          for (int a = 0; a < 3; ++a) {
+            g.corner[0][a][lane] = tri.a[a];
+            g.corner[1][a][lane] = tri.b[a];
+            g.corner[2][a][lane] = tri.c[a];
+          }
+          g.index[lane] = t;
+        }
+      }
+    }
+  });
   auto fill = [&](auto& out) {
     using Node = typename std::decay_t<decltype(out)>::value_type;
     constexpr int W = sizeof(Node::child) / sizeof(std::uint32_t);
@@ -188,8 +215,8 @@ void TriangleBvh::build_wide() {
         w.bounds[2 * a][slot] = boxes[c].lo[a];
         w.bounds[2 * a + 1][slot] = boxes[c].hi[a];
       }
-      w.child[slot] = nodes[c].leaf() ? nodes[c].prim_first : wide_index[c];
-      w.count[slot] = nodes[c].leaf() ? nodes[c].prim_count : 0;
+      w.child[slot] = wide_index[c];
+      w.count[slot] = nodes[c].leaf() ? (nodes[c].prim_count + 3) / 4 : 0;
     };
     auto empty_node = [] {
       Node w;
@@ -241,7 +268,7 @@ RayHit TriangleBvh::intersect_wide(const std::vector<WideNode<W>>& nodes, const 
   using vf = typename SimdTypes<W>::vf;
   RayHit hit;
   if (nodes.empty()) return hit;
-  const RayTriangleTest<float> test(ray);
+  const RayTriangle4Test test(ray);
   // A zero direction component gives an infinite inverse; the 0 * inf NaN of
   // an origin on a slab plane is then skipped by the NaN-ignoring min/max
   // below, so a ray inside a (possibly flat) slab keeps the whole line. The
@@ -265,19 +292,23 @@ RayHit TriangleBvh::intersect_wide(const std::vector<WideNode<W>>& nodes, const 
     const Entry e = stack.pop();
     if (!may_hit_before(e.t, tmax)) continue;
     if (e.count > 0) {
-      for (std::uint32_t i = e.child; i < e.child + e.count; ++i) {
-        const Triangle& tri = triangles_[i];
-        float t, u, v;
-        if (test.intersect(tri.a, tri.b, tri.c, tmin, tmax, t, u, v)) {
-          tmax = t;
-          hit.t = t;
-          hit.u = u;
-          hit.v = v;
-          hit.prim = i;  // mapped to the mesh index at the end
-          if (any) {
-            hit.prim = topology_.prim_order[i];
-            return hit;
-          }
+      for (std::uint32_t g = e.child; g < e.child + e.count; ++g) {
+        RayTriangle4Test::vf t, u, v;
+        const int mask = test.intersect(groups_[g], tmin, tmax, t, u, v);
+        if (mask == 0) continue;
+        // The nearest lane, ties to the last one: what testing the triangles
+        // one after the other, each against the shrinking tmax, would keep.
+        int best = -1;
+        for (int i = 0; i < 4; ++i)
+          if ((mask >> i & 1) && (best < 0 || t[i] <= t[best])) best = i;
+        tmax = t[best];
+        hit.t = t[best];
+        hit.u = u[best];
+        hit.v = v[best];
+        hit.prim = groups_[g].index[best];  // mapped to the mesh index at the end
+        if (any) {
+          hit.prim = topology_.prim_order[hit.prim];
+          return hit;
         }
       }
       continue;
@@ -313,7 +344,7 @@ RayHit TriangleBvh::intersect_wide(const std::vector<WideNode<W>>& nodes, const 
     for (int i = 0; i < nh; ++i) {
       // Start fetching what the nearest children need; the cache misses on
       // nodes and triangles dominate incoherent rays.
-      const char* next = hits[i].count ? reinterpret_cast<const char*>(&triangles_[hits[i].child])
+      const char* next = hits[i].count ? reinterpret_cast<const char*>(&groups_[hits[i].child])
                                        : reinterpret_cast<const char*>(&nodes[hits[i].child]);
       __builtin_prefetch(next);
       __builtin_prefetch(next + 64);
@@ -562,7 +593,7 @@ BvhStats TriangleBvh::stats() const {
   s.depth = depth_;
   s.bytes = nodes.size() * sizeof(TopoNode) + topology_.prim_order.size() * sizeof(std::uint32_t) +
             triangles_.size() * sizeof(Triangle) + wide4_.size() * sizeof(WideNode<4>) +
-            wide8_.size() * sizeof(WideNode<8>);
+            wide8_.size() * sizeof(WideNode<8>) + groups_.size() * sizeof(TriangleGroup);
   if (nodes.empty()) return s;
   std::visit(
       [&](const auto& volumes) {
@@ -696,11 +727,24 @@ void TriangleBvh::validate() const {
           stack.push_back(w.child[s]);
           continue;
         }
-        for (std::uint32_t t = w.child[s]; t < w.child[s] + w.count[s]; ++t) {
-          if (t >= n || covered[t]) fail("wide leaves do not cover each triangle once");
-          covered[t] = 1;
-          if (!box.contains(triangles_[t].a) || !box.contains(triangles_[t].b) || !box.contains(triangles_[t].c))
-            fail("a wide leaf box does not hold its triangle");
+        if (w.child[s] + std::size_t(w.count[s]) > groups_.size()) fail("wide leaf groups out of range");
+        for (std::uint32_t g = w.child[s]; g < w.child[s] + w.count[s]; ++g) {
+          const TriangleGroup& group = groups_[g];
+          for (int lane = 0; lane < 4; ++lane) {
+            const std::uint32_t t = group.index[lane];
+            if (t >= n) fail("triangle group index out of range");
+            // Unused lanes repeat the group's last triangle.
+            if (lane > 0 && t == group.index[lane - 1]) continue;
+            if (covered[t]) fail("wide leaves do not cover each triangle once");
+            covered[t] = 1;
+            const Triangle& tri = triangles_[t];
+            for (int a = 0; a < 3; ++a)
+              if (group.corner[0][a][lane] != tri.a[a] || group.corner[1][a][lane] != tri.b[a] ||
+                  group.corner[2][a][lane] != tri.c[a])
+                fail("a triangle group differs from its triangle");
+            if (!box.contains(tri.a) || !box.contains(tri.b) || !box.contains(tri.c))
+              fail("a wide leaf box does not hold its triangle");
+          }
         }
       }
     }

@@ -14,6 +14,7 @@
 #include "geods/bvh/build_options.hpp"
 #include "geods/bvh/kdop.hpp"
 #include "geods/bvh/obb.hpp"
+#include "geods/bvh/ray_triangle4.hpp"
 #include "geods/bvh/sphere.hpp"
 #include "geods/bvh/topology.hpp"
 #include "geods/bvh/wide_node.hpp"
@@ -120,6 +121,8 @@ class TriangleBvh {
   std::vector<Triangle> triangles_;
   std::vector<WideNode<4>> wide4_;
   std::vector<WideNode<8>> wide8_;
+  // The triangles of the wide leaves in groups of 4, in leaf order.
+  std::vector<TriangleGroup> groups_;
 };
 
 }  // namespace geods::bvh

@@ -17,7 +17,8 @@ struct alignas(64) WideNode {  // whole cache lines: 128 bytes (4 wide), 256 (8 
   /// Empty slots hold lo = +inf, hi = -inf, which no ray interval overlaps.
   float bounds[6][W];
   /// Inner child (count 0): index of its WideNode; leaf child (count > 0): its
-  /// first triangle in leaf order; empty slot: kEmpty with count 0.
+  /// first TriangleGroup (ray_triangle4.hpp) and count = its number of groups;
+  /// empty slot: kEmpty with count 0.
   std::uint32_t child[W];
   std::uint32_t count[W];
 };

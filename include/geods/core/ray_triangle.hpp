@@ -82,6 +82,16 @@ class RayTriangleTest {
     return true;
   }
 
+  // The per-ray setup, for SIMD versions of the test that must decide exactly
+  // as this one does (bvh/ray_triangle4.hpp).
+  const Vec<T, 3>& origin() const { return origin_; }
+  int axis_x() const { return kx_; }
+  int axis_y() const { return ky_; }
+  int axis_z() const { return kz_; }
+  T shear_x() const { return shear_x_; }
+  T shear_y() const { return shear_y_; }
+  T shear_z() const { return shear_z_; }
+
  private:
   Vec<T, 3> origin_;
   int kx_, ky_, kz_;
