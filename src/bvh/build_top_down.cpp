@@ -228,6 +228,10 @@ class TopDown {
             return a;
           });
     }
+    // The wide AABB layout tests leaf triangles in groups of 4
+    // (ray_triangle4.hpp): a leaf costs one test per started group.
+    const bool grouped = options_.bv == BoundingVolume::aabb && options_.arity >= 4;
+    auto leaf_tests = [&](std::uint32_t n) { return float(grouped ? (n + 3) / 4 : n); };
     const float parent_area = rb.box.surface_area();
     float best_cost = std::numeric_limits<float>::infinity();
     int best_axis = -1, best_bin = -1;
@@ -238,17 +242,17 @@ class TopDown {
       acc.reset();
       for (int k = nbins - 1; k > 0; --k) {
         acc.extend(bins.bin[a][k]);
-        right_cost[k] = acc.area() * float(acc.n);
+        right_cost[k] = acc.area() * leaf_tests(acc.n);
       }
       acc.reset();
       for (int k = 0; k < nbins - 1; ++k) {
         acc.extend(bins.bin[a][k]);
         if (acc.n == 0 || acc.n == count) continue;
-        const float cost = acc.area() * float(acc.n) + right_cost[k + 1];
+        const float cost = acc.area() * leaf_tests(acc.n) + right_cost[k + 1];
         if (cost < best_cost) best_cost = cost, best_axis = a, best_bin = k;
       }
     }
-    const float leaf_cost = float(count);
+    const float leaf_cost = leaf_tests(count);
     const float split_cost =
         best_axis < 0 ? std::numeric_limits<float>::infinity() : 1.0f + best_cost / std::max(parent_area, 1e-30f);
     if (count <= std::uint32_t(options_.leaf_size) && leaf_cost <= split_cost) {

@@ -9,6 +9,10 @@
 #include <string>
 #include <type_traits>
 
+#if defined(__SSE__)
+#include <immintrin.h>
+#endif
+
 #include "geods/bvh/ray_triangle4.hpp"
 #include "geods/bvh/triangle_box.hpp"
 #include "geods/core/error.hpp"
@@ -202,7 +206,7 @@ void TriangleBvh::build_wide() {
             g.corner[1][a][lane] = tri.b[a];
             g.corner[2][a][lane] = tri.c[a];
           }
-          g.index[lane] = t;
+          g.index[lane] = topology_.prim_order[t];
         }
       }
     }
@@ -261,10 +265,24 @@ struct SimdTypes<8> {
   typedef float vf __attribute__((vector_size(32)));
 };
 
+// Bit i set where lane i of a comparison result is true.
+template <typename Mask>
+inline unsigned lane_bits(Mask m) {
+#if defined(__AVX__)
+  if constexpr (sizeof(Mask) == 32) return unsigned(_mm256_movemask_ps(reinterpret_cast<__m256>(m)));
+#endif
+#if defined(__SSE__)
+  if constexpr (sizeof(Mask) == 16) return unsigned(_mm_movemask_ps(reinterpret_cast<__m128>(m)));
+#endif
+  unsigned bits = 0;
+  for (int i = 0; i < int(sizeof(Mask) / 4); ++i) bits |= unsigned(m[i] & 1) << i;
+  return bits;
+}
+
 }  // namespace
 
 template <int W>
-RayHit TriangleBvh::intersect_wide(const std::vector<WideNode<W>>& nodes, const Ray3f& ray, bool any) const {
+RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray, bool any) const {
   using vf = typename SimdTypes<W>::vf;
   RayHit hit;
   if (nodes.empty()) return hit;
@@ -273,26 +291,80 @@ RayHit TriangleBvh::intersect_wide(const std::vector<WideNode<W>>& nodes, const 
   // an origin on a slab plane is then skipped by the NaN-ignoring min/max
   // below, so a ray inside a (possibly flat) slab keeps the whole line. The
   // near bound of each axis is chosen by the sign.
-  float org[3], inv[3];
+  vf org[3], inv[3];
   int near_row[3];
   for (int a = 0; a < 3; ++a) {
-    inv[a] = 1.0f / ray.direction[a];
-    org[a] = ray.origin[a];
-    near_row[a] = 2 * a + (inv[a] < 0 ? 1 : 0);
+    const float inv_a = 1.0f / ray.direction[a];
+    near_row[a] = 2 * a + (inv_a < 0 ? 1 : 0);
+    for (int i = 0; i < W; ++i) org[a][i] = ray.origin[a], inv[a][i] = inv_a;
   }
   float tmax = ray.tmax;
   const float tmin = ray.tmin;
+  vf tmin_v;
+  for (int i = 0; i < W; ++i) tmin_v[i] = tmin;
   struct Entry {
     std::uint32_t child, count;
     float t;
   };
   TraversalStack<Entry> stack(std::size_t(depth_ + 2) * W);
-  stack.push({0, 0, tmin});
-  while (!stack.empty()) {
-    const Entry e = stack.pop();
-    if (!may_hit_before(e.t, tmax)) continue;
-    if (e.count > 0) {
-      for (std::uint32_t g = e.child; g < e.child + e.count; ++g) {
+  // Start fetching what a child needs; the cache misses on nodes and
+  // triangles dominate incoherent rays.
+  auto prefetch = [&](const Entry& e) {
+    const char* p = e.count ? reinterpret_cast<const char*>(&groups_[e.child])
+                            : reinterpret_cast<const char*>(&nodes[e.child]);
+    __builtin_prefetch(p);
+    __builtin_prefetch(p + 64);
+  };
+  // The node being visited stays out of the stack: the nearest hit child is
+  // visited next, only the others are pushed.
+  Entry cur{0, 0, tmin};
+  for (;;) {
+    if (cur.count == 0) {
+      const WideNode<W>& node = nodes[cur.child];
+      vf tn = tmin_v, tf;
+      for (int i = 0; i < W; ++i) tf[i] = tmax;
+      for (int a = 0; a < 3; ++a) {
+        vf lo, hi;
+        std::memcpy(&lo, node.bounds[near_row[a]], sizeof(vf));
+        std::memcpy(&hi, node.bounds[near_row[a] ^ 1], sizeof(vf));
+        const vf t0 = (lo - org[a]) * inv[a];
+        const vf t1 = (hi - org[a]) * inv[a];
+        // Written so that a NaN t0 or t1 leaves the interval unchanged.
+        tn = t0 > tn ? t0 : tn;
+        tf = t1 < tf ? t1 : tf;
+      }
+      // Widened far bound: a box hit that rounding would lose is kept (Ize 2013).
+      const auto mask = tn <= tf * (1.0f + 4e-7f);
+      unsigned bits = lane_bits(mask);
+      if (bits != 0) {
+        const int first = __builtin_ctz(bits);
+        bits &= bits - 1;
+        if (bits == 0) {  // one child hit: no stack traffic
+          cur = {node.child[first], node.count[first], tn[first]};
+          prefetch(cur);
+          continue;
+        }
+        Entry hits[W];
+        hits[0] = {node.child[first], node.count[first], tn[first]};
+        int nh = 1;
+        for (; bits != 0; bits &= bits - 1) {
+          const int i = __builtin_ctz(bits);
+          const Entry h{node.child[i], node.count[i], tn[i]};
+          // Insertion sort, farthest first, so the nearest child is last.
+          int k = nh++;
+          while (k > 0 && hits[k - 1].t < h.t) {
+            hits[k] = hits[k - 1];
+            --k;
+          }
+          hits[k] = h;
+        }
+        for (int i = 0; i < nh; ++i) prefetch(hits[i]);
+        for (int i = 0; i + 1 < nh; ++i) stack.push(hits[i]);
+        cur = hits[nh - 1];
+        continue;
+      }
+    } else {
+      for (std::uint32_t g = cur.child; g < cur.child + cur.count; ++g) {
         RayTriangle4Test::vf t, u, v;
         const int mask = test.intersect(groups_[g], tmin, tmax, t, u, v);
         if (mask == 0) continue;
@@ -305,53 +377,18 @@ RayHit TriangleBvh::intersect_wide(const std::vector<WideNode<W>>& nodes, const 
         hit.t = t[best];
         hit.u = u[best];
         hit.v = v[best];
-        hit.prim = groups_[g].index[best];  // mapped to the mesh index at the end
-        if (any) {
-          hit.prim = topology_.prim_order[hit.prim];
-          return hit;
-        }
+        hit.prim = groups_[g].index[best];
+        if (any) return hit;
       }
-      continue;
     }
-    const WideNode<W>& node = nodes[e.child];
-    vf tn, tf;
-    for (int i = 0; i < W; ++i) tn[i] = tmin, tf[i] = tmax;
-    for (int a = 0; a < 3; ++a) {
-      vf lo, hi;
-      std::memcpy(&lo, node.bounds[near_row[a]], sizeof(vf));
-      std::memcpy(&hi, node.bounds[near_row[a] ^ 1], sizeof(vf));
-      const vf t0 = (lo - org[a]) * inv[a];
-      const vf t1 = (hi - org[a]) * inv[a];
-      // Written so that a NaN t0 or t1 leaves the interval unchanged.
-      tn = t0 > tn ? t0 : tn;
-      tf = t1 < tf ? t1 : tf;
+    // The next pushed node that may still hold a hit before tmax.
+    bool more = false;
+    while (!more && !stack.empty()) {
+      cur = stack.pop();
+      more = may_hit_before(cur.t, tmax);
     }
-    // Widened far bound: a box hit that rounding would lose is kept (Ize 2013).
-    const auto mask = tn <= tf * (1.0f + 4e-7f);
-    Entry hits[W];
-    int nh = 0;
-    for (int i = 0; i < W; ++i) {
-      if (!mask[i]) continue;
-      Entry h{node.child[i], node.count[i], tn[i]};
-      // Insertion sort, farthest first, so the nearest child is popped first.
-      int k = nh++;
-      while (k > 0 && hits[k - 1].t < h.t) {
-        hits[k] = hits[k - 1];
-        --k;
-      }
-      hits[k] = h;
-    }
-    for (int i = 0; i < nh; ++i) {
-      // Start fetching what the nearest children need; the cache misses on
-      // nodes and triangles dominate incoherent rays.
-      const char* next = hits[i].count ? reinterpret_cast<const char*>(&groups_[hits[i].child])
-                                       : reinterpret_cast<const char*>(&nodes[hits[i].child]);
-      __builtin_prefetch(next);
-      __builtin_prefetch(next + 64);
-      stack.push(hits[i]);
-    }
+    if (!more) break;
   }
-  if (hit.hit()) hit.prim = topology_.prim_order[hit.prim];
   return hit;
 }
 
@@ -715,6 +752,8 @@ void TriangleBvh::validate() const {
   auto check_wide = [&](const auto& wnodes) {
     // Every triangle must be reachable exactly once through the wide nodes.
     std::vector<char> covered(n, 0);
+    std::vector<std::uint32_t> leaf_position(n);  // groups name mesh triangles; triangles_ is in leaf order
+    for (std::uint32_t i = 0; i < n; ++i) leaf_position[topology_.prim_order[i]] = i;
     std::vector<std::uint32_t> stack{0};
     while (!stack.empty()) {
       const auto& w = wnodes[stack.back()];
@@ -737,7 +776,7 @@ void TriangleBvh::validate() const {
             if (lane > 0 && t == group.index[lane - 1]) continue;
             if (covered[t]) fail("wide leaves do not cover each triangle once");
             covered[t] = 1;
-            const Triangle& tri = triangles_[t];
+            const Triangle& tri = triangles_[leaf_position[t]];
             for (int a = 0; a < 3; ++a)
               if (group.corner[0][a][lane] != tri.a[a] || group.corner[1][a][lane] != tri.b[a] ||
                   group.corner[2][a][lane] != tri.c[a])

@@ -20,8 +20,8 @@ namespace geods::bvh {
 struct alignas(32) TriangleGroup {  // 160 bytes
   /// corner[k][a][i]: coordinate a of corner k (a, b, c) of lane i's triangle.
   float corner[3][3][4];
-  /// Leaf-order index of each lane's triangle. A group holds 1 to 4
-  /// triangles; unused lanes repeat the last one (same result, same index).
+  /// Index of each lane's triangle (TriangleBvh: in the mesh). A group holds
+  /// 1 to 4 triangles; unused lanes repeat the last one (same result, same index).
   std::uint32_t index[4];
 };
 
@@ -58,15 +58,17 @@ class RayTriangle4Test {
     const vi on_edge = (eu == zero) | (ev == zero) | (ew == zero);
     const vi mixed = ((eu < zero) | (ev < zero) | (ew < zero)) & ((eu > zero) | (ev > zero) | (ew > zero));
     const vf det = eu + ev + ew;
+    // det - det is 0 exactly for a finite det (NaN for inf and NaN).
+    const vi inside = ~mixed & ~on_edge & (det != zero) & (det - det == zero);
+    const int edge_mask = movemask(on_edge);
+    // Most groups a ray reaches are missed: skip the division then.
+    if (movemask(inside) == 0 && edge_mask == 0) return 0;
     const vf scaled_t = eu * (shear_z_ * pz[0]) + ev * (shear_z_ * pz[1]) + ew * (shear_z_ * pz[2]);
     const vf inv_det = splat(1.0f) / det;
     t = scaled_t * inv_det;
-    // det - det is 0 exactly for a finite det (NaN for inf and NaN).
-    const vi ok = ~mixed & ~on_edge & (det != zero) & (det - det == zero) & (t >= splat(tmin)) & (t <= splat(tmax));
     u = ev * inv_det;
     v = ew * inv_det;
-    int mask = movemask(ok);
-    const int edge_mask = movemask(on_edge);
+    int mask = movemask(inside & (t >= splat(tmin)) & (t <= splat(tmax)));
     if (edge_mask != 0) [[unlikely]] {
       for (int i = 0; i < 4; ++i) {
         if (!(edge_mask >> i & 1)) continue;

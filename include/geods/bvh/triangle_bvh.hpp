@@ -12,6 +12,7 @@
 
 #include "geods/bvh/aabb_bv.hpp"
 #include "geods/bvh/build_options.hpp"
+#include "geods/bvh/huge_page_allocator.hpp"
 #include "geods/bvh/kdop.hpp"
 #include "geods/bvh/obb.hpp"
 #include "geods/bvh/ray_triangle4.hpp"
@@ -104,7 +105,9 @@ class TriangleBvh {
   template <typename BV>
   RayHit intersect_generic(const std::vector<BV>& volumes, const Ray3f& ray, bool any) const;
   template <int W>
-  RayHit intersect_wide(const std::vector<WideNode<W>>& nodes, const Ray3f& ray, bool any) const;
+  using WideNodes = std::vector<WideNode<W>, HugePageAllocator<WideNode<W>>>;
+  template <int W>
+  RayHit intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray, bool any) const;
   template <typename BV>
   ClosestPoint closest_generic(const std::vector<BV>& volumes, std::uint32_t start, const Vec3f& p,
                                float max_distance) const;
@@ -119,10 +122,10 @@ class TriangleBvh {
   int depth_ = 0;  // of topology_, sizes the traversal stacks
   VolumeArray volumes_;
   std::vector<Triangle> triangles_;
-  std::vector<WideNode<4>> wide4_;
-  std::vector<WideNode<8>> wide8_;
+  WideNodes<4> wide4_;
+  WideNodes<8> wide8_;
   // The triangles of the wide leaves in groups of 4, in leaf order.
-  std::vector<TriangleGroup> groups_;
+  std::vector<TriangleGroup, HugePageAllocator<TriangleGroup>> groups_;
 };
 
 }  // namespace geods::bvh
