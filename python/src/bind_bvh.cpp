@@ -132,6 +132,29 @@ class PyBvh {
     return out;
   }
 
+  // planes: (k, 4) rows (nx, ny, nz, offset) of n.x = offset, n pointing into the frustum.
+  py::array_t<std::int64_t> cull_frustum(const CArray<float>& planes) const {
+    if (planes.ndim() != 2 || planes.shape(1) != 4)
+      throw Error("Bvh.cull_frustum: planes must be a (k, 4) array of rows (nx, ny, nz, offset)");
+    std::vector<Plane3f> ps;
+    const float* p = planes.data();
+    for (py::ssize_t i = 0; i < planes.shape(0); ++i, p += 4) {
+      const Vec3f n(p[0], p[1], p[2]);
+      const float len = n.norm();
+      if (!(len > 0) || !std::isfinite(len) || !std::isfinite(p[3]))
+        throw Error("Bvh.cull_frustum: plane " + std::to_string(i) + " has a zero or non-finite normal or offset");
+      ps.push_back({n / len, p[3] / len});
+    }
+    std::vector<std::uint32_t> ids;
+    {
+      py::gil_scoped_release release;
+      ids = bvh_.cull_frustum(ps);
+    }
+    py::array_t<std::int64_t> out(py::ssize_t(ids.size()));
+    for (std::size_t i = 0; i < ids.size(); ++i) out.mutable_data()[i] = ids[i];
+    return out;
+  }
+
   py::dict stats() const {
     bvh::BvhStats s;
     {
@@ -180,6 +203,9 @@ void bind_bvh(py::module_& m) {
            "Whether each point is inside the (closed) mesh: majority of ray parities.")
       .def("cull_box", &PyBvh::cull_box, py::arg("lo"), py::arg("hi"),
            "Indices of the triangles that intersect the box [lo, hi], sorted.")
+      .def("cull_frustum", &PyBvh::cull_frustum, py::arg("planes"),
+           "Indices of the triangles not entirely behind one of the planes, sorted; planes (k, 4): rows "
+           "(nx, ny, nz, offset) of n.x = offset with n pointing into the frustum (conservative culling).")
       .def("stats", &PyBvh::stats,
            "dict: builder, bv, arity, leaf_size, triangles, nodes, leaves, depth, bytes, sah_cost, "
            "tightness_volume, tightness_hausdorff")

@@ -152,6 +152,25 @@ def test_cull_box(bunny):
     assert set(np.nonzero(vertex_in)[0]) <= set(ids)
 
 
+def test_cull_frustum(bunny):
+    V, F = bunny
+    bvh = geods.Bvh(V, F)
+    # A box-shaped frustum with unnormalized normals (the binding normalizes them).
+    planes = np.array([[2, 0, 0, -2], [-1, 0, 0, -3], [0, 3, 0, 6],
+                       [0, -1, 0, -6], [0, 0, 1, -2.5], [0, 0, -1, -2.5]], np.float32)
+    ids = bvh.cull_frustum(planes)
+    n = planes[:, :3] / np.linalg.norm(planes[:, :3], axis=1)[:, None]
+    off = planes[:, 3] / np.linalg.norm(planes[:, :3], axis=1)
+    d = np.einsum('tvk,pk->tvp', V[F], n) - off  # (triangles, 3 corners, planes)
+    behind = np.any(np.all(d < 0, axis=1), axis=1)
+    assert list(ids) == list(np.nonzero(~behind)[0])
+    assert 0 < len(ids) < len(F)
+    with pytest.raises(geods.Error):
+        bvh.cull_frustum(np.zeros((1, 4), np.float32))
+    with pytest.raises(geods.Error):
+        bvh.cull_frustum(np.zeros((2, 3), np.float32))
+
+
 def test_bad_input_raises():
     V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], np.float32)
     F = np.array([[0, 1, 2]])
