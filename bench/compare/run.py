@@ -32,7 +32,8 @@ declares them with geods_compare_program(), and a compare.json read here:
               the same arguments and must print the same JSON lines.
   threads     "all": run with every --threads count; "1": single thread only
   metrics     timing fields to tabulate, e.g. ["build_s", "query_s"]
-  rate        optional {"unit": "Mcalls/s", "scale": 1e-6}: also show count / time * scale
+  rate        optional {"unit": "Mcalls/s", "scale": 1e-6, "metric": "query_s"}: also show
+              count / time * scale in the rows of that metric (default query_s)
   agree       optional {"field": "sign_hash", "anchors": ["geods", "cgal"], "label": "..."}:
               that field must be equal across these anchors for each (variant, threads)
   args        optional extra command-line arguments for every program
@@ -339,8 +340,8 @@ def tabulate(c, records):
             bt = med(base)
             for a in present:
                 t = med(a)
-                cell = fmt_time(t)
-                if t and c.get("rate") and g.get(a):
+                cell = fmt_time(t) if t else "–"  # 0: the program has no such phase
+                if t and c.get("rate") and g.get(a) and m == c["rate"].get("metric", "query_s"):
                     cnt = g[a][0].get("count")
                     if cnt:
                         cell += f" ({fmt_rate(cnt / t * c['rate'].get('scale', 1))} {c['rate'].get('unit', '/s')})"
