@@ -1,5 +1,5 @@
 // Python bindings of geods::core: the exact predicates (on single points or
-// on stacked arrays of points) and the thread limit.
+// on stacked arrays of points), the 3D convex hull and the thread limit.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
@@ -8,8 +8,10 @@
 #include <string>
 #include <tuple>
 #include <utility>
+#include <vector>
 
 #include "bindings.hpp"
+#include "geods/core/convex_hull3.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"
 #include "geods/core/predicates.hpp"
@@ -147,6 +149,34 @@ For a, b, c, d with orient3d(a, b, c, d) > 0: a float > 0 if e is inside
 their sphere, < 0 outside, exactly 0 on it; the sign flips when
 orient3d(a, b, c, d) < 0. Arguments are points (length 3) or (n, 3) arrays
 with the same n.)doc");
+
+  m.def(
+      "convex_hull",
+      [](const DoubleArray& points) {
+        if (points.ndim() != 2 || points.shape(1) != 3) throw Error("convex_hull: points must be an (n, 3) array");
+        std::vector<Vec3d> p(std::size_t(points.shape(0)));
+        for (std::size_t i = 0; i < p.size(); ++i) p[i] = Vec3d(points.data()[3 * i], points.data()[3 * i + 1], points.data()[3 * i + 2]);
+        ConvexHull3 hull;
+        {
+          py::gil_scoped_release release;
+          hull = convex_hull3(p);
+        }
+        py::array_t<std::int64_t> vertices(py::ssize_t(hull.vertices.size()));
+        for (std::size_t i = 0; i < hull.vertices.size(); ++i) vertices.mutable_data()[i] = hull.vertices[i];
+        py::array_t<std::int64_t> faces({py::ssize_t(hull.faces.size()), py::ssize_t(3)});
+        for (std::size_t i = 0; i < hull.faces.size(); ++i)
+          for (std::size_t k = 0; k < 3; ++k) faces.mutable_data()[3 * i + k] = hull.faces[i][k];
+        return py::make_tuple(vertices, faces, hull.dimension);
+      },
+      py::arg("points"),
+      R"doc(Convex hull of (n, 3) points, exact (orient3d decides every side test).
+
+Returns (vertices, faces, dimension): the indices of the points that are
+corners of the hull (ascending), the (k, 3) triangles over point indices,
+counter-clockwise seen from outside (empty unless dimension is 3), and the
+affine dimension of the points (-1 for none, 0 equal, 1 collinear, 2 coplanar:
+then vertices are the corners of the planar hull polygon). Raises geods.Error
+for NaN or infinite coordinates.)doc");
 
   m.def("set_num_threads", &set_num_threads, py::arg("n"),
         "Limits the worker threads of every later parallel call; n <= 0 restores all cores.");

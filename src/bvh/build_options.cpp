@@ -15,13 +15,14 @@ constexpr std::array<std::pair<std::string_view, Builder>, 7> kBuilders = {{{"sa
                                                                             {"tiling", Builder::tiling},
                                                                             {"insertion", Builder::insertion},
                                                                             {"boxtree", Builder::boxtree}}};
-constexpr std::array<std::pair<std::string_view, BoundingVolume>, 7> kVolumes = {{{"aabb", BoundingVolume::aabb},
+constexpr std::array<std::pair<std::string_view, BoundingVolume>, 8> kVolumes = {{{"aabb", BoundingVolume::aabb},
                                                                                  {"sphere", BoundingVolume::sphere},
                                                                                  {"kdop6", BoundingVolume::kdop6},
                                                                                  {"kdop14", BoundingVolume::kdop14},
                                                                                  {"kdop18", BoundingVolume::kdop18},
                                                                                  {"kdop26", BoundingVolume::kdop26},
-                                                                                 {"obb", BoundingVolume::obb}}};
+                                                                                 {"obb", BoundingVolume::obb},
+                                                                                 {"obb_hull", BoundingVolume::obb_hull}}};
 
 template <typename Table>
 std::string names_of(const Table& table) {

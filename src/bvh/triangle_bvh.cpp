@@ -15,6 +15,7 @@
 
 #include "geods/bvh/ray_triangle4.hpp"
 #include "geods/bvh/triangle_box.hpp"
+#include "geods/core/convex_hull3.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"
 #include "geods/core/triangle.hpp"
@@ -129,6 +130,7 @@ TriangleBvh TriangleBvh::build(const TriMesh& mesh, const BuildOptions& options)
     case BoundingVolume::kdop18: bvh.fit_volumes<Kdop<float, 18>>(); break;
     case BoundingVolume::kdop26: bvh.fit_volumes<Kdop<float, 26>>(); break;
     case BoundingVolume::obb: bvh.fit_volumes<Obb3f>(); break;
+    case BoundingVolume::obb_hull: bvh.fit_hull_obbs(); break;
   }
   progress.update(2);
   if (options.bv == BoundingVolume::aabb && options.arity >= 4 && n > 0) bvh.build_wide();
@@ -172,6 +174,44 @@ void TriangleBvh::fit_volumes() {
       for (std::size_t i = b; i < e; ++i) {
         points_of(nodes[i], pts);
         vols[i] = fit_points<BV>(pts);
+      }
+    });
+  }
+  volumes_ = std::move(vols);
+}
+
+// A node's convex hull is the hull of its children's hull corners, so the
+// hull-based OBBs are fitted bottom-up, level by level in parallel, each node
+// to a few corners instead of every vertex below it.
+void TriangleBvh::fit_hull_obbs() {
+  const auto& nodes = topology_.nodes;
+  std::vector<Obb3f> vols(nodes.size());
+  std::vector<std::vector<Vec3f>> corners(nodes.size());
+  std::vector<std::vector<std::uint32_t>> levels(1, {0});
+  while (true) {
+    std::vector<std::uint32_t> next;
+    for (std::uint32_t i : levels.back())
+      for (std::uint32_t c = 0; c < nodes[i].num_children; ++c) next.push_back(nodes[i].first_child + c);
+    if (next.empty()) break;
+    levels.push_back(std::move(next));
+  }
+  for (std::size_t l = levels.size(); l-- > 0;) {
+    const auto& level = levels[l];
+    parallel_for(0, level.size(), 16, [&](std::size_t b, std::size_t e) {
+      std::vector<Vec3d> pts;
+      for (std::size_t k = b; k < e; ++k) {
+        const std::uint32_t i = level[k];
+        const TopoNode& node = nodes[i];
+        pts.clear();
+        for (std::uint32_t t = node.prim_first; t < node.prim_first + node.prim_count && node.leaf(); ++t)
+          for (const Vec3f* v : {&triangles_[t].a, &triangles_[t].b, &triangles_[t].c}) pts.push_back(v->cast<double>());
+        for (std::uint32_t c = node.first_child; c < node.first_child + node.num_children; ++c) {
+          for (const Vec3f& v : corners[c]) pts.push_back(v.cast<double>());
+          std::vector<Vec3f>().swap(corners[c]);
+        }
+        const ConvexHull3 hull = convex_hull3(pts);
+        for (std::uint32_t v : hull.vertices) corners[i].push_back(pts[v].cast<float>());
+        vols[i] = fit_obb<float>(corners[i], ObbFit::hull);
       }
     });
   }

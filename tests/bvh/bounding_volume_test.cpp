@@ -1,6 +1,9 @@
 // Bounding volumes against sampling oracles, in float and double.
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <vector>
@@ -87,7 +90,79 @@ TEST(BoundingVolumes, Sphere) {
 TEST(BoundingVolumes, Obb) {
   check_volume<float>([](const auto& p) { return fit_obb<float>(p); }, true);
   check_volume<double>([](const auto& p) { return fit_obb<double>(p); }, true);
+  check_volume<float>([](const auto& p) { return fit_obb<float>(p, ObbFit::hull); }, true);
+  check_volume<double>([](const auto& p) { return fit_obb<double>(p, ObbFit::hull); }, true);
 }
+// Volume of the box along the points' principal axes (the classic fit,
+// computed here independently as the oracle the hull fit must not exceed).
+double pca_box_volume(const std::vector<Vec3d>& pts) {
+  Vec3d mean = Vec3d::Zero();
+  for (const Vec3d& p : pts) mean += p;
+  mean /= double(pts.size());
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const Vec3d& p : pts) cov += (p - mean) * (p - mean).transpose();
+  const Eigen::Matrix3d axes = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvectors();
+  Vec3d lo = Vec3d::Constant(1e300), hi = -lo;
+  for (const Vec3d& p : pts) {
+    lo = lo.cwiseMin(axes.transpose() * p);
+    hi = hi.cwiseMax(axes.transpose() * p);
+  }
+  return (hi - lo).prod();
+}
+
+TEST(BoundingVolumes, ObbFitIsTighterThanPrincipalAxes) {
+  Rng rng(8);
+  const Eigen::Matrix3d rot = (Eigen::AngleAxisd(0.4, Vec3d(1, 2, 3).normalized()) *
+                               Eigen::AngleAxisd(1.1, Vec3d::UnitZ())).toRotationMatrix();
+  for (int trial = 0; trial < 30; ++trial) {
+    // A rotated box with its corners, points on its faces and a dense cluster
+    // near one corner, which tilts the principal axes away from the box.
+    const Vec3d ext(rng.uniform(0.5, 3), rng.uniform(0.5, 3), rng.uniform(0.5, 3));
+    std::vector<Vec3d> local;
+    for (int c = 0; c < 8; ++c) local.emplace_back(c & 1 ? ext[0] : 0, c & 2 ? ext[1] : 0, c & 4 ? ext[2] : 0);
+    for (int i = 0; i < 40; ++i) {
+      Vec3d q(rng.uniform(0, 1), rng.uniform(0, 1), rng.uniform(0, 1));
+      q[i % 3] = double(i % 2);
+      local.push_back(q.cwiseProduct(ext));
+    }
+    for (int i = 0; i < 200; ++i) local.push_back(Vec3d(rng.uniform(0, 0.2), rng.uniform(0, 0.2), rng.uniform(0, 0.2)).cwiseProduct(ext));
+    std::vector<Vec3d> pts;
+    for (const Vec3d& q : local) pts.push_back(rot * q + Vec3d(1, -2, 0.5));
+    const Obb3d box = fit_obb<double>(pts, ObbFit::hull);
+    for (const Vec3d& p : pts) ASSERT_TRUE(contains(box, p));
+    const double exact = ext.prod();
+    EXPECT_LE(volume(box), exact * (1 + 1e-4)) << "the hull-face-flush candidate finds the box";
+    EXPECT_LE(volume(box), pca_box_volume(pts) * (1 + 1e-4));
+    EXPECT_GT(volume(fit_obb<double>(pts)), exact * 1.05) << "the cluster tilts the principal axes";
+    // Random blobs: never worse than the principal axes.
+    const auto blob = cloud<double>(rng, 50, Vec3d::Zero(), 1.0);
+    EXPECT_LE(volume(fit_obb<double>(blob, ObbFit::hull)), pca_box_volume(blob) * (1 + 1e-4));
+  }
+}
+
+TEST(BoundingVolumes, ObbOfFlatAndDegenerateSets) {
+  // A single triangle: a flat box around it, containing its corners.
+  const std::vector<Vec3f> tri{{0, 0, 0}, {2, 1, 0.5f}, {0.3f, 1.7f, -1}};
+  const Obb3f t = fit_obb<float>(tri, ObbFit::hull);
+  for (const auto& p : tri) EXPECT_TRUE(contains(t, p));
+  EXPECT_LT(volume(t), 1e-4f);
+  // The minimum-area rectangle of a rotated flat rectangle is that rectangle.
+  std::vector<Vec3d> rect;
+  const Vec3d u = Vec3d(1, 1, 0).normalized(), w = Vec3d(-1, 1, 1).normalized().cross(u).normalized();
+  Rng rng(9);
+  for (int i = 0; i < 100; ++i) rect.push_back(rng.uniform(0, 4) * u + rng.uniform(0, 1) * w);
+  for (int c = 0; c < 4; ++c) rect.push_back((c & 1 ? 4.0 : 0.0) * u + (c & 2 ? 1.0 : 0.0) * w);
+  const Obb3d r = fit_obb<double>(rect, ObbFit::hull);
+  const Vec3d e = 2 * r.half;
+  std::vector<double> sorted{e[0], e[1], e[2]};
+  std::sort(sorted.begin(), sorted.end());
+  EXPECT_NEAR(sorted[1] * sorted[2], 4.0, 1e-3);
+  // Collinear points and a single point.
+  const Obb3d line = fit_obb<double>(std::vector<Vec3d>{{0, 0, 0}, {1, 2, 3}, {2, 4, 6}}, ObbFit::hull);
+  EXPECT_TRUE(contains(line, Vec3d(2, 4, 6)));
+  EXPECT_TRUE(contains(fit_obb<double>(std::vector<Vec3d>{{5, 5, 5}}, ObbFit::hull), Vec3d(5, 5, 5)));
+}
+
 TEST(BoundingVolumes, Kdops) {
   check_volume<float>([](const auto& p) { return fit_kdop<float, 6>(p); }, true);
   check_volume<float>([](const auto& p) { return fit_kdop<float, 14>(p); }, false);

@@ -19,7 +19,10 @@ enum class Builder {
   boxtree,    // top-down, Zachmann's restricted boxtree criterion (least total volume, §4.1.5)
 };
 
-enum class BoundingVolume { aabb, sphere, kdop6, kdop14, kdop18, kdop26, obb };
+/// obb: principal axes of the vertices below a node (ObbFit::pca); obb_hull:
+/// the smallest of the hull-based candidates of ObbFit::hull (tighter, slower
+/// to build; the same Obb3f volumes and queries).
+enum class BoundingVolume { aabb, sphere, kdop6, kdop14, kdop18, kdop26, obb, obb_hull };
 
 struct BuildOptions {
   Builder builder = Builder::sah;
@@ -35,7 +38,7 @@ struct BuildOptions {
 
 /// "sah", "median", "pca", "bottomup", "tiling", "insertion", "boxtree"; throws geods::Error otherwise.
 Builder parse_builder(std::string_view name);
-/// "aabb", "sphere", "kdop6", "kdop14", "kdop18", "kdop26", "obb"; throws geods::Error otherwise.
+/// "aabb", "sphere", "kdop6", "kdop14", "kdop18", "kdop26", "obb", "obb_hull"; throws geods::Error otherwise.
 BoundingVolume parse_bounding_volume(std::string_view name);
 std::string_view to_string(Builder builder);
 std::string_view to_string(BoundingVolume bv);

@@ -1,15 +1,18 @@
 #pragma once
 // Oriented bounding box: center, three orthonormal axes (the columns of
 // `axes`) and half extents along them, with the bounding volume operations of
-// aabb_bv.hpp. The fit takes the principal axes of the points (PCA of their
-// covariance, as in Gottschalk's OBB-tree) and the extents of the projections.
-#include <Eigen/Eigenvalues>
+// aabb_bv.hpp. The fit tries the principal axes of the points (PCA, as in
+// Gottschalk's OBB-tree) and orientations from their convex hull, and keeps
+// the smallest box.
+#include <Eigen/Core>
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
 #include <span>
+#include <type_traits>
 #include <utility>
+#include <vector>
 
 #include "geods/bvh/aabb_bv.hpp"
 
@@ -37,32 +40,49 @@ struct Obb {
 using Obb3f = Obb<float>;
 using Obb3d = Obb<double>;
 
-/// Box around the points along their principal axes (computed in double;
-/// degenerate point sets get the coordinate axes). Grown by a relative 1e-6 so
-/// that rounding never leaves a point outside.
+/// How fit_obb orients the box.
+enum class ObbFit {
+  /// The principal axes of the points (PCA of their covariance; Gottschalk's
+  /// OBB-tree): O(n), but dense clusters of points tilt the box.
+  pca,
+  /// The smallest of several candidates: the principal axes, the principal
+  /// axes of the convex hull's surface (Gottschalk's continuous formula), and
+  /// for each of the 16 largest hull faces the face normal with the
+  /// minimum-area rectangle of the hull's projection on that face (rotating
+  /// calipers; O'Rourke's optimal box has a face flush with a hull face in
+  /// most cases). Never larger than the pca box; O(n log n) for the hull.
+  hull,
+};
+
+namespace detail {
+/// Axes (columns, right-handed) of the box fit_obb builds. "Smallest" is the
+/// least product of the extents, each grown by 1e-6 of the diameter so that
+/// flat sets compare by area. Degenerate sets get PCA or the coordinate axes.
+Eigen::Matrix3d obb_fit_axes(std::span<const Vec3d> points, ObbFit fit);
+}  // namespace detail
+
+/// Box around the points, oriented as `fit` says. Grown by a relative 1e-6
+/// so that rounding never leaves a point outside.
 template <typename T>
-Obb<T> fit_obb(std::span<const Vec<T, 3>> points) {
+Obb<T> fit_obb(std::span<const Vec<T, 3>> points, ObbFit fit = ObbFit::pca) {
   Obb<T> box;
   if (points.empty()) return box;
+  std::vector<Vec3d> converted;
+  std::span<const Vec3d> pd;
+  if constexpr (std::is_same_v<T, double>) {
+    pd = points;
+  } else {
+    converted.reserve(points.size());
+    for (const auto& p : points) converted.push_back(p.template cast<double>());
+    pd = converted;
+  }
+  const Eigen::Matrix3d axes = detail::obb_fit_axes(pd, fit);
   Vec3d mean = Vec3d::Zero();
-  for (const auto& p : points) mean += p.template cast<double>();
-  mean /= double(points.size());
-  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-  for (const auto& p : points) {
-    const Vec3d d = p.template cast<double>() - mean;
-    cov += d * d.transpose();
-  }
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(cov);
-  Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();
-  if (solver.info() == Eigen::Success && std::isfinite(solver.eigenvectors().sum())) {
-    axes = solver.eigenvectors();
-    // Largest variance first, right-handed.
-    axes.col(0).swap(axes.col(2));
-    axes.col(2) = axes.col(0).cross(axes.col(1)).normalized();
-  }
+  for (const Vec3d& p : pd) mean += p;
+  mean /= double(pd.size());
   Vec3d lo = Vec3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
-  for (const auto& p : points) {
-    const Vec3d s = axes.transpose() * (p.template cast<double>() - mean);
+  for (const Vec3d& p : pd) {
+    const Vec3d s = axes.transpose() * (p - mean);
     lo = lo.cwiseMin(s);
     hi = hi.cwiseMax(s);
   }
@@ -110,7 +130,7 @@ bool contains(const Obb<T>& a, const Obb<T>& b) {
     if (!contains(a, c)) return false;
   return true;
 }
-/// A box around both, fitted to their 16 corners (contains both).
+/// A box around both, fitted (principal axes) to their 16 corners (contains both).
 template <typename T>
 Obb<T> merge(const Obb<T>& a, const Obb<T>& b) {
   if (a.empty()) return b;

@@ -115,6 +115,7 @@ class TriangleBvh {
   void for_each_crossing(const Ray3f& ray, Fn&& fn) const;
   template <typename BV>
   void fit_volumes();
+  void fit_hull_obbs();
   void build_wide();
 
   BuildOptions options_;
