@@ -113,7 +113,7 @@ class BvhCommand : public Command {
  private:
   std::string mesh_, rays_, output_;
   std::string builder_ = "sah", bv_ = "aabb";
-  int leaf_size_ = 4, arity_ = 4;
+  int leaf_size_ = 8, arity_ = 4;
 };
 
 const bool registered = register_command<BvhCommand>();

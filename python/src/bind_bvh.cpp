@@ -189,7 +189,7 @@ void bind_bvh(py::module_& m) {
   const float inf = std::numeric_limits<float>::infinity();
   py::class_<PyBvh>(m, "Bvh", "Bounding volume hierarchy over the triangles (V, F) of a mesh (float32).")
       .def(py::init<const CArray<float>&, const CArray<std::int64_t>&, const std::string&, const std::string&, int, int>(),
-           py::arg("V"), py::arg("F"), py::arg("builder") = "sah", py::arg("bv") = "aabb", py::arg("leaf_size") = 4,
+           py::arg("V"), py::arg("F"), py::arg("builder") = "sah", py::arg("bv") = "aabb", py::arg("leaf_size") = 8,
            py::arg("arity") = 4,
            "builder: sah, median, pca, bottomup, tiling, insertion, boxtree; "
            "bv: aabb, sphere, kdop6, kdop14, kdop18, kdop26, obb, obb_hull; arity 2, 4 or 8")

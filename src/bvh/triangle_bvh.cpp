@@ -314,12 +314,46 @@ inline unsigned lane_bits(Mask m) {
 #if defined(__SSE__)
   if constexpr (sizeof(Mask) == 16) return unsigned(_mm_movemask_ps(reinterpret_cast<__m128>(m)));
 #endif
+#if defined(__SSE__)
+  if constexpr (sizeof(Mask) == 32) {  // two SSE halves (one AVX instruction where the compiler may use AVX)
+    __m128 half[2];
+    std::memcpy(half, &m, sizeof half);
+    return unsigned(_mm_movemask_ps(half[0])) | unsigned(_mm_movemask_ps(half[1])) << 4;
+  }
+#endif
   unsigned bits = 0;
   for (int i = 0; i < int(sizeof(Mask) / 4); ++i) bits |= unsigned(m[i] & 1) << i;
   return bits;
 }
 
+// Whether the CPU runs AVX code, for the ray queries compiled for it too
+// (the build targets plain x86-64 or x86-64-v2). No FMA: AVX code does the
+// same IEEE operations as SSE code, so the results are identical.
+#if defined(__x86_64__) && !defined(__AVX__) && defined(__GNUC__)
+#define GEODS_BVH_AVX_DISPATCH 1
+const bool kCpuHasAvx = [] {
+  __builtin_cpu_init();  // this runs during static initialization
+  return __builtin_cpu_supports("avx") != 0;
+}();
+#endif
+
 }  // namespace
+
+#if defined(GEODS_BVH_AVX_DISPATCH)
+template <int W>
+__attribute__((target("avx"), flatten)) RayHit TriangleBvh::intersect_wide_avx(const WideNodes<W>& nodes,
+                                                                               const Ray3f& ray, bool any) const {
+  return intersect_wide(nodes, ray, any);
+}
+#endif
+
+template <int W>
+RayHit TriangleBvh::intersect_wide_best(const WideNodes<W>& nodes, const Ray3f& ray, bool any) const {
+#if defined(GEODS_BVH_AVX_DISPATCH)
+  if (kCpuHasAvx) return intersect_wide_avx(nodes, ray, any);
+#endif
+  return intersect_wide(nodes, ray, any);
+}
 
 template <int W>
 RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray, bool any) const {
@@ -479,14 +513,14 @@ RayHit TriangleBvh::intersect_generic(const std::vector<BV>& volumes, const Ray3
 }
 
 RayHit TriangleBvh::intersect(const Ray3f& ray) const {
-  if (!wide4_.empty()) return intersect_wide(wide4_, ray, false);
-  if (!wide8_.empty()) return intersect_wide(wide8_, ray, false);
+  if (!wide4_.empty()) return intersect_wide_best(wide4_, ray, false);
+  if (!wide8_.empty()) return intersect_wide_best(wide8_, ray, false);
   return std::visit([&](const auto& vols) { return intersect_generic(vols, ray, false); }, volumes_);
 }
 
 bool TriangleBvh::occluded(const Ray3f& ray) const {
-  if (!wide4_.empty()) return intersect_wide(wide4_, ray, true).hit();
-  if (!wide8_.empty()) return intersect_wide(wide8_, ray, true).hit();
+  if (!wide4_.empty()) return intersect_wide_best(wide4_, ray, true).hit();
+  if (!wide8_.empty()) return intersect_wide_best(wide8_, ray, true).hit();
   return std::visit([&](const auto& vols) { return intersect_generic(vols, ray, true).hit(); }, volumes_);
 }
 

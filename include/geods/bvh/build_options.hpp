@@ -28,7 +28,8 @@ struct BuildOptions {
   Builder builder = Builder::sah;
   BoundingVolume bv = BoundingVolume::aabb;
   /// Most primitives in a leaf (1..255); the SAH builder may stop earlier.
-  int leaf_size = 4;
+  /// 8: two groups of 4 triangles in the wide AABB layout (ray_triangle4.hpp).
+  int leaf_size = 8;
   /// Children per inner node: 2, 4 or 8. Wider trees come from collapsing the binary one.
   int arity = 4;
   /// Bins per axis of the SAH builder (2..64).

@@ -108,6 +108,11 @@ class TriangleBvh {
   using WideNodes = std::vector<WideNode<W>, HugePageAllocator<WideNode<W>>>;
   template <int W>
   RayHit intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray, bool any) const;
+  // The same compiled for AVX, and the choice between the two by the CPU.
+  template <int W>
+  RayHit intersect_wide_avx(const WideNodes<W>& nodes, const Ray3f& ray, bool any) const;
+  template <int W>
+  RayHit intersect_wide_best(const WideNodes<W>& nodes, const Ray3f& ray, bool any) const;
   template <typename BV>
   ClosestPoint closest_generic(const std::vector<BV>& volumes, std::uint32_t start, const Vec3f& p,
                                float max_distance) const;
