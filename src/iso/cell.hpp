@@ -150,8 +150,9 @@ class VertexPlacer {
     const double va = double(g_.data[a]), vb = double(g_.data[b]);
     const double s = std::clamp((iso_ - va) / (vb - va), kEdgeMargin, 1.0 - kEdgeMargin);
     if (positions_.empty()) {
-      double idx[3] = {double(i), double(j), double(k)};
-      idx[axis] += s;
+      // Each coordinate on its own (not an indexed array), so that nothing goes through memory.
+      const double idx[3] = {double(i) + (axis == 0 ? s : 0.0), double(j) + (axis == 1 ? s : 0.0),
+                             double(k) + (axis == 2 ? s : 0.0)};
       for (int d = 0; d < 3; ++d) position[d] = float(double(g_.origin[d]) + idx[d] * double(g_.spacing[d]));
     } else {
       position = ((1 - s) * positions_[a].cast<double>() + s * positions_[b].cast<double>()).cast<float>();

@@ -554,23 +554,46 @@ struct MinMaxOctree<T>::BlockQuery {
     // The owner of an edge: this leaf or its neighbour +x, +y, +z (bits 0-2), looked up once.
     std::uint32_t owner[8];
     std::fill(owner, owner + 8, kUnknown);
-    owner[0] = std::uint32_t(s);
     const std::size_t leaf = leaves[s];
     std::size_t centre = vertex_first[s + 1] - centre_count[s];
     TriMesh::Triangle* out = mesh.triangles.data() + triangle_first[s];
     const Vec3f* normals = placer.normals() ? mesh.normals.data() : nullptr;
+    // The ids of the edges this leaf owns, by bit (only those bits are read).
+    thread_local std::vector<std::uint32_t> own_ids;
+    own_ids.resize(words * 64);
+    std::uint32_t next_id = std::uint32_t(vertex_first[s]);
+    for (std::size_t i = 0; i < words; ++i)
+      for (std::uint64_t bits = masks[s * words + i]; bits != 0; bits &= bits - 1)
+        own_ids[i * 64 + std::size_t(std::countr_zero(bits))] = next_id++;
+    // Edge e of cell (x, y, z) has bit (z * S + y) * S + x + edge_bit[e] when this leaf owns it.
+    std::size_t edge_bit[12];
+    for (int edge = 0; edge < 12; ++edge) {
+      const int lo = detail::kEdgeCorners[edge][0];
+      edge_bit[edge] = ((std::size_t(edge >> 2) * S + std::size_t((lo >> 2) & 1)) * S + std::size_t((lo >> 1) & 1)) * S +
+                       std::size_t(lo & 1);
+    }
+    // Cells at these coordinates (L - 1, or none in the last leaf) have edges owned by the next leaf.
+    std::size_t last_cell[3];
+    for (int d = 0; d < 3; ++d) last_cell[d] = b.leaf_xyz[d] + 1 < leaf_dims[d] ? L - 1 : L;
     const std::uint32_t* cells = crossed_cells.data() + s * L * L * L;
     for (std::uint32_t i = 0; i < crossed_count[s]; ++i) {
       const std::size_t e = cells[i] >> kEntryShift, c = e >> 6;
       const std::size_t x = cells[i] & 31, y = (cells[i] >> 5) & 31, z = (cells[i] >> 10) & 31;
+      const std::size_t cell_bit = (z * S + y) * S + x;
+      const bool inner = x != last_cell[0] && y != last_cell[1] && z != last_cell[2];
       std::uint32_t ids[12 + kMaxCentres];
       for (unsigned crossed = detail::kCrossedEdges[c]; crossed != 0; crossed &= crossed - 1) {
         const int edge = std::countr_zero(crossed);
         const int lo = detail::kEdgeCorners[edge][0];
         std::size_t p[3] = {x + (lo & 1), y + ((lo >> 1) & 1), z + ((lo >> 2) & 1)};
         unsigned neighbour = 0;
-        for (int d = 0; d < 3; ++d)
-          if (p[d] == L && b.leaf_xyz[d] + 1 < leaf_dims[d]) p[d] = 0, neighbour |= 1u << d;
+        if (!inner)
+          for (int d = 0; d < 3; ++d)
+            if (p[d] == L && b.leaf_xyz[d] + 1 < leaf_dims[d]) p[d] = 0, neighbour |= 1u << d;
+        if (neighbour == 0) {
+          ids[edge] = own_ids[cell_bit + edge_bit[edge]];
+          continue;
+        }
         if (owner[neighbour] == kUnknown)
           owner[neighbour] = slot[leaf + (neighbour & 1) + leaf_dims[0] * (((neighbour >> 1) & 1) +
                                                                            leaf_dims[1] * ((neighbour >> 2) & 1))];
