@@ -386,7 +386,7 @@ struct MinMaxOctree<T>::BlockQuery {
   std::unique_ptr<std::uint32_t[]> slot;    // leaf-grid index -> place in `leaves`, set for crossed leaves only
   std::vector<std::uint64_t> masks;         // `words` per crossed leaf
   std::vector<std::uint32_t> ranks;         // per word: bits set in the leaf's earlier words
-  std::vector<std::uint32_t> crossed_cells;  // L^3 per crossed leaf: its crossed cells (pass 1), then unused
+  std::vector<const std::uint32_t*> crossed_cells;  // per crossed leaf: its crossed cells (kept by pass 1)
   std::vector<std::uint32_t> crossed_count, centre_count;  // per crossed leaf
   std::vector<std::size_t> vertex_first;    // per crossed leaf: its edge vertices, then its centre vertices
   std::vector<std::size_t> triangle_first;
@@ -493,7 +493,7 @@ struct MinMaxOctree<T>::BlockQuery {
   static constexpr int kEntryShift = 15;
 
   // Pass 1 for crossed leaf s: its edge masks, its crossed cells and counts; returns its cells.
-  std::size_t count(std::size_t s, std::size_t& triangles) {
+  std::size_t count(std::size_t s, std::size_t& triangles, std::vector<std::uint32_t>& cells) {
     const Box b = box(leaves[s]);
     std::uint64_t rows[(kMaxLeafCells + 1) * (kMaxLeafCells + 1)];
     inside_rows(b, rows);
@@ -520,15 +520,14 @@ struct MinMaxOctree<T>::BlockQuery {
     }
     std::size_t centres = 0;
     triangles = 0;
-    std::uint32_t* cells = crossed_cells.data() + s * L * L * L;
-    std::uint32_t crossed = 0;
+    const std::size_t before = cells.size();
     for_each_crossed_cell(b, rows, [&](std::size_t x, std::size_t y, std::size_t z, unsigned c) {
       const std::size_t e = entry(b, x, y, z, c);
       triangles += (table.offsets[e + 1] - table.offsets[e]) / 3;
       for (std::size_t n = 0; n < kMaxCentres && table.centres[e * kMaxCentres + n] != 0; ++n) ++centres;
-      cells[crossed++] = std::uint32_t(e << kEntryShift | z << 10 | y << 5 | x);
+      cells.push_back(std::uint32_t(e << kEntryShift | z << 10 | y << 5 | x));
     });
-    crossed_count[s] = crossed;
+    crossed_count[s] = std::uint32_t(cells.size() - before);
     centre_count[s] = std::uint32_t(centres);
     return b.cells[0] * b.cells[1] * b.cells[2];
   }
@@ -575,7 +574,7 @@ struct MinMaxOctree<T>::BlockQuery {
     // Cells at these coordinates (L - 1, or none in the last leaf) have edges owned by the next leaf.
     std::size_t last_cell[3];
     for (int d = 0; d < 3; ++d) last_cell[d] = b.leaf_xyz[d] + 1 < leaf_dims[d] ? L - 1 : L;
-    const std::uint32_t* cells = crossed_cells.data() + s * L * L * L;
+    const std::uint32_t* cells = crossed_cells[s];
     for (std::uint32_t i = 0; i < crossed_count[s]; ++i) {
       const std::size_t e = cells[i] >> kEntryShift, c = e >> 6;
       const std::size_t x = cells[i] & 31, y = (cells[i] >> 5) & 31, z = (cells[i] >> 10) & 31;
@@ -655,20 +654,28 @@ OctreeIsoResult MinMaxOctree<T>::block_isosurface(double iso, const IsoOptions& 
   Progress progress(options.progress, "isosurface", double(chunks + n));
   struct Chunk {
     std::vector<Vec3f> positions, normals;
+    std::vector<std::uint32_t> cells;  // the crossed cells of its leaves
   };
   std::vector<Chunk> chunk(chunks);
-  q.crossed_cells.resize(n * leaf_cells_ * leaf_cells_ * leaf_cells_);
+  q.crossed_cells.resize(n);
   q.crossed_count.resize(n);
   q.centre_count.resize(n);
   q.vertex_first.resize(n + 1);
   q.triangle_first.resize(n + 1);
   std::vector<std::size_t> triangles(n), cells(n);
   for_each_in_batches(chunks, bool(options.progress), progress, 0, 1, [&](std::size_t c) {
-    for (std::size_t s = n * c / chunks; s < n * (c + 1) / chunks; ++s) {
-      cells[s] = q.count(s, triangles[s]);
+    const std::size_t first = n * c / chunks, last = n * (c + 1) / chunks;
+    // Room for about L^2 vertices and cells per leaf, what a smooth surface through it has.
+    chunk[c].positions.reserve((last - first) * leaf_cells_ * leaf_cells_);
+    if (options.normals) chunk[c].normals.reserve((last - first) * leaf_cells_ * leaf_cells_);
+    chunk[c].cells.reserve((last - first) * leaf_cells_ * leaf_cells_);
+    for (std::size_t s = first; s < last; ++s) {
+      cells[s] = q.count(s, triangles[s], chunk[c].cells);
       q.vertex_first[s] = chunk[c].positions.size();  // within the chunk for now
       q.place_edge_vertices(s, chunk[c].positions, chunk[c].normals);
     }
+    const std::uint32_t* next = chunk[c].cells.data();
+    for (std::size_t s = first; s < last; ++s) q.crossed_cells[s] = next, next += q.crossed_count[s];
   });
   std::vector<std::size_t> chunk_first(chunks + 1, 0);
   for (std::size_t c = 0; c < chunks; ++c) {
@@ -697,7 +704,6 @@ OctreeIsoResult MinMaxOctree<T>::block_isosurface(double iso, const IsoOptions& 
       std::copy(chunk[c].normals.begin(), chunk[c].normals.end(), mesh.normals.begin() + std::ptrdiff_t(chunk_first[c]));
     }, 1);
   }
-  chunk.clear();
   mesh.triangles.resize(q.triangle_first[n]);
   for_each_in_batches(n, bool(options.progress), progress, double(chunks), 16, [&](std::size_t s) { q.march(s, mesh); });
   progress.finish();
