@@ -619,6 +619,9 @@ struct MinMaxOctree<T>::BlockQuery {
 
 template <typename T>
 OctreeIsoResult MinMaxOctree<T>::block_isosurface(double iso, const IsoOptions& options, bool flip) const {
+  const auto& dims = levels_[0].dims;
+  if (dims[0] * dims[1] * dims[2] > std::size_t(UINT32_MAX))
+    throw Error("isosurface: more than 2^32 - 1 octree leaves; use larger leaves or VertexSharing::hash_table");
   OctreeIsoResult result;
   BlockQuery q(*this, iso, options, flip);
   // The crossed leaves, subtree by subtree in parallel, in the order of the sequential descent.
@@ -639,7 +642,6 @@ OctreeIsoResult MinMaxOctree<T>::block_isosurface(double iso, const IsoOptions& 
     Progress(options.progress, "isosurface", 1).finish();
     return result;
   }
-  const auto& dims = levels_[0].dims;
   q.slot = std::make_unique_for_overwrite<std::uint32_t[]>(dims[0] * dims[1] * dims[2]);
   for (std::size_t s = 0; s < n; ++s) q.slot[q.leaves[s]] = std::uint32_t(s);
   q.masks.resize(n * q.words);

@@ -380,7 +380,7 @@ TEST(MinMaxOctree, BothSharingModesOnBordersThinVolumesAndCurvilinearGrids) {
     for (std::size_t k = 0; k < d[2]; ++k)
       for (std::size_t j = 0; j < d[1]; ++j)
         for (std::size_t i = 0; i < d[0]; ++i) ints(i, j, k) = std::int16_t(std::lround(2 * ball(double(i), double(j), double(k))));
-    for (std::size_t leaf : {1, 3, 4}) {
+    for (std::size_t leaf : {1, 3, 4, 32}) {  // 32: one leaf holds the whole volume
       const MinMaxOctree<float> tree(g, leaf);
       const MinMaxOctree<std::int16_t> int_tree(ints, leaf);
       for (bool normals : {true, false}) {
