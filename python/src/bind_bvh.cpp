@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "bindings.hpp"
+#include "index_arrays.hpp"
 #include "mesh_arrays.hpp"
 #include "geods/bvh/triangle_bvh.hpp"
 #include "geods/core/error.hpp"
@@ -127,9 +128,7 @@ class PyBvh {
       py::gil_scoped_release release;
       ids = bvh_.cull_box(box);
     }
-    py::array_t<std::int64_t> out(py::ssize_t(ids.size()));
-    for (std::size_t i = 0; i < ids.size(); ++i) out.mutable_data()[i] = ids[i];
-    return out;
+    return index_array(ids);
   }
 
   // planes: (k, 4) rows (nx, ny, nz, offset) of n.x = offset, n pointing into the frustum.
@@ -150,9 +149,7 @@ class PyBvh {
       py::gil_scoped_release release;
       ids = bvh_.cull_frustum(ps);
     }
-    py::array_t<std::int64_t> out(py::ssize_t(ids.size()));
-    for (std::size_t i = 0; i < ids.size(); ++i) out.mutable_data()[i] = ids[i];
-    return out;
+    return index_array(ids);
   }
 
   py::dict stats() const {

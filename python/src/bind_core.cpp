@@ -5,12 +5,14 @@
 
 #include <array>
 #include <cstddef>
+#include <span>
 #include <string>
 #include <tuple>
 #include <utility>
 #include <vector>
 
 #include "bindings.hpp"
+#include "index_arrays.hpp"
 #include "geods/core/convex_hull3.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"
@@ -161,12 +163,10 @@ with the same n.)doc");
           py::gil_scoped_release release;
           hull = convex_hull3(p);
         }
-        py::array_t<std::int64_t> vertices(py::ssize_t(hull.vertices.size()));
-        for (std::size_t i = 0; i < hull.vertices.size(); ++i) vertices.mutable_data()[i] = hull.vertices[i];
-        py::array_t<std::int64_t> faces({py::ssize_t(hull.faces.size()), py::ssize_t(3)});
-        for (std::size_t i = 0; i < hull.faces.size(); ++i)
-          for (std::size_t k = 0; k < 3; ++k) faces.mutable_data()[3 * i + k] = hull.faces[i][k];
-        return py::make_tuple(vertices, faces, hull.dimension);
+        const std::span<const std::uint32_t> corners(hull.faces.empty() ? nullptr : hull.faces[0].data(),
+                                                     3 * hull.faces.size());  // std::array rows are contiguous
+        return py::make_tuple(index_array(hull.vertices), index_array(corners, {py::ssize_t(hull.faces.size()), 3}),
+                              hull.dimension);
       },
       py::arg("points"),
       R"doc(Convex hull of (n, 3) points, exact (orient3d decides every side test).

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "bindings.hpp"
+#include "index_arrays.hpp"
 #include "geods/core/error.hpp"
 #include "geods/voronoi/delaunay2.hpp"
 
@@ -31,14 +32,6 @@ Vec2d as_point(const py::handle& h, const char* what) {
   const auto a = Rows::ensure(h);
   if (!a || a.ndim() != 1 || a.shape(0) != 2) throw Error(std::string(what) + ": expected a point (x, y)");
   return {a.at(0), a.at(1)};
-}
-
-// -1 for no_edge, as numpy users expect of a missing index.
-py::array_t<std::int64_t> as_int64(const std::vector<std::uint32_t>& v, std::vector<py::ssize_t> shape) {
-  py::array_t<std::int64_t> out(shape);
-  std::int64_t* o = out.mutable_data();
-  for (std::size_t i = 0; i < v.size(); ++i) o[i] = v[i] == Delaunay2::no_edge ? -1 : std::int64_t(v[i]);
-  return out;
 }
 
 std::int64_t as_index(std::uint32_t i) { return i == Delaunay2::no_edge ? -1 : std::int64_t(i); }
@@ -110,14 +103,14 @@ new appended point (intersection_points). NaN/inf raise geods.Error (ValueError)
           "(n, 2) float64: the input points, then intersection and inserted points")
       .def_property_readonly(
           "triangles",
-          [](const Delaunay2& dt) { return as_int64(dt.triangles(), {py::ssize_t(dt.triangle_count()), 3}); },
+          [](const Delaunay2& dt) { return index_array(dt.triangles(), {py::ssize_t(dt.triangle_count()), 3}); },
           "(m, 3) int64: counter-clockwise vertex indices (first occurrences of duplicates)")
       .def_property_readonly(
-          "halfedges", [](const Delaunay2& dt) { return as_int64(dt.halfedges(), {py::ssize_t(dt.halfedges().size())}); },
+          "halfedges", [](const Delaunay2& dt) { return index_array(dt.halfedges(), {py::ssize_t(dt.halfedges().size())}); },
           "(3m,) int64: the opposite half-edge of half-edge e (from triangles.flat[e] to the next vertex "
           "of its triangle), -1 on the hull")
       .def_property_readonly(
-          "hull", [](const Delaunay2& dt) { return as_int64(dt.hull(), {py::ssize_t(dt.hull().size())}); },
+          "hull", [](const Delaunay2& dt) { return index_array(dt.hull(), {py::ssize_t(dt.hull().size())}); },
           "hull vertices counter-clockwise (for a degenerate set: the distinct points sorted by x, y)")
       .def_property_readonly("degenerate", &Delaunay2::degenerate, "True when there are no triangles")
       .def_property_readonly(
@@ -135,13 +128,13 @@ new appended point (intersection_points). NaN/inf raise geods.Error (ValueError)
             const auto edges = dt.constrained_edges();
             std::vector<std::uint32_t> flat;
             for (const auto& e : edges) flat.insert(flat.end(), e.begin(), e.end());
-            return as_int64(flat, {py::ssize_t(edges.size()), 2});
+            return index_array(flat, {py::ssize_t(edges.size()), 2});
           },
           "(k, 2) int64: the constrained edges, each once")
       .def_property_readonly(
           "intersection_points",
           [](const Delaunay2& dt) {
-            return as_int64(dt.intersection_points(), {py::ssize_t(dt.intersection_points().size())});
+            return index_array(dt.intersection_points(), {py::ssize_t(dt.intersection_points().size())});
           },
           "indices of the points added where segments cross")
       .def_property_readonly(
@@ -170,7 +163,7 @@ new appended point (intersection_points). NaN/inf raise geods.Error (ValueError)
           "neighbors",
           [](const Delaunay2& dt, std::int64_t v) {
             const auto nb = dt.neighbors(vertex_index(v, dt, "Delaunay2.neighbors"));
-            return as_int64(nb, {py::ssize_t(nb.size())});
+            return index_array(nb, {py::ssize_t(nb.size())});
           },
           py::arg("v"), "Delaunay neighbours of vertex v, counter-clockwise")
       .def(
