@@ -115,7 +115,7 @@ void BM_Query(benchmark::State& state) {
   std::vector<Tree::Neighbor> out(10);
   std::size_t i = 0;
   for (auto _ : state) {
-    benchmark::DoNotOptimize(tree.query_into(queries[i++ % queries.size()], 10, out.data()));
+    benchmark::DoNotOptimize(tree.query_into(queries[i++ % queries.size()], spatial::KnnRequest{10}, out.data()));
   }
   state.SetItemsProcessed(std::int64_t(state.iterations()));
   state.counters["trees"] = double(tree.stats().structure.structures);

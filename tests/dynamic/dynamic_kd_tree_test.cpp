@@ -42,7 +42,7 @@ struct Oracle {
       if (lo[0] <= p[0] && p[0] <= hi[0] && lo[1] <= p[1] && p[1] <= hi[1]) out.push_back(id);
     return out;
   }
-  // The same sum in the same order as KdBlock, so distances compare exactly.
+  // The same sum in the same order as spatial::KdTree, so distances compare exactly.
   static double squared_distance(const P& q, const P& p) {
     double d = 0;
     for (int a = 0; a < 2; ++a) d += (q[a] - p[a]) * (q[a] - p[a]);
@@ -299,7 +299,7 @@ TEST(DynamicKdTree, ReinsertingARemovedPointDoesNotDuplicateIt) {
     EXPECT_FALSE(tree.contains(a));
     const auto at_p = tree.query_radius(p, 0.0);
     ASSERT_EQ(at_p.size(), 1u);
-    EXPECT_EQ(at_p[0].id, b);
+    EXPECT_EQ(at_p[0].index, b);
     EXPECT_THROW(tree.remove(a), Error);
     // After a reconstruction, still one copy.
     tree.rebuild();

@@ -1,4 +1,4 @@
-// The generic wrapper with other static structures, and the k-d block on its own.
+// The generic wrapper with other static structures, and the k-d tree block on its own.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -8,7 +8,7 @@
 #include "geods/core/error.hpp"
 #include "geods/core/rng.hpp"
 #include "geods/dynamic/dynamized.hpp"
-#include "geods/dynamic/kd_block.hpp"
+#include "geods/dynamic/dynamic_kd_tree.hpp"
 #include "geods/dynamic/locator.hpp"
 
 namespace geods::dynamic {
@@ -34,7 +34,8 @@ struct SortedArray {
 
 static_assert(StaticStructure<SortedArray>);
 static_assert(!WeakDeletable<SortedArray>);
-static_assert(WeakDeletable<KdBlock<float, 3>> && SteppedBuild<KdBlock<float, 3>>);
+static_assert(WeakDeletable<KdTreeBlock<float, 3>> && SteppedBuild<KdTreeBlock<float, 3>>);
+static_assert(WeakDeletable<KdTreeBlock<double, spatial::Dynamic>> && SteppedBuild<KdTreeBlock<double, spatial::Dynamic>>);
 
 TEST(Dynamized, InsertOnlyStructureAnswersDecomposedQueries) {
   Dynamized<SortedArray> set;
@@ -55,47 +56,51 @@ TEST(Dynamized, InsertOnlyStructureAnswersDecomposedQueries) {
   EXPECT_EQ(std::set<Id>(item_ids.begin(), item_ids.end()), std::set<Id>(ids.begin(), ids.end()));
 }
 
-TEST(KdBlock, SteppedBuildGivesTheSameTree) {
+TEST(KdTreeBlock, SteppedBuildGivesTheSameTree) {
   Rng rng(11);
-  std::vector<KdBlock<double, 3>::Item> items(5000);
+  std::vector<KdTreeBlock<double, 3>::Item> items(5000);
   for (auto& p : items) p = {rng.uniform(), double(rng.below(4)), rng.normal()};
-  const KdBlock<double, 3> whole = KdBlock<double, 3>::build(items);
-  KdBlock<double, 3>::Builder builder(items);
+  const KdTreeBlock<double, 3> whole = KdTreeBlock<double, 3>::build(items);
+  KdTreeBlock<double, 3>::Builder builder(items);
   std::size_t steps = 0;
   while (!builder.step(97)) ++steps;
   EXPECT_GT(steps, builder.estimated_work() / 97 / 4) << "the build really runs in many small steps";
-  const KdBlock<double, 3> stepped = builder.finish();
+  const KdTreeBlock<double, 3> stepped = builder.finish();
   whole.validate();
   stepped.validate();
   EXPECT_EQ(stepped.extract(), items);
+  EXPECT_EQ(stepped.tree().permutation(), whole.tree().permutation());
   const double q[3] = {0.5, 1, 0};
   const double lo[3] = {0.2, 0, -1}, hi[3] = {0.6, 2, 1};
   std::vector<std::size_t> a, b;
-  whole.in_box(lo, hi, [&](std::size_t slot) { a.push_back(slot); });
-  stepped.in_box(lo, hi, [&](std::size_t slot) { b.push_back(slot); });
+  whole.tree().search_box(lo, hi, [&](std::uint32_t slot) { a.push_back(slot); }, whole.dead_slots());
+  stepped.tree().search_box(lo, hi, [&](std::uint32_t slot) { b.push_back(slot); }, stepped.dead_slots());
   EXPECT_EQ(a, b);
   std::vector<std::size_t> near;
-  stepped.within(q, 0.01, [&](std::size_t slot, double) { near.push_back(slot); });
+  stepped.tree().search_radius(q, 0.01, [&](std::uint32_t slot, double) { near.push_back(slot); }, stepped.dead_slots());
   std::size_t expected = 0;
   for (const auto& p : items)
     expected += (p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) + (p[2] - q[2]) * (p[2] - q[2]) <= 0.01;
   EXPECT_EQ(near.size(), expected);
 }
 
-TEST(KdBlock, WeakDeleteHidesSlots) {
-  std::vector<KdBlock<float, 2>::Item> items;
+TEST(KdTreeBlock, WeakDeleteHidesSlots) {
+  std::vector<KdTreeBlock<float, 2>::Item> items;
   for (int i = 0; i < 100; ++i) items.push_back({float(i % 10), float(i / 10)});
-  KdBlock<float, 2> block = KdBlock<float, 2>::build(items);
+  KdTreeBlock<float, 2> block = KdTreeBlock<float, 2>::build(items);
   for (std::size_t slot = 0; slot < 100; slot += 2) block.weak_delete(slot);
   EXPECT_THROW(block.weak_delete(0), Error);
   EXPECT_EQ(block.dead(), 50u);
   block.validate();
   const float lo[2] = {0, 0}, hi[2] = {9, 9};
   std::size_t count = 0;
-  block.in_box(lo, hi, [&](std::size_t slot) {
-    EXPECT_EQ(slot % 2, 1u);
-    ++count;
-  });
+  block.tree().search_box(
+      lo, hi,
+      [&](std::uint32_t slot) {
+        EXPECT_EQ(slot % 2, 1u);
+        ++count;
+      },
+      block.dead_slots());
   EXPECT_EQ(count, 50u);
   EXPECT_EQ(block.extract().size(), 100u) << "dead slots stay until a rebuild";
 }

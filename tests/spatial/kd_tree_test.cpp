@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -16,6 +17,7 @@
 #include "geods/core/parallel.hpp"
 #include "geods/core/rng.hpp"
 #include "geods/spatial/kd_tree.hpp"
+#include "geods/spatial/kd_tree_stepped_build.hpp"
 
 namespace geods::spatial {
 namespace {
@@ -403,6 +405,111 @@ TEST(KdTree, CorruptedFilesThrow) {
   EXPECT_THROW((KdTree<double, 2>::load(temp_file("missing.kdt"))), Error);
   std::filesystem::remove(path);
   std::filesystem::remove(bad);
+}
+
+// The stepped build (pausing every `budget` element visits) and queries with a
+// filter of skipped points: the same answers as brute force over the kept
+// points, and without a filter the same as the parallel build.
+template <typename T, int Dim>
+void check_stepped_and_filtered(Shape shape, std::size_t n, std::size_t d, std::size_t budget) {
+  SCOPED_TRACE(name(shape) + " n=" + std::to_string(n) + " d=" + std::to_string(d) + " budget=" +
+               std::to_string(budget) + (sizeof(T) == 4 ? " float" : " double"));
+  const std::vector<T> pts = make_points<T>(shape, n, d, 41 + n + d);
+  using Build = KdTreeSteppedBuild<T, Dim>;
+  std::vector<typename Build::Row> rows(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    if constexpr (Dim == Dynamic) rows[i].resize(d);
+    std::copy(&pts[i * d], &pts[i * d] + d, rows[i].begin());
+  }
+  Build build(rows, d, 6);
+  std::size_t steps = 0;
+  while (!build.step(budget)) ++steps;
+  if (n > 100) {
+    EXPECT_GE(steps, build.estimated_work() / budget / 4) << "the build runs in many small steps";
+  }
+  const KdTree<T, Dim> stepped = build.finish();
+  ASSERT_NO_THROW(stepped.validate());
+  EXPECT_TRUE(stepped.stores_points_in_tree_order());
+  EXPECT_EQ(stepped.size(), n);
+  const KdTree<T, Dim> plain(PointView<T>(pts.data(), n, d), 6);
+  EXPECT_EQ(stepped.stats().depth, plain.stats().depth);
+  EXPECT_EQ(stepped.nodes().size(), plain.nodes().size());
+
+  std::vector<std::uint8_t> flags(n);
+  Rng rng(3 + n);
+  for (std::size_t i = 0; i < n; ++i) flags[i] = i % 3 == 0 || rng.below(4) == 0;
+  const SkipFlagged skip{flags.data()};
+  const auto skip_odd_lambda = [&](std::uint32_t i) { return flags[i] != 0; };
+  const std::vector<T> qs = make_queries(pts, n, d, 20, 7 + n);
+  for (std::size_t i = 0; i < 20; ++i) {
+    const T* q = &qs[i * d];
+    const std::span<const T> qspan(q, d);
+    std::vector<Neighbor<T>> kept;
+    for (const auto& nb : brute_all(pts, d, q))
+      if (!flags[nb.index]) kept.push_back(nb);
+    for (std::size_t k : {std::size_t(1), std::size_t(5), std::size_t(23)}) {
+      ASSERT_EQ(stepped.query(qspan, k), plain.query(qspan, k)) << "k=" << k;
+      const std::vector<Neighbor<T>> want(kept.begin(), kept.begin() + std::min(k, kept.size()));
+      ASSERT_EQ(stepped.query(qspan, KnnRequest{k}, skip), want) << "k=" << k;
+      ASSERT_EQ(plain.query(qspan, KnnRequest{k}, skip_odd_lambda), want) << "k=" << k;
+    }
+    const double r = kept.empty() ? 0.1 : std::sqrt(double(kept[std::min<std::size_t>(3, kept.size() - 1)].squared_distance));
+    std::vector<Neighbor<T>> within;
+    for (const auto& nb : kept)
+      if (nb.squared_distance <= T(r * r)) within.push_back(nb);
+    ASSERT_EQ(stepped.query_radius(qspan, r, skip), within);
+    ASSERT_EQ(plain.query_radius(qspan, r, skip), within);
+    ASSERT_EQ(stepped.query_radius(qspan, r), plain.query_radius(qspan, r));
+    // max_distance and (1 + eps) with a filter: fewer than k within the limit, each within the bound.
+    const std::vector<Neighbor<T>> limited = stepped.query(qspan, KnnRequest{8, 0, r}, skip);
+    ASSERT_EQ(limited, std::vector<Neighbor<T>>(within.begin(), within.begin() + std::min<std::size_t>(8, within.size())));
+    const std::vector<Neighbor<T>> approx = stepped.query(qspan, KnnRequest{7, 1.0}, skip);
+    ASSERT_EQ(approx.size(), std::min<std::size_t>(7, kept.size()));
+    for (std::size_t j = 0; j < approx.size(); ++j) {
+      ASSERT_FALSE(flags[approx[j].index]);
+      ASSERT_LE(std::sqrt(double(approx[j].squared_distance)),
+                2 * std::sqrt(double(kept[j].squared_distance)) * (1 + 1e-6) + 1e-12);
+    }
+    std::vector<T> lo(d), hi(d);
+    for (std::size_t a = 0; a < d; ++a) lo[a] = q[a] - T(0.3), hi[a] = q[a] + T(0.4);
+    std::vector<std::uint32_t> want_box, all_box;
+    for (std::size_t j = 0; j < n; ++j) {
+      bool in = true;
+      for (std::size_t a = 0; a < d; ++a) in = in && lo[a] <= pts[j * d + a] && pts[j * d + a] <= hi[a];
+      if (in) all_box.push_back(std::uint32_t(j));
+      if (in && !flags[j]) want_box.push_back(std::uint32_t(j));
+    }
+    for (const KdTree<T, Dim>* tree : {&stepped, &plain}) {
+      std::vector<std::uint32_t> got = tree->query_box(lo, hi, nullptr, skip), all = tree->query_box(lo, hi);
+      std::sort(got.begin(), got.end());
+      std::sort(all.begin(), all.end());
+      ASSERT_EQ(got, want_box);
+      ASSERT_EQ(all, all_box);
+      ASSERT_EQ(tree->count_box(lo, hi, nullptr, skip), want_box.size());
+    }
+  }
+}
+
+TEST(KdTree, SteppedBuildAndFilterMatchBruteForce) {
+  for (Shape shape : kShapes) {
+    for (std::size_t n : {0, 1, 9, 700}) {
+      check_stepped_and_filtered<float, 3>(shape, n, 3, 37);
+      check_stepped_and_filtered<double, 2>(shape, n, 2, 1);
+      check_stepped_and_filtered<double, Dynamic>(shape, n, 5, 100);
+    }
+  }
+}
+
+TEST(KdTree, SteppedBuildRejectsBadRows) {
+  std::vector<std::array<double, 2>> rows = {{0, 0}, {1, std::nan("")}, {2, 2}};
+  KdTreeSteppedBuild<double, 2> nan_build(rows);
+  EXPECT_THROW(nan_build.finish(), Error);
+  std::vector<std::vector<float>> ragged = {{0, 0, 0}, {1, 1}};
+  KdTreeSteppedBuild<float, Dynamic> ragged_build(ragged, 3);
+  EXPECT_THROW(ragged_build.finish(), Error);
+  EXPECT_THROW((KdTreeSteppedBuild<float, Dynamic>(ragged, 0)), Error);
+  EXPECT_THROW((KdTreeSteppedBuild<double, 2>(rows, 3)), Error);
+  EXPECT_THROW((KdTreeSteppedBuild<double, 2>(rows, 2, 0)), Error);
 }
 
 TEST(KdTree, BadInputThrows) {

@@ -35,8 +35,8 @@ struct Geods {
     void knn(const float* q, std::size_t k, std::uint32_t* ids, float* distances) const {
       thread_local std::vector<Tree::Neighbor> out;
       out.resize(k);
-      tree.query_into(std::span<const float>(q, 3), k, out.data());
-      for (std::size_t i = 0; i < k; ++i) ids[i] = out[i].id, distances[i] = out[i].squared_distance;
+      tree.query_into(std::span<const float>(q, 3), geods::spatial::KnnRequest{k}, out.data());
+      for (std::size_t i = 0; i < k; ++i) ids[i] = std::uint32_t(out[i].index), distances[i] = out[i].squared_distance;
     }
   };
 };

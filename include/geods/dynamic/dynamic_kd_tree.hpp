@@ -1,6 +1,6 @@
 #pragma once
 // Dyn(k-d) (seed §7.4): a k-d tree with insert and delete, made of static
-// k-d blocks (kd_block.hpp) by the generic dynamization (dynamized.hpp).
+// spatial::KdTree blocks by the generic dynamization (dynamized.hpp).
 // With the worst-case variant (Theorem 14): build O(n log n), query
 // O(sqrt(n) log n + a) for ranges in 2D, insert O(log^2 n), delete O(log n)
 // (weak delete plus a share of a global reconstruction that runs in steps),
@@ -15,7 +15,6 @@
 // of the stored slots are dead, and in the worst-case variant ends within a
 // bounded number of later operations), or on rebuild().
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -26,37 +25,128 @@
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"
 #include "geods/dynamic/dynamized.hpp"
-#include "geods/dynamic/kd_block.hpp"
+#include "geods/spatial/kd_tree.hpp"
+#include "geods/spatial/kd_tree_stepped_build.hpp"
+#include "geods/spatial/knn_result.hpp"
+#include "geods/spatial/point_filter.hpp"
 #include "geods/spatial/point_view.hpp"
 
 namespace geods::dynamic {
+
+/// One block V_i of Dyn(k-d): a spatial::KdTree over its items (point index =
+/// slot), built in steps (KdTreeSteppedBuild), and one flag per slot for the
+/// weak delete (WD_k-d of §7.4), which its queries skip.
+template <typename T, int Dim>
+class KdTreeBlock {
+ public:
+  using Tree = spatial::KdTree<T, Dim>;
+  using Item = typename spatial::KdTreeSteppedBuild<T, Dim>::Row;
+  static constexpr std::size_t kLeafSize = 8;
+
+  class Builder {
+   public:
+    explicit Builder(std::vector<Item> items) : dim_(item_dim(items)), build_(std::move(items), dim_, kLeafSize) {}
+    std::size_t estimated_work() const { return build_.estimated_work(); }
+    bool step(std::size_t work) { return build_.step(work); }
+    KdTreeBlock finish() {
+      KdTreeBlock block;
+      block.tree_ = build_.finish();
+      block.dead_.assign(block.tree_.size(), 0);
+      return block;
+    }
+
+   private:
+    // A block of a run-time dimension takes it from its items (an empty one has none).
+    static std::size_t item_dim(const std::vector<Item>& items) {
+      if constexpr (Dim == spatial::Dynamic)
+        return items.empty() ? 1 : items.front().size();
+      else
+        return std::size_t(Dim);
+    }
+    std::size_t dim_;
+    spatial::KdTreeSteppedBuild<T, Dim> build_;
+  };
+
+  static KdTreeBlock build(std::vector<Item> items) { return Builder(std::move(items)).finish(); }
+
+  /// Slots, dead ones included.
+  std::size_t size() const { return tree_.size(); }
+  std::size_t dead() const { return dead_count_; }
+  bool all_dead() const { return dead_count_ == size(); }
+  /// Every item, dead ones included, in slot order.
+  std::vector<Item> extract() const {
+    std::vector<Item> out;
+    out.reserve(size());
+    for (std::size_t slot = 0; slot < size(); ++slot) out.push_back(item(slot));
+    return out;
+  }
+  Item item(std::size_t slot) const {
+    const T* p = tree_.point(slot);
+    Item out;
+    if constexpr (Dim == spatial::Dynamic) out.resize(tree_.dim());
+    std::copy(p, p + tree_.dim(), out.begin());
+    return out;
+  }
+  bool is_dead(std::size_t slot) const { return dead_.at(slot) != 0; }
+  void weak_delete(std::size_t slot) {
+    if (slot >= size() || dead_[slot])
+      throw Error("KdTreeBlock::weak_delete: slot " + std::to_string(slot) + " is not a live slot");
+    dead_[slot] = 1;
+    ++dead_count_;
+  }
+
+  /// The tree (point index = slot) and the filter its queries take to skip dead slots.
+  const Tree& tree() const { return tree_; }
+  spatial::SkipFlagged dead_slots() const { return {dead_.data()}; }
+
+  /// Heap bytes held.
+  std::size_t bytes() const { return tree_.bytes() + dead_.capacity(); }
+
+  /// The tree's invariants (it keeps its points in tree order too) and the dead flags.
+  void validate() const {
+    tree_.validate();
+    if (!tree_.stores_points_in_tree_order()) throw Error("KdTreeBlock::validate: points not in tree order");
+    if (dead_.size() != size()) throw Error("KdTreeBlock::validate: dead flags of the wrong size");
+    if (std::size_t(std::count(dead_.begin(), dead_.end(), 1)) != dead_count_)
+      throw Error("KdTreeBlock::validate: dead count is wrong");
+  }
+
+ private:
+  Tree tree_;
+  std::vector<std::uint8_t> dead_;  // by slot
+  std::size_t dead_count_ = 0;
+};
 
 struct DynamicKdTreeStats {
   DynamizedStats structure;
   std::size_t bytes = 0;  // blocks and locator
 };
 
+/// Dim is the dimension, or spatial::Dynamic for one given at run time.
 template <typename T, int Dim>
 class DynamicKdTree {
  public:
-  using Block = KdBlock<T, Dim>;
+  using Block = KdTreeBlock<T, Dim>;
+  /// A point: std::array<T, Dim>, or std::vector<T> for a run-time dimension.
   using Point = typename Block::Item;
+  /// An item (index: its id) and its squared distance; results are sorted by distance, ties by id.
+  using Neighbor = spatial::Neighbor<T, Id>;
 
-  /// An item and its squared distance; results are sorted by distance, ties by id.
-  struct Neighbor {
-    Id id = kNoId;
-    T squared_distance = std::numeric_limits<T>::infinity();
-    friend bool operator<(const Neighbor& a, const Neighbor& b) {
-      return a.squared_distance < b.squared_distance || (a.squared_distance == b.squared_distance && a.id < b.id);
-    }
-    friend bool operator==(const Neighbor&, const Neighbor&) = default;
-  };
-
-  explicit DynamicKdTree(DynamizeOptions options = {}) : tree_(options) {}
+  explicit DynamicKdTree(DynamizeOptions options = {})
+    requires(Dim != spatial::Dynamic)
+      : dim_(std::size_t(Dim)), tree_(options) {}
+  /// A tree of points of dimension `dim` (>= 1), given at run time.
+  explicit DynamicKdTree(std::size_t dim, DynamizeOptions options = {})
+      : dim_(dim), tree_(options) {
+    if (dim == 0 || (Dim != spatial::Dynamic && dim != std::size_t(Dim)))
+      throw Error("DynamicKdTree: dim must be " +
+                  (Dim == spatial::Dynamic ? std::string(">= 1") : std::to_string(Dim)) + ", got " +
+                  std::to_string(dim));
+  }
 
   std::size_t size() const { return tree_.size(); }
   bool empty() const { return tree_.size() == 0; }
-  static constexpr std::size_t dim() { return Dim; }
+  std::size_t dim() const { return dim_; }
   bool contains(Id id) const { return tree_.contains(id); }
   /// The coordinates of a stored item; throws for an id not stored.
   Point point(Id id) const {
@@ -65,28 +155,30 @@ class DynamicKdTree {
     return block->item(slot);
   }
 
-  /// Inserts the points (rows of a view of dimension Dim); returns their ids.
+  /// Inserts the points (rows of a view of dimension dim()); returns their ids.
   /// All are checked first: a wrong dimension or a NaN/inf coordinate throws
   /// geods::Error and inserts nothing.
   std::vector<Id> insert(spatial::PointView<T> points) {
-    if (points.dim != std::size_t(Dim))
+    if (points.dim != dim_)
       throw Error("DynamicKdTree::insert: points of dimension " + std::to_string(points.dim) + ", the tree has " +
-                  std::to_string(Dim));
+                  std::to_string(dim_));
     if (points.count > 0 && (points.data == nullptr || points.stride < points.dim))
       throw Error("DynamicKdTree::insert: bad point array");
     if (size() + tree_.dead() + points.count >= std::numeric_limits<std::uint32_t>::max())
       throw Error("DynamicKdTree::insert: more than 2^32 - 2 points");
     std::vector<Point> items(points.count);
-    for (std::size_t i = 0; i < points.count; ++i)
-      for (int a = 0; a < Dim; ++a) {
+    for (std::size_t i = 0; i < points.count; ++i) {
+      if constexpr (Dim == spatial::Dynamic) items[i].resize(dim_);
+      for (std::size_t a = 0; a < dim_; ++a) {
         if (!std::isfinite(points[i][a]))
           throw Error("DynamicKdTree::insert: point " + std::to_string(i) + " has a non-finite coordinate (axis " +
                       std::to_string(a) + ")");
         items[i][a] = points[i][a];
       }
+    }
     return tree_.insert(std::move(items));
   }
-  Id insert(const Point& p) { return insert(spatial::PointView<T>(p.data(), 1, Dim)).front(); }
+  Id insert(const Point& p) { return insert(spatial::PointView<T>(p.data(), 1, p.size())).front(); }
 
   /// Removes the items; throws geods::Error (removing nothing) for an id not stored or given twice.
   void remove(std::span<const Id> ids) { tree_.remove(ids); }
@@ -94,52 +186,69 @@ class DynamicKdTree {
   /// Global reconstruction now: drops dead points and returns their memory.
   void rebuild() { tree_.rebuild(); }
 
-  /// The k nearest stored points to q, sorted by distance, ties by id (fewer if fewer are stored).
-  /// All blocks share one k-best list, so later blocks prune with what earlier ones found.
-  std::vector<Neighbor> query(std::span<const T> q, std::size_t k) const {
-    if (k == 0) throw Error("DynamicKdTree::query: k must be >= 1");
-    std::vector<Neighbor> out(k);
-    out.resize(query_into(q, k, out.data()));
+  /// The request.k nearest stored points to q, sorted by distance, ties by id;
+  /// fewer if fewer are stored or request.max_distance excludes them; with
+  /// request.eps > 0 the i-th distance is within (1 + eps) of the true i-th
+  /// (as spatial::KdTree). All blocks share one k-best list, so later blocks
+  /// prune with what earlier ones found.
+  std::vector<Neighbor> query(std::span<const T> q, const spatial::KnnRequest& request) const {
+    std::vector<Neighbor> out(spatial::check_request(request, "DynamicKdTree::query"));
+    out.resize(query_into(q, request, out.data()));
     return out;
   }
-  std::vector<Neighbor> query(const Point& q, std::size_t k) const { return query(std::span<const T>(q), k); }
-
-  /// Writes k slots (unused ones {kNoId, +inf}); returns how many were found.
-  std::size_t query_into(std::span<const T> q, std::size_t k, Neighbor* out) const {
-    check_point(q, "query point");
-    Best best{out, k};
-    tree_.for_each([&](const Block& block, std::span<const Id> ids) {
-      BlockResult result{best, ids.data()};
-      block.nearest(q.data(), result);
-    });
-    for (std::size_t i = best.size; i < k; ++i) out[i] = Neighbor{};
-    return best.size;
+  std::vector<Neighbor> query(std::span<const T> q, std::size_t k, double eps = 0) const {
+    return query(q, spatial::KnnRequest{k, eps});
+  }
+  std::vector<Neighbor> query(const Point& q, std::size_t k, double eps = 0) const {
+    return query(std::span<const T>(q.data(), q.size()), spatial::KnnRequest{k, eps});
   }
 
-  /// k slots per query, query i at [i * k, (i + 1) * k); queries run in parallel.
-  std::vector<Neighbor> query_batch(spatial::PointView<T> queries, std::size_t k) const {
-    if (k == 0) throw Error("DynamicKdTree::query: k must be >= 1");
-    if (queries.dim != std::size_t(Dim) || (queries.count > 0 && (!queries.data || queries.stride < queries.dim)))
+  /// Writes request.k slots (unused ones {kNoId, +inf}); returns how many were found.
+  std::size_t query_into(std::span<const T> q, const spatial::KnnRequest& request, Neighbor* out) const {
+    const std::size_t k = spatial::check_request(request, "DynamicKdTree::query");
+    check_point(q, "query point");
+    spatial::KnnResultSet<T, Id> best(out, k, spatial::squared_limit<T>(request.max_distance));
+    tree_.for_each([&](const Block& block, std::span<const Id> ids) {
+      if (block.all_dead()) return;
+      BlockResult result{best, ids.data()};
+      block.tree().search_nearest(q.data(), result, request.eps, block.dead_slots());
+    });
+    best.finish();
+    return best.size();
+  }
+
+  /// request.k slots per query, query i at [i * k, (i + 1) * k); queries run in parallel.
+  std::vector<Neighbor> query_batch(spatial::PointView<T> queries, const spatial::KnnRequest& request) const {
+    const std::size_t k = spatial::check_request(request, "DynamicKdTree::query");
+    if (queries.dim != dim_ || (queries.count > 0 && (!queries.data || queries.stride < queries.dim)))
       throw Error("DynamicKdTree::query: queries of dimension " + std::to_string(queries.dim) + ", the tree has " +
-                  std::to_string(Dim));
+                  std::to_string(dim_));
     std::vector<Neighbor> out(queries.count * k);
     parallel_for(0, queries.count, 64, [&](std::size_t b, std::size_t e) {
-      for (std::size_t i = b; i < e; ++i) query_into(std::span<const T>(queries[i], Dim), k, out.data() + i * k);
+      for (std::size_t i = b; i < e; ++i) query_into(std::span<const T>(queries[i], dim_), request, out.data() + i * k);
     });
     return out;
+  }
+  std::vector<Neighbor> query_batch(spatial::PointView<T> queries, std::size_t k, double eps = 0) const {
+    return query_batch(queries, spatial::KnnRequest{k, eps});
   }
 
   /// Every stored point within distance r of q (inclusive), sorted like query.
   std::vector<Neighbor> query_radius(std::span<const T> q, double r) const {
     check_point(q, "query point");
     if (!(r >= 0)) throw Error("DynamicKdTree::query_radius: radius must be >= 0, got " + std::to_string(r));
-    const T r2 = r * r >= double(std::numeric_limits<T>::max()) ? std::numeric_limits<T>::infinity() : T(r * r);
+    const T r2 = spatial::squared_limit<T>(r);
     std::vector<Neighbor> out;
     tree_.for_each([&](const Block& block, std::span<const Id> ids) {
-      block.within(q.data(), r2, [&](std::size_t slot, T d) { out.push_back({ids[slot], d}); });
+      if (block.all_dead()) return;
+      block.tree().search_radius(
+          q.data(), r2, [&](std::uint32_t slot, T d) { out.push_back({ids[slot], d}); }, block.dead_slots());
     });
     std::sort(out.begin(), out.end());
     return out;
+  }
+  std::vector<Neighbor> query_radius(const Point& q, double r) const {
+    return query_radius(std::span<const T>(q.data(), q.size()), r);
   }
 
   /// Ids (ascending) of the stored points p with lo <= p <= hi on every axis.
@@ -148,10 +257,15 @@ class DynamicKdTree {
     check_point(hi, "box high corner");
     std::vector<Id> out;
     tree_.for_each([&](const Block& block, std::span<const Id> ids) {
-      block.in_box(lo.data(), hi.data(), [&](std::size_t slot) { out.push_back(ids[slot]); });
+      if (block.all_dead()) return;
+      block.tree().search_box(
+          lo.data(), hi.data(), [&](std::uint32_t slot) { out.push_back(ids[slot]); }, block.dead_slots());
     });
     std::sort(out.begin(), out.end());
     return out;
+  }
+  std::vector<Id> query_box(const Point& lo, const Point& hi) const {
+    return query_box(std::span<const T>(lo.data(), lo.size()), std::span<const T>(hi.data(), hi.size()));
   }
 
   /// The decomposition and the locator (Dynamized::validate), and every block.
@@ -168,42 +282,24 @@ class DynamicKdTree {
   const Dynamized<Block>& structure() const { return tree_; }
 
  private:
-  // The k best so far in a caller's array, sorted; k is small, so insertion beats a heap.
-  struct Best {
-    Neighbor* slots;
-    std::size_t k;
-    std::size_t size = 0;
-    T worst() const { return size == k ? slots[k - 1].squared_distance : std::numeric_limits<T>::infinity(); }
-    void insert(Id id, T d) {
-      const Neighbor candidate{id, d};
-      std::size_t pos;
-      if (size < k) {
-        pos = size++;
-      } else if (candidate < slots[k - 1]) {
-        pos = k - 1;
-      } else {
-        return;
-      }
-      for (; pos > 0 && candidate < slots[pos - 1]; --pos) slots[pos] = slots[pos - 1];
-      slots[pos] = candidate;
-    }
-  };
-  // What KdBlock::nearest talks to: slots of one block mapped to ids.
+  // What a block's search_nearest talks to: its slots mapped to ids in the shared k-best list.
   struct BlockResult {
-    Best& best;
+    spatial::KnnResultSet<T, Id>& best;
     const Id* ids;
     T worst() const { return best.worst(); }
-    void insert(std::size_t slot, T d) { best.insert(ids[slot], d); }
+    bool full() const { return best.full(); }
+    void insert(std::uint32_t slot, T d) { best.insert(ids[slot], d); }
   };
 
-  static void check_point(std::span<const T> q, const char* what) {
-    if (q.size() != std::size_t(Dim))
+  void check_point(std::span<const T> q, const char* what) const {
+    if (q.size() != dim_)
       throw Error(std::string("DynamicKdTree: ") + what + " of dimension " + std::to_string(q.size()) +
-                  ", the tree has " + std::to_string(Dim));
+                  ", the tree has " + std::to_string(dim_));
     for (T x : q)
       if (!std::isfinite(x)) throw Error(std::string("DynamicKdTree: ") + what + " has a non-finite coordinate");
   }
 
+  std::size_t dim_;
   Dynamized<Block> tree_;
 };
 

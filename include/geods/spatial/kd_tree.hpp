@@ -15,6 +15,13 @@
 // degenerate sets (all points on a line or a plane). Each inner node stores the
 // largest coordinate of its left points and the smallest of its right points on
 // the split axis, so empty space between them is pruned too (as in nanoflann).
+//
+// Searches: k-NN and radius search are one depth-first descent (descend) with
+// a small policy each (the bound that prunes, what happens to a leaf point);
+// box queries have their own descent over the cells. Every query takes an
+// optional filter of points to skip (point_filter.hpp; the dynamic k-d tree
+// hides its deleted points this way). kd_tree_stepped_build.hpp builds the
+// same tree in pauses.
 #include <tbb/parallel_invoke.h>
 
 #include <algorithm>
@@ -39,6 +46,7 @@
 #include "geods/spatial/kd_tree_file.hpp"
 #include "geods/spatial/knn_result.hpp"
 #include "geods/spatial/permutation.hpp"
+#include "geods/spatial/point_filter.hpp"
 #include "geods/spatial/point_view.hpp"
 
 namespace geods::spatial {
@@ -53,6 +61,9 @@ struct KdTreeStats {
   std::size_t depth = 0;  // edges on the longest root-to-leaf path
   std::size_t bytes = 0;  // nodes, permutation and owned points
 };
+
+template <typename T, int Dim>
+class KdTreeSteppedBuild;
 
 template <typename T, int Dim = Dynamic>
 class KdTree {
@@ -121,11 +132,13 @@ class KdTree {
 
   // ---------------------------------------------------------------- k nearest neighbours
   /// The request.k nearest points to `query`, sorted by distance, ties by index;
-  /// fewer if the tree holds fewer or request.max_distance excludes them.
+  /// fewer if the tree holds fewer or request.max_distance excludes them. Points
+  /// for which skip(index) is true are left out (see point_filter.hpp).
   /// Cost: O(log n) expected for uniform data and small k.
-  std::vector<Neighbor<T>> query(std::span<const T> query, const KnnRequest& request) const {
-    std::vector<Neighbor<T>> out(check_request(request));
-    out.resize(query_into(query, request, out.data()));
+  template <typename Skip = KeepAll>
+  std::vector<Neighbor<T>> query(std::span<const T> query, const KnnRequest& request, const Skip& skip = {}) const {
+    std::vector<Neighbor<T>> out(check_request(request, "KdTree::query"));
+    out.resize(query_into(query, request, out.data(), skip));
     return out;
   }
   std::vector<Neighbor<T>> query(std::span<const T> q, std::size_t k, double eps = 0) const {
@@ -139,40 +152,25 @@ class KdTree {
 
   /// Allocation-free form: writes exactly request.k slots to `out` (unused ones
   /// are {kNoIndex, +inf}) and returns how many neighbours were found.
-  std::size_t query_into(std::span<const T> query, const KnnRequest& request, Neighbor<T>* out) const {
-    const std::size_t k = check_request(request);
+  template <typename Skip = KeepAll>
+  std::size_t query_into(std::span<const T> query, const KnnRequest& request, Neighbor<T>* out,
+                         const Skip& skip = {}) const {
+    const std::size_t k = check_request(request, "KdTree::query");
     check_point(query, "query point");
-    const T limit = squared_limit(request.max_distance);
-    KnnResultSet<T> result(out, k, limit);
-    if (!empty()) {
-      // Visit a subtree while its lower bound is <= worst * factor: the slack keeps
-      // exact ties from being pruned by rounding in the incremental distance, and
-      // 1/(1+eps)^2 turns the search approximate.
-      const T slack = T(1) + T(4 * (dim() + 2)) * std::numeric_limits<T>::epsilon();
-      const T approx = slack / T((1 + request.eps) * (1 + request.eps));
-      Scratch<T> dists(dim());
-      const T mindist = initial_distances(query.data(), dists.data());
-      if (ordered_)
-        KnnSearch<true>{*this, query.data(), dists.data(), result, slack, approx}.visit(0, mindist);
-      else
-        KnnSearch<false>{*this, query.data(), dists.data(), result, slack, approx}.visit(0, mindist);
-    }
+    KnnResultSet<T> result(out, k, squared_limit<T>(request.max_distance));
+    search_nearest(query.data(), result, request.eps, skip);
     result.finish();
     return result.size();
   }
 
-  /// Every point within Euclidean distance `radius` of `query` (inclusive),
-  /// sorted by distance, ties by index.
-  std::vector<Neighbor<T>> query_radius(std::span<const T> query, double radius) const {
+  /// Every point within Euclidean distance `radius` of `query` (inclusive) that
+  /// skip does not hide, sorted by distance, ties by index.
+  template <typename Skip = KeepAll>
+  std::vector<Neighbor<T>> query_radius(std::span<const T> query, double radius, const Skip& skip = {}) const {
     check_point(query, "query point");
     if (!(radius >= 0)) throw Error("KdTree::query_radius: radius must be >= 0, got " + std::to_string(radius));
     std::vector<Neighbor<T>> out;
-    if (empty()) return out;
-    const T r2 = squared_limit(radius);
-    const T bound = r2 * (T(1) + T(4 * (dim() + 2)) * std::numeric_limits<T>::epsilon());
-    Scratch<T> dists(dim());
-    const T mindist = initial_distances(query.data(), dists.data());
-    search_radius(0, query.data(), mindist, dists.data(), r2, bound, out);
+    search_radius(query.data(), squared_limit<T>(radius), [&](std::uint32_t i, T d) { out.push_back({i, d}); }, skip);
     std::sort(out.begin(), out.end());
     return out;
   }
@@ -182,21 +180,92 @@ class KdTree {
     return query_radius(std::span<const T>(q.data(), Dim), radius);
   }
 
+  // ---------------------------------------------------------------- the searches the queries are made of
+  // For callers that merge the answers of several trees (DynamicKdTree shares
+  // one k-best list across its blocks). `q` points to dim() finite values (not
+  // checked here); points for which skip(index) is true are not visited.
+
+  /// Feeds result.insert(index, squared distance) the points that may improve
+  /// `result`: result.worst() is the squared distance a point must not exceed,
+  /// result.full() says whether k points are found (until then eps does not
+  /// shrink the search). KnnResultSet is such a result; query_into is this search.
+  template <typename Result, typename Skip = KeepAll>
+  void search_nearest(const T* q, Result& result, double eps = 0, const Skip& skip = {}) const {
+    // A subtree is visited while its lower bound is <= worst * factor: the slack keeps
+    // exact ties from being pruned by rounding in the incremental distance, and
+    // 1/(1+eps)^2 turns the search approximate.
+    struct Nearest {
+      Result& result;
+      T slack, approx;
+      T limit() const { return result.worst(); }
+      T bound() const { return result.worst() * (result.full() ? approx : slack); }
+      void report(std::uint32_t index, T d) { result.insert(index, d); }
+    } search{result, slack(), slack() / T((1 + eps) * (1 + eps))};
+    descend(q, search, skip);
+  }
+
+  /// Calls f(index, squared distance) for every point within squared distance r2 of q, in no particular order.
+  template <typename F, typename Skip = KeepAll>
+  void search_radius(const T* q, T r2, const F& f, const Skip& skip = {}) const {
+    struct Within {
+      const F& f;
+      T r2, bound_;
+      T limit() const { return r2; }
+      T bound() const { return bound_; }
+      void report(std::uint32_t index, T d) { f(index, d); }
+    } search{f, r2, r2 * slack()};
+    descend(q, search, skip);
+  }
+
+  /// Calls f(index) for every point p with lo <= p <= hi on every axis, in tree order.
+  template <typename F, typename Skip = KeepAll>
+  void search_box(const T* lo, const T* hi, const F& f, const Skip& skip = {}) const {
+    struct Each {
+      const KdTree& tree;
+      const F& f;
+      void range(std::uint32_t begin, std::uint32_t end) const {
+        for (std::uint32_t i = begin; i < end; ++i) f(tree.perm_[i]);
+      }
+      void point(std::uint32_t index) const { f(index); }
+    } visit{*this, f};
+    box(lo, hi, visit, skip);
+  }
+
   // ---------------------------------------------------------------- box range
   /// Indices of the points p with lo <= p <= hi on every axis (closed box), in
-  /// tree order. Subtrees whose cell lies inside the box are reported without
-  /// visiting their nodes: O(sqrt(n) + a) in 2D (Theorem 4). `visited`, if given,
-  /// is increased by the number of nodes visited.
-  std::vector<std::uint32_t> query_box(std::span<const T> lo, std::span<const T> hi,
-                                       std::size_t* visited = nullptr) const {
-    std::vector<std::uint32_t> out;
-    range<true>(lo, hi, &out, visited);
-    return out;
+  /// tree order, without those skip hides. Subtrees whose cell lies inside the
+  /// box are reported without visiting their nodes: O(sqrt(n) + a) in 2D
+  /// (Theorem 4). `visited`, if given, is increased by the number of nodes visited.
+  template <typename Skip = KeepAll>
+  std::vector<std::uint32_t> query_box(std::span<const T> lo, std::span<const T> hi, std::size_t* visited = nullptr,
+                                       const Skip& skip = {}) const {
+    check_box(lo, hi);
+    struct Report {
+      const KdTree& tree;
+      std::vector<std::uint32_t> out;
+      void range(std::uint32_t begin, std::uint32_t end) {
+        out.insert(out.end(), tree.perm_.begin() + begin, tree.perm_.begin() + end);
+      }
+      void point(std::uint32_t index) { out.push_back(index); }
+    } report{*this, {}};
+    const std::size_t nodes = box(lo.data(), hi.data(), report, skip);
+    if (visited) *visited += nodes;
+    return std::move(report.out);
   }
   /// How many points lie in the closed box; whole subtrees inside the box count
-  /// in O(1) each, so this is O(sqrt(n)) in 2D whatever the answer.
-  std::size_t count_box(std::span<const T> lo, std::span<const T> hi, std::size_t* visited = nullptr) const {
-    return range<false>(lo, hi, nullptr, visited);
+  /// in O(1) each (without a filter), so this is O(sqrt(n)) in 2D whatever the answer.
+  template <typename Skip = KeepAll>
+  std::size_t count_box(std::span<const T> lo, std::span<const T> hi, std::size_t* visited = nullptr,
+                        const Skip& skip = {}) const {
+    check_box(lo, hi);
+    struct Count {
+      std::size_t count = 0;
+      void range(std::uint32_t begin, std::uint32_t end) { count += end - begin; }
+      void point(std::uint32_t) { ++count; }
+    } counter;
+    const std::size_t nodes = box(lo.data(), hi.data(), counter, skip);
+    if (visited) *visited += nodes;
+    return counter.count;
   }
   std::vector<std::uint32_t> query_box(const AABB<T, Dim>& box) const
     requires(Dim != Dynamic)
@@ -212,7 +281,7 @@ class KdTree {
   // ---------------------------------------------------------------- batches (parallel over queries)
   /// request.k slots per query, query i at [i * k, (i + 1) * k); missing ones are {kNoIndex, +inf}.
   std::vector<Neighbor<T>> query_batch(PointView<T> queries, const KnnRequest& request) const {
-    const std::size_t k = check_request(request);
+    const std::size_t k = check_request(request, "KdTree::query");
     check_batch(queries, dim(), "queries");
     std::vector<Neighbor<T>> out(queries.count * k);
     parallel_for(0, queries.count, 64, [&](std::size_t b, std::size_t e) {
@@ -239,12 +308,18 @@ class KdTree {
   }
 
   // ---------------------------------------------------------------- inspection
+  /// Bytes held: nodes, permutation, owned points and their copy in tree order; O(1).
+  std::size_t bytes() const {
+    return nodes_.size() * sizeof(Node) + perm_.size() * sizeof(std::uint32_t) +
+           (owned_ ? owned_->size() * sizeof(T) : 0) + (ordered_ ? ordered_->size() * sizeof(T) : 0) +
+           2 * root_lo_.size() * sizeof(T);
+  }
+
   KdTreeStats stats() const {
     KdTreeStats s;
     s.points = size();
     s.nodes = nodes_.size();
-    s.bytes = nodes_.size() * sizeof(Node) + perm_.size() * sizeof(std::uint32_t) +
-              (owned_ ? owned_->size() * sizeof(T) : 0) + 2 * root_lo_.size() * sizeof(T);
+    s.bytes = bytes();
     std::vector<std::pair<std::uint32_t, std::size_t>> stack;
     if (!nodes_.empty()) stack.push_back({0, 0});
     while (!stack.empty()) {
@@ -265,7 +340,8 @@ class KdTree {
   /// the permutation is a permutation; nodes form a tree in depth-first order
   /// whose children split their parent's range at its middle (balance); leaves
   /// hold 1..leaf_size points; low <= high; every point lies in the cell of its
-  /// leaf (the root box cut by the low/high values on the path), so no split lies.
+  /// leaf (the root box cut by the low/high values on the path), so no split lies;
+  /// the copy in tree order, if any, holds the points.
   void validate() const {
     const std::size_t n = size();
     auto fail = [](const std::string& what) { throw Error("KdTree::validate: " + what); };
@@ -319,6 +395,12 @@ class KdTree {
     }
     if (visited != nodes_.size()) fail("unreachable nodes");
     if (covered != n) fail("leaves do not cover all points");
+    if (ordered_) {
+      if (ordered_->size() != n * dim()) fail("points in tree order: wrong size");
+      for (std::size_t i = 0; i < n; ++i)
+        if (!std::equal(point(perm_[i]), point(perm_[i]) + dim(), ordered_->data() + i * dim()))
+          fail("points in tree order differ from the points");
+    }
   }
 
   // ---------------------------------------------------------------- files
@@ -381,6 +463,7 @@ class KdTree {
   }
 
  private:
+  friend class KdTreeSteppedBuild<T, Dim>;
   static_assert(sizeof(Node) == 16 + 2 * sizeof(T), "Node is written to files as is");
 
   // A small per-query array: on the stack for compile-time and small run-time dimensions.
@@ -456,6 +539,14 @@ class KdTree {
     }
   }
 
+  // The split axis of a node whose points span [lo, hi]: the first of widest spread.
+  static std::uint32_t widest_axis(const T* lo, const T* hi, std::size_t dim) {
+    std::uint32_t axis = 0;
+    for (std::uint32_t a = 1; a < dim; ++a)
+      if (hi[a] - lo[a] > hi[axis] - lo[axis]) axis = a;
+    return axis;
+  }
+
   std::uint32_t count_nodes(std::size_t m, std::map<std::size_t, std::uint32_t>& memo) const {
     if (m <= leaf_size_) return 1;
     if (auto it = memo.find(m); it != memo.end()) return it->second;
@@ -484,9 +575,7 @@ class KdTree {
       node = Node{begin, end, 0, 0, T(0), T(0)};
       const std::size_t m = end - begin;
       if (m <= tree->leaf_size_) return;
-      std::uint32_t axis = 0;
-      for (std::uint32_t a = 1; a < dim; ++a)
-        if (hi[a] - lo[a] > hi[axis] - lo[axis]) axis = a;
+      const std::uint32_t axis = widest_axis(lo, hi, dim);
       const std::uint32_t mid = begin + std::uint32_t(m / 2);
       std::nth_element(items + begin, items + mid, items + end,
                        [&](const Item& a, const Item& b) { return coords(a)[axis] < coords(b)[axis]; });
@@ -523,16 +612,6 @@ class KdTree {
   };
 
   // ---------------------------------------------------------------- search
-  std::size_t check_request(const KnnRequest& request) const {
-    if (request.k == 0) throw Error("KdTree::query: k must be >= 1");
-    if (request.k > (std::size_t(1) << 32)) throw Error("KdTree::query: k is too large");
-    if (!(request.eps >= 0) || std::isinf(request.eps))
-      throw Error("KdTree::query: eps must be finite and >= 0, got " + std::to_string(request.eps));
-    if (!(request.max_distance >= 0))
-      throw Error("KdTree::query: max_distance must be >= 0, got " + std::to_string(request.max_distance));
-    return request.k;
-  }
-
   void check_point(std::span<const T> q, const char* what) const {
     if (q.size() != dim())
       throw Error(std::string("KdTree: ") + what + " of dimension " + std::to_string(q.size()) + ", the tree has " +
@@ -547,12 +626,6 @@ class KdTree {
                   std::to_string(width));
     if (rows.count > 0 && (rows.data == nullptr || rows.stride < rows.dim))
       throw Error(std::string("KdTree: bad ") + what + " array");
-  }
-
-  // Squared distance limit in T; distances beyond T's range mean "no limit".
-  static T squared_limit(double distance) {
-    const double d2 = distance * distance;
-    return d2 >= double(std::numeric_limits<T>::max()) ? std::numeric_limits<T>::infinity() : T(d2);
   }
 
   T squared_distance(const T* q, const T* p) const {
@@ -577,40 +650,55 @@ class KdTree {
     return sum;
   }
 
-  // One k-NN search: the query state in one place, so the recursion passes only (node, mindist).
+  // Rounding slack of the pruning bound: keeps exact ties from being pruned by
+  // rounding in the incremental distance.
+  T slack() const { return T(1) + T(4 * (dim() + 2)) * std::numeric_limits<T>::epsilon(); }
+
+  // The one descent of the distance searches (Arya & Mount's incremental
+  // distance): nearer child first; a subtree is entered while the squared
+  // distance from q to its cell is <= search.bound(); every leaf point that
+  // skip keeps and whose squared distance is <= search.limit() goes to
+  // search.report(index, d). bound() and limit() are read again after each
+  // report, so a k-best list tightens the search as it fills.
+  template <typename Search, typename Skip>
+  void descend(const T* q, Search& search, const Skip& skip) const {
+    if (empty()) return;
+    Scratch<T> dists(dim());
+    const T mindist = initial_distances(q, dists.data());
+    if (!(mindist <= search.bound())) return;  // the whole tree is too far (one of several, or beyond max_distance)
+    if (ordered_)
+      Descent<true, Search, Skip>{*this, q, dists.data(), search, skip}.visit(0, mindist);
+    else
+      Descent<false, Search, Skip>{*this, q, dists.data(), search, skip}.visit(0, mindist);
+  }
+
+  // The query state in one place, so the recursion passes only (node, mindist).
   // Ordered: read the leaf points from ordered_ (store_points_in_tree_order) instead of via perm_.
-  template <bool Ordered>
-  struct KnnSearch {
+  template <bool Ordered, typename Search, typename Skip>
+  struct Descent {
     const KdTree& tree;
     const T* q;
     T* dists;  // per-axis terms of mindist
-    KnnResultSet<T>& result;
-    T slack, approx;
+    Search& search;
+    const Skip& skip;
 
     // mindist is a lower bound of the squared distance from q to the cell of node v.
-    // A subtree is entered when mindist <= worst * factor.
     void visit(std::uint32_t v, T mindist) const {
       const Node& node = tree.nodes_[v];
       if (node.leaf()) {
-        T worst = result.worst();  // cheap rejection first; insert() breaks exact ties by index
-        if constexpr (Ordered) {
-          const std::size_t dim = tree.dim();
-          const T* p = tree.ordered_->data() + std::size_t(node.begin) * dim;
-          for (std::uint32_t i = node.begin; i < node.end; ++i, p += dim) {
-            const T d = tree.squared_distance(q, p);
-            if (d <= worst) {
-              result.insert(tree.perm_[i], d);
-              worst = result.worst();
-            }
-          }
-          return;
-        }
+        T limit = search.limit();  // cheap rejection first; a k-best list breaks exact ties by index
         for (std::uint32_t i = node.begin; i < node.end; ++i) {
-          const std::uint32_t j = tree.perm_[i];
-          const T d = tree.squared_distance(q, tree.point(j));
-          if (d <= worst) {
-            result.insert(j, d);
-            worst = result.worst();
+          if constexpr (!kSkipsNothing<Skip>)
+            if (skip(tree.perm_[i])) continue;
+          const T* p;
+          if constexpr (Ordered)
+            p = tree.ordered_->data() + std::size_t(i) * tree.dim();
+          else
+            p = tree.point(tree.perm_[i]);
+          const T d = tree.squared_distance(q, p);
+          if (d <= limit) {
+            search.report(tree.perm_[i], d);
+            limit = search.limit();
           }
         }
         return;
@@ -627,9 +715,7 @@ class KdTree {
       visit(near, mindist);
       const T old = dists[axis];
       mindist += cut - old;
-      // While fewer than k are found, the limit is the max distance and eps must not shrink it.
-      const T bound = result.worst() * (result.full() ? approx : slack);
-      if (mindist <= bound) {
+      if (mindist <= search.bound()) {
         dists[axis] = cut;
         visit(far, mindist);
         dists[axis] = old;
@@ -637,55 +723,29 @@ class KdTree {
     }
   };
 
-  void search_radius(std::uint32_t v, const T* q, T mindist, T* dists, T r2, T bound,
-                     std::vector<Neighbor<T>>& out) const {
-    const Node& node = nodes_[v];
-    if (node.leaf()) {
-      for (std::uint32_t i = node.begin; i < node.end; ++i) {
-        const std::uint32_t j = perm_[i];
-        const T d = squared_distance(q, ordered_ ? ordered_->data() + std::size_t(i) * dim() : point(j));
-        if (d <= r2) out.push_back({j, d});
-      }
-      return;
-    }
-    const std::uint32_t axis = node.axis;
-    const T x = q[axis];
-    const T to_low = x - node.low, to_high = node.high - x;
-    std::uint32_t near = v + 1, far = node.right;
-    T cut = to_high * to_high;
-    if (to_low > to_high) {
-      std::swap(near, far);
-      cut = to_low * to_low;
-    }
-    search_radius(near, q, mindist, dists, r2, bound, out);
-    const T old = dists[axis];
-    mindist += cut - old;
-    if (mindist <= bound) {
-      dists[axis] = cut;
-      search_radius(far, q, mindist, dists, r2, bound, out);
-      dists[axis] = old;
-    }
-  }
-
-  template <bool Report>
-  std::size_t range(std::span<const T> lo, std::span<const T> hi, std::vector<std::uint32_t>* out,
-                    std::size_t* visited) const {
+  void check_box(std::span<const T> lo, std::span<const T> hi) const {
     check_point(lo, "box low corner");
     check_point(hi, "box high corner");
+  }
+
+  // The box descent: visit.range(begin, end) gets the permutation ranges of
+  // subtrees inside the box (without a filter), visit.point(index) every other
+  // point in the box. Returns the number of nodes visited.
+  template <typename Visit, typename Skip>
+  std::size_t box(const T* lo, const T* hi, Visit& visit, const Skip& skip) const {
     if (empty()) return 0;
     Scratch<T> cell_lo(dim()), cell_hi(dim());
     std::copy(root_lo_.begin(), root_lo_.end(), cell_lo.data());
     std::copy(root_hi_.begin(), root_hi_.end(), cell_hi.data());
-    std::size_t count = 0, nodes = 0;
-    range_node<Report>(0, lo.data(), hi.data(), cell_lo.data(), cell_hi.data(), count, out, nodes);
-    if (visited) *visited += nodes;
-    return count;
+    std::size_t nodes = 0;
+    box_node(0, lo, hi, cell_lo.data(), cell_hi.data(), visit, skip, nodes);
+    return nodes;
   }
 
   // cell_lo/cell_hi bound the points of node v; they are restored on return.
-  template <bool Report>
-  void range_node(std::uint32_t v, const T* lo, const T* hi, T* cell_lo, T* cell_hi, std::size_t& count,
-                  std::vector<std::uint32_t>* out, std::size_t& visited) const {
+  template <typename Visit, typename Skip>
+  void box_node(std::uint32_t v, const T* lo, const T* hi, T* cell_lo, T* cell_hi, Visit& visit, const Skip& skip,
+                std::size_t& visited) const {
     ++visited;
     bool inside = true;
     for (std::size_t a = 0; a < dim(); ++a) {
@@ -693,31 +753,29 @@ class KdTree {
       inside = inside && lo[a] <= cell_lo[a] && cell_hi[a] <= hi[a];
     }
     const Node& node = nodes_[v];
-    if (inside) {
-      count += node.end - node.begin;
-      if constexpr (Report) out->insert(out->end(), perm_.begin() + node.begin, perm_.begin() + node.end);
+    if (inside && kSkipsNothing<Skip>) {
+      visit.range(node.begin, node.end);
       return;
     }
-    if (node.leaf()) {
+    if (inside || node.leaf()) {
       for (std::uint32_t i = node.begin; i < node.end; ++i) {
-        const T* p = point(perm_[i]);
+        const std::uint32_t j = perm_[i];
+        if (skip(j)) continue;
+        const T* p = ordered_ ? ordered_->data() + std::size_t(i) * dim() : point(j);
         bool in = true;
-        for (std::size_t a = 0; a < dim() && in; ++a) in = lo[a] <= p[a] && p[a] <= hi[a];
-        if (in) {
-          ++count;
-          if constexpr (Report) out->push_back(perm_[i]);
-        }
+        for (std::size_t a = 0; a < dim() && in && !inside; ++a) in = lo[a] <= p[a] && p[a] <= hi[a];
+        if (in) visit.point(j);
       }
       return;
     }
     const std::uint32_t axis = node.axis;
     const T saved_hi = cell_hi[axis];
     cell_hi[axis] = node.low;
-    range_node<Report>(v + 1, lo, hi, cell_lo, cell_hi, count, out, visited);
+    box_node(v + 1, lo, hi, cell_lo, cell_hi, visit, skip, visited);
     cell_hi[axis] = saved_hi;
     const T saved_lo = cell_lo[axis];
     cell_lo[axis] = node.high;
-    range_node<Report>(node.right, lo, hi, cell_lo, cell_hi, count, out, visited);
+    box_node(node.right, lo, hi, cell_lo, cell_hi, visit, skip, visited);
     cell_lo[axis] = saved_lo;
   }
 

@@ -7,7 +7,7 @@
 #include <exception>
 #include <utility>
 
-namespace geods::dynamic {
+namespace geods {
 
 class Steps {
  public:
@@ -57,4 +57,4 @@ class Steps {
   std::coroutine_handle<promise_type> handle_;
 };
 
-}  // namespace geods::dynamic
+}  // namespace geods
