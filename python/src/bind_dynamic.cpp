@@ -11,6 +11,7 @@
 #include "bindings.hpp"
 #include "geods/core/error.hpp"
 #include "geods/dynamic/dynamic_kd_tree.hpp"
+#include "geods/spatial/knn_result.hpp"
 
 namespace py = pybind11;
 
@@ -38,12 +39,14 @@ class PyDynamicKdTree {
     } else if (dim == 3) {
       tree_.emplace<DynamicKdTree<double, 3>>(options);
     } else {
-      throw Error("DynamicKdTree: dim must be 2 or 3, got " + std::to_string(dim));
+      tree_.emplace<DynamicKdTree<double, spatial::Dynamic>>(dim, options);
     }
     variant_ = variant;
   }
 
-  std::size_t dim() const { return tree_.index() == 0 ? 2 : 3; }
+  std::size_t dim() const {
+    return std::visit([](const auto& t) { return t.dim(); }, tree_);
+  }
   const std::string& variant() const { return variant_; }
   std::size_t size() const {
     return std::visit([](const auto& t) { return t.size(); }, tree_);
@@ -80,7 +83,7 @@ class PyDynamicKdTree {
     std::visit([&](auto& t) { t.remove(list); }, tree_);
   }
 
-  py::tuple query(const py::handle& q, std::size_t k) const {
+  py::tuple query(const py::handle& q, std::size_t k, double eps, double max_distance) const {
     const auto [rows, single] = as_rows(q, "DynamicKdTree.query");
     const std::size_t m = count(rows);
     py::array_t<double> distances(std::vector<py::ssize_t>{py::ssize_t(m), py::ssize_t(k)});
@@ -91,11 +94,12 @@ class PyDynamicKdTree {
       py::gil_scoped_release release;
       std::visit(
           [&](const auto& t) {
-            const auto result = t.query_batch(spatial::PointView<double>(rows.data(), m, dim()), k);
+            const auto result = t.query_batch(spatial::PointView<double>(rows.data(), m, dim()),
+                                              spatial::KnnRequest{k, eps, max_distance});
             for (std::size_t i = 0; i < result.size(); ++i) {
-              const bool missing = result[i].id == dynamic::kNoId;
+              const bool missing = result[i].index == dynamic::kNoId;
               d[i] = missing ? std::numeric_limits<double>::infinity() : std::sqrt(result[i].squared_distance);
-              idx[i] = missing ? -1 : std::int64_t(result[i].id);
+              idx[i] = missing ? -1 : std::int64_t(result[i].index);
             }
           },
           tree_);
@@ -113,7 +117,7 @@ class PyDynamicKdTree {
       std::visit(
           [&](const auto& t) {
             for (const auto& nb : t.query_radius(std::span<const double>(rows.data(), dim()), r))
-              out.push_back(std::int64_t(nb.id));
+              out.push_back(std::int64_t(nb.index));
           },
           tree_);
     }
@@ -179,7 +183,7 @@ class PyDynamicKdTree {
                 std::to_string(dim()) + ") for a tree of dimension " + std::to_string(dim()));
   }
 
-  std::variant<DynamicKdTree<double, 2>, DynamicKdTree<double, 3>> tree_;
+  std::variant<DynamicKdTree<double, 2>, DynamicKdTree<double, 3>, DynamicKdTree<double, spatial::Dynamic>> tree_;
   std::string variant_;
 };
 
@@ -187,9 +191,9 @@ class PyDynamicKdTree {
 
 void bind_dynamic(py::module_& m) {
   py::class_<PyDynamicKdTree>(m, "DynamicKdTree", R"doc(
-A k-d tree with insert and delete (seed §7.4, Dyn(k-d)) over float64 points of dimension 2 or 3.
+A k-d tree with insert and delete (seed §7.4, Dyn(k-d)) over float64 points of any dimension dim >= 1.
 
-Made of static k-d trees of 2^i slots (the binary structure). variant="amortized" rebuilds
+Made of static k-d trees (the same as geods.KdTree) of 2^i slots (the binary structure). variant="amortized" rebuilds
 merged trees at once (Theorem 11); variant="worst_case" builds them in small steps spread
 over later inserts, so no single insert pays for a large rebuild (Theorem 14). Deleted
 points are hidden at once and dropped (memory freed) when more than max_dead_fraction of
@@ -201,9 +205,11 @@ is not stored raises ValueError and removes nothing.
       .def("insert", &PyDynamicKdTree::insert, py::arg("points"),
            "Inserts one point (d,) or rows (n, d); returns their ids (int64 array, or one int64 for one point).")
       .def("remove", &PyDynamicKdTree::remove, py::arg("ids"), "Removes the items with these ids (int or 1-d array).")
-      .def("query", &PyDynamicKdTree::query, py::arg("q"), py::arg("k") = 1,
+      .def("query", &PyDynamicKdTree::query, py::arg("q"), py::arg("k") = 1, py::arg("eps") = 0.0,
+           py::arg("max_distance") = std::numeric_limits<double>::infinity(),
            "k nearest stored points of one point (d,) or m points (m, d): (distances float64, ids int64), each (k,) "
-           "or (m, k), ascending by distance, ties by id; -1 / inf where fewer than k are stored.")
+           "or (m, k), ascending by distance, ties by id; -1 / inf where fewer than k are stored or within "
+           "max_distance. eps > 0: each distance within (1 + eps) of the true one (as KdTree.query).")
       .def("query_radius", &PyDynamicKdTree::query_radius, py::arg("q"), py::arg("r"),
            "Ids within distance r of q (inclusive), sorted by distance.")
       .def("query_box", &PyDynamicKdTree::query_box, py::arg("lo"), py::arg("hi"),

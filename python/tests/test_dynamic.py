@@ -53,6 +53,40 @@ def test_random_sequence_matches_brute_force(variant, dim):
     assert tree.stats()["rebuilds"] >= 1
 
 
+@pytest.mark.parametrize("variant", ["amortized", "worst_case"])
+@pytest.mark.parametrize("dim", [1, 5])
+def test_any_dimension_eps_and_max_distance(variant, dim):
+    # Duplicates on a coarse grid, deletions, then exact, approximate and limited queries against brute force.
+    rng = np.random.default_rng(10 + dim)
+    tree = geods.DynamicKdTree(dim=dim, variant=variant)
+    assert tree.dim == dim
+    pts = rng.integers(0, 6, (600, dim)).astype(np.float64)
+    ids = np.concatenate([tree.insert(chunk) for chunk in np.array_split(pts, 40)])
+    gone = rng.choice(ids, size=250, replace=False)
+    tree.remove(gone)
+    tree.validate()
+    keep = ~np.isin(ids, gone)
+    points, live = pts[keep], ids[keep]
+    q = rng.uniform(-1, 7, (20, dim))
+    dist, idx = tree.query(q, 9)
+    approx, approx_idx = tree.query(q, 9, eps=0.5)
+    limited, limited_idx = tree.query(q, 9, max_distance=1.5)
+    for j in range(len(q)):
+        bd, bi = brute_knn(points, live, q[j], 9)
+        np.testing.assert_allclose(dist[j], bd)
+        np.testing.assert_array_equal(idx[j], bi)
+        assert np.isin(approx_idx[j], live).all()
+        np.testing.assert_allclose(approx[j], np.sqrt(((pts[approx_idx[j]] - q[j]) ** 2).sum(axis=1)))
+        assert (approx[j] <= 1.5 * bd * (1 + 1e-9) + 1e-12).all()
+        within = bd <= 1.5
+        np.testing.assert_array_equal(limited_idx[j][within], bi[within])
+        assert (limited_idx[j][~within] == -1).all() and np.isinf(limited[j][~within]).all()
+    near = tree.query_radius(q[0], 2.0)
+    assert set(near.tolist()) == set(live[((points - q[0]) ** 2).sum(axis=1) <= 4.0].tolist())
+    with pytest.raises(ValueError, match="eps"):
+        tree.query(q[0], 1, eps=-1.0)
+
+
 def test_single_point_and_reinsert():
     tree = geods.DynamicKdTree(dim=2)
     a = tree.insert([1.0, 2.0])
@@ -88,7 +122,7 @@ def test_bad_input():
     with pytest.raises(ValueError, match="variant"):
         geods.DynamicKdTree(variant="fast")
     with pytest.raises(ValueError, match="dim"):
-        geods.DynamicKdTree(dim=4)
+        geods.DynamicKdTree(dim=0)
     with pytest.raises(ValueError, match="shape"):
         tree.insert(np.zeros((4, 2)))
     with pytest.raises(ValueError, match="non-finite"):

@@ -345,6 +345,97 @@ TEST(DynamicKdTree, EmptyTreeAnswersNothing) {
   tree.validate();
 }
 
+// KnnRequest (eps, max_distance) and a run-time dimension, which the blocks
+// (spatial::KdTree) provide: against brute force over the live items, with
+// duplicates and deletions, for both variants.
+template <int Dim>
+void check_requests(Variant variant, std::size_t dim) {
+  SCOPED_TRACE("dim " + std::to_string(dim));
+  using DTree = DynamicKdTree<double, Dim>;
+  Rng rng(30 + dim);
+  DTree tree = [&] {
+    if constexpr (Dim == spatial::Dynamic)
+      return DTree(dim, DynamizeOptions{variant});
+    else
+      return DTree(DynamizeOptions{variant});
+  }();
+  EXPECT_EQ(tree.dim(), dim);
+  std::map<Id, std::vector<double>> live;
+  auto random_row = [&] {
+    std::vector<double> p(dim);
+    for (double& x : p) x = rng.below(2) ? double(rng.below(5)) : rng.uniform(0, 5);  // duplicates and ties
+    return p;
+  };
+  for (int step = 0; step < 1500; ++step) {
+    const std::vector<double> p = random_row();
+    typename DTree::Point point{};
+    if constexpr (Dim == spatial::Dynamic) point.resize(dim);
+    std::copy(p.begin(), p.end(), point.begin());
+    live[tree.insert(point)] = p;
+    if (step % 3 == 2) {
+      auto it = live.begin();
+      std::advance(it, rng.below(live.size()));
+      tree.remove(it->first);
+      live.erase(it);
+    }
+    if (step % 100 != 99) continue;
+    ASSERT_NO_THROW(tree.validate());
+    const std::vector<double> q = random_row();
+    std::vector<typename DTree::Neighbor> all;
+    for (const auto& [id, x] : live) {
+      double d = 0;
+      for (std::size_t a = 0; a < dim; ++a) d += (q[a] - x[a]) * (q[a] - x[a]);
+      all.push_back({id, d});
+    }
+    std::sort(all.begin(), all.end());
+    const std::size_t k = 1 + rng.below(15);
+    const auto exact = tree.query(q, spatial::KnnRequest{k});
+    ASSERT_EQ(exact, std::vector<typename DTree::Neighbor>(all.begin(), all.begin() + std::min(k, all.size())));
+    const double r = rng.uniform(0, 2);
+    std::vector<typename DTree::Neighbor> within;
+    for (const auto& nb : all)
+      if (nb.squared_distance <= r * r) within.push_back(nb);
+    ASSERT_EQ(tree.query(q, spatial::KnnRequest{k, 0, r}),
+              std::vector<typename DTree::Neighbor>(within.begin(), within.begin() + std::min(k, within.size())));
+    ASSERT_EQ(tree.query_radius(q, r), within);
+    for (double eps : {0.25, 2.0}) {
+      const auto approx = tree.query(q, k, eps);
+      ASSERT_EQ(approx.size(), std::min(k, all.size()));
+      for (std::size_t j = 0; j < approx.size(); ++j) {
+        ASSERT_TRUE(live.count(approx[j].index)) << "a deleted or unknown id";
+        ASSERT_LE(std::sqrt(approx[j].squared_distance), (1 + eps) * std::sqrt(all[j].squared_distance) * (1 + 1e-9) + 1e-12);
+        if (j > 0) ASSERT_TRUE(approx[j - 1] < approx[j]);
+      }
+    }
+    std::vector<double> lo = random_row(), hi(dim);
+    for (std::size_t a = 0; a < dim; ++a) hi[a] = lo[a] + rng.uniform(0, 3);
+    std::vector<Id> in_box;
+    for (const auto& [id, x] : live) {
+      bool in = true;
+      for (std::size_t a = 0; a < dim; ++a) in = in && lo[a] <= x[a] && x[a] <= hi[a];
+      if (in) in_box.push_back(id);
+    }
+    ASSERT_EQ(tree.query_box(lo, hi), in_box);
+  }
+  for (const auto& [id, x] : live) {
+    const auto p = tree.point(id);
+    ASSERT_TRUE(std::equal(x.begin(), x.end(), p.begin()));
+  }
+  EXPECT_THROW(tree.query(std::vector<double>(dim + 1, 0.0), 1), Error);
+  EXPECT_THROW(tree.query(std::vector<double>(dim, 0.0), spatial::KnnRequest{1, -1}), Error);
+  EXPECT_THROW(tree.query(std::vector<double>(dim, 0.0), spatial::KnnRequest{1, 0, -1}), Error);
+}
+
+TEST(DynamicKdTree, RequestsAndRunTimeDimensionMatchBruteForce) {
+  for (Variant variant : {Variant::amortized, Variant::worst_case}) {
+    check_requests<2>(variant, 2);
+    check_requests<spatial::Dynamic>(variant, 1);
+    check_requests<spatial::Dynamic>(variant, 4);
+  }
+  EXPECT_THROW((DynamicKdTree<float, spatial::Dynamic>(0)), Error);
+  EXPECT_THROW((DynamicKdTree<float, 3>(2)), Error);
+}
+
 TEST(DynamicKdTree, BatchQueriesMatchSingleOnes) {
   DynamicKdTree<float, 3> tree(DynamizeOptions{Variant::worst_case});
   Rng rng(5);
