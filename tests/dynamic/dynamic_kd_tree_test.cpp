@@ -404,7 +404,9 @@ void check_requests(Variant variant, std::size_t dim) {
       for (std::size_t j = 0; j < approx.size(); ++j) {
         ASSERT_TRUE(live.count(approx[j].index)) << "a deleted or unknown id";
         ASSERT_LE(std::sqrt(approx[j].squared_distance), (1 + eps) * std::sqrt(all[j].squared_distance) * (1 + 1e-9) + 1e-12);
-        if (j > 0) ASSERT_TRUE(approx[j - 1] < approx[j]);
+        if (j > 0) {
+          ASSERT_TRUE(approx[j - 1] < approx[j]);
+        }
       }
     }
     std::vector<double> lo = random_row(), hi(dim);
