@@ -687,14 +687,18 @@ class KdTree {
       const Node& node = tree.nodes_[v];
       if (node.leaf()) {
         T limit = search.limit();  // cheap rejection first; a k-best list breaks exact ties by index
+        const std::size_t dim = tree.dim();
+        const T* next = Ordered ? tree.ordered_->data() + std::size_t(node.begin) * dim : nullptr;
         for (std::uint32_t i = node.begin; i < node.end; ++i) {
+          const T* p;
+          if constexpr (Ordered) {
+            p = next;
+            next += dim;
+          } else {
+            p = tree.point(tree.perm_[i]);
+          }
           if constexpr (!kSkipsNothing<Skip>)
             if (skip(tree.perm_[i])) continue;
-          const T* p;
-          if constexpr (Ordered)
-            p = tree.ordered_->data() + std::size_t(i) * tree.dim();
-          else
-            p = tree.point(tree.perm_[i]);
           const T d = tree.squared_distance(q, p);
           if (d <= limit) {
             search.report(tree.perm_[i], d);
@@ -753,17 +757,23 @@ class KdTree {
       inside = inside && lo[a] <= cell_lo[a] && cell_hi[a] <= hi[a];
     }
     const Node& node = nodes_[v];
-    if (inside && kSkipsNothing<Skip>) {
-      visit.range(node.begin, node.end);
+    if (inside) {
+      if constexpr (kSkipsNothing<Skip>) {
+        visit.range(node.begin, node.end);
+      } else {
+        for (std::uint32_t i = node.begin; i < node.end; ++i)
+          if (!skip(perm_[i])) visit.point(perm_[i]);
+      }
       return;
     }
-    if (inside || node.leaf()) {
+    if (node.leaf()) {
       for (std::uint32_t i = node.begin; i < node.end; ++i) {
         const std::uint32_t j = perm_[i];
-        if (skip(j)) continue;
-        const T* p = ordered_ ? ordered_->data() + std::size_t(i) * dim() : point(j);
+        if constexpr (!kSkipsNothing<Skip>)
+          if (skip(j)) continue;
+        const T* p = point(j);
         bool in = true;
-        for (std::size_t a = 0; a < dim() && in && !inside; ++a) in = lo[a] <= p[a] && p[a] <= hi[a];
+        for (std::size_t a = 0; a < dim() && in; ++a) in = lo[a] <= p[a] && p[a] <= hi[a];
         if (in) visit.point(j);
       }
       return;
