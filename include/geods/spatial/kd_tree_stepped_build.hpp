@@ -130,8 +130,11 @@ class KdTreeSteppedBuild {
       else
         return item.p.data();
     };
+    // Built here, handed to the tree at the end.
+    std::vector<typename Tree::Node> nodes;
+    std::vector<std::uint32_t> perm(n);
     std::map<std::size_t, std::uint32_t> subtree_nodes;
-    if (n > 0) tree.nodes_.reserve(tree.count_nodes(n, subtree_nodes));
+    if (n > 0) nodes.reserve(tree.count_nodes(n, subtree_nodes));
 
     constexpr std::uint32_t kRoot = std::numeric_limits<std::uint32_t>::max();
     struct Range {
@@ -144,9 +147,9 @@ class KdTreeSteppedBuild {
     while (!stack.empty()) {
       const Range r = stack.back();
       stack.pop_back();
-      const std::uint32_t v = std::uint32_t(tree.nodes_.size());
-      tree.nodes_.push_back(typename Tree::Node{r.begin, r.end, 0, 0, T(0), T(0)});
-      if (r.parent != kRoot && r.right) tree.nodes_[r.parent].right = v;
+      const std::uint32_t v = std::uint32_t(nodes.size());
+      nodes.push_back(typename Tree::Node{r.begin, r.end, 0, 0, T(0), T(0)});
+      if (r.parent != kRoot && r.right) nodes[r.parent].right = v;
 
       const T* first = coords(items[r.begin]);
       std::copy(first, first + dim, lo.begin());
@@ -166,14 +169,14 @@ class KdTreeSteppedBuild {
         tree.root_lo_ = lo;
         tree.root_hi_ = hi;
       } else if (r.right) {
-        tree.nodes_[r.parent].high = lo[tree.nodes_[r.parent].axis];
+        nodes[r.parent].high = lo[nodes[r.parent].axis];
       } else {
-        tree.nodes_[r.parent].low = hi[tree.nodes_[r.parent].axis];
+        nodes[r.parent].low = hi[nodes[r.parent].axis];
       }
       if (r.end - r.begin <= s.leaf_size) continue;
 
       const std::uint32_t axis = Tree::widest_axis(lo.data(), hi.data(), dim);
-      tree.nodes_[v].axis = axis;
+      nodes[v].axis = axis;
       auto key = [&](std::uint32_t i) { return coords(items[i])[axis]; };
       const std::uint32_t mid = r.begin + (r.end - r.begin) / 2;
       std::uint32_t a = r.begin, b = r.end;  // [a, b) holds the median position; left of a is smaller, right of b larger
@@ -214,13 +217,12 @@ class KdTreeSteppedBuild {
       stack.push_back({mid, r.end, v, true});
       stack.push_back({r.begin, mid, v, false});
     }
-    tree.perm_.resize(n);
     auto ordered = std::make_shared<std::vector<T>>(std::size_t(n) * dim);
     for (std::uint32_t i = 0; i < n; ++i) {
       if constexpr (Dim == Dynamic)
-        tree.perm_[i] = items[i];
+        perm[i] = items[i];
       else
-        tree.perm_[i] = items[i].index;
+        perm[i] = items[i].index;
       const T* p = coords(items[i]);
       std::copy(p, p + dim, ordered->data() + std::size_t(i) * dim);
       if (++used >= s.budget) {
@@ -228,6 +230,8 @@ class KdTreeSteppedBuild {
         co_yield Steps::pause;
       }
     }
+    tree.nodes_ = std::move(nodes);
+    tree.perm_ = std::move(perm);
     tree.ordered_ = std::move(ordered);
   }
 
