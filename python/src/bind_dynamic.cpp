@@ -9,6 +9,7 @@
 #include <variant>
 
 #include "bindings.hpp"
+#include "geods/core/archive.hpp"
 #include "geods/core/error.hpp"
 #include "geods/dynamic/dynamic_kd_tree.hpp"
 #include "geods/spatial/knn_result.hpp"
@@ -42,6 +43,29 @@ class PyDynamicKdTree {
       tree_.emplace<DynamicKdTree<double, spatial::Dynamic>>(dim, options);
     }
     variant_ = variant;
+  }
+
+  void save(const std::string& path) const {
+    std::visit([&](const auto& t) { t.save(path); }, tree_);
+  }
+
+  /// A tree saved by save(): the dimension picks the C++ type.
+  static PyDynamicKdTree load(const std::string& path) {
+    using Any = DynamicKdTree<double, spatial::Dynamic>;
+    const std::uint64_t dim = Archive::open(path, Any::kArchiveKind, Any::kArchiveVersion, Archive::Verify::structure_only)
+                                  .value<std::uint64_t>("dim");
+    PyDynamicKdTree out;
+    if (dim == 2) {
+      out.tree_ = DynamicKdTree<double, 2>::load(path);
+    } else if (dim == 3) {
+      out.tree_ = DynamicKdTree<double, 3>::load(path);
+    } else {
+      out.tree_ = DynamicKdTree<double, spatial::Dynamic>::load(path);
+    }
+    const bool worst_case = std::visit([](const auto& t) { return t.structure().options().variant; }, out.tree_) ==
+                            dynamic::Variant::worst_case;
+    out.variant_ = worst_case ? "worst_case" : "amortized";
+    return out;
   }
 
   std::size_t dim() const {
@@ -167,6 +191,8 @@ class PyDynamicKdTree {
   }
 
  private:
+  PyDynamicKdTree() = default;
+
   struct RowsOf {
     Rows array;
     bool single;
@@ -220,6 +246,10 @@ is not stored raises ValueError and removes nothing.
       .def("stats", &PyDynamicKdTree::stats,
            "dict: live, dead, structures, building, per_level (trees of 2^i slots on level i), rebuilds, "
            "forced_builds, bytes")
+      .def("save", &PyDynamicKdTree::save, py::arg("path"),
+           "Writes the tree (its blocks, ids and deletions) to a geods archive file.")
+      .def_static("load", &PyDynamicKdTree::load, py::arg("path"),
+                  "A tree written by save(): the same ids, points and answers. Raises ValueError for a bad file.")
       .def("__len__", &PyDynamicKdTree::size)
       .def("__contains__", &PyDynamicKdTree::contains)
       .def_property_readonly("dim", &PyDynamicKdTree::dim)

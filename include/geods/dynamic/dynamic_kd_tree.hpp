@@ -17,12 +17,17 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <filesystem>
 #include <limits>
 #include <span>
 #include <string>
+#include <string_view>
+#include <utility>
 #include <vector>
 
+#include "geods/core/archive.hpp"
 #include "geods/core/error.hpp"
+#include "geods/core/flat_array.hpp"
 #include "geods/core/parallel.hpp"
 #include "geods/dynamic/dynamized.hpp"
 #include "geods/spatial/kd_tree.hpp"
@@ -68,6 +73,14 @@ class KdTreeBlock {
   };
 
   static KdTreeBlock build(std::vector<Item> items) { return Builder(std::move(items)).finish(); }
+  /// A block of a tree built elsewhere (read from a file), no slot dead yet.
+  static KdTreeBlock adopt(Tree tree) {
+    KdTreeBlock block;
+    block.tree_ = std::move(tree);
+    if (!block.tree_.stores_points_in_tree_order()) block.tree_.store_points_in_tree_order();
+    block.dead_.assign(block.tree_.size(), 0);
+    return block;
+  }
 
   /// Slots, dead ones included.
   std::size_t size() const { return tree_.size(); }
@@ -98,6 +111,8 @@ class KdTreeBlock {
   /// The tree (point index = slot) and the filter its queries take to skip dead slots.
   const Tree& tree() const { return tree_; }
   spatial::SkipFlagged dead_slots() const { return {dead_.data()}; }
+  /// One byte per slot, 1 if weakly deleted.
+  const std::vector<std::uint8_t>& dead_flags() const { return dead_; }
 
   /// Heap bytes held.
   std::size_t bytes() const { return tree_.bytes() + dead_.capacity(); }
@@ -131,6 +146,9 @@ class DynamicKdTree {
   using Point = typename Block::Item;
   /// An item (index: its id) and its squared distance; results are sorted by distance, ties by id.
   using Neighbor = spatial::Neighbor<T, Id>;
+  /// The archive kind and layout version of a saved tree (save / load).
+  static constexpr std::string_view kArchiveKind = "dynamic.KdTree";
+  static constexpr std::uint32_t kArchiveVersion = 1;
 
   explicit DynamicKdTree(DynamizeOptions options = {})
     requires(Dim != spatial::Dynamic)
@@ -266,6 +284,70 @@ class DynamicKdTree {
   }
   std::vector<Id> query_box(const Point& lo, const Point& hi) const {
     return query_box(std::span<const T>(lo.data(), lo.size()), std::span<const T>(hi.data(), hi.size()));
+  }
+
+  // ---------------------------------------------------------------- files
+  /// Writes the tree as a "dynamic.KdTree" archive (core/archive.hpp): value
+  /// sections scalar_bytes, dim, variant, max_dead_fraction, next_id, blocks;
+  /// per block k, under the prefix "b<k>.", the k-d tree's sections
+  /// (KdTree::add_sections), its ids (slot -> id, kNoId if deleted) and its
+  /// dead flags. Builds and reconstructions under way are not saved: their
+  /// items are in the blocks that answer queries, and load() starts them again.
+  void save(const std::filesystem::path& path) const {
+    ArchiveWriter w(std::string(kArchiveKind), kArchiveVersion);
+    w.add_value("scalar_bytes", std::uint32_t(sizeof(T)));
+    w.add_value("dim", std::uint64_t(dim_));
+    w.add_value("variant", std::uint32_t(tree_.options().variant));
+    w.add_value("max_dead_fraction", tree_.options().max_dead_fraction);
+    w.add_value("next_id", std::uint64_t(tree_.next_id()));
+    std::uint64_t blocks = 0;
+    tree_.for_each([&](const Block& block, std::span<const Id> ids) {
+      const std::string prefix = "b" + std::to_string(blocks++) + ".";
+      block.tree().add_sections(w, prefix);
+      w.add(prefix + "ids", ids);
+      w.add(prefix + "dead", block.dead_flags());
+    });
+    w.add_value("blocks", blocks);
+    w.write(path);
+  }
+
+  /// Reads a tree written by save(): same ids, points, deletions and answers;
+  /// later inserts continue the ids. The file is mapped while it is read.
+  /// Throws geods::Error naming the file for another scalar type or
+  /// dimension, a truncated or corrupt file or contents that fail validate().
+  static DynamicKdTree load(const std::filesystem::path& path) {
+    const Archive a = Archive::open(path, kArchiveKind, kArchiveVersion);
+    const std::uint32_t scalar_bytes = a.value<std::uint32_t>("scalar_bytes");
+    if (scalar_bytes != sizeof(T))
+      throw a.error(std::string("a dynamic k-d tree of ") + (scalar_bytes == 4 ? "float" : "double") + ", expected " +
+                    (sizeof(T) == 4 ? "float" : "double"));
+    const std::uint64_t dim = a.value<std::uint64_t>("dim");
+    if (dim == 0 || dim > (1u << 16) || (Dim != spatial::Dynamic && dim != std::uint64_t(Dim)))
+      throw a.error("a dynamic k-d tree of dimension " + std::to_string(dim) + ", expected " +
+                    (Dim == spatial::Dynamic ? std::string("1 to 65536") : std::to_string(Dim)));
+    const std::uint32_t variant = a.value<std::uint32_t>("variant");
+    if (variant > std::uint32_t(Variant::worst_case)) throw a.error("bad variant " + std::to_string(variant));
+    const DynamizeOptions options{Variant(variant), a.value<double>("max_dead_fraction")};
+    const std::uint64_t blocks = a.value<std::uint64_t>("blocks");
+    std::vector<std::pair<Block, std::vector<Id>>> parts;
+    for (std::uint64_t k = 0; k < blocks; ++k) {
+      const std::string prefix = "b" + std::to_string(k) + ".";
+      Block block = Block::adopt(spatial::KdTree<T, Dim>::from_sections(a, prefix, std::size_t(dim)));
+      std::vector<Id> ids = a.array<Id>(prefix + "ids", block.size()).to_vector();
+      const FlatArray<std::uint8_t> dead = a.array<std::uint8_t>(prefix + "dead", block.size());
+      for (std::size_t slot = 0; slot < ids.size(); ++slot)
+        if ((dead[slot] != 0) != (ids[slot] == kNoId))
+          throw a.error("block " + std::to_string(k) + ": dead flags and ids disagree at slot " + std::to_string(slot));
+      parts.emplace_back(std::move(block), std::move(ids));
+    }
+    try {
+      DynamicKdTree tree(std::size_t(dim), options);
+      tree.tree_ = Dynamized<Block>::restore(options, std::move(parts), a.value<std::uint64_t>("next_id"));
+      tree.validate();
+      return tree;
+    } catch (const Error& e) {
+      throw a.error(std::string("corrupted dynamic k-d tree: ") + e.what());
+    }
   }
 
   /// The decomposition and the locator (Dynamized::validate), and every block.

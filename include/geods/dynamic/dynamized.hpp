@@ -128,6 +128,57 @@ class Dynamized {
     return {copy ? &copy->structure : &part(*at).structure, at->slot};
   }
 
+  /// The id the next insert hands out.
+  Id next_id() const { return next_id_; }
+
+  /// A structure made of the given parts, e.g. read back from a file: each part
+  /// is a structure and its slot -> id table (kNoId for a dead slot, which is
+  /// weakly deleted here), of 2^i slots, and goes to level i in the given order.
+  /// The worst-case variant starts a build on every level holding two or more,
+  /// and a reconstruction if too many slots are dead (the amortized variant
+  /// rebuilds then). `next_id` is the id the next insert hands out. Throws
+  /// geods::Error for a part whose size is not a power of two or disagrees
+  /// with its ids, two parts on one level (amortized variant), or an id given
+  /// twice or not below next_id.
+  static Dynamized restore(DynamizeOptions options, std::vector<std::pair<S, std::vector<Id>>> parts, Id next_id) {
+    Dynamized d(options);
+    d.next_id_ = next_id;
+    std::size_t slots = 0;
+    for (const auto& part : parts) slots += part.second.size();
+    d.locator_ = Locator(slots);
+    for (auto& [structure, ids] : parts) {
+      const std::size_t n = ids.size();
+      if (n == 0 || (n & (n - 1)) != 0 || structure.size() != n)
+        throw Error("Dynamized::restore: a structure of " + std::to_string(structure.size()) + " slots with " +
+                    std::to_string(n) + " ids, expected a power of two of both");
+      for (Id id : ids)
+        if (id != kNoId && (id >= next_id || d.locator_.find(id)))
+          throw Error("Dynamized::restore: id " + std::to_string(id) + " is given twice or not below the next id");
+      const std::size_t level = std::size_t(std::countr_zero(n));
+      Part p = d.make_part(level, std::move(structure), std::move(ids));
+      d.dead_ += p.dead;
+      if (options.variant == Variant::amortized) {
+        if (level < d.levels_.size() && !d.levels_[level].empty())
+          throw Error("Dynamized::restore: two structures of " + std::to_string(n) + " slots");
+        d.add(level, std::move(p));
+      } else {
+        d.push(level, std::move(p));
+      }
+    }
+    if (options.variant == Variant::amortized) {
+      if (d.over(options.max_dead_fraction)) d.rebuild();
+    } else {
+      for (std::size_t i = 0; i < d.levels_.size(); ++i)
+        if (d.levels_[i].size() >= 2 && !d.building(i)) d.start_build(i);
+      if (d.over(d.hard_fraction())) {
+        d.rebuild();
+      } else if (d.over(options.max_dead_fraction)) {
+        d.start_reconstruction();
+      }
+    }
+    return d;
+  }
+
   /// Inserts one item; returns its new id.
   Id insert(Item item) {
     const Id id = next_id_++;

@@ -40,6 +40,7 @@
 #include <vector>
 
 #include "geods/core/aabb.hpp"
+#include "geods/core/archive.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"
 #include "geods/core/vec.hpp"
@@ -401,6 +402,53 @@ class KdTree {
         if (!std::equal(point(perm_[i]), point(perm_[i]) + dim(), ordered_->data() + i * dim()))
           fail("points in tree order differ from the points");
     }
+  }
+
+  // ---------------------------------------------------------------- archive sections
+  /// Adds the tree to an archive (core/archive.hpp) as sections whose names
+  /// start with `prefix`, so that one archive can hold several trees (the
+  /// blocks of a DynamicKdTree): leaf_size, bounds_lo, bounds_hi, nodes,
+  /// permutation, points (n x dim, row-major, in input order). The arrays are
+  /// not copied: the tree must live until w.write(). Its points must be packed
+  /// (stride = dim, as in a tree that owns them).
+  void add_sections(ArchiveWriter& w, const std::string& prefix) const {
+    if (view_.stride != view_.dim && size() > 1) throw Error("KdTree::add_sections: strided points");
+    w.add_value(prefix + "leaf_size", std::uint64_t(leaf_size_));
+    w.add(prefix + "bounds_lo", root_lo_);
+    w.add(prefix + "bounds_hi", root_hi_);
+    w.add(prefix + "nodes", std::span<const Node>(nodes_.data(), nodes_.size()));
+    w.add(prefix + "permutation", std::span<const std::uint32_t>(perm_.data(), perm_.size()));
+    w.add(prefix + "points", std::span<const T>(view_.data, size() * dim()));
+  }
+
+  /// The tree add_sections wrote under `prefix`, of dimension `dim`; it owns
+  /// its points. Throws geods::Error naming the file for missing or
+  /// inconsistent sections or contents that fail validate().
+  static KdTree from_sections(const Archive& a, const std::string& prefix, std::size_t dim) {
+    if (dim == 0 || (Dim != Dynamic && dim != std::size_t(Dim)))
+      throw a.error("a k-d tree of dimension " + std::to_string(dim));
+    const std::uint64_t leaf_size = a.value<std::uint64_t>(prefix + "leaf_size");
+    if (leaf_size == 0 || leaf_size > std::numeric_limits<std::uint32_t>::max())
+      throw a.error("bad k-d tree leaf size " + std::to_string(leaf_size));
+    const FlatArray<T> points = a.array<T>(prefix + "points");
+    if (points.size() % dim != 0 || points.size() / dim >= std::numeric_limits<std::uint32_t>::max())
+      throw a.error(std::to_string(points.size()) + " coordinates are not rows of dimension " + std::to_string(dim));
+    const std::size_t n = points.size() / dim;
+    KdTree tree;
+    tree.leaf_size_ = std::size_t(leaf_size);
+    tree.adopt(points.to_vector(), dim);
+    tree.nodes_ = a.array<Node>(prefix + "nodes").to_vector();
+    tree.perm_ = a.array<std::uint32_t>(prefix + "permutation", n).to_vector();
+    tree.root_lo_ = a.array<T>(prefix + "bounds_lo", n > 0 ? dim : 0).to_vector();
+    tree.root_hi_ = a.array<T>(prefix + "bounds_hi", n > 0 ? dim : 0).to_vector();
+    for (T x : points)
+      if (!std::isfinite(x)) throw a.error("corrupted k-d tree: a non-finite coordinate");
+    try {
+      tree.validate();
+    } catch (const Error& e) {
+      throw a.error(std::string("corrupted k-d tree: ") + e.what());
+    }
+    return tree;
   }
 
   // ---------------------------------------------------------------- files
