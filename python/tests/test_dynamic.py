@@ -136,3 +136,32 @@ def test_bad_input():
     assert len(tree) == 3
     with pytest.raises(ValueError, match="k must be"):
         tree.query([0, 0, 0], k=0)
+
+
+@pytest.mark.parametrize("variant", ["amortized", "worst_case"])
+@pytest.mark.parametrize("dim", [2, 4])
+def test_save_load_round_trip(tmp_path, variant, dim):
+    rng = np.random.default_rng(dim)
+    tree = geods.DynamicKdTree(dim=dim, variant=variant)
+    ids = np.concatenate([tree.insert(rng.integers(0, 9, (int(rng.integers(1, 30)), dim)).astype(float))
+                          for _ in range(60)])
+    tree.remove(ids[::3])
+    path = str(tmp_path / "dyn.geods")
+    tree.save(path)
+    loaded = geods.DynamicKdTree.load(path)
+    loaded.validate()
+    assert loaded.dim == dim and loaded.variant == variant and len(loaded) == len(tree)
+    q = rng.uniform(0, 9, (25, dim))
+    for a, b in zip(tree.query(q, 6), loaded.query(q, 6)):
+        np.testing.assert_array_equal(a, b)
+    np.testing.assert_array_equal(tree.query_radius(q[0], 3.0), loaded.query_radius(q[0], 3.0))
+    assert int(loaded.insert(np.zeros(dim))) == int(tree.insert(np.zeros(dim)))
+    with open(path, "rb") as f:
+        data = f.read()
+    bad = tmp_path / "bad.geods"
+    bad.write_bytes(data[: len(data) // 2])
+    with pytest.raises(ValueError):
+        geods.DynamicKdTree.load(str(bad))
+    bad.write_bytes(b"not an archive")
+    with pytest.raises(ValueError):
+        geods.DynamicKdTree.load(str(bad))

@@ -200,7 +200,7 @@ class KdTree {
       T slack, approx;
       T limit() const { return result.worst(); }
       T bound() const { return result.worst() * (result.full() ? approx : slack); }
-      void report(std::uint32_t index, T d) { result.insert(index, d); }
+      void report(std::uint32_t index, T d) const { result.insert(index, d); }
     } search{result, slack(), slack() / T((1 + eps) * (1 + eps))};
     descend(q, search, skip);
   }
@@ -213,7 +213,7 @@ class KdTree {
       T r2, bound_;
       T limit() const { return r2; }
       T bound() const { return bound_; }
-      void report(std::uint32_t index, T d) { f(index, d); }
+      void report(std::uint32_t index, T d) const { f(index, d); }
     } search{f, r2, r2 * slack()};
     descend(q, search, skip);
   }
@@ -709,7 +709,7 @@ class KdTree {
   // search.report(index, d). bound() and limit() are read again after each
   // report, so a k-best list tightens the search as it fills.
   template <typename Search, typename Skip>
-  void descend(const T* q, Search& search, const Skip& skip) const {
+  void descend(const T* q, const Search& search, const Skip& skip) const {
     if (empty()) return;
     Scratch<T> dists(dim());
     const T mindist = initial_distances(q, dists.data());
@@ -720,14 +720,15 @@ class KdTree {
       Descent<false, Search, Skip>{*this, q, dists.data(), search, skip}.visit(0, mindist);
   }
 
-  // The query state in one place, so the recursion passes only (node, mindist).
+  // The query state in one place, so the recursion passes only (node, mindist);
+  // the policy is held by value (it refers to its result), one indirection less.
   // Ordered: read the leaf points from ordered_ (store_points_in_tree_order) instead of via perm_.
   template <bool Ordered, typename Search, typename Skip>
   struct Descent {
     const KdTree& tree;
     const T* q;
     T* dists;  // per-axis terms of mindist
-    Search& search;
+    Search search;
     const Skip& skip;
 
     // mindist is a lower bound of the squared distance from q to the cell of node v.
