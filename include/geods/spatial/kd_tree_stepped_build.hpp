@@ -99,8 +99,10 @@ class KdTreeSteppedBuild {
     const std::size_t dim = s.dim;
     const std::uint32_t n = std::uint32_t(s.rows.size());
     std::size_t used = 0;
-    std::vector<T> coordinates(std::size_t(n) * dim);
-    std::vector<Item> items(n);
+    std::vector<T> coordinates;  // filled as the rows are read: no pass to zero them first
+    std::vector<Item> items;
+    coordinates.reserve(std::size_t(n) * dim);
+    items.reserve(n);
     for (std::uint32_t i = 0; i < n; ++i) {
       const Row& row = s.rows[i];
       if (row.size() != dim)
@@ -110,11 +112,11 @@ class KdTreeSteppedBuild {
         if (!std::isfinite(row[a]))
           throw Error("KdTree: point " + std::to_string(i) + " has a non-finite coordinate (axis " +
                       std::to_string(a) + ")");
-      std::copy(row.begin(), row.end(), coordinates.begin() + std::size_t(i) * dim);
+      coordinates.insert(coordinates.end(), row.begin(), row.end());
       if constexpr (Dim == Dynamic)
-        items[i] = i;
+        items.push_back(i);
       else
-        items[i] = Record{row, i};
+        items.push_back(Record{row, i});
       if (++used >= s.budget) {
         used = 0;
         co_yield Steps::pause;
@@ -143,7 +145,8 @@ class KdTreeSteppedBuild {
     };
     std::vector<Range> stack;
     if (n > 0) stack.push_back({0, n, kRoot, false});
-    std::vector<T> lo(dim), hi(dim);
+    std::conditional_t<Dim == Dynamic, std::vector<T>, std::array<T, std::size_t(Dim == Dynamic ? 1 : Dim)>> lo{}, hi{};
+    if constexpr (Dim == Dynamic) lo.resize(dim), hi.resize(dim);
     while (!stack.empty()) {
       const Range r = stack.back();
       stack.pop_back();
@@ -166,8 +169,8 @@ class KdTreeSteppedBuild {
         }
       }
       if (r.parent == kRoot) {
-        tree.root_lo_ = lo;
-        tree.root_hi_ = hi;
+        tree.root_lo_.assign(lo.begin(), lo.end());
+        tree.root_hi_.assign(hi.begin(), hi.end());
       } else if (r.right) {
         nodes[r.parent].high = lo[nodes[r.parent].axis];
       } else {
@@ -217,14 +220,15 @@ class KdTreeSteppedBuild {
       stack.push_back({mid, r.end, v, true});
       stack.push_back({r.begin, mid, v, false});
     }
-    auto ordered = std::make_shared<std::vector<T>>(std::size_t(n) * dim);
+    auto ordered = std::make_shared<std::vector<T>>();
+    ordered->reserve(std::size_t(n) * dim);
     for (std::uint32_t i = 0; i < n; ++i) {
       if constexpr (Dim == Dynamic)
         perm[i] = items[i];
       else
         perm[i] = items[i].index;
       const T* p = coords(items[i]);
-      std::copy(p, p + dim, ordered->data() + std::size_t(i) * dim);
+      ordered->insert(ordered->end(), p, p + dim);
       if (++used >= s.budget) {
         used = 0;
         co_yield Steps::pause;
