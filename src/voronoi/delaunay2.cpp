@@ -446,6 +446,41 @@ Delaunay2Stats Delaunay2::stats() const {
   return s;
 }
 
+// The closed triangulation's combinatorics: twins, vertices, orientation.
+Delaunay2::TriangleCounts Delaunay2::check_triangles() const {
+  const auto fail = [](const std::string& what) { throw Error("Delaunay2::validate: " + what); };
+  const std::size_t n = points_.size();
+  const std::uint32_t half_edges = std::uint32_t(core_.vert.size());
+  if (core_.twin.size() != half_edges || half_edges % 3) fail("array sizes");
+  if (has_constraints_ && fixed_.size() != half_edges) fail("constraint flags have the wrong size");
+  std::size_t live = 0, ghosts = 0;
+  std::vector<char> present(n, 0);
+  for (std::uint32_t t = 0; t < half_edges / 3; ++t) {
+    if (core_.vert[3 * t] == kNone) continue;
+    ++live;
+    const bool ghost = core_.is_ghost_triangle(t);
+    ghosts += ghost;
+    if ((core_.vert[3 * t] == kGhost) + (core_.vert[3 * t + 1] == kGhost) + (core_.vert[3 * t + 2] == kGhost) > 1)
+      fail("triangle " + std::to_string(t) + " has two ghost vertices");
+    for (std::uint32_t e = 3 * t; e < 3 * t + 3; ++e) {
+      const std::uint32_t v = core_.vert[e], f = core_.twin[e];
+      if (v != kGhost) {
+        const std::uint32_t o = v < core_.coords.size() ? original_of_[v] : kNone;
+        if (o >= n || rep_[o] != o || internal_of_[o] != v || points_[o] != core_.coords[v])
+          fail("triangle " + std::to_string(t) + " uses a vertex that is not a representative");
+        present[o] = 1;
+      }
+      if (f >= half_edges || core_.twin[f] != e || core_.vert[f] == kNone) fail("twin of half-edge " + std::to_string(e));
+      if (core_.vert[f] != core_.vert[next(e)] || core_.vert[next(f)] != v) fail("twins of half-edge " + std::to_string(e) + " do not share their end points");
+    }
+    if (!ghost && !(orient2d(core_.at(core_.vert[3 * t]), core_.at(core_.vert[3 * t + 1]), core_.at(core_.vert[3 * t + 2])) > 0))
+      fail("triangle " + std::to_string(t) + " is not counter-clockwise");
+  }
+  for (std::uint32_t i = 0; i < n; ++i)
+    if (rep_[i] == i && !present[i]) fail("point " + std::to_string(i) + " is in no triangle");
+  return {live, ghosts};
+}
+
 void Delaunay2::validate() const {
   const auto fail = [](const std::string& what) { throw Error("Delaunay2::validate: " + what); };
   const std::size_t n = points_.size();
@@ -472,32 +507,8 @@ void Delaunay2::validate() const {
     }
     return;
   }
-  // The closed triangulation.
+  const auto [live, ghosts] = check_triangles();
   const std::uint32_t half_edges = std::uint32_t(core_.vert.size());
-  if (core_.twin.size() != half_edges || half_edges % 3) fail("array sizes");
-  std::size_t live = 0, ghosts = 0;
-  std::vector<char> present(n, 0);
-  for (std::uint32_t t = 0; t < half_edges / 3; ++t) {
-    if (core_.vert[3 * t] == kNone) continue;
-    ++live;
-    const bool ghost = core_.is_ghost_triangle(t);
-    ghosts += ghost;
-    for (std::uint32_t e = 3 * t; e < 3 * t + 3; ++e) {
-      const std::uint32_t v = core_.vert[e], f = core_.twin[e];
-      if (v != kGhost) {
-        const std::uint32_t o = v < core_.coords.size() ? original_of_[v] : kNone;
-        if (o >= n || rep_[o] != o || internal_of_[o] != v || points_[o] != core_.coords[v])
-          fail("triangle " + std::to_string(t) + " uses a vertex that is not a representative");
-        present[o] = 1;
-      }
-      if (f >= half_edges || core_.twin[f] != e || core_.vert[f] == kNone) fail("twin of half-edge " + std::to_string(e));
-      if (core_.vert[f] != core_.vert[next(e)] || core_.vert[next(f)] != v) fail("twins of half-edge " + std::to_string(e) + " do not share their end points");
-    }
-    if (!ghost && !(orient2d(core_.at(core_.vert[3 * t]), core_.at(core_.vert[3 * t + 1]), core_.at(core_.vert[3 * t + 2])) > 0))
-      fail("triangle " + std::to_string(t) + " is not counter-clockwise");
-  }
-  for (std::uint32_t i = 0; i < n; ++i)
-    if (rep_[i] == i && !present[i]) fail("point " + std::to_string(i) + " is in no triangle");
   // Locally Delaunay: the vertex opposite each edge is not inside the circle
   // (half-plane for a ghost triangle) of the triangle on the other side. With
   // ghost triangles this also says that the hull is convex.
@@ -509,7 +520,6 @@ void Delaunay2::validate() const {
       fail("edge " + std::to_string(core_.vert[e]) + "-" + std::to_string(core_.vert[next(e)]) + " is not locally Delaunay");
   }
   if (has_constraints_) {
-    if (fixed_.size() != half_edges) fail("constraint flags have the wrong size");
     for (std::uint32_t e = 0; e < half_edges; ++e)
       if (core_.vert[e] != kNone && fixed_[e] != fixed_[core_.twin[e]]) fail("constraint flags of twins differ");
     // Every input segment is a path of constrained edges through vertices on

@@ -29,6 +29,7 @@
 // geods::Error.
 #include <array>
 #include <cstdint>
+#include <filesystem>
 #include <span>
 #include <string>
 #include <vector>
@@ -159,6 +160,17 @@ class Delaunay2 {
   /// then v is cut out at degree 3. O(d^2) for degree d plus O(n) renumbering.
   void remove(std::uint32_t v);
 
+  /// Writes the triangulation to `path` as a geods archive (core/archive.hpp,
+  /// kind "voronoi.Delaunay2"): points, segments and the internal arrays.
+  /// Throws geods::Error naming the file if it cannot be written.
+  void save(const std::filesystem::path& path) const;
+  /// A triangulation equal to the one save()d to `path`: the same arrays, the
+  /// same answers, and insert() and remove() go on as they would have (the
+  /// mapped arrays are copied into the triangulation's own). Throws
+  /// geods::Error naming the file if it is missing, truncated, corrupt, of
+  /// another kind or version, or fails validate().
+  static Delaunay2 load(const std::filesystem::path& path);
+
   Delaunay2Stats stats() const;
   /// Checks every invariant; throws geods::Error naming the first violation:
   /// twins consistent, triangles counter-clockwise, every edge locally Delaunay
@@ -177,6 +189,10 @@ class Delaunay2 {
   void insert_vertex(std::uint32_t k, std::uint32_t start, Hooks& hooks);
   void insert_constraints();
   void publish();
+  struct TriangleCounts {
+    std::size_t live, ghosts;
+  };
+  TriangleCounts check_triangles() const;  // validate()'s first part, safe on any arrays of the right sizes
 
   Options options_;
   std::vector<Vec2d> points_;
