@@ -481,7 +481,7 @@ Delaunay2::TriangleCounts Delaunay2::check_triangles() const {
   return {live, ghosts};
 }
 
-void Delaunay2::validate() const {
+std::size_t Delaunay2::check_representatives() const {
   const auto fail = [](const std::string& what) { throw Error("Delaunay2::validate: " + what); };
   const std::size_t n = points_.size();
   if (rep_.size() != n) fail("one representative per point expected");
@@ -493,6 +493,12 @@ void Delaunay2::validate() const {
     if (points_[r] != points_[i]) fail("point " + std::to_string(i) + " differs from its representative");
     vertices += r == i;
   }
+  return vertices;
+}
+
+void Delaunay2::validate() const {
+  const auto fail = [](const std::string& what) { throw Error("Delaunay2::validate: " + what); };
+  const std::size_t vertices = check_representatives();
   if (internal_triangle_.empty()) {
     const auto at = [&](std::uint32_t i) { return points_[i]; };
     if (!triangles_.empty() || !halfedges_.empty()) fail("degenerate set with triangles");

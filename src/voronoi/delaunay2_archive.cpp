@@ -1,5 +1,6 @@
 // Delaunay2::save and load: the points, the segments and the closed triangulation
-// as archive sections; the public view is rebuilt on load and all of it validated.
+// as archive sections; on load every index is range-checked, the triangulation's
+// combinatorics checked and the public view rebuilt.
 #include <string>
 
 #include "archive_sections.hpp"
@@ -71,13 +72,14 @@ Delaunay2 Delaunay2::load(const std::filesystem::path& path) {
     if (dt.core_.vert[3 * t] != kNone) throw a.error("free_triangles: triangle " + std::to_string(t) + " is in use");
 
   try {
+    dt.check_representatives();
     if (half_edges == 0) {
       dt.build_degenerate();
+      dt.validate();
     } else {
-      dt.check_triangles();  // before publish() relies on the arrays
+      dt.check_triangles();
       dt.publish();
     }
-    dt.validate();
   } catch (const Error& e) {
     throw a.error(e.what());
   }

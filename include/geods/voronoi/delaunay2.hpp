@@ -166,9 +166,12 @@ class Delaunay2 {
   void save(const std::filesystem::path& path) const;
   /// A triangulation equal to the one save()d to `path`: the same arrays, the
   /// same answers, and insert() and remove() go on as they would have (the
-  /// mapped arrays are copied into the triangulation's own). Throws
-  /// geods::Error naming the file if it is missing, truncated, corrupt, of
-  /// another kind or version, or fails validate().
+  /// mapped arrays are copied into the triangulation's own); O(n). Throws
+  /// geods::Error naming the file if it is missing, truncated, corrupt (the
+  /// checksums), of another kind or version, or its arrays are not a closed
+  /// triangulation of its points (validate()'s checks but the geometric ones,
+  /// incircle and the segments' paths, which a checksummed file written by
+  /// save() cannot fail).
   static Delaunay2 load(const std::filesystem::path& path);
 
   Delaunay2Stats stats() const;
@@ -192,7 +195,9 @@ class Delaunay2 {
   struct TriangleCounts {
     std::size_t live, ghosts;
   };
-  TriangleCounts check_triangles() const;  // validate()'s first part, safe on any arrays of the right sizes
+  // validate()'s first parts, safe on any arrays of the right sizes: what load() checks.
+  std::size_t check_representatives() const;  // returns the number of distinct vertices
+  TriangleCounts check_triangles() const;
 
   Options options_;
   std::vector<Vec2d> points_;
