@@ -14,7 +14,7 @@
 #endif
 
 #include "geods/bvh/ray_triangle4.hpp"
-#include "geods/bvh/triangle_box.hpp"
+#include "geods/core/triangle_box.hpp"
 #include "geods/core/convex_hull3.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"

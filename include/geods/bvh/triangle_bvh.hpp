@@ -12,7 +12,7 @@
 
 #include "geods/bvh/aabb_bv.hpp"
 #include "geods/bvh/build_options.hpp"
-#include "geods/bvh/huge_page_allocator.hpp"
+#include "geods/core/huge_page_allocator.hpp"
 #include "geods/bvh/kdop.hpp"
 #include "geods/bvh/obb.hpp"
 #include "geods/bvh/ray_triangle4.hpp"
