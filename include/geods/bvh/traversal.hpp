@@ -1,9 +1,12 @@
 #pragma once
-// Simultaneous traversal of two hierarchies (seed §4.2's traverse(A, B)):
-// node pairs are opened while a predicate says they may interact, and every
-// surviving pair of leaves is handed to a callback. The predicate sees node
-// indices, so it can test any volumes under any relative transformation;
-// collision detection builds on this.
+// Traversal of hierarchies, generic over what happens at inner nodes and
+// leaves (madmann91/bvh v2's shape): one depth-first loop, `traverse`, over
+// any node layout (the Topology of any bounding volume through
+// `traverse_topology`, the wide SIMD nodes of TriangleBvh), every query a
+// small callback on it; and the simultaneous traversal of two hierarchies
+// (seed §4.2's traverse(A, B)) that collision detection builds on.
+#include <array>
+#include <cstddef>
 #include <cstdint>
 #include <type_traits>
 #include <utility>
@@ -11,12 +14,154 @@
 
 #include "geods/bvh/topology.hpp"
 
+// The traversal loops and their callbacks are the hot path of the ray
+// queries: they must melt into one function.
+// GEODS_BVH_INLINE_LAMBDA goes after a lambda's parameter list.
+#if defined(__GNUC__)
+#define GEODS_BVH_INLINE_LAMBDA __attribute__((always_inline))
+#else
+#define GEODS_BVH_INLINE_LAMBDA
+#endif
+#define GEODS_BVH_INLINE inline GEODS_BVH_INLINE_LAMBDA
+
 namespace geods::bvh {
+
+/// The stack a caller hands to `traverse`: an inline buffer for the usual
+/// depths, the heap for the deep trees the insertion builder can make.
+/// `capacity` must bound the pending entries: (depth + 2) x arity suffices.
+template <typename Entry>
+class TraversalStack {
+ public:
+  explicit TraversalStack(std::size_t capacity) {
+    if (capacity > inline_.size()) {
+      heap_.resize(capacity);
+      data_ = heap_.data();
+    }
+  }
+  TraversalStack(const TraversalStack&) = delete;
+  TraversalStack& operator=(const TraversalStack&) = delete;
+  void push(const Entry& e) { data_[size_++] = e; }
+  Entry pop() { return data_[--size_]; }
+  bool empty() const { return size_ == 0; }
+
+ private:
+  std::array<Entry, 256> inline_;
+  std::vector<Entry> heap_;
+  Entry* data_ = inline_.data();
+  std::size_t size_ = 0;
+};
+
+/// The children of an inner node that a traversal goes on to. `add_ordered`
+/// keeps them farthest first (largest key), so the nearest is visited next;
+/// children of equal keys are visited last-added first, as `add` visits all.
+template <typename Entry, int MaxChildren>
+struct ChildList {
+  Entry entries[MaxChildren];
+  int size = 0;
+
+  void add(const Entry& e) { entries[size++] = e; }
+  void add_ordered(const Entry& e) {  // insertion sort: at most 8 children
+    int k = size++;
+    while (k > 0 && entries[k - 1].key < e.key) {
+      entries[k] = entries[k - 1];
+      --k;
+    }
+    entries[k] = e;
+  }
+};
+
+namespace detail {
+// A callback returning void never stops; one returning bool stops on false.
+template <typename Fn, typename... Args>
+GEODS_BVH_INLINE bool keep_going(Fn& fn, Args&&... args) {
+  if constexpr (std::is_same_v<decltype(fn(std::forward<Args>(args)...)), bool>) {
+    return fn(std::forward<Args>(args)...);
+  } else {
+    fn(std::forward<Args>(args)...);
+    return true;
+  }
+}
+}  // namespace detail
+
+/// Depth-first traversal from `root` (already accepted). For the entry being
+/// visited, inner(e, children) returns false if e is a leaf, else adds the
+/// children to visit to `children` (a ChildList<Entry, MaxChildren>); the
+/// last one is visited next, the others wait on `stack`. A leaf goes to
+/// leaf(e), which returns void, or bool: false stops the traversal. A waiting
+/// entry is visited only if still_needed(e) when its turn comes (a closer hit
+/// may have been found since). Returns false if leaf stopped it.
+/// Cost: proportional to the nodes visited.
+template <int MaxChildren, typename Entry, typename Inner, typename Leaf, typename StillNeeded>
+GEODS_BVH_INLINE bool traverse(Entry root, TraversalStack<Entry>& stack, Inner&& inner, Leaf&& leaf,
+                               StillNeeded&& still_needed) {
+  Entry cur = root;
+  for (;;) {
+    ChildList<Entry, MaxChildren> children;
+    if (inner(cur, children)) {
+      if (children.size > 0) {
+        for (int i = 0; i + 1 < children.size; ++i) stack.push(children.entries[i]);
+        cur = children.entries[children.size - 1];
+        continue;
+      }
+    } else if (!detail::keep_going(leaf, cur)) {
+      return false;
+    }
+    bool more = false;
+    while (!more && !stack.empty()) {
+      cur = stack.pop();
+      more = still_needed(cur);
+    }
+    if (!more) return true;
+  }
+}
+
+/// A node of a Topology waiting to be visited, with the key it is ordered by
+/// (the entry distance along a ray, a squared distance to a point, ...).
+struct NodeRef {
+  std::uint32_t node;
+  float key;
+};
+
+/// Stack capacity for traverse_topology over `topology`, `depth` = topology.depth().
+inline std::size_t traversal_stack_size(int depth, int arity) { return std::size_t(depth + 2) * std::size_t(arity); }
+
+/// `traverse` over a Topology from node `start` (0: the root). accept(node,
+/// key) says whether a node may matter (testing its bounding volume; the
+/// root too) and sets its key; with Ordered the accepted children are visited
+/// nearest (smallest key) first. leaf(const TopoNode&) sees the leaf's
+/// primitive range and returns void or bool (false stops); still_needed(key)
+/// re-checks a waiting node. Returns false if leaf stopped the traversal.
+template <bool Ordered, typename Accept, typename Leaf, typename StillNeeded>
+GEODS_BVH_INLINE bool traverse_topology(const Topology& topology, std::uint32_t start, TraversalStack<NodeRef>& stack,
+                                        Accept&& accept, Leaf&& leaf, StillNeeded&& still_needed) {
+  NodeRef root{start, 0.0f};
+  if (topology.nodes.empty() || !accept(start, root.key)) return true;
+  const TopoNode* nodes = topology.nodes.data();
+  return traverse<8>(
+      root, stack,
+      [&](const NodeRef& e, ChildList<NodeRef, 8>& children) GEODS_BVH_INLINE_LAMBDA {
+        const TopoNode& node = nodes[e.node];
+        if (node.leaf()) return false;
+        for (std::uint32_t c = node.first_child; c < node.first_child + node.num_children; ++c) {
+          NodeRef child{c, 0.0f};
+          if (!accept(c, child.key)) continue;
+          if constexpr (Ordered) {
+            children.add_ordered(child);
+          } else {
+            children.add(child);
+          }
+        }
+        return true;
+      },
+      [&](const NodeRef& e) GEODS_BVH_INLINE_LAMBDA { return leaf(nodes[e.node]); },
+      [&](const NodeRef& e) GEODS_BVH_INLINE_LAMBDA { return still_needed(e.key); });
+}
 
 /// Calls node_pair(i, j) for node i of `a` and node j of `b`, starting at the
 /// roots; a pair it accepts is refined (the node covering more primitives is
 /// opened; two leaves go to leaf_pair(i, j)). leaf_pair returns void, or bool:
 /// false stops the whole traversal. Returns false if it was stopped.
+/// A loop of its own: it walks pairs, in no order, to an unknown depth.
 /// Cost: proportional to the accepted node pairs.
 template <typename NodePair, typename LeafPair>
 bool traverse_simultaneously(const Topology& a, const Topology& b, NodePair&& node_pair, LeafPair&& leaf_pair) {
@@ -29,11 +174,7 @@ bool traverse_simultaneously(const Topology& a, const Topology& b, NodePair&& no
     const TopoNode& na = a.nodes[i];
     const TopoNode& nb = b.nodes[j];
     if (na.leaf() && nb.leaf()) {
-      if constexpr (std::is_same_v<decltype(leaf_pair(i, j)), bool>) {
-        if (!leaf_pair(i, j)) return false;
-      } else {
-        leaf_pair(i, j);
-      }
+      if (!detail::keep_going(leaf_pair, i, j)) return false;
       continue;
     }
     const bool open_a = !na.leaf() && (nb.leaf() || na.prim_count >= nb.prim_count);
