@@ -43,6 +43,7 @@ class TraversalStack {
   void push(const Entry& e) { data_[size_++] = e; }
   Entry pop() { return data_[--size_]; }
   bool empty() const { return size_ == 0; }
+  void clear() { size_ = 0; }
 
  private:
   std::array<Entry, 256> inline_;
@@ -83,7 +84,8 @@ GEODS_BVH_INLINE bool keep_going(Fn& fn, Args&&... args) {
 }
 }  // namespace detail
 
-/// Depth-first traversal from `root` (already accepted). For the entry being
+/// Depth-first traversal from `root` (already accepted), on `stack` (cleared
+/// first: a stopped traversal leaves entries behind). For the entry being
 /// visited, inner(e, children) returns false if e is a leaf, else adds the
 /// children to visit to `children` (a ChildList<Entry, MaxChildren>); the
 /// last one is visited next, the others wait on `stack`. A leaf goes to
@@ -94,6 +96,7 @@ GEODS_BVH_INLINE bool keep_going(Fn& fn, Args&&... args) {
 template <int MaxChildren, typename Entry, typename Inner, typename Leaf, typename StillNeeded>
 GEODS_BVH_INLINE bool traverse(Entry root, TraversalStack<Entry>& stack, Inner&& inner, Leaf&& leaf,
                                StillNeeded&& still_needed) {
+  stack.clear();
   Entry cur = root;
   for (;;) {
     ChildList<Entry, MaxChildren> children;
