@@ -368,8 +368,7 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray, 
     __builtin_prefetch(p + 64);
   };
   // The children whose boxes the ray enters before tmax, all W at once.
-  auto inner = [&](const WideEntry& e, ChildList<WideEntry, W>& children) GEODS_BVH_INLINE_LAMBDA {
-    if (e.count != 0) return false;
+  auto children = [&](const WideEntry& e, float* keys) GEODS_BVH_INLINE_LAMBDA {
     const WideNode<W>& node = nodes[e.child];
     vf tn = tmin_v, tf;
     for (int i = 0; i < W; ++i) tf[i] = tmax;
@@ -383,13 +382,14 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray, 
       tn = t0 > tn ? t0 : tn;
       tf = t1 < tf ? t1 : tf;
     }
+    std::memcpy(keys, &tn, sizeof tn);
     // Widened far bound: a box hit that rounding would lose is kept (Ize 2013).
-    for (unsigned bits = lane_bits(tn <= tf * (1.0f + 4e-7f)); bits != 0; bits &= bits - 1) {
-      const int i = __builtin_ctz(bits);
-      children.add_ordered({node.child[i], node.count[i], tn[i]});
-    }
-    for (int i = 0; i < children.size; ++i) prefetch(children.entries[i]);
-    return true;
+    return lane_bits(tn <= tf * (1.0f + 4e-7f));
+  };
+  auto child = [&](const WideEntry& e, int i, float t) GEODS_BVH_INLINE_LAMBDA {
+    const WideEntry c{nodes[e.child].child[i], nodes[e.child].count[i], t};
+    prefetch(c);
+    return c;
   };
   auto leaf = [&](const WideEntry& e) GEODS_BVH_INLINE_LAMBDA {
     for (std::uint32_t g = e.child; g < e.child + e.count; ++g) {
@@ -407,8 +407,8 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray, 
     }
     return true;
   };
-  traverse<W>(WideEntry{0, 0, tmin}, stack, inner, leaf,
-              [&](const WideEntry& e) GEODS_BVH_INLINE_LAMBDA { return may_hit_before(e.key, tmax); });
+  traverse<W, true>(WideEntry{0, 0, tmin}, stack, [](const WideEntry& e) { return e.count != 0; }, children, child, leaf,
+                    [&](const WideEntry& e) GEODS_BVH_INLINE_LAMBDA { return may_hit_before(e.key, tmax); });
   return hit;
 }
 

@@ -52,25 +52,6 @@ class TraversalStack {
   std::size_t size_ = 0;
 };
 
-/// The children of an inner node that a traversal goes on to. `add_ordered`
-/// keeps them farthest first (largest key), so the nearest is visited next;
-/// children of equal keys are visited last-added first, as `add` visits all.
-template <typename Entry, int MaxChildren>
-struct ChildList {
-  Entry entries[MaxChildren];
-  int size = 0;
-
-  void add(const Entry& e) { entries[size++] = e; }
-  void add_ordered(const Entry& e) {  // insertion sort: at most 8 children
-    int k = size++;
-    while (k > 0 && entries[k - 1].key < e.key) {
-      entries[k] = entries[k - 1];
-      --k;
-    }
-    entries[k] = e;
-  }
-};
-
 namespace detail {
 // A callback returning void never stops; one returning bool stops on false.
 template <typename Fn, typename... Args>
@@ -85,25 +66,56 @@ GEODS_BVH_INLINE bool keep_going(Fn& fn, Args&&... args) {
 }  // namespace detail
 
 /// Depth-first traversal from `root` (already accepted), on `stack` (cleared
-/// first: a stopped traversal leaves entries behind). For the entry being
-/// visited, inner(e, children) returns false if e is a leaf, else adds the
-/// children to visit to `children` (a ChildList<Entry, MaxChildren>); the
-/// last one is visited next, the others wait on `stack`. A leaf goes to
-/// leaf(e), which returns void, or bool: false stops the traversal. A waiting
-/// entry is visited only if still_needed(e) when its turn comes (a closer hit
-/// may have been found since). Returns false if leaf stopped it.
-/// Cost: proportional to the nodes visited.
-template <int MaxChildren, typename Entry, typename Inner, typename Leaf, typename StillNeeded>
-GEODS_BVH_INLINE bool traverse(Entry root, TraversalStack<Entry>& stack, Inner&& inner, Leaf&& leaf,
-                               StillNeeded&& still_needed) {
+/// first: a stopped traversal leaves entries behind), over any node layout
+/// whose entries (the nodes waiting to be visited) have a float `key`:
+/// - is_leaf(e): whether entry e is a leaf;
+/// - children(e, keys): the children of inner node e to visit, as a bit mask
+///   (bit i: child i, at most MaxChildren), keys[i] the key child i is
+///   ordered by (an entry distance, ...);
+/// - child(e, i, key): the entry of child i of e (a good place to prefetch it).
+/// With Ordered the nearest child (smallest key) is visited next, the others
+/// wait on `stack` farthest first; children of equal keys, and all children
+/// without Ordered, are visited last first. A node with one child to visit
+/// goes on to it without stack traffic. A leaf goes to leaf(e), which returns
+/// void, or bool: false stops the traversal. A waiting entry is visited only
+/// if still_needed(e) when its turn comes (a closer hit may have been found
+/// since). Returns false if leaf stopped it. `stack` must hold (depth + 2) x
+/// MaxChildren entries. Cost: proportional to the nodes visited.
+template <int MaxChildren, bool Ordered, typename Entry, typename IsLeaf, typename Children, typename Child,
+          typename Leaf, typename StillNeeded>
+GEODS_BVH_INLINE bool traverse(Entry root, TraversalStack<Entry>& stack, IsLeaf&& is_leaf, Children&& children,
+                               Child&& child, Leaf&& leaf, StillNeeded&& still_needed) {
+  static_assert(MaxChildren >= 2 && MaxChildren <= 32, "children are reported as 32-bit masks");
   stack.clear();
   Entry cur = root;
   for (;;) {
-    ChildList<Entry, MaxChildren> children;
-    if (inner(cur, children)) {
-      if (children.size > 0) {
-        for (int i = 0; i + 1 < children.size; ++i) stack.push(children.entries[i]);
-        cur = children.entries[children.size - 1];
+    if (!is_leaf(cur)) {
+      float keys[MaxChildren];
+      unsigned bits = children(cur, keys);
+      if (bits != 0) {
+        const int first = __builtin_ctz(bits);
+        bits &= bits - 1;
+        if (bits == 0) {
+          cur = child(cur, first, keys[first]);
+          continue;
+        }
+        Entry visit[MaxChildren];  // farthest first: the last one is visited next
+        visit[0] = child(cur, first, keys[first]);
+        int n = 1;
+        for (; bits != 0; bits &= bits - 1) {
+          const int i = __builtin_ctz(bits);
+          const Entry e = child(cur, i, keys[i]);
+          int k = n++;
+          if constexpr (Ordered) {  // insertion sort: at most MaxChildren
+            while (k > 0 && visit[k - 1].key < keys[i]) {
+              visit[k] = visit[k - 1];
+              --k;
+            }
+          }
+          visit[k] = e;
+        }
+        for (int i = 0; i + 1 < n; ++i) stack.push(visit[i]);
+        cur = visit[n - 1];
         continue;
       }
     } else if (!detail::keep_going(leaf, cur)) {
@@ -140,21 +152,19 @@ GEODS_BVH_INLINE bool traverse_topology(const Topology& topology, std::uint32_t 
   NodeRef root{start, 0.0f};
   if (topology.nodes.empty() || !accept(start, root.key)) return true;
   const TopoNode* nodes = topology.nodes.data();
-  return traverse<8>(
-      root, stack,
-      [&](const NodeRef& e, ChildList<NodeRef, 8>& children) GEODS_BVH_INLINE_LAMBDA {
+  return traverse<8, Ordered>(
+      root, stack, [&](const NodeRef& e) GEODS_BVH_INLINE_LAMBDA { return nodes[e.node].leaf(); },
+      [&](const NodeRef& e, float* keys) GEODS_BVH_INLINE_LAMBDA {
         const TopoNode& node = nodes[e.node];
-        if (node.leaf()) return false;
-        for (std::uint32_t c = node.first_child; c < node.first_child + node.num_children; ++c) {
-          NodeRef child{c, 0.0f};
-          if (!accept(c, child.key)) continue;
-          if constexpr (Ordered) {
-            children.add_ordered(child);
-          } else {
-            children.add(child);
-          }
+        unsigned bits = 0;
+        for (std::uint32_t c = 0; c < node.num_children; ++c) {
+          keys[c] = 0.0f;  // for an accept that leaves the key alone
+          if (accept(node.first_child + c, keys[c])) bits |= 1u << c;
         }
-        return true;
+        return bits;
+      },
+      [&](const NodeRef& e, int i, float key) GEODS_BVH_INLINE_LAMBDA {
+        return NodeRef{nodes[e.node].first_child + std::uint32_t(i), key};
       },
       [&](const NodeRef& e) GEODS_BVH_INLINE_LAMBDA { return leaf(nodes[e.node]); },
       [&](const NodeRef& e) GEODS_BVH_INLINE_LAMBDA { return still_needed(e.key); });
