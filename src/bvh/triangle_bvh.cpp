@@ -358,7 +358,7 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray, 
   const float tmin = ray.tmin;
   vf tmin_v;
   for (int i = 0; i < W; ++i) tmin_v[i] = tmin;
-  TraversalStack<WideEntry> stack(std::size_t(depth_ + 2) * W);
+  TraversalStack<WideEntry> stack(traversal_stack_size(depth_, W));
   // Start fetching what a child needs; the cache misses on nodes and
   // triangles dominate incoherent rays.
   auto prefetch = [&](const WideEntry& e) GEODS_BVH_INLINE_LAMBDA {

@@ -137,7 +137,8 @@ struct NodeRef {
   float key;
 };
 
-/// Stack capacity for traverse_topology over `topology`, `depth` = topology.depth().
+/// Stack capacity for `traverse` over a tree of this depth (Topology::depth())
+/// and arity (at most arity - 1 entries wait per level).
 inline std::size_t traversal_stack_size(int depth, int arity) { return std::size_t(depth + 2) * std::size_t(arity); }
 
 /// `traverse` over a Topology from node `start` (0: the root). accept(node,
