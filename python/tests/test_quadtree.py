@@ -202,5 +202,5 @@ def test_save_load_round_trip(tmp_path, d):
     with pytest.raises(ValueError, match="truncated"):
         cls.load(tmp_path / "bad.geods")
     geods.KdTree(np.zeros((2, d))).save(tmp_path / "bad.geods")
-    with pytest.raises(ValueError, match="spatial.KdTree archive"):
+    with pytest.raises(ValueError, match="of kind spatial.KdTree"):
         cls.load(tmp_path / "bad.geods")

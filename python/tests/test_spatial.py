@@ -151,7 +151,7 @@ def test_load_errors(tmp_path):
         with pytest.raises(ValueError, match=what):
             geods.KdTree.load(bad)
     geods.Quadtree(np.zeros((3, 2))).save(bad)
-    with pytest.raises(ValueError, match="spatial.Orthtree archive, expected a spatial.KdTree"):
+    with pytest.raises(ValueError, match="kind spatial.Orthtree, expected kind spatial.KdTree"):
         geods.KdTree.load(bad)
     with pytest.raises(ValueError):
         geods.KdTree.load(tmp_path / "missing.geods")
