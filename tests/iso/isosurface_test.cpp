@@ -576,7 +576,8 @@ void expect_round_trip(const MinMaxOctree<T>& tree, std::initializer_list<double
   EXPECT_EQ(loaded.volume().data, tree.volume().data);
   EXPECT_EQ(loaded.node_min(), tree.node_min());
   EXPECT_EQ(loaded.node_max(), tree.node_max());
-  EXPECT_EQ(loaded.node_min().mapped(), !tree.node_min().empty());  // read in place
+  EXPECT_TRUE(loaded.node_min().mapped());  // read in place
+  EXPECT_TRUE(loaded.node_max().mapped());
   EXPECT_FALSE(tree.node_min().mapped());
   EXPECT_EQ(loaded.stats().nodes, tree.stats().nodes);
   EXPECT_EQ(loaded.stats().leaf_cells, tree.stats().leaf_cells);
