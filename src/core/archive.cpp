@@ -173,8 +173,9 @@ Archive Archive::open(const std::filesystem::path& path, std::string_view kind, 
     if (e.element_bytes == 0 || (e.type != kRecordType && (e.type > std::uint32_t(DType::f64) ||
                                                            dtype_size(DType(e.type)) != e.element_bytes)))
       throw fail("corrupt archive (" + where + " has a bad element type)");
-    if (e.offset % kAlign != 0 || e.offset > size) throw fail("corrupt archive (" + where + " offset)");
-    if (e.count > (size - e.offset) / e.element_bytes) throw fail("truncated archive (" + where + ")");
+    if (e.offset % kAlign != 0) throw fail("corrupt archive (" + where + " offset)");
+    if (e.offset > size || e.count > (size - e.offset) / e.element_bytes)
+      throw fail("truncated archive (" + where + ")");
     if (verify == Verify::checksums && checksum(file->data() + e.offset, e.count * e.element_bytes) != r.checksum)
       throw fail("corrupt archive (" + where + " checksum)");
     for (const Entry& other : entries)
