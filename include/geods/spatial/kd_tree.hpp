@@ -6,7 +6,9 @@
 // Layout: a flat array of nodes in depth-first order (the left child of node i is
 // i + 1, the right child is stored) with 32-bit indices, and a permutation of the
 // point indices so that every node owns a contiguous range of it. The points stay
-// in the caller's array (zero-copy, PointView) or in one the tree owns.
+// in the caller's array (zero-copy, PointView) or in one the tree owns. The node
+// array and the permutation are FlatArrays: a tree loaded from a file (load())
+// reads them, and its points, in place from the mapped file.
 //
 // Split rule: each node splits its points at the median (std::nth_element) along
 // the axis of widest spread of those points. Median splits bound the depth by
@@ -22,7 +24,6 @@
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <map>
 #include <memory>
@@ -33,10 +34,11 @@
 #include <vector>
 
 #include "geods/core/aabb.hpp"
+#include "geods/core/archive.hpp"
 #include "geods/core/error.hpp"
+#include "geods/core/flat_array.hpp"
 #include "geods/core/parallel.hpp"
 #include "geods/core/vec.hpp"
-#include "geods/spatial/kd_tree_file.hpp"
 #include "geods/spatial/knn_result.hpp"
 #include "geods/spatial/permutation.hpp"
 #include "geods/spatial/point_view.hpp"
@@ -45,6 +47,22 @@ namespace geods::spatial {
 
 /// The dimension template argument for a dimension known only at run time (as in Eigen).
 inline constexpr int Dynamic = -1;
+
+/// The archive kind and layout version of a saved k-d tree (KdTree::save).
+inline constexpr std::string_view kKdTreeArchiveKind = "spatial.KdTree";
+inline constexpr std::uint32_t kKdTreeArchiveVersion = 1;
+
+/// What a saved k-d tree holds, to pick the tree type before loading it.
+struct KdTreeFileInfo {
+  DType scalar;     // f32 or f64
+  std::size_t dim;  // coordinates per point
+};
+/// Reads the scalar type and dimension of the k-d tree saved at `path` (reads
+/// only the header and section table). Throws geods::Error naming the file.
+inline KdTreeFileInfo read_kd_tree_info(const std::filesystem::path& path) {
+  const Archive a = Archive::open(path, kKdTreeArchiveKind, kKdTreeArchiveVersion, Archive::Verify::structure_only);
+  return {a.dtype("scalar"), std::size_t(a.value<std::uint64_t>("dim"))};
+}
 
 struct KdTreeStats {
   std::size_t points = 0;
@@ -99,9 +117,9 @@ class KdTree {
   /// Coordinates of point i (its index in the input).
   const T* point(std::size_t i) const { return view_[i]; }
   PointView<T> points() const { return view_; }
-  const std::vector<Node>& nodes() const { return nodes_; }
+  const FlatArray<Node>& nodes() const { return nodes_; }
   /// Point indices in tree order: node v owns permutation()[v.begin, v.end).
-  const std::vector<std::uint32_t>& permutation() const { return perm_; }
+  const FlatArray<std::uint32_t>& permutation() const { return perm_; }
 
   /// Opt-in speed-up for large inputs: keeps a copy of the points in tree order
   /// (size() * dim() values, shared by copies of the tree) so that k-NN and radius
@@ -265,7 +283,8 @@ class KdTree {
   /// the permutation is a permutation; nodes form a tree in depth-first order
   /// whose children split their parent's range at its middle (balance); leaves
   /// hold 1..leaf_size points; low <= high; every point lies in the cell of its
-  /// leaf (the root box cut by the low/high values on the path), so no split lies.
+  /// leaf (the root box cut by the low/high values on the path), so no split
+  /// lies, and is finite.
   void validate() const {
     const std::size_t n = size();
     auto fail = [](const std::string& what) { throw Error("KdTree::validate: " + what); };
@@ -296,8 +315,8 @@ class KdTree {
         for (std::uint32_t i = node.begin; i < node.end; ++i) {
           const T* p = point(perm_[i]);
           for (std::size_t a = 0; a < dim(); ++a)
-            if (!(p[a] >= item.lo[a] && p[a] <= item.hi[a]))
-              fail(where + "point " + std::to_string(perm_[i]) + " lies outside its leaf's cell");
+            if (!(std::isfinite(p[a]) && p[a] >= item.lo[a] && p[a] <= item.hi[a]))
+              fail(where + "point " + std::to_string(perm_[i]) + " is not finite or lies outside its leaf's cell");
         }
         continue;
       }
@@ -322,66 +341,66 @@ class KdTree {
   }
 
   // ---------------------------------------------------------------- files
-  /// Writes the tree and its points (see kd_tree_file.hpp).
+  /// Writes the tree and its points (in input order) as a "spatial.KdTree"
+  /// archive (core/archive.hpp): value sections scalar, dim, leaf_size; arrays
+  /// bounds_lo, bounds_hi, nodes, permutation, points (n x dim, row-major).
   void save(const std::filesystem::path& path) const {
-    std::ofstream out(path, std::ios::binary);
-    if (!out) throw Error(path.string() + ": cannot open for writing");
-    KdTreeFileHeader h;
-    h.scalar_bytes = sizeof(T);
-    h.dim = std::uint32_t(dim());
-    h.leaf_size = std::uint32_t(leaf_size_);
-    h.points = size();
-    h.nodes = nodes_.size();
-    write_kd_tree_header(out, h, path);
-    std::vector<T> box(2 * dim(), T(0));
-    std::copy(root_lo_.begin(), root_lo_.end(), box.begin());
-    std::copy(root_hi_.begin(), root_hi_.end(), box.begin() + dim());
-    write_bytes(out, box.data(), box.size() * sizeof(T), path);
-    write_bytes(out, nodes_.data(), nodes_.size() * sizeof(Node), path);
-    write_bytes(out, perm_.data(), perm_.size() * sizeof(std::uint32_t), path);
-    for (std::size_t i = 0; i < size(); ++i) write_bytes(out, point(i), dim() * sizeof(T), path);
-    out.flush();
-    if (!out) throw Error(path.string() + ": cannot write");
+    ArchiveWriter w(std::string(kKdTreeArchiveKind), kKdTreeArchiveVersion);
+    w.add_dtype("scalar", dtype_of<T>());
+    w.add_value("dim", std::uint64_t(dim()));
+    w.add_value("leaf_size", std::uint64_t(leaf_size_));
+    w.add("bounds_lo", root_lo_);
+    w.add("bounds_hi", root_hi_);
+    w.add("nodes", nodes_);
+    w.add("permutation", perm_);
+    std::vector<T> packed;  // only for a strided view: packed points are written as they are
+    if (view_.stride != view_.dim && size() > 0) {
+      packed.reserve(size() * dim());
+      for (std::size_t i = 0; i < size(); ++i) packed.insert(packed.end(), point(i), point(i) + dim());
+    }
+    w.add("points", packed.empty() ? std::span<const T>(view_.data, size() * dim()) : std::span<const T>(packed));
+    w.write(path);
   }
 
-  /// Reads a tree written by save(); the loaded tree owns its points. Throws
-  /// geods::Error for another scalar type or dimension, a bad header, truncation
-  /// or contents that fail validate().
-  static KdTree load(const std::filesystem::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw Error(path.string() + ": cannot open");
-    const KdTreeFileHeader h = read_kd_tree_header(in, path);
-    if (h.scalar_bytes != sizeof(T))
-      throw Error(path.string() + ": k-d tree of " + (h.scalar_bytes == 4 ? "float" : "double") + ", expected " +
-                  (sizeof(T) == 4 ? "float" : "double"));
-    if (Dim != Dynamic && h.dim != std::uint32_t(Dim))
-      throw Error(path.string() + ": k-d tree of dimension " + std::to_string(h.dim) + ", expected " +
-                  std::to_string(Dim));
+  /// Maps a tree written by save(): its nodes, permutation and points are read
+  /// in place from the file (no parse, no copy), which stays mapped while the
+  /// tree or a copy of it lives. Throws geods::Error naming the file for another
+  /// scalar type or dimension, a truncated or corrupt file (checksums, unless
+  /// `verify` says structure_only) or contents that fail validate().
+  static KdTree load(const std::filesystem::path& path, Archive::Verify verify = Archive::Verify::checksums) {
+    const Archive a = Archive::open(path, kKdTreeArchiveKind, kKdTreeArchiveVersion, verify);
+    a.require_dtype<T>("scalar", "k-d tree");
+    const std::uint64_t dim = a.value<std::uint64_t>("dim");
+    if ((Dim != Dynamic && dim != std::uint64_t(Dim)) || dim > (1u << 16))
+      throw a.error("a k-d tree of dimension " + std::to_string(dim) + ", expected " +
+                    (Dim == Dynamic ? std::string("at most 65536") : std::to_string(Dim)));
+    const std::uint64_t leaf_size = a.value<std::uint64_t>("leaf_size");
+    if (leaf_size == 0 || leaf_size > std::numeric_limits<std::uint32_t>::max())
+      throw a.error("bad k-d tree leaf size " + std::to_string(leaf_size));
+    auto points = std::make_shared<const FlatArray<T>>(a.array<T>("points"));
+    if (dim == 0 ? !points->empty() : points->size() % dim != 0)
+      throw a.error(std::to_string(points->size()) + " coordinates are not rows of dimension " + std::to_string(dim));
+    const std::size_t n = dim == 0 ? 0 : points->size() / dim;
+    if (n >= std::numeric_limits<std::uint32_t>::max()) throw a.error("too many points for a k-d tree");
     KdTree tree;
-    tree.leaf_size_ = h.leaf_size;
-    std::vector<T> box(2 * h.dim);
-    read_bytes(in, box.data(), box.size() * sizeof(T), path);
-    tree.nodes_.resize(h.nodes);
-    read_bytes(in, tree.nodes_.data(), tree.nodes_.size() * sizeof(Node), path);
-    tree.perm_.resize(h.points);
-    read_bytes(in, tree.perm_.data(), tree.perm_.size() * sizeof(std::uint32_t), path);
-    std::vector<T> coordinates(h.points * h.dim);
-    read_bytes(in, coordinates.data(), coordinates.size() * sizeof(T), path);
-    tree.adopt(std::move(coordinates), h.dim);
-    if (h.points > 0) {
-      tree.root_lo_.assign(box.begin(), box.begin() + h.dim);
-      tree.root_hi_.assign(box.begin() + h.dim, box.end());
-    }
+    tree.leaf_size_ = std::size_t(leaf_size);
+    tree.view_ = PointView<T>(points->data(), n, std::size_t(dim));
+    tree.owned_ = std::move(points);
+    tree.nodes_ = a.array<Node>("nodes");
+    tree.perm_ = a.array<std::uint32_t>("permutation", n);
+    tree.root_lo_ = a.array<T>("bounds_lo", n > 0 ? dim : 0).to_vector();
+    tree.root_hi_ = a.array<T>("bounds_hi", n > 0 ? dim : 0).to_vector();
     try {
       tree.validate();
     } catch (const Error& e) {
-      throw Error(path.string() + ": corrupted k-d tree: " + e.what());
+      throw a.error(std::string("corrupted k-d tree: ") + e.what());
     }
     return tree;
   }
 
  private:
   static_assert(sizeof(Node) == 16 + 2 * sizeof(T), "Node is written to files as is");
+  static_assert(std::is_trivially_copyable_v<Node>);
 
   // A small per-query array: on the stack for compile-time and small run-time dimensions.
   template <typename U>
@@ -399,7 +418,7 @@ class KdTree {
   };
 
   void adopt(std::vector<T> coordinates, std::size_t dim) {
-    owned_ = std::make_shared<std::vector<T>>(std::move(coordinates));
+    owned_ = std::make_shared<const FlatArray<T>>(std::move(coordinates));
     view_ = PointView<T>(owned_->data(), owned_->size() / dim, dim);
   }
 
@@ -423,16 +442,16 @@ class KdTree {
           throw Error("KdTree: point " + std::to_string(i) + " has a non-finite coordinate (axis " +
                       std::to_string(a) + ")");
     }
-    perm_.resize(n);
+    std::vector<std::uint32_t> perm(n);
     if (n == 0) return;
     // The size of every subtree depends only on its point count, so each one
     // knows its place in the node array before its siblings are built: the
     // parallel build writes disjoint parts and its output is deterministic.
     std::map<std::size_t, std::uint32_t> subtree_nodes;
-    nodes_.resize(count_nodes(n, subtree_nodes));
+    std::vector<Node> nodes(count_nodes(n, subtree_nodes));
     root_lo_.assign(dim(), T(0));
     root_hi_.assign(dim(), T(0));
-    const Builder builder{this, subtree_nodes, num_threads() > 1};
+    const Builder builder{this, nodes.data(), subtree_nodes, num_threads() > 1};
     if constexpr (Dim != Dynamic) {
       // Partitioning copies of the points (with their index) streams through
       // memory instead of following the permutation into the caller's array:
@@ -448,12 +467,14 @@ class KdTree {
       });
       builder.node(records.data(), [](const Record& r) { return r.p.data(); }, 0, 0, std::uint32_t(n),
                    root_lo_.data(), root_hi_.data());
-      parallel_for_each_index(0, n, [&](std::size_t i) { perm_[i] = records[i].index; });
+      parallel_for_each_index(0, n, [&](std::size_t i) { perm[i] = records[i].index; });
     } else {
-      std::iota(perm_.begin(), perm_.end(), 0u);
-      builder.node(perm_.data(), [this](std::uint32_t i) { return point(i); }, 0, 0, std::uint32_t(n),
+      std::iota(perm.begin(), perm.end(), 0u);
+      builder.node(perm.data(), [this](std::uint32_t i) { return point(i); }, 0, 0, std::uint32_t(n),
                    root_lo_.data(), root_hi_.data());
     }
+    nodes_ = std::move(nodes);
+    perm_ = std::move(perm);
   }
 
   std::uint32_t count_nodes(std::size_t m, std::map<std::size_t, std::uint32_t>& memo) const {
@@ -467,7 +488,8 @@ class KdTree {
   // Median-split recursion over a sequence of items (point records or point
   // indices) whose coordinates coords(item) returns.
   struct Builder {
-    KdTree* tree;
+    const KdTree* tree;
+    Node* nodes;  // the node array being built
     const std::map<std::size_t, std::uint32_t>& subtree_nodes;
     bool parallel;
 
@@ -480,7 +502,7 @@ class KdTree {
               T* hi) const {
       const std::size_t dim = tree->dim();
       bounds(items, coords, begin, end, lo, hi);
-      Node& node = tree->nodes_[v];
+      Node& node = nodes[v];
       node = Node{begin, end, 0, 0, T(0), T(0)};
       const std::size_t m = end - begin;
       if (m <= tree->leaf_size_) return;
@@ -722,11 +744,11 @@ class KdTree {
   }
 
   PointView<T> view_;
-  std::shared_ptr<const std::vector<T>> owned_;  // the points, when the tree owns them (shared by copies)
+  std::shared_ptr<const FlatArray<T>> owned_;  // the points, when the tree owns or maps them (shared by copies)
   std::shared_ptr<const std::vector<T>> ordered_;  // opt-in copy in tree order (store_points_in_tree_order)
   std::size_t leaf_size_ = kDefaultLeafSize;
-  std::vector<Node> nodes_;
-  std::vector<std::uint32_t> perm_;
+  FlatArray<Node> nodes_;
+  FlatArray<std::uint32_t> perm_;
   std::vector<T> root_lo_, root_hi_;
 };
 
