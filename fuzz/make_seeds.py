@@ -96,6 +96,120 @@ def glb():
     return b"glTF" + struct.pack("<II", 2, 12 + len(chunks)) + chunks
 
 
+def checksum(data):
+    """The payload checksum of core/archive.cpp."""
+    mask = (1 << 64) - 1
+    h = 0x9e3779b97f4a7c15 ^ len(data)
+    whole = len(data) // 8 * 8
+    for i in range(0, whole, 8):
+        h = ((h ^ int.from_bytes(data[i:i + 8], "little")) * 0xff51afd7ed558ccd) & mask
+        h ^= h >> 32
+    tail = int.from_bytes(data[whole:], "little")
+    h = ((h ^ tail) * 0xc4ceb9fe1a85ec53) & mask
+    return h ^ (h >> 29)
+
+
+def archive(kind, sections, version=1):
+    """A geods archive (core/archive.hpp): sections are (name, type code, element bytes, payload)."""
+    def up(x):
+        return (x + 63) // 64 * 64
+    table, payloads = b"", []
+    offset = up(64 + 64 * len(sections))
+    for name, code, size, data in sections:
+        table += name.encode().ljust(32, b"\0") + struct.pack("<IIQQQ", code, size, offset, len(data) // size,
+                                                                checksum(data))
+        payloads.append((offset, data))
+        offset = up(offset + len(data))
+    out = bytearray(b"GEODSARC" + struct.pack("<II", 1, 0x01020304) + kind.encode().ljust(32, b"\0") +
+                    struct.pack("<IIQ", version, len(sections), checksum(table)) + table)
+    for at, data in payloads:
+        out += bytes(at - len(out)) + data
+    return bytes(out)
+
+
+U8, U32, U64, F32, F64, RECORD = 0, 4, 6, 8, 9, 255
+
+
+def value(name, code, fmt, x):
+    return (name, code, struct.calcsize(fmt), struct.pack(fmt, x))
+
+
+def kd_tree(points, nodes, perm, leaf_size):
+    """A k-d tree of float64 2-D points: nodes are (begin, end, right, axis, low, high)."""
+    xs, ys = [p[0] for p in points], [p[1] for p in points]
+    return archive("spatial.KdTree", [
+        value("scalar", U32, "<I", F64), value("dim", U64, "<Q", 2), value("leaf_size", U64, "<Q", leaf_size),
+        ("bounds_lo", F64, 8, struct.pack("<2d", min(xs), min(ys))),
+        ("bounds_hi", F64, 8, struct.pack("<2d", max(xs), max(ys))),
+        ("nodes", RECORD, 32, b"".join(struct.pack("<4I2d", *n) for n in nodes)),
+        ("permutation", U32, 4, struct.pack("<%dI" % len(perm), *perm)),
+        ("points", F64, 8, b"".join(struct.pack("<2d", *p) for p in points))])
+
+
+def quadtree(points, nodes, bucket, side):
+    """A quadtree of float64 points rooted at (0, 0): nodes are (first_child, parent, begin, end, depth, cx, cy)."""
+    return archive("spatial.Orthtree", [
+        value("scalar", U32, "<I", F64), value("dim", U64, "<Q", 2), value("bucket", U64, "<Q", bucket),
+        value("max_depth", U32, "<I", 32), value("balanced", U32, "<I", 0), value("root_side", F64, "<d", side),
+        ("root_lo", F64, 8, struct.pack("<2d", 0, 0)),
+        ("nodes", RECORD, 28, b"".join(struct.pack("<7I", *n) for n in nodes)),
+        ("permutation", U32, 4, struct.pack("<%dI" % len(points), *range(len(points)))),
+        ("points", F64, 8, b"".join(struct.pack("<2d", *p) for p in points))])
+
+
+def min_max_octree(n, code, fmt, samples, leaf_cells):
+    """A min/max octree over an n x n x n volume (samples x fastest)."""
+    cells = n - 1
+    levels, dims = [], (cells + leaf_cells - 1) // leaf_cells
+    while True:
+        levels.append(dims)
+        if dims == 1:
+            break
+        dims = (dims + 1) // 2
+    lo, hi, below = [], [], None
+    for level, d in enumerate(levels):
+        mins, maxs = [], []
+        for z in range(d):
+            for y in range(d):
+                for x in range(d):
+                    if level == 0:
+                        r = range(x * leaf_cells, min(x * leaf_cells + leaf_cells, cells) + 1)
+                        s = [samples[i + n * (j + n * k)] for k in range(z * leaf_cells, min(z * leaf_cells + leaf_cells, cells) + 1)
+                             for j in range(y * leaf_cells, min(y * leaf_cells + leaf_cells, cells) + 1) for i in r]
+                        mins.append(min(s))
+                        maxs.append(max(s))
+                    else:
+                        cd, (cmin, cmax) = levels[level - 1], below
+                        kids = [cx + cd * (cy + cd * cz) for cz in range(2 * z, min(2 * z + 2, cd))
+                                for cy in range(2 * y, min(2 * y + 2, cd)) for cx in range(2 * x, min(2 * x + 2, cd))]
+                        mins.append(min(cmin[c] for c in kids))
+                        maxs.append(max(cmax[c] for c in kids))
+        below = (mins, maxs)
+        lo += mins
+        hi += maxs
+    size = struct.calcsize(fmt)
+    pack = lambda xs: struct.pack("<%d%s" % (len(xs), fmt), *xs)
+    return archive("iso.MinMaxOctree", [
+        value("scalar", U32, "<I", code), value("leaf_cells", U64, "<Q", leaf_cells),
+        ("dims", U64, 8, struct.pack("<3Q", n, n, n)), ("origin", F32, 4, struct.pack("<3f", 0, 0, 0)),
+        ("spacing", F32, 4, struct.pack("<3f", 1, 1, 1)), ("samples", code, size, pack(samples)),
+        ("min", code, size, pack(lo)), ("max", code, size, pack(hi))])
+
+
+def archive_seeds():
+    no = 0xFFFFFFFF
+    square = [(0, 0), (1, 1), (2, 0), (3, 1)]
+    return {
+        "leaf.kdt": kd_tree([(0, 0), (1, 0.5), (0.25, 1)], [(0, 3, 0, 0, 0, 0)], [0, 1, 2], 10),
+        "split.kdt": kd_tree(square, [(0, 4, 2, 0, 1, 2), (0, 2, 0, 0, 0, 0), (2, 4, 0, 0, 0, 0)], [0, 1, 2, 3], 2),
+        "leaf.qt": quadtree([(0, 0), (1, 0.5), (0.25, 1)], [(0, no, 0, 3, 0, 0, 0)], 4, 1.0),
+        "split.qt": quadtree([(0, 0), (1, 1)], [(1, no, 0, 2, 0, 0, 0), (0, 0, 0, 1, 1, 0, 0), (0, 0, 1, 1, 1, 1, 0),
+                                                (0, 0, 1, 1, 1, 0, 1), (0, 0, 1, 2, 1, 1, 1)], 1, 1.0),
+        "u8.mmo": min_max_octree(3, U8, "B", list(range(27)), 4),
+        "f32.mmo": min_max_octree(4, F32, "f", [float((i * 7) % 27) for i in range(64)], 1),
+    }
+
+
 def main():
     out = Path(sys.argv[1])
     raw = bytes(range(24))
@@ -119,6 +233,7 @@ def main():
         "points": {"p.npy": b"\x00" + npy("<f8", (2, 3), struct.pack("<6d", *range(6))),
                    "p.xyz": b"\x01" + b"0 0 0 0 0 1\n1 2 3 0 1 0\n", "p.csv": b"\x02x,y\n1,2\n3,4\n",
                    "p.ply": b"\x03" + PLY_ASCII},
+        "archive": archive_seeds(),
         "segments": {"s.npy": b"\x00" + npy("<f8", (1, 4), struct.pack("<4d", 0, 0, 1, 1)),
                      "s.edg": b"\x01" + b"2\n0 0 1 1\n1 1 2 0\n", "s.cin": b"\x02" + b"p 0 0\ns 0 0 1 1\ns 1 1 2 0\n"},
     }

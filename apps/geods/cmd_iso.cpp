@@ -39,6 +39,8 @@ class IsoCommand : public Command {
                    "(the hash table of seed 2.4)")
         ->check(CLI::IsMember({"blocks", "hash"}));
     app.add_flag("--no-normals", no_normals_, "Do not compute vertex normals");
+    app.add_option("--save", save_, "Octree: also write the min/max octree (with its volume) as a geods archive")
+        ->needs("--octree");
   }
 
   void run(const RunContext& context, Report& report) override {
@@ -62,6 +64,7 @@ class IsoCommand : public Command {
             Stopwatch build_watch;
             const iso::MinMaxOctree<T> tree(std::move(grid), leaf_cells_);
             build_s = build_watch.seconds();
+            if (!save_.empty()) tree.save(save_);
             Stopwatch query_watch;
             iso::OctreeIsoResult r = tree.isosurface(iso_, options, sharing);
             query_s = query_watch.seconds();
@@ -97,6 +100,7 @@ class IsoCommand : public Command {
     j["query_s"] = query_s;
     j["compute_s"] = build_s + query_s;
     if (!output_.empty()) j["output"] = output_;
+    if (!save_.empty()) j["saved"] = save_;
     report.lines.push_back(fmt::format("iso: {} ({} x {} x {}) at {}{}", volume_, dims[0], dims[1], dims[2], iso_,
                                        coords_.empty() ? "" : ", curvilinear"));
     report.lines.push_back(fmt::format("  {} vertices, {} triangles; {} of {} cells visited ({:.2f} %)",
@@ -108,6 +112,7 @@ class IsoCommand : public Command {
     else
       report.lines.push_back(fmt::format("  extracted in {:.3f} s", query_s));
     if (!output_.empty()) report.lines.push_back("  wrote " + output_);
+    if (!save_.empty()) report.lines.push_back("  wrote the octree to " + save_);
   }
 
  private:
@@ -132,7 +137,7 @@ class IsoCommand : public Command {
     return positions;
   }
 
-  std::string volume_, output_, dtype_, coords_, sharing_ = "blocks";
+  std::string volume_, output_, dtype_, coords_, save_, sharing_ = "blocks";
   double iso_ = 0;
   std::vector<std::size_t> dims_;
   bool octree_ = false, no_normals_ = false;

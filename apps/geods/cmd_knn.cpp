@@ -20,12 +20,11 @@ class KnnCommand : public Command {
     return "k nearest neighbours of query points (k-d tree): indices and distances as .npy";
   }
   void add_options(CLI::App& app) override {
-    app.add_option("--points", points_, "Points, n x d (.npy any d; .xyz/.csv/.ply)")->required();
+    input_.add_options(app);
     app.add_option("--queries", queries_, "Query points, m x d")->required();
     app.add_option("--k", k_, "Neighbours per query")->required()->check(CLI::PositiveNumber);
     app.add_option("--radius", radius_, "Only neighbours within this distance (fewer than k: index -1, distance inf)");
     app.add_option("--eps", eps_, "Approximation: distances within (1 + eps) of the true ones (default 0: exact)");
-    app.add_option("--leaf-size", leaf_size_, "Points per leaf of the k-d tree")->check(CLI::PositiveNumber);
     app.add_option("--indices", indices_, "Output: int64 m x k neighbour indices, -1 where missing");
     app.add_option("--distances", distances_, "Output: float64 m x k Euclidean distances, ascending, inf where missing");
   }
@@ -33,19 +32,20 @@ class KnnCommand : public Command {
   void run(const RunContext&, Report& report) override {
     if (radius_ && !(*radius_ >= 0)) throw Error("knn: --radius must be >= 0");
     if (!(eps_ >= 0)) throw Error("knn: --eps must be >= 0");
-    const Table points = read_table(points_);
     const Table queries = read_table(queries_);
-    if (queries.cols != points.cols)
-      throw Error(fmt::format("{}: queries of dimension {}, but the points ({}) have dimension {}", queries_,
-                              queries.cols, points_, points.cols));
     const spatial::KnnRequest request{k_, eps_, radius_.value_or(std::numeric_limits<double>::infinity())};
 
     double build_s = 0, query_s = 0;
-    std::size_t nodes = 0, depth = 0;
+    std::size_t n = 0, dim = 0, leaf_size = 0, nodes = 0, depth = 0;
     std::vector<spatial::Neighbor<double>> result;
-    Stopwatch build_watch;
-    with_kd_tree(points, leaf_size_, [&](const auto& tree) {  // called right after the build
-      build_s = build_watch.seconds();
+    input_.with_tree("knn", [&](const auto& tree, double build_seconds) {
+      build_s = build_seconds;
+      n = tree.size();
+      dim = tree.dim();
+      leaf_size = tree.leaf_size();
+      if (queries.cols != dim)
+        throw Error(fmt::format("{}: queries of dimension {}, but the points ({}) have dimension {}", queries_,
+                                queries.cols, input_.source(), dim));
       const spatial::KdTreeStats stats = tree.stats();
       nodes = stats.nodes;
       depth = stats.depth;
@@ -68,13 +68,15 @@ class KnnCommand : public Command {
     if (!distances_.empty()) io::write_npy<double>(distances_, distances, shape);
 
     Json& j = report.json;
-    j["points"] = points.rows;
+    j["points"] = n;
     j["queries"] = queries.rows;
     j["k"] = k_;
-    j["dim"] = points.cols;
+    j["dim"] = dim;
     j["eps"] = eps_;
     if (radius_) j["radius"] = *radius_;
-    j["leaf_size"] = leaf_size_;
+    j["leaf_size"] = leaf_size;
+    if (!input_.tree.empty()) j["tree"] = input_.tree;
+    if (!input_.save.empty()) j["saved"] = input_.save;
     j["found"] = found;
     j["tree_nodes"] = nodes;
     j["tree_depth"] = depth;
@@ -82,22 +84,24 @@ class KnnCommand : public Command {
     j["query_s"] = query_s;
     j["compute_s"] = build_s + query_s;
     j["queries_per_s"] = query_s > 0 ? double(queries.rows) / query_s : 0.0;
-    report.lines.push_back(fmt::format("knn: {} points of dimension {}, {} queries, k = {}{}{}", points.rows,
-                                       points.cols, queries.rows, k_, eps_ > 0 ? fmt::format(", eps = {}", eps_) : "",
+    report.lines.push_back(fmt::format("knn: {} points of dimension {}, {} queries, k = {}{}{}", n, dim, queries.rows, k_, eps_ > 0 ? fmt::format(", eps = {}", eps_) : "",
                                        radius_ ? fmt::format(", radius = {}", *radius_) : ""));
-    report.lines.push_back(fmt::format("  k-d tree: {} nodes, depth {}, built in {:.3f} s", nodes, depth, build_s));
+    report.lines.push_back(input_.tree.empty()
+                               ? fmt::format("  k-d tree: {} nodes, depth {}, built in {:.3f} s", nodes, depth, build_s)
+                               : fmt::format("  k-d tree: {} nodes, depth {}, loaded from {}", nodes, depth, input_.tree));
     report.lines.push_back(fmt::format("  {} neighbours found in {:.3f} s ({:.0f} queries/s)", found, query_s,
                                        query_s > 0 ? double(queries.rows) / query_s : 0.0));
     if (!indices_.empty()) report.lines.push_back("  wrote " + indices_);
     if (!distances_.empty()) report.lines.push_back("  wrote " + distances_);
+    if (!input_.save.empty()) report.lines.push_back("  wrote the k-d tree to " + input_.save);
   }
 
  private:
-  std::string points_, queries_, indices_, distances_;
+  KdTreeInput input_;
+  std::string queries_, indices_, distances_;
   std::size_t k_ = 1;
   std::optional<double> radius_;
   double eps_ = 0;
-  std::size_t leaf_size_ = spatial::KdTree<double>::kDefaultLeafSize;
 };
 
 const bool registered = register_command<KnnCommand>();

@@ -15,23 +15,24 @@ class RangeCommand : public Command {
   std::string name() const override { return "range"; }
   std::string summary() const override { return "Count the points in axis-parallel boxes (k-d tree range counting)"; }
   void add_options(CLI::App& app) override {
-    app.add_option("--points", points_, "Points, n x d (.npy any d; .xyz/.csv/.ply)")->required();
+    input_.add_options(app);
     app.add_option("--boxes", boxes_, "Boxes, m x 2d: the low corner, then the high corner (closed)")->required();
     app.add_option("-o,--output", output_, "Output: int64 counts, one per box");
-    app.add_option("--leaf-size", leaf_size_, "Points per leaf of the k-d tree")->check(CLI::PositiveNumber);
   }
 
   void run(const RunContext&, Report& report) override {
-    const Table points = read_table(points_);
     const Table boxes = read_table(boxes_);
-    if (boxes.cols != 2 * points.cols)
-      throw Error(fmt::format("{}: boxes need 2 x {} = {} columns (low corner, high corner) for the points of {}, got {}",
-                              boxes_, points.cols, 2 * points.cols, points_, boxes.cols));
     double build_s = 0, query_s = 0;
+    std::size_t n = 0, dim = 0, leaf_size = 0;
     std::vector<std::size_t> counts;
-    Stopwatch build_watch;
-    with_kd_tree(points, leaf_size_, [&](const auto& tree) {  // called right after the build
-      build_s = build_watch.seconds();
+    input_.with_tree("range", [&](const auto& tree, double build_seconds) {
+      build_s = build_seconds;
+      n = tree.size();
+      dim = tree.dim();
+      leaf_size = tree.leaf_size();
+      if (boxes.cols != 2 * dim)
+        throw Error(fmt::format("{}: boxes need 2 x {} = {} columns (low corner, high corner) for the points of {}, got {}",
+                                boxes_, dim, 2 * dim, input_.source(), boxes.cols));
       Stopwatch query_watch;
       counts = tree.count_box_batch(spatial::PointView<double>(boxes.values.data(), boxes.rows, boxes.cols));
       query_s = query_watch.seconds();
@@ -42,24 +43,26 @@ class RangeCommand : public Command {
     for (std::size_t c : counts) total += c;
 
     Json& j = report.json;
-    j["points"] = points.rows;
+    j["points"] = n;
     j["boxes"] = boxes.rows;
-    j["dim"] = points.cols;
-    j["leaf_size"] = leaf_size_;
+    j["dim"] = dim;
+    j["leaf_size"] = leaf_size;
+    if (!input_.tree.empty()) j["tree"] = input_.tree;
+    if (!input_.save.empty()) j["saved"] = input_.save;
     j["total_count"] = total;
     j["build_s"] = build_s;
     j["query_s"] = query_s;
     j["compute_s"] = build_s + query_s;
-    report.lines.push_back(fmt::format("range: {} points of dimension {}, {} boxes", points.rows, points.cols,
-                                       boxes.rows));
+    report.lines.push_back(fmt::format("range: {} points of dimension {}, {} boxes", n, dim, boxes.rows));
     report.lines.push_back(fmt::format("  k-d tree built in {:.3f} s, boxes counted in {:.3f} s; {} points in all boxes",
                                        build_s, query_s, total));
     if (!output_.empty()) report.lines.push_back("  wrote " + output_);
+    if (!input_.save.empty()) report.lines.push_back("  wrote the k-d tree to " + input_.save);
   }
 
  private:
-  std::string points_, boxes_, output_;
-  std::size_t leaf_size_ = spatial::KdTree<double>::kDefaultLeafSize;
+  KdTreeInput input_;
+  std::string boxes_, output_;
 };
 
 const bool registered = register_command<RangeCommand>();

@@ -1,6 +1,6 @@
 #pragma once
-// What the knn and range commands share: reading an n x d table of numbers and
-// building the k-d tree of the right dimension over it.
+// What the knn and range commands share: reading an n x d table of numbers,
+// building the k-d tree of the right dimension over it, or loading a saved one.
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -11,10 +11,13 @@
 #include <string>
 #include <vector>
 
+#include <CLI/CLI.hpp>
+
 #include "geods/core/error.hpp"
 #include "geods/io/npy.hpp"
 #include "geods/io/point_io.hpp"
 #include "geods/spatial/kd_tree.hpp"
+#include "stopwatch.hpp"
 
 namespace geods::cli {
 
@@ -100,5 +103,46 @@ void with_kd_tree(const Table& points, std::size_t leaf_size, const Fn& fn) {
     fn(spatial::KdTree<double, spatial::Dynamic>(view, leaf_size));
   }
 }
+
+/// The tree a command queries: built over --points, or loaded from --tree (a
+/// file written by --save, which writes the tree the command built).
+struct KdTreeInput {
+  std::string points, tree, save;
+  std::size_t leaf_size = spatial::KdTree<double>::kDefaultLeafSize;
+
+  void add_options(CLI::App& app) {
+    CLI::Option* p = app.add_option("--points", points, "Points, n x d (.npy any d; .xyz/.csv/.ply)");
+    app.add_option("--tree", tree, "Instead of --points: a k-d tree written by --save (float64 points)")->excludes(p);
+    app.add_option("--leaf-size", leaf_size, "Points per leaf of the k-d tree")->check(CLI::PositiveNumber);
+    app.add_option("--save", save, "Output: the k-d tree and its points as a geods archive, for --tree");
+  }
+  /// The file the points come from.
+  const std::string& source() const { return tree.empty() ? points : tree; }
+
+  /// Calls fn(tree, build_s) with the tree for its dimension (the compile-time
+  /// trees for 2 and 3, the run-time one otherwise); build_s is 0 for a loaded tree.
+  template <typename Fn>
+  void with_tree(const std::string& command, const Fn& fn) const {
+    if (points.empty() == tree.empty()) throw Error(command + ": give the points with --points or a saved tree with --tree");
+    auto use = [&](const auto& t, double build_s) {
+      if (!save.empty()) t.save(save);
+      fn(t, build_s);
+    };
+    if (!tree.empty()) {
+      const std::size_t dim = spatial::read_kd_tree_info(tree).dim;
+      if (dim == 2) {
+        use(spatial::KdTree<double, 2>::load(tree), 0.0);
+      } else if (dim == 3) {
+        use(spatial::KdTree<double, 3>::load(tree), 0.0);
+      } else {
+        use(spatial::KdTree<double, spatial::Dynamic>::load(tree), 0.0);
+      }
+      return;
+    }
+    const Table table = read_table(points);
+    Stopwatch build_watch;
+    with_kd_tree(table, leaf_size, [&](const auto& t) { use(t, build_watch.seconds()); });
+  }
+};
 
 }  // namespace geods::cli

@@ -2,9 +2,11 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
 
 #include <array>
 #include <cstring>
+#include <filesystem>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -153,6 +155,22 @@ class PyOctree {
     std::visit([](const auto& t) { t->validate(); }, tree_);
   }
 
+  void save(const std::filesystem::path& path) const {
+    py::gil_scoped_release release;
+    std::visit([&](const auto& t) { t->save(path); }, tree_);
+  }
+  static PyOctree load(const std::filesystem::path& path) {
+    py::gil_scoped_release release;
+    switch (iso::read_min_max_octree_scalar(path)) {
+      case DType::u8: return PyOctree(load_tree<std::uint8_t>(path));
+      case DType::u16: return PyOctree(load_tree<std::uint16_t>(path));
+      case DType::i16: return PyOctree(load_tree<std::int16_t>(path));
+      case DType::f32: return PyOctree(load_tree<float>(path));
+      case DType::f64: return PyOctree(load_tree<double>(path));
+      default: throw Error(path.string() + ": a min/max octree of an unsupported sample type");
+    }
+  }
+
   std::optional<std::size_t> cells_visited() const { return cells_visited_; }
   std::optional<std::size_t> nodes_visited() const { return nodes_visited_; }
 
@@ -162,6 +180,12 @@ class PyOctree {
                                std::shared_ptr<const iso::MinMaxOctree<std::int16_t>>,
                                std::shared_ptr<const iso::MinMaxOctree<float>>,
                                std::shared_ptr<const iso::MinMaxOctree<double>>>;
+  explicit PyOctree(AnyTree tree) : tree_(std::move(tree)) {}
+  template <typename T>
+  static AnyTree load_tree(const std::filesystem::path& path) {
+    return std::make_shared<const iso::MinMaxOctree<T>>(iso::MinMaxOctree<T>::load(path));
+  }
+
   AnyTree tree_;
   std::optional<std::size_t> cells_visited_, nodes_visited_;
 };
@@ -203,7 +227,12 @@ cell per leaf, the textbook octree).)doc")
       .def_property_readonly("nodes_visited", &PyOctree::nodes_visited,
                              "Octree nodes tested by the last isosurface() call (None before the first).")
       .def("stats", &PyOctree::stats, "dict: nodes, levels, leaf_cells, cells, bytes")
-      .def("validate", &PyOctree::validate, "Checks every node's min/max; raises geods.Error if one is wrong.");
+      .def("validate", &PyOctree::validate, "Checks every node's min/max; raises geods.Error if one is wrong.")
+      .def("save", &PyOctree::save, py::arg("path"),
+           "Writes the octree and its volume to a geods archive (the file format of every structure).")
+      .def_static("load", &PyOctree::load, py::arg("path"),
+                  "Reads an octree written by save() (any sample type): the min/max arrays are read in place\n"
+                  "from the file, the volume is copied. Raises ValueError for a truncated, corrupt or other file.");
 }
 
 }  // namespace geods::python

@@ -6,12 +6,12 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <limits>
 #include <string>
 #include <variant>
 
 #include "bindings.hpp"
+#include "geods/core/archive.hpp"
 #include "geods/core/error.hpp"
 #include "geods/spatial/quadtree.hpp"
 
@@ -119,16 +119,12 @@ class PyOrthtree {
     py::gil_scoped_release release;
     visit([&](const auto& t) { t.save(path); });
   }
-  // The scalar size sits after the 8-byte magic and the version word.
   static PyOrthtree load(const std::filesystem::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw Error(path.string() + ": cannot open");
-    std::uint32_t words[3] = {0, 0, 0};
-    in.seekg(8);
-    in.read(reinterpret_cast<char*>(words), sizeof words);
-    in.close();
     py::gil_scoped_release release;
-    if (words[1] == 4) return PyOrthtree(AnyTree(Orthtree<float, Dim>::load(path)));
+    const DType scalar = Archive::open(path, spatial::kOrthtreeArchiveKind, spatial::kOrthtreeArchiveVersion,
+                                       Archive::Verify::structure_only)
+                             .dtype("scalar");
+    if (scalar == DType::f32) return PyOrthtree(AnyTree(Orthtree<float, Dim>::load(path)));
     return PyOrthtree(AnyTree(Orthtree<double, Dim>::load(path)));
   }
 
@@ -307,8 +303,11 @@ void bind_orthtree(py::module_& m, const char* doc) {
       .def("balanced", &Py::balanced, "A new, 2:1-balanced tree: face-adjacent leaves differ by at most one in depth.")
       .def("validate", &Py::validate, "Checks every invariant (and the 2:1 balance of balanced trees); raises if one fails.")
       .def("stats", &Py::stats, "dict: points, nodes, leaves, empty_leaves, depth, bytes")
-      .def("save", &Py::save, py::arg("path"), "Writes the tree and its points to a binary file.")
-      .def_static("load", &Py::load, py::arg("path"), "Reads a tree written by save().")
+      .def("save", &Py::save, py::arg("path"),
+           "Writes the tree and its points to a geods archive (the file format of every structure).")
+      .def_static("load", &Py::load, py::arg("path"),
+                  "Maps a tree written by save(): its arrays are read in place from the file. Raises\n"
+                  "ValueError for a truncated, corrupt or other file.")
       .def("locate", &Py::locate, py::arg("p"), "The leaf whose cell contains p, or -1 outside the root cell.")
       .def("query_box", &Py::query_box, py::arg("lo"), py::arg("hi"),
            "Indices (ascending) of the points p with lo <= p <= hi.")

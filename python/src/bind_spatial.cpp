@@ -34,7 +34,7 @@ AnyTree make_tree(spatial::PointView<T> view, std::size_t leaf_size) {
 }
 
 template <typename T>
-AnyTree load_tree(const std::filesystem::path& path, std::uint32_t dim) {
+AnyTree load_tree(const std::filesystem::path& path, std::size_t dim) {
   if (dim == 2) return KdTree<T, 2>::load(path);
   if (dim == 3) return KdTree<T, 3>::load(path);
   return KdTree<T, Dynamic>::load(path);
@@ -77,9 +77,9 @@ class PyKdTree {
   explicit PyKdTree(AnyTree tree) : tree_(std::move(tree)) {}
 
   static PyKdTree load(const std::filesystem::path& path) {
-    const spatial::KdTreeFileHeader h = spatial::read_kd_tree_header(path);
+    const spatial::KdTreeFileInfo info = spatial::read_kd_tree_info(path);
     py::gil_scoped_release release;
-    return PyKdTree(h.scalar_bytes == 4 ? load_tree<float>(path, h.dim) : load_tree<double>(path, h.dim));
+    return PyKdTree(info.scalar == DType::f32 ? load_tree<float>(path, info.dim) : load_tree<double>(path, info.dim));
   }
 
   std::size_t size() const {
@@ -259,8 +259,11 @@ Queries are thread-safe and release the GIL; batches run in parallel.
            "Number of points with lo <= p <= hi; for (m, d) corners an int64 array of m counts.")
       .def("stats", &PyKdTree::stats, "dict: points, nodes, leaves, depth, bytes")
       .def("validate", &PyKdTree::validate, "Checks every invariant of the tree; raises if one fails.")
-      .def("save", &PyKdTree::save, py::arg("path"), "Writes the tree and its points to a binary file.")
-      .def_static("load", &PyKdTree::load, py::arg("path"), "Reads a tree written by save().")
+      .def("save", &PyKdTree::save, py::arg("path"),
+           "Writes the tree and its points to a geods archive (the file format of every structure).")
+      .def_static("load", &PyKdTree::load, py::arg("path"),
+                  "Maps a tree written by save() (float32 or float64, any dimension): its arrays are read in\n"
+                  "place from the file. Raises ValueError for a truncated, corrupt or other file.")
       .def("__len__", &PyKdTree::size)
       .def_property_readonly("dim", &PyKdTree::dim)
       .def_property_readonly("leaf_size", &PyKdTree::leaf_size)

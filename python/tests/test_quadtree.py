@@ -178,3 +178,29 @@ def test_save_load(tmp_path):
     np.testing.assert_array_equal(loaded.query(pts[:3], 4)[1], tree.query(pts[:3], 4)[1])
     with pytest.raises(geods.Error):
         geods.Octree.load(tmp_path / "t.ort")
+
+
+@pytest.mark.parametrize("d", [2, 3])
+def test_save_load_round_trip(tmp_path, d):
+    """Loaded trees answer like the originals (duplicates, one point, no points); bad files raise."""
+    rng = np.random.default_rng(d)
+    cls = tree_class(d)
+    for pts in (rng.random((300, d)), np.repeat(rng.random((5, d)), 20, axis=0), rng.random((1, d)),
+                np.zeros((0, d))):
+        for dtype in (np.float32, np.float64):
+            tree = cls(pts.astype(dtype), bucket=3)
+            tree.save(tmp_path / "t.geods")
+            loaded = cls.load(tmp_path / "t.geods")
+            assert loaded.stats() == tree.stats() and loaded.dtype == dtype
+            loaded.validate()
+            if len(pts):
+                q = rng.random((10, d))
+                for a, b in zip(tree.query(q, 4), loaded.query(q, 4)):
+                    np.testing.assert_array_equal(a, b)
+    data = (tmp_path / "t.geods").read_bytes()
+    (tmp_path / "bad.geods").write_bytes(data[:-3])
+    with pytest.raises(ValueError, match="truncated"):
+        cls.load(tmp_path / "bad.geods")
+    geods.KdTree(np.zeros((2, d))).save(tmp_path / "bad.geods")
+    with pytest.raises(ValueError, match="of kind spatial.KdTree"):
+        cls.load(tmp_path / "bad.geods")

@@ -119,6 +119,44 @@ def test_stats_save_load(tmp_path):
         geods.KdTree.load(path)
 
 
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+@pytest.mark.parametrize("d", [2, 3, 5])
+def test_save_load_round_trip(tmp_path, d, dtype):
+    """Loaded trees (mapped) answer like the originals, also for duplicates, one point and no points."""
+    rng = np.random.default_rng(d)
+    sets = [rng.random((700, d)), np.repeat(rng.random((20, d)), 30, axis=0), np.ones((50, d)), rng.random((1, d))]
+    for pts in sets:
+        tree = geods.KdTree(pts.astype(dtype), leaf_size=4)
+        tree.save(tmp_path / "t.geods")
+        loaded = geods.KdTree.load(tmp_path / "t.geods")
+        assert (loaded.dim, loaded.dtype, len(loaded), loaded.stats()["nodes"]) == (d, dtype, len(tree),
+                                                                                    tree.stats()["nodes"])
+        loaded.validate()
+        q = rng.random((30, d))
+        for a, b in zip(tree.query(q, 6), loaded.query(q, 6)):
+            np.testing.assert_array_equal(a, b)
+        for a, b in zip(tree.query_radius(q, 0.3), loaded.query_radius(q, 0.3)):
+            np.testing.assert_array_equal(a, b)
+        np.testing.assert_array_equal(tree.count_box(q * 0.5, q), loaded.count_box(q * 0.5, q))
+
+
+def test_load_errors(tmp_path):
+    tree = geods.KdTree(np.random.default_rng(1).random((100, 2)))
+    tree.save(tmp_path / "t.geods")
+    good = (tmp_path / "t.geods").read_bytes()
+    bad = tmp_path / "bad.geods"
+    for data, what in ((good[:100], "truncated"), (good + b"\0", "trailing"), (b"x" * 200, "not a geods archive"),
+                       (good[:-1] + bytes([good[-1] ^ 1]), "checksum")):
+        bad.write_bytes(data)
+        with pytest.raises(ValueError, match=what):
+            geods.KdTree.load(bad)
+    geods.Quadtree(np.zeros((3, 2))).save(bad)
+    with pytest.raises(ValueError, match="kind spatial.Orthtree, expected kind spatial.KdTree"):
+        geods.KdTree.load(bad)
+    with pytest.raises(ValueError):
+        geods.KdTree.load(tmp_path / "missing.geods")
+
+
 def test_bad_input():
     pts = np.random.default_rng(6).random((20, 2))
     with pytest.raises(ERRORS):
@@ -168,6 +206,25 @@ def test_cli_knn(cli, workdir):
     assert r.returncode == 0, r.stderr
     idx, dist = np.load(workdir / "i.npy"), np.load(workdir / "d.npy")
     assert np.any(idx == -1) and np.all((idx == -1) == np.isinf(dist)) and np.all(dist[idx >= 0] <= 0.05)
+    # --save writes the tree; --tree answers from it, and so does geods.KdTree.load
+    r = run(cli, "knn", "--points", "p.npy", "--queries", "q.npy", "--k", 5, "--save", "p.geods", cwd=workdir)
+    assert r.returncode == 0, r.stderr
+    r = run(cli, "knn", "--tree", "p.geods", "--queries", "q.npy", "--k", 5, "--indices", "i2.npy", "--distances",
+            "d2.npy", "--json", cwd=workdir)
+    assert r.returncode == 0, r.stderr
+    report = json.loads(r.stdout)
+    assert (report["points"], report["dim"], report["tree"], report["build_s"]) == (2000, 3, "p.geods", 0)
+    r = run(cli, "knn", "--points", "p.npy", "--queries", "q.npy", "--k", 5, "--indices", "i.npy", "--distances",
+            "d.npy", cwd=workdir)
+    np.testing.assert_array_equal(np.load(workdir / "i2.npy"), np.load(workdir / "i.npy"))
+    np.testing.assert_array_equal(np.load(workdir / "d2.npy"), np.load(workdir / "d.npy"))
+    saved = geods.KdTree.load(workdir / "p.geods")
+    assert saved.dtype == np.float64 and len(saved) == 2000
+    np.testing.assert_array_equal(saved.query(q, 5)[1], np.load(workdir / "i.npy"))
+    # --tree and --points together, neither, or a file that is not a tree: exit code 2 and one line
+    for args in (["--points", "p.npy", "--tree", "p.geods"], [], ["--tree", "p.npy"]):
+        r = run(cli, "knn", *args, "--queries", "q.npy", "--k", 3, cwd=workdir)
+        assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1, r.stderr
     # bad input: exit code 2 and one line
     np.save(workdir / "q2.npy", rng.random((10, 2)))
     for args in (["--queries", "q2.npy", "--k", 3], ["--queries", "q.npy", "--k", 0],
@@ -191,6 +248,13 @@ def test_cli_range(cli, workdir, data_dir):
     want = [np.sum(np.all((pts >= b[:2]) & (pts <= b[2:]), axis=1)) for b in boxes]
     assert counts.dtype == np.int64
     np.testing.assert_array_equal(counts, want)
+    # --save writes the tree, --tree answers from it without the points
+    r = run(cli, "range", "--points", "data/land_points.npy", "--boxes", "b.npy", "--save", "land.geods", cwd=workdir)
+    assert r.returncode == 0, r.stderr
+    r = run(cli, "range", "--tree", "land.geods", "--boxes", "b.npy", "-o", "c2.npy", "--json", cwd=workdir)
+    assert r.returncode == 0, r.stderr
+    assert json.loads(r.stdout)["points"] == len(pts)
+    np.testing.assert_array_equal(np.load(workdir / "c2.npy"), want)
     np.save(workdir / "bad.npy", boxes[:, :3])
     r = run(cli, "range", "--points", "data/land_points.npy", "--boxes", "bad.npy", "-o", "c.npy", cwd=workdir)
     assert r.returncode == 2 and "columns" in r.stderr

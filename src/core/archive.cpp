@@ -165,6 +165,7 @@ Archive Archive::open(const std::filesystem::path& path, std::string_view kind, 
 
   std::vector<Entry> entries;
   entries.reserve(h.sections);
+  std::uint64_t end = sizeof(FileHeader) + std::uint64_t(h.sections) * sizeof(SectionRecord);
   for (std::uint32_t i = 0; i < h.sections; ++i) {
     const SectionRecord& r = table[i];
     Entry e{fixed_string(r.name, kNameBytes), r.type, r.element_bytes, r.offset, r.count};
@@ -172,14 +173,17 @@ Archive Archive::open(const std::filesystem::path& path, std::string_view kind, 
     if (e.element_bytes == 0 || (e.type != kRecordType && (e.type > std::uint32_t(DType::f64) ||
                                                            dtype_size(DType(e.type)) != e.element_bytes)))
       throw fail("corrupt archive (" + where + " has a bad element type)");
-    if (e.offset % kAlign != 0 || e.offset > size) throw fail("corrupt archive (" + where + " offset)");
-    if (e.count > (size - e.offset) / e.element_bytes) throw fail("truncated archive (" + where + ")");
+    if (e.offset % kAlign != 0) throw fail("corrupt archive (" + where + " offset)");
+    if (e.offset > size || e.count > (size - e.offset) / e.element_bytes)
+      throw fail("truncated archive (" + where + ")");
     if (verify == Verify::checksums && checksum(file->data() + e.offset, e.count * e.element_bytes) != r.checksum)
       throw fail("corrupt archive (" + where + " checksum)");
     for (const Entry& other : entries)
       if (other.name == e.name) throw fail("corrupt archive (" + where + " twice)");
+    end = std::max(end, e.offset + e.count * e.element_bytes);
     entries.push_back(std::move(e));
   }
+  if (size > end) throw fail("trailing bytes after the archive");
   return Archive(std::move(file), std::move(entries));
 }
 
@@ -202,6 +206,12 @@ const Archive::Entry& Archive::entry(std::string_view name, std::uint32_t type, 
 void Archive::fail_count(std::string_view name, std::uint64_t count, std::uint64_t expected) const {
   throw error("section '" + std::string(name) + "' holds " + std::to_string(count) + " elements, expected " +
               std::to_string(expected));
+}
+
+DType Archive::dtype(std::string_view name) const {
+  const std::uint32_t code = value<std::uint32_t>(name);
+  if (code > std::uint32_t(DType::f64)) throw error("section '" + std::string(name) + "' holds no element type");
+  return DType(code);
 }
 
 Error Archive::error(const std::string& what) const { return Error(path().string() + ": " + what); }

@@ -200,16 +200,12 @@ struct MinMaxOctree<T>::Query {
 };
 
 template <typename T>
-MinMaxOctree<T>::MinMaxOctree(Grid3<T> volume, std::size_t leaf_cells)
-    : volume_(std::move(volume)), leaf_cells_(leaf_cells) {
-  if (leaf_cells_ == 0 || leaf_cells_ > kMaxLeafCells)
-    throw Error("MinMaxOctree: leaf_cells must be in [1, " + std::to_string(kMaxLeafCells) + "], not " +
-                std::to_string(leaf_cells_));
-  detail::check_samples(volume_);
-  for (int d = 0; d < 3; ++d) {
-    if (volume_.dims[d] < 2) return;  // no cells
-    cells_[d] = volume_.dims[d] - 1;
-  }
+std::size_t MinMaxOctree<T>::make_levels() {
+  levels_.clear();
+  cells_ = {0, 0, 0};
+  for (int d = 0; d < 3; ++d)
+    if (volume_.dims[d] < 2) return 0;  // no cells
+  for (int d = 0; d < 3; ++d) cells_[d] = volume_.dims[d] - 1;
   std::array<std::size_t, 3> dims;
   for (int d = 0; d < 3; ++d) dims[d] = (cells_[d] + leaf_cells_ - 1) / leaf_cells_;
   std::size_t total = 0;
@@ -219,15 +215,26 @@ MinMaxOctree<T>::MinMaxOctree(Grid3<T> volume, std::size_t leaf_cells)
     if (dims[0] == 1 && dims[1] == 1 && dims[2] == 1) break;
     for (int d = 0; d < 3; ++d) dims[d] = (dims[d] + 1) / 2;
   }
-  min_.resize(total);
-  max_.resize(total);
+  return total;
+}
+
+template <typename T>
+MinMaxOctree<T>::MinMaxOctree(Grid3<T> volume, std::size_t leaf_cells)
+    : volume_(std::move(volume)), leaf_cells_(leaf_cells) {
+  if (leaf_cells_ == 0 || leaf_cells_ > kMaxLeafCells)
+    throw Error("MinMaxOctree: leaf_cells must be in [1, " + std::to_string(kMaxLeafCells) + "], not " +
+                std::to_string(leaf_cells_));
+  detail::check_samples(volume_);
+  const std::size_t total = make_levels();
+  if (total == 0) return;
+  std::vector<T> min(total), max(total);
   const auto& leaves = levels_[0].dims;
   parallel_for_each_index(0, leaves[2], [&](std::size_t z) {
     for (std::size_t y = 0; y < leaves[1]; ++y)
       for (std::size_t x = 0; x < leaves[0]; ++x) {
         const std::array<T, 2> r = leaf_range(x, y, z);
-        min_[node_index(0, x, y, z)] = r[0];
-        max_[node_index(0, x, y, z)] = r[1];
+        min[node_index(0, x, y, z)] = r[0];
+        max[node_index(0, x, y, z)] = r[1];
       }
   }, 1);
   for (std::size_t level = 1; level < levels_.size(); ++level) {
@@ -237,19 +244,21 @@ MinMaxOctree<T>::MinMaxOctree(Grid3<T> volume, std::size_t leaf_cells)
       for (std::size_t y = 0; y < d[1]; ++y)
         for (std::size_t x = 0; x < d[0]; ++x) {
           const std::size_t first = node_index(level - 1, 2 * x, 2 * y, 2 * z);
-          T lo = min_[first], hi = max_[first];
+          T lo = min[first], hi = max[first];
           for (std::size_t cz = 2 * z; cz < std::min(2 * z + 2, cd[2]); ++cz)
             for (std::size_t cy = 2 * y; cy < std::min(2 * y + 2, cd[1]); ++cy)
               for (std::size_t cx = 2 * x; cx < std::min(2 * x + 2, cd[0]); ++cx) {
                 const std::size_t c = node_index(level - 1, cx, cy, cz);
-                lo = std::min(lo, min_[c]);
-                hi = std::max(hi, max_[c]);
+                lo = std::min(lo, min[c]);
+                hi = std::max(hi, max[c]);
               }
-          min_[node_index(level, x, y, z)] = lo;
-          max_[node_index(level, x, y, z)] = hi;
+          min[node_index(level, x, y, z)] = lo;
+          max[node_index(level, x, y, z)] = hi;
         }
     }, 1);
   }
+  min_ = std::move(min);
+  max_ = std::move(max);
 }
 
 template <typename T>
@@ -753,6 +762,63 @@ void MinMaxOctree<T>::validate() const {
   }
   const auto& root = levels_.empty() ? std::array<std::size_t, 3>{1, 1, 1} : levels_.back().dims;
   if (root[0] != 1 || root[1] != 1 || root[2] != 1) throw Error("MinMaxOctree: the top level is not a single root");
+}
+
+template <typename T>
+void MinMaxOctree<T>::save(const std::filesystem::path& path) const {
+  ArchiveWriter w(std::string(kMinMaxOctreeArchiveKind), kMinMaxOctreeArchiveVersion);
+  w.add_dtype("scalar", dtype_of<T>());
+  w.add_value("leaf_cells", std::uint64_t(leaf_cells_));
+  const std::array<std::uint64_t, 3> dims{volume_.dims[0], volume_.dims[1], volume_.dims[2]};
+  w.add("dims", std::span<const std::uint64_t>(dims));
+  w.add("origin", std::span<const float>(volume_.origin.data(), 3));
+  w.add("spacing", std::span<const float>(volume_.spacing.data(), 3));
+  w.add("samples", volume_.data);
+  w.add("min", min_);
+  w.add("max", max_);
+  w.write(path);
+}
+
+template <typename T>
+MinMaxOctree<T> MinMaxOctree<T>::load(const std::filesystem::path& path, Archive::Verify verify) {
+  const Archive a = Archive::open(path, kMinMaxOctreeArchiveKind, kMinMaxOctreeArchiveVersion, verify);
+  a.require_dtype<T>("scalar", "min/max octree");
+  MinMaxOctree tree;
+  const std::uint64_t leaf_cells = a.value<std::uint64_t>("leaf_cells");
+  if (leaf_cells == 0 || leaf_cells > kMaxLeafCells) throw a.error("bad leaf_cells " + std::to_string(leaf_cells));
+  tree.leaf_cells_ = std::size_t(leaf_cells);
+  const FlatArray<std::uint64_t> dims = a.array<std::uint64_t>("dims", 3);
+  const FlatArray<float> origin = a.array<float>("origin", 3), spacing = a.array<float>("spacing", 3);
+  const FlatArray<T> samples = a.array<T>("samples");
+  bool sized = false;
+  try {
+    sized = Grid3<T>::checked_size(dims[0], dims[1], dims[2]) == samples.size();
+  } catch (const Error&) {  // dimensions that overflow
+  }
+  if (!sized) {
+    throw a.error(std::to_string(samples.size()) + " samples for a volume of " + std::to_string(dims[0]) + " x " +
+                  std::to_string(dims[1]) + " x " + std::to_string(dims[2]));
+  }
+  Grid3<T>& g = tree.volume_;
+  g.dims = {dims[0], dims[1], dims[2]};
+  g.origin = Vec3f(origin[0], origin[1], origin[2]);
+  g.spacing = Vec3f(spacing[0], spacing[1], spacing[2]);
+  g.data = samples.to_vector();
+  const std::size_t nodes = tree.make_levels();
+  tree.min_ = a.array<T>("min", nodes);
+  tree.max_ = a.array<T>("max", nodes);
+  try {
+    detail::check_samples(g);
+    tree.validate();
+  } catch (const Error& e) {
+    throw a.error(std::string("corrupted min/max octree: ") + e.what());
+  }
+  return tree;
+}
+
+DType read_min_max_octree_scalar(const std::filesystem::path& path) {
+  return Archive::open(path, kMinMaxOctreeArchiveKind, kMinMaxOctreeArchiveVersion, Archive::Verify::structure_only)
+      .dtype("scalar");
 }
 
 template class MinMaxOctree<std::uint8_t>;

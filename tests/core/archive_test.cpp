@@ -130,6 +130,43 @@ TEST(Archive, EveryTruncationIsAnError) {
   fs::remove(q);
 }
 
+TEST(Archive, TrailingBytesAreAnError) {
+  const fs::path p = write_sample("trailing");
+  std::vector<char> bytes = read_all(p);
+  bytes.push_back(0);
+  write_all(p, bytes);
+  EXPECT_THROW(Archive::open(p, "test.Sample", 3, Archive::Verify::structure_only), Error);
+  fs::remove(p);
+}
+
+TEST(Archive, ElementTypesRecordedAsValues) {
+  ArchiveWriter w("test.Typed", 1);
+  w.add_dtype("scalar", DType::f32);
+  w.add_value("not_a_type", std::uint32_t(77));
+  const fs::path p = temp_file("typed");
+  w.write(p);
+  const Archive a = Archive::open(p, "test.Typed", 1);
+  EXPECT_EQ(a.dtype("scalar"), DType::f32);
+  EXPECT_NO_THROW(a.require_dtype<float>("scalar", "sample"));
+  try {
+    a.require_dtype<double>("scalar", "sample");
+    FAIL() << "f32 accepted as f64";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()), p.string() + ": a sample of f32, expected f64");
+  }
+  EXPECT_THROW(a.dtype("not_a_type"), Error);
+  fs::remove(p);
+}
+
+TEST(FlatArray, EqualityComparesElements) {
+  static const int backing[3] = {1, 2, 3};
+  const FlatArray<int> owned(std::vector<int>{1, 2, 3});
+  const FlatArray<int> viewed(std::span<const int>(backing), std::make_shared<int>(0));
+  EXPECT_EQ(owned, viewed);
+  EXPECT_NE(owned, FlatArray<int>(std::vector<int>{1, 2}));
+  EXPECT_NE(owned, FlatArray<int>(std::vector<int>{1, 2, 4}));
+}
+
 TEST(Archive, EveryFlippedByteIsAnErrorOrHarmlessPadding) {
   const fs::path p = write_sample("flip");
   const std::vector<char> bytes = read_all(p);

@@ -494,6 +494,11 @@ TEST(DynamicKdTree, SaveLoadRoundTrip) {
     EXPECT_EQ(loaded.structure().options().max_dead_fraction, 0.4);
     for (Id id : live) ASSERT_EQ(loaded.point(id), tree.point(id));
     EXPECT_EQ(loaded.stats().structure.dead, before.dead);
+    // The blocks' trees read their nodes, permutation and points in place from the file.
+    loaded.structure().for_each([](const auto& block, std::span<const Id>) {
+      EXPECT_TRUE(block.tree().nodes().mapped());
+      EXPECT_TRUE(block.tree().permutation().mapped());
+    });
     expect_same_answers(tree, loaded, rng);
     // Both go on the same way: the same ids for the same inserts, the same answers.
     for (int i = 0; i < 500; ++i) {

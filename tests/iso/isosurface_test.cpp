@@ -4,15 +4,23 @@
 // one thread; normals, spacing, curvilinear grids; bad input.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <functional>
+#include <limits>
 #include <string>
 #include <tuple>
 #include <utility>
 #include <vector>
 
+#include "archive_bytes.hpp"
+#include "geods/core/archive.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"
 #include "geods/core/rng.hpp"
@@ -533,6 +541,119 @@ TEST(Isosurface, DemoHeadVolumePaddedIsClosed) {
     expect_closed_surface(mesh, "head at " + std::to_string(iso));
     for (VertexSharing sharing : kSharings) expect_same_surface(tree.isosurface(iso, {}, sharing).mesh, mesh, name(sharing));
   }
+}
+
+}  // namespace
+}  // namespace geods::iso
+
+namespace geods::iso {
+namespace {
+
+std::filesystem::path temp_octree_file(const std::string& name) {
+  return std::filesystem::temp_directory_path() / ("geods_mmo_" + std::to_string(::getpid()) + "_" + name);
+}
+
+std::vector<char> read_all(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), {}};
+}
+void write_all(const std::filesystem::path& p, const std::vector<char>& bytes) {
+  std::ofstream(p, std::ios::binary).write(bytes.data(), std::streamsize(bytes.size()));
+}
+
+// Saves and loads `tree`; the loaded octree holds the same volume and nodes and
+// extracts the same meshes (order included), visiting the same nodes and cells.
+template <typename T>
+void expect_round_trip(const MinMaxOctree<T>& tree, std::initializer_list<double> isos) {
+  const auto path = temp_octree_file("round_trip.geods");
+  tree.save(path);
+  const MinMaxOctree<T> loaded = MinMaxOctree<T>::load(path);
+  EXPECT_EQ(read_min_max_octree_scalar(path), dtype_of<T>());
+  std::filesystem::remove(path);  // the mapping outlives the name
+  EXPECT_EQ(loaded.volume().dims, tree.volume().dims);
+  EXPECT_EQ(loaded.volume().origin, tree.volume().origin);
+  EXPECT_EQ(loaded.volume().spacing, tree.volume().spacing);
+  EXPECT_EQ(loaded.volume().data, tree.volume().data);
+  EXPECT_EQ(loaded.node_min(), tree.node_min());
+  EXPECT_EQ(loaded.node_max(), tree.node_max());
+  EXPECT_TRUE(loaded.node_min().mapped());  // read in place
+  EXPECT_TRUE(loaded.node_max().mapped());
+  EXPECT_FALSE(tree.node_min().mapped());
+  EXPECT_EQ(loaded.stats().nodes, tree.stats().nodes);
+  EXPECT_EQ(loaded.stats().leaf_cells, tree.stats().leaf_cells);
+  for (double iso : isos)
+    for (VertexSharing sharing : kSharings) {
+      const OctreeIsoResult a = tree.isosurface(iso, {}, sharing), b = loaded.isosurface(iso, {}, sharing);
+      const std::string what = name(sharing) + " iso " + std::to_string(iso);
+      EXPECT_EQ(a.mesh.vertices, b.mesh.vertices) << what;
+      EXPECT_EQ(a.mesh.normals, b.mesh.normals) << what;
+      EXPECT_EQ(a.mesh.triangles, b.mesh.triangles) << what;
+      EXPECT_EQ(a.nodes_visited, b.nodes_visited) << what;
+      EXPECT_EQ(a.cells_visited, b.cells_visited) << what;
+    }
+}
+
+TEST(MinMaxOctree, SaveLoadGivesTheSameSurfaces) {
+  auto blobs = sample(21, 18, 25, [](double x, double y, double z) {
+    return std::max(sphere(8, 9, 10, 6)(x, y, z), torus(12, 9, 14, 5, 2)(x, y, z));
+  });
+  blobs.origin = Vec3f(-1.5f, 2, 0.25f);
+  blobs.spacing = Vec3f(0.5f, 1, 2);
+  for (std::size_t leaf : {1, 4, 32}) expect_round_trip(MinMaxOctree<float>(blobs, leaf), {-2.0, 0.0, 1.5});
+  for (std::uint64_t seed : {1, 2}) {
+    expect_round_trip(MinMaxOctree<std::uint8_t>(noise<std::uint8_t>(11, 5, seed), 2), {1.0, 2.5});
+    expect_round_trip(MinMaxOctree<std::uint16_t>(noise<std::uint16_t>(9, 300, seed), 3), {100.0});
+    expect_round_trip(MinMaxOctree<std::int16_t>(noise<std::int16_t>(9, 7, seed, std::int16_t(-3)), 1), {0.0, 3.0});
+    expect_round_trip(MinMaxOctree<double>(noise<double>(10, 4, seed), 4), {1.0, 2.0});
+  }
+  // Degenerate volumes: all samples equal, a single cell, no cells at all.
+  expect_round_trip(MinMaxOctree<float>(Grid3<float>(6, 5, 4, 1.0f)), {1.0, 0.5});
+  Grid3<float> cell(2, 2, 2, 0.0f);
+  cell(1, 1, 1) = 1;
+  expect_round_trip(MinMaxOctree<float>(cell), {0.5});
+  expect_round_trip(MinMaxOctree<float>(Grid3<float>(1, 1, 1, 0.0f)), {0.5});
+  expect_round_trip(MinMaxOctree<float>(Grid3<float>(5, 0, 3)), {0.5});
+}
+
+TEST(MinMaxOctree, BadFilesThrow) {
+  const auto path = temp_octree_file("good.geods"), bad = temp_octree_file("bad.geods");
+  const MinMaxOctree<float> tree(noise<float>(9, 6, 3), 2);
+  tree.save(path);
+  const std::vector<char> good = read_all(path);
+  auto expect_error = [&](const std::vector<char>& bytes, const std::string& what) {
+    write_all(bad, bytes);
+    EXPECT_THROW(MinMaxOctree<float>::load(bad), Error) << what;
+    EXPECT_THROW(MinMaxOctree<float>::load(bad, Archive::Verify::structure_only), Error) << what;
+  };
+  for (std::size_t size = 0; size < good.size(); size += 1 + size / 4)
+    expect_error(std::vector<char>(good.begin(), good.begin() + std::ptrdiff_t(size)), "truncated");
+  // A min that lies, a NaN sample, bad leaf_cells, dims that do not match the samples.
+  auto patched = [&](const char* section, const auto& value) {
+    std::vector<char> bytes = good;
+    std::memcpy(&bytes[testing::archive_section_offset(bytes, section)], &value, sizeof value);
+    return bytes;
+  };
+  expect_error(patched("min", 2.5f), "min");
+  expect_error(patched("max", -1.0f), "max");
+  expect_error(patched("samples", std::numeric_limits<float>::quiet_NaN()), "NaN sample");
+  expect_error(patched("leaf_cells", std::uint64_t(0)), "leaf_cells 0");
+  expect_error(patched("leaf_cells", std::uint64_t(33)), "leaf_cells 33");
+  expect_error(patched("leaf_cells", std::uint64_t(3)), "other leaf_cells: the min/max arrays have the wrong size");
+  expect_error(patched("dims", std::uint64_t(10)), "dims");
+  expect_error(patched("dims", ~std::uint64_t(0)), "dims that overflow");
+  // Another sample type, with a message that says so; another structure's archive.
+  try {
+    (void)MinMaxOctree<std::uint8_t>::load(path);
+    FAIL() << "a float octree loaded as u8";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()), path.string() + ": a min/max octree of f32, expected u8");
+  }
+  ArchiveWriter("spatial.KdTree", 1).write(bad);
+  EXPECT_THROW(MinMaxOctree<float>::load(bad), Error);
+  EXPECT_THROW(read_min_max_octree_scalar(bad), Error);
+  EXPECT_THROW(MinMaxOctree<float>::load(temp_octree_file("missing.geods")), Error);
+  std::filesystem::remove(path);
+  std::filesystem::remove(bad);
 }
 
 }  // namespace

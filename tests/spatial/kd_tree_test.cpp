@@ -13,6 +13,8 @@
 
 #include <unistd.h>
 
+#include "archive_bytes.hpp"
+#include "geods/core/archive.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"
 #include "geods/core/rng.hpp"
@@ -331,27 +333,90 @@ TEST(KdTree, SaveLoadRoundTrip) {
   const std::size_t n = 3000;
   const auto pts = make_points<float>(Shape::clustered, n, 3, 4);
   const KdTree<float, 3> tree(PointView<float>(pts.data(), n, 3), 7);
-  const auto path = temp_file("roundtrip.kdt");
+  const auto path = temp_file("roundtrip.geods");
   tree.save(path);
   const KdTree<float, 3> loaded = KdTree<float, 3>::load(path);
   EXPECT_EQ(loaded.permutation(), tree.permutation());
   EXPECT_EQ(loaded.leaf_size(), 7u);
   EXPECT_EQ(loaded.stats().nodes, tree.stats().nodes);
+  // Read in place from the mapped file, not copied.
+  EXPECT_TRUE(loaded.nodes().mapped());
+  EXPECT_TRUE(loaded.permutation().mapped());
+  EXPECT_FALSE(tree.nodes().mapped());
   const auto qs = make_queries(pts, n, 3, 50, 1);
   for (std::size_t i = 0; i < 50; ++i) {
     const std::span<const float> q(&qs[i * 3], 3);
     EXPECT_EQ(loaded.query(q, 5), tree.query(q, 5));
   }
-  // The runtime-dimension tree reads the same file; the header says what it holds.
+  // The runtime-dimension tree reads the same file; the info says what it holds.
   const auto dynamic = KdTree<float, Dynamic>::load(path);
   EXPECT_EQ(dynamic.dim(), 3u);
-  EXPECT_EQ(read_kd_tree_header(path).scalar_bytes, 4u);
+  EXPECT_EQ(read_kd_tree_info(path).scalar, DType::f32);
+  EXPECT_EQ(read_kd_tree_info(path).dim, 3u);
   // An empty tree round-trips too.
-  const auto empty_path = temp_file("empty.kdt");
+  const auto empty_path = temp_file("empty.geods");
   KdTree<double, 2>().save(empty_path);
   EXPECT_EQ((KdTree<double, 2>::load(empty_path).size()), 0u);
+  KdTree<double, Dynamic>().save(empty_path);
+  EXPECT_EQ((KdTree<double, Dynamic>::load(empty_path).size()), 0u);
   std::filesystem::remove(path);
   std::filesystem::remove(empty_path);
+}
+
+// Every query of a loaded tree answers as the original's, on every shape (duplicates,
+// identical points, lines, grids), a single point, strided input and the runtime dimension.
+template <typename T, int Dim>
+void expect_same_answers(const KdTree<T, Dim>& a, const KdTree<T, Dim>& b, const std::vector<T>& qs, std::size_t m,
+                         std::size_t d) {
+  ASSERT_EQ(a.size(), b.size());
+  ASSERT_EQ(a.nodes().size(), b.nodes().size());
+  EXPECT_EQ(a.bounds_lo(), b.bounds_lo());
+  EXPECT_EQ(a.bounds_hi(), b.bounds_hi());
+  for (std::size_t i = 0; i < a.size(); ++i)
+    ASSERT_TRUE(std::equal(a.point(i), a.point(i) + d, b.point(i))) << "point " << i;
+  for (std::size_t i = 0; i < m; ++i) {
+    const std::span<const T> q(&qs[i * d], d);
+    ASSERT_EQ(a.query(q, 7), b.query(q, 7));
+    ASSERT_EQ(a.query(q, 3, 0.5), b.query(q, 3, 0.5));
+    ASSERT_EQ(a.query_radius(q, 0.2), b.query_radius(q, 0.2));
+    std::vector<T> lo(d), hi(d);
+    for (std::size_t k = 0; k < d; ++k) lo[k] = q[k] - T(0.3), hi[k] = q[k] + T(0.2);
+    ASSERT_EQ(a.query_box(lo, hi), b.query_box(lo, hi));
+  }
+}
+
+TEST(KdTree, LoadedTreesAnswerLikeTheOriginal) {
+  const auto path = temp_file("answers.geods");
+  for (Shape shape : kShapes) {
+    for (std::size_t n : {1, 2, 11, 1000}) {
+      SCOPED_TRACE(name(shape) + " n=" + std::to_string(n));
+      const auto pts = make_points<double>(shape, n, 3, n + 7);
+      const auto qs = make_queries(pts, n, 3, 20, 5);
+      const KdTree<double, 3> tree(PointView<double>(pts.data(), n, 3), 4);
+      tree.save(path);
+      const auto loaded = KdTree<double, 3>::load(path);
+      loaded.validate();
+      EXPECT_TRUE(loaded.points().data != pts.data());
+      expect_same_answers(tree, loaded, qs, 20, 3);
+      // Points in tree order are a copy made after loading; answers stay the same.
+      auto ordered = KdTree<double, 3>::load(path);
+      ordered.store_points_in_tree_order();
+      expect_same_answers(tree, ordered, qs, 20, 3);
+    }
+  }
+  // A strided view is saved packed; the runtime dimension (5) round-trips.
+  const auto pts = make_points<float>(Shape::uniform, 600, 6, 3);
+  const KdTree<float, Dynamic> strided(PointView<float>(pts.data(), 600, 5, 6), 6);
+  strided.save(path);
+  const auto loaded = KdTree<float, Dynamic>::load(path);
+  EXPECT_EQ(loaded.dim(), 5u);
+  const auto qs = make_points<float>(Shape::uniform, 30, 5, 9);
+  expect_same_answers(strided, loaded, qs, 30, 5);
+  // Copies share the mapping; it outlives the file name.
+  const auto copy = loaded;
+  std::filesystem::remove(path);
+  EXPECT_EQ(copy.nodes().data(), loaded.nodes().data());
+  expect_same_answers(strided, copy, qs, 30, 5);
 }
 
 std::vector<char> read_all(const std::filesystem::path& p) {
@@ -366,12 +431,14 @@ TEST(KdTree, CorruptedFilesThrow) {
   const std::size_t n = 500;
   const auto pts = make_points<double>(Shape::uniform, n, 2, 8);
   const KdTree<double, 2> tree(PointView<double>(pts.data(), n, 2));
-  const auto path = temp_file("good.kdt"), bad = temp_file("bad.kdt");
+  const auto path = temp_file("good.geods"), bad = temp_file("bad.geods");
   tree.save(path);
   const std::vector<char> good = read_all(path);
+  // Checked by the container (checksums on) and, with the checksums skipped, by validate().
   auto expect_error = [&](std::vector<char> bytes, const std::string& what) {
     write_all(bad, bytes);
     EXPECT_THROW((KdTree<double, 2>::load(bad)), Error) << what;
+    EXPECT_THROW((KdTree<double, 2>::load(bad, Archive::Verify::structure_only)), Error) << what;
   };
   expect_error(std::vector<char>(good.begin(), good.end() - 5), "truncated");
   expect_error(std::vector<char>(good.begin(), good.begin() + 20), "truncated header");
@@ -382,27 +449,52 @@ TEST(KdTree, CorruptedFilesThrow) {
   bytes[0] = 'X';
   expect_error(bytes, "magic");
   bytes = good;
-  bytes[8] = 9;  // version
+  bytes[8] = 9;  // container version
   expect_error(bytes, "version");
+  bytes = good;
+  bytes[48] = 9;  // k-d tree layout version
+  expect_error(bytes, "kind version");
   // Permutation entry duplicated: validate() refuses it.
-  const KdTreeFileHeader h = read_kd_tree_header(path);
-  const std::size_t perm_at = 40 + 2 * 2 * 8 + h.nodes * sizeof(KdTree<double, 2>::Node);
+  const std::size_t perm_at = testing::archive_section_offset(good, "permutation");
+  const std::size_t nodes_at = testing::archive_section_offset(good, "nodes");
+  const std::size_t points_at = testing::archive_section_offset(good, "points");
   bytes = good;
   std::copy(bytes.begin() + perm_at, bytes.begin() + perm_at + 4, bytes.begin() + perm_at + 4);
   expect_error(bytes, "permutation");
   // A child index pointing outside the node array.
   bytes = good;
-  bytes[40 + 32 + 8] = char(0xff), bytes[40 + 32 + 9] = char(0xff);
+  bytes[nodes_at + 8] = char(0xff), bytes[nodes_at + 9] = char(0xff);
   expect_error(bytes, "child index");
   // A split value that lies about the points below it.
   bytes = good;
   const double lie = -1e9;
-  std::memcpy(&bytes[40 + 32 + 16], &lie, sizeof lie);
+  std::memcpy(&bytes[nodes_at + 16], &lie, sizeof lie);
   expect_error(bytes, "split value");
-  // Wrong type or dimension.
+  // A point that is not finite.
+  for (double x : {std::nan(""), double(INFINITY)}) {
+    bytes = good;
+    std::memcpy(&bytes[points_at], &x, sizeof x);
+    expect_error(bytes, "non-finite point");
+  }
+  // Wrong type or dimension, with a message that says so; another structure's file.
   EXPECT_THROW((KdTree<float, 2>::load(path)), Error);
   EXPECT_THROW((KdTree<double, 3>::load(path)), Error);
-  EXPECT_THROW((KdTree<double, 2>::load(temp_file("missing.kdt"))), Error);
+  try {
+    (void)KdTree<float, Dynamic>::load(path);
+    FAIL() << "a double tree loaded as float";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()), path.string() + ": a k-d tree of f64, expected f32");
+  }
+  ArchiveWriter other("spatial.Orthtree", 1);
+  other.write(bad);
+  EXPECT_THROW((KdTree<double, 2>::load(bad)), Error);
+  EXPECT_THROW(read_kd_tree_info(bad), Error);
+  EXPECT_THROW((KdTree<double, 2>::load(temp_file("missing.geods"))), Error);
+  // Every truncation is an error, never a crash.
+  for (std::size_t size = 0; size < good.size(); size += 1 + size / 8) {
+    write_all(bad, std::vector<char>(good.begin(), good.begin() + std::ptrdiff_t(size)));
+    EXPECT_THROW((KdTree<double, 2>::load(bad, Archive::Verify::structure_only)), Error) << size;
+  }
   std::filesystem::remove(path);
   std::filesystem::remove(bad);
 }

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -14,6 +15,8 @@
 #include <string>
 #include <vector>
 
+#include "archive_bytes.hpp"
+#include "geods/core/archive.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/rng.hpp"
 #include "geods/spatial/quadtree.hpp"
@@ -341,6 +344,14 @@ TEST(Octree, BalancingLargeClusteredTree) {
   EXPECT_LE(balanced.nodes().size(), 16 * tree.nodes().size());  // O(m) nodes
 }
 
+std::vector<char> read_all(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), {}};
+}
+void write_all(const std::filesystem::path& p, const std::vector<char>& bytes) {
+  std::ofstream(p, std::ios::binary).write(bytes.data(), std::streamsize(bytes.size()));
+}
+
 TEST(Orthtree, SaveLoad) {
   const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("geods_qt_" + std::to_string(getpid()));
   std::filesystem::create_directories(dir);
@@ -348,49 +359,111 @@ TEST(Orthtree, SaveLoad) {
   const Octree<float> tree(points, {.bucket = 2, .max_depth = 12});
   const Octree<float> balanced = tree.balanced();
   for (const Octree<float>* t : {&tree, &balanced}) {
-    t->save(dir / "t.ort");
-    const Octree<float> loaded = Octree<float>::load(dir / "t.ort");
+    t->save(dir / "t.geods");
+    const Octree<float> loaded = Octree<float>::load(dir / "t.geods");
     EXPECT_EQ(loaded.nodes(), t->nodes());
     EXPECT_EQ(loaded.permutation(), t->permutation());
     EXPECT_EQ(loaded.is_balanced(), t->is_balanced());
     EXPECT_EQ(loaded.bucket(), 2u);
     EXPECT_EQ(loaded.query(points[7], 4), t->query(points[7], 4));
+    EXPECT_TRUE(loaded.nodes().mapped());  // read in place
+    EXPECT_TRUE(loaded.permutation().mapped());
   }
-  EXPECT_THROW(Octree<double>::load(dir / "t.ort"), Error);    // other scalar type
-  EXPECT_THROW(Quadtree<float>::load(dir / "t.ort"), Error);   // other dimension
-  EXPECT_THROW(Octree<float>::load(dir / "missing.ort"), Error);
-  // Truncated, and single corrupted bytes: an Error or a tree that validates, never a crash.
-  std::ifstream in(dir / "t.ort", std::ios::binary);
-  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  std::ofstream(dir / "short.ort", std::ios::binary) << bytes.substr(0, bytes.size() - 5);
-  EXPECT_THROW(Octree<float>::load(dir / "short.ort"), Error);
+  EXPECT_THROW(Octree<double>::load(dir / "t.geods"), Error);    // other scalar type
+  EXPECT_THROW(Quadtree<float>::load(dir / "t.geods"), Error);   // other dimension
+  EXPECT_THROW(Octree<float>::load(dir / "missing.geods"), Error);
+  // Truncated, and single corrupted bytes: an Error or a tree that validates, never a crash
+  // (with the checksums skipped, so that validate() sees the corruption).
+  const std::vector<char> bytes = read_all(dir / "t.geods");
+  write_all(dir / "short.geods", std::vector<char>(bytes.begin(), bytes.end() - 5));
+  EXPECT_THROW(Octree<float>::load(dir / "short.geods"), Error);
   Rng rng(1);
   for (int t = 0; t < 200; ++t) {
-    std::string bad = bytes;
+    std::vector<char> bad = bytes;
     bad[rng.below(bad.size())] ^= char(1 + rng.below(255));
-    std::ofstream(dir / "bad.ort", std::ios::binary) << bad;
-    try {
-      Octree<float>::load(dir / "bad.ort").validate();
-    } catch (const Error&) {
+    write_all(dir / "bad.geods", bad);
+    for (auto verify : {Archive::Verify::checksums, Archive::Verify::structure_only}) {
+      try {
+        Octree<float>::load(dir / "bad.geods", verify).validate();
+      } catch (const Error&) {
+      }
     }
   }
   // validate() checks the 2:1 condition of trees that claim it: mark an unbalanced tree balanced.
   ASSERT_FALSE(balanced_oracle(tree));
-  tree.save(dir / "t.ort");
-  std::ifstream again(dir / "t.ort", std::ios::binary);
-  std::string claim((std::istreambuf_iterator<char>(again)), std::istreambuf_iterator<char>());
-  claim[8 + 4 * 4] = 1;  // the `balanced` word of the header
-  std::ofstream(dir / "claim.ort", std::ios::binary) << claim;
+  tree.save(dir / "t.geods");
+  std::vector<char> claim = read_all(dir / "t.geods");
+  claim[testing::archive_section_offset(claim, "balanced")] = 1;
+  write_all(dir / "claim.geods", claim);
+  EXPECT_THROW(Octree<float>::load(dir / "claim.geods"), Error);  // the checksum sees it
   try {
-    Octree<float>::load(dir / "claim.ort");
+    Octree<float>::load(dir / "claim.geods", Archive::Verify::structure_only);
     FAIL() << "an unbalanced tree passed as balanced";
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("not 2:1 balanced"), std::string::npos) << e.what();
   }
   const Quadtree<> empty(std::vector<Vec2d>{});
-  empty.save(dir / "empty.ort");
-  EXPECT_TRUE(Quadtree<>::load(dir / "empty.ort").empty());
+  empty.save(dir / "empty.geods");
+  EXPECT_TRUE(Quadtree<>::load(dir / "empty.geods").empty());
   std::filesystem::remove_all(dir);
+}
+
+// A loaded tree answers every query as the original, on every shape, a single point and a
+// balanced tree; bad parameters, points and kinds are errors naming the file.
+template <typename T, int D>
+void expect_round_trip(const Orthtree<T, D>& tree, const std::vector<Vec<T, D>>& queries,
+                       const std::filesystem::path& path) {
+  tree.save(path);
+  const auto loaded = Orthtree<T, D>::load(path);
+  ASSERT_EQ(loaded.nodes(), tree.nodes());
+  ASSERT_EQ(loaded.permutation(), tree.permutation());
+  ASSERT_EQ(loaded.size(), tree.size());
+  EXPECT_EQ(loaded.max_depth(), tree.max_depth());
+  EXPECT_EQ(loaded.root_side(), tree.root_side());
+  for (std::size_t i = 0; i < tree.size(); ++i) ASSERT_EQ(loaded.point(i), tree.point(i));
+  for (const auto& q : queries) {
+    ASSERT_EQ(loaded.query(q, 5), tree.query(q, 5));
+    ASSERT_EQ(loaded.query_radius(q, 0.1), tree.query_radius(q, 0.1));
+    ASSERT_EQ(loaded.locate(q), tree.locate(q));
+    const Vec<T, D> lo = q.array() - T(0.2), hi = q.array() + T(0.1);
+    ASSERT_EQ(loaded.query_box(lo, hi), tree.query_box(lo, hi));
+  }
+  for (std::uint32_t v = 0; v < tree.nodes().size(); ++v)
+    for (int d = 0; d < 2 * D; ++d) ASSERT_EQ(loaded.neighbor(v, Direction(d)), tree.neighbor(v, Direction(d)));
+  const auto rebalanced = loaded.balanced();  // balancing a mapped tree copies its arrays
+  EXPECT_EQ(rebalanced.nodes(), tree.balanced().nodes());
+  EXPECT_FALSE(rebalanced.nodes().mapped());
+}
+
+TEST(Orthtree, LoadedTreesAnswerLikeTheOriginal) {
+  const auto path = std::filesystem::temp_directory_path() / ("geods_qt_rt_" + std::to_string(getpid()));
+  for (Shape shape : kShapes) {
+    for (std::size_t n : {1, 2, 9, 400}) {
+      SCOPED_TRACE(name(shape) + " n=" + std::to_string(n));
+      const auto p2 = make_points<double, 2>(shape, n, n + 1);
+      const auto q2 = make_points<double, 2>(Shape::uniform, 20, n + 2);
+      expect_round_trip(Quadtree<double>(p2, {.bucket = 3}), q2, path);
+      expect_round_trip(Quadtree<double>(p2).balanced(), q2, path);
+      const auto p3 = make_points<float, 3>(shape, n, n + 3);
+      const auto q3 = make_points<float, 3>(Shape::uniform, 20, n + 4);
+      expect_round_trip(Octree<float>(p3, {.bucket = 2, .max_depth = 8, .build = OrthtreeBuild::Morton}), q3, path);
+    }
+  }
+  // A non-finite point, a bad parameter, another structure's archive.
+  const auto pts = make_points<double, 2>(Shape::uniform, 50, 5);
+  Quadtree<double>(pts).save(path);
+  const std::vector<char> good = read_all(path);
+  for (const char* section : {"points", "bucket", "max_depth", "root_side"}) {
+    std::vector<char> bad = good;
+    const double nan = std::nan("");
+    std::memcpy(&bad[testing::archive_section_offset(bad, section)], &nan, sizeof nan);
+    write_all(path, bad);
+    EXPECT_THROW(Quadtree<double>::load(path, Archive::Verify::structure_only), Error) << section;
+    EXPECT_THROW(Quadtree<double>::load(path), Error) << section;
+  }
+  ArchiveWriter("spatial.KdTree", 1).write(path);
+  EXPECT_THROW(Quadtree<double>::load(path), Error);
+  std::filesystem::remove(path);
 }
 
 TEST(Orthtree, EmptyTree) {

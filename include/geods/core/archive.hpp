@@ -16,7 +16,7 @@
 //   any element type), zero-padded between.
 // Reading checks the magic, the versions, the kind, that every section lies
 // inside the file at an aligned offset with its declared element type and size,
-// and (unless told not to) the checksums, so truncated, corrupt, wrong-type and
+// that nothing follows the last one, and (unless told not to) the checksums, so truncated, corrupt, wrong-type and
 // wrong-version files raise geods::Error naming the file. A structure still
 // validates what it loads (indices in range, finite coordinates).
 #include <cstddef>
@@ -77,6 +77,9 @@ class ArchiveWriter {
     add_bytes(name, archive_type_of<T>(), sizeof(T), copy.data(), 1);
   }
 
+  /// Adds a section recording an element type (a structure's scalar type), read back by Archive::dtype().
+  void add_dtype(std::string_view name, DType type) { add_value(name, std::uint32_t(type)); }
+
   /// Writes the archive; throws geods::Error naming the file on failure.
   void write(const std::filesystem::path& path) const;
 
@@ -132,6 +135,17 @@ class Archive {
   template <typename T>
   T value(std::string_view name) const {
     return array<T>(name, 1)[0];
+  }
+
+  /// The element type recorded by ArchiveWriter::add_dtype (geods::Error if it is not a DType).
+  DType dtype(std::string_view name) const;
+  /// Throws "PATH: a <what> of f32, expected f64" unless section `name` records dtype_of<T>().
+  template <typename T>
+  void require_dtype(std::string_view name, std::string_view what) const {
+    const DType recorded = dtype(name);
+    if (recorded != dtype_of<T>())
+      throw error("a " + std::string(what) + " of " + std::string(dtype_name(recorded)) + ", expected " +
+                  std::string(dtype_name(dtype_of<T>())));
   }
 
   /// A geods::Error "PATH: what" for a structure's own checks of what it loaded.

@@ -3,6 +3,8 @@
 // (in a memory-mapped file, kept alive by a shared owner). Structures hold their
 // node and index arrays in it, so that a loaded structure reads the file's pages
 // directly: no parse, no copy. Element access costs what std::vector's does.
+#include <algorithm>
+#include <concepts>
 #include <cstddef>
 #include <memory>
 #include <span>
@@ -64,6 +66,13 @@ class FlatArray {
   std::size_t owned_bytes() const { return owner_ ? 0 : size_ * sizeof(T); }
   /// A copy of the elements that the caller may change.
   std::vector<T> to_vector() const { return {begin(), end()}; }
+
+  /// Element-wise equality, whether owned or viewed.
+  friend bool operator==(const FlatArray& a, const FlatArray& b)
+    requires std::equality_comparable<T>
+  {
+    return std::equal(a.begin(), a.end(), b.begin(), b.end());
+  }
 
  private:
   std::vector<T> owned_;

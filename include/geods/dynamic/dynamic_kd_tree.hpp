@@ -288,14 +288,14 @@ class DynamicKdTree {
 
   // ---------------------------------------------------------------- files
   /// Writes the tree as a "dynamic.KdTree" archive (core/archive.hpp): value
-  /// sections scalar_bytes, dim, variant, max_dead_fraction, next_id, blocks;
+  /// sections scalar, dim, variant, max_dead_fraction, next_id, blocks;
   /// per block k, under the prefix "b<k>.", the k-d tree's sections
   /// (KdTree::add_sections), its ids (slot -> id, kNoId if deleted) and its
   /// dead flags. Builds and reconstructions under way are not saved: their
   /// items are in the blocks that answer queries, and load() starts them again.
   void save(const std::filesystem::path& path) const {
     ArchiveWriter w(std::string(kArchiveKind), kArchiveVersion);
-    w.add_value("scalar_bytes", std::uint32_t(sizeof(T)));
+    w.add_dtype("scalar", dtype_of<T>());
     w.add_value("dim", std::uint64_t(dim_));
     w.add_value("variant", std::uint32_t(tree_.options().variant));
     w.add_value("max_dead_fraction", tree_.options().max_dead_fraction);
@@ -317,10 +317,7 @@ class DynamicKdTree {
   /// dimension, a truncated or corrupt file or contents that fail validate().
   static DynamicKdTree load(const std::filesystem::path& path) {
     const Archive a = Archive::open(path, kArchiveKind, kArchiveVersion);
-    const std::uint32_t scalar_bytes = a.value<std::uint32_t>("scalar_bytes");
-    if (scalar_bytes != sizeof(T))
-      throw a.error(std::string("a dynamic k-d tree of ") + (scalar_bytes == 4 ? "float" : "double") + ", expected " +
-                    (sizeof(T) == 4 ? "float" : "double"));
+    a.require_dtype<T>("scalar", "dynamic k-d tree");
     const std::uint64_t dim = a.value<std::uint64_t>("dim");
     if (dim == 0 || dim > (1u << 16) || (Dim != spatial::Dynamic && dim != std::uint64_t(Dim)))
       throw a.error("a dynamic k-d tree of dimension " + std::to_string(dim) + ", expected " +

@@ -4,13 +4,25 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <filesystem>
+#include <string_view>
 #include <vector>
 
+#include "geods/core/archive.hpp"
+#include "geods/core/flat_array.hpp"
 #include "geods/core/grid3.hpp"
 #include "geods/core/tri_mesh.hpp"
 #include "geods/iso/marching_cubes.hpp"
 
 namespace geods::iso {
+
+/// The archive kind and layout version of a saved min/max octree (MinMaxOctree::save).
+inline constexpr std::string_view kMinMaxOctreeArchiveKind = "iso.MinMaxOctree";
+inline constexpr std::uint32_t kMinMaxOctreeArchiveVersion = 1;
+
+/// The sample type of the octree saved at `path`, to pick MinMaxOctree<T> before
+/// loading (reads only the header and section table). Throws geods::Error naming the file.
+DType read_min_max_octree_scalar(const std::filesystem::path& path);
 
 struct MinMaxOctreeStats {
   std::size_t nodes = 0;       // all levels, leaves included
@@ -72,12 +84,31 @@ class MinMaxOctree {
                              VertexSharing sharing = VertexSharing::block_masks) const;
 
   const Grid3<T>& volume() const { return volume_; }
+  /// The min and max sample of every node, level by level from the leaves (read
+  /// in place from the file for a loaded octree).
+  const FlatArray<T>& node_min() const { return min_; }
+  const FlatArray<T>& node_max() const { return max_; }
   MinMaxOctreeStats stats() const;
   /// Checks that every node's min/max is that of its cells' samples
   /// (leaves) or of its children; throws geods::Error naming the first bad node.
   void validate() const;
 
+  /// Writes the octree and its volume as an "iso.MinMaxOctree" archive
+  /// (core/archive.hpp): value sections scalar, leaf_cells, dims (3 x u64),
+  /// origin, spacing (3 x f32); arrays samples, min, max.
+  void save(const std::filesystem::path& path) const;
+  /// Reads an octree written by save(): the min/max arrays are read in place
+  /// from the mapped file, the samples are copied into volume() (a Grid3 owns
+  /// them). Throws geods::Error naming the file for another sample type, a
+  /// truncated or corrupt file (checksums, unless `verify` says structure_only),
+  /// NaN samples or min/max values that fail validate().
+  static MinMaxOctree load(const std::filesystem::path& path, Archive::Verify verify = Archive::Verify::checksums);
+
  private:
+  MinMaxOctree() = default;
+  // The level table of a volume: the size of each level and its offset in min_/max_ (sets cells_).
+  std::size_t make_levels();
+
   struct Level {
     std::array<std::size_t, 3> dims;
     std::size_t offset;
@@ -103,10 +134,10 @@ class MinMaxOctree {
   std::array<T, 2> leaf_range(std::size_t x, std::size_t y, std::size_t z) const;
 
   Grid3<T> volume_;
-  std::size_t leaf_cells_;
+  std::size_t leaf_cells_ = kDefaultLeafCells;
   std::array<std::size_t, 3> cells_{0, 0, 0};
   std::vector<Level> levels_;  // levels_[0]: leaves, back(): the root
-  std::vector<T> min_, max_;
+  FlatArray<T> min_, max_;
 };
 
 }  // namespace geods::iso

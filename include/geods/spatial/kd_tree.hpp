@@ -6,7 +6,9 @@
 // Layout: a flat array of nodes in depth-first order (the left child of node i is
 // i + 1, the right child is stored) with 32-bit indices, and a permutation of the
 // point indices so that every node owns a contiguous range of it. The points stay
-// in the caller's array (zero-copy, PointView) or in one the tree owns.
+// in the caller's array (zero-copy, PointView) or in one the tree owns. The node
+// array and the permutation are FlatArrays: a tree loaded from a file (load())
+// reads them, and its points, in place from the mapped file.
 //
 // Split rule: each node splits its points at the median (std::nth_element) along
 // the axis of widest spread of those points. Median splits bound the depth by
@@ -29,7 +31,6 @@
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <map>
 #include <memory>
@@ -42,9 +43,9 @@
 #include "geods/core/aabb.hpp"
 #include "geods/core/archive.hpp"
 #include "geods/core/error.hpp"
+#include "geods/core/flat_array.hpp"
 #include "geods/core/parallel.hpp"
 #include "geods/core/vec.hpp"
-#include "geods/spatial/kd_tree_file.hpp"
 #include "geods/spatial/knn_result.hpp"
 #include "geods/spatial/permutation.hpp"
 #include "geods/spatial/point_filter.hpp"
@@ -54,6 +55,22 @@ namespace geods::spatial {
 
 /// The dimension template argument for a dimension known only at run time (as in Eigen).
 inline constexpr int Dynamic = -1;
+
+/// The archive kind and layout version of a saved k-d tree (KdTree::save).
+inline constexpr std::string_view kKdTreeArchiveKind = "spatial.KdTree";
+inline constexpr std::uint32_t kKdTreeArchiveVersion = 1;
+
+/// What a saved k-d tree holds, to pick the tree type before loading it.
+struct KdTreeFileInfo {
+  DType scalar;     // f32 or f64
+  std::size_t dim;  // coordinates per point
+};
+/// Reads the scalar type and dimension of the k-d tree saved at `path` (reads
+/// only the header and section table). Throws geods::Error naming the file.
+inline KdTreeFileInfo read_kd_tree_info(const std::filesystem::path& path) {
+  const Archive a = Archive::open(path, kKdTreeArchiveKind, kKdTreeArchiveVersion, Archive::Verify::structure_only);
+  return {a.dtype("scalar"), std::size_t(a.value<std::uint64_t>("dim"))};
+}
 
 struct KdTreeStats {
   std::size_t points = 0;
@@ -111,9 +128,9 @@ class KdTree {
   /// Coordinates of point i (its index in the input).
   const T* point(std::size_t i) const { return view_[i]; }
   PointView<T> points() const { return view_; }
-  const std::vector<Node>& nodes() const { return nodes_; }
+  const FlatArray<Node>& nodes() const { return nodes_; }
   /// Point indices in tree order: node v owns permutation()[v.begin, v.end).
-  const std::vector<std::uint32_t>& permutation() const { return perm_; }
+  const FlatArray<std::uint32_t>& permutation() const { return perm_; }
 
   /// Opt-in speed-up for large inputs: keeps a copy of the points in tree order
   /// (size() * dim() values, shared by copies of the tree) so that k-NN and radius
@@ -341,8 +358,8 @@ class KdTree {
   /// the permutation is a permutation; nodes form a tree in depth-first order
   /// whose children split their parent's range at its middle (balance); leaves
   /// hold 1..leaf_size points; low <= high; every point lies in the cell of its
-  /// leaf (the root box cut by the low/high values on the path), so no split lies;
-  /// the copy in tree order, if any, holds the points.
+  /// leaf (the root box cut by the low/high values on the path), so no split
+  /// lies, and is finite; the copy in tree order, if any, holds the points.
   void validate() const {
     const std::size_t n = size();
     auto fail = [](const std::string& what) { throw Error("KdTree::validate: " + what); };
@@ -373,8 +390,8 @@ class KdTree {
         for (std::uint32_t i = node.begin; i < node.end; ++i) {
           const T* p = point(perm_[i]);
           for (std::size_t a = 0; a < dim(); ++a)
-            if (!(p[a] >= item.lo[a] && p[a] <= item.hi[a]))
-              fail(where + "point " + std::to_string(perm_[i]) + " lies outside its leaf's cell");
+            if (!(std::isfinite(p[a]) && p[a] >= item.lo[a] && p[a] <= item.hi[a]))
+              fail(where + "point " + std::to_string(perm_[i]) + " is not finite or lies outside its leaf's cell");
         }
         continue;
       }
@@ -410,39 +427,37 @@ class KdTree {
   /// blocks of a DynamicKdTree): leaf_size, bounds_lo, bounds_hi, nodes,
   /// permutation, points (n x dim, row-major, in input order). The arrays are
   /// not copied: the tree must live until w.write(). Its points must be packed
-  /// (stride = dim, as in a tree that owns them).
+  /// (stride = dim, as in a tree that owns them; save() packs a strided view).
   void add_sections(ArchiveWriter& w, const std::string& prefix) const {
     if (view_.stride != view_.dim && size() > 1) throw Error("KdTree::add_sections: strided points");
-    w.add_value(prefix + "leaf_size", std::uint64_t(leaf_size_));
-    w.add(prefix + "bounds_lo", root_lo_);
-    w.add(prefix + "bounds_hi", root_hi_);
-    w.add(prefix + "nodes", std::span<const Node>(nodes_.data(), nodes_.size()));
-    w.add(prefix + "permutation", std::span<const std::uint32_t>(perm_.data(), perm_.size()));
-    w.add(prefix + "points", std::span<const T>(view_.data, size() * dim()));
+    add_sections(w, prefix, std::span<const T>(view_.data, size() * dim()));
   }
 
-  /// The tree add_sections wrote under `prefix`, of dimension `dim`; it owns
-  /// its points. Throws geods::Error naming the file for missing or
+  /// The tree add_sections wrote under `prefix`, of dimension `dim`. Its nodes,
+  /// permutation and points are read in place from the mapped file (no parse,
+  /// no copy), which stays mapped while the tree or a copy of it lives. Throws
+  /// geods::Error naming the file for another dimension, missing or
   /// inconsistent sections or contents that fail validate().
   static KdTree from_sections(const Archive& a, const std::string& prefix, std::size_t dim) {
-    if (dim == 0 || (Dim != Dynamic && dim != std::size_t(Dim)))
-      throw a.error("a k-d tree of dimension " + std::to_string(dim));
+    if ((Dim != Dynamic && dim != std::size_t(Dim)) || dim > (1u << 16))
+      throw a.error("a k-d tree of dimension " + std::to_string(dim) + ", expected " +
+                    (Dim == Dynamic ? std::string("at most 65536") : std::to_string(Dim)));
     const std::uint64_t leaf_size = a.value<std::uint64_t>(prefix + "leaf_size");
     if (leaf_size == 0 || leaf_size > std::numeric_limits<std::uint32_t>::max())
       throw a.error("bad k-d tree leaf size " + std::to_string(leaf_size));
-    const FlatArray<T> points = a.array<T>(prefix + "points");
-    if (points.size() % dim != 0 || points.size() / dim >= std::numeric_limits<std::uint32_t>::max())
-      throw a.error(std::to_string(points.size()) + " coordinates are not rows of dimension " + std::to_string(dim));
-    const std::size_t n = points.size() / dim;
+    auto points = std::make_shared<const FlatArray<T>>(a.array<T>(prefix + "points"));
+    if (dim == 0 ? !points->empty() : points->size() % dim != 0)
+      throw a.error(std::to_string(points->size()) + " coordinates are not rows of dimension " + std::to_string(dim));
+    const std::size_t n = dim == 0 ? 0 : points->size() / dim;
+    if (n >= std::numeric_limits<std::uint32_t>::max()) throw a.error("too many points for a k-d tree");
     KdTree tree;
     tree.leaf_size_ = std::size_t(leaf_size);
-    tree.adopt(points.to_vector(), dim);
-    tree.nodes_ = a.array<Node>(prefix + "nodes").to_vector();
-    tree.perm_ = a.array<std::uint32_t>(prefix + "permutation", n).to_vector();
+    tree.view_ = PointView<T>(points->data(), n, dim);
+    tree.owned_ = std::move(points);
+    tree.nodes_ = a.array<Node>(prefix + "nodes");
+    tree.perm_ = a.array<std::uint32_t>(prefix + "permutation", n);
     tree.root_lo_ = a.array<T>(prefix + "bounds_lo", n > 0 ? dim : 0).to_vector();
     tree.root_hi_ = a.array<T>(prefix + "bounds_hi", n > 0 ? dim : 0).to_vector();
-    for (T x : points)
-      if (!std::isfinite(x)) throw a.error("corrupted k-d tree: a non-finite coordinate");
     try {
       tree.validate();
     } catch (const Error& e) {
@@ -452,67 +467,46 @@ class KdTree {
   }
 
   // ---------------------------------------------------------------- files
-  /// Writes the tree and its points (see kd_tree_file.hpp).
+  /// Writes the tree and its points (in input order) as a "spatial.KdTree"
+  /// archive (core/archive.hpp): value sections scalar and dim, then the
+  /// tree's sections (add_sections) without a prefix.
   void save(const std::filesystem::path& path) const {
-    std::ofstream out(path, std::ios::binary);
-    if (!out) throw Error(path.string() + ": cannot open for writing");
-    KdTreeFileHeader h;
-    h.scalar_bytes = sizeof(T);
-    h.dim = std::uint32_t(dim());
-    h.leaf_size = std::uint32_t(leaf_size_);
-    h.points = size();
-    h.nodes = nodes_.size();
-    write_kd_tree_header(out, h, path);
-    std::vector<T> box(2 * dim(), T(0));
-    std::copy(root_lo_.begin(), root_lo_.end(), box.begin());
-    std::copy(root_hi_.begin(), root_hi_.end(), box.begin() + dim());
-    write_bytes(out, box.data(), box.size() * sizeof(T), path);
-    write_bytes(out, nodes_.data(), nodes_.size() * sizeof(Node), path);
-    write_bytes(out, perm_.data(), perm_.size() * sizeof(std::uint32_t), path);
-    for (std::size_t i = 0; i < size(); ++i) write_bytes(out, point(i), dim() * sizeof(T), path);
-    out.flush();
-    if (!out) throw Error(path.string() + ": cannot write");
+    ArchiveWriter w(std::string(kKdTreeArchiveKind), kKdTreeArchiveVersion);
+    w.add_dtype("scalar", dtype_of<T>());
+    w.add_value("dim", std::uint64_t(dim()));
+    std::vector<T> packed;  // only for a strided view: packed points are written as they are
+    if (view_.stride != view_.dim && size() > 0) {
+      packed.reserve(size() * dim());
+      for (std::size_t i = 0; i < size(); ++i) packed.insert(packed.end(), point(i), point(i) + dim());
+    }
+    add_sections(w, "", packed.empty() ? std::span<const T>(view_.data, size() * dim()) : std::span<const T>(packed));
+    w.write(path);
   }
 
-  /// Reads a tree written by save(); the loaded tree owns its points. Throws
-  /// geods::Error for another scalar type or dimension, a bad header, truncation
-  /// or contents that fail validate().
-  static KdTree load(const std::filesystem::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw Error(path.string() + ": cannot open");
-    const KdTreeFileHeader h = read_kd_tree_header(in, path);
-    if (h.scalar_bytes != sizeof(T))
-      throw Error(path.string() + ": k-d tree of " + (h.scalar_bytes == 4 ? "float" : "double") + ", expected " +
-                  (sizeof(T) == 4 ? "float" : "double"));
-    if (Dim != Dynamic && h.dim != std::uint32_t(Dim))
-      throw Error(path.string() + ": k-d tree of dimension " + std::to_string(h.dim) + ", expected " +
-                  std::to_string(Dim));
-    KdTree tree;
-    tree.leaf_size_ = h.leaf_size;
-    std::vector<T> box(2 * h.dim);
-    read_bytes(in, box.data(), box.size() * sizeof(T), path);
-    tree.nodes_.resize(h.nodes);
-    read_bytes(in, tree.nodes_.data(), tree.nodes_.size() * sizeof(Node), path);
-    tree.perm_.resize(h.points);
-    read_bytes(in, tree.perm_.data(), tree.perm_.size() * sizeof(std::uint32_t), path);
-    std::vector<T> coordinates(h.points * h.dim);
-    read_bytes(in, coordinates.data(), coordinates.size() * sizeof(T), path);
-    tree.adopt(std::move(coordinates), h.dim);
-    if (h.points > 0) {
-      tree.root_lo_.assign(box.begin(), box.begin() + h.dim);
-      tree.root_hi_.assign(box.begin() + h.dim, box.end());
-    }
-    try {
-      tree.validate();
-    } catch (const Error& e) {
-      throw Error(path.string() + ": corrupted k-d tree: " + e.what());
-    }
-    return tree;
+  /// Maps a tree written by save() (see from_sections). Throws geods::Error
+  /// naming the file for another scalar type or dimension, a truncated or
+  /// corrupt file (checksums, unless `verify` says structure_only) or contents
+  /// that fail validate().
+  static KdTree load(const std::filesystem::path& path, Archive::Verify verify = Archive::Verify::checksums) {
+    const Archive a = Archive::open(path, kKdTreeArchiveKind, kKdTreeArchiveVersion, verify);
+    a.require_dtype<T>("scalar", "k-d tree");
+    return from_sections(a, "", std::size_t(a.value<std::uint64_t>("dim")));
   }
 
  private:
   friend class KdTreeSteppedBuild<T, Dim>;
+
+  // add_sections with the points given packed (save() packs a strided view).
+  void add_sections(ArchiveWriter& w, const std::string& prefix, std::span<const T> points) const {
+    w.add_value(prefix + "leaf_size", std::uint64_t(leaf_size_));
+    w.add(prefix + "bounds_lo", root_lo_);
+    w.add(prefix + "bounds_hi", root_hi_);
+    w.add(prefix + "nodes", nodes_);
+    w.add(prefix + "permutation", perm_);
+    w.add(prefix + "points", points);
+  }
   static_assert(sizeof(Node) == 16 + 2 * sizeof(T), "Node is written to files as is");
+  static_assert(std::is_trivially_copyable_v<Node>);
 
   // A small per-query array: on the stack for compile-time and small run-time dimensions.
   template <typename U>
@@ -530,7 +524,7 @@ class KdTree {
   };
 
   void adopt(std::vector<T> coordinates, std::size_t dim) {
-    owned_ = std::make_shared<std::vector<T>>(std::move(coordinates));
+    owned_ = std::make_shared<const FlatArray<T>>(std::move(coordinates));
     view_ = PointView<T>(owned_->data(), owned_->size() / dim, dim);
   }
 
@@ -554,16 +548,16 @@ class KdTree {
           throw Error("KdTree: point " + std::to_string(i) + " has a non-finite coordinate (axis " +
                       std::to_string(a) + ")");
     }
-    perm_.resize(n);
+    std::vector<std::uint32_t> perm(n);
     if (n == 0) return;
     // The size of every subtree depends only on its point count, so each one
     // knows its place in the node array before its siblings are built: the
     // parallel build writes disjoint parts and its output is deterministic.
     std::map<std::size_t, std::uint32_t> subtree_nodes;
-    nodes_.resize(count_nodes(n, subtree_nodes));
+    std::vector<Node> nodes(count_nodes(n, subtree_nodes));
     root_lo_.assign(dim(), T(0));
     root_hi_.assign(dim(), T(0));
-    const Builder builder{this, subtree_nodes, num_threads() > 1};
+    const Builder builder{this, nodes.data(), subtree_nodes, num_threads() > 1};
     if constexpr (Dim != Dynamic) {
       // Partitioning copies of the points (with their index) streams through
       // memory instead of following the permutation into the caller's array:
@@ -579,12 +573,14 @@ class KdTree {
       });
       builder.node(records.data(), [](const Record& r) { return r.p.data(); }, 0, 0, std::uint32_t(n),
                    root_lo_.data(), root_hi_.data());
-      parallel_for_each_index(0, n, [&](std::size_t i) { perm_[i] = records[i].index; });
+      parallel_for_each_index(0, n, [&](std::size_t i) { perm[i] = records[i].index; });
     } else {
-      std::iota(perm_.begin(), perm_.end(), 0u);
-      builder.node(perm_.data(), [this](std::uint32_t i) { return point(i); }, 0, 0, std::uint32_t(n),
+      std::iota(perm.begin(), perm.end(), 0u);
+      builder.node(perm.data(), [this](std::uint32_t i) { return point(i); }, 0, 0, std::uint32_t(n),
                    root_lo_.data(), root_hi_.data());
     }
+    nodes_ = std::move(nodes);
+    perm_ = std::move(perm);
   }
 
   // The split axis of a node whose points span [lo, hi]: the first of widest spread.
@@ -606,7 +602,8 @@ class KdTree {
   // Median-split recursion over a sequence of items (point records or point
   // indices) whose coordinates coords(item) returns.
   struct Builder {
-    KdTree* tree;
+    const KdTree* tree;
+    Node* nodes;  // the node array being built
     const std::map<std::size_t, std::uint32_t>& subtree_nodes;
     bool parallel;
 
@@ -619,7 +616,7 @@ class KdTree {
               T* hi) const {
       const std::size_t dim = tree->dim();
       bounds(items, coords, begin, end, lo, hi);
-      Node& node = tree->nodes_[v];
+      Node& node = nodes[v];
       node = Node{begin, end, 0, 0, T(0), T(0)};
       const std::size_t m = end - begin;
       if (m <= tree->leaf_size_) return;
@@ -839,11 +836,11 @@ class KdTree {
   }
 
   PointView<T> view_;
-  std::shared_ptr<const std::vector<T>> owned_;  // the points, when the tree owns them (shared by copies)
+  std::shared_ptr<const FlatArray<T>> owned_;  // the points, when the tree owns or maps them (shared by copies)
   std::shared_ptr<const std::vector<T>> ordered_;  // opt-in copy in tree order (store_points_in_tree_order)
   std::size_t leaf_size_ = kDefaultLeafSize;
-  std::vector<Node> nodes_;
-  std::vector<std::uint32_t> perm_;
+  FlatArray<Node> nodes_;
+  FlatArray<std::uint32_t> perm_;
   std::vector<T> root_lo_, root_hi_;
 };
 

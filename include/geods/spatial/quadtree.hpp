@@ -19,6 +19,8 @@
 // a iff bit a of c is set, i.e. Morton order), every node knows its parent,
 // depth and integer cell coordinates. Points are referenced by a permutation in
 // which each node owns a contiguous range (ascending indices inside a leaf).
+// Nodes, permutation and points are FlatArrays: a tree loaded from a file
+// (load()) reads them in place from the mapped file.
 //
 // Two builds give the same tree, node for node: top-down (each level's nodes
 // partition their points in parallel, the recursive definition level by level),
@@ -31,19 +33,19 @@
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <memory>
 #include <numeric>
 #include <span>
 #include <string>
-#include <string_view>
 #include <type_traits>
 #include <utility>
 #include <vector>
 
 #include "geods/core/aabb.hpp"
+#include "geods/core/archive.hpp"
 #include "geods/core/error.hpp"
+#include "geods/core/flat_array.hpp"
 #include "geods/core/morton.hpp"
 #include "geods/core/parallel.hpp"
 #include "geods/core/vec.hpp"
@@ -64,6 +66,10 @@ inline constexpr Direction kNorth = Direction::PosY;
 inline constexpr Direction kSouth = Direction::NegY;
 
 enum class OrthtreeBuild { TopDown, Morton };
+
+/// The archive kind and layout version of a saved quadtree or octree (Orthtree::save).
+inline constexpr std::string_view kOrthtreeArchiveKind = "spatial.Orthtree";
+inline constexpr std::uint32_t kOrthtreeArchiveVersion = 1;
 
 struct OrthtreeOptions {
   std::size_t bucket = 1;  // a leaf holds at most this many points (unless they coincide or max_depth is reached)
@@ -114,23 +120,26 @@ class Orthtree {
       : Orthtree(PointView<T>(points), options) {}
 
   // ---------------------------------------------------------------- accessors
-  std::size_t size() const { return points_ ? points_->size() : 0; }
+  std::size_t size() const { return points_ ? points_->size() / Dim : 0; }
   bool empty() const { return size() == 0; }
   std::size_t bucket() const { return bucket_; }
   int max_depth() const { return max_depth_; }
   /// True for trees returned by balanced(): validate() then checks the 2:1 condition.
   bool is_balanced() const { return balanced_; }
-  const VecT& point(std::size_t i) const { return (*points_)[i]; }
-  const std::vector<Node>& nodes() const { return nodes_; }
-  const Node& node(std::uint32_t v) const { return nodes_.at(v); }
-  const std::vector<std::uint32_t>& permutation() const { return perm_; }
+  VecT point(std::size_t i) const { return Eigen::Map<const VecT>(points_->data() + i * Dim); }
+  const FlatArray<Node>& nodes() const { return nodes_; }
+  const Node& node(std::uint32_t v) const {
+    if (v >= nodes_.size()) throw Error("Orthtree: node " + std::to_string(v) + " does not exist");
+    return nodes_[v];
+  }
+  const FlatArray<std::uint32_t>& permutation() const { return perm_; }
   /// The root square (cube); empty for an empty tree.
   Box root_bounds() const { return nodes_.empty() ? Box() : node_bounds(0); }
   double root_side() const { return side_; }
 
   /// The closed cell of node v.
   Box node_bounds(std::uint32_t v) const {
-    const Node& n = nodes_.at(v);
+    const Node& n = node(v);
     Box box;
     for (int a = 0; a < Dim; ++a) {
       box.lo[a] = coordinate(n.cell[a], n.depth, a);
@@ -148,27 +157,7 @@ class Orthtree {
     const int axis = int(dir) / 2;
     if (axis >= Dim) throw Error("Orthtree::neighbor: direction along axis " + std::to_string(axis) +
                                  " in a tree of dimension " + std::to_string(Dim));
-    const std::uint32_t toward = int(dir) % 2 == 0 ? 1 : 0;  // the slot bit on the side we move to
-    const std::uint32_t flip = 1u << axis;
-    // Climb while v is on the `dir` side of its parent (its neighbor lies outside
-    // the parent), recording the slots; the first sibling across is the turn.
-    std::array<std::uint8_t, kMaxDepth + 1> path;
-    std::size_t len = 0;
-    std::uint32_t u = v;
-    for (;;) {
-      if (u == 0) return kNoNode;
-      const Node& p = nodes_[nodes_[u].parent];
-      const std::uint32_t slot = u - p.first_child;
-      if (((slot >> axis) & 1) != toward) {
-        u = p.first_child + (slot ^ flip);
-        break;
-      }
-      path[len++] = std::uint8_t(slot);
-      u = nodes_[u].parent;
-    }
-    // Come down mirrored while the nodes are inner (a leaf is the answer itself).
-    while (len > 0 && !nodes_[u].leaf()) u = nodes_[u].first_child + (path[--len] ^ flip);
-    return u;
+    return neighbor_in(nodes_, v, dir);
   }
 
   // ---------------------------------------------------------------- balancing (§2.1.3, de Berg et al. 14.2)
@@ -179,21 +168,24 @@ class Orthtree {
     Orthtree out = *this;
     out.balanced_ = true;
     if (nodes_.empty()) return out;
-    std::vector<std::uint32_t> stack, scratch(size());
-    for (std::uint32_t v = 0; v < nodes_.size(); ++v)
-      if (nodes_[v].leaf()) stack.push_back(v);
+    std::vector<Node> nodes = nodes_.to_vector();
+    std::vector<std::uint32_t> perm = perm_.to_vector(), stack, scratch(size());
+    for (std::uint32_t v = 0; v < nodes.size(); ++v)
+      if (nodes[v].leaf()) stack.push_back(v);
     while (!stack.empty()) {
       const std::uint32_t mu = stack.back();
       stack.pop_back();
-      if (!out.nodes_[mu].leaf() || !out.must_refine(mu)) continue;
-      out.split(mu, scratch.data());
-      for (std::uint32_t c = 0; c < kChildren; ++c) stack.push_back(out.nodes_[mu].first_child + c);
+      if (!nodes[mu].leaf() || !must_refine(nodes, mu)) continue;
+      split(nodes, perm, mu, scratch.data());
+      for (std::uint32_t c = 0; c < kChildren; ++c) stack.push_back(nodes[mu].first_child + c);
       // Larger neighbors now touch mu's children, two levels deeper: they split too.
       for (int d = 0; d < 2 * Dim; ++d) {
-        const std::uint32_t nb = out.neighbor(mu, Direction(d));
-        if (nb != kNoNode && out.nodes_[nb].leaf() && out.nodes_[nb].depth < out.nodes_[mu].depth) stack.push_back(nb);
+        const std::uint32_t nb = neighbor_in(nodes, mu, Direction(d));
+        if (nb != kNoNode && nodes[nb].leaf() && nodes[nb].depth < nodes[mu].depth) stack.push_back(nb);
       }
     }
+    out.nodes_ = std::move(nodes);
+    out.perm_ = std::move(perm);
     return out;
   }
 
@@ -282,7 +274,8 @@ class Orthtree {
       fail("bad root");
     const Box root_box = root_bounds();
     for (std::size_t i = 0; i < n; ++i)
-      if (!root_box.contains(point(i).template cast<double>())) fail("point " + std::to_string(i) + " outside the root");
+      if (!point(i).allFinite() || !root_box.contains(point(i).template cast<double>()))
+        fail("point " + std::to_string(i) + " is not finite or lies outside the root");
     std::vector<std::uint32_t> stack{0};
     std::size_t visited = 0;
     while (!stack.empty()) {
@@ -294,12 +287,12 @@ class Orthtree {
       if (node.begin > node.end || node.end > n) fail(where + "bad point range");
       if (int(node.depth) > max_depth_) fail(where + "deeper than max_depth");
       if (node.leaf()) {
-        if (must_split(node)) fail(where + "leaf that has to be split");
+        if (must_split(perm_, node)) fail(where + "leaf that has to be split");
         for (std::uint32_t i = node.begin + 1; i < node.end; ++i)
           if (perm_[i - 1] >= perm_[i]) fail(where + "leaf indices not ascending");
         continue;
       }
-      if (!balanced_ && !must_split(node)) fail(where + "inner node that did not have to split");
+      if (!balanced_ && !must_split(perm_, node)) fail(where + "inner node that did not have to split");
       if (node.first_child <= v || std::size_t(node.first_child) + kChildren > nodes_.size())
         fail(where + "bad child index");
       std::uint32_t at = node.begin;
@@ -324,88 +317,68 @@ class Orthtree {
     }
     if (!balanced_) return;
     for (std::uint32_t v = 0; v < nodes_.size(); ++v)
-      if (nodes_[v].leaf() && must_refine(v)) fail("node " + std::to_string(v) + ": not 2:1 balanced");
+      if (nodes_[v].leaf() && must_refine(nodes_, v)) fail("node " + std::to_string(v) + ": not 2:1 balanced");
   }
 
   // ---------------------------------------------------------------- files
-  /// Writes the tree and its points. Layout (little-endian): "GEODSORT", then
-  /// uint32 version, scalar bytes, Dim, max_depth, balanced, 0; uint64 bucket,
-  /// points, nodes; the root corner (Dim doubles) and side (double); the nodes
-  /// as in memory; the permutation (uint32 each); the points (Dim scalars each).
+  /// Writes the tree and its points as a "spatial.Orthtree" archive
+  /// (core/archive.hpp): value sections scalar, dim, bucket, max_depth,
+  /// balanced, root_side; arrays root_lo (Dim doubles), nodes, permutation,
+  /// points (n x Dim, row-major).
   void save(const std::filesystem::path& path) const {
-    std::ofstream out(path, std::ios::binary);
-    if (!out) throw Error(path.string() + ": cannot open for writing");
-    const std::uint32_t words[6] = {kFileVersion, sizeof(T), Dim, std::uint32_t(max_depth_), balanced_, 0};
-    const std::uint64_t counts[3] = {bucket_, size(), nodes_.size()};
-    out.write(kMagic, sizeof kMagic);
-    out.write(reinterpret_cast<const char*>(words), sizeof words);
-    out.write(reinterpret_cast<const char*>(counts), sizeof counts);
-    out.write(reinterpret_cast<const char*>(lo_.data()), Dim * sizeof(double));
-    out.write(reinterpret_cast<const char*>(&side_), sizeof side_);
-    out.write(reinterpret_cast<const char*>(nodes_.data()), std::streamsize(nodes_.size() * sizeof(Node)));
-    out.write(reinterpret_cast<const char*>(perm_.data()), std::streamsize(perm_.size() * sizeof(std::uint32_t)));
-    if (points_) out.write(reinterpret_cast<const char*>(points_->data()), std::streamsize(size() * sizeof(VecT)));
-    out.flush();
-    if (!out) throw Error(path.string() + ": cannot write");
+    ArchiveWriter w(std::string(kOrthtreeArchiveKind), kOrthtreeArchiveVersion);
+    w.add_dtype("scalar", dtype_of<T>());
+    w.add_value("dim", std::uint64_t(Dim));
+    w.add_value("bucket", std::uint64_t(bucket_));
+    w.add_value("max_depth", std::uint32_t(max_depth_));
+    w.add_value("balanced", std::uint32_t(balanced_));
+    w.add_value("root_side", side_);
+    w.add("root_lo", std::span<const double>(lo_.data(), Dim));
+    w.add("nodes", nodes_);
+    w.add("permutation", perm_);
+    w.add("points", points_ ? points_->span() : std::span<const T>());
+    w.write(path);
   }
 
-  /// Reads a tree written by save(). Throws geods::Error for another scalar type
-  /// or dimension, a bad header, a wrong file size or contents that fail validate().
-  static Orthtree load(const std::filesystem::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw Error(path.string() + ": cannot open");
-    auto fail = [&](const std::string& what) { return Error(path.string() + ": " + what); };
-    char magic[sizeof kMagic];
-    std::uint32_t words[6];
-    std::uint64_t counts[3];
-    in.read(magic, sizeof magic);
-    in.read(reinterpret_cast<char*>(words), sizeof words);
-    in.read(reinterpret_cast<char*>(counts), sizeof counts);
-    if (!in || std::string_view(magic, sizeof magic) != std::string_view(kMagic, sizeof kMagic))
-      throw fail("not a geods quadtree/octree file");
-    if (words[0] != kFileVersion) throw fail("quadtree/octree file version " + std::to_string(words[0]) +
-                                             ", this geods reads version " + std::to_string(kFileVersion));
-    if (words[1] != sizeof(T) || words[2] != std::uint32_t(Dim))
-      throw fail("a tree of " + std::to_string(words[1] * 8) + "-bit scalars in dimension " + std::to_string(words[2]) +
-                 ", expected " + std::to_string(sizeof(T) * 8) + "-bit scalars in dimension " + std::to_string(Dim));
-    if (words[3] > std::uint32_t(kMaxDepth) || words[4] > 1 || counts[0] == 0 || counts[1] >= kNoNode ||
-        counts[2] >= kNoNode)
-      throw fail("bad quadtree/octree header");
-    const std::uint64_t body = Dim * sizeof(double) + sizeof(double) + counts[2] * sizeof(Node) +
-                               counts[1] * (sizeof(std::uint32_t) + sizeof(VecT));
-    const auto here = in.tellg();
-    in.seekg(0, std::ios::end);
-    const auto end = in.tellg();
-    in.seekg(here);
-    if (here < 0 || end < 0 || std::uint64_t(end - here) != body) throw fail("truncated or oversized tree file");
+  /// Maps a tree written by save(): nodes, permutation and points are read in
+  /// place from the file. Throws geods::Error naming the file for another
+  /// scalar type or dimension, a truncated or corrupt file (checksums, unless
+  /// `verify` says structure_only) or contents that fail validate().
+  static Orthtree load(const std::filesystem::path& path, Archive::Verify verify = Archive::Verify::checksums) {
+    const Archive a = Archive::open(path, kOrthtreeArchiveKind, kOrthtreeArchiveVersion, verify);
+    a.require_dtype<T>("scalar", Dim == 2 ? "quadtree" : "octree");
+    const std::uint64_t dim = a.value<std::uint64_t>("dim");
+    if (dim != std::uint64_t(Dim))
+      throw a.error("a tree of dimension " + std::to_string(dim) + ", expected " + std::to_string(Dim));
     Orthtree tree;
-    tree.max_depth_ = int(words[3]);
-    tree.balanced_ = words[4] == 1;
-    tree.bucket_ = counts[0];
-    tree.nodes_.resize(counts[2]);
-    tree.perm_.resize(counts[1]);
-    auto points = std::make_shared<std::vector<VecT>>(counts[1]);
-    in.read(reinterpret_cast<char*>(tree.lo_.data()), Dim * sizeof(double));
-    in.read(reinterpret_cast<char*>(&tree.side_), sizeof tree.side_);
-    in.read(reinterpret_cast<char*>(tree.nodes_.data()), std::streamsize(counts[2] * sizeof(Node)));
-    in.read(reinterpret_cast<char*>(tree.perm_.data()), std::streamsize(counts[1] * sizeof(std::uint32_t)));
-    in.read(reinterpret_cast<char*>(points->data()), std::streamsize(counts[1] * sizeof(VecT)));
-    if (!in) throw fail("cannot read");
-    for (const VecT& p : *points)
-      if (!p.allFinite()) throw fail("corrupted tree: non-finite point");
+    const std::uint64_t bucket = a.value<std::uint64_t>("bucket");
+    const std::uint32_t max_depth = a.value<std::uint32_t>("max_depth"), balanced = a.value<std::uint32_t>("balanced");
+    if (bucket == 0 || max_depth > std::uint32_t(kMaxDepth) || balanced > 1) throw a.error("bad quadtree/octree parameters");
+    tree.bucket_ = std::size_t(bucket);
+    tree.max_depth_ = int(max_depth);
+    tree.balanced_ = balanced == 1;
+    tree.side_ = a.value<double>("root_side");
+    const FlatArray<double> lo = a.array<double>("root_lo", Dim);
+    std::copy(lo.begin(), lo.end(), tree.lo_.data());
+    auto points = std::make_shared<const FlatArray<T>>(a.array<T>("points"));
+    if (points->size() % Dim != 0 || points->size() / Dim >= kNoNode)
+      throw a.error(std::to_string(points->size()) + " coordinates are not a point set of dimension " +
+                    std::to_string(Dim));
     tree.points_ = std::move(points);
+    tree.nodes_ = a.array<Node>("nodes");
+    if (tree.nodes_.size() >= kNoNode) throw a.error("too many quadtree/octree nodes");
+    tree.perm_ = a.array<std::uint32_t>("permutation", tree.size());
     try {
       tree.validate();
     } catch (const Error& e) {
-      throw fail(std::string("corrupted tree: ") + e.what());
+      throw a.error(std::string("corrupted tree: ") + e.what());
     }
     return tree;
   }
 
  private:
-  static constexpr char kMagic[8] = {'G', 'E', 'O', 'D', 'S', 'O', 'R', 'T'};
-  static constexpr std::uint32_t kFileVersion = 1;
   static_assert(sizeof(Node) == 4 * (5 + Dim), "Node is written to files as is");
+  static_assert(std::is_trivially_copyable_v<Node>);
 
   // ---------------------------------------------------------------- geometry
   // 2^-d for every depth: k * 2^-d is exact, so every caller gets the same rounding.
@@ -432,28 +405,55 @@ class Orthtree {
   }
   std::uint32_t child_slot(const Node& node, const VecT& p) const { return slot_of(middle(node), p); }
 
-  bool coincident(const Node& node) const {
+  // neighbor() over a node array (the tree's, or one being balanced).
+  static std::uint32_t neighbor_in(std::span<const Node> nodes, std::uint32_t v, Direction dir) {
+    const int axis = int(dir) / 2;
+    const std::uint32_t toward = int(dir) % 2 == 0 ? 1 : 0;  // the slot bit on the side we move to
+    const std::uint32_t flip = 1u << axis;
+    // Climb while v is on the `dir` side of its parent (its neighbor lies outside
+    // the parent), recording the slots; the first sibling across is the turn.
+    std::array<std::uint8_t, kMaxDepth + 1> path;
+    std::size_t len = 0;
+    std::uint32_t u = v;
+    for (;;) {
+      if (u == 0) return kNoNode;
+      const Node& p = nodes[nodes[u].parent];
+      const std::uint32_t slot = u - p.first_child;
+      if (((slot >> axis) & 1) != toward) {
+        u = p.first_child + (slot ^ flip);
+        break;
+      }
+      path[len++] = std::uint8_t(slot);
+      u = nodes[u].parent;
+    }
+    // Come down mirrored while the nodes are inner (a leaf is the answer itself).
+    while (len > 0 && !nodes[u].leaf()) u = nodes[u].first_child + (path[--len] ^ flip);
+    return u;
+  }
+
+
+  bool coincident(std::span<const std::uint32_t> perm, const Node& node) const {
     if (node.end - node.begin < 2) return true;
-    const VecT& first = point(perm_[node.begin]);
+    const VecT first = point(perm[node.begin]);
     for (std::uint32_t i = node.begin + 1; i < node.end; ++i)
-      if (point(perm_[i]) != first) return false;
+      if (point(perm[i]) != first) return false;
     return true;
   }
 
-  bool must_split(const Node& node) const {
-    return node.end - node.begin > bucket_ && int(node.depth) < max_depth_ && !coincident(node);
+  bool must_split(std::span<const std::uint32_t> perm, const Node& node) const {
+    return node.end - node.begin > bucket_ && int(node.depth) < max_depth_ && !coincident(perm, node);
   }
 
   // A leaf must be refined for the 2:1 condition iff a same-depth neighbor has an
   // inner child on the face toward it (a leaf two or more levels deeper touches it).
-  bool must_refine(std::uint32_t mu) const {
+  static bool must_refine(std::span<const Node> nodes, std::uint32_t mu) {
     for (int d = 0; d < 2 * Dim; ++d) {
-      const std::uint32_t nb = neighbor(mu, Direction(d));
-      if (nb == kNoNode || nodes_[nb].leaf()) continue;
+      const std::uint32_t nb = neighbor_in(nodes, mu, Direction(d));
+      if (nb == kNoNode || nodes[nb].leaf()) continue;
       const int axis = d / 2;
       const std::uint32_t near_bit = d % 2 == 0 ? 0 : 1;  // the neighbor's children facing mu
       for (std::uint32_t c = 0; c < kChildren; ++c)
-        if (((c >> axis) & 1) == near_bit && !nodes_[nodes_[nb].first_child + c].leaf()) return true;
+        if (((c >> axis) & 1) == near_bit && !nodes[nodes[nb].first_child + c].leaf()) return true;
     }
     return false;
   }
@@ -472,36 +472,39 @@ class Orthtree {
     bucket_ = options.bucket;
     max_depth_ = options.max_depth < 0 ? kMaxDepth : options.max_depth;
     const std::size_t n = view.count;
-    auto points = std::make_shared<std::vector<VecT>>(n);
+    std::vector<T> points(n * Dim);
     for (std::size_t i = 0; i < n; ++i) {
       for (int a = 0; a < Dim; ++a) {
         const T x = view[i][a];
         if (!std::isfinite(x))
           throw Error("Orthtree: point " + std::to_string(i) + " has a non-finite coordinate (axis " +
                       std::to_string(a) + ")");
-        (*points)[i][a] = x;
+        points[i * Dim + a] = x;
       }
     }
-    points_ = std::move(points);
+    points_ = std::make_shared<const FlatArray<T>>(std::move(points));
     if (n == 0) return;
     root_square();
-    perm_.resize(n);
+    std::vector<Node> nodes;
+    std::vector<std::uint32_t> perm(n);
     if (options.build == OrthtreeBuild::Morton) {
-      const std::vector<std::uint64_t> keys = sorted_morton_keys();
-      build_levels([&](std::uint32_t v) { split_by_keys(v, keys); });
+      const std::vector<std::uint64_t> keys = sorted_morton_keys(perm);
+      build_levels(nodes, perm, [&](std::uint32_t v) { split_by_keys(nodes, v, keys); });
     } else {
-      std::iota(perm_.begin(), perm_.end(), 0u);
+      std::iota(perm.begin(), perm.end(), 0u);
       std::vector<std::uint32_t> scratch(n);
-      build_levels([&](std::uint32_t v) { split_points(v, scratch.data()); });
+      build_levels(nodes, perm, [&](std::uint32_t v) { split_points(nodes, perm, v, scratch.data()); });
     }
-    parallel_for_each_index(0, nodes_.size(), [&](std::size_t v) {
-      if (nodes_[v].leaf()) std::sort(perm_.begin() + nodes_[v].begin, perm_.begin() + nodes_[v].end);
+    parallel_for_each_index(0, nodes.size(), [&](std::size_t v) {
+      if (nodes[v].leaf()) std::sort(perm.begin() + nodes[v].begin, perm.begin() + nodes[v].end);
     }, 256);
+    nodes_ = std::move(nodes);
+    perm_ = std::move(perm);
   }
 
   void root_square() {
     AABB<double, Dim> box;
-    for (const VecT& p : *points_) box.extend(p.template cast<double>());
+    for (std::size_t i = 0; i < size(); ++i) box.extend(point(i).template cast<double>());
     lo_ = box.lo;
     side_ = box.extent().maxCoeff();
     // Rounding in hi - lo may leave lo + side a hair short of hi: grow by ulps.
@@ -513,21 +516,21 @@ class Orthtree {
   // children are numbered in order (breadth first), then each splitting node
   // fills its children (and orders its points) in parallel.
   template <typename Partition>
-  void build_levels(const Partition& partition) {
-    nodes_.assign(1, Node{0, kNoNode, 0, std::uint32_t(size()), 0, {}});
+  void build_levels(std::vector<Node>& nodes, std::span<const std::uint32_t> perm, const Partition& partition) const {
+    nodes.assign(1, Node{0, kNoNode, 0, std::uint32_t(size()), 0, {}});
     std::vector<std::uint8_t> splits;
     for (std::size_t level_begin = 0, level_end = 1; level_begin < level_end;) {
       splits.assign(level_end - level_begin, 0);
-      parallel_for_each_index(0, splits.size(), [&](std::size_t i) { splits[i] = must_split(nodes_[level_begin + i]); },
-                              64);
-      std::size_t next = nodes_.size();
+      parallel_for_each_index(0, splits.size(),
+                              [&](std::size_t i) { splits[i] = must_split(perm, nodes[level_begin + i]); }, 64);
+      std::size_t next = nodes.size();
       for (std::size_t i = 0; i < splits.size(); ++i) {
         if (!splits[i]) continue;
-        nodes_[level_begin + i].first_child = std::uint32_t(next);
+        nodes[level_begin + i].first_child = std::uint32_t(next);
         next += kChildren;
         if (next >= kNoNode) throw Error("Orthtree: more than 2^32 - 2 nodes");
       }
-      nodes_.resize(next);
+      nodes.resize(next);
       parallel_for_each_index(0, splits.size(), [&](std::size_t i) {
         if (splits[i]) partition(std::uint32_t(level_begin + i));
       }, 16);
@@ -537,37 +540,39 @@ class Orthtree {
   }
 
   // Fills the children of v (already allocated) given where their point ranges start.
-  void make_children(std::uint32_t v, const std::array<std::uint32_t, kChildren + 1>& bounds) {
-    const Node parent = nodes_[v];
+  static void make_children(std::vector<Node>& nodes, std::uint32_t v,
+                            const std::array<std::uint32_t, kChildren + 1>& bounds) {
+    const Node parent = nodes[v];
     for (std::uint32_t c = 0; c < kChildren; ++c) {
-      Node& child = nodes_[parent.first_child + c];
+      Node& child = nodes[parent.first_child + c];
       child = Node{0, v, bounds[c], bounds[c + 1], parent.depth + 1, {}};
       for (int a = 0; a < Dim; ++a) child.cell[a] = 2 * parent.cell[a] + ((c >> a) & 1);
     }
   }
 
   // Top-down: a counting sort of v's points by child slot (scratch: n entries).
-  void split_points(std::uint32_t v, std::uint32_t* scratch) {
-    const Node node = nodes_[v];
+  void split_points(std::vector<Node>& nodes, std::vector<std::uint32_t>& perm, std::uint32_t v,
+                    std::uint32_t* scratch) const {
+    const Node node = nodes[v];
     const Vec<double, Dim> mid = middle(node);
     std::array<std::uint32_t, kChildren + 1> bounds{};
     for (std::uint32_t i = node.begin; i < node.end; ++i) {
-      scratch[i] = perm_[i];
-      ++bounds[slot_of(mid, point(perm_[i])) + 1];
+      scratch[i] = perm[i];
+      ++bounds[slot_of(mid, point(perm[i])) + 1];
     }
     bounds[0] = node.begin;
     for (std::uint32_t c = 0; c < kChildren; ++c) bounds[c + 1] += bounds[c];
     std::array<std::uint32_t, kChildren> at;
     std::copy(bounds.begin(), bounds.end() - 1, at.begin());
-    for (std::uint32_t i = node.begin; i < node.end; ++i) perm_[at[slot_of(mid, point(scratch[i]))]++] = scratch[i];
-    make_children(v, bounds);
+    for (std::uint32_t i = node.begin; i < node.end; ++i) perm[at[slot_of(mid, point(scratch[i]))]++] = scratch[i];
+    make_children(nodes, v, bounds);
   }
 
   // Linear: the key of a point is its cell path down to max_depth, taken by the
   // same comparisons as the top-down build, as interleaved (Morton) digits.
-  // Sorted by (key, index), every node's points are a run of perm_ and its
-  // children are sub-runs. Returns the keys in perm_ order.
-  std::vector<std::uint64_t> sorted_morton_keys() {
+  // Sorted by (key, index), every node's points are a run of perm and its
+  // children are sub-runs. Returns the keys in perm order.
+  std::vector<std::uint64_t> sorted_morton_keys(std::vector<std::uint32_t>& perm) const {
     const std::size_t n = size();
     std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(n);
     parallel_for_each_index(0, n, [&](std::size_t i) {
@@ -587,13 +592,13 @@ class Orthtree {
     std::vector<std::uint64_t> keys(n);
     parallel_for_each_index(0, n, [&](std::size_t i) {
       keys[i] = keyed[i].first;
-      perm_[i] = keyed[i].second;
+      perm[i] = keyed[i].second;
     });
     return keys;
   }
 
-  void split_by_keys(std::uint32_t v, const std::vector<std::uint64_t>& keys) {
-    const Node node = nodes_[v];
+  void split_by_keys(std::vector<Node>& nodes, std::uint32_t v, const std::vector<std::uint64_t>& keys) const {
+    const Node node = nodes[v];
     const int shift = Dim * (max_depth_ - 1 - int(node.depth));  // v's digit: the slot of its child
     std::array<std::uint32_t, kChildren + 1> bounds;
     bounds[0] = node.begin;
@@ -603,18 +608,18 @@ class Orthtree {
           std::partition_point(first, last, [&](std::uint64_t key) { return ((key >> shift) & (kChildren - 1)) <= c; }) -
           keys.begin());
     }
-    make_children(v, bounds);
+    make_children(nodes, v, bounds);
   }
 
   // Balancing: turns leaf v into an inner node with children appended at the end.
-  void split(std::uint32_t v, std::uint32_t* scratch) {
-    nodes_[v].first_child = std::uint32_t(nodes_.size());
-    if (nodes_.size() + kChildren >= kNoNode) throw Error("Orthtree: more than 2^32 - 2 nodes");
-    nodes_.resize(nodes_.size() + kChildren);
-    split_points(v, scratch);
+  void split(std::vector<Node>& nodes, std::vector<std::uint32_t>& perm, std::uint32_t v, std::uint32_t* scratch) const {
+    nodes[v].first_child = std::uint32_t(nodes.size());
+    if (nodes.size() + kChildren >= kNoNode) throw Error("Orthtree: more than 2^32 - 2 nodes");
+    nodes.resize(nodes.size() + kChildren);
+    split_points(nodes, perm, v, scratch);
     for (std::uint32_t c = 0; c < kChildren; ++c) {
-      const Node& child = nodes_[nodes_[v].first_child + c];
-      std::sort(perm_.begin() + child.begin, perm_.begin() + child.end);
+      const Node& child = nodes[nodes[v].first_child + c];
+      std::sort(perm.begin() + child.begin, perm.begin() + child.end);
     }
   }
 
@@ -705,7 +710,7 @@ class Orthtree {
     }
     if (node.leaf()) {
       for (std::uint32_t i = node.begin; i < node.end; ++i) {
-        const VecT& p = point(perm_[i]);
+        const VecT p = point(perm_[i]);
         if ((p.array() >= lo.array()).all() && (p.array() <= hi.array()).all()) {
           ++count;
           if constexpr (Report) out->push_back(perm_[i]);
@@ -716,14 +721,14 @@ class Orthtree {
     for (std::uint32_t c = 0; c < kChildren; ++c) box_node<Report>(node.first_child + c, box, lo, hi, count, out);
   }
 
-  std::shared_ptr<const std::vector<VecT>> points_;  // shared by copies and balanced trees
+  std::shared_ptr<const FlatArray<T>> points_;  // n x Dim coordinates, shared by copies and balanced trees
   std::size_t bucket_ = 1;
   int max_depth_ = kMaxDepth;
   bool balanced_ = false;
   Vec<double, Dim> lo_ = Vec<double, Dim>::Zero();
   double side_ = 0;
-  std::vector<Node> nodes_;
-  std::vector<std::uint32_t> perm_;
+  FlatArray<Node> nodes_;
+  FlatArray<std::uint32_t> perm_;
 };
 
 template <typename T = double>
