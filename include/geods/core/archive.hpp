@@ -57,7 +57,7 @@ class ArchiveWriter {
   /// Adds a section of `elements` (not copied: they must live until write()).
   template <typename T>
   void add(std::string_view name, std::span<const T> elements) {
-    static_assert(std::is_trivially_copyable_v<T>, "archive sections hold trivially copyable elements");
+    static_assert(is_bytewise_v<T>, "archive sections hold elements stored as their bytes");
     add_bytes(name, archive_type_of<T>(), sizeof(T), elements.data(), elements.size());
   }
   template <typename T>
@@ -71,7 +71,7 @@ class ArchiveWriter {
   /// Adds a section of one element (a count, a parameter, a header struct), copied.
   template <typename T>
   void add_value(std::string_view name, const T& value) {
-    static_assert(std::is_trivially_copyable_v<T>, "archive sections hold trivially copyable elements");
+    static_assert(is_bytewise_v<T>, "archive sections hold elements stored as their bytes");
     std::vector<std::byte>& copy = values_.emplace_back(sizeof(T));
     std::memcpy(copy.data(), &value, sizeof(T));
     add_bytes(name, archive_type_of<T>(), sizeof(T), copy.data(), 1);
