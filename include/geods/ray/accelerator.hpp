@@ -114,6 +114,8 @@ class Accelerator {
   /// not to an address that a later accelerator may reuse).
   std::uint64_t id() const { return id_; }
   std::size_t num_triangles() const { return corners_.size() / 3; }
+  /// True for an accelerator from load(): its arrays view the mapped file.
+  bool mapped() const { return corners_.mapped(); }
 
  protected:
   /// Copies the triangle corners (three per triangle, flat) after checking the mesh.
