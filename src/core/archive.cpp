@@ -152,7 +152,8 @@ Archive Archive::open(const std::filesystem::path& path, std::string_view kind, 
   auto fail = [&](const std::string& what) { return Error(path.string() + ": " + what); };
   const FileHeader& h = read_header(*file);
   const std::string file_kind = fixed_string(h.kind, kNameBytes);
-  if (file_kind != kind) throw fail("a " + file_kind + " archive, expected a " + std::string(kind));
+  if (file_kind != kind)
+    throw fail("holds a geods archive of kind " + file_kind + ", expected kind " + std::string(kind));
   if (h.kind_version != kind_version)
     throw fail(file_kind + " format version " + std::to_string(h.kind_version) + ", this geods reads version " +
                std::to_string(kind_version));

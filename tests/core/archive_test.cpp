@@ -106,7 +106,7 @@ TEST(Archive, WrongKindVersionTypeCountAndMissingSectionsAreErrors) {
     (void)Archive::open(p, "test.Other", 3);
     FAIL() << "a test.Sample archive opened as a test.Other";
   } catch (const Error& e) {  // one line naming the file, what it holds and what was expected
-    EXPECT_EQ(std::string(e.what()), p.string() + ": a test.Sample archive, expected a test.Other");
+    EXPECT_EQ(std::string(e.what()), p.string() + ": holds a geods archive of kind test.Sample, expected kind test.Other");
   }
   EXPECT_THROW(Archive::open(p, "test.Sample", 4), Error);
   const Archive a = Archive::open(p, "test.Sample", 3);
