@@ -175,3 +175,24 @@ def test_render_command(cli, data_dir, tmp_path):
     bad = subprocess.run([str(cli), "render", str(data_dir / "bunny.ply"), "-o", str(out), "--camera", "1,2,3"],
                          capture_output=True, text=True)
     assert bad.returncode == 2 and "10 numbers" in bad.stderr
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_save_load_gives_identical_hits(bunny, tmp_path, kind):
+    V, F = bunny
+    accel = geods.RayAccelerator(V, F, kind)
+    accel.save(tmp_path / "bunny.accel")
+    loaded = geods.RayAccelerator.load(tmp_path / "bunny.accel")
+    assert loaded.kind == kind
+    loaded.validate()
+    origins, directions = random_rays(V, 500, 12)
+    for a, b in zip(accel.intersect(origins, directions), loaded.intersect(origins, directions)):
+        assert np.array_equal(a, b)
+    assert np.array_equal(accel.occluded(origins, directions), loaded.occluded(origins, directions))
+    if kind != "rays5d":  # its 5D trees grow with the rays it is shot
+        for key in ("nodes", "references", "depth", "build_s"):
+            assert accel.stats()[key] == loaded.stats()[key]
+    data = (tmp_path / "bunny.accel").read_bytes()
+    (tmp_path / "cut.accel").write_bytes(data[:-1000])
+    with pytest.raises(geods.Error, match="truncated"):
+        geods.RayAccelerator.load(tmp_path / "cut.accel")
