@@ -346,11 +346,7 @@ TriangleBvh TriangleBvh::from_sections(const Archive& in) {
   bvh.options_.leaf_size = in.value<std::int32_t>("leaf_size");
   bvh.options_.arity = in.value<std::int32_t>("arity");
   bvh.options_.sah_bins = in.value<std::int32_t>("sah_bins");
-  try {
-    check_options(bvh.options_);
-  } catch (const Error& e) {
-    throw in.error(e.what());
-  }
+  in.check([&] { check_options(bvh.options_); });
   bvh.topology_.nodes = in.array<TopoNode>("nodes");
   const std::size_t nodes = bvh.topology_.nodes.size();
   bvh.topology_.prim_order = in.array<std::uint32_t>("triangle_ids");
@@ -361,11 +357,7 @@ TriangleBvh TriangleBvh::from_sections(const Archive& in) {
   if (wide && bvh.options_.arity == 8) bvh.wide8_ = in.array<WideNode<8>>("wide8");
   if (wide && bvh.options_.arity == 4) bvh.wide4_ = in.array<WideNode<4>>("wide4");
   bvh.groups_ = in.array<TriangleGroup>("groups");
-  try {
-    bvh.validate();  // before anything walks the nodes
-  } catch (const Error& e) {
-    throw in.error(e.what());
-  }
+  in.check([&] { bvh.validate(); });  // before anything walks the nodes
   bvh.depth_ = bvh.topology_.depth();
   return bvh;
 }

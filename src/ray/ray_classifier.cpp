@@ -93,11 +93,7 @@ std::unique_ptr<RayClassifier> RayClassifier::load(const std::filesystem::path& 
   options.rays5d_max_depth = in.value<std::uint32_t>("max_depth");
   options.rays5d_max_references = std::size_t(in.value<std::uint64_t>("max_references"));
   options.rays5d_cutoff = in.value<float>("cutoff");
-  try {
-    check_rays5d_options(options);
-  } catch (const Error& e) {
-    throw in.error(e.what());
-  }
+  in.check([&] { check_rays5d_options(options); });
   const auto start = std::chrono::steady_clock::now();
   std::unique_ptr<RayClassifier> rc(new RayClassifier(in));
   rc->build_roots(options);

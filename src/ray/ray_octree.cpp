@@ -142,11 +142,7 @@ std::unique_ptr<RayOctree> RayOctree::load(const std::filesystem::path& path) {
   o.depth_ = in.value<std::uint64_t>("depth");
   o.nodes_ = in.array<Node>("nodes");
   o.leaf_triangles_ = in.array<std::uint32_t>("leaf_triangles");
-  try {
-    o.validate();
-  } catch (const Error& e) {
-    throw in.error(e.what());
-  }
+  in.check([&] { o.validate(); });
   return tree;
 }
 

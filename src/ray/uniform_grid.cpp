@@ -142,11 +142,7 @@ std::unique_ptr<UniformGrid> UniformGrid::load(const std::filesystem::path& path
   }
   if (cells + 1 != g.cell_begin_.size()) throw in.error("the cell offsets do not match the grid resolution");
   g.set_cells();
-  try {
-    g.validate();
-  } catch (const Error& e) {
-    throw in.error(e.what());
-  }
+  in.check([&] { g.validate(); });
   return grid;
 }
 

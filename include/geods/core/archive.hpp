@@ -136,6 +136,16 @@ class Archive {
 
   /// A geods::Error "PATH: what" for a structure's own checks of what it loaded.
   Error error(const std::string& what) const;
+  /// Runs `checks` (say a structure's validate() on what it loaded); a
+  /// geods::Error they throw is thrown again as error(its message).
+  template <typename Checks>
+  void check(Checks&& checks) const {
+    try {
+      checks();
+    } catch (const Error& e) {
+      throw error(e.what());
+    }
+  }
 
  private:
   struct Entry {
