@@ -196,3 +196,22 @@ def test_save_load_gives_identical_hits(bunny, tmp_path, kind):
     (tmp_path / "cut.accel").write_bytes(data[:-1000])
     with pytest.raises(geods.Error, match="truncated"):
         geods.RayAccelerator.load(tmp_path / "cut.accel")
+
+
+def test_render_save_and_load(cli, data_dir, tmp_path):
+    mesh, saved = str(data_dir / "bunny.ply"), str(tmp_path / "bunny.grid")
+    common = ["--width", "48", "--height", "32", "--json"]
+    built = json.loads(subprocess.run([str(cli), "render", mesh, "-o", str(tmp_path / "a.png"), "--accel", "grid",
+                                       "--save", saved] + common, capture_output=True, text=True, check=True).stdout)
+    loaded = json.loads(subprocess.run([str(cli), "render", mesh, "-o", str(tmp_path / "b.png"), "--load", saved]
+                                       + common, capture_output=True, text=True, check=True).stdout)
+    assert built["saved"] == saved and loaded["loaded"] == saved and loaded["accel"] == "grid"
+    assert loaded["build_s"] == 0 and loaded["accel_nodes"] == built["accel_nodes"]
+    assert np.array_equal(geods.read_image(str(tmp_path / "a.png")), geods.read_image(str(tmp_path / "b.png")))
+    assert geods.RayAccelerator.load(saved).kind == "grid"
+    bad = subprocess.run([str(cli), "render", mesh, "-o", str(tmp_path / "c.png"), "--load", saved, "--accel", "octree"],
+                         capture_output=True, text=True)
+    assert bad.returncode == 2 and "grid" in bad.stderr and bad.stderr.count("\n") == 1
+    bvh_file = tmp_path / "bunny.bvh"
+    subprocess.run([str(cli), "bvh", mesh, "--save", str(bvh_file)], check=True, capture_output=True)
+    assert geods.Bvh.load(bvh_file).stats()["triangles"] == 3674
