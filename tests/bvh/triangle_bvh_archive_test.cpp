@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "../common/archive_files.hpp"
+#include "common/archive_files.hpp"
 #include "bvh_test_util.hpp"
 #include "geods/bvh/triangle_bvh.hpp"
 #include "geods/core/archive.hpp"

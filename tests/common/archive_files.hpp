@@ -1,7 +1,8 @@
 #pragma once
 // Bad archive files for the save/load tests of every structure: a saved file
 // truncated, with a flipped byte, or with another kind version, each of which
-// the structure's load() must refuse with geods::Error.
+// the structure's load() must refuse with geods::Error; and where a section
+// lies, to corrupt one array past the checksums.
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -9,7 +10,9 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "geods/core/error.hpp"
@@ -27,6 +30,24 @@ inline std::vector<char> read_bytes(const std::filesystem::path& p) {
 inline void write_bytes(const std::filesystem::path& p, const std::vector<char>& bytes) {
   std::ofstream out(p, std::ios::binary | std::ios::trunc);
   out.write(bytes.data(), std::streamsize(bytes.size()));
+}
+
+/// Where the payload of section `name` starts in a saved archive's bytes (the
+/// section table layout of core/archive.hpp), so that a test can corrupt one
+/// array and load with Archive::Verify::structure_only: the checksums are
+/// skipped and the structure's own checks must catch it.
+inline std::size_t archive_section_offset(const std::vector<char>& bytes, std::string_view name) {
+  constexpr std::size_t kHeader = 64, kRecord = 64, kCountAt = 52, kOffsetAt = 40;
+  std::uint32_t sections = 0;
+  std::memcpy(&sections, bytes.data() + kCountAt, sizeof sections);
+  for (std::size_t i = 0; i < sections; ++i) {
+    const char* record = bytes.data() + kHeader + i * kRecord;
+    if (std::string_view(record, strnlen(record, 32)) != name) continue;
+    std::uint64_t offset = 0;
+    std::memcpy(&offset, record + kOffsetAt, sizeof offset);
+    return std::size_t(offset);
+  }
+  throw std::runtime_error("no section " + std::string(name));
 }
 
 /// load(path) on copies of the archive at `saved` cut short at `cuts` sizes,

@@ -11,7 +11,7 @@
 #include <limits>
 #include <vector>
 
-#include "../common/archive_files.hpp"
+#include "common/archive_files.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"
 #include "geods/core/rng.hpp"
