@@ -210,6 +210,43 @@ def archive_seeds():
     }
 
 
+I32 = 5
+INF = float("inf")
+
+
+def bvh_sections():
+    """The sections of a one-triangle TriangleBvh (AABB, 4 wide)."""
+    tri = (0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0)
+    values = [("builder", U32, 4, struct.pack("<I", 0)), ("bv", U32, 4, struct.pack("<I", 0)),
+              ("leaf_size", I32, 4, struct.pack("<i", 8)), ("arity", I32, 4, struct.pack("<i", 4)),
+              ("sah_bins", I32, 4, struct.pack("<i", 32))]
+    bounds = [[0.0, INF, INF, INF], [1.0, -INF, -INF, -INF]] * 2 + [[0.0, INF, INF, INF], [0.0, -INF, -INF, -INF]]
+    wide = b"".join(struct.pack("<4f", *row) for row in bounds) + struct.pack("<4I", 0, *[0xFFFFFFFF] * 3)
+    wide += struct.pack("<4I", 1, 0, 0, 0)
+    corners = b"".join(struct.pack("<4f", *[tri[3 * k + a]] * 4) for k in range(3) for a in range(3))
+    return values + [("nodes", RECORD, 16, struct.pack("<4I", 0, 0, 0, 1)), ("triangle_ids", U32, 4, struct.pack("<I", 0)),
+                     ("volumes", RECORD, 24, struct.pack("<6f", 0, 0, 0, 1, 1, 0)),
+                     ("triangles", RECORD, 36, struct.pack("<9f", *tri)), ("wide4", RECORD, 128, wide),
+                     ("groups", RECORD, 160, corners + bytes(16))]
+
+
+def accelerator_seeds():
+    corners = ("corners", RECORD, 12, struct.pack("<9f", 0, 0, 0, 1, 0, 0, 0, 1, 0))
+    build_s = ("build_s", F64, 8, struct.pack("<d", 0))
+    grid = archive("ray.UniformGrid", [corners, build_s, ("resolution", RECORD, 12, struct.pack("<3i", 1, 1, 1)),
+                                         ("cell_begin", U32, 4, struct.pack("<2I", 0, 1)),
+                                         ("cell_triangles", U32, 4, struct.pack("<I", 0))])
+    octree = archive("ray.RayOctree", [corners, build_s, ("depth", 6, 8, struct.pack("<Q", 0)),
+                                         ("nodes", RECORD, 8, struct.pack("<2I", 0, 1)),
+                                         ("leaf_triangles", U32, 4, struct.pack("<I", 0))])
+    rays5d = archive("ray.RayClassifier", [corners, build_s, ("leaf_size", U32, 4, struct.pack("<I", 8)),
+                                             ("max_depth", U32, 4, struct.pack("<I", 8)),
+                                             ("max_references", 6, 8, struct.pack("<Q", 1 << 20)),
+                                             ("cutoff", 8, 4, struct.pack("<f", 0.25))])
+    bvh = archive("ray.BvhAccelerator", [corners, build_s] + bvh_sections())
+    return {"grid.geods": grid, "octree.geods": octree, "rays5d.geods": rays5d, "bvh_accel.geods": bvh}
+
+
 def main():
     out = Path(sys.argv[1])
     raw = bytes(range(24))
@@ -236,6 +273,9 @@ def main():
         "archive": archive_seeds(),
         "segments": {"s.npy": b"\x00" + npy("<f8", (1, 4), struct.pack("<4d", 0, 0, 1, 1)),
                      "s.edg": b"\x01" + b"2\n0 0 1 1\n1 1 2 0\n", "s.cin": b"\x02" + b"p 0 0\ns 0 0 1 1\ns 1 1 2 0\n"},
+        "bvh_archive": {"bvh_structure.geods": b"\x00" + archive("bvh.TriangleBvh", bvh_sections()),
+                        "bvh.geods": b"\x01" + archive("bvh.TriangleBvh", bvh_sections()),
+                        **{name: b"\x02" + data for name, data in accelerator_seeds().items()}},
     }
     for target, files in seeds.items():
         (out / target).mkdir(parents=True, exist_ok=True)

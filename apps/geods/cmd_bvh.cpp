@@ -31,6 +31,7 @@ class BvhCommand : public Command {
     app.add_option("--arity", arity_, "Children per node: 2, 4 or 8");
     app.add_option("--rays", rays_, "Rays, n x 6 (ox oy oz dx dy dz; .npy, .csv)");
     app.add_option("-o,--output", output_, "Output for --rays: float64 n x 2 (t, triangle), inf and -1 on a miss");
+    app.add_option("--save", save_, "Write the hierarchy to this file (geods archive; Bvh.load, TriangleBvh::load)");
   }
 
   void run(const RunContext& context, Report& report) override {
@@ -52,6 +53,7 @@ class BvhCommand : public Command {
     Stopwatch build_watch;
     const bvh::TriangleBvh bvh = bvh::TriangleBvh::build(mesh, options);
     const double build_s = build_watch.seconds();
+    if (!save_.empty()) bvh.save(save_);
     Stopwatch stats_watch;
     const bvh::BvhStats s = bvh.stats();
     const double stats_s = stats_watch.seconds();
@@ -97,6 +99,7 @@ class BvhCommand : public Command {
       j["query_s"] = query_s;
       j["mrays_per_s"] = query_s > 0 ? double(rays.rows) / query_s * 1e-6 : 0.0;
     }
+    if (!save_.empty()) j["saved"] = save_;
     j["compute_s"] = build_s + stats_s + query_s;
     report.lines.push_back(fmt::format("bvh: {} triangles, builder {}, {} volumes, arity {}, leaf size {}",
                                        s.triangles, builder_, bv_, arity_, leaf_size_));
@@ -108,10 +111,11 @@ class BvhCommand : public Command {
       report.lines.push_back(fmt::format("  {} rays, {} hits in {:.3f} s ({:.2f} Mrays/s){}", rays.rows, hits, query_s,
                                          query_s > 0 ? double(rays.rows) / query_s * 1e-6 : 0.0,
                                          output_.empty() ? "" : ", wrote " + output_));
+    if (!save_.empty()) report.lines.push_back("  saved the hierarchy to " + save_);
   }
 
  private:
-  std::string mesh_, rays_, output_;
+  std::string mesh_, rays_, output_, save_;
   std::string builder_ = "sah", bv_ = "aabb";
   int leaf_size_ = 8, arity_ = 4;
 };

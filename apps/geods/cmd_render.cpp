@@ -1,6 +1,7 @@
 // geods render: ray-trace a mesh into a PNG with one of the ray accelerators.
 #include <fmt/format.h>
 
+#include <memory>
 #include <optional>
 #include <sstream>
 
@@ -44,7 +45,9 @@ class RenderCommand : public Command {
   void add_options(CLI::App& app) override {
     app.add_option("mesh", mesh_, "Mesh (PLY, OBJ, OFF, STL, glTF)")->required();
     app.add_option("-o,--output", output_, "Output image (.png)")->required();
-    app.add_option("--accel", accel_, "Accelerator: bvh, grid, octree or rays5d")->default_val(accel_);
+    accel_option_ = app.add_option("--accel", accel_, "Accelerator: bvh, grid, octree or rays5d")->default_val(accel_);
+    app.add_option("--save", save_, "Write the accelerator to this file before rendering (geods archive)");
+    app.add_option("--load", load_, "Render with an accelerator saved by --save over the same mesh (no build)");
     app.add_option("--width", width_, "Image width in pixels")->default_val(width_);
     app.add_option("--height", height_, "Image height in pixels")->default_val(height_);
     app.add_option("--camera", camera_, "ex,ey,ez,tx,ty,tz,ux,uy,uz,fov (default: a three-quarter view of the mesh)");
@@ -60,7 +63,19 @@ class RenderCommand : public Command {
     if (!camera_.empty()) options.camera = parse_camera(camera_);
     options.progress = context.progress;
     const TriMesh mesh = io::read_mesh(mesh_);
-    const ray::RenderResult result = ray::render(mesh, options);
+    std::unique_ptr<ray::Accelerator> accel;
+    if (load_.empty()) {
+      accel = ray::make_accelerator(mesh, options.accel, options.accel_options);
+    } else {
+      accel = ray::load_accelerator(load_);
+      if (accel_option_->count() > 0 && accel->kind() != options.accel)
+        throw Error(fmt::format("render: {} holds a {} accelerator, --accel asks for {}", load_,
+                                ray::to_string(accel->kind()), accel_));
+      accel_ = std::string(ray::to_string(accel->kind()));
+    }
+    if (!save_.empty()) accel->save(save_);
+    ray::RenderResult result = ray::render(mesh, *accel, options);
+    if (load_.empty()) result.build_s = accel->build_s();
     io::write_png(output_, result.image);
 
     const ray::AcceleratorStats& s = result.accel_stats;
@@ -69,6 +84,8 @@ class RenderCommand : public Command {
     j["output"] = output_;
     j["triangles"] = mesh.num_triangles();
     j["accel"] = accel_;
+    if (!load_.empty()) j["loaded"] = load_;
+    if (!save_.empty()) j["saved"] = save_;
     j["width"] = width_;
     j["height"] = height_;
     j["shadows"] = shadows_;
@@ -84,15 +101,19 @@ class RenderCommand : public Command {
     j["mrays_per_s"] = result.mrays_per_s();
     report.lines.push_back(fmt::format("render: {} ({} triangles), {} x {}{}, accelerator {}", mesh_,
                                        mesh.num_triangles(), width_, height_, shadows_ ? ", shadows" : "", accel_));
-    report.lines.push_back(fmt::format("  built in {:.3f} s: {} nodes, {} triangle references, {:.1f} MB", result.build_s,
+    report.lines.push_back(fmt::format("  {}: {} nodes, {} triangle references, {:.1f} MB",
+                                       load_.empty() ? fmt::format("built in {:.3f} s", result.build_s)
+                                                     : "loaded from " + load_,
                                        s.nodes, s.references, double(s.bytes) / 1e6));
+    if (!save_.empty()) report.lines.push_back("  saved the accelerator to " + save_);
     report.lines.push_back(fmt::format("  {} rays in {:.3f} s: {:.2f} Mrays/s", result.rays, result.render_s,
                                        result.mrays_per_s()));
     report.lines.push_back("  wrote " + output_);
   }
 
  private:
-  std::string mesh_, output_, accel_ = "bvh", camera_;
+  std::string mesh_, output_, accel_ = "bvh", camera_, save_, load_;
+  CLI::Option* accel_option_ = nullptr;
   int width_ = 512, height_ = 512;
   bool shadows_ = false;
 };

@@ -35,7 +35,7 @@ void run_bvh(const DemoContext& context, DemoResult& result) {
     svg.polygon(p, {.stroke = "#bbbbbb", .stroke_width = 0.3});
   }
   const auto& nodes = tree.topology().nodes;
-  const auto& boxes = std::get<std::vector<AABB3f>>(tree.volumes());
+  const auto& boxes = std::get<FlatArray<AABB3f>>(tree.volumes());
   const std::array<const char*, 3> colours = {"#c0392b", "#2471a3", "#27ae60"};
   std::vector<int> level(nodes.size(), 0);
   for (std::size_t i = 0; i < nodes.size(); ++i) {

@@ -1,6 +1,7 @@
 // Python bindings of the bvh module: geods.Bvh.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
+#include <pybind11/stl/filesystem.h>
 #include <pybind11/stl.h>
 
 #include <cmath>
@@ -41,6 +42,13 @@ class PyBvh {
     options.arity = arity;
     py::gil_scoped_release release;
     bvh_ = bvh::TriangleBvh::build(mesh, options);
+  }
+  explicit PyBvh(bvh::TriangleBvh bvh) : bvh_(std::move(bvh)) {}
+
+  void save(const std::filesystem::path& path) const { bvh_.save(path); }
+  static PyBvh load(const std::filesystem::path& path) {
+    py::gil_scoped_release release;
+    return PyBvh(bvh::TriangleBvh::load(path));
   }
 
   std::vector<Ray3f> rays(const CArray<float>& origins, const CArray<float>& directions, const CArray<float>& tmax) const {
@@ -206,7 +214,10 @@ void bind_bvh(py::module_& m) {
       .def("stats", &PyBvh::stats,
            "dict: builder, bv, arity, leaf_size, triangles, nodes, leaves, depth, bytes, sah_cost, "
            "tightness_volume, tightness_hausdorff")
-      .def("validate", &PyBvh::validate, "Checks every invariant; raises geods.Error if one fails.");
+      .def("validate", &PyBvh::validate, "Checks every invariant; raises geods.Error if one fails.")
+      .def("save", &PyBvh::save, py::arg("path"), "Writes the hierarchy with its triangles to a binary file.")
+      .def_static("load", &PyBvh::load, py::arg("path"),
+                  "Maps a file written by save() (read in place; the mesh is not needed).");
 }
 
 }  // namespace geods::python

@@ -1,6 +1,7 @@
 // Python bindings of the ray module: geods.RayAccelerator and geods.render.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
+#include <pybind11/stl/filesystem.h>
 #include <pybind11/stl.h>
 
 #include <cmath>
@@ -50,6 +51,13 @@ class PyRayAccelerator {
     const ray::AcceleratorKind k = ray::parse_accelerator_kind(kind);
     py::gil_scoped_release release;
     accel_ = ray::make_accelerator(mesh, k);
+  }
+  explicit PyRayAccelerator(std::unique_ptr<ray::Accelerator> accel) : accel_(std::move(accel)) {}
+
+  void save(const std::filesystem::path& path) const { accel_->save(path); }
+  static PyRayAccelerator load(const std::filesystem::path& path) {
+    py::gil_scoped_release release;
+    return PyRayAccelerator(ray::load_accelerator(path));
   }
 
   py::tuple intersect(const CArray<float>& origins, const CArray<float>& directions, const CArray<float>& tmax) const {
@@ -159,6 +167,10 @@ void bind_ray(py::module_& m) {
            py::arg("tmax") = CArray<float>(py::ssize_t(1), &inf), "Whether each ray hits anything before tmax.")
       .def("stats", &PyRayAccelerator::stats, "Nodes, leaves, triangle references, depth, bytes, build_s.")
       .def("validate", &PyRayAccelerator::validate, "Checks the structure's invariants; raises ValueError if broken.")
+      .def("save", &PyRayAccelerator::save, py::arg("path"),
+           "Writes the accelerator with its triangles to a binary file ('rays5d': triangles and options only).")
+      .def_static("load", &PyRayAccelerator::load, py::arg("path"),
+                  "Maps a file written by save(), of any kind (read in place; the mesh is not needed).")
       .def_property_readonly("kind", &PyRayAccelerator::kind)
       .def_property_readonly("build_s", &PyRayAccelerator::build_s);
   m.def("render", &render_py, py::arg("V"), py::arg("F"), py::arg("width") = 512, py::arg("height") = 512,

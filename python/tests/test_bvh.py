@@ -209,3 +209,43 @@ def test_cli_bvh(cli, data_dir, workdir):
     assert np.allclose(hits[:, 0][prim >= 0], t[prim >= 0])
     bad = subprocess.run([cli, "bvh", data_dir / "bunny.ply", "--arity", "3"], capture_output=True, text=True)
     assert bad.returncode == 2 and bad.stderr.count("\n") == 1
+
+
+@pytest.mark.parametrize("bv", ["aabb", "kdop14", "obb"])
+def test_save_load_gives_identical_answers(bunny, tmp_path, bv):
+    V, F = bunny
+    bvh = geods.Bvh(V, F, bv=bv, arity=8 if bv == "aabb" else 4)
+    bvh.save(tmp_path / "bunny.bvh")
+    loaded = geods.Bvh.load(str(tmp_path / "bunny.bvh"))  # str or path
+    assert loaded.stats()["bv"] == bv and loaded.stats()["triangles"] == len(F)
+    loaded.validate()
+    origins, directions = rays_at(V, 300, 9)
+    for a, b in zip(bvh.intersect(origins, directions), loaded.intersect(origins, directions)):
+        assert np.array_equal(a, b)
+    assert np.array_equal(bvh.occluded(origins, directions), loaded.occluded(origins, directions))
+    points = origins * 0.3 + V.mean(0) * 0.7
+    for a, b in zip(bvh.closest_point(points), loaded.closest_point(points)):
+        assert np.array_equal(a, b)
+    assert np.array_equal(bvh.contains(points), loaded.contains(points))
+    lo, hi = V.min(0), V.mean(0)
+    assert np.array_equal(bvh.cull_box(lo, hi), loaded.cull_box(lo, hi))
+
+
+def test_load_refuses_bad_files(bunny, tmp_path):
+    V, F = bunny
+    path = tmp_path / "bunny.bvh"
+    geods.Bvh(V, F).save(path)
+    data = path.read_bytes()
+    (tmp_path / "cut.bvh").write_bytes(data[: len(data) // 2])
+    with pytest.raises(geods.Error, match="cut.bvh"):
+        geods.Bvh.load(tmp_path / "cut.bvh")
+    flipped = bytearray(data)
+    flipped[len(data) - 100] ^= 0x40
+    (tmp_path / "flipped.bvh").write_bytes(bytes(flipped))
+    with pytest.raises(ValueError, match="corrupt"):
+        geods.Bvh.load(tmp_path / "flipped.bvh")
+    geods.RayAccelerator(V, F, "grid").save(tmp_path / "grid.geods")
+    with pytest.raises(geods.Error, match="ray.UniformGrid"):
+        geods.Bvh.load(tmp_path / "grid.geods")
+    with pytest.raises(geods.Error):
+        geods.Bvh.load(tmp_path / "missing.bvh")

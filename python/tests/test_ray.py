@@ -175,3 +175,43 @@ def test_render_command(cli, data_dir, tmp_path):
     bad = subprocess.run([str(cli), "render", str(data_dir / "bunny.ply"), "-o", str(out), "--camera", "1,2,3"],
                          capture_output=True, text=True)
     assert bad.returncode == 2 and "10 numbers" in bad.stderr
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_save_load_gives_identical_hits(bunny, tmp_path, kind):
+    V, F = bunny
+    accel = geods.RayAccelerator(V, F, kind)
+    accel.save(tmp_path / "bunny.accel")
+    loaded = geods.RayAccelerator.load(tmp_path / "bunny.accel")
+    assert loaded.kind == kind
+    loaded.validate()
+    origins, directions = random_rays(V, 500, 12)
+    for a, b in zip(accel.intersect(origins, directions), loaded.intersect(origins, directions)):
+        assert np.array_equal(a, b)
+    assert np.array_equal(accel.occluded(origins, directions), loaded.occluded(origins, directions))
+    if kind != "rays5d":  # its 5D trees grow with the rays it is shot
+        for key in ("nodes", "references", "depth", "build_s"):
+            assert accel.stats()[key] == loaded.stats()[key]
+    data = (tmp_path / "bunny.accel").read_bytes()
+    (tmp_path / "cut.accel").write_bytes(data[:-1000])
+    with pytest.raises(geods.Error, match="truncated"):
+        geods.RayAccelerator.load(tmp_path / "cut.accel")
+
+
+def test_render_save_and_load(cli, data_dir, tmp_path):
+    mesh, saved = str(data_dir / "bunny.ply"), str(tmp_path / "bunny.grid")
+    common = ["--width", "48", "--height", "32", "--json"]
+    built = json.loads(subprocess.run([str(cli), "render", mesh, "-o", str(tmp_path / "a.png"), "--accel", "grid",
+                                       "--save", saved] + common, capture_output=True, text=True, check=True).stdout)
+    loaded = json.loads(subprocess.run([str(cli), "render", mesh, "-o", str(tmp_path / "b.png"), "--load", saved]
+                                       + common, capture_output=True, text=True, check=True).stdout)
+    assert built["saved"] == saved and loaded["loaded"] == saved and loaded["accel"] == "grid"
+    assert loaded["build_s"] == 0 and loaded["accel_nodes"] == built["accel_nodes"]
+    assert np.array_equal(geods.read_image(str(tmp_path / "a.png")), geods.read_image(str(tmp_path / "b.png")))
+    assert geods.RayAccelerator.load(saved).kind == "grid"
+    bad = subprocess.run([str(cli), "render", mesh, "-o", str(tmp_path / "c.png"), "--load", saved, "--accel", "octree"],
+                         capture_output=True, text=True)
+    assert bad.returncode == 2 and "grid" in bad.stderr and bad.stderr.count("\n") == 1
+    bvh_file = tmp_path / "bunny.bvh"
+    subprocess.run([str(cli), "bvh", mesh, "--save", str(bvh_file)], check=True, capture_output=True)
+    assert geods.Bvh.load(bvh_file).stats()["triangles"] == 3674

@@ -37,25 +37,26 @@ void gather_prims(const BinaryTree& tree, std::uint32_t id, std::vector<std::uin
 // parallel builders allocated nodes) and opens the largest inner children
 // until a node has `arity` children.
 Topology finalize(const BinaryTree& tree, int leaf_size, int arity) {
-  Topology topo;
-  topo.prim_order.reserve(tree.prims.size());
-  topo.nodes.reserve(tree.nodes.size());
+  std::vector<TopoNode> nodes;
+  std::vector<std::uint32_t> prim_order;
+  prim_order.reserve(tree.prims.size());
+  nodes.reserve(tree.nodes.size());
   auto final_leaf = [&](std::uint32_t id) {
     const BinaryNode& n = tree.nodes[id];
     return n.leaf() || (tree.merge_small_subtrees && n.prim_count <= std::uint32_t(leaf_size));
   };
   std::vector<std::pair<std::uint32_t, std::uint32_t>> work;  // (binary node, topology node)
   std::vector<std::uint32_t> scratch;
-  topo.nodes.push_back({});
+  nodes.push_back({});
   work.push_back({tree.root, 0});
   std::vector<std::uint32_t> children;
   while (!work.empty()) {
     const auto [b, t] = work.back();
     work.pop_back();
-    topo.nodes[t].prim_first = std::uint32_t(topo.prim_order.size());
-    topo.nodes[t].prim_count = tree.nodes[b].prim_count;
+    nodes[t].prim_first = std::uint32_t(prim_order.size());
+    nodes[t].prim_count = tree.nodes[b].prim_count;
     if (final_leaf(b)) {
-      gather_prims(tree, b, topo.prim_order, scratch);
+      gather_prims(tree, b, prim_order, scratch);
       continue;
     }
     children = {tree.nodes[b].left, tree.nodes[b].right};
@@ -72,13 +73,13 @@ Topology finalize(const BinaryTree& tree, int leaf_size, int arity) {
       children[widest] = open.left;
       children.insert(children.begin() + widest + 1, open.right);
     }
-    const auto first = std::uint32_t(topo.nodes.size());
-    topo.nodes[t].first_child = first;
-    topo.nodes[t].num_children = std::uint32_t(children.size());
-    topo.nodes.resize(topo.nodes.size() + children.size());
+    const auto first = std::uint32_t(nodes.size());
+    nodes[t].first_child = first;
+    nodes[t].num_children = std::uint32_t(children.size());
+    nodes.resize(nodes.size() + children.size());
     for (std::size_t i = children.size(); i-- > 0;) work.push_back({children[i], first + std::uint32_t(i)});
   }
-  return topo;
+  return {std::move(nodes), std::move(prim_order)};
 }
 
 }  // namespace

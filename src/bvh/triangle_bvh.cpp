@@ -91,11 +91,12 @@ TriangleBvh TriangleBvh::build(const TriMesh& mesh, const BuildOptions& options)
   bvh.topology_ = build_topology(boxes, options);
   bvh.depth_ = bvh.topology_.depth();
   progress.update(1);
-  bvh.triangles_.resize(n);
+  std::vector<Triangle> triangles(n);
   parallel_for_each_index(0, n, [&](std::size_t i) {
     const auto& t = mesh.triangles[bvh.topology_.prim_order[i]];
-    bvh.triangles_[i] = {mesh.vertices[t[0]], mesh.vertices[t[1]], mesh.vertices[t[2]]};
+    triangles[i] = {mesh.vertices[t[0]], mesh.vertices[t[1]], mesh.vertices[t[2]]};
   });
+  bvh.triangles_ = std::move(triangles);
   switch (options.bv) {
     case BoundingVolume::aabb: bvh.fit_volumes<AABB3f>(); break;
     case BoundingVolume::sphere: bvh.fit_volumes<Sphere3f>(); break;
@@ -151,7 +152,7 @@ void TriangleBvh::fit_volumes() {
       }
     });
   }
-  volumes_ = std::move(vols);
+  volumes_ = FlatArray<BV>(std::move(vols));
 }
 
 // A node's convex hull is the hull of its children's hull corners, so the
@@ -189,12 +190,12 @@ void TriangleBvh::fit_hull_obbs() {
       }
     });
   }
-  volumes_ = std::move(vols);
+  volumes_ = FlatArray<Obb3f>(std::move(vols));
 }
 
 void TriangleBvh::build_wide() {
   const auto& nodes = topology_.nodes;
-  const auto& boxes = std::get<std::vector<AABB3f>>(volumes_);
+  const auto& boxes = std::get<FlatArray<AABB3f>>(volumes_);
   // Inner nodes: their wide node; leaves: their first triangle group.
   std::vector<std::uint32_t> wide_index(nodes.size(), 0);
   std::uint32_t inner = 0, groups = 0;
@@ -206,12 +207,12 @@ void TriangleBvh::build_wide() {
       wide_index[i] = inner++;
     }
   }
-  groups_.resize(groups);
+  std::vector<TriangleGroup, HugePageAllocator<TriangleGroup>> group_array(groups);
   parallel_for(0, nodes.size(), 1024, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) {
       if (!nodes[i].leaf()) continue;
       for (std::uint32_t k = 0; k < nodes[i].prim_count; k += 4) {
-        TriangleGroup& g = groups_[wide_index[i] + k / 4];
+        TriangleGroup& g = group_array[wide_index[i] + k / 4];
         for (std::uint32_t lane = 0; lane < 4; ++lane) {
           const std::uint32_t t = nodes[i].prim_first + std::min(k + lane, nodes[i].prim_count - 1);
           const Triangle& tri = triangles_[t];
@@ -225,9 +226,10 @@ void TriangleBvh::build_wide() {
       }
     }
   });
-  auto fill = [&](auto& out) {
-    using Node = typename std::decay_t<decltype(out)>::value_type;
-    constexpr int W = sizeof(Node::child) / sizeof(std::uint32_t);
+  groups_ = std::move(group_array);
+  auto fill = [&]<int W>(WideNodes<W>& wide) {
+    using Node = WideNode<W>;
+    std::vector<Node, HugePageAllocator<Node>> out;
     auto set_child = [&](Node& w, int slot, std::uint32_t c) {
       for (int a = 0; a < 3; ++a) {
         w.bounds[2 * a][slot] = boxes[c].lo[a];
@@ -249,19 +251,93 @@ void TriangleBvh::build_wide() {
     out.assign(std::max<std::uint32_t>(inner, 1), empty_node());
     if (nodes[0].leaf()) {  // a single leaf: one wide node holding it
       set_child(out[0], 0, 0);
-      return;
+    } else {
+      for (std::size_t i = 0; i < nodes.size(); ++i) {
+        if (nodes[i].leaf()) continue;
+        for (std::uint32_t c = 0; c < nodes[i].num_children; ++c)
+          set_child(out[wide_index[i]], int(c), nodes[i].first_child + c);
+      }
     }
-    for (std::size_t i = 0; i < nodes.size(); ++i) {
-      if (nodes[i].leaf()) continue;
-      for (std::uint32_t c = 0; c < nodes[i].num_children; ++c)
-        set_child(out[wide_index[i]], int(c), nodes[i].first_child + c);
-    }
+    wide = std::move(out);
   };
   if (options_.arity == 8) {
     fill(wide8_);
   } else {
     fill(wide4_);
   }
+}
+
+// ------------------------------------------------------------------ save, load
+
+namespace {
+
+// The volume type of each BoundingVolume, for code that picks it at run time.
+template <typename Fn>
+void with_volume_type(BoundingVolume bv, Fn&& fn) {
+  switch (bv) {
+    case BoundingVolume::aabb: return fn(AABB3f{});
+    case BoundingVolume::sphere: return fn(Sphere3f{});
+    case BoundingVolume::kdop6: return fn(Kdop<float, 6>{});
+    case BoundingVolume::kdop14: return fn(Kdop<float, 14>{});
+    case BoundingVolume::kdop18: return fn(Kdop<float, 18>{});
+    case BoundingVolume::kdop26: return fn(Kdop<float, 26>{});
+    case BoundingVolume::obb:
+    case BoundingVolume::obb_hull: return fn(Obb3f{});
+  }
+}
+
+}  // namespace
+
+void TriangleBvh::add_sections(ArchiveWriter& out) const {
+  out.add_value("builder", std::uint32_t(options_.builder));
+  out.add_value("bv", std::uint32_t(options_.bv));
+  out.add_value("leaf_size", std::int32_t(options_.leaf_size));
+  out.add_value("arity", std::int32_t(options_.arity));
+  out.add_value("sah_bins", std::int32_t(options_.sah_bins));
+  out.add("nodes", topology_.nodes);
+  out.add("triangle_ids", topology_.prim_order);
+  std::visit([&](const auto& volumes) { out.add("volumes", volumes); }, volumes_);
+  out.add("triangles", triangles_);
+  if (!wide4_.empty()) out.add("wide4", wide4_);
+  if (!wide8_.empty()) out.add("wide8", wide8_);
+  out.add("groups", groups_);
+}
+
+void TriangleBvh::save(const std::filesystem::path& path) const {
+  ArchiveWriter out(kArchiveKind, kArchiveVersion);
+  add_sections(out);
+  out.write(path);
+}
+
+TriangleBvh TriangleBvh::from_sections(const Archive& in) {
+  TriangleBvh bvh;
+  const auto builder = in.value<std::uint32_t>("builder");
+  const auto bv = in.value<std::uint32_t>("bv");
+  if (builder > std::uint32_t(Builder::boxtree)) throw in.error("unknown bvh builder " + std::to_string(builder));
+  if (bv > std::uint32_t(BoundingVolume::obb_hull)) throw in.error("unknown bounding volume " + std::to_string(bv));
+  bvh.options_.builder = Builder(builder);
+  bvh.options_.bv = BoundingVolume(bv);
+  bvh.options_.leaf_size = in.value<std::int32_t>("leaf_size");
+  bvh.options_.arity = in.value<std::int32_t>("arity");
+  bvh.options_.sah_bins = in.value<std::int32_t>("sah_bins");
+  in.check([&] { check_options(bvh.options_); });
+  bvh.topology_.nodes = in.array<TopoNode>("nodes");
+  const std::size_t nodes = bvh.topology_.nodes.size();
+  bvh.topology_.prim_order = in.array<std::uint32_t>("triangle_ids");
+  bvh.triangles_ = in.array<Triangle>("triangles", bvh.topology_.prim_order.size());
+  // The volume type the file says it holds; a section of another type is refused by its element size.
+  with_volume_type(bvh.options_.bv, [&]<typename BV>(BV) { bvh.volumes_ = in.array<BV>("volumes", nodes); });
+  const bool wide = bvh.options_.bv == BoundingVolume::aabb && bvh.options_.arity >= 4 && nodes > 0;
+  if (wide && bvh.options_.arity == 8) bvh.wide8_ = in.array<WideNode<8>>("wide8");
+  if (wide && bvh.options_.arity == 4) bvh.wide4_ = in.array<WideNode<4>>("wide4");
+  bvh.groups_ = in.array<TriangleGroup>("groups");
+  in.check([&] { bvh.validate(); });  // before anything walks the nodes
+  bvh.depth_ = bvh.topology_.depth();
+  return bvh;
+}
+
+TriangleBvh TriangleBvh::load(const std::filesystem::path& path) {
+  return from_sections(Archive::open(path, kArchiveKind, kArchiveVersion));
 }
 
 // ------------------------------------------------------------------ rays
@@ -413,7 +489,7 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray, 
 }
 
 template <typename BV>
-RayHit TriangleBvh::intersect_generic(const std::vector<BV>& volumes, const Ray3f& ray, bool any) const {
+RayHit TriangleBvh::intersect_generic(const FlatArray<BV>& volumes, const Ray3f& ray, bool any) const {
   RayHit hit;
   const RayTriangleTest<float> test(ray);
   const Vec3f inv = ray.direction.cwiseInverse();
@@ -457,7 +533,7 @@ bool TriangleBvh::occluded(const Ray3f& ray) const {
 // ------------------------------------------------------------------ closest point, containment
 
 template <typename BV>
-ClosestPoint TriangleBvh::closest_generic(const std::vector<BV>& volumes, std::uint32_t start, const Vec3f& p,
+ClosestPoint TriangleBvh::closest_generic(const FlatArray<BV>& volumes, std::uint32_t start, const Vec3f& p,
                                           float max_distance) const {
   ClosestPoint best;
   float best_d2 = max_distance * max_distance;
@@ -674,7 +750,7 @@ void TriangleBvh::validate() const {
     if (id >= n || seen[id]) fail("triangle ids are not a permutation");
     seen[id] = 1;
   }
-  if (nodes[0].prim_first != 0 || nodes[0].prim_count != n) fail("the root does not cover every triangle");
+  if (nodes.empty() || nodes[0].prim_first != 0 || nodes[0].prim_count != n) fail("the root does not cover every triangle");
   std::vector<char> reached(nodes.size(), 0);
   reached[0] = 1;
   for (std::size_t i = 0; i < nodes.size(); ++i) {
@@ -712,20 +788,34 @@ void TriangleBvh::validate() const {
   const bool wide = options_.bv == BoundingVolume::aabb && options_.arity >= 4 && n > 0;
   if (wide != (!wide4_.empty() || !wide8_.empty())) fail("wide nodes missing or unexpected");
   auto check_wide = [&](const auto& wnodes) {
-    // Every triangle must be reachable exactly once through the wide nodes.
-    std::vector<char> covered(n, 0);
+    // Every triangle must be reachable exactly once through the wide nodes,
+    // every wide node once, no deeper than the traversal stack is sized for.
+    std::vector<char> covered(n, 0), visited(wnodes.size(), 0);
     std::vector<std::uint32_t> leaf_position(n);  // groups name mesh triangles; triangles_ is in leaf order
     for (std::uint32_t i = 0; i < n; ++i) leaf_position[topology_.prim_order[i]] = i;
-    std::vector<std::uint32_t> stack{0};
+    std::vector<std::pair<std::uint32_t, int>> stack{{0, 0}};  // (wide node, its depth)
+    const int max_depth = topology_.depth();
     while (!stack.empty()) {
-      const auto& w = wnodes[stack.back()];
+      const auto [index, level] = stack.back();
       stack.pop_back();
+      if (visited[index]) fail("wide node " + std::to_string(index) + " reached twice");
+      visited[index] = 1;
+      if (level > max_depth) fail("wide nodes deeper than the hierarchy");
+      const auto& w = wnodes[index];
       for (std::size_t s = 0; s < std::size(w.child); ++s) {
-        if (w.child[s] == std::decay_t<decltype(w)>::kEmpty) continue;
+        if (w.child[s] == std::decay_t<decltype(w)>::kEmpty) {
+          // An empty slot must stay unhittable: lo = +inf, hi = -inf.
+          bool unhittable = w.count[s] == 0;
+          for (int a = 0; a < 3; ++a)
+            unhittable = unhittable && w.bounds[2 * a][s] == std::numeric_limits<float>::infinity() &&
+                         w.bounds[2 * a + 1][s] == -std::numeric_limits<float>::infinity();
+          if (!unhittable) fail("wide node " + std::to_string(index) + ": an empty slot can be hit");
+          continue;
+        }
         const AABB3f box({w.bounds[0][s], w.bounds[2][s], w.bounds[4][s]}, {w.bounds[1][s], w.bounds[3][s], w.bounds[5][s]});
         if (w.count[s] == 0) {
           if (w.child[s] >= wnodes.size()) fail("wide node child out of range");
-          stack.push_back(w.child[s]);
+          stack.push_back({w.child[s], level + 1});
           continue;
         }
         if (w.child[s] + std::size_t(w.count[s]) > groups_.size()) fail("wide leaf groups out of range");

@@ -37,9 +37,14 @@ AcceleratorKind parse_accelerator_kind(std::string_view name) {
 
 std::span<const AcceleratorKind> all_accelerator_kinds() { return kKinds; }
 
-Accelerator::Accelerator(const TriMesh& mesh) {
-  static std::atomic<std::uint64_t> next_id{1};
-  id_ = next_id.fetch_add(1, std::memory_order_relaxed);
+namespace {
+std::uint64_t next_id() {
+  static std::atomic<std::uint64_t> next{1};
+  return next.fetch_add(1, std::memory_order_relaxed);
+}
+}  // namespace
+
+Accelerator::Accelerator(const TriMesh& mesh) : id_(next_id()) {
   // The O(n) checks first; the full validation (which sorts the edges) only
   // to word the error message.
   bool usable = true;
@@ -49,12 +54,30 @@ Accelerator::Accelerator(const TriMesh& mesh) {
   if (!usable) mesh.require_valid("ray accelerator");
   if (mesh.num_triangles() >= std::size_t(RayHit::no_hit))
     throw Error("ray accelerator: more than 2^32 - 2 triangles");
-  corners_.resize(mesh.num_triangles() * 3);
+  std::vector<Vec3f> corners(mesh.num_triangles() * 3);
   for (std::size_t i = 0; i < mesh.num_triangles(); ++i)
-    for (int k = 0; k < 3; ++k) {
-      corners_[3 * i + k] = mesh.vertices[mesh.triangles[i][k]];
-      bounds_.extend(corners_[3 * i + k]);
-    }
+    for (int k = 0; k < 3; ++k) corners[3 * i + k] = mesh.vertices[mesh.triangles[i][k]];
+  corners_ = std::move(corners);
+  set_bounds();
+}
+
+Accelerator::Accelerator(const Archive& in) : id_(next_id()) {
+  corners_ = in.array<Vec3f>("corners");
+  if (corners_.size() % 3 != 0) throw in.error("the corner count is not a multiple of 3");
+  if (corners_.size() / 3 >= std::size_t(RayHit::no_hit)) throw in.error("more than 2^32 - 2 triangles");
+  for (std::size_t i = 0; i < corners_.size(); ++i)
+    if (!corners_[i].allFinite()) throw in.error("triangle " + std::to_string(i / 3) + " has a non-finite corner");
+  build_s_ = in.value<double>("build_s");
+  set_bounds();
+}
+
+void Accelerator::add_sections(ArchiveWriter& out) const {
+  out.add("corners", corners_);
+  out.add_value("build_s", build_s_);
+}
+
+void Accelerator::set_bounds() {
+  for (const Vec3f& p : corners_) bounds_.extend(p);
   // Float rounding of the traversal is relative to the coordinates (about 1e-7
   // of them); 1e-5 of the scene's size and largest coordinate covers rays
   // starting up to a hundred scene sizes away.
@@ -112,6 +135,15 @@ std::unique_ptr<Accelerator> make_accelerator(const TriMesh& mesh, AcceleratorKi
     case AcceleratorKind::rays5d: return RayClassifier::build(mesh, options);
   }
   throw Error("make_accelerator: unknown kind");
+}
+
+std::unique_ptr<Accelerator> load_accelerator(const std::filesystem::path& path) {
+  const std::string kind = Archive::peek(path).kind;
+  if (kind == BvhAccelerator::kArchiveKind) return BvhAccelerator::load(path);
+  if (kind == UniformGrid::kArchiveKind) return UniformGrid::load(path);
+  if (kind == RayOctree::kArchiveKind) return RayOctree::load(path);
+  if (kind == RayClassifier::kArchiveKind) return RayClassifier::load(path);
+  throw Error(path.string() + ": a " + kind + " archive, not a ray accelerator");
 }
 
 }  // namespace geods::ray

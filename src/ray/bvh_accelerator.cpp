@@ -12,6 +12,21 @@ std::unique_ptr<BvhAccelerator> BvhAccelerator::build(const TriMesh& mesh, const
   return accel;
 }
 
+void BvhAccelerator::save(const std::filesystem::path& path) const {
+  ArchiveWriter out(kArchiveKind, kArchiveVersion);
+  add_sections(out);
+  bvh_.add_sections(out);
+  out.write(path);
+}
+
+std::unique_ptr<BvhAccelerator> BvhAccelerator::load(const std::filesystem::path& path) {
+  const Archive in = Archive::open(path, kArchiveKind, kArchiveVersion);
+  std::unique_ptr<BvhAccelerator> accel(new BvhAccelerator(in));
+  if (accel->bvh_.num_triangles() != accel->num_triangles())
+    throw in.error("the hierarchy and the corners hold different triangle counts");
+  return accel;
+}
+
 RayHit BvhAccelerator::closest_hit(const Ray3f& ray, RayCache&) const { return bvh_.intersect(ray); }
 
 std::uint32_t BvhAccelerator::any_hit(const Ray3f& ray, RayCache&) const {

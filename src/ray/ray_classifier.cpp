@@ -56,49 +56,84 @@ bool contains(const AABB3f& box, const float* uv_lo, const float* uv_hi, const V
 }  // namespace
 
 RayClassifier::RayClassifier(const TriMesh& mesh) : Accelerator(mesh) {}
+RayClassifier::RayClassifier(const Archive& in) : Accelerator(in) {}
 RayClassifier::~RayClassifier() = default;
 
-std::unique_ptr<RayClassifier> RayClassifier::build(const TriMesh& mesh, const AcceleratorOptions& options) {
+namespace {
+void check_rays5d_options(const AcceleratorOptions& options) {
   if (options.rays5d_leaf_size == 0) throw Error("5D ray classification: rays5d_leaf_size must be at least 1");
   if (options.rays5d_max_depth > 20) throw Error("5D ray classification: rays5d_max_depth must be at most 20");
   if (std::isnan(options.rays5d_cutoff)) throw Error("5D ray classification: rays5d_cutoff is NaN");
+}
+}  // namespace
+
+std::unique_ptr<RayClassifier> RayClassifier::build(const TriMesh& mesh, const AcceleratorOptions& options) {
+  check_rays5d_options(options);
   const auto start = std::chrono::steady_clock::now();
   std::unique_ptr<RayClassifier> rc(new RayClassifier(mesh));
-  RayClassifier& c = *rc;
-  c.options_ = options;
-  const std::size_t n = c.num_triangles();
-  c.scene_ = n == 0 ? AABB3f(Vec3f::Zero(), Vec3f::Ones()) : detail::widened(c.bounds_, 2 * c.margin_);
+  rc->build_roots(options);
+  rc->build_s_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return rc;
+}
+
+void RayClassifier::save(const std::filesystem::path& path) const {
+  ArchiveWriter out(kArchiveKind, kArchiveVersion);
+  add_sections(out);
+  out.add_value("leaf_size", options_.rays5d_leaf_size);
+  out.add_value("max_depth", options_.rays5d_max_depth);
+  out.add_value("max_references", std::uint64_t(options_.rays5d_max_references));
+  out.add_value("cutoff", options_.rays5d_cutoff);
+  out.write(path);
+}
+
+std::unique_ptr<RayClassifier> RayClassifier::load(const std::filesystem::path& path) {
+  const Archive in = Archive::open(path, kArchiveKind, kArchiveVersion);
+  AcceleratorOptions options;
+  options.rays5d_leaf_size = in.value<std::uint32_t>("leaf_size");
+  options.rays5d_max_depth = in.value<std::uint32_t>("max_depth");
+  options.rays5d_max_references = std::size_t(in.value<std::uint64_t>("max_references"));
+  options.rays5d_cutoff = in.value<float>("cutoff");
+  in.check([&] { check_rays5d_options(options); });
+  const auto start = std::chrono::steady_clock::now();
+  std::unique_ptr<RayClassifier> rc(new RayClassifier(in));
+  rc->build_roots(options);
+  rc->build_s_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return rc;
+}
+
+void RayClassifier::build_roots(const AcceleratorOptions& options) {
+  options_ = options;
+  const std::size_t n = num_triangles();
+  scene_ = n == 0 ? AABB3f(Vec3f::Zero(), Vec3f::Ones()) : detail::widened(bounds_, 2 * margin_);
   for (int a = 0; a < 3; ++a) {
-    const float extent = c.scene_.hi[a] - c.scene_.lo[a];
+    const float extent = scene_.hi[a] - scene_.lo[a];
     // At least 1% of the extent, so a query restarts at most about 100 times.
-    c.cutoff_[a] = options.rays5d_cutoff > 0 && std::isfinite(options.rays5d_cutoff)
-                       ? std::max(options.rays5d_cutoff, 0.01f) * extent
-                       : std::numeric_limits<float>::infinity();
+    cutoff_[a] = options.rays5d_cutoff > 0 && std::isfinite(options.rays5d_cutoff)
+                     ? std::max(options.rays5d_cutoff, 0.01f) * extent
+                     : std::numeric_limits<float>::infinity();
   }
-  c.boxes_.resize(n);
+  boxes_.resize(n);
   parallel_for_each_index(0, n, [&](std::size_t i) {
-    const Vec3f* t = &c.corners_[3 * i];
-    c.boxes_[i] = detail::widened(triangle_bounds(t[0], t[1], t[2]), c.margin_);
+    const Vec3f* t = &corners_[3 * i];
+    boxes_[i] = detail::widened(triangle_bounds(t[0], t[1], t[2]), margin_);
   });
   // The six roots hold every triangle, sorted along their axis (ties by index,
   // a total order: the parallel sort is deterministic).
   parallel_for_each_index(0, 6, [&](std::size_t face) {
     auto root = std::make_unique<Node>();
-    root->box = c.scene_;
+    root->box = scene_;
     root->face = std::uint8_t(face);
     const int axis = root->axis();
     const bool negative = root->negative();
     std::vector<std::pair<float, std::uint32_t>> keys(n);
-    for (std::uint32_t i = 0; i < n; ++i) keys[i] = {start_along(c.boxes_[i], axis, negative), i};
+    for (std::uint32_t i = 0; i < n; ++i) keys[i] = {start_along(boxes_[i], axis, negative), i};
     tbb::parallel_sort(keys.begin(), keys.end());
     root->candidates.resize(n);
     for (std::size_t i = 0; i < n; ++i) root->candidates[i] = keys[i].second;
     root->ready.store(true, std::memory_order_release);
-    c.roots_[face] = std::move(root);
+    roots_[face] = std::move(root);
   }, 1);
-  c.references_ = 6 * n;
-  c.build_s_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return rc;
+  references_ = 6 * n;
 }
 
 // Whether the triangle's box meets the node's beam: the rays leaving the box

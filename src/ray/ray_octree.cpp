@@ -41,19 +41,21 @@ struct Pending {
 
 std::unique_ptr<RayOctree> RayOctree::build(const TriMesh& mesh, const AcceleratorOptions& options) {
   if (options.octree_leaf_size == 0) throw Error("ray octree: octree_leaf_size must be at least 1");
-  if (options.octree_max_depth > 30) throw Error("ray octree: octree_max_depth must be at most 30");
+  if (options.octree_max_depth > kMaxDepth)
+    throw Error(fmt::format("ray octree: octree_max_depth must be at most {}", kMaxDepth));
   const auto start = std::chrono::steady_clock::now();
   std::unique_ptr<RayOctree> tree(new RayOctree(mesh));
   RayOctree& o = *tree;
   const std::size_t n = o.num_triangles();
-  o.root_bounds_ = n == 0 ? AABB3f(Vec3f::Zero(), Vec3f::Ones()) : detail::widened(o.bounds_, o.margin_);
+  o.set_root_bounds();
 
   // Level by level: the nodes of one level decide and partition in parallel,
   // then are numbered in order, so the layout is the same for any thread count.
   std::vector<Pending> level(1);
   level[0] = {0, o.root_bounds_, std::vector<std::uint32_t>(n)};
   for (std::uint32_t i = 0; i < n; ++i) level[0].triangles[i] = i;
-  o.nodes_.resize(1);
+  std::vector<Node> nodes(1);
+  std::vector<std::uint32_t> leaf_triangles;
   for (std::size_t depth = 0; !level.empty(); ++depth) {
     o.depth_ = depth;
     std::vector<std::array<std::vector<std::uint32_t>, 8>> children(level.size());
@@ -100,20 +102,47 @@ std::unique_ptr<RayOctree> RayOctree::build(const TriMesh& mesh, const Accelerat
     for (std::size_t k = 0; k < level.size(); ++k) {
       Pending& p = level[k];
       if (!split[k]) {
-        if (o.leaf_triangles_.size() + p.triangles.size() >= Node::kInner)
+        if (leaf_triangles.size() + p.triangles.size() >= Node::kInner)
           throw Error("ray octree: more than 2^32 triangle references");
-        o.nodes_[p.node] = {std::uint32_t(o.leaf_triangles_.size()), std::uint32_t(p.triangles.size())};
-        o.leaf_triangles_.insert(o.leaf_triangles_.end(), p.triangles.begin(), p.triangles.end());
+        nodes[p.node] = {std::uint32_t(leaf_triangles.size()), std::uint32_t(p.triangles.size())};
+        leaf_triangles.insert(leaf_triangles.end(), p.triangles.begin(), p.triangles.end());
         continue;
       }
-      const std::uint32_t first = std::uint32_t(o.nodes_.size());
-      o.nodes_[p.node] = {first, Node::kInner};
-      o.nodes_.resize(o.nodes_.size() + 8);
+      const std::uint32_t first = std::uint32_t(nodes.size());
+      nodes[p.node] = {first, Node::kInner};
+      nodes.resize(nodes.size() + 8);
       for (int c = 0; c < 8; ++c) next.push_back({first + std::uint32_t(c), child_box(p.box, c), std::move(children[k][c])});
     }
     level = std::move(next);
   }
+  o.nodes_ = std::move(nodes);
+  o.leaf_triangles_ = std::move(leaf_triangles);
   o.build_s_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return tree;
+}
+
+void RayOctree::set_root_bounds() {
+  root_bounds_ = num_triangles() == 0 ? AABB3f(Vec3f::Zero(), Vec3f::Ones()) : detail::widened(bounds_, margin_);
+}
+
+void RayOctree::save(const std::filesystem::path& path) const {
+  ArchiveWriter out(kArchiveKind, kArchiveVersion);
+  add_sections(out);
+  out.add_value("depth", std::uint64_t(depth_));
+  out.add("nodes", nodes_);
+  out.add("leaf_triangles", leaf_triangles_);
+  out.write(path);
+}
+
+std::unique_ptr<RayOctree> RayOctree::load(const std::filesystem::path& path) {
+  const Archive in = Archive::open(path, kArchiveKind, kArchiveVersion);
+  std::unique_ptr<RayOctree> tree(new RayOctree(in));
+  RayOctree& o = *tree;
+  o.set_root_bounds();
+  o.depth_ = in.value<std::uint64_t>("depth");
+  o.nodes_ = in.array<Node>("nodes");
+  o.leaf_triangles_ = in.array<std::uint32_t>("leaf_triangles");
+  in.check([&] { o.validate(); });
   return tree;
 }
 
@@ -271,13 +300,24 @@ void RayOctree::validate() const {
   if (nodes_.empty()) throw Error("ray octree: no root");
   // Walk from the root with each node's box: children in range, every leaf's
   // range in bounds, and every triangle listed in the leaf of each of its corners.
+  // The depth recorded is the deepest node's, within the build's limit (the
+  // traversal recurses that deep).
+  if (depth_ > kMaxDepth) throw Error(fmt::format("ray octree: depth {} above {}", depth_, kMaxDepth));
   std::vector<char> reached(nodes_.size(), 0);
-  std::vector<std::pair<std::uint32_t, AABB3f>> stack = {{0, root_bounds_}};
+  struct Item {
+    std::uint32_t index;
+    AABB3f box;
+    std::size_t depth;
+  };
+  std::vector<Item> stack = {{0, root_bounds_, 0}};
+  std::size_t deepest = 0;
   while (!stack.empty()) {
-    const auto [index, box] = stack.back();
+    const auto [index, box, depth] = stack.back();
     stack.pop_back();
     if (reached[index]) throw Error(fmt::format("ray octree: node {} reached twice", index));
     reached[index] = 1;
+    deepest = std::max(deepest, depth);
+    if (depth > depth_) throw Error(fmt::format("ray octree: node {} deeper than the tree's depth {}", index, depth_));
     const Node& node = nodes_[index];
     if (node.leaf()) {
       if (std::size_t(node.first) + node.count > leaf_triangles_.size())
@@ -290,8 +330,9 @@ void RayOctree::validate() const {
     }
     if (std::size_t(node.first) + 8 > nodes_.size() || node.first <= index)
       throw Error(fmt::format("ray octree: node {} has children out of range", index));
-    for (int c = 0; c < 8; ++c) stack.push_back({node.first + std::uint32_t(c), child_box(box, c)});
+    for (int c = 0; c < 8; ++c) stack.push_back({node.first + std::uint32_t(c), child_box(box, c), depth + 1});
   }
+  if (deepest != depth_) throw Error(fmt::format("ray octree: depth {} recorded, {} found", depth_, deepest));
   if (std::find(reached.begin(), reached.end(), 0) != reached.end())
     throw Error("ray octree: a node is not reachable from the root");
   for (std::size_t i = 0; i < num_triangles(); ++i)

@@ -53,12 +53,11 @@ std::unique_ptr<UniformGrid> UniformGrid::build(const TriMesh& mesh, const Accel
   std::unique_ptr<UniformGrid> grid(new UniformGrid(mesh));
   UniformGrid& g = *grid;
   const std::size_t n = g.num_triangles();
-  g.grid_bounds_ = n == 0 ? AABB3f(Vec3f::Zero(), Vec3f::Ones()) : detail::widened(g.bounds_, g.margin_);
-  const Vec3f extent = g.grid_bounds_.extent();
-  g.resolution_ = grid_resolution(extent, double(options.grid_density) * double(std::max<std::size_t>(n, 1)),
+  g.set_cells();
+  g.resolution_ = grid_resolution(g.grid_bounds_.extent(),
+                                  double(options.grid_density) * double(std::max<std::size_t>(n, 1)),
                                   options.grid_max_resolution);
-  g.cell_size_ = extent.cwiseQuotient(g.resolution_.cast<float>());
-  g.inv_cell_size_ = g.cell_size_.cwiseInverse();
+  g.set_cells();
   const std::size_t cells = std::size_t(g.resolution_.prod());
 
   // The cells each triangle overlaps, gathered per fixed chunk of triangles so
@@ -95,16 +94,55 @@ std::unique_ptr<UniformGrid> UniformGrid::build(const TriMesh& mesh, const Accel
   }, 1);
 
   // Counting sort by cell; within a cell the triangles stay in increasing order.
-  g.cell_begin_.assign(cells + 1, 0);
+  std::vector<std::uint32_t> cell_begin(cells + 1, 0);
   for (const auto& chunk : pairs)
-    for (const auto& [cell, tri] : chunk) ++g.cell_begin_[cell + 1];
-  std::partial_sum(g.cell_begin_.begin(), g.cell_begin_.end(), g.cell_begin_.begin());
-  if (g.cell_begin_.back() >= RayHit::no_hit) throw Error("uniform grid: more than 2^32 triangle references");
-  g.cell_triangles_.resize(g.cell_begin_.back());
-  std::vector<std::uint32_t> cursor(g.cell_begin_.begin(), g.cell_begin_.end() - 1);
+    for (const auto& [cell, tri] : chunk) ++cell_begin[cell + 1];
+  std::partial_sum(cell_begin.begin(), cell_begin.end(), cell_begin.begin());
+  if (cell_begin.back() >= RayHit::no_hit) throw Error("uniform grid: more than 2^32 triangle references");
+  std::vector<std::uint32_t> cell_triangles(cell_begin.back());
+  std::vector<std::uint32_t> cursor(cell_begin.begin(), cell_begin.end() - 1);
   for (const auto& chunk : pairs)
-    for (const auto& [cell, tri] : chunk) g.cell_triangles_[cursor[cell]++] = tri;
+    for (const auto& [cell, tri] : chunk) cell_triangles[cursor[cell]++] = tri;
+  g.cell_begin_ = std::move(cell_begin);
+  g.cell_triangles_ = std::move(cell_triangles);
   g.build_s_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return grid;
+}
+
+void UniformGrid::set_cells() {
+  grid_bounds_ = num_triangles() == 0 ? AABB3f(Vec3f::Zero(), Vec3f::Ones()) : detail::widened(bounds_, margin_);
+  cell_size_ = grid_bounds_.extent().cwiseQuotient(resolution_.cast<float>());
+  inv_cell_size_ = cell_size_.cwiseInverse();
+}
+
+void UniformGrid::save(const std::filesystem::path& path) const {
+  ArchiveWriter out(kArchiveKind, kArchiveVersion);
+  add_sections(out);
+  out.add_value("resolution", resolution_);
+  out.add("cell_begin", cell_begin_);
+  out.add("cell_triangles", cell_triangles_);
+  out.write(path);
+}
+
+std::unique_ptr<UniformGrid> UniformGrid::load(const std::filesystem::path& path) {
+  const Archive in = Archive::open(path, kArchiveKind, kArchiveVersion);
+  std::unique_ptr<UniformGrid> grid(new UniformGrid(in));
+  UniformGrid& g = *grid;
+  g.resolution_ = in.value<Vec3i>("resolution");
+  g.cell_begin_ = in.array<std::uint32_t>("cell_begin");
+  g.cell_triangles_ = in.array<std::uint32_t>("cell_triangles");
+  // The cell count, without overflow, before validate() multiplies it out.
+  std::uint64_t cells = 1;
+  for (int a = 0; a < 3; ++a) {
+    if (g.resolution_[a] < 1 || std::uint64_t(g.resolution_[a]) > g.cell_begin_.size())
+      throw in.error(fmt::format("bad grid resolution {} x {} x {}", g.resolution_[0], g.resolution_[1],
+                                 g.resolution_[2]));
+    cells *= std::uint64_t(g.resolution_[a]);
+    if (cells >= g.cell_begin_.size()) break;
+  }
+  if (cells + 1 != g.cell_begin_.size()) throw in.error("the cell offsets do not match the grid resolution");
+  g.set_cells();
+  in.check([&] { g.validate(); });
   return grid;
 }
 

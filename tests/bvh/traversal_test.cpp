@@ -130,8 +130,8 @@ void check_all_pairs(BoundingVolume kind, Fit fit) {
     options.bv = kind;
     options.arity = arity;
     const TriangleBvh ba = TriangleBvh::build(a, options), bb = TriangleBvh::build(b, options);
-    const auto& va = std::get<std::vector<BV>>(ba.volumes());
-    const auto& vb = std::get<std::vector<BV>>(bb.volumes());
+    const auto& va = std::get<FlatArray<BV>>(ba.volumes());
+    const auto& vb = std::get<FlatArray<BV>>(bb.volumes());
     std::set<std::pair<std::uint32_t, std::uint32_t>> found;
     traverse_simultaneously(
         ba.topology(), bb.topology(), [&](std::uint32_t i, std::uint32_t j) { return overlaps(va[i], vb[j]); },
@@ -156,7 +156,7 @@ TEST(SimultaneousTraversal, FindsEveryPairOfOverlappingTriangleVolumes) {
 TEST(SimultaneousTraversal, StopsWhenTheLeafCallbackSaysSo) {
   const TriMesh a = test::random_soup(300, 61);
   const TriangleBvh ba = TriangleBvh::build(a);
-  const auto& boxes = std::get<std::vector<AABB3f>>(ba.volumes());
+  const auto& boxes = std::get<FlatArray<AABB3f>>(ba.volumes());
   int calls = 0;
   const bool finished = traverse_simultaneously(
       ba.topology(), ba.topology(), [&](std::uint32_t i, std::uint32_t j) { return boxes[i].overlaps(boxes[j]); },

@@ -70,6 +70,32 @@ TEST(FlatArray, OwnsOrViewsAndCopiesKeepTheirOwnData) {
   EXPECT_EQ(w[3], 7);
 }
 
+// An allocator other than std::allocator (as HugePageAllocator is).
+template <typename T>
+struct CountingAllocator {
+  using value_type = T;
+  CountingAllocator() = default;
+  template <typename U>
+  CountingAllocator(const CountingAllocator<U>&) {}
+  T* allocate(std::size_t n) { return std::allocator<T>().allocate(n); }
+  void deallocate(T* p, std::size_t n) { std::allocator<T>().deallocate(p, n); }
+  bool operator==(const CountingAllocator&) const { return true; }
+};
+
+TEST(FlatArray, HoldsAVectorOfAnotherAllocatorAndCompares) {
+  std::vector<int, CountingAllocator<int>> v = {5, 6, 7};
+  const int* buffer = v.data();
+  const FlatArray<int> a(std::move(v));
+  EXPECT_EQ(a.data(), buffer);  // moved in, not copied
+  EXPECT_FALSE(a.mapped());
+  EXPECT_EQ(a.owned_bytes(), 3 * sizeof(int));
+  const FlatArray<int> b = a;  // copies share the held vector
+  EXPECT_EQ(b.data(), buffer);
+  EXPECT_TRUE(a == FlatArray<int>(std::vector<int>{5, 6, 7}));
+  EXPECT_FALSE(a == FlatArray<int>(std::vector<int>{5, 6}));
+  EXPECT_FALSE(a == FlatArray<int>(std::vector<int>{5, 6, 8}));
+}
+
 TEST(Archive, RoundTripReadsSectionsInPlace) {
   const fs::path p = write_sample("round_trip");
   const Archive a = Archive::open(p, "test.Sample", 3);
@@ -221,6 +247,19 @@ TEST(Archive, BadNamesAndFilesAreErrors) {
   write_all(q, std::vector<char>(200, 'x'));
   EXPECT_THROW(Archive::peek(q), Error);
   fs::remove(q);
+}
+
+TEST(Archive, CheckRethrowsAStructuresErrorNamingTheFile) {
+  const fs::path p = write_sample("check");
+  const Archive a = Archive::open(p, "test.Sample", 3);
+  EXPECT_NO_THROW(a.check([] {}));
+  try {
+    a.check([] { throw Error("node 3: bad child index"); });
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()), p.string() + ": node 3: bad child index");
+  }
+  fs::remove(p);
 }
 
 }  // namespace

@@ -19,7 +19,7 @@
 #include <utility>
 #include <vector>
 
-#include "archive_bytes.hpp"
+#include "common/archive_files.hpp"
 #include "geods/core/archive.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"
@@ -630,7 +630,7 @@ TEST(MinMaxOctree, BadFilesThrow) {
   // A min that lies, a NaN sample, bad leaf_cells, dims that do not match the samples.
   auto patched = [&](const char* section, const auto& value) {
     std::vector<char> bytes = good;
-    std::memcpy(&bytes[testing::archive_section_offset(bytes, section)], &value, sizeof value);
+    std::memcpy(&bytes[test::archive_section_offset(bytes, section)], &value, sizeof value);
     return bytes;
   };
   expect_error(patched("min", 2.5f), "min");

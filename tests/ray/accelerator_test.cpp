@@ -6,14 +6,18 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
+#include <filesystem>
 #include <limits>
 #include <vector>
 
+#include "common/archive_files.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"
 #include "geods/core/rng.hpp"
 #include "geods/io/mesh_io.hpp"
 #include "geods/ray/accelerator.hpp"
+#include "geods/ray/bvh_accelerator.hpp"
 #include "geods/ray/ray_classifier.hpp"
 #include "geods/ray/ray_octree.hpp"
 #include "geods/ray/uniform_grid.hpp"
@@ -432,6 +436,163 @@ TEST(Accelerators, StatsDescribeTheStructures) {
   EXPECT_GE(o.references, mesh.num_triangles());
   EXPECT_GT(o.depth, 2u);
   EXPECT_LE(o.depth, 12u);
+}
+
+// save() / load_accelerator(): every kind comes back mapped (the 5D classifier
+// rebuilt from its saved triangles) and answers every ray bit for bit like the
+// original, caches included; bad files give geods::Error naming the file.
+TEST(AcceleratorArchive, EveryKindRoundTripsBitForBit) {
+  TriMesh one;
+  one.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  one.triangles = {{0, 1, 2}};
+  TriMesh flat = ugly_soup(31, 400);
+  for (Vec3f& v : flat.vertices) v.y() = -0.5f;
+  const std::pair<const char*, TriMesh> meshes[] = {
+      {"bunny", load("bunny.ply")}, {"one", one}, {"flat", flat}, {"soup", ugly_soup(32, 1500)}};
+  for (const auto& [name, mesh] : meshes)
+    for (AcceleratorKind kind : all_accelerator_kinds()) {
+      SCOPED_TRACE(std::string(name) + " " + std::string(to_string(kind)));
+      const auto built = make_accelerator(mesh, kind);
+      const auto path = geods::test::temp_archive("accel_" + std::string(to_string(kind)));
+      built->save(path);
+      const auto loaded = load_accelerator(path);
+      std::filesystem::remove(path);
+      ASSERT_EQ(loaded->kind(), kind);
+      EXPECT_TRUE(loaded->mapped());
+      EXPECT_FALSE(built->mapped());
+      EXPECT_EQ(loaded->num_triangles(), mesh.num_triangles());
+      EXPECT_NO_THROW(loaded->validate());
+      const AcceleratorStats a = built->stats(), b = loaded->stats();
+      if (kind != AcceleratorKind::rays5d) {  // its trees grow with the rays
+        EXPECT_EQ(a.nodes, b.nodes);
+        EXPECT_EQ(a.references, b.references);
+        EXPECT_EQ(a.depth, b.depth);
+      }
+      EXPECT_EQ(a.build_s, kind == AcceleratorKind::rays5d ? a.build_s : b.build_s);
+      RayCache ca, cb, sa, sb;
+      for (const Ray3f& ray : test_rays(mesh, 41, 900)) {
+        const RayHit ha = built->intersect(ray, ca), hb = loaded->intersect(ray, cb);
+        ASSERT_EQ(std::memcmp(&ha, &hb, sizeof ha), 0) << "t " << ha.t << " vs " << hb.t;
+        ASSERT_EQ(built->occluded(ray, sa), loaded->occluded(ray, sb));
+      }
+    }
+}
+
+TEST(AcceleratorArchive, OctreeArraysAreMappedAndEqual) {
+  const TriMesh mesh = load("teapot.obj");
+  const auto built = RayOctree::build(mesh);
+  const auto path = geods::test::temp_archive("octree_arrays");
+  built->save(path);
+  const auto loaded = RayOctree::load(path);
+  EXPECT_TRUE(loaded->nodes().mapped());
+  EXPECT_TRUE(loaded->triangles().mapped());
+  EXPECT_EQ(loaded->triangles(), built->triangles());
+  ASSERT_EQ(loaded->nodes().size(), built->nodes().size());
+  for (std::size_t i = 0; i < built->nodes().size(); ++i) {
+    EXPECT_EQ(loaded->nodes()[i].first, built->nodes()[i].first);
+    EXPECT_EQ(loaded->nodes()[i].count, built->nodes()[i].count);
+  }
+  std::filesystem::remove(path);
+}
+
+TEST(AcceleratorArchive, BadFilesAreRefused) {
+  const TriMesh mesh = ugly_soup(33, 300);
+  for (AcceleratorKind kind : all_accelerator_kinds()) {
+    SCOPED_TRACE(to_string(kind));
+    const auto path = geods::test::temp_archive("accel_bad_" + std::string(to_string(kind)));
+    make_accelerator(mesh, kind)->save(path);
+    geods::test::expect_bad_copies_refused(path, [](const auto& p) { load_accelerator(p); }, 20, 60);
+    std::filesystem::remove(path);
+  }
+  // Each class refuses the others' files, naming the file and both kinds.
+  const auto path = geods::test::temp_archive("accel_kind");
+  UniformGrid::build(mesh)->save(path);
+  try {
+    RayOctree::load(path);
+    ADD_FAILURE() << "loaded a grid as an octree";
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find(path.string()), std::string::npos) << what;
+    EXPECT_NE(what.find("ray.UniformGrid"), std::string::npos) << what;
+  }
+  EXPECT_THROW(RayClassifier::load(path), Error);
+  EXPECT_THROW(BvhAccelerator::load(path), Error);
+  EXPECT_THROW(bvh::TriangleBvh::load(path), Error);
+  EXPECT_NO_THROW(UniformGrid::load(path));
+  bvh::TriangleBvh::build(mesh).save(path);
+  EXPECT_THROW(load_accelerator(path), Error);
+  std::filesystem::remove(path);
+}
+
+// Archives with the right checksums and an inconsistent structure.
+TEST(AcceleratorArchive, InconsistentGridsAndOctreesAreRefused) {
+  const TriMesh mesh = ugly_soup(34, 200);
+  const auto grid = UniformGrid::build(mesh);
+  const auto path = geods::test::temp_archive("accel_inconsistent");
+  std::vector<Vec3f> corners;
+  for (const auto& t : mesh.triangles)
+    for (int k = 0; k < 3; ++k) corners.push_back(mesh.vertices[t[k]]);
+  auto write_grid = [&](const Vec3i& resolution, const std::vector<std::uint32_t>& begin,
+                        const std::vector<std::uint32_t>& triangles, const std::vector<Vec3f>& c) {
+    ArchiveWriter out(UniformGrid::kArchiveKind, UniformGrid::kArchiveVersion);
+    out.add("corners", c);
+    out.add_value("build_s", 0.0);
+    out.add_value("resolution", resolution);
+    out.add("cell_begin", begin);
+    out.add("cell_triangles", triangles);
+    out.write(path);
+  };
+  const Vec3i res = grid->resolution();
+  std::vector<std::uint32_t> begin, triangles;
+  begin.push_back(0);
+  for (int z = 0; z < res[2]; ++z)
+    for (int y = 0; y < res[1]; ++y)
+      for (int x = 0; x < res[0]; ++x) {
+        const auto cell = grid->cell(x, y, z);
+        triangles.insert(triangles.end(), cell.begin(), cell.end());
+        begin.push_back(std::uint32_t(triangles.size()));
+      }
+  write_grid(res, begin, triangles, corners);
+  EXPECT_NO_THROW(UniformGrid::load(path));  // the writer is right
+  write_grid(Vec3i(res[0], res[1], res[2] + 1), begin, triangles, corners);
+  EXPECT_THROW(UniformGrid::load(path), Error);
+  write_grid(Vec3i(-1, res[1], res[2]), begin, triangles, corners);
+  EXPECT_THROW(UniformGrid::load(path), Error);
+  write_grid(Vec3i(1 << 30, 1 << 30, 1 << 30), begin, triangles, corners);
+  EXPECT_THROW(UniformGrid::load(path), Error);
+  std::vector<std::uint32_t> bad = triangles;
+  bad[0] = std::uint32_t(mesh.num_triangles());
+  write_grid(res, begin, bad, corners);
+  EXPECT_THROW(UniformGrid::load(path), Error);
+  std::vector<Vec3f> nan_corners = corners;
+  nan_corners[4].x() = std::numeric_limits<float>::quiet_NaN();
+  write_grid(res, begin, triangles, nan_corners);
+  EXPECT_THROW(UniformGrid::load(path), Error);
+
+  const auto octree = RayOctree::build(mesh);
+  auto write_octree = [&](std::uint64_t depth, const std::vector<RayOctree::Node>& nodes) {
+    ArchiveWriter out(RayOctree::kArchiveKind, RayOctree::kArchiveVersion);
+    out.add("corners", corners);
+    out.add_value("build_s", 0.0);
+    out.add_value("depth", depth);
+    out.add("nodes", nodes);
+    out.add("leaf_triangles", octree->triangles());
+    out.write(path);
+  };
+  const std::vector<RayOctree::Node> nodes = octree->nodes().to_vector();
+  const std::uint64_t depth = octree->stats().depth;
+  write_octree(depth, nodes);
+  EXPECT_NO_THROW(RayOctree::load(path));
+  write_octree(depth + 1, nodes);
+  EXPECT_THROW(RayOctree::load(path), Error);
+  write_octree(1000000, nodes);
+  EXPECT_THROW(RayOctree::load(path), Error);
+  std::vector<RayOctree::Node> cycle = nodes;
+  ASSERT_FALSE(cycle[0].leaf());
+  cycle[0].first = 0;  // the root its own child
+  write_octree(depth, cycle);
+  EXPECT_THROW(RayOctree::load(path), Error);
+  std::filesystem::remove(path);
 }
 
 }  // namespace

@@ -13,7 +13,7 @@
 
 #include <unistd.h>
 
-#include "archive_bytes.hpp"
+#include "common/archive_files.hpp"
 #include "geods/core/archive.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"
@@ -455,9 +455,9 @@ TEST(KdTree, CorruptedFilesThrow) {
   bytes[48] = 9;  // k-d tree layout version
   expect_error(bytes, "kind version");
   // Permutation entry duplicated: validate() refuses it.
-  const std::size_t perm_at = testing::archive_section_offset(good, "permutation");
-  const std::size_t nodes_at = testing::archive_section_offset(good, "nodes");
-  const std::size_t points_at = testing::archive_section_offset(good, "points");
+  const std::size_t perm_at = test::archive_section_offset(good, "permutation");
+  const std::size_t nodes_at = test::archive_section_offset(good, "nodes");
+  const std::size_t points_at = test::archive_section_offset(good, "points");
   bytes = good;
   std::copy(bytes.begin() + perm_at, bytes.begin() + perm_at + 4, bytes.begin() + perm_at + 4);
   expect_error(bytes, "permutation");

@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "archive_bytes.hpp"
+#include "common/archive_files.hpp"
 #include "geods/core/archive.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/rng.hpp"
@@ -393,7 +393,7 @@ TEST(Orthtree, SaveLoad) {
   ASSERT_FALSE(balanced_oracle(tree));
   tree.save(dir / "t.geods");
   std::vector<char> claim = read_all(dir / "t.geods");
-  claim[testing::archive_section_offset(claim, "balanced")] = 1;
+  claim[test::archive_section_offset(claim, "balanced")] = 1;
   write_all(dir / "claim.geods", claim);
   EXPECT_THROW(Octree<float>::load(dir / "claim.geods"), Error);  // the checksum sees it
   try {
@@ -456,7 +456,7 @@ TEST(Orthtree, LoadedTreesAnswerLikeTheOriginal) {
   for (const char* section : {"points", "bucket", "max_depth", "root_side"}) {
     std::vector<char> bad = good;
     const double nan = std::nan("");
-    std::memcpy(&bad[testing::archive_section_offset(bad, section)], &nan, sizeof nan);
+    std::memcpy(&bad[test::archive_section_offset(bad, section)], &nan, sizeof nan);
     write_all(path, bad);
     EXPECT_THROW(Quadtree<double>::load(path, Archive::Verify::structure_only), Error) << section;
     EXPECT_THROW(Quadtree<double>::load(path), Error) << section;

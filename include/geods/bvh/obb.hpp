@@ -37,6 +37,11 @@ struct Obb {
   }
 };
 
+}  // namespace geods::bvh
+template <typename T>
+struct geods::is_bytewise<geods::bvh::Obb<T>> : geods::is_bytewise<geods::Vec<T, 3>> {};
+namespace geods::bvh {
+
 using Obb3f = Obb<float>;
 using Obb3d = Obb<double>;
 

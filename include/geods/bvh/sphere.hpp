@@ -22,6 +22,11 @@ struct Sphere {
   bool empty() const { return radius < T(0); }
 };
 
+}  // namespace geods::bvh
+template <typename T>
+struct geods::is_bytewise<geods::bvh::Sphere<T>> : geods::is_bytewise<geods::Vec<T, 3>> {};
+namespace geods::bvh {
+
 using Sphere3f = Sphere<float>;
 using Sphere3d = Sphere<double>;
 

@@ -8,6 +8,7 @@
 
 #include "geods/bvh/build_options.hpp"
 #include "geods/core/aabb.hpp"
+#include "geods/core/flat_array.hpp"
 
 namespace geods::bvh {
 
@@ -25,8 +26,8 @@ struct TopoNode {
 };
 
 struct Topology {
-  std::vector<TopoNode> nodes;             // root at 0 (empty for no primitives)
-  std::vector<std::uint32_t> prim_order;  // primitive ids in leaf order
+  FlatArray<TopoNode> nodes;             // root at 0 (empty for no primitives)
+  FlatArray<std::uint32_t> prim_order;  // primitive ids in leaf order
 
   /// Longest root-to-leaf path in edges (0 for a single leaf).
   int depth() const;

@@ -4,7 +4,16 @@
 // point, point containment, box and frustum culling. Any builder and any
 // bounding volume of build_options.hpp; the default (binned SAH, AABB, 4 wide)
 // is the fast path, whose ray queries test the 4 child boxes of a node at once.
+//
+// save() writes the whole hierarchy, triangle copies included, to one archive
+// (core/archive.hpp, kind "bvh.TriangleBvh"); load() maps it and queries read
+// the file's pages in place, without the mesh it was built over. A built
+// hierarchy keeps its wide nodes and triangle groups in transparent huge pages
+// (huge_page_allocator.hpp); a loaded one reads them from the page cache in
+// ordinary pages (the kernel gives huge pages to anonymous memory, not to
+// mappings of ordinary files), which costs incoherent rays some TLB misses.
 #include <cstdint>
+#include <filesystem>
 #include <limits>
 #include <span>
 #include <variant>
@@ -19,6 +28,8 @@
 #include "geods/bvh/sphere.hpp"
 #include "geods/bvh/topology.hpp"
 #include "geods/bvh/wide_node.hpp"
+#include "geods/core/archive.hpp"
+#include "geods/core/flat_array.hpp"
 #include "geods/core/plane.hpp"
 #include "geods/core/ray_triangle.hpp"
 #include "geods/core/tri_mesh.hpp"
@@ -49,16 +60,24 @@ struct ClosestPoint {
   float distance = std::numeric_limits<float>::infinity();
 };
 
-using VolumeArray = std::variant<std::vector<AABB3f>, std::vector<Sphere3f>, std::vector<Kdop<float, 6>>,
-                                 std::vector<Kdop<float, 14>>, std::vector<Kdop<float, 18>>,
-                                 std::vector<Kdop<float, 26>>, std::vector<Obb3f>>;
+using VolumeArray = std::variant<FlatArray<AABB3f>, FlatArray<Sphere3f>, FlatArray<Kdop<float, 6>>,
+                                 FlatArray<Kdop<float, 14>>, FlatArray<Kdop<float, 18>>,
+                                 FlatArray<Kdop<float, 26>>, FlatArray<Obb3f>>;
+
+/// A triangle of the mesh, copied into the hierarchy (TriangleBvh::Triangle).
+struct BvhTriangle {
+  Vec3f a, b, c;
+};
+
+}  // namespace geods::bvh
+template <>
+struct geods::is_bytewise<geods::bvh::BvhTriangle> : std::true_type {};
+namespace geods::bvh {
 
 class TriangleBvh {
  public:
   /// The triangles of `mesh`, copied in leaf order.
-  struct Triangle {
-    Vec3f a, b, c;
-  };
+  using Triangle = BvhTriangle;
 
   /// An empty hierarchy (every ray misses).
   TriangleBvh() = default;
@@ -67,6 +86,22 @@ class TriangleBvh {
   /// Throws geods::Error for invalid meshes (see TriMesh::require_valid) and bad
   /// options. Degenerate triangles are kept (rays never hit them).
   static TriangleBvh build(const TriMesh& mesh, const BuildOptions& options = {});
+
+  /// Archive kind and layout version of save().
+  static constexpr const char* kArchiveKind = "bvh.TriangleBvh";
+  static constexpr std::uint32_t kArchiveVersion = 1;
+  /// Writes the hierarchy (options, nodes, volumes, triangles, wide nodes) to
+  /// `path`; throws geods::Error naming the file if it cannot be written.
+  void save(const std::filesystem::path& path) const;
+  /// Maps a file written by save(): the arrays are read in place. Checks the
+  /// archive (kind, version, sizes, checksums) and then validate(), so a
+  /// truncated, corrupt or foreign file gives geods::Error naming the file.
+  /// O(size of the file) once; the mesh it was built over is not needed.
+  static TriangleBvh load(const std::filesystem::path& path);
+  /// The same sections added to / read from an archive of another kind that
+  /// embeds a hierarchy (ray::BvhAccelerator).
+  void add_sections(ArchiveWriter& out) const;
+  static TriangleBvh from_sections(const Archive& in);
 
   /// Closest hit with t in [ray.tmin, ray.tmax]; prim = RayHit::no_hit on a miss.
   RayHit intersect(const Ray3f& ray) const;
@@ -97,15 +132,15 @@ class TriangleBvh {
   /// One bounding volume per topology node, of the type options().bv selects.
   const VolumeArray& volumes() const { return volumes_; }
   /// Triangles in leaf order and their indices in the mesh.
-  const std::vector<Triangle>& triangles() const { return triangles_; }
-  const std::vector<std::uint32_t>& triangle_ids() const { return topology_.prim_order; }
+  const FlatArray<Triangle>& triangles() const { return triangles_; }
+  const FlatArray<std::uint32_t>& triangle_ids() const { return topology_.prim_order; }
   std::size_t num_triangles() const { return triangles_.size(); }
 
  private:
   template <typename BV>
-  RayHit intersect_generic(const std::vector<BV>& volumes, const Ray3f& ray, bool any) const;
+  RayHit intersect_generic(const FlatArray<BV>& volumes, const Ray3f& ray, bool any) const;
   template <int W>
-  using WideNodes = std::vector<WideNode<W>, HugePageAllocator<WideNode<W>>>;
+  using WideNodes = FlatArray<WideNode<W>>;  // built in huge pages (HugePageAllocator)
   template <int W>
   RayHit intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray, bool any) const;
   // The same compiled for AVX, and the choice between the two by the CPU.
@@ -114,7 +149,7 @@ class TriangleBvh {
   template <int W>
   RayHit intersect_wide_best(const WideNodes<W>& nodes, const Ray3f& ray, bool any) const;
   template <typename BV>
-  ClosestPoint closest_generic(const std::vector<BV>& volumes, std::uint32_t start, const Vec3f& p,
+  ClosestPoint closest_generic(const FlatArray<BV>& volumes, std::uint32_t start, const Vec3f& p,
                                float max_distance) const;
   template <typename Fn>
   void for_each_crossing(const Ray3f& ray, Fn&& fn) const;
@@ -131,11 +166,12 @@ class TriangleBvh {
   Topology topology_;
   int depth_ = 0;  // of topology_, sizes the traversal stacks
   VolumeArray volumes_;
-  std::vector<Triangle> triangles_;
+  FlatArray<Triangle> triangles_;
   WideNodes<4> wide4_;
   WideNodes<8> wide8_;
-  // The triangles of the wide leaves in groups of 4, in leaf order.
-  std::vector<TriangleGroup, HugePageAllocator<TriangleGroup>> groups_;
+  // The triangles of the wide leaves in groups of 4, in leaf order (huge pages when built).
+  FlatArray<TriangleGroup> groups_;
 };
 
 }  // namespace geods::bvh
+

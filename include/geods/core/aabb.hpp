@@ -72,6 +72,8 @@ struct AABB {
 
   bool operator==(const AABB& b) const { return lo == b.lo && hi == b.hi; }
 };
+template <typename T, int N>
+struct is_bytewise<AABB<T, N>> : is_bytewise<Vec<T, N>> {};
 
 using AABB2f = AABB<float, 2>;
 using AABB3f = AABB<float, 3>;

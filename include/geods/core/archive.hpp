@@ -57,7 +57,7 @@ class ArchiveWriter {
   /// Adds a section of `elements` (not copied: they must live until write()).
   template <typename T>
   void add(std::string_view name, std::span<const T> elements) {
-    static_assert(std::is_trivially_copyable_v<T>, "archive sections hold trivially copyable elements");
+    static_assert(is_bytewise_v<T>, "archive sections hold elements stored as their bytes");
     add_bytes(name, archive_type_of<T>(), sizeof(T), elements.data(), elements.size());
   }
   template <typename T>
@@ -71,7 +71,7 @@ class ArchiveWriter {
   /// Adds a section of one element (a count, a parameter, a header struct), copied.
   template <typename T>
   void add_value(std::string_view name, const T& value) {
-    static_assert(std::is_trivially_copyable_v<T>, "archive sections hold trivially copyable elements");
+    static_assert(is_bytewise_v<T>, "archive sections hold elements stored as their bytes");
     std::vector<std::byte>& copy = values_.emplace_back(sizeof(T));
     std::memcpy(copy.data(), &value, sizeof(T));
     add_bytes(name, archive_type_of<T>(), sizeof(T), copy.data(), 1);
@@ -150,6 +150,16 @@ class Archive {
 
   /// A geods::Error "PATH: what" for a structure's own checks of what it loaded.
   Error error(const std::string& what) const;
+  /// Runs `checks` (say a structure's validate() on what it loaded); a
+  /// geods::Error they throw is thrown again as error(its message).
+  template <typename Checks>
+  void check(Checks&& checks) const {
+    try {
+      checks();
+    } catch (const Error& e) {
+      throw error(e.what());
+    }
+  }
 
  private:
   struct Entry {

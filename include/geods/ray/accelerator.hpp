@@ -8,13 +8,20 @@
 // smallest triangle index. Queries are const and thread-safe; a RayCache is the
 // caller's per-thread (per ray-tree level, per light source) memory that
 // speeds coherent queries up without changing any answer.
+//
+// save() writes an accelerator with its triangle copies to one archive
+// (core/archive.hpp, kind "ray.<Class>"); load_accelerator() or the class's
+// load() maps it back without the mesh, its arrays read in place.
 #include <cstdint>
+#include <filesystem>
 #include <memory>
 #include <span>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "geods/core/archive.hpp"
+#include "geods/core/flat_array.hpp"
 #include "geods/core/ray.hpp"
 #include "geods/core/ray_triangle.hpp"
 #include "geods/core/tri_mesh.hpp"
@@ -94,6 +101,10 @@ class Accelerator {
   bool occluded(const Ray3f& ray) const;
   bool occluded(const Ray3f& ray, RayCache& cache) const;
 
+  /// Writes the accelerator to `path` (an archive of kind "ray.<Class>");
+  /// throws geods::Error naming the file if it cannot be written.
+  virtual void save(const std::filesystem::path& path) const = 0;
+
   virtual AcceleratorStats stats() const = 0;
   /// Checks the structure's invariants (every triangle reachable where a ray
   /// could hit it, ranges in bounds...); throws geods::Error on a violation.
@@ -103,10 +114,17 @@ class Accelerator {
   /// not to an address that a later accelerator may reuse).
   std::uint64_t id() const { return id_; }
   std::size_t num_triangles() const { return corners_.size() / 3; }
+  /// True for an accelerator from load(): its arrays view the mapped file.
+  bool mapped() const { return corners_.mapped(); }
 
  protected:
   /// Copies the triangle corners (three per triangle, flat) after checking the mesh.
   explicit Accelerator(const TriMesh& mesh);
+  /// Views the corners of an archive written with add_sections() (in place)
+  /// after checking that they are finite; bounds and margin as the build computes them.
+  explicit Accelerator(const Archive& in);
+  /// The corners and build time, the sections every accelerator's archive starts with.
+  void add_sections(ArchiveWriter& out) const;
 
   virtual RayHit closest_hit(const Ray3f& ray, RayCache& cache) const = 0;
   /// The index of some triangle hit in [ray.tmin, ray.tmax], or RayHit::no_hit.
@@ -130,7 +148,7 @@ class Accelerator {
   /// interval hit nothing (as in the triangle test itself).
   static bool shootable(const Ray3f& ray);
 
-  std::vector<Vec3f> corners_;  // triangle i: corners_[3i..3i+2]
+  FlatArray<Vec3f> corners_;    // triangle i: corners_[3i..3i+2]
   AABB3f bounds_;               // of all triangles
   // Cells and beams are widened by this much when triangles are assigned to
   // them, so that float rounding in the traversal never loses a triangle.
@@ -138,6 +156,8 @@ class Accelerator {
   double build_s_ = 0;
 
  private:
+  void set_bounds();
+
   std::uint64_t id_;
 };
 
@@ -146,5 +166,10 @@ class Accelerator {
 /// (indices out of range, non-finite coordinates).
 std::unique_ptr<Accelerator> make_accelerator(const TriMesh& mesh, AcceleratorKind kind,
                                               const AcceleratorOptions& options = {});
+
+/// Loads an accelerator of any kind saved with Accelerator::save() (the kind is
+/// read from the file). Throws geods::Error naming the file if it is not one, or
+/// is truncated, corrupt or of another version.
+std::unique_ptr<Accelerator> load_accelerator(const std::filesystem::path& path);
 
 }  // namespace geods::ray

@@ -12,6 +12,13 @@ class BvhAccelerator final : public Accelerator {
   /// Builds a bvh::TriangleBvh with options.bvh.
   static std::unique_ptr<BvhAccelerator> build(const TriMesh& mesh, const AcceleratorOptions& options = {});
 
+  static constexpr const char* kArchiveKind = "ray.BvhAccelerator";
+  static constexpr std::uint32_t kArchiveVersion = 1;
+  /// The corners and the hierarchy's sections (bvh::TriangleBvh::save's).
+  void save(const std::filesystem::path& path) const override;
+  /// Maps a file written by save(); throws geods::Error naming the file if it is bad.
+  static std::unique_ptr<BvhAccelerator> load(const std::filesystem::path& path);
+
   AcceleratorKind kind() const override { return AcceleratorKind::bvh; }
   AcceleratorStats stats() const override;
   void validate() const override { bvh_.validate(); }
@@ -25,6 +32,7 @@ class BvhAccelerator final : public Accelerator {
 
  private:
   explicit BvhAccelerator(const TriMesh& mesh) : Accelerator(mesh) {}
+  explicit BvhAccelerator(const Archive& in) : Accelerator(in), bvh_(bvh::TriangleBvh::from_sections(in)) {}
   bvh::TriangleBvh bvh_;
 };
 

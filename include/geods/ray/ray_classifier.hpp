@@ -30,6 +30,13 @@
 // again from the point of the ray at the cut-off. A RayCache keeps the leaf
 // of the previous ray (the per-level cache for coherent rays: the next ray
 // starts there if its 5D point is inside) and the last occluder of shadow rays.
+//
+// save() stores the triangles and the rays5d options, not the 5D trees: they
+// are built by the queries (their shape depends on which rays came in which
+// order), linked by pointers and published atomically, so a saved tree would
+// be a snapshot of one workload in a second, pointer-free layout. load() sorts
+// the six root lists again (the build, O(n log n)) and the trees regrow as
+// rays arrive; the answers are the same.
 #include <array>
 #include <atomic>
 #include <cstdint>
@@ -46,6 +53,13 @@ class RayClassifier final : public Accelerator {
   ~RayClassifier() override;
 
   static std::unique_ptr<RayClassifier> build(const TriMesh& mesh, const AcceleratorOptions& options = {});
+
+  static constexpr const char* kArchiveKind = "ray.RayClassifier";
+  static constexpr std::uint32_t kArchiveVersion = 1;
+  /// The corners and the rays5d options (see above: the trees are rebuilt on demand).
+  void save(const std::filesystem::path& path) const override;
+  /// Reads a file written by save() and builds the roots again (build_s() is that time).
+  static std::unique_ptr<RayClassifier> load(const std::filesystem::path& path);
 
   AcceleratorKind kind() const override { return AcceleratorKind::rays5d; }
   AcceleratorStats stats() const override;
@@ -65,6 +79,9 @@ class RayClassifier final : public Accelerator {
   struct Node;
   struct Ray5;
   explicit RayClassifier(const TriMesh& mesh);
+  explicit RayClassifier(const Archive& in);
+  // Checks the options, then sorts the six roots (the whole eager build).
+  void build_roots(const AcceleratorOptions& options);
   template <bool AnyHit>
   std::uint32_t shoot(const Ray3f& ray, RayCache& cache, RayHit& best) const;
   const Node& locate(const Ray5& r, RayCache& cache) const;

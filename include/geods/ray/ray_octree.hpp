@@ -36,13 +36,23 @@ class RayOctree final : public Accelerator {
 
   static std::unique_ptr<RayOctree> build(const TriMesh& mesh, const AcceleratorOptions& options = {});
 
+  /// Deepest octree_max_depth (cells 2^-30 of the root's size are float noise).
+  static constexpr std::uint32_t kMaxDepth = 30;
+
+  static constexpr const char* kArchiveKind = "ray.RayOctree";
+  static constexpr std::uint32_t kArchiveVersion = 1;
+  /// The corners, the nodes and the leaf lists (the root box follows from the corners).
+  void save(const std::filesystem::path& path) const override;
+  /// Maps a file written by save() and validate()s it; geods::Error naming the file if it is bad.
+  static std::unique_ptr<RayOctree> load(const std::filesystem::path& path);
+
   AcceleratorKind kind() const override { return AcceleratorKind::octree; }
   AcceleratorStats stats() const override;
   void validate() const override;
 
   const AABB3f& root_bounds() const { return root_bounds_; }
-  const std::vector<Node>& nodes() const { return nodes_; }
-  const std::vector<std::uint32_t>& triangles() const { return leaf_triangles_; }
+  const FlatArray<Node>& nodes() const { return nodes_; }
+  const FlatArray<std::uint32_t>& triangles() const { return leaf_triangles_; }
 
  protected:
   RayHit closest_hit(const Ray3f& ray, RayCache& cache) const override;
@@ -50,13 +60,15 @@ class RayOctree final : public Accelerator {
 
  private:
   explicit RayOctree(const TriMesh& mesh) : Accelerator(mesh) {}
+  explicit RayOctree(const Archive& in) : Accelerator(in) {}
+  void set_root_bounds();
   template <bool AnyHit>
   struct Traversal;
 
   AABB3f root_bounds_;
-  std::vector<Node> nodes_;
-  std::vector<std::uint32_t> leaf_triangles_;
-  std::size_t depth_ = 0;
+  FlatArray<Node> nodes_;
+  FlatArray<std::uint32_t> leaf_triangles_;
+  std::size_t depth_ = 0;  // of the deepest node; the traversal recurses this deep
 };
 
 }  // namespace geods::ray

@@ -29,6 +29,13 @@ class UniformGrid final : public Accelerator {
  public:
   static std::unique_ptr<UniformGrid> build(const TriMesh& mesh, const AcceleratorOptions& options = {});
 
+  static constexpr const char* kArchiveKind = "ray.UniformGrid";
+  static constexpr std::uint32_t kArchiveVersion = 1;
+  /// The corners, the resolution and the cell lists (the bounds follow from the corners).
+  void save(const std::filesystem::path& path) const override;
+  /// Maps a file written by save() and validate()s it; geods::Error naming the file if it is bad.
+  static std::unique_ptr<UniformGrid> load(const std::filesystem::path& path);
+
   AcceleratorKind kind() const override { return AcceleratorKind::grid; }
   AcceleratorStats stats() const override;
   void validate() const override;
@@ -44,6 +51,9 @@ class UniformGrid final : public Accelerator {
 
  private:
   explicit UniformGrid(const TriMesh& mesh) : Accelerator(mesh) {}
+  explicit UniformGrid(const Archive& in) : Accelerator(in) {}
+  // The grid's box and cell size for the current resolution.
+  void set_cells();
   template <bool AnyHit>
   std::uint32_t traverse(const Ray3f& ray, RayHit& best) const;
   std::size_t cell_index(int x, int y, int z) const {
@@ -55,8 +65,8 @@ class UniformGrid final : public Accelerator {
   Vec3i resolution_ = Vec3i::Ones();
   Vec3f cell_size_ = Vec3f::Ones();
   Vec3f inv_cell_size_ = Vec3f::Ones();
-  std::vector<std::uint32_t> cell_begin_;
-  std::vector<std::uint32_t> cell_triangles_;
+  FlatArray<std::uint32_t> cell_begin_;
+  FlatArray<std::uint32_t> cell_triangles_;
 };
 
 }  // namespace geods::ray
