@@ -20,14 +20,12 @@
 #include <limits>
 #include <map>
 #include <memory>
-#include <span>
 #include <string>
 #include <type_traits>
 #include <utility>
 #include <vector>
 
 #include "geods/core/error.hpp"
-#include "geods/core/flat_array.hpp"
 #include "geods/core/steps.hpp"
 #include "geods/spatial/kd_tree.hpp"
 
@@ -101,9 +99,9 @@ class KdTreeSteppedBuild {
     const std::size_t dim = s.dim;
     const std::uint32_t n = std::uint32_t(s.rows.size());
     std::size_t used = 0;
-    std::vector<T> coordinates;  // run-time dimension: filled as the rows are read, no pass to zero them first
+    std::vector<T> coordinates;  // filled as the rows are read: no pass to zero them first
     std::vector<Item> items;
-    if constexpr (Dim == Dynamic) coordinates.reserve(std::size_t(n) * dim);
+    coordinates.reserve(std::size_t(n) * dim);
     items.reserve(n);
     for (std::uint32_t i = 0; i < n; ++i) {
       const Row& row = s.rows[i];
@@ -114,30 +112,18 @@ class KdTreeSteppedBuild {
         if (!std::isfinite(row[a]))
           throw Error("KdTree: point " + std::to_string(i) + " has a non-finite coordinate (axis " +
                       std::to_string(a) + ")");
-      if constexpr (Dim == Dynamic) {
-        coordinates.insert(coordinates.end(), row.begin(), row.end());
+      coordinates.insert(coordinates.end(), row.begin(), row.end());
+      if constexpr (Dim == Dynamic)
         items.push_back(i);
-      } else {
+      else
         items.push_back(Record{row, i});
-      }
       if (++used >= s.budget) {
         used = 0;
         co_yield Steps::pause;
       }
     }
-    if constexpr (Dim == Dynamic) {
-      s.rows = {};
-      tree.adopt(std::move(coordinates), dim);
-    } else {
-      // Rows of a compile-time dimension are packed coordinates already: the
-      // tree keeps them as its points instead of a copy (one allocation and
-      // pass less per block of the dynamic k-d tree).
-      static_assert(sizeof(Row) == std::size_t(Dim) * sizeof(T), "Row is Dim packed coordinates");
-      auto rows = std::make_shared<const std::vector<Row>>(std::move(s.rows));
-      const std::span<const T> packed(rows->empty() ? nullptr : rows->front().data(), rows->size() * dim);
-      tree.owned_ = std::make_shared<const FlatArray<T>>(packed, std::move(rows));
-      tree.view_ = PointView<T>(tree.owned_->data(), n, dim);
-    }
+    s.rows = {};
+    tree.adopt(std::move(coordinates), dim);
     tree.leaf_size_ = s.leaf_size;
     const T* points = tree.view_.data;
     auto coords = [&](const Item& item) -> const T* {
