@@ -118,9 +118,10 @@ def main():
         "nifti": {"u8.nii": nifti((2, 3, 4), 2, 8, raw), "f4.nii.gz": gzip.compress(nifti((2, 2, 2), 16, 32, bytes(32)))},
         "points": {"p.npy": b"\x00" + npy("<f8", (2, 3), struct.pack("<6d", *range(6))),
                    "p.xyz": b"\x01" + b"0 0 0 0 0 1\n1 2 3 0 1 0\n", "p.csv": b"\x02x,y\n1,2\n3,4\n",
-                   "p.ply": b"\x03" + PLY_ASCII},
+                   "p.ply": b"\x03" + PLY_ASCII, "p.txt": b"\x04x y z w\n1,2,3,4\n5 6 7 8\n"},
         "segments": {"s.npy": b"\x00" + npy("<f8", (1, 4), struct.pack("<4d", 0, 0, 1, 1)),
-                     "s.edg": b"\x01" + b"2\n0 0 1 1\n1 1 2 0\n", "s.cin": b"\x02" + b"p 0 0\ns 0 0 1 1\ns 1 1 2 0\n"},
+                     "s.edg": b"\x01" + b"2\n0 0 1 1\n1 1 2 0\n", "s.cin": b"\x02" + b"p 0 0\ns 0 0 1 1\ns 1 1 2 0\n",
+                     "s.csv": b"\x03" + b"x0,y0,x1,y1\n0,0,1,1\n"},
     }
     for target, files in seeds.items():
         (out / target).mkdir(parents=True, exist_ok=True)

@@ -5,9 +5,15 @@
 #include <cstdint>
 #include <limits>
 #include <optional>
+#include <variant>
 
 #include "command.hpp"
-#include "kd_tree_cli.hpp"
+#include "geods/core/error.hpp"
+#include "geods/io/npy.hpp"
+#include "geods/io/table_io.hpp"
+#include "geods/spatial/kd_tree_dimensions.hpp"
+#include "geods/spatial/stats_fields.hpp"
+#include "stats_json.hpp"
 #include "stopwatch.hpp"
 
 namespace geods::cli {
@@ -20,7 +26,7 @@ class KnnCommand : public Command {
     return "k nearest neighbours of query points (k-d tree): indices and distances as .npy";
   }
   void add_options(CLI::App& app) override {
-    app.add_option("--points", points_, "Points, n x d (.npy any d; .xyz/.csv/.ply)")->required();
+    add_input(app, "points", points_, "Points, n x d (.npy, .csv, .txt, .xyz, .ply)", "--points");
     app.add_option("--queries", queries_, "Query points, m x d")->required();
     app.add_option("--k", k_, "Neighbours per query")->required()->check(CLI::PositiveNumber);
     app.add_option("--radius", radius_, "Only neighbours within this distance (fewer than k: index -1, distance inf)");
@@ -33,26 +39,28 @@ class KnnCommand : public Command {
   void run(const RunContext&, Report& report) override {
     if (radius_ && !(*radius_ >= 0)) throw Error("knn: --radius must be >= 0");
     if (!(eps_ >= 0)) throw Error("knn: --eps must be >= 0");
-    const Table points = read_table(points_);
-    const Table queries = read_table(queries_);
+    const io::Table points = io::read_table(points_, "point");
+    const io::Table queries = io::read_table(queries_, "query point");
     if (queries.cols != points.cols)
       throw Error(fmt::format("{}: queries of dimension {}, but the points ({}) have dimension {}", queries_,
                               queries.cols, points_, points.cols));
     const spatial::KnnRequest request{k_, eps_, radius_.value_or(std::numeric_limits<double>::infinity())};
 
     double build_s = 0, query_s = 0;
-    std::size_t nodes = 0, depth = 0;
+    spatial::KdTreeStats stats;
     std::vector<spatial::Neighbor<double>> result;
     Stopwatch build_watch;
-    with_kd_tree(points, leaf_size_, [&](const auto& tree) {  // called right after the build
-      build_s = build_watch.seconds();
-      const spatial::KdTreeStats stats = tree.stats();
-      nodes = stats.nodes;
-      depth = stats.depth;
-      Stopwatch query_watch;
-      result = tree.query_batch(spatial::PointView<double>(queries.values.data(), queries.rows, queries.cols), request);
-      query_s = query_watch.seconds();
-    });
+    const auto any_tree =
+        spatial::make_kd_tree(spatial::PointView<double>(points.values.data(), points.rows, points.cols), leaf_size_);
+    build_s = build_watch.seconds();
+    std::visit(
+        [&](const auto& tree) {
+          stats = tree.stats();
+          Stopwatch query_watch;
+          result = tree.query_batch(spatial::PointView<double>(queries.values.data(), queries.rows, queries.cols), request);
+          query_s = query_watch.seconds();
+        },
+        any_tree);
 
     std::vector<std::int64_t> indices(result.size());
     std::vector<double> distances(result.size());
@@ -76,8 +84,7 @@ class KnnCommand : public Command {
     if (radius_) j["radius"] = *radius_;
     j["leaf_size"] = leaf_size_;
     j["found"] = found;
-    j["tree_nodes"] = nodes;
-    j["tree_depth"] = depth;
+    put_stats(j, stats, "tree_");
     j["build_s"] = build_s;
     j["query_s"] = query_s;
     j["compute_s"] = build_s + query_s;
@@ -85,7 +92,7 @@ class KnnCommand : public Command {
     report.lines.push_back(fmt::format("knn: {} points of dimension {}, {} queries, k = {}{}{}", points.rows,
                                        points.cols, queries.rows, k_, eps_ > 0 ? fmt::format(", eps = {}", eps_) : "",
                                        radius_ ? fmt::format(", radius = {}", *radius_) : ""));
-    report.lines.push_back(fmt::format("  k-d tree: {} nodes, depth {}, built in {:.3f} s", nodes, depth, build_s));
+    report.lines.push_back(fmt::format("  k-d tree: {} nodes, depth {}, built in {:.3f} s", stats.nodes, stats.depth, build_s));
     report.lines.push_back(fmt::format("  {} neighbours found in {:.3f} s ({:.0f} queries/s)", found, query_s,
                                        query_s > 0 ? double(queries.rows) / query_s : 0.0));
     if (!indices_.empty()) report.lines.push_back("  wrote " + indices_);

@@ -2,9 +2,13 @@
 #include <fmt/format.h>
 
 #include <cstdint>
+#include <variant>
 
 #include "command.hpp"
-#include "kd_tree_cli.hpp"
+#include "geods/core/error.hpp"
+#include "geods/io/npy.hpp"
+#include "geods/io/table_io.hpp"
+#include "geods/spatial/kd_tree_dimensions.hpp"
 #include "stopwatch.hpp"
 
 namespace geods::cli {
@@ -15,27 +19,31 @@ class RangeCommand : public Command {
   std::string name() const override { return "range"; }
   std::string summary() const override { return "Count the points in axis-parallel boxes (k-d tree range counting)"; }
   void add_options(CLI::App& app) override {
-    app.add_option("--points", points_, "Points, n x d (.npy any d; .xyz/.csv/.ply)")->required();
+    add_input(app, "points", points_, "Points, n x d (.npy, .csv, .txt, .xyz, .ply)", "--points");
     app.add_option("--boxes", boxes_, "Boxes, m x 2d: the low corner, then the high corner (closed)")->required();
     app.add_option("-o,--output", output_, "Output: int64 counts, one per box");
     app.add_option("--leaf-size", leaf_size_, "Points per leaf of the k-d tree")->check(CLI::PositiveNumber);
   }
 
   void run(const RunContext&, Report& report) override {
-    const Table points = read_table(points_);
-    const Table boxes = read_table(boxes_);
+    const io::Table points = io::read_table(points_, "point");
+    const io::Table boxes = io::read_table(boxes_, "box row");
     if (boxes.cols != 2 * points.cols)
       throw Error(fmt::format("{}: boxes need 2 x {} = {} columns (low corner, high corner) for the points of {}, got {}",
                               boxes_, points.cols, 2 * points.cols, points_, boxes.cols));
     double build_s = 0, query_s = 0;
     std::vector<std::size_t> counts;
     Stopwatch build_watch;
-    with_kd_tree(points, leaf_size_, [&](const auto& tree) {  // called right after the build
-      build_s = build_watch.seconds();
-      Stopwatch query_watch;
-      counts = tree.count_box_batch(spatial::PointView<double>(boxes.values.data(), boxes.rows, boxes.cols));
-      query_s = query_watch.seconds();
-    });
+    const auto any_tree =
+        spatial::make_kd_tree(spatial::PointView<double>(points.values.data(), points.rows, points.cols), leaf_size_);
+    build_s = build_watch.seconds();
+    std::visit(
+        [&](const auto& tree) {
+          Stopwatch query_watch;
+          counts = tree.count_box_batch(spatial::PointView<double>(boxes.values.data(), boxes.rows, boxes.cols));
+          query_s = query_watch.seconds();
+        },
+        any_tree);
     const std::vector<std::int64_t> out(counts.begin(), counts.end());
     if (!output_.empty()) io::write_npy<std::int64_t>(output_, out, {boxes.rows});
     std::size_t total = 0;

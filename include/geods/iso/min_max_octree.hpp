@@ -4,6 +4,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <string_view>
 #include <vector>
 
 #include "geods/core/grid3.hpp"
@@ -37,6 +38,11 @@ enum class VertexSharing {
   /// run in parallel and are merged into the output of the sequential descent.
   hash_table,
 };
+
+/// "block_masks" or "hash_table" (the enum value's name; "blocks" and "hash"
+/// are the deprecated spellings); throws geods::Error otherwise.
+VertexSharing parse_vertex_sharing(std::string_view name);
+std::string_view to_string(VertexSharing sharing);
 
 struct OctreeIsoResult {
   TriMesh mesh;
