@@ -48,8 +48,7 @@ class BvhCommand : public Command {
     const TriMesh mesh = io::read_mesh(mesh_);
     io::Table rays;
     if (!rays_.empty()) {
-      rays = io::read_table(rays_, "ray");
-      if (rays.cols != 6) throw Error(fmt::format("{}: rays must have 6 columns, got {}", rays_, rays.cols));
+      rays = io::read_table(rays_, "ray", 6);
     }
 
     Stopwatch build_watch;

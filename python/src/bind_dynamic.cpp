@@ -61,7 +61,7 @@ class PyDynamicKdTree {
       py::gil_scoped_release release;
       ids = std::visit([&](auto& t) { return t.insert(rows.view()); }, tree_);
     }
-    const py::array_t<std::int64_t> out = index_array(ids);
+    py::array_t<std::int64_t> out = index_array(ids);
     if (rows.single) return out.reshape(std::vector<py::ssize_t>{});
     return out;
   }

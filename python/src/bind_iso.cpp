@@ -39,7 +39,7 @@ io::AnyGrid3 volume_from(const py::array& array, const std::array<double, 3>& sp
 // Curvilinear node positions: float (nz, ny, nx, 3), x, y, z per sample.
 std::vector<Vec3f> positions_from(const py::object& coords, const std::array<std::size_t, 3>& dims) {
   if (coords.is_none()) return {};
-  const auto a = CArray<float>::ensure(coords);
+  auto a = CArray<float>::ensure(coords);
   if (!a || a.ndim() != 4 || std::size_t(a.shape(0)) != dims[2] || std::size_t(a.shape(1)) != dims[1] ||
       std::size_t(a.shape(2)) != dims[0] || a.shape(3) != 3)
     throw Error("isosurface: coords must be a float array of shape (nz, ny, nx, 3) matching the volume");

@@ -72,9 +72,7 @@ SegmentMatrix read_segments(const fs::path& path) {
   if (ext != ".edg" && ext != ".cin") {
     if (ext != ".npy" && ext != ".csv" && ext != ".txt")
       fail(path, "unsupported segment format '" + ext + "' (expected .npy, .csv, .txt, .edg or .cin)");
-    const Table t = read_table(path, "segment");
-    if (t.cols != 4) fail(path, "expected an n x 4 array of segments x0 y0 x1 y1, got " + std::to_string(t.cols) + " columns");
-    return to_matrix(t.values, 4);
+    return to_matrix(read_table(path, "segment", 4).values, 4);
   }
   const auto bytes = detail::read_file(path);
   if (bytes.empty()) fail(path, "empty file");

@@ -30,8 +30,9 @@ struct Table {
 /// In text files blank lines and lines starting with '#' are skipped and
 /// every row has as many numbers as the first. `row_name` names a row in
 /// messages ("point" gives "no points", "point 3 has a non-finite value").
+/// With `cols` > 0 a table of another width is an error, found before its values are read.
 /// Throws geods::Error naming the file (and the line) for malformed input,
 /// non-finite values or no rows.
-Table read_table(const std::filesystem::path& path, const std::string& row_name = "row");
+Table read_table(const std::filesystem::path& path, const std::string& row_name = "row", std::size_t cols = 0);
 
 }  // namespace geods::io
