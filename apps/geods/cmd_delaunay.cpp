@@ -38,6 +38,7 @@ class DelaunayCommand : public Command {
                    "Output: int64 m x 3 counter-clockwise triangles, indices into the points (duplicates map to "
                    "their first occurrence)");
     app.add_option("--svg", svg_, "Output: a picture of the triangulation");
+    app.add_option("--save", save_, "Output: the triangulation as a geods archive (Delaunay2.load reads it)");
   }
 
   void run(const RunContext&, Report& report) override {
@@ -59,6 +60,7 @@ class DelaunayCommand : public Command {
       io::write_npy<std::int64_t>(output_, tri, {dt.triangle_count(), 3});
     }
     if (!svg_.empty()) write_svg(dt);
+    if (!save_.empty()) dt.save(save_);
 
     Json& j = report.json;
     put_stats(j, stats);
@@ -84,6 +86,7 @@ class DelaunayCommand : public Command {
     report.lines.push_back(fmt::format("  built in {:.3f} s ({} flips)", build_s, stats.flips));
     if (!output_.empty()) report.lines.push_back("  wrote " + output_);
     if (!svg_.empty()) report.lines.push_back("  wrote " + svg_);
+    if (!save_.empty()) report.lines.push_back("  saved " + save_);
   }
 
  private:
@@ -128,7 +131,7 @@ class DelaunayCommand : public Command {
     svg.save(svg_);
   }
 
-  std::string points_, segments_, output_, svg_;
+  std::string points_, segments_, output_, svg_, save_;
 };
 
 const bool registered = register_command<DelaunayCommand>();

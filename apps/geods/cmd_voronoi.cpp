@@ -27,10 +27,13 @@ class VoronoiCommand : public Command {
     app.add_option("--box", box_, "Clip cells to x0,y0,x1,y1 (default: the points' bounding box grown by 25%)");
     app.add_option("--svg", svg_, "Output: a figure of the cells, edges and sites");
     app.add_option("-o,--output", output_, "Output: JSON with the box, each point's cell polygon and the edges");
+    app.add_option("--save", save_, "Output: the diagram as a geods archive (Voronoi2.load reads it; l2 only)");
   }
 
   void run(const RunContext&, Report& report) override {
     const voronoi::Metric metric = voronoi::parse_metric(metric_);
+    if (!save_.empty() && metric != voronoi::Metric::l2)
+      throw Error("--save: only the l2 diagram can be saved, not --metric " + metric_);
     const std::vector<Vec2d> points = read_points_2d(points_);
     const AABB2d box = box_.empty() ? voronoi::frame_around(points) : parse_box(box_);
 
@@ -54,6 +57,7 @@ class VoronoiCommand : public Command {
       }
       cells_s = cells_watch.seconds();
       put_stats(stats, diagram.stats());
+      if (!save_.empty()) diagram.save(save_);
     } else {
       Stopwatch build_watch;
       const voronoi::MetricVoronoi diagram(points, metric, box);
@@ -110,10 +114,11 @@ class VoronoiCommand : public Command {
     report.lines.push_back(fmt::format("  built in {:.3f} s, cells clipped in {:.3f} s", build_s, cells_s));
     if (!svg_.empty()) report.lines.push_back("  wrote " + svg_);
     if (!output_.empty()) report.lines.push_back("  wrote " + output_);
+    if (!save_.empty()) report.lines.push_back("  saved " + save_);
   }
 
  private:
-  std::string points_, metric_ = "l2", box_, svg_, output_;
+  std::string points_, metric_ = "l2", box_, svg_, output_, save_;
 };
 
 const bool registered = register_command<VoronoiCommand>();

@@ -2,6 +2,7 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
 
 #include <cstdint>
 #include <string>
@@ -150,6 +151,11 @@ new appended point (intersection_points). NaN/inf raise geods.Error (ValueError)
       .def(
           "remove", [](Delaunay2& dt, std::int64_t v) { dt.remove(vertex_index(v, dt, "Delaunay2.remove")); },
           py::arg("i"), "removes point i (not with segments)")
+      .def(
+          "save", [](const Delaunay2& dt, const std::filesystem::path& path) { dt.save(path); }, py::arg("path"),
+          "writes the triangulation to a geods archive")
+      .def_static("load", &Delaunay2::load, py::arg("path"),
+                  "reads a triangulation written by save(); insert and remove go on as before")
       .def("validate", &Delaunay2::validate, "checks every invariant; raises geods.Error on a violation")
       .def("stats", [](const Delaunay2& dt) { return stats_dict(dt.stats()); });
 }

@@ -3,6 +3,7 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
 
 #include <memory>
 #include <optional>
@@ -67,6 +68,14 @@ class PyVoronoi2 {
       diagram_ = std::make_unique<Voronoi2>(p);
     }
     box_ = box.is_none() ? diagram_->default_box() : to_box(box, "Voronoi2");
+  }
+  PyVoronoi2(Voronoi2 diagram, const py::object& box)
+      : diagram_(std::make_unique<Voronoi2>(std::move(diagram))),
+        box_(box.is_none() ? diagram_->default_box() : to_box(box, "Voronoi2")) {}
+
+  void save(const std::filesystem::path& path) const { diagram_->save(path); }
+  static PyVoronoi2 load(const std::filesystem::path& path, const py::object& box) {
+    return PyVoronoi2(Voronoi2::load(path), box);
   }
 
   py::tuple box() const { return py::make_tuple(box_.lo[0], box_.lo[1], box_.hi[0], box_.hi[1]); }
@@ -217,6 +226,9 @@ void bind_voronoi(py::module_& m) {
                          "box = (x0, y0, x1, y1) clips the cells (default: the points' bounding box grown by 25%).")
       .def(py::init<const py::handle&, const py::object&>(), py::arg("points"), py::arg("box") = py::none())
       .def("__len__", &PyVoronoi2::size)
+      .def("save", &PyVoronoi2::save, py::arg("path"), "Writes the diagram to a geods archive.")
+      .def_static("load", &PyVoronoi2::load, py::arg("path"), py::arg("box") = py::none(),
+                  "Reads a diagram written by save(); box as in the constructor.")
       .def_property_readonly("box", &PyVoronoi2::box)
       .def_property_readonly("points", &PyVoronoi2::points)
       .def_property_readonly("cells", &PyVoronoi2::cells,

@@ -159,3 +159,45 @@ def test_cli_delaunay(cli, tmp_path):
     r = subprocess.run([str(cli), "delaunay", str(tmp_path / "bad.npy"), "-o", str(out)], capture_output=True,
                        text=True)
     assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1
+
+
+def test_save_load_round_trip_and_bad_files(cli, tmp_path):
+    rng = np.random.default_rng(6)
+    pts = rng.random((400, 2))
+    pts[7] = pts[2]
+    dt = geods.Delaunay2(pts, segments=np.array([[0, 1], [3, 4]]))
+    path = tmp_path / "dt.geods"
+    dt.save(path)
+    loaded = geods.Delaunay2.load(str(path))
+    loaded.validate()
+    for name in ("triangles", "halfedges", "hull", "constrained", "inside", "points"):
+        assert np.array_equal(getattr(loaded, name), getattr(dt, name)), name
+    queries = rng.random((50, 2))
+    assert [loaded.locate(q) for q in queries] == [dt.locate(q) for q in queries]
+    assert [loaded.nearest(q) for q in queries] == [dt.nearest(q) for q in queries]
+    # Updates go on as on the original.
+    plain = geods.Delaunay2(pts)
+    plain.save(path)
+    again = geods.Delaunay2.load(path)
+    for p in rng.random((20, 2)):
+        assert again.insert(p) == plain.insert(p)
+    again.remove(5)
+    plain.remove(5)
+    again.validate()
+    assert np.array_equal(again.triangles, plain.triangles)
+    # Truncated, corrupt, wrong kind, missing: ValueError.
+    data = path.read_bytes()
+    (tmp_path / "short.geods").write_bytes(data[: len(data) // 2])
+    corrupt = bytearray(data)
+    corrupt[data.index(pts[:4].tobytes()) + 20] ^= 0xFF  # inside the points section
+    (tmp_path / "corrupt.geods").write_bytes(bytes(corrupt))
+    geods.Voronoi2(pts).save(tmp_path / "voronoi.geods")
+    for bad in ("short.geods", "corrupt.geods", "voronoi.geods", "missing.geods"):
+        with pytest.raises(ValueError):
+            geods.Delaunay2.load(tmp_path / bad)
+    # The CLI's --save writes the same triangulation.
+    np.save(tmp_path / "p.npy", pts)
+    r = subprocess.run([str(cli), "delaunay", str(tmp_path / "p.npy"), "--save", str(tmp_path / "cli.geods")],
+                       capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    assert np.array_equal(geods.Delaunay2.load(tmp_path / "cli.geods").triangles, geods.Delaunay2(pts).triangles)

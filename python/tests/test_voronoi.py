@@ -165,3 +165,25 @@ def test_cli_voronoi_and_nearest(cli, workdir):
         np.testing.assert_array_equal(d[np.arange(500), idx], best)
     bad = subprocess.run([cli, "voronoi", "p.npy", "--box", "1,1,0,0"], cwd=workdir, capture_output=True, text=True)
     assert bad.returncode == 2 and bad.stderr.count("\n") == 1
+
+
+def test_voronoi2_save_load(cli, workdir):
+    import subprocess
+
+    p = uniform(300, 10)
+    v = geods.Voronoi2(p)
+    v.save(workdir / "v.geods")
+    w = geods.Voronoi2.load(workdir / "v.geods", box=v.box)
+    w.validate()
+    assert np.array_equal(w.vertices, v.vertices) and np.array_equal(w.edges, v.edges)
+    q = np.random.default_rng(11).random((100, 2))
+    assert np.array_equal(w.nearest(q), v.nearest(q))
+    (workdir / "half.geods").write_bytes((workdir / "v.geods").read_bytes()[:500])
+    with pytest.raises(ValueError):
+        geods.Voronoi2.load(workdir / "half.geods")
+    np.save(workdir / "p2.npy", p)
+    subprocess.run([cli, "voronoi", "p2.npy", "--save", "cli.geods"], cwd=workdir, check=True, capture_output=True)
+    assert np.array_equal(geods.Voronoi2.load(workdir / "cli.geods").edges, v.edges)
+    bad = subprocess.run([cli, "voronoi", "p2.npy", "--metric", "l1", "--save", "x.geods"], cwd=workdir,
+                         capture_output=True, text=True)
+    assert bad.returncode == 2 and bad.stderr.count("\n") == 1

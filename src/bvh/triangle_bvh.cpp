@@ -14,41 +14,15 @@
 #endif
 
 #include "geods/bvh/ray_triangle4.hpp"
-#include "geods/bvh/triangle_box.hpp"
+#include "geods/bvh/traversal.hpp"
 #include "geods/core/convex_hull3.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"
 #include "geods/core/triangle.hpp"
+#include "geods/core/triangle_box.hpp"
 
 namespace geods::bvh {
 namespace {
-
-// A traversal stack: an inline buffer for the usual depths, the heap for the
-// deep trees the insertion builder can make.
-template <typename Entry>
-class TraversalStack {
- public:
-  explicit TraversalStack(std::size_t capacity) {
-    if (capacity > inline_.size()) {
-      heap_.resize(capacity);
-      data_ = heap_.data();
-    }
-  }
-  void push(const Entry& e) { data_[size_++] = e; }
-  Entry pop() { return data_[--size_]; }
-  bool empty() const { return size_ == 0; }
-
- private:
-  std::array<Entry, 256> inline_;
-  std::vector<Entry> heap_;
-  Entry* data_ = inline_.data();
-  std::size_t size_ = 0;
-};
-
-struct NodeEntry {
-  std::uint32_t node;
-  float t;
-};
 
 template <typename BV>
 BV fit_points(std::span<const Vec3f> points) {
@@ -294,6 +268,14 @@ void TriangleBvh::build_wide() {
 
 namespace {
 
+// A child of a wide node waiting to be visited: an inner node (count 0, its
+// WideNode) or a leaf (its first TriangleGroup and group count), keyed by the
+// distance at which the ray enters its box.
+struct WideEntry {
+  std::uint32_t child, count;
+  float key;
+};
+
 template <int W>
 struct SimdTypes;
 template <>
@@ -376,139 +358,87 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray, 
   const float tmin = ray.tmin;
   vf tmin_v;
   for (int i = 0; i < W; ++i) tmin_v[i] = tmin;
-  struct Entry {
-    std::uint32_t child, count;
-    float t;
-  };
-  TraversalStack<Entry> stack(std::size_t(depth_ + 2) * W);
+  TraversalStack<WideEntry> stack(traversal_stack_size(depth_, W));
   // Start fetching what a child needs; the cache misses on nodes and
   // triangles dominate incoherent rays.
-  auto prefetch = [&](const Entry& e) {
+  auto prefetch = [&](const WideEntry& e) GEODS_BVH_INLINE_LAMBDA {
     const char* p = e.count ? reinterpret_cast<const char*>(&groups_[e.child])
                             : reinterpret_cast<const char*>(&nodes[e.child]);
     __builtin_prefetch(p);
     __builtin_prefetch(p + 64);
   };
-  // The node being visited stays out of the stack: the nearest hit child is
-  // visited next, only the others are pushed.
-  Entry cur{0, 0, tmin};
-  for (;;) {
-    if (cur.count == 0) {
-      const WideNode<W>& node = nodes[cur.child];
-      vf tn = tmin_v, tf;
-      for (int i = 0; i < W; ++i) tf[i] = tmax;
-      for (int a = 0; a < 3; ++a) {
-        vf lo, hi;
-        std::memcpy(&lo, node.bounds[near_row[a]], sizeof(vf));
-        std::memcpy(&hi, node.bounds[near_row[a] ^ 1], sizeof(vf));
-        const vf t0 = (lo - org[a]) * inv[a];
-        const vf t1 = (hi - org[a]) * inv[a];
-        // Written so that a NaN t0 or t1 leaves the interval unchanged.
-        tn = t0 > tn ? t0 : tn;
-        tf = t1 < tf ? t1 : tf;
-      }
-      // Widened far bound: a box hit that rounding would lose is kept (Ize 2013).
-      const auto mask = tn <= tf * (1.0f + 4e-7f);
-      unsigned bits = lane_bits(mask);
-      if (bits != 0) {
-        const int first = __builtin_ctz(bits);
-        bits &= bits - 1;
-        if (bits == 0) {  // one child hit: no stack traffic
-          cur = {node.child[first], node.count[first], tn[first]};
-          prefetch(cur);
-          continue;
-        }
-        Entry hits[W];
-        hits[0] = {node.child[first], node.count[first], tn[first]};
-        int nh = 1;
-        for (; bits != 0; bits &= bits - 1) {
-          const int i = __builtin_ctz(bits);
-          const Entry h{node.child[i], node.count[i], tn[i]};
-          // Insertion sort, farthest first, so the nearest child is last.
-          int k = nh++;
-          while (k > 0 && hits[k - 1].t < h.t) {
-            hits[k] = hits[k - 1];
-            --k;
-          }
-          hits[k] = h;
-        }
-        for (int i = 0; i < nh; ++i) prefetch(hits[i]);
-        for (int i = 0; i + 1 < nh; ++i) stack.push(hits[i]);
-        cur = hits[nh - 1];
-        continue;
-      }
-    } else {
-      for (std::uint32_t g = cur.child; g < cur.child + cur.count; ++g) {
-        RayTriangle4Test::vf t, u, v;
-        const int mask = test.intersect(groups_[g], tmin, tmax, t, u, v);
-        if (mask == 0) continue;
-        // The nearest lane, ties to the last one: what testing the triangles
-        // one after the other, each against the shrinking tmax, would keep.
-        int best = -1;
-        for (int i = 0; i < 4; ++i)
-          if ((mask >> i & 1) && (best < 0 || t[i] <= t[best])) best = i;
-        tmax = t[best];
-        hit.t = t[best];
-        hit.u = u[best];
-        hit.v = v[best];
-        hit.prim = groups_[g].index[best];
-        if (any) return hit;
-      }
+  // The children whose boxes the ray enters before tmax, all W at once.
+  auto children = [&](const WideEntry& e, float* keys) GEODS_BVH_INLINE_LAMBDA {
+    const WideNode<W>& node = nodes[e.child];
+    vf tn = tmin_v, tf;
+    for (int i = 0; i < W; ++i) tf[i] = tmax;
+    for (int a = 0; a < 3; ++a) {
+      vf lo, hi;
+      std::memcpy(&lo, node.bounds[near_row[a]], sizeof(vf));
+      std::memcpy(&hi, node.bounds[near_row[a] ^ 1], sizeof(vf));
+      const vf t0 = (lo - org[a]) * inv[a];
+      const vf t1 = (hi - org[a]) * inv[a];
+      // Written so that a NaN t0 or t1 leaves the interval unchanged.
+      tn = t0 > tn ? t0 : tn;
+      tf = t1 < tf ? t1 : tf;
     }
-    // The next pushed node that may still hold a hit before tmax.
-    bool more = false;
-    while (!more && !stack.empty()) {
-      cur = stack.pop();
-      more = may_hit_before(cur.t, tmax);
+    std::memcpy(keys, &tn, sizeof tn);
+    // Widened far bound: a box hit that rounding would lose is kept (Ize 2013).
+    return lane_bits(tn <= tf * (1.0f + 4e-7f));
+  };
+  auto child = [&](const WideEntry& e, int i, float t) GEODS_BVH_INLINE_LAMBDA {
+    const WideEntry c{nodes[e.child].child[i], nodes[e.child].count[i], t};
+    prefetch(c);
+    return c;
+  };
+  auto leaf = [&](const WideEntry& e) GEODS_BVH_INLINE_LAMBDA {
+    for (std::uint32_t g = e.child; g < e.child + e.count; ++g) {
+      RayTriangle4Test::vf t, u, v;
+      const int mask = test.intersect(groups_[g], tmin, tmax, t, u, v);
+      if (mask == 0) continue;
+      // The nearest lane, ties to the last one: what testing the triangles
+      // one after the other, each against the shrinking tmax, would keep.
+      int best = -1;
+      for (int i = 0; i < 4; ++i)
+        if ((mask >> i & 1) && (best < 0 || t[i] <= t[best])) best = i;
+      tmax = t[best];
+      hit = {t[best], groups_[g].index[best], u[best], v[best]};
+      if (any) return false;
     }
-    if (!more) break;
-  }
+    return true;
+  };
+  traverse<W, true>(WideEntry{0, 0, tmin}, stack, [](const WideEntry& e) { return e.count != 0; }, children, child, leaf,
+                    [&](const WideEntry& e) GEODS_BVH_INLINE_LAMBDA { return may_hit_before(e.key, tmax); });
   return hit;
 }
 
 template <typename BV>
 RayHit TriangleBvh::intersect_generic(const std::vector<BV>& volumes, const Ray3f& ray, bool any) const {
   RayHit hit;
-  if (volumes.empty()) return hit;
   const RayTriangleTest<float> test(ray);
   const Vec3f inv = ray.direction.cwiseInverse();
   Ray3f clipped = ray;
-  const auto& nodes = topology_.nodes;
-  TraversalStack<NodeEntry> stack(std::size_t(depth_ + 2) * std::size_t(options_.arity));
-  const auto root = ray_interval(volumes[0], clipped, inv);
-  if (!interval_hit(root)) return hit;
-  stack.push({0, root.first});
-  while (!stack.empty()) {
-    const NodeEntry e = stack.pop();
-    if (!may_hit_before(e.t, clipped.tmax)) continue;
-    const TopoNode& node = nodes[e.node];
-    if (node.leaf()) {
-      for (std::uint32_t i = node.prim_first; i < node.prim_first + node.prim_count; ++i) {
-        const Triangle& tri = triangles_[i];
-        float t, u, v;
-        if (test.intersect(tri.a, tri.b, tri.c, ray.tmin, clipped.tmax, t, u, v)) {
-          clipped.tmax = t;
-          hit = {t, topology_.prim_order[i], u, v};
-          if (any) return hit;
+  TraversalStack<NodeRef> stack(traversal_stack_size(depth_, options_.arity));
+  traverse_topology<true>(
+      topology_, 0, stack,
+      [&](std::uint32_t node, float& t) GEODS_BVH_INLINE_LAMBDA {
+        const auto iv = ray_interval(volumes[node], clipped, inv);
+        t = iv.first;
+        return interval_hit(iv) && may_hit_before(t, clipped.tmax);
+      },
+      [&](const TopoNode& node) GEODS_BVH_INLINE_LAMBDA {
+        for (std::uint32_t i = node.prim_first; i < node.prim_first + node.prim_count; ++i) {
+          const Triangle& tri = triangles_[i];
+          float t, u, v;
+          if (test.intersect(tri.a, tri.b, tri.c, ray.tmin, clipped.tmax, t, u, v)) {
+            clipped.tmax = t;
+            hit = {t, topology_.prim_order[i], u, v};
+            if (any) return false;
+          }
         }
-      }
-      continue;
-    }
-    NodeEntry hits[8];
-    int nh = 0;
-    for (std::uint32_t c = 0; c < node.num_children; ++c) {
-      const auto iv = ray_interval(volumes[node.first_child + c], clipped, inv);
-      if (!interval_hit(iv)) continue;
-      NodeEntry h{node.first_child + c, iv.first};
-      int k = nh++;
-      while (k > 0 && hits[k - 1].t < h.t) {
-        hits[k] = hits[k - 1];
-        --k;
-      }
-      hits[k] = h;
-    }
-    for (int i = 0; i < nh; ++i) stack.push(hits[i]);
-  }
+        return true;
+      },
+      [&](float t) GEODS_BVH_INLINE_LAMBDA { return may_hit_before(t, clipped.tmax); });
   return hit;
 }
 
@@ -530,43 +460,27 @@ template <typename BV>
 ClosestPoint TriangleBvh::closest_generic(const std::vector<BV>& volumes, std::uint32_t start, const Vec3f& p,
                                           float max_distance) const {
   ClosestPoint best;
-  if (volumes.empty()) return best;
   float best_d2 = max_distance * max_distance;
-  const auto& nodes = topology_.nodes;
-  TraversalStack<NodeEntry> stack(std::size_t(depth_ + 2) * std::size_t(options_.arity));
-  stack.push({start, squared_distance(volumes[start], p)});
-  while (!stack.empty()) {
-    const NodeEntry e = stack.pop();
-    if (e.t > best_d2) continue;
-    const TopoNode& node = nodes[e.node];
-    if (node.leaf()) {
-      for (std::uint32_t i = node.prim_first; i < node.prim_first + node.prim_count; ++i) {
-        const Triangle& tri = triangles_[i];
-        const Vec3f q = closest_point_on_triangle(p, tri.a, tri.b, tri.c);
-        const float d2 = (q - p).squaredNorm();
-        if (d2 < best_d2 || (d2 == best_d2 && best.prim == RayHit::no_hit)) {
-          best_d2 = d2;
-          best.point = q;
-          best.prim = topology_.prim_order[i];
+  TraversalStack<NodeRef> stack(traversal_stack_size(depth_, options_.arity));
+  traverse_topology<true>(
+      topology_, start, stack,
+      [&](std::uint32_t node, float& d2) GEODS_BVH_INLINE_LAMBDA {
+        d2 = squared_distance(volumes[node], p);
+        return d2 <= best_d2;
+      },
+      [&](const TopoNode& node) GEODS_BVH_INLINE_LAMBDA {
+        for (std::uint32_t i = node.prim_first; i < node.prim_first + node.prim_count; ++i) {
+          const Triangle& tri = triangles_[i];
+          const Vec3f q = closest_point_on_triangle(p, tri.a, tri.b, tri.c);
+          const float d2 = (q - p).squaredNorm();
+          if (d2 < best_d2 || (d2 == best_d2 && best.prim == RayHit::no_hit)) {
+            best_d2 = d2;
+            best.point = q;
+            best.prim = topology_.prim_order[i];
+          }
         }
-      }
-      continue;
-    }
-    NodeEntry hits[8];
-    int nh = 0;
-    for (std::uint32_t c = 0; c < node.num_children; ++c) {
-      const float d2 = squared_distance(volumes[node.first_child + c], p);
-      if (d2 > best_d2) continue;
-      NodeEntry h{node.first_child + c, d2};
-      int k = nh++;
-      while (k > 0 && hits[k - 1].t < h.t) {
-        hits[k] = hits[k - 1];
-        --k;
-      }
-      hits[k] = h;
-    }
-    for (int i = 0; i < nh; ++i) stack.push(hits[i]);
-  }
+      },
+      [&](float d2) GEODS_BVH_INLINE_LAMBDA { return d2 <= best_d2; });
   if (best.prim != RayHit::no_hit) best.distance = std::sqrt(best_d2);
   return best;
 }
@@ -578,29 +492,14 @@ ClosestPoint TriangleBvh::closest_point(const Vec3f& p, float max_distance) cons
 
 template <typename Fn>
 void TriangleBvh::for_each_crossing(const Ray3f& ray, Fn&& fn) const {
-  std::visit(
-      [&](const auto& volumes) {
-        if (volumes.empty()) return;
-        const RayTriangleTest<float> test(ray);
-        const Vec3f inv = ray.direction.cwiseInverse();
-        const auto& nodes = topology_.nodes;
-        TraversalStack<std::uint32_t> stack(std::size_t(depth_ + 2) * std::size_t(options_.arity));
-        if (interval_hit(ray_interval(volumes[0], ray, inv))) stack.push(0);
-        while (!stack.empty()) {
-          const TopoNode& node = nodes[stack.pop()];
-          if (node.leaf()) {
-            for (std::uint32_t i = node.prim_first; i < node.prim_first + node.prim_count; ++i) {
-              float t, u, v;
-              if (test.intersect(triangles_[i].a, triangles_[i].b, triangles_[i].c, ray.tmin, ray.tmax, t, u, v))
-                fn(t, u, v);
-            }
-            continue;
-          }
-          for (std::uint32_t c = 0; c < node.num_children; ++c)
-            if (interval_hit(ray_interval(volumes[node.first_child + c], ray, inv))) stack.push(node.first_child + c);
-        }
-      },
-      volumes_);
+  const RayTriangleTest<float> test(ray);
+  const Vec3f inv = ray.direction.cwiseInverse();
+  visit_unordered(
+      [&](const auto& volume) { return interval_hit(ray_interval(volume, ray, inv)); },
+      [&](std::uint32_t i) {
+        float t, u, v;
+        if (test.intersect(triangles_[i].a, triangles_[i].b, triangles_[i].c, ray.tmin, ray.tmax, t, u, v)) fn(t, u, v);
+      });
 }
 
 bool TriangleBvh::contains(const Vec3f& p) const {
@@ -634,27 +533,29 @@ bool TriangleBvh::contains(const Vec3f& p) const {
 
 // ------------------------------------------------------------------ culling
 
-std::vector<std::uint32_t> TriangleBvh::cull_box(const AABB3f& box) const {
-  std::vector<std::uint32_t> out;
+template <typename Accept, typename OnTriangle>
+void TriangleBvh::visit_unordered(Accept&& accept, OnTriangle&& triangle) const {
   std::visit(
       [&](const auto& volumes) {
-        if (volumes.empty() || box.empty()) return;
-        std::vector<std::uint32_t> stack{0};
-        while (!stack.empty()) {
-          const std::uint32_t id = stack.back();
-          stack.pop_back();
-          if (!bounds(volumes[id]).overlaps(box)) continue;
-          const TopoNode& node = topology_.nodes[id];
-          if (node.leaf()) {
-            for (std::uint32_t i = node.prim_first; i < node.prim_first + node.prim_count; ++i)
-              if (triangle_box_overlap(triangles_[i].a, triangles_[i].b, triangles_[i].c, box))
-                out.push_back(topology_.prim_order[i]);
-            continue;
-          }
-          for (std::uint32_t c = 0; c < node.num_children; ++c) stack.push_back(node.first_child + c);
-        }
+        TraversalStack<NodeRef> stack(traversal_stack_size(depth_, options_.arity));
+        traverse_topology<false>(
+            topology_, 0, stack, [&](std::uint32_t node, float&) { return accept(volumes[node]); },
+            [&](const TopoNode& node) {
+              for (std::uint32_t i = node.prim_first; i < node.prim_first + node.prim_count; ++i) triangle(i);
+            },
+            [](float) { return true; });
       },
       volumes_);
+}
+
+std::vector<std::uint32_t> TriangleBvh::cull_box(const AABB3f& box) const {
+  std::vector<std::uint32_t> out;
+  if (box.empty()) return out;
+  visit_unordered([&](const auto& volume) { return bounds(volume).overlaps(box); },
+                  [&](std::uint32_t i) {
+                    if (triangle_box_overlap(triangles_[i].a, triangles_[i].b, triangles_[i].c, box))
+                      out.push_back(topology_.prim_order[i]);
+                  });
   std::sort(out.begin(), out.end());
   return out;
 }
@@ -663,32 +564,19 @@ std::vector<std::uint32_t> TriangleBvh::cull_frustum(std::span<const Plane3f> pl
   std::vector<std::uint32_t> out;
   std::vector<Plane3f> outward;
   for (const Plane3f& p : planes) outward.push_back(p.flipped());
-  std::visit(
-      [&](const auto& volumes) {
-        if (volumes.empty()) return;
-        std::vector<std::uint32_t> stack{0};
-        while (!stack.empty()) {
-          const std::uint32_t id = stack.back();
-          stack.pop_back();
-          bool culled = false;
-          for (const Plane3f& p : outward) culled = culled || above(volumes[id], p);
-          if (culled) continue;
-          const TopoNode& node = topology_.nodes[id];
-          if (node.leaf()) {
-            for (std::uint32_t i = node.prim_first; i < node.prim_first + node.prim_count; ++i) {
-              const Triangle& t = triangles_[i];
-              bool outside = false;
-              for (const Plane3f& p : planes)
-                outside = outside || (p.signed_distance(t.a) < 0 && p.signed_distance(t.b) < 0 &&
-                                      p.signed_distance(t.c) < 0);
-              if (!outside) out.push_back(topology_.prim_order[i]);
-            }
-            continue;
-          }
-          for (std::uint32_t c = 0; c < node.num_children; ++c) stack.push_back(node.first_child + c);
-        }
+  visit_unordered(
+      [&](const auto& volume) {
+        bool culled = false;
+        for (const Plane3f& p : outward) culled = culled || above(volume, p);
+        return !culled;
       },
-      volumes_);
+      [&](std::uint32_t i) {
+        const Triangle& t = triangles_[i];
+        bool outside = false;
+        for (const Plane3f& p : planes)
+          outside = outside || (p.signed_distance(t.a) < 0 && p.signed_distance(t.b) < 0 && p.signed_distance(t.c) < 0);
+        if (!outside) out.push_back(topology_.prim_order[i]);
+      });
   std::sort(out.begin(), out.end());
   return out;
 }

@@ -11,7 +11,7 @@
 #include "geods/core/parallel.hpp"
 #include "mailbox.hpp"
 #include "box_margin.hpp"
-#include "geods/bvh/triangle_box.hpp"
+#include "geods/core/triangle_box.hpp"
 #include "geods/core/triangle.hpp"
 
 namespace geods::ray {
@@ -78,7 +78,7 @@ std::unique_ptr<RayOctree> RayOctree::build(const TriMesh& mesh, const Accelerat
         for (int c = 0; c < 8; ++c) {
           // Child c takes the upper half of the axes whose bit is set in c.
           if ((c & ~hi_bits & 7) != 0 || (~c & ~lo_bits & 7) != 0) continue;
-          if (single || bvh::triangle_box_overlap(corners[0], corners[1], corners[2], boxes[c]))
+          if (single || triangle_box_overlap(corners[0], corners[1], corners[2], boxes[c]))
             children[k][c].push_back(t);
         }
       }

@@ -12,7 +12,7 @@
 #include "geods/core/parallel.hpp"
 #include "mailbox.hpp"
 #include "box_margin.hpp"
-#include "geods/bvh/triangle_box.hpp"
+#include "geods/core/triangle_box.hpp"
 #include "geods/core/triangle.hpp"
 
 namespace geods::ray {
@@ -85,7 +85,7 @@ std::unique_ptr<UniformGrid> UniformGrid::build(const TriMesh& mesh, const Accel
             if (!single) {
               const Vec3f cell_lo = g.grid_bounds_.lo + Vec3f(float(x), float(y), float(z)).cwiseProduct(g.cell_size_);
               const AABB3f cell_box(cell_lo, cell_lo + g.cell_size_);
-              if (!bvh::triangle_box_overlap(corners[0], corners[1], corners[2],
+              if (!triangle_box_overlap(corners[0], corners[1], corners[2],
                                                  detail::widened(cell_box, g.margin_)))
                 continue;
             }

@@ -1,4 +1,6 @@
-// Simultaneous traversal against all pairs.
+// The one-tree traversal against brute force (unordered sphere query,
+// ordered nearest triangle box, stopping, degenerate trees) and the
+// simultaneous traversal against all pairs.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -10,6 +12,104 @@
 
 namespace geods::bvh {
 namespace {
+
+AABB3f triangle_box(const TriMesh& m, std::size_t t) {
+  AABB3f box;
+  for (int k = 0; k < 3; ++k) box.extend(test::corner(m, t, k));
+  return box;
+}
+
+// Every triangle whose box meets a ball, unordered: exactly the brute-force set.
+TEST(Traversal, UnorderedQueryReachesExactlyTheAcceptedLeaves) {
+  const TriMesh soup = test::random_soup(3000, 71);
+  Rng rng(72);
+  for (int arity : {2, 4, 8}) {
+    BuildOptions options;
+    options.arity = arity;
+    options.builder = arity == 2 ? Builder::insertion : Builder::sah;  // insertion: deep trees, heap stack
+    const TriangleBvh bvh = TriangleBvh::build(soup, options);
+    const auto& boxes = std::get<std::vector<AABB3f>>(bvh.volumes());
+    for (int q = 0; q < 30; ++q) {
+      const Vec3f c = test::random_point(rng, -1.2f, 1.2f);
+      const float r2 = float(rng.uniform(0.0, 0.3));
+      std::vector<std::uint32_t> expected, found;
+      for (std::size_t t = 0; t < soup.num_triangles(); ++t)
+        if (triangle_box(soup, t).squared_distance(c) <= r2) expected.push_back(std::uint32_t(t));
+      TraversalStack<NodeRef> stack(traversal_stack_size(bvh.topology().depth(), arity));
+      const bool finished = traverse_topology<false>(
+          bvh.topology(), 0, stack, [&](std::uint32_t node, float&) { return boxes[node].squared_distance(c) <= r2; },
+          [&](const TopoNode& leaf) {
+            for (std::uint32_t i = leaf.prim_first; i < leaf.prim_first + leaf.prim_count; ++i) {
+              const std::uint32_t t = bvh.triangle_ids()[i];
+              if (triangle_box(soup, t).squared_distance(c) <= r2) found.push_back(t);
+            }
+          },
+          [](float) { return true; });
+      EXPECT_TRUE(finished);
+      std::sort(found.begin(), found.end());
+      ASSERT_EQ(found, expected) << "arity " << arity << " query " << q;
+    }
+  }
+}
+
+// Ordered by distance with pruning: the nearest triangle box; a leaf is only
+// visited while it may hold something nearer than the best so far, so most
+// leaves are never visited.
+TEST(Traversal, OrderedQueryFindsTheNearestAndVisitsLeavesNearFirst) {
+  const TriMesh soup = test::random_soup(3000, 73);
+  Rng rng(74);
+  for (int arity : {2, 4}) {
+    BuildOptions options;
+    options.arity = arity;
+    const TriangleBvh bvh = TriangleBvh::build(soup, options);
+    const auto& boxes = std::get<std::vector<AABB3f>>(bvh.volumes());
+    TraversalStack<NodeRef> stack(traversal_stack_size(bvh.topology().depth(), arity));
+    const int total_leaves = int(bvh.stats().leaves);
+    for (int q = 0; q < 50; ++q) {
+      const Vec3f c = test::random_point(rng, -2, 2);
+      float want = std::numeric_limits<float>::infinity();
+      for (std::size_t t = 0; t < soup.num_triangles(); ++t) want = std::min(want, triangle_box(soup, t).squared_distance(c));
+      float best = std::numeric_limits<float>::infinity();
+      int leaves = 0;
+      traverse_topology<true>(
+          bvh.topology(), 0, stack,
+          [&](std::uint32_t node, float& d2) {
+            d2 = boxes[node].squared_distance(c);
+            return d2 <= best;
+          },
+          [&](const TopoNode& leaf) {
+            ++leaves;
+            EXPECT_LE(boxes[std::size_t(&leaf - bvh.topology().nodes.data())].squared_distance(c), best);
+            for (std::uint32_t i = leaf.prim_first; i < leaf.prim_first + leaf.prim_count; ++i)
+              best = std::min(best, triangle_box(soup, bvh.triangle_ids()[i]).squared_distance(c));
+          },
+          [&](float d2) { return d2 <= best; });
+      ASSERT_EQ(best, want) << q;
+      EXPECT_LT(leaves * 4, total_leaves) << "pruning";
+    }
+  }
+}
+
+TEST(Traversal, StopsWhenTheLeafCallbackSaysSoAndHandlesTinyTrees) {
+  const TriMesh soup = test::random_soup(500, 75);
+  const TriangleBvh bvh = TriangleBvh::build(soup);
+  TraversalStack<NodeRef> stack(traversal_stack_size(bvh.topology().depth(), 4));
+  int calls = 0;
+  auto all = [](std::uint32_t, float&) { return true; };
+  auto keep = [](float) { return true; };
+  EXPECT_FALSE(traverse_topology<false>(bvh.topology(), 0, stack, all, [&](const TopoNode&) { return ++calls < 3; }, keep));
+  EXPECT_EQ(calls, 3);
+  // No nodes, a rejected root, a single leaf.
+  calls = 0;
+  EXPECT_TRUE(traverse_topology<true>(Topology{}, 0, stack, all, [&](const TopoNode&) { ++calls; }, keep));
+  EXPECT_TRUE(traverse_topology<true>(bvh.topology(), 0, stack, [](std::uint32_t, float&) { return false; },
+                                      [&](const TopoNode&) { ++calls; }, keep));
+  EXPECT_EQ(calls, 0);
+  const TriMesh one = test::random_soup(1, 76);
+  const TriangleBvh single = TriangleBvh::build(one);
+  EXPECT_TRUE(traverse_topology<true>(single.topology(), 0, stack, all, [&](const TopoNode& leaf) { calls += leaf.prim_count; }, keep));
+  EXPECT_EQ(calls, 1);
+}
 
 // Every pair of triangles whose own fitted volumes overlap must be reached:
 // the volumes of their ancestors contain those.

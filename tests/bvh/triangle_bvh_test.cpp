@@ -5,9 +5,9 @@
 #include <tuple>
 
 #include "bvh_test_util.hpp"
-#include "geods/bvh/triangle_box.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"
+#include "geods/core/triangle_box.hpp"
 
 namespace geods::bvh {
 namespace {
@@ -230,45 +230,6 @@ TEST(TriangleBvh, BoxAndFrustumCullingMatchBruteForce) {
       ASSERT_EQ(bvh.cull_frustum(planes), expected);
     }
   }
-}
-
-// An independent oracle for the triangle-box test: clip the triangle by the
-// six box planes; it overlaps iff something is left.
-bool clipped_nonempty(const Vec3f& a, const Vec3f& b, const Vec3f& c, const AABB3f& box) {
-  std::vector<Vec3d> poly = {a.cast<double>(), b.cast<double>(), c.cast<double>()};
-  for (int axis = 0; axis < 3; ++axis)
-    for (int side = 0; side < 2; ++side) {
-      std::vector<Vec3d> out;
-      auto inside = [&](const Vec3d& p) { return side ? p[axis] <= box.hi[axis] : p[axis] >= box.lo[axis]; };
-      const double plane = side ? box.hi[axis] : box.lo[axis];
-      for (std::size_t i = 0; i < poly.size(); ++i) {
-        const Vec3d& p = poly[i];
-        const Vec3d& q = poly[(i + 1) % poly.size()];
-        if (inside(p)) out.push_back(p);
-        if (inside(p) != inside(q)) {
-          Vec3d x = p + (plane - p[axis]) / (q[axis] - p[axis]) * (q - p);
-          x[axis] = plane;
-          out.push_back(x);
-        }
-      }
-      poly = out;
-      if (poly.empty()) return false;
-    }
-  return true;
-}
-
-TEST(TriangleBox, AgreesWithPolygonClipping) {
-  Rng rng(31);
-  int overlapping = 0;
-  for (int i = 0; i < 20000; ++i) {
-    const Vec3f a = test::random_point(rng, -1, 1), b = test::random_point(rng, -1, 1), c = test::random_point(rng, -1, 1);
-    const Vec3f lo = test::random_point(rng, -1, 0.5f);
-    const AABB3f box(lo, lo + test::random_point(rng, 0.01f, 0.5f));
-    const bool expected = clipped_nonempty(a, b, c, box);
-    ASSERT_EQ(triangle_box_overlap(a, b, c, box), expected) << i;
-    overlapping += expected;
-  }
-  EXPECT_GT(overlapping, 1000);
 }
 
 TEST(TriangleBvh, ParallelBuildIsDeterministic) {

@@ -1,9 +1,12 @@
 #pragma once
-// Simultaneous traversal of two hierarchies (seed §4.2's traverse(A, B)):
-// node pairs are opened while a predicate says they may interact, and every
-// surviving pair of leaves is handed to a callback. The predicate sees node
-// indices, so it can test any volumes under any relative transformation;
-// collision detection builds on this.
+// Traversal of hierarchies, generic over what happens at inner nodes and
+// leaves (madmann91/bvh v2's shape): one depth-first loop, `traverse`, over
+// any node layout (the Topology of any bounding volume through
+// `traverse_topology`, the wide SIMD nodes of TriangleBvh), every query a
+// small callback on it; and the simultaneous traversal of two hierarchies
+// (seed §4.2's traverse(A, B)) that collision detection builds on.
+#include <array>
+#include <cstddef>
 #include <cstdint>
 #include <type_traits>
 #include <utility>
@@ -11,12 +14,168 @@
 
 #include "geods/bvh/topology.hpp"
 
+// The traversal loops and their callbacks are the hot path of the ray
+// queries: they must melt into one function.
+// GEODS_BVH_INLINE_LAMBDA goes after a lambda's parameter list.
+#if defined(__GNUC__)
+#define GEODS_BVH_INLINE_LAMBDA __attribute__((always_inline))
+#else
+#define GEODS_BVH_INLINE_LAMBDA
+#endif
+#define GEODS_BVH_INLINE inline GEODS_BVH_INLINE_LAMBDA
+
 namespace geods::bvh {
+
+/// The stack a caller hands to `traverse`: an inline buffer for the usual
+/// depths, the heap for the deep trees the insertion builder can make.
+/// `capacity` must bound the pending entries: (depth + 2) x arity suffices.
+template <typename Entry>
+class TraversalStack {
+ public:
+  explicit TraversalStack(std::size_t capacity) {
+    if (capacity > inline_.size()) {
+      heap_.resize(capacity);
+      data_ = heap_.data();
+    }
+  }
+  TraversalStack(const TraversalStack&) = delete;
+  TraversalStack& operator=(const TraversalStack&) = delete;
+  void push(const Entry& e) { data_[size_++] = e; }
+  Entry pop() { return data_[--size_]; }
+  bool empty() const { return size_ == 0; }
+  void clear() { size_ = 0; }
+
+ private:
+  std::array<Entry, 256> inline_;
+  std::vector<Entry> heap_;
+  Entry* data_ = inline_.data();
+  std::size_t size_ = 0;
+};
+
+namespace detail {
+// A callback returning void never stops; one returning bool stops on false.
+template <typename Fn, typename... Args>
+GEODS_BVH_INLINE bool keep_going(Fn& fn, Args&&... args) {
+  if constexpr (std::is_same_v<decltype(fn(std::forward<Args>(args)...)), bool>) {
+    return fn(std::forward<Args>(args)...);
+  } else {
+    fn(std::forward<Args>(args)...);
+    return true;
+  }
+}
+}  // namespace detail
+
+/// Depth-first traversal from `root` (already accepted), on `stack` (cleared
+/// first: a stopped traversal leaves entries behind), over any node layout
+/// whose entries (the nodes waiting to be visited) have a float `key`:
+/// - is_leaf(e): whether entry e is a leaf;
+/// - children(e, keys): the children of inner node e to visit, as a bit mask
+///   (bit i: child i, at most MaxChildren), keys[i] the key child i is
+///   ordered by (an entry distance, ...);
+/// - child(e, i, key): the entry of child i of e (a good place to prefetch it).
+/// With Ordered the nearest child (smallest key) is visited next, the others
+/// wait on `stack` farthest first; children of equal keys, and all children
+/// without Ordered, are visited last first. A node with one child to visit
+/// goes on to it without stack traffic. A leaf goes to leaf(e), which returns
+/// void, or bool: false stops the traversal. A waiting entry is visited only
+/// if still_needed(e) when its turn comes (a closer hit may have been found
+/// since). Returns false if leaf stopped it. `stack` must hold (depth + 2) x
+/// MaxChildren entries. Cost: proportional to the nodes visited.
+template <int MaxChildren, bool Ordered, typename Entry, typename IsLeaf, typename Children, typename Child,
+          typename Leaf, typename StillNeeded>
+GEODS_BVH_INLINE bool traverse(Entry root, TraversalStack<Entry>& stack, IsLeaf&& is_leaf, Children&& children,
+                               Child&& child, Leaf&& leaf, StillNeeded&& still_needed) {
+  static_assert(MaxChildren >= 2 && MaxChildren <= 32, "children are reported as 32-bit masks");
+  stack.clear();
+  Entry cur = root;
+  for (;;) {
+    if (!is_leaf(cur)) {
+      float keys[MaxChildren];
+      unsigned bits = children(cur, keys);
+      if (bits != 0) {
+        const int first = __builtin_ctz(bits);
+        bits &= bits - 1;
+        if (bits == 0) {
+          cur = child(cur, first, keys[first]);
+          continue;
+        }
+        Entry visit[MaxChildren];  // farthest first: the last one is visited next
+        visit[0] = child(cur, first, keys[first]);
+        int n = 1;
+        for (; bits != 0; bits &= bits - 1) {
+          const int i = __builtin_ctz(bits);
+          const Entry e = child(cur, i, keys[i]);
+          int k = n++;
+          if constexpr (Ordered) {  // insertion sort: at most MaxChildren
+            while (k > 0 && visit[k - 1].key < keys[i]) {
+              visit[k] = visit[k - 1];
+              --k;
+            }
+          }
+          visit[k] = e;
+        }
+        for (int i = 0; i + 1 < n; ++i) stack.push(visit[i]);
+        cur = visit[n - 1];
+        continue;
+      }
+    } else if (!detail::keep_going(leaf, cur)) {
+      return false;
+    }
+    bool more = false;
+    while (!more && !stack.empty()) {
+      cur = stack.pop();
+      more = still_needed(cur);
+    }
+    if (!more) return true;
+  }
+}
+
+/// A node of a Topology waiting to be visited, with the key it is ordered by
+/// (the entry distance along a ray, a squared distance to a point, ...).
+struct NodeRef {
+  std::uint32_t node;
+  float key;
+};
+
+/// Stack capacity for `traverse` over a tree of this depth (Topology::depth())
+/// and arity (at most arity - 1 entries wait per level).
+inline std::size_t traversal_stack_size(int depth, int arity) { return std::size_t(depth + 2) * std::size_t(arity); }
+
+/// `traverse` over a Topology from node `start` (0: the root). accept(node,
+/// key) says whether a node may matter (testing its bounding volume; the
+/// root too) and sets its key; with Ordered the accepted children are visited
+/// nearest (smallest key) first. leaf(const TopoNode&) sees the leaf's
+/// primitive range and returns void or bool (false stops); still_needed(key)
+/// re-checks a waiting node. Returns false if leaf stopped the traversal.
+template <bool Ordered, typename Accept, typename Leaf, typename StillNeeded>
+GEODS_BVH_INLINE bool traverse_topology(const Topology& topology, std::uint32_t start, TraversalStack<NodeRef>& stack,
+                                        Accept&& accept, Leaf&& leaf, StillNeeded&& still_needed) {
+  NodeRef root{start, 0.0f};
+  if (topology.nodes.empty() || !accept(start, root.key)) return true;
+  const TopoNode* nodes = topology.nodes.data();
+  return traverse<8, Ordered>(
+      root, stack, [&](const NodeRef& e) GEODS_BVH_INLINE_LAMBDA { return nodes[e.node].leaf(); },
+      [&](const NodeRef& e, float* keys) GEODS_BVH_INLINE_LAMBDA {
+        const TopoNode& node = nodes[e.node];
+        unsigned bits = 0;
+        for (std::uint32_t c = 0; c < node.num_children; ++c) {
+          keys[c] = 0.0f;  // for an accept that leaves the key alone
+          if (accept(node.first_child + c, keys[c])) bits |= 1u << c;
+        }
+        return bits;
+      },
+      [&](const NodeRef& e, int i, float key) GEODS_BVH_INLINE_LAMBDA {
+        return NodeRef{nodes[e.node].first_child + std::uint32_t(i), key};
+      },
+      [&](const NodeRef& e) GEODS_BVH_INLINE_LAMBDA { return leaf(nodes[e.node]); },
+      [&](const NodeRef& e) GEODS_BVH_INLINE_LAMBDA { return still_needed(e.key); });
+}
 
 /// Calls node_pair(i, j) for node i of `a` and node j of `b`, starting at the
 /// roots; a pair it accepts is refined (the node covering more primitives is
 /// opened; two leaves go to leaf_pair(i, j)). leaf_pair returns void, or bool:
 /// false stops the whole traversal. Returns false if it was stopped.
+/// A loop of its own: it walks pairs, in no order, to an unknown depth.
 /// Cost: proportional to the accepted node pairs.
 template <typename NodePair, typename LeafPair>
 bool traverse_simultaneously(const Topology& a, const Topology& b, NodePair&& node_pair, LeafPair&& leaf_pair) {
@@ -29,11 +188,7 @@ bool traverse_simultaneously(const Topology& a, const Topology& b, NodePair&& no
     const TopoNode& na = a.nodes[i];
     const TopoNode& nb = b.nodes[j];
     if (na.leaf() && nb.leaf()) {
-      if constexpr (std::is_same_v<decltype(leaf_pair(i, j)), bool>) {
-        if (!leaf_pair(i, j)) return false;
-      } else {
-        leaf_pair(i, j);
-      }
+      if (!detail::keep_going(leaf_pair, i, j)) return false;
       continue;
     }
     const bool open_a = !na.leaf() && (nb.leaf() || na.prim_count >= nb.prim_count);

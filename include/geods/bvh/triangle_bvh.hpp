@@ -12,7 +12,7 @@
 
 #include "geods/bvh/aabb_bv.hpp"
 #include "geods/bvh/build_options.hpp"
-#include "geods/bvh/huge_page_allocator.hpp"
+#include "geods/core/huge_page_allocator.hpp"
 #include "geods/bvh/kdop.hpp"
 #include "geods/bvh/obb.hpp"
 #include "geods/bvh/ray_triangle4.hpp"
@@ -118,6 +118,10 @@ class TriangleBvh {
                                float max_distance) const;
   template <typename Fn>
   void for_each_crossing(const Ray3f& ray, Fn&& fn) const;
+  // triangle(leaf-order index) for every triangle in a leaf whose volumes
+  // (the root's too) all pass accept(volume), in no particular order.
+  template <typename Accept, typename OnTriangle>
+  void visit_unordered(Accept&& accept, OnTriangle&& triangle) const;
   template <typename BV>
   void fit_volumes();
   void fit_hull_obbs();

@@ -7,12 +7,14 @@
 // next(e) = e % 3 == 2 ? e - 2 : e + 1; halfedges()[e] is the opposite half-edge
 // or no_edge on the convex hull. Triangles are counter-clockwise.
 //
-// Internally the triangulation is closed by a "ghost" vertex at infinity: every
-// hull edge has a ghost triangle on its outer side (seed §5.2's infinite
-// triangles), so insertion outside the hull, on the hull and inside are the same
-// two operations (split a triangle or an edge, then flip). The public arrays are
-// the finite triangles only, renumbered densely after each construction,
-// insert() and remove().
+// Internally the triangulation is a DelaunayCore (delaunay_core.hpp), closed by
+// a "ghost" vertex at infinity: every hull edge has a ghost triangle on its
+// outer side (seed §5.2's infinite triangles), so insertion outside the hull, on
+// the hull and inside are the same steps (walk, split a triangle or an edge,
+// flip). Constrained edges, the history DAG and removal are parts of their own
+// beside the core (src/voronoi/constrained_delaunay, history_dag,
+// vertex_removal). The public arrays are the finite triangles only, renumbered
+// densely after each construction, insert() and remove().
 //
 // Order of insertion: BRIO (biased randomized insertion order: random rounds of
 // doubling size, each sorted along a Hilbert curve); each point is located by a
@@ -27,12 +29,13 @@
 // geods::Error.
 #include <array>
 #include <cstdint>
-#include <initializer_list>
+#include <filesystem>
 #include <span>
 #include <string>
 #include <vector>
 
 #include "geods/core/vec.hpp"
+#include "geods/voronoi/delaunay_core.hpp"
 
 namespace geods::voronoi {
 
@@ -157,6 +160,20 @@ class Delaunay2 {
   /// then v is cut out at degree 3. O(d^2) for degree d plus O(n) renumbering.
   void remove(std::uint32_t v);
 
+  /// Writes the triangulation to `path` as a geods archive (core/archive.hpp,
+  /// kind "voronoi.Delaunay2"): points, segments and the internal arrays.
+  /// Throws geods::Error naming the file if it cannot be written.
+  void save(const std::filesystem::path& path) const;
+  /// A triangulation equal to the one save()d to `path`: the same arrays, the
+  /// same answers, and insert() and remove() go on as they would have (the
+  /// mapped arrays are copied into the triangulation's own); O(n). Throws
+  /// geods::Error naming the file if it is missing, truncated, corrupt (the
+  /// checksums), of another kind or version, or its arrays are not a closed
+  /// triangulation of its points (validate()'s checks but the geometric ones,
+  /// incircle and the segments' paths, which a checksummed file written by
+  /// save() cannot fail).
+  static Delaunay2 load(const std::filesystem::path& path);
+
   Delaunay2Stats stats() const;
   /// Checks every invariant; throws geods::Error naming the first violation:
   /// twins consistent, triangles counter-clockwise, every edge locally Delaunay
@@ -165,49 +182,22 @@ class Delaunay2 {
   void validate() const;
 
  private:
-  static constexpr std::uint32_t kGhost = std::uint32_t(-2);  // the vertex at infinity
-  static constexpr std::uint32_t kGhostBit = 1u << 31;         // set in kGhost, never in a vertex
-
-  enum class Where { inside, on_edge, on_vertex, outside };
-  struct Location {
-    Where where;
-    std::uint32_t edge;  // inside: any half-edge of the triangle; on_edge: the edge;
-                         // on_vertex: a half-edge leaving the vertex; outside: the ghost triangle's hull half-edge
-  };
-
   void init(std::span<const Vec2d> points, std::span<const Segment> segments, Options options);
   void build(Options options);
-  void insert_constraints();
-  void insert_segment(std::uint32_t a, std::uint32_t b, std::vector<std::pair<std::uint32_t, std::uint32_t>>& pending);
-  void split_crossing(std::uint32_t a, std::uint32_t b, std::uint32_t crossing,
-                      std::vector<std::pair<std::uint32_t, std::uint32_t>>& pending);
-  void mark_fixed(std::uint32_t e);
-  std::uint32_t add_history_node(std::uint32_t tri);
-  bool history_contains(std::uint32_t node, const Vec2d& q) const;
-  std::uint32_t history_locate(const Vec2d& q) const;
-  void note_vertex_edges(std::initializer_list<std::uint32_t> half_edges);
+  template <class Location>
+  void insert_all(Location& location);
   void build_degenerate();
-  std::vector<std::uint32_t> insertion_order(std::uint64_t seed) const;
-  bool make_first_triangle();
-  void insert_vertex(std::uint32_t i, std::uint32_t start_tri);
-  Location walk(const Vec2d& p, std::uint32_t start_tri, std::size_t* steps) const;
-  bool in_conflict(std::uint32_t tri, const Vec2d& p) const;
-  std::uint32_t new_triangle();
-  void link(std::uint32_t a, std::uint32_t b) {
-    twin_[a] = b;
-    twin_[b] = a;
-  }
-  void split_triangle(std::uint32_t e, std::uint32_t p);
-  void split_edge(std::uint32_t e, std::uint32_t p);
-  void legalize(std::uint32_t p);
-  void flip(std::uint32_t e);
-  bool remove_by_flips(std::uint32_t v);
+  std::uint32_t add_vertex(std::uint32_t i);  // appends an internal vertex for point i
+  template <class Hooks>
+  void insert_vertex(std::uint32_t k, std::uint32_t start, Hooks& hooks);
+  void insert_constraints();
   void publish();
-  std::uint32_t finite_triangle_near(std::uint32_t tri) const;
-  bool is_ghost_triangle(std::uint32_t t) const {
-    return ((vert_[3 * t] | vert_[3 * t + 1] | vert_[3 * t + 2]) & kGhostBit) != 0;
-  }
-  const Vec2d& at(std::uint32_t v) const { return coords_[v]; }
+  struct TriangleCounts {
+    std::size_t live, ghosts;
+  };
+  // validate()'s first parts, safe on any arrays of the right sizes: what load() checks.
+  std::size_t check_representatives() const;  // returns the number of distinct vertices
+  TriangleCounts check_triangles() const;
 
   Options options_;
   std::vector<Vec2d> points_;
@@ -215,41 +205,21 @@ class Delaunay2 {
   std::vector<std::uint32_t> intersections_;
   std::vector<std::uint32_t> rep_;  // representative per point, no_edge when removed
 
-  // Vertices are numbered internally in insertion order, their coordinates
-  // copied in that order, so that the spatially sorted insertion reads memory
-  // sequentially.
-  std::vector<Vec2d> coords_;              // per internal vertex
+  // The closed triangulation. Its vertices are numbered in insertion order,
+  // their coordinates copied in that order, so that the spatially sorted
+  // insertion reads memory sequentially.
+  DelaunayCore core_;
   std::vector<std::uint32_t> original_of_;  // internal vertex -> the point it stands for
   std::vector<std::uint32_t> internal_of_;  // point -> its internal vertex, no_edge if removed
-
-  // The closed triangulation with ghost triangles: 3 vertices and 3 twins per triangle.
-  std::vector<std::uint32_t> vert_, twin_;
-  std::vector<std::uint32_t> free_triangles_;  // slots freed by remove(); their vert_ are no_edge
-  std::vector<std::uint32_t> vertex_edge_;     // per internal vertex: a half-edge leaving it, or no_edge
-  std::vector<std::uint32_t> flip_stack_;
+  std::vector<std::uint8_t> fixed_;         // per internal half-edge: on a segment (only with segments)
   bool has_constraints_ = false;
-  // History DAG (construction with history_dag only): a node per triangle ever
-  // created, its children the triangles that replaced it.
-  struct HistoryNode {
-    std::uint32_t vertex[3];
-    std::uint32_t child[3];
-    std::uint32_t triangle;  // the triangle slot while the node is a leaf
-  };
-  bool history_ = false;
-  std::vector<HistoryNode> history_nodes_;
-  std::vector<std::uint32_t> triangle_node_;  // per triangle slot: its leaf node
-  Vec2d history_center_{0, 0};                // a point strictly inside the first triangle
   std::size_t dag_nodes_ = 0;
-  std::vector<std::uint8_t> fixed_;  // per internal half-edge: on a segment (only with segments)
-  std::uint32_t last_triangle_ = 0;  // where the next walk starts
-  std::uint32_t walk_seed_ = 1;
 
   // The public, finite-only view.
   std::vector<std::uint32_t> triangles_, halfedges_, hull_;
   std::vector<std::uint8_t> constrained_;
   std::vector<std::uint32_t> public_triangle_;  // internal triangle -> public index or no_edge
   std::vector<std::uint32_t> internal_triangle_;  // public -> internal
-  std::size_t flips_ = 0, walk_steps_ = 0;
 };
 
 }  // namespace geods::voronoi

@@ -19,6 +19,7 @@
 // Cells are convex polygons; cell_polygon(i, box) clips one to a box.
 // Size: at most 2n - 5 vertices and 3n - 6 edges for n distinct sites.
 #include <cstdint>
+#include <filesystem>
 #include <optional>
 #include <utility>
 #include <span>
@@ -106,6 +107,14 @@ class Voronoi2 {
   /// The part of half-edge e inside `box` (from its origin side to its target side), if any.
   std::optional<std::pair<Vec2d, Vec2d>> clipped_edge(std::uint32_t e, const AABB2d& box) const;
 
+  /// Writes the diagram to `path` as a geods archive (core/archive.hpp, kind
+  /// "voronoi.Voronoi2"). Throws geods::Error naming the file if it cannot be written.
+  void save(const std::filesystem::path& path) const;
+  /// The diagram save()d to `path` (its arrays copied from the mapped file).
+  /// Throws geods::Error naming the file if it is missing, truncated, corrupt,
+  /// of another kind or version, or fails validate().
+  static Voronoi2 load(const std::filesystem::path& path);
+
   Voronoi2Stats stats() const;
   /// Checks twins, next cycles, that each cell's cycle holds only its site,
   /// that every finite vertex is equidistant from the sites of its edges, and
@@ -113,6 +122,7 @@ class Voronoi2 {
   void validate() const;
 
  private:
+  Voronoi2() = default;  // for load()
   void build_dual(std::span<const std::uint32_t> triangles, std::span<const std::uint32_t> halfedges);
   void build_collinear();
   void build_neighbors(std::span<const std::uint32_t> triangles);

@@ -5,11 +5,15 @@
 #include <numeric>
 #include <vector>
 
-#include "geods/bvh/huge_page_allocator.hpp"
-#include "geods/bvh/wide_node.hpp"
+#include "geods/core/huge_page_allocator.hpp"
 
-namespace geods::bvh {
+namespace geods {
 namespace {
+
+// A type aligned to a cache line, like the wide BVH nodes the allocator serves.
+struct alignas(64) CacheLine {
+  float data[32];
+};
 
 TEST(HugePageAllocator, LargeBlocksAreHugePageAlignedAndSmallOnesTypeAligned) {
   std::vector<std::uint32_t, HugePageAllocator<std::uint32_t>> large(std::size_t(3) << 20);  // 12 MiB
@@ -17,11 +21,11 @@ TEST(HugePageAllocator, LargeBlocksAreHugePageAlignedAndSmallOnesTypeAligned) {
   EXPECT_EQ(reinterpret_cast<std::uintptr_t>(large.data()) % HugePageAllocator<int>::kHugePage, 0u);
   EXPECT_EQ(large.back(), std::uint32_t((std::size_t(3) << 20) - 1));
 
-  std::vector<WideNode<4>, HugePageAllocator<WideNode<4>>> small(3);
-  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(small.data()) % alignof(WideNode<4>), 0u);
+  std::vector<CacheLine, HugePageAllocator<CacheLine>> small(3);
+  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(small.data()) % alignof(CacheLine), 0u);
   small.resize(10000);  // 1.2 MiB: moves to a huge-page block
   EXPECT_EQ(reinterpret_cast<std::uintptr_t>(small.data()) % HugePageAllocator<int>::kHugePage, 0u);
 }
 
 }  // namespace
-}  // namespace geods::bvh
+}  // namespace geods

@@ -6,7 +6,7 @@
 
 #include "geods/core/aabb.hpp"
 
-namespace geods::bvh {
+namespace geods {
 
 template <typename T>
 bool triangle_box_overlap(const Vec<T, 3>& a, const Vec<T, 3>& b, const Vec<T, 3>& c, const AABB<T, 3>& box) {
@@ -30,4 +30,4 @@ bool triangle_box_overlap(const Vec<T, 3>& a, const Vec<T, 3>& b, const Vec<T, 3
   return true;
 }
 
-}  // namespace geods::bvh
+}  // namespace geods

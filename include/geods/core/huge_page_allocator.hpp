@@ -1,6 +1,6 @@
 #pragma once
-// A std::vector allocator for the large arrays that ray traversal reads at
-// random (wide nodes, triangle groups): blocks of 1 MiB or more are 2 MiB
+// A std::vector allocator for large arrays that queries read at random (the
+// wide nodes and triangle groups of bvh::TriangleBvh): blocks of 1 MiB or more are 2 MiB
 // aligned (and sized) and, on Linux, advised to use transparent huge pages, so that an
 // incoherent ray does not pay a TLB miss (a page walk) on top of each cache
 // miss. Smaller blocks and other systems get ordinary aligned memory.
@@ -13,7 +13,7 @@
 #include <sys/mman.h>
 #endif
 
-namespace geods::bvh {
+namespace geods {
 
 template <typename T>
 class HugePageAllocator {
@@ -46,4 +46,4 @@ class HugePageAllocator {
   }
 };
 
-}  // namespace geods::bvh
+}  // namespace geods

@@ -1,0 +1,228 @@
+// Delaunay2 and Voronoi2 save/load: a loaded structure equals the saved one
+// (arrays, queries, and for Delaunay2 further insert/remove step by step against
+// the unsaved original), validate() passes; truncated, corrupt, wrong-kind and
+// missing files raise geods::Error.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <unistd.h>
+#include <string>
+#include <vector>
+
+#include "geods/core/archive.hpp"
+#include "geods/core/error.hpp"
+#include "geods/core/rng.hpp"
+#include "geods/voronoi/delaunay2.hpp"
+#include "geods/voronoi/voronoi2.hpp"
+
+namespace geods::voronoi {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path temp_file(const std::string& name) {
+  return fs::temp_directory_path() / ("geods_voronoi_archive_" + std::to_string(::getpid()) + "_" + name);
+}
+
+std::vector<Vec2d> random_points(std::size_t n, std::uint64_t seed, bool integer = false) {
+  Rng rng(seed);
+  std::vector<Vec2d> p(n);
+  for (auto& q : p) q = integer ? Vec2d(double(rng.below(8)), double(rng.below(8))) : Vec2d(rng.uniform(), rng.uniform());
+  return p;
+}
+
+void expect_same(const Delaunay2& a, const Delaunay2& b) {
+  ASSERT_EQ(a.points().size(), b.points().size());
+  for (std::size_t i = 0; i < a.points().size(); ++i) {
+    EXPECT_EQ(a.points()[i], b.points()[i]);
+    EXPECT_EQ(a.representative(std::uint32_t(i)), b.representative(std::uint32_t(i)));
+  }
+  EXPECT_EQ(a.triangles(), b.triangles());
+  EXPECT_EQ(a.halfedges(), b.halfedges());
+  EXPECT_EQ(a.hull(), b.hull());
+  EXPECT_EQ(a.constrained(), b.constrained());
+  EXPECT_EQ(a.segments(), b.segments());
+  EXPECT_EQ(a.intersection_points(), b.intersection_points());
+  EXPECT_EQ(a.inside(), b.inside());
+  const Delaunay2Stats sa = a.stats(), sb = b.stats();
+  EXPECT_EQ(sa.vertices, sb.vertices);
+  EXPECT_EQ(sa.flips, sb.flips);
+  EXPECT_EQ(sa.walk_steps, sb.walk_steps);
+  EXPECT_EQ(sa.dag_nodes, sb.dag_nodes);
+  Rng rng(7);
+  for (int k = 0; k < 200; ++k) {
+    const Vec2d q(rng.uniform() * 1.4 - 0.2, rng.uniform() * 1.4 - 0.2);
+    EXPECT_EQ(a.locate(q), b.locate(q));
+    EXPECT_EQ(a.nearest(q), b.nearest(q));
+  }
+  for (std::uint32_t v = 0; v < a.points().size(); ++v) EXPECT_EQ(a.neighbors(v), b.neighbors(v));
+}
+
+Delaunay2 round_trip(const Delaunay2& dt, const std::string& name) {
+  const fs::path path = temp_file(name);
+  dt.save(path);
+  Delaunay2 loaded = Delaunay2::load(path);
+  fs::remove(path);
+  loaded.validate();
+  return loaded;
+}
+
+TEST(Delaunay2Archive, RoundTripThenUpdatesMatchTheOriginal) {
+  Delaunay2 original(random_points(2000, 1));
+  Delaunay2 loaded = round_trip(original, "uniform");
+  expect_same(original, loaded);
+  Rng rng(3);
+  for (int k = 0; k < 50; ++k) {
+    const Vec2d p(rng.uniform() * 1.2 - 0.1, rng.uniform() * 1.2 - 0.1);
+    EXPECT_EQ(original.insert(p), loaded.insert(p));
+    const std::uint32_t v = std::uint32_t(rng.below(original.points().size()));
+    if (original.representative(v) != Delaunay2::no_edge) {
+      original.remove(v);
+      loaded.remove(v);
+    }
+  }
+  loaded.validate();
+  expect_same(original, loaded);
+  // Saved after updates (freed triangle slots in use), loaded again.
+  expect_same(original, round_trip(loaded, "updated"));
+}
+
+TEST(Delaunay2Archive, DuplicatesDegenerateAndHistoryDag) {
+  expect_same(Delaunay2(random_points(300, 2, true)), round_trip(Delaunay2(random_points(300, 2, true)), "grid"));
+  const std::vector<Vec2d> line = {{0, 0}, {2, 2}, {1, 1}, {1, 1}, {3, 3}};
+  Delaunay2 collinear(line);
+  Delaunay2 loaded = round_trip(collinear, "collinear");
+  ASSERT_TRUE(loaded.degenerate());
+  expect_same(collinear, loaded);
+  collinear.insert({0, 3});
+  loaded.insert({0, 3});
+  expect_same(collinear, loaded);
+  expect_same(Delaunay2(), round_trip(Delaunay2(), "empty"));
+  Delaunay2::Options dag;
+  dag.location = Delaunay2Location::history_dag;
+  expect_same(Delaunay2(random_points(500, 4), dag), round_trip(Delaunay2(random_points(500, 4), dag), "dag"));
+}
+
+TEST(Delaunay2Archive, ConstrainedRoundTrip) {
+  std::vector<Vec2d> p = random_points(200, 5);
+  for (Vec2d q : {Vec2d(0, 0), Vec2d(1, 0), Vec2d(1, 1), Vec2d(0, 1), Vec2d(0.5, -0.2), Vec2d(0.5, 1.2)}) p.push_back(q);
+  const std::uint32_t n = std::uint32_t(p.size());
+  const std::vector<Delaunay2::Segment> segments = {{n - 6, n - 5}, {n - 5, n - 4}, {n - 4, n - 3}, {n - 3, n - 6},
+                                                    {n - 2, n - 1}};  // the last crosses the square
+  Delaunay2 original(p, segments);
+  ASSERT_FALSE(original.intersection_points().empty());
+  Delaunay2 loaded = round_trip(original, "constrained");
+  expect_same(original, loaded);
+  EXPECT_EQ(original.insert({0.3, 0.3}), loaded.insert({0.3, 0.3}));
+  expect_same(original, loaded);
+}
+
+std::string read_bytes(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), {}};
+}
+
+void write_bytes(const fs::path& path, const std::string& bytes) {
+  std::ofstream(path, std::ios::binary).write(bytes.data(), std::streamsize(bytes.size()));
+}
+
+// Every truncation raises geods::Error; so does a flipped byte, unless it was
+// padding (then the file loads to the same structure: saved again, the same bytes).
+template <class Load>
+void expect_bad_files_rejected(const fs::path& good, Load load) {
+  const std::string bytes = read_bytes(good);
+  const fs::path bad = temp_file("bad");
+  for (std::size_t size = 0; size < bytes.size(); size += 1 + size / 16) {
+    write_bytes(bad, bytes.substr(0, size));
+    EXPECT_THROW(load(bad), Error) << "truncated to " << size;
+  }
+  const fs::path again = temp_file("again");
+  int caught = 0;
+  for (std::size_t at = 0; at < bytes.size(); at += 1 + at / 32) {
+    std::string flipped = bytes;
+    flipped[at] ^= 0x10;
+    write_bytes(bad, flipped);
+    try {
+      load(bad).save(again);
+      EXPECT_EQ(read_bytes(again), bytes) << "byte " << at << " flipped, and the file loads to something else";
+    } catch (const Error&) {
+      ++caught;
+    }
+  }
+  EXPECT_GT(caught, 100);
+  fs::remove(bad);
+  fs::remove(again);
+  EXPECT_THROW(load(temp_file("missing")), Error);
+}
+
+TEST(Delaunay2Archive, BadFilesRaise) {
+  const fs::path path = temp_file("good");
+  Delaunay2(random_points(100, 6)).save(path);
+  expect_bad_files_rejected(path, [](const fs::path& p) { return Delaunay2::load(p); });
+  EXPECT_THROW(Voronoi2::load(path), Error);  // another kind
+  fs::remove(path);
+  // A file with the right kind whose triangulation is wrong (checksums made to fit).
+  Delaunay2 dt(random_points(50, 8));
+  ArchiveWriter w("voronoi.Delaunay2", 1);
+  const std::vector<std::uint32_t> no_indices;
+  const std::vector<double> xy = {0, 0, 1, 0, 0, 1};
+  const std::vector<std::uint32_t> vert = {0, 2, 1, 1, 2, DelaunayCore::ghost, 2, 0, DelaunayCore::ghost,
+                                           0, 1, DelaunayCore::ghost};  // clockwise
+  const std::vector<std::uint32_t> twin = {3, 9, 6, 0, 11, 7, 2, 5, 10, 1, 8, 4}, iota = {0, 1, 2};
+  const std::vector<std::uint64_t> counters = {0, 0, 0};
+  const std::vector<std::uint8_t> no_marks;
+  w.add_value("seed", std::uint64_t(1));
+  w.add_value("location", std::uint32_t(0));
+  w.add_value("has_constraints", std::uint8_t(0));
+  w.add_value("last_triangle", std::uint32_t(0));
+  w.add("counters", counters);
+  w.add("points", xy);
+  w.add("segments", no_indices);
+  w.add("intersections", no_indices);
+  w.add("representative", iota);
+  w.add("coords", xy);
+  w.add("original_of", iota);
+  w.add("internal_of", iota);
+  w.add("vert", vert);
+  w.add("twin", twin);
+  w.add("free_triangles", no_indices);
+  w.add("fixed", no_marks);
+  w.write(path);
+  EXPECT_THROW(Delaunay2::load(path), Error);
+  fs::remove(path);
+}
+
+TEST(Voronoi2Archive, RoundTripAndBadFiles) {
+  const std::vector<Vec2d> p = random_points(500, 9);
+  const Voronoi2 original(p);
+  const fs::path path = temp_file("voronoi");
+  original.save(path);
+  const Voronoi2 loaded = Voronoi2::load(path);
+  loaded.validate();
+  ASSERT_EQ(loaded.size(), original.size());
+  EXPECT_EQ(loaded.vertices(), original.vertices());
+  ASSERT_EQ(loaded.edges().size(), original.edges().size());
+  for (std::size_t e = 0; e < original.edges().size(); ++e) {
+    const auto &a = original.edges()[e], &b = loaded.edges()[e];
+    EXPECT_TRUE(a.site == b.site && a.twin == b.twin && a.next == b.next && a.origin == b.origin && a.target == b.target);
+  }
+  const AABB2d box = original.default_box();
+  for (std::uint32_t i = 0; i < p.size(); i += 7) {
+    EXPECT_EQ(loaded.cell_polygon(i, box), original.cell_polygon(i, box));
+    const auto na = original.neighbors(i), nb = loaded.neighbors(i);
+    EXPECT_EQ(std::vector<std::uint32_t>(na.begin(), na.end()), std::vector<std::uint32_t>(nb.begin(), nb.end()));
+  }
+  expect_bad_files_rejected(path, [](const fs::path& f) { return Voronoi2::load(f); });
+  EXPECT_THROW(Delaunay2::load(path), Error);  // another kind
+  fs::remove(path);
+  // Collinear sites (no vertices) round trip too.
+  const Voronoi2 line(std::vector<Vec2d>{{0, 0}, {1, 1}, {2, 2}});
+  line.save(path);
+  EXPECT_EQ(Voronoi2::load(path).edges().size(), line.edges().size());
+  fs::remove(path);
+}
+
+}  // namespace
+}  // namespace geods::voronoi
