@@ -7,11 +7,14 @@
 #include <limits>
 
 #include "command.hpp"
+#include "geods/core/error.hpp"
 #include "geods/bvh/triangle_bvh.hpp"
 #include "geods/core/parallel.hpp"
 #include "geods/io/mesh_io.hpp"
 #include "geods/io/npy.hpp"
-#include "kd_tree_cli.hpp"
+#include "geods/bvh/stats_fields.hpp"
+#include "geods/io/table_io.hpp"
+#include "stats_json.hpp"
 #include "stopwatch.hpp"
 
 namespace geods::cli {
@@ -24,8 +27,8 @@ class BvhCommand : public Command {
     return "bounding volume hierarchy of a mesh: build time, nodes, depth, SAH cost, tightness; optional ray hits";
   }
   void add_options(CLI::App& app) override {
-    app.add_option("mesh", mesh_, "Triangle mesh (.ply, .obj, .off, .stl, .gltf)")->required();
-    app.add_option("--builder", builder_, "sah, median, pca, bottomup, tiling, insertion or boxtree");
+    add_input(app, "mesh", mesh_, "Triangle mesh (.ply, .obj, .off, .stl, .gltf)");
+    app.add_option("--builder", builder_, "sah, median, pca, bottom_up, tiling, insertion or boxtree (bottomup: deprecated)");
     app.add_option("--bv", bv_, "Bounding volume: aabb, sphere, kdop6, kdop14, kdop18, kdop26, obb or obb_hull");
     app.add_option("--leaf-size", leaf_size_, "Most triangles per leaf (1..255)");
     app.add_option("--arity", arity_, "Children per node: 2, 4 or 8");
@@ -44,10 +47,9 @@ class BvhCommand : public Command {
     bvh::check_options(options);
     if (!output_.empty() && rays_.empty()) throw Error("bvh: -o needs --rays");
     const TriMesh mesh = io::read_mesh(mesh_);
-    Table rays;
+    io::Table rays;
     if (!rays_.empty()) {
-      rays = read_table(rays_);
-      if (rays.cols != 6) throw Error(fmt::format("{}: rays must have 6 columns, got {}", rays_, rays.cols));
+      rays = io::read_table(rays_, "ray", 6);
     }
 
     Stopwatch build_watch;
@@ -83,14 +85,7 @@ class BvhCommand : public Command {
     j["bv"] = bv_;
     j["leaf_size"] = leaf_size_;
     j["arity"] = arity_;
-    j["triangles"] = s.triangles;
-    j["nodes"] = s.nodes;
-    j["leaves"] = s.leaves;
-    j["depth"] = s.depth;
-    j["bytes"] = s.bytes;
-    j["sah_cost"] = s.sah_cost;
-    j["tightness_volume"] = s.tightness_volume;
-    j["tightness_hausdorff"] = s.tightness_hausdorff;
+    put_stats(j, s);
     j["build_s"] = build_s;
     j["stats_s"] = stats_s;
     if (!rays_.empty()) {

@@ -10,9 +10,13 @@
 #include "geods/core/error.hpp"
 #include "geods/io/npy.hpp"
 #include "geods/io/point_io.hpp"
+#include "geods/io/table_io.hpp"
 #include "geods/io/svg.hpp"
 #include "geods/voronoi/delaunay2.hpp"
+#include "geods/voronoi/stats_fields.hpp"
+#include "stats_json.hpp"
 #include "stopwatch.hpp"
+#include "voronoi_cli.hpp"
 
 namespace geods::cli {
 namespace {
@@ -26,7 +30,7 @@ class DelaunayCommand : public Command {
     return "Delaunay triangulation of 2D points (constrained by --segments): triangles as int64 .npy";
   }
   void add_options(CLI::App& app) override {
-    app.add_option("points", points_, "Points, n x 2 (.npy, .xyz, .csv)")->required();
+    add_input(app, "points", points_, "Points, n x 2 (.npy, .csv, .txt, .xyz, .ply)");
     app.add_option("--segments", segments_,
                    "Constraints: int m x 2 point indices (.npy), or m x 4 end coordinates x0 y0 x1 y1 "
                    "(.npy/.edg/.cin; the end points are appended to the points)");
@@ -38,11 +42,7 @@ class DelaunayCommand : public Command {
   }
 
   void run(const RunContext&, Report& report) override {
-    const io::PointMatrix matrix = io::read_points(points_);
-    if (matrix.cols() != 2)
-      throw Error(fmt::format("{}: expected 2D points, got {} columns", points_, matrix.cols()));
-    std::vector<Vec2d> points(std::size_t(matrix.rows()));
-    for (std::size_t i = 0; i < points.size(); ++i) points[i] = Vec2d(matrix(long(i), 0), matrix(long(i), 1));
+    const std::vector<Vec2d> points = read_points_2d(points_);
 
     std::vector<Delaunay2::Segment> index_segments;
     std::vector<std::array<Vec2d, 2>> end_segments;
@@ -63,17 +63,13 @@ class DelaunayCommand : public Command {
     if (!save_.empty()) dt.save(save_);
 
     Json& j = report.json;
-    j["points"] = points.size();
-    j["all_points"] = dt.points().size();  // with appended segment ends and intersection points
-    j["vertices"] = stats.vertices;
-    j["duplicates"] = stats.duplicates;
-    j["triangles"] = stats.triangles;
-    j["hull"] = stats.hull;
+    put_stats(j, stats);
+    j["points"] = points.size();  // the input points: the stats' count, with appended ones, is all_points
+    j["all_points"] = stats.points;
     j["degenerate"] = dt.degenerate();
     j["segments"] = index_segments.size() + end_segments.size();
     j["constrained_edges"] = dt.constrained_edges().size();
     j["intersection_points"] = dt.intersection_points().size();
-    j["flips"] = stats.flips;
     j["build_s"] = build_s;
     j["compute_s"] = build_s;
     const std::string added =
@@ -98,18 +94,14 @@ class DelaunayCommand : public Command {
     // Integer .npy m x 2: point indices; anything else: end coordinates.
     const bool npy = segments_.size() > 4 && segments_.substr(segments_.size() - 4) == ".npy";
     if (npy) {
-      const io::NpyArray a = io::read_npy(segments_);
-      const bool integer = a.dtype != DType::f32 && a.dtype != DType::f64;
-      if (integer) {
-        if (a.shape.size() != 2 || a.shape[1] != 2)
-          throw Error(fmt::format("{}: integer segments must be m x 2 point indices", segments_));
-        const std::vector<std::int64_t> v = a.to_vector<std::int64_t>();
-        for (std::size_t k = 0; k < a.shape[0]; ++k) {
-          for (int s = 0; s < 2; ++s)
-            if (v[2 * k + s] < 0 || std::size_t(v[2 * k + s]) >= n)
-              throw Error(fmt::format("{}: segment {} refers to point {}, but there are {} points", segments_, k,
-                                      v[2 * k + s], n));
-          indices.push_back({std::uint32_t(v[2 * k]), std::uint32_t(v[2 * k + 1])});
+      const io::Table t = io::read_table(segments_, "segment");
+      if (t.integer()) {
+        if (t.cols != 2) throw Error(fmt::format("{}: integer segments must be m x 2 point indices", segments_));
+        for (std::size_t k = 0; k < t.rows; ++k) {
+          for (const double v : t.row(k))
+            if (v < 0 || v >= double(n))
+              throw Error(fmt::format("{}: segment {} refers to point {}, but there are {} points", segments_, k, v, n));
+          indices.push_back({std::uint32_t(t.row(k)[0]), std::uint32_t(t.row(k)[1])});
         }
         return;
       }

@@ -16,7 +16,7 @@ class InfoCommand : public Command {
     return "Describe a mesh, volume, image, point or segment file: counts, bounds, dtype, dims, problems";
   }
   void add_options(CLI::App& app) override {
-    app.add_option("file", file_, "The file to describe")->required();
+    add_input(app, "file", file_, "The file to describe");
     app.add_option("--dims", dims_, "Dimensions X,Y,Z of a raw volume")->delimiter(',')->expected(3);
     app.add_option("--dtype", dtype_, "Sample type of a raw volume: u8, u16, i16, f32, f64");
   }

@@ -23,8 +23,7 @@ class IsoCommand : public Command {
     return "isosurface of a volume (marching cubes, optionally through a min/max octree) as a mesh";
   }
   void add_options(CLI::App& app) override {
-    app.add_option("volume", volume_, "Volume: .npy (z, y, x), .nrrd, .nii/.nii.gz, or raw with --dims/--dtype")
-        ->required();
+    add_input(app, "volume", volume_, "Volume: .npy (z, y, x), .nrrd, .nii/.nii.gz, or raw with --dims/--dtype");
     app.add_option("--iso", iso_, "Iso-value: samples >= it are inside")->required();
     app.add_option("-o,--output", output_, "Output mesh (.ply, .obj, .stl) with normals where the format has them");
     app.add_option("--dims", dims_, "Raw input: samples along x, y, z (x fastest)")->delimiter(',')->expected(3);
@@ -35,9 +34,8 @@ class IsoCommand : public Command {
     app.add_option("--leaf-cells", leaf_cells_, "Octree: cells per leaf along each axis (1 to 32)")
         ->check(CLI::Range(std::size_t(1), iso::MinMaxOctree<float>::kMaxLeafCells));
     app.add_option("--sharing", sharing_,
-                   "Octree: how cells share edge vertices: blocks (bit masks per leaf, the default) or hash "
-                   "(the hash table of seed 2.4)")
-        ->check(CLI::IsMember({"blocks", "hash"}));
+                   "Octree: how cells share edge vertices: block_masks (bit masks per leaf, the default) or "
+                   "hash_table (the hash table of seed 2.4); blocks and hash are deprecated spellings");
     app.add_flag("--no-normals", no_normals_, "Do not compute vertex normals");
     app.add_option("--save", save_, "Octree: also write the min/max octree (with its volume) as a geods archive")
         ->needs("--octree");
@@ -52,7 +50,7 @@ class IsoCommand : public Command {
     options.normals = !no_normals_;
     options.positions = positions;
     options.progress = context.progress;
-    const iso::VertexSharing sharing = sharing_ == "hash" ? iso::VertexSharing::hash_table : iso::VertexSharing::block_masks;
+    const iso::VertexSharing sharing = iso::parse_vertex_sharing(sharing_);
 
     TriMesh mesh;
     std::size_t cells_visited = 0, nodes_visited = 0;
@@ -93,7 +91,7 @@ class IsoCommand : public Command {
     j["cells_visited"] = cells_visited;
     if (octree_) {
       j["leaf_cells"] = leaf_cells_;
-      j["sharing"] = sharing_;
+      j["sharing"] = iso::to_string(sharing);
       j["nodes_visited"] = nodes_visited;
       j["build_s"] = build_s;
     }
@@ -108,7 +106,7 @@ class IsoCommand : public Command {
                                        cells ? 100.0 * double(cells_visited) / double(cells) : 0.0));
     if (octree_)
       report.lines.push_back(fmt::format("  min/max octree built in {:.3f} s, queried in {:.3f} s ({} nodes tested, {} sharing)",
-                                         build_s, query_s, nodes_visited, sharing_));
+                                         build_s, query_s, nodes_visited, iso::to_string(sharing)));
     else
       report.lines.push_back(fmt::format("  extracted in {:.3f} s", query_s));
     if (!output_.empty()) report.lines.push_back("  wrote " + output_);
@@ -137,7 +135,7 @@ class IsoCommand : public Command {
     return positions;
   }
 
-  std::string volume_, output_, dtype_, coords_, save_, sharing_ = "blocks";
+  std::string volume_, output_, dtype_, coords_, save_, sharing_ = "block_masks";
   double iso_ = 0;
   std::vector<std::size_t> dims_;
   bool octree_ = false, no_normals_ = false;

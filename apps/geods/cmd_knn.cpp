@@ -7,7 +7,11 @@
 #include <optional>
 
 #include "command.hpp"
+#include "geods/io/npy.hpp"
+#include "geods/io/table_io.hpp"
+#include "geods/spatial/stats_fields.hpp"
 #include "kd_tree_cli.hpp"
+#include "stats_json.hpp"
 #include "stopwatch.hpp"
 
 namespace geods::cli {
@@ -32,11 +36,12 @@ class KnnCommand : public Command {
   void run(const RunContext&, Report& report) override {
     if (radius_ && !(*radius_ >= 0)) throw Error("knn: --radius must be >= 0");
     if (!(eps_ >= 0)) throw Error("knn: --eps must be >= 0");
-    const Table queries = read_table(queries_);
+    const io::Table queries = io::read_table(queries_, "query point");
     const spatial::KnnRequest request{k_, eps_, radius_.value_or(std::numeric_limits<double>::infinity())};
 
     double build_s = 0, query_s = 0;
-    std::size_t n = 0, dim = 0, leaf_size = 0, nodes = 0, depth = 0;
+    std::size_t n = 0, dim = 0, leaf_size = 0;
+    spatial::KdTreeStats stats;
     std::vector<spatial::Neighbor<double>> result;
     input_.with_tree("knn", [&](const auto& tree, double build_seconds) {
       build_s = build_seconds;
@@ -46,9 +51,7 @@ class KnnCommand : public Command {
       if (queries.cols != dim)
         throw Error(fmt::format("{}: queries of dimension {}, but the points ({}) have dimension {}", queries_,
                                 queries.cols, input_.source(), dim));
-      const spatial::KdTreeStats stats = tree.stats();
-      nodes = stats.nodes;
-      depth = stats.depth;
+      stats = tree.stats();
       Stopwatch query_watch;
       result = tree.query_batch(spatial::PointView<double>(queries.values.data(), queries.rows, queries.cols), request);
       query_s = query_watch.seconds();
@@ -78,17 +81,19 @@ class KnnCommand : public Command {
     if (!input_.tree.empty()) j["tree"] = input_.tree;
     if (!input_.save.empty()) j["saved"] = input_.save;
     j["found"] = found;
-    j["tree_nodes"] = nodes;
-    j["tree_depth"] = depth;
+    put_stats(j, stats, "tree_");
     j["build_s"] = build_s;
     j["query_s"] = query_s;
     j["compute_s"] = build_s + query_s;
     j["queries_per_s"] = query_s > 0 ? double(queries.rows) / query_s : 0.0;
-    report.lines.push_back(fmt::format("knn: {} points of dimension {}, {} queries, k = {}{}{}", n, dim, queries.rows, k_, eps_ > 0 ? fmt::format(", eps = {}", eps_) : "",
+    report.lines.push_back(fmt::format("knn: {} points of dimension {}, {} queries, k = {}{}{}", n, dim, queries.rows,
+                                       k_, eps_ > 0 ? fmt::format(", eps = {}", eps_) : "",
                                        radius_ ? fmt::format(", radius = {}", *radius_) : ""));
     report.lines.push_back(input_.tree.empty()
-                               ? fmt::format("  k-d tree: {} nodes, depth {}, built in {:.3f} s", nodes, depth, build_s)
-                               : fmt::format("  k-d tree: {} nodes, depth {}, loaded from {}", nodes, depth, input_.tree));
+                               ? fmt::format("  k-d tree: {} nodes, depth {}, built in {:.3f} s", stats.nodes,
+                                             stats.depth, build_s)
+                               : fmt::format("  k-d tree: {} nodes, depth {}, loaded from {}", stats.nodes, stats.depth,
+                                             input_.tree));
     report.lines.push_back(fmt::format("  {} neighbours found in {:.3f} s ({:.0f} queries/s)", found, query_s,
                                        query_s > 0 ? double(queries.rows) / query_s : 0.0));
     if (!indices_.empty()) report.lines.push_back("  wrote " + indices_);

@@ -8,6 +8,8 @@
 #include "geods/io/npy.hpp"
 #include "geods/spatial/kd_tree.hpp"
 #include "geods/voronoi/post_office.hpp"
+#include "geods/voronoi/stats_fields.hpp"
+#include "stats_json.hpp"
 #include "geods/voronoi/voronoi2.hpp"
 #include "stopwatch.hpp"
 #include "voronoi_cli.hpp"
@@ -22,11 +24,12 @@ class NearestCommand : public Command {
     return "nearest site of 2D query points: slab structure (Theorem 8), Delaunay walk, or k-d tree";
   }
   void add_options(CLI::App& app) override {
-    app.add_option("--sites", sites_, "Sites, n x 2")->required();
+    add_input(app, "sites", sites_, "Sites, n x 2 (.npy, .csv, .txt, .xyz, .ply)", "--sites");
     app.add_option("--queries", queries_, "Query points, m x 2")->required();
     app.add_option("-o,--output", output_, "Output: int64 (m,) index of the nearest site (first occurrence of duplicates)");
-    app.add_option("--method", method_, "slab (default), walk or kdtree")
-        ->check(CLI::IsMember({"slab", "walk", "kdtree"}));
+    app.add_option("--method", method_, "slab (SlabLocator, the default), walk (WalkLocator) or kd_tree (KdTree); "
+                                        "kdtree is the deprecated spelling of kd_tree")
+        ->check(CLI::IsMember({"slab", "walk", "kd_tree", "kdtree"}));
   }
 
   void run(const RunContext&, Report& report) override {
@@ -35,7 +38,8 @@ class NearestCommand : public Command {
     std::vector<std::uint32_t> nearest;
     double build_s = 0, query_s = 0;
     Json& j = report.json;
-    if (method_ == "kdtree") {
+    if (method_ == "kdtree") method_ = "kd_tree";
+    if (method_ == "kd_tree") {
       Stopwatch build_watch;
       const spatial::KdTree<double, 2> tree{spatial::PointView<double>(std::span<const Vec2d>(sites))};
       build_s = build_watch.seconds();
@@ -50,10 +54,7 @@ class NearestCommand : public Command {
       if (method_ == "slab") {
         const voronoi::SlabLocator locator(diagram);
         build_s = build_watch.seconds();
-        const voronoi::SlabLocatorStats stats = locator.stats();
-        j["slabs"] = stats.slabs;
-        j["slab_crossings"] = stats.crossings;
-        j["locator_bytes"] = stats.bytes;
+        put_stats(j, locator.stats(), "locator_");
         Stopwatch query_watch;
         nearest = locator.nearest_batch(queries);
         query_s = query_watch.seconds();

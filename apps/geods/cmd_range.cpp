@@ -4,6 +4,8 @@
 #include <cstdint>
 
 #include "command.hpp"
+#include "geods/io/npy.hpp"
+#include "geods/io/table_io.hpp"
 #include "kd_tree_cli.hpp"
 #include "stopwatch.hpp"
 
@@ -21,7 +23,7 @@ class RangeCommand : public Command {
   }
 
   void run(const RunContext&, Report& report) override {
-    const Table boxes = read_table(boxes_);
+    const io::Table boxes = io::read_table(boxes_, "box row");
     double build_s = 0, query_s = 0;
     std::size_t n = 0, dim = 0, leaf_size = 0;
     std::vector<std::size_t> counts;

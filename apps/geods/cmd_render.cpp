@@ -10,6 +10,8 @@
 #include "geods/io/image_io.hpp"
 #include "geods/io/mesh_io.hpp"
 #include "geods/ray/render.hpp"
+#include "geods/ray/stats_fields.hpp"
+#include "stats_json.hpp"
 
 namespace geods::cli {
 namespace {
@@ -43,7 +45,7 @@ class RenderCommand : public Command {
     return "ray-trace a mesh into a PNG (Lambert shading, optional shadows) with a ray accelerator";
   }
   void add_options(CLI::App& app) override {
-    app.add_option("mesh", mesh_, "Mesh (PLY, OBJ, OFF, STL, glTF)")->required();
+    add_input(app, "mesh", mesh_, "Mesh (PLY, OBJ, OFF, STL, glTF)");
     app.add_option("-o,--output", output_, "Output image (.png)")->required();
     accel_option_ = app.add_option("--accel", accel_, "Accelerator: bvh, grid, octree or rays5d")->default_val(accel_);
     app.add_option("--save", save_, "Write the accelerator to this file before rendering (geods archive)");
@@ -92,9 +94,7 @@ class RenderCommand : public Command {
     j["rays"] = result.rays;
     j["primary_hits"] = result.hits;
     j["occluder_cache_hits"] = result.occluder_hits;
-    j["accel_nodes"] = s.nodes;
-    j["accel_references"] = s.references;
-    j["accel_bytes"] = s.bytes;
+    put_stats(j, s, "accel_");
     j["build_s"] = result.build_s;
     j["render_s"] = result.render_s;
     j["compute_s"] = result.build_s + result.render_s;

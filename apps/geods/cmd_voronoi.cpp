@@ -6,7 +6,9 @@
 
 #include "command.hpp"
 #include "geods/voronoi/metric_voronoi.hpp"
+#include "geods/voronoi/stats_fields.hpp"
 #include "geods/voronoi/voronoi2.hpp"
+#include "stats_json.hpp"
 #include "stopwatch.hpp"
 #include "voronoi_cli.hpp"
 
@@ -20,7 +22,7 @@ class VoronoiCommand : public Command {
     return "Voronoi diagram of 2D points (L2 from the Delaunay triangulation, or L1 / L-infinity): SVG and cells as JSON";
   }
   void add_options(CLI::App& app) override {
-    app.add_option("points", points_, "Points, n x 2 (.npy, .csv, .xyz...)")->required();
+    add_input(app, "points", points_, "Points, n x 2 (.npy, .csv, .txt, .xyz, .ply)");
     app.add_option("--metric", metric_, "l2 (default), l1 or linf");
     app.add_option("--box", box_, "Clip cells to x0,y0,x1,y1 (default: the points' bounding box grown by 25%)");
     app.add_option("--svg", svg_, "Output: a figure of the cells, edges and sites");
@@ -38,7 +40,7 @@ class VoronoiCommand : public Command {
     std::vector<std::vector<Vec2d>> cells;
     std::vector<std::pair<std::uint32_t, std::uint32_t>> edge_sites;
     std::vector<std::pair<Vec2d, Vec2d>> edges;
-    std::size_t distinct = 0, vertices = 0;
+    Json stats = Json::object();  // the diagram's stats: distinct sites, vertices (L2), ...
     double build_s = 0, cells_s = 0;
     if (metric == voronoi::Metric::l2) {
       Stopwatch build_watch;
@@ -54,8 +56,7 @@ class VoronoiCommand : public Command {
         }
       }
       cells_s = cells_watch.seconds();
-      distinct = diagram.stats().distinct;
-      vertices = diagram.vertices().size();
+      put_stats(stats, diagram.stats());
       if (!save_.empty()) diagram.save(save_);
     } else {
       Stopwatch build_watch;
@@ -66,7 +67,7 @@ class VoronoiCommand : public Command {
         edges.push_back({e.p0, e.p1});
         edge_sites.push_back({e.a, e.b});
       }
-      distinct = diagram.stats().distinct;
+      put_stats(stats, diagram.stats());
     }
 
     if (!svg_.empty()) {
@@ -100,17 +101,16 @@ class VoronoiCommand : public Command {
 
     Json& j = report.json;
     j["points"] = points.size();
-    j["distinct"] = distinct;
+    j.update(stats);
     j["metric"] = voronoi::metric_name(metric);
     j["box"] = {box.lo[0], box.lo[1], box.hi[0], box.hi[1]};
-    if (metric == voronoi::Metric::l2) j["vertices"] = vertices;
     j["edges_in_box"] = edges.size();
     j["build_s"] = build_s;
     j["cells_s"] = cells_s;
     j["compute_s"] = build_s + cells_s;
     report.lines.push_back(fmt::format("voronoi ({}): {} points ({} distinct), {} edges in the box{}",
-                                       voronoi::metric_name(metric), points.size(), distinct, edges.size(),
-                                       metric == voronoi::Metric::l2 ? fmt::format(", {} vertices", vertices) : ""));
+                                       voronoi::metric_name(metric), points.size(), stats["distinct"].get<std::size_t>(), edges.size(),
+                                       stats.contains("vertices") ? fmt::format(", {} vertices", stats["vertices"].get<std::size_t>()) : ""));
     report.lines.push_back(fmt::format("  built in {:.3f} s, cells clipped in {:.3f} s", build_s, cells_s));
     if (!svg_.empty()) report.lines.push_back("  wrote " + svg_);
     if (!output_.empty()) report.lines.push_back("  wrote " + output_);

@@ -15,6 +15,20 @@ std::vector<std::unique_ptr<Command>>& registered_commands() {
   return commands;
 }
 
+void add_input(CLI::App& app, const std::string& name, std::string& value, const std::string& description,
+               const std::string& alias) {
+  if (alias.empty()) {
+    app.add_option(name, value, description)->required();
+    return;
+  }
+  CLI::Option* positional = app.add_option(name, value, description);
+  CLI::Option* named = app.add_option(alias, value, "Deprecated: give " + name + " as the first argument");
+  positional->excludes(named);
+  app.callback([&value, name] {
+    if (value.empty()) throw CLI::RequiredError(name);
+  });
+}
+
 namespace {
 
 // The first line of a message: the contract is one line on stderr.

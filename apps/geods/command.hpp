@@ -39,6 +39,13 @@ class Command {
   virtual void run(const RunContext& context, Report& report) = 0;
 };
 
+/// Declares the command's main input as the positional argument `name`
+/// (the rule for every command: what the command is about is positional,
+/// every other input is a named option). `alias`, e.g. "--points", keeps an
+/// older option spelling working; it is deprecated. One of the two is required.
+void add_input(CLI::App& app, const std::string& name, std::string& value, const std::string& description,
+               const std::string& alias = "");
+
 std::vector<std::unique_ptr<Command>>& registered_commands();
 
 template <typename C>

@@ -10,9 +10,11 @@
 #include "demo.hpp"
 #include "geods/core/rng.hpp"
 #include "geods/dynamic/dynamic_kd_tree.hpp"
+#include "geods/dynamic/stats_fields.hpp"
 #include "geods/io/point_io.hpp"
 #include "geods/io/svg.hpp"
 #include "geods/spatial/kd_tree.hpp"
+#include "stats_json.hpp"
 #include "stopwatch.hpp"
 
 namespace geods::cli {
@@ -143,10 +145,7 @@ void run_dynamic_kdtree(const DemoContext& context, DemoResult& result) {
     result.stat(name + ": inserts / s", fmt::format("{:.0f}", double(n) / run.insert_s));
     result.stat(name + ": deletes / s", fmt::format("{:.0f}", double(removed) / run.remove_s));
     result.stat(name + ": 10-NN queries / s", fmt::format("{:.0f}", double(queries.size()) / run.query_s));
-    result.stat(name + ": trees per level at the end", fmt::format("{}", fmt::join(run.stats.structure.per_level, " ")));
-    result.stat(name + ": live / dead / rebuilds / bytes",
-                fmt::format("{} / {} / {} / {}", run.stats.structure.live, run.stats.structure.dead,
-                            run.stats.structure.rebuilds, run.stats.bytes));
+    result.stat(name + ": DynamicKdTree at the end", stats_text(run.stats));
     result.timing(name + ": " + std::to_string(n) + " inserts", run.insert_s);
     result.timing(name + ": " + std::to_string(removed) + " deletes", run.remove_s);
   }

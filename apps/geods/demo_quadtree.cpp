@@ -8,6 +8,8 @@
 #include "geods/io/point_io.hpp"
 #include "geods/io/svg.hpp"
 #include "geods/spatial/quadtree.hpp"
+#include "geods/spatial/stats_fields.hpp"
+#include "stats_json.hpp"
 #include "stopwatch.hpp"
 
 namespace geods::cli {
@@ -67,12 +69,10 @@ void run_quadtree(const DemoContext& context, DemoResult& result) {
   result.figures.push_back({"quadtree_balanced.svg", fmt::format("balanced: {} leaves, depth {}", after.leaves,
                                                                  after.depth)});
   result.stat("points shown", std::to_string(points.size()));
-  result.stat("nodes / leaves / depth", fmt::format("{} / {} / {}", before.nodes, before.leaves, before.depth));
-  result.stat("balanced: nodes / leaves / depth", fmt::format("{} / {} / {}", after.nodes, after.leaves, after.depth));
-  const spatial::OrthtreeStats fs = full.stats(), fbs = full_balanced.stats();
-  result.stat("all points (bucket 8): nodes / leaves / depth / bytes",
-              fmt::format("{} / {} / {} / {}", fs.nodes, fs.leaves, fs.depth, fs.bytes));
-  result.stat("all points balanced: nodes / leaves", fmt::format("{} / {}", fbs.nodes, fbs.leaves));
+  result.stat("Quadtree", stats_text(before));
+  result.stat("balanced: Quadtree", stats_text(after));
+  result.stat("all points (bucket 8): Quadtree", stats_text(full.stats()));
+  result.stat("all points balanced: Quadtree", stats_text(full_balanced.stats()));
 }
 
 const bool registered =

@@ -6,6 +6,8 @@
 #include "geods/io/image_io.hpp"
 #include "geods/io/mesh_io.hpp"
 #include "geods/ray/render.hpp"
+#include "geods/ray/stats_fields.hpp"
+#include "stats_json.hpp"
 
 namespace geods::cli {
 namespace {
@@ -21,12 +23,10 @@ void run_render(const DemoContext& context, DemoResult& result) {
     const std::string name(ray::to_string(kind));
     const std::string file = "render_" + name + ".png";
     io::write_png(context.out_dir / file, r.image);
-    const ray::AcceleratorStats& s = r.accel_stats;
     result.figures.push_back(
         {file, fmt::format("{}: built in {:.1f} ms, {} rays at {:.2f} Mrays/s", name, 1e3 * r.build_s, r.rays,
                            r.mrays_per_s())});
-    result.stat(name + ": nodes / triangle references / MB",
-                fmt::format("{} / {} / {:.2f}", s.nodes, s.references, double(s.bytes) / 1e6));
+    result.stat(name + ": accelerator", stats_text(r.accel_stats));
     result.stat(name + ": shadow rays answered by the occluder cache", std::to_string(r.occluder_hits));
     result.timing("build " + name, r.build_s);
     result.timing("render " + name, r.render_s);

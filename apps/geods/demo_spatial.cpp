@@ -8,6 +8,8 @@
 #include "geods/io/point_io.hpp"
 #include "geods/io/svg.hpp"
 #include "geods/spatial/kd_tree.hpp"
+#include "geods/spatial/stats_fields.hpp"
+#include "stats_json.hpp"
 #include "stopwatch.hpp"
 
 namespace geods::cli {
@@ -81,11 +83,9 @@ void run_kdtree(const DemoContext& context, DemoResult& result) {
                                         points.size(), inside.size(), visited, tree.nodes().size())});
   const spatial::KdTreeStats stats = tree.stats();
   result.stat("points shown", std::to_string(points.size()));
-  result.stat("nodes / leaves / depth", fmt::format("{} / {} / {}", stats.nodes, stats.leaves, stats.depth));
+  result.stat("KdTree", stats_text(stats));
   result.stat("reported / nodes visited", fmt::format("{} / {}", inside.size(), visited));
-  const spatial::KdTreeStats full_stats = full.stats();
-  result.stat("all points: nodes (leaf size 10) / depth / bytes",
-              fmt::format("{} / {} / {}", full_stats.nodes, full_stats.depth, full_stats.bytes));
+  result.stat("all points, leaf size 10: KdTree", stats_text(full.stats()));
   result.stat("all points: count in the rectangle / nodes visited", fmt::format("{} / {}", full_count, full_visited));
 }
 

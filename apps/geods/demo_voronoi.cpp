@@ -17,7 +17,9 @@
 #include "geods/voronoi/metric_voronoi.hpp"
 #include "geods/voronoi/post_office.hpp"
 #include "geods/voronoi/proximity.hpp"
+#include "geods/voronoi/stats_fields.hpp"
 #include "geods/voronoi/voronoi2.hpp"
+#include "stats_json.hpp"
 #include "stopwatch.hpp"
 #include "voronoi_cli.hpp"
 
@@ -77,16 +79,14 @@ void run_dual(const DemoContext& context, DemoResult& result) {
                 "Voronoi edge is perpendicular to the Delaunay edge of its two sites, and the cells of hull sites "
                 "are unbounded (their rays are cut by the frame, the curve Gamma of Figure 42).";
   result.figures.push_back({"voronoi_delaunay.svg", "60 seeded uniform sites"});
-  const voronoi::Voronoi2Stats s = v.stats();
-  result.stat("sites / Voronoi vertices / edges / unbounded cells",
-              fmt::format("{} / {} / {} / {}", s.sites, s.vertices, s.edges, s.unbounded_cells));
+  result.stat("Voronoi2", stats_text(v.stats()));
   result.stat("Delaunay triangles / hull vertices", fmt::format("{} / {}", dt.triangle_count(), dt.hull().size()));
   // The whole land set, timed.
   const std::vector<Vec2d> land = land_points(context);
   Stopwatch land_watch;
   const voronoi::Voronoi2 all(land);
   result.timing(fmt::format("Voronoi2 of all {} land points", land.size()), land_watch.seconds());
-  result.stat("land points: Voronoi vertices / edges", fmt::format("{} / {}", all.stats().vertices, all.stats().edges));
+  result.stat("land points: Voronoi2", stats_text(all.stats()));
 }
 
 void run_metrics(const DemoContext& context, DemoResult& result) {
@@ -111,8 +111,7 @@ void run_metrics(const DemoContext& context, DemoResult& result) {
     draw_diagram(svg, v.cells(), edges, p, "#1f4e79", 3.0);
     svg.save(context.out_dir / ("voronoi_" + name + ".svg"));
     result.figures.push_back({"voronoi_" + name + ".svg", name});
-    result.stat(name + ": edge pieces / cell vertices",
-                fmt::format("{} / {}", v.stats().edges, v.stats().cell_vertices));
+    result.stat(name + ": MetricVoronoi", stats_text(v.stats()));
   }
   // The whole land set under L1, timed.
   const std::vector<Vec2d> land = every_kth(land_points(context), 1000);
@@ -173,9 +172,7 @@ void run_post_office(const DemoContext& context, DemoResult& result) {
   result.timing("200000 queries, slab", slab_q);
   result.timing("200000 queries, walk", walk_q);
   result.timing("200000 queries, k-d tree", tree_q);
-  const voronoi::SlabLocatorStats s = big_slab.stats();
-  result.stat("20000 sites: slabs / stored crossings / largest slab / MB",
-              fmt::format("{} / {} / {} / {:.1f}", s.slabs, s.crossings, s.max_crossings, s.bytes / 1e6));
+  result.stat("20000 sites: SlabLocator", stats_text(big_slab.stats()));
   result.stat("queries per second: slab / walk / k-d tree",
               fmt::format("{:.3g} / {:.3g} / {:.3g}", queries.size() / slab_q, queries.size() / walk_q,
                           queries.size() / tree_q));

@@ -11,14 +11,13 @@
 #include "geods/core/aabb.hpp"
 #include "geods/core/error.hpp"
 #include "geods/io/svg.hpp"
-#include "kd_tree_cli.hpp"
+#include "geods/io/table_io.hpp"
 
 namespace geods::cli {
 
-/// An n x 2 table of points (.npy, .csv, .txt, .xyz...). Throws geods::Error naming the file.
+/// An n x 2 table of points (io::read_table: .npy, .csv, .txt, .xyz, .ply). Throws geods::Error naming the file.
 inline std::vector<Vec2d> read_points_2d(const std::filesystem::path& path) {
-  const Table t = read_table(path);
-  if (t.cols != 2) throw Error(fmt::format("{}: expected points with 2 columns (x, y), got {}", path.string(), t.cols));
+  const io::Table t = io::read_table(path, "point", 2);
   std::vector<Vec2d> points(t.rows);
   for (std::size_t i = 0; i < t.rows; ++i) points[i] = {t.values[2 * i], t.values[2 * i + 1]};
   return points;

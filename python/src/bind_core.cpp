@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "bindings.hpp"
-#include "index_arrays.hpp"
+#include "arrays.hpp"
 #include "geods/core/convex_hull3.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"
@@ -23,7 +23,7 @@ namespace py = pybind11;
 namespace geods::python {
 namespace {
 
-using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
+using DoubleArray = Rows<double>;
 
 // Calls of a predicate with N points of dimension Dim, one row per call.
 template <int Dim, std::size_t N>
@@ -154,10 +154,8 @@ with the same n.)doc");
 
   m.def(
       "convex_hull",
-      [](const DoubleArray& points) {
-        if (points.ndim() != 2 || points.shape(1) != 3) throw Error("convex_hull: points must be an (n, 3) array");
-        std::vector<Vec3d> p(std::size_t(points.shape(0)));
-        for (std::size_t i = 0; i < p.size(); ++i) p[i] = Vec3d(points.data()[3 * i], points.data()[3 * i + 1], points.data()[3 * i + 2]);
+      [](const py::handle& points) {
+        const std::vector<Vec3d> p = points_of<double, 3>(points, "convex_hull: points");
         ConvexHull3 hull;
         {
           py::gil_scoped_release release;

@@ -9,9 +9,11 @@
 #include <vector>
 
 #include "bindings.hpp"
-#include "index_arrays.hpp"
+#include "arrays.hpp"
 #include "geods/core/error.hpp"
 #include "geods/voronoi/delaunay2.hpp"
+#include "geods/voronoi/stats_fields.hpp"
+#include "stats_dict.hpp"
 
 namespace py = pybind11;
 
@@ -19,23 +21,11 @@ namespace geods::python {
 namespace {
 
 using voronoi::Delaunay2;
-using Rows = py::array_t<double, py::array::c_style | py::array::forcecast>;
+std::vector<Vec2d> as_points(const py::handle& h, const char* what) { return points_of<double, 2>(h, what); }
 
-std::vector<Vec2d> as_points(const py::handle& h, const char* what) {
-  const auto a = Rows::ensure(h);
-  if (!a || a.ndim() != 2 || a.shape(1) != 2) throw Error(std::string(what) + ": expected an (n, 2) array of numbers");
-  std::vector<Vec2d> points(std::size_t(a.shape(0)));
-  for (std::size_t i = 0; i < points.size(); ++i) points[i] = Vec2d(a.at(i, 0), a.at(i, 1));
-  return points;
-}
+Vec2d as_point(const py::handle& h, const char* what) { return point_of<double, 2>(h, what); }
 
-Vec2d as_point(const py::handle& h, const char* what) {
-  const auto a = Rows::ensure(h);
-  if (!a || a.ndim() != 1 || a.shape(0) != 2) throw Error(std::string(what) + ": expected a point (x, y)");
-  return {a.at(0), a.at(1)};
-}
-
-std::int64_t as_index(std::uint32_t i) { return i == Delaunay2::no_edge ? -1 : std::int64_t(i); }
+std::int64_t as_index(std::uint32_t i) { return index_value(i); }
 
 std::uint32_t vertex_index(std::int64_t i, const Delaunay2& dt, const char* what) {
   if (i < 0 || std::size_t(i) >= dt.points().size())
@@ -55,10 +45,12 @@ Delaunay2 make(const py::handle& points_in, const py::object& segments_in, std::
   if (!seg || seg.ndim() != 2 || (seg.shape(1) != 2 && seg.shape(1) != 4))
     throw Error("Delaunay2: segments must be (m, 2) point indices or (m, 4) end coordinates x0, y0, x1, y1");
   if (seg.shape(1) == 4) {
-    const auto ends = Rows::ensure(seg);
-    std::vector<std::array<Vec2d, 2>> segments(std::size_t(ends.shape(0)));
-    for (std::size_t k = 0; k < segments.size(); ++k)
-      segments[k] = {Vec2d(ends.at(k, 0), ends.at(k, 1)), Vec2d(ends.at(k, 2), ends.at(k, 3))};
+    const PointRows<double> ends = point_rows<double>(seg, 4, "Delaunay2 segments", false);
+    std::vector<std::array<Vec2d, 2>> segments(ends.count);
+    for (std::size_t k = 0; k < segments.size(); ++k) {
+      const Vec4d e = ends.point<4>(k);
+      segments[k] = {e.head<2>(), e.tail<2>()};
+    }
     py::gil_scoped_release release;
     return Delaunay2::from_segment_ends(points, segments, options);
   }
@@ -95,32 +87,25 @@ new appended point (intersection_points). NaN/inf raise geods.Error (ValueError)
            py::arg("seed") = Delaunay2::Options{}.seed)
       .def_property_readonly(
           "points",
-          [](const Delaunay2& dt) {
-            py::array_t<double> out({py::ssize_t(dt.points().size()), py::ssize_t(2)});
-            double* o = out.mutable_data();
-            for (const Vec2d& p : dt.points()) *o++ = p[0], *o++ = p[1];
-            return out;
-          },
+          [](const Delaunay2& dt) { return points_array(dt.points()); },
           "(n, 2) float64: the input points, then intersection and inserted points")
       .def_property_readonly(
           "triangles",
           [](const Delaunay2& dt) { return index_array(dt.triangles(), {py::ssize_t(dt.triangle_count()), 3}); },
           "(m, 3) int64: counter-clockwise vertex indices (first occurrences of duplicates)")
       .def_property_readonly(
-          "halfedges", [](const Delaunay2& dt) { return index_array(dt.halfedges(), {py::ssize_t(dt.halfedges().size())}); },
+          "halfedges", [](const Delaunay2& dt) { return index_array(dt.halfedges()); },
           "(3m,) int64: the opposite half-edge of half-edge e (from triangles.flat[e] to the next vertex "
           "of its triangle), -1 on the hull")
       .def_property_readonly(
-          "hull", [](const Delaunay2& dt) { return index_array(dt.hull(), {py::ssize_t(dt.hull().size())}); },
+          "hull", [](const Delaunay2& dt) { return index_array(dt.hull()); },
           "hull vertices counter-clockwise (for a degenerate set: the distinct points sorted by x, y)")
       .def_property_readonly("degenerate", &Delaunay2::degenerate, "True when there are no triangles")
       .def_property_readonly(
           "constrained",
-          [](const Delaunay2& dt) {
-            py::array_t<bool> out(py::ssize_t(dt.halfedges().size()));
-            bool* o = out.mutable_data();
-            for (std::size_t e = 0; e < dt.halfedges().size(); ++e) o[e] = !dt.constrained().empty() && dt.constrained()[e];
-            return out;
+          [](const Delaunay2& dt) {  // empty without segments: all false
+            return dt.constrained().empty() ? bool_array(std::vector<std::uint8_t>(dt.halfedges().size()))
+                                            : bool_array(dt.constrained());
           },
           "(3m,) bool: half-edges on a segment")
       .def_property_readonly(
@@ -134,18 +119,11 @@ new appended point (intersection_points). NaN/inf raise geods.Error (ValueError)
           "(k, 2) int64: the constrained edges, each once")
       .def_property_readonly(
           "intersection_points",
-          [](const Delaunay2& dt) {
-            return index_array(dt.intersection_points(), {py::ssize_t(dt.intersection_points().size())});
-          },
+          [](const Delaunay2& dt) { return index_array(dt.intersection_points()); },
           "indices of the points added where segments cross")
       .def_property_readonly(
           "inside",
-          [](const Delaunay2& dt) {
-            const auto in = dt.inside();
-            py::array_t<bool> out(py::ssize_t(in.size()));
-            for (std::size_t t = 0; t < in.size(); ++t) out.mutable_data()[t] = in[t];
-            return out;
-          },
+          [](const Delaunay2& dt) { return bool_array(dt.inside()); },
           "(m,) bool: triangles inside the segments (even-odd from outside the hull): a polygon minus its holes")
       .def(
           "representative", [](const Delaunay2& dt, std::int64_t i) {
@@ -164,7 +142,7 @@ new appended point (intersection_points). NaN/inf raise geods.Error (ValueError)
           "neighbors",
           [](const Delaunay2& dt, std::int64_t v) {
             const auto nb = dt.neighbors(vertex_index(v, dt, "Delaunay2.neighbors"));
-            return index_array(nb, {py::ssize_t(nb.size())});
+            return index_array(nb);
           },
           py::arg("v"), "Delaunay neighbours of vertex v, counter-clockwise")
       .def(
@@ -179,14 +157,7 @@ new appended point (intersection_points). NaN/inf raise geods.Error (ValueError)
       .def_static("load", &Delaunay2::load, py::arg("path"),
                   "reads a triangulation written by save(); insert and remove go on as before")
       .def("validate", &Delaunay2::validate, "checks every invariant; raises geods.Error on a violation")
-      .def("stats", [](const Delaunay2& dt) {
-        const auto s = dt.stats();
-        py::dict d;
-        d["points"] = s.points, d["vertices"] = s.vertices, d["duplicates"] = s.duplicates, d["removed"] = s.removed;
-        d["triangles"] = s.triangles, d["hull"] = s.hull, d["flips"] = s.flips, d["walk_steps"] = s.walk_steps;
-        d["bytes"] = s.bytes;
-        return d;
-      });
+      .def("stats", [](const Delaunay2& dt) { return stats_dict(dt.stats()); });
 }
 
 }  // namespace geods::python

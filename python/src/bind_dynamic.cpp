@@ -8,11 +8,14 @@
 #include <string>
 #include <variant>
 
+#include "arrays.hpp"
 #include "bindings.hpp"
 #include "geods/core/archive.hpp"
 #include "geods/core/error.hpp"
 #include "geods/dynamic/dynamic_kd_tree.hpp"
+#include "geods/dynamic/stats_fields.hpp"
 #include "geods/spatial/knn_result.hpp"
+#include "stats_dict.hpp"
 
 namespace py = pybind11;
 
@@ -21,7 +24,6 @@ namespace {
 
 using dynamic::DynamicKdTree;
 using dynamic::Id;
-using Rows = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
 class PyDynamicKdTree {
  public:
@@ -80,17 +82,14 @@ class PyDynamicKdTree {
   }
 
   py::array_t<std::int64_t> insert(const py::handle& points) {
-    const auto [rows, single] = as_rows(points, "DynamicKdTree.insert");
+    const PointRows<double> rows = point_rows<double>(points, dim(), "DynamicKdTree.insert");
     std::vector<Id> ids;
     {
       py::gil_scoped_release release;
-      ids = std::visit([&](auto& t) { return t.insert(spatial::PointView<double>(rows.data(), count(rows), dim())); },
-                       tree_);
+      ids = std::visit([&](auto& t) { return t.insert(rows.view()); }, tree_);
     }
-    py::array_t<std::int64_t> out(py::ssize_t(ids.size()));
-    std::int64_t* p = out.mutable_data();
-    for (std::size_t i = 0; i < ids.size(); ++i) p[i] = std::int64_t(ids[i]);
-    if (single) return out.reshape(std::vector<py::ssize_t>{});
+    py::array_t<std::int64_t> out = index_array(ids);
+    if (rows.single) return out.reshape(std::vector<py::ssize_t>{});
     return out;
   }
 
@@ -108,61 +107,50 @@ class PyDynamicKdTree {
   }
 
   py::tuple query(const py::handle& q, std::size_t k, double eps, double max_distance) const {
-    const auto [rows, single] = as_rows(q, "DynamicKdTree.query");
-    const std::size_t m = count(rows);
-    py::array_t<double> distances(std::vector<py::ssize_t>{py::ssize_t(m), py::ssize_t(k)});
-    py::array_t<std::int64_t> ids(std::vector<py::ssize_t>{py::ssize_t(m), py::ssize_t(k)});
-    double* d = distances.mutable_data();
-    std::int64_t* idx = ids.mutable_data();
-    {
-      py::gil_scoped_release release;
-      std::visit(
-          [&](const auto& t) {
-            const auto result = t.query_batch(spatial::PointView<double>(rows.data(), m, dim()),
-                                              spatial::KnnRequest{k, eps, max_distance});
-            for (std::size_t i = 0; i < result.size(); ++i) {
-              const bool missing = result[i].index == dynamic::kNoId;
-              d[i] = missing ? std::numeric_limits<double>::infinity() : std::sqrt(result[i].squared_distance);
-              idx[i] = missing ? -1 : std::int64_t(result[i].index);
-            }
-          },
-          tree_);
-    }
-    if (single) return py::make_tuple(distances.reshape({py::ssize_t(k)}), ids.reshape({py::ssize_t(k)}));
-    return py::make_tuple(distances, ids);
+    const PointRows<double> rows = point_rows<double>(q, dim(), "DynamicKdTree.query");
+    return std::visit(
+        [&](const auto& t) {
+          using Neighbor = typename std::decay_t<decltype(t)>::Neighbor;
+          std::vector<Neighbor> result;
+          {
+            py::gil_scoped_release release;
+            result = t.query_batch(rows.view(), spatial::KnnRequest{k, eps, max_distance});
+          }
+          return neighbor_arrays(std::span<const Neighbor>(result), rows.count, k, rows.single, &Neighbor::index);
+        },
+        tree_);
   }
 
   py::array_t<std::int64_t> query_radius(const py::handle& q, double r) const {
-    const auto [rows, single] = as_rows(q, "DynamicKdTree.query_radius");
-    if (!single) throw Error("DynamicKdTree.query_radius: q is one point");
-    std::vector<std::int64_t> out;
-    {
-      py::gil_scoped_release release;
-      std::visit(
-          [&](const auto& t) {
-            for (const auto& nb : t.query_radius(std::span<const double>(rows.data(), dim()), r))
-              out.push_back(std::int64_t(nb.index));
-          },
-          tree_);
-    }
-    return py::array_t<std::int64_t>(py::ssize_t(out.size()), out.data());
+    const PointRows<double> rows = point_rows<double>(q, dim(), "DynamicKdTree.query_radius");
+    if (!rows.single) throw Error("DynamicKdTree.query_radius: q is one point");
+    return std::visit(
+        [&](const auto& t) {
+          using Neighbor = typename std::decay_t<decltype(t)>::Neighbor;
+          std::vector<std::vector<Neighbor>> result(1);
+          {
+            py::gil_scoped_release release;
+            result[0] = t.query_radius(std::span<const double>(rows.data(), dim()), r);
+          }
+          return py::array_t<std::int64_t>(neighbor_lists(result, true, &Neighbor::index));
+        },
+        tree_);
   }
 
   py::array_t<std::int64_t> query_box(const py::handle& lo, const py::handle& hi) const {
-    const auto [l, l_single] = as_rows(lo, "DynamicKdTree.query_box lo");
-    const auto [h, h_single] = as_rows(hi, "DynamicKdTree.query_box hi");
-    if (!l_single || !h_single) throw Error("DynamicKdTree.query_box: lo and hi are single points");
-    std::vector<std::int64_t> out;
+    const PointRows<double> l = point_rows<double>(lo, dim(), "DynamicKdTree.query_box lo");
+    const PointRows<double> h = point_rows<double>(hi, dim(), "DynamicKdTree.query_box hi");
+    if (!l.single || !h.single) throw Error("DynamicKdTree.query_box: lo and hi are single points");
+    std::vector<Id> ids;
     {
       py::gil_scoped_release release;
-      std::visit(
+      ids = std::visit(
           [&](const auto& t) {
-            for (Id id : t.query_box(std::span<const double>(l.data(), dim()), std::span<const double>(h.data(), dim())))
-              out.push_back(std::int64_t(id));
+            return t.query_box(std::span<const double>(l.data(), dim()), std::span<const double>(h.data(), dim()));
           },
           tree_);
     }
-    return py::array_t<std::int64_t>(py::ssize_t(out.size()), out.data());
+    return index_array(ids);
   }
 
   void validate() const {
@@ -173,41 +161,11 @@ class PyDynamicKdTree {
   }
 
   py::dict stats() const {
-    const dynamic::DynamicKdTreeStats s = std::visit([](const auto& t) { return t.stats(); }, tree_);
-    py::dict d;
-    d["live"] = s.structure.live;
-    d["dead"] = s.structure.dead;
-    d["structures"] = s.structure.structures;
-    d["building"] = s.structure.building;
-    d["per_level"] = s.structure.per_level;
-    d["rebuilds"] = s.structure.rebuilds;
-    d["forced_builds"] = s.structure.forced_builds;
-    d["reconstructing"] = s.structure.reconstructing;
-    d["forced_rebuilds"] = s.structure.forced_rebuilds;
-    d["work"] = s.structure.work;
-    d["locator_bytes"] = s.structure.locator_bytes;
-    d["bytes"] = s.bytes;
-    return d;
+    return stats_dict(std::visit([](const auto& t) { return t.stats(); }, tree_));
   }
 
  private:
   PyDynamicKdTree() = default;
-
-  struct RowsOf {
-    Rows array;
-    bool single;
-  };
-  static std::size_t count(const Rows& rows) { return rows.ndim() == 1 ? 1 : std::size_t(rows.shape(0)); }
-
-  // One point (d,) or rows (m, d) as C-order float64.
-  RowsOf as_rows(const py::handle& x, const char* what) const {
-    auto a = Rows::ensure(x);
-    if (!a) throw Error(std::string(what) + ": expected an array of numbers");
-    if (a.ndim() == 1 && std::size_t(a.shape(0)) == dim()) return {a, true};
-    if (a.ndim() == 2 && std::size_t(a.shape(1)) == dim()) return {a, false};
-    throw Error(std::string(what) + ": expected shape (" + std::to_string(dim()) + ",) or (m, " +
-                std::to_string(dim()) + ") for a tree of dimension " + std::to_string(dim()));
-  }
 
   std::variant<DynamicKdTree<double, 2>, DynamicKdTree<double, 3>, DynamicKdTree<double, spatial::Dynamic>> tree_;
   std::string variant_;

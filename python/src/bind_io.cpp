@@ -10,11 +10,12 @@
 #include <string>
 
 #include "bindings.hpp"
-#include "mesh_arrays.hpp"
+#include "arrays.hpp"
 #include "geods/core/error.hpp"
 #include "geods/io/image_io.hpp"
 #include "geods/io/mesh_io.hpp"
 #include "geods/io/point_io.hpp"
+#include "geods/io/table_io.hpp"
 #include "geods/io/volume_io.hpp"
 
 namespace py = pybind11;
@@ -25,15 +26,7 @@ namespace {
 using std::filesystem::path;
 
 template <typename T>
-using CArray = py::array_t<T, py::array::c_style | py::array::forcecast>;
-
-// A numpy array that owns a copy of `n` values shaped `shape`.
-template <typename T>
-py::array_t<T> to_numpy(const T* data, std::vector<py::ssize_t> shape) {
-  py::array_t<T> a(shape);
-  if (a.size() > 0) std::memcpy(a.mutable_data(), data, std::size_t(a.size()) * sizeof(T));
-  return a;
-}
+using CArray = Rows<T>;
 
 py::tuple read_mesh_py(const path& p) {
   TriMesh mesh;
@@ -41,19 +34,7 @@ py::tuple read_mesh_py(const path& p) {
     py::gil_scoped_release release;
     mesh = io::read_mesh(p);
   }
-  const auto nv = py::ssize_t(mesh.num_vertices()), nf = py::ssize_t(mesh.num_triangles());
-  py::array_t<float> v = to_numpy(mesh.vertices.empty() ? nullptr : mesh.vertices[0].data(), {nv, 3});
-  // int32 indices unless the mesh is too large for them.
-  if (mesh.num_vertices() <= std::size_t(std::numeric_limits<std::int32_t>::max())) {
-    py::array_t<std::int32_t> f({nf, py::ssize_t(3)});
-    std::memcpy(f.mutable_data(), mesh.triangles.data(), std::size_t(nf) * 3 * sizeof(std::int32_t));
-    return py::make_tuple(v, f);
-  }
-  py::array_t<std::int64_t> f({nf, py::ssize_t(3)});
-  auto* out = f.mutable_data();
-  for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
-    for (int c = 0; c < 3; ++c) out[3 * t + std::size_t(c)] = mesh.triangles[t][std::size_t(c)];
-  return py::make_tuple(v, f);
+  return mesh_arrays(mesh, false);
 }
 
 void write_mesh_py(const path& p, const CArray<float>& v, const CArray<std::int64_t>& f, bool binary) {
@@ -70,7 +51,7 @@ py::object read_volume_py(const path& p, bool with_meta) {
   }
   return std::visit(
       [&](const auto& g) -> py::object {
-        const py::array a = to_numpy(g.data.data(), {py::ssize_t(g.dims[2]), py::ssize_t(g.dims[1]), py::ssize_t(g.dims[0])});
+        const py::array a = copy_array(g.data.data(), {py::ssize_t(g.dims[2]), py::ssize_t(g.dims[1]), py::ssize_t(g.dims[0])});
         if (!with_meta) return a;
         return py::make_tuple(a, py::make_tuple(g.origin.x(), g.origin.y(), g.origin.z()),
                               py::make_tuple(g.spacing.x(), g.spacing.y(), g.spacing.z()));
@@ -78,32 +59,9 @@ py::object read_volume_py(const path& p, bool with_meta) {
       grid);
 }
 
-template <typename T>
-io::AnyGrid3 grid_from(const py::array& array) {
-  const auto a = CArray<T>::ensure(array);
-  Grid3<T> g;
-  g.dims = {std::size_t(a.shape(2)), std::size_t(a.shape(1)), std::size_t(a.shape(0))};
-  g.data.assign(a.data(), a.data() + a.size());
-  return g;
-}
-
 void write_volume_py(const path& p, const py::array& array, const std::array<double, 3>& origin,
                      const std::array<double, 3>& spacing) {
-  if (array.ndim() != 3) throw Error("write_volume: the array must be 3-D (nz, ny, nx)");
-  io::AnyGrid3 grid;
-  const py::dtype dt = array.dtype();
-  if (dt.is(py::dtype::of<std::uint8_t>()) || dt.kind() == 'b') grid = grid_from<std::uint8_t>(array);
-  else if (dt.is(py::dtype::of<std::uint16_t>())) grid = grid_from<std::uint16_t>(array);
-  else if (dt.is(py::dtype::of<std::int16_t>()) || dt.is(py::dtype::of<std::int8_t>())) grid = grid_from<std::int16_t>(array);
-  else if (dt.is(py::dtype::of<float>())) grid = grid_from<float>(array);
-  else if (dt.is(py::dtype::of<double>()) || dt.kind() == 'i' || dt.kind() == 'u') grid = grid_from<double>(array);
-  else throw Error("write_volume: unsupported dtype " + py::cast<std::string>(py::repr(dt)));
-  std::visit(
-      [&](auto& g) {
-        g.origin = Vec3d(origin[0], origin[1], origin[2]).cast<float>();
-        g.spacing = Vec3d(spacing[0], spacing[1], spacing[2]).cast<float>();
-      },
-      grid);
+  io::AnyGrid3 grid = volume_from_array(array, spacing, origin, "write_volume");
   py::gil_scoped_release release;
   io::write_volume(p, grid);
 }
@@ -114,7 +72,16 @@ py::array_t<double> read_points_py(const path& p) {
     py::gil_scoped_release release;
     m = io::read_points(p);
   }
-  return to_numpy(m.data(), {py::ssize_t(m.rows()), py::ssize_t(m.cols())});
+  return copy_array(m.data(), {py::ssize_t(m.rows()), py::ssize_t(m.cols())});
+}
+
+py::array_t<double> read_table_py(const path& p) {
+  io::Table t;
+  {
+    py::gil_scoped_release release;
+    t = io::read_table(p);
+  }
+  return copy_array(t.values.data(), {py::ssize_t(t.rows), py::ssize_t(t.cols)});
 }
 
 void write_points_py(const path& p, const CArray<double>& a) {
@@ -131,7 +98,7 @@ py::array_t<double> read_segments_py(const path& p) {
     py::gil_scoped_release release;
     m = io::read_segments(p);
   }
-  return to_numpy(m.data(), {py::ssize_t(m.rows()), py::ssize_t(4)});
+  return copy_array(m.data(), {py::ssize_t(m.rows()), py::ssize_t(4)});
 }
 
 py::array_t<std::uint8_t> read_image_py(const path& p) {
@@ -140,8 +107,7 @@ py::array_t<std::uint8_t> read_image_py(const path& p) {
     py::gil_scoped_release release;
     im = io::read_image(p);
   }
-  const auto h = py::ssize_t(im.height), w = py::ssize_t(im.width), c = py::ssize_t(im.channels);
-  return im.channels == 1 ? to_numpy(im.data.data(), {h, w}) : to_numpy(im.data.data(), {h, w, c});
+  return image_array(im);
 }
 
 void write_png_py(const path& p, const CArray<std::uint8_t>& a) {
@@ -193,13 +159,19 @@ integers as float64.)doc");
   m.def("read_points", &read_points_py, py::arg("path"),
         R"doc(Reads points from .npy, .xyz, .csv or .ply as a float64 (n, 2) or (n, 3) array.
 
-Text files: 2 columns are 2D points, 3 or more are 3D (extra columns such as
-normals are ignored); a CSV header line is skipped. Raises geods.Error for
+Reads through read_table. Text files: 2 columns are 2D points, 3 or more are 3D
+(extra columns such as normals are ignored); a CSV header line is skipped. Raises geods.Error for
 malformed files, NaN/inf coordinates or no points.)doc");
+  m.def("read_table", &read_table_py, py::arg("path"),
+        R"doc(Reads a table of numbers as a float64 (n, d) array, any d: .npy (any numeric dtype), .csv
+(a header line is skipped), .txt (blanks or commas), .xyz or .ply (vertex x, y[, z]).
+
+read_points and read_segments read through it. Every row has as many numbers as the first; raises
+geods.Error naming the file and line for malformed files, NaN/inf values or no rows.)doc");
   m.def("write_points", &write_points_py, py::arg("path"), py::arg("points"),
         R"doc(Writes an (n, 2) or (n, 3) array as .npy, .xyz, .csv or .ply by extension.)doc");
   m.def("read_segments", &read_segments_py, py::arg("path"),
-        R"doc(Reads 2D segments from .npy (m, 4), .edg or .cin as a float64 (m, 4) array of x0, y0, x1, y1.)doc");
+        R"doc(Reads 2D segments from a table of 4 columns (.npy, .csv, .txt), .edg or .cin as a float64 (m, 4) array of x0, y0, x1, y1.)doc");
   m.def("read_image", &read_image_py, py::arg("path"),
         R"doc(Reads a PNG, JPEG or BMP as uint8: (h, w) for grey, (h, w, c) for 2 to 4 channels.)doc");
   m.def("write_png", &write_png_py, py::arg("path"), py::arg("image"),

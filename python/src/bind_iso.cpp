@@ -13,10 +13,13 @@
 #include <string>
 #include <variant>
 
+#include "arrays.hpp"
 #include "bindings.hpp"
 #include "geods/core/error.hpp"
 #include "geods/iso/marching_cubes.hpp"
 #include "geods/iso/min_max_octree.hpp"
+#include "geods/iso/stats_fields.hpp"
+#include "stats_dict.hpp"
 
 namespace py = pybind11;
 
@@ -24,76 +27,30 @@ namespace geods::python {
 namespace {
 
 template <typename T>
-using CArray = py::array_t<T, py::array::c_style | py::array::forcecast>;
+using CArray = Rows<T>;
 
-using AnyGrid = std::variant<Grid3<std::uint8_t>, Grid3<std::uint16_t>, Grid3<std::int16_t>, Grid3<float>, Grid3<double>>;
-
-template <typename T>
-Grid3<T> grid_from(const py::array& array, const std::array<double, 3>& spacing, const std::array<double, 3>& origin) {
-  const auto a = CArray<T>::ensure(array);
-  Grid3<T> g;
-  g.dims = {std::size_t(a.shape(2)), std::size_t(a.shape(1)), std::size_t(a.shape(0))};
-  g.data.assign(a.data(), a.data() + a.size());
-  g.spacing = Vec3d(spacing[0], spacing[1], spacing[2]).cast<float>();
-  g.origin = Vec3d(origin[0], origin[1], origin[2]).cast<float>();
-  return g;
-}
-
-// A (nz, ny, nx) array as a volume of its own sample type (x fastest, as io's read_volume
-// maps .npy files): uint8, uint16, int16, float32, float64 as they are; bool as uint8, int8 as
-// int16, other integers as float64.
-AnyGrid volume_from(const py::array& array, const std::array<double, 3>& spacing, const std::array<double, 3>& origin) {
-  if (array.ndim() != 3) throw Error("isosurface: the volume must be a 3-D array (nz, ny, nx)");
+// The volume of isosurface() and MinMaxOctree(): volume_from_array with a finite, non-zero spacing.
+io::AnyGrid3 volume_from(const py::array& array, const std::array<double, 3>& spacing,
+                         const std::array<double, 3>& origin) {
   for (int d = 0; d < 3; ++d)
     if (!std::isfinite(spacing[d]) || spacing[d] == 0 || !std::isfinite(origin[d]))
       throw Error("isosurface: spacing must be finite and non-zero, origin finite");
-  const py::dtype dt = array.dtype();
-  if (dt.is(py::dtype::of<std::uint8_t>()) || dt.kind() == 'b') return grid_from<std::uint8_t>(array, spacing, origin);
-  if (dt.is(py::dtype::of<std::uint16_t>())) return grid_from<std::uint16_t>(array, spacing, origin);
-  if (dt.is(py::dtype::of<std::int16_t>()) || dt.is(py::dtype::of<std::int8_t>()))
-    return grid_from<std::int16_t>(array, spacing, origin);
-  if (dt.is(py::dtype::of<float>())) return grid_from<float>(array, spacing, origin);
-  if (dt.is(py::dtype::of<double>()) || dt.kind() == 'i' || dt.kind() == 'u')
-    return grid_from<double>(array, spacing, origin);
-  throw Error("isosurface: unsupported dtype " + py::cast<std::string>(py::repr(dt)));
+  return volume_from_array(array, spacing, origin, "isosurface");
 }
 
 // Curvilinear node positions: float (nz, ny, nx, 3), x, y, z per sample.
 std::vector<Vec3f> positions_from(const py::object& coords, const std::array<std::size_t, 3>& dims) {
   if (coords.is_none()) return {};
-  const auto a = CArray<float>::ensure(coords);
+  auto a = CArray<float>::ensure(coords);
   if (!a || a.ndim() != 4 || std::size_t(a.shape(0)) != dims[2] || std::size_t(a.shape(1)) != dims[1] ||
       std::size_t(a.shape(2)) != dims[0] || a.shape(3) != 3)
     throw Error("isosurface: coords must be a float array of shape (nz, ny, nx, 3) matching the volume");
-  std::vector<Vec3f> p(std::size_t(a.size() / 3));
-  const float* xyz = a.data();
-  for (std::size_t i = 0; i < p.size(); ++i) p[i] = Vec3f(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
-  return p;
-}
-
-py::tuple mesh_arrays(const TriMesh& mesh) {
-  const auto nv = py::ssize_t(mesh.num_vertices()), nf = py::ssize_t(mesh.num_triangles());
-  py::array_t<float> v({nv, py::ssize_t(3)});
-  py::array_t<float> n({mesh.normals.empty() ? 0 : nv, py::ssize_t(3)});
-  if (nv > 0) std::memcpy(v.mutable_data(), mesh.vertices.data(), std::size_t(nv) * sizeof(Vec3f));
-  if (!mesh.normals.empty() && nv > 0) std::memcpy(n.mutable_data(), mesh.normals.data(), std::size_t(nv) * sizeof(Vec3f));
-  py::object f;
-  if (mesh.num_vertices() <= std::size_t(std::numeric_limits<std::int32_t>::max())) {
-    py::array_t<std::int32_t> fi({nf, py::ssize_t(3)});
-    if (nf > 0) std::memcpy(fi.mutable_data(), mesh.triangles.data(), std::size_t(nf) * 3 * sizeof(std::int32_t));
-    f = fi;
-  } else {
-    py::array_t<std::int64_t> fl({nf, py::ssize_t(3)});
-    for (py::ssize_t t = 0; t < nf; ++t)
-      for (int c = 0; c < 3; ++c) fl.mutable_at(t, c) = mesh.triangles[std::size_t(t)][std::size_t(c)];
-    f = fl;
-  }
-  return py::make_tuple(v, f, n);
+  return points_of<float, 3>(a.reshape({a.size() / 3, py::ssize_t(3)}), "isosurface: coords");
 }
 
 py::tuple isosurface_py(const py::array& volume, double iso, const std::array<double, 3>& spacing,
                         const std::array<double, 3>& origin, bool normals, const py::object& coords) {
-  const AnyGrid grid = volume_from(volume, spacing, origin);
+  const io::AnyGrid3 grid = volume_from(volume, spacing, origin);
   const auto dims = std::visit([](const auto& g) { return g.dims; }, grid);
   const std::vector<Vec3f> positions = positions_from(coords, dims);
   TriMesh mesh;
@@ -104,7 +61,7 @@ py::tuple isosurface_py(const py::array& volume, double iso, const std::array<do
     options.positions = positions;
     mesh = std::visit([&](const auto& g) { return iso::isosurface(g, iso, options); }, grid);
   }
-  return mesh_arrays(mesh);
+  return mesh_arrays(mesh, true);
 }
 
 // geods.MinMaxOctree: an octree of any sample type plus the counts of the last query.
@@ -112,7 +69,7 @@ class PyOctree {
  public:
   PyOctree(const py::array& volume, std::size_t leaf_cells, const std::array<double, 3>& spacing,
            const std::array<double, 3>& origin) {
-    AnyGrid grid = volume_from(volume, spacing, origin);
+    io::AnyGrid3 grid = volume_from(volume, spacing, origin);
     py::gil_scoped_release release;
     tree_ = std::visit(
         [&](auto& g) -> AnyTree {
@@ -123,9 +80,7 @@ class PyOctree {
   }
 
   py::tuple isosurface(double iso, bool normals, const py::object& coords, const std::string& sharing) {
-    if (sharing != "blocks" && sharing != "hash")
-      throw Error("MinMaxOctree.isosurface: sharing must be 'blocks' or 'hash', not '" + sharing + "'");
-    const iso::VertexSharing mode = sharing == "hash" ? iso::VertexSharing::hash_table : iso::VertexSharing::block_masks;
+    const iso::VertexSharing mode = iso::parse_vertex_sharing(sharing);
     const auto dims = std::visit([](const auto& t) { return t->volume().dims; }, tree_);
     const std::vector<Vec3f> positions = positions_from(coords, dims);
     iso::OctreeIsoResult r;
@@ -138,18 +93,11 @@ class PyOctree {
     }
     cells_visited_ = r.cells_visited;
     nodes_visited_ = r.nodes_visited;
-    return mesh_arrays(r.mesh);
+    return mesh_arrays(r.mesh, true);
   }
 
   py::dict stats() const {
-    const iso::MinMaxOctreeStats s = std::visit([](const auto& t) { return t->stats(); }, tree_);
-    py::dict d;
-    d["nodes"] = s.nodes;
-    d["levels"] = s.levels;
-    d["leaf_cells"] = s.leaf_cells;
-    d["cells"] = s.cells;
-    d["bytes"] = s.bytes;
-    return d;
+    return stats_dict(std::visit([](const auto& t) { return t->stats(); }, tree_));
   }
   void validate() const {
     std::visit([](const auto& t) { t->validate(); }, tree_);
@@ -218,10 +166,10 @@ cell per leaf, the textbook octree).)doc")
            py::arg("volume"), py::arg("leaf_cells") = iso::MinMaxOctree<float>::kDefaultLeafCells,
            py::arg("spacing") = ones, py::arg("origin") = zeros)
       .def("isosurface", &PyOctree::isosurface, py::arg("t"), py::arg("normals") = true,
-           py::arg("coords") = py::none(), py::arg("sharing") = "blocks",
+           py::arg("coords") = py::none(), py::arg("sharing") = "block_masks",
            "(V, F, N) exactly as geods.isosurface(volume, t) gives them (in another order). sharing: how the\n"
-           "cells around a grid edge share its vertex, 'blocks' (bit masks per crossed leaf, the default) or\n"
-           "'hash' (the edge hash table of seed 2.4).")
+           "cells around a grid edge share its vertex, 'block_masks' (bit masks per crossed leaf, the default)\n"
+           "or 'hash_table' (the edge hash table of seed 2.4); 'blocks' and 'hash' are deprecated spellings.")
       .def_property_readonly("cells_visited", &PyOctree::cells_visited,
                              "Cells examined by the last isosurface() call (None before the first).")
       .def_property_readonly("nodes_visited", &PyOctree::nodes_visited,

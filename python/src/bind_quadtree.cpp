@@ -10,10 +10,13 @@
 #include <string>
 #include <variant>
 
+#include "arrays.hpp"
 #include "bindings.hpp"
 #include "geods/core/archive.hpp"
 #include "geods/core/error.hpp"
 #include "geods/spatial/quadtree.hpp"
+#include "geods/spatial/stats_fields.hpp"
+#include "stats_dict.hpp"
 
 namespace py = pybind11;
 
@@ -21,9 +24,6 @@ namespace geods::python {
 namespace {
 
 using spatial::Orthtree;
-
-template <typename T>
-using Rows = py::array_t<T, py::array::c_style | py::array::forcecast>;
 
 // "N"/"S"/"E"/"W", "+x"/"-x"/"+y"/"-y"/"+z"/"-z", or the integer 2 * axis + (1 if negative).
 spatial::Direction parse_direction(const py::handle& d, int dim, const char* cls) {
@@ -62,9 +62,9 @@ class PyOrthtree {
     if (max_depth.is_none() == false && options.max_depth < 0)
       throw Error(std::string(kName) + ": max_depth must be >= 0");
     if (build == "morton") {
-      options.build = spatial::OrthtreeBuild::Morton;
-    } else if (build != "topdown") {
-      throw Error(std::string(kName) + ": build is 'topdown' or 'morton', got '" + build + "'");
+      options.build = spatial::OrthtreeBuild::morton;
+    } else if (build != "top_down" && build != "topdown") {  // topdown: the deprecated spelling
+      throw Error(std::string(kName) + ": build is 'top_down' or 'morton', got '" + build + "'");
     }
     if (points.dtype().is(py::dtype::of<float>())) {
       make<float>(points, options);
@@ -101,8 +101,7 @@ class PyOrthtree {
 
   std::int64_t neighbor(std::int64_t v, const py::handle& direction) const {
     const spatial::Direction dir = parse_direction(direction, Dim, kName);
-    const std::uint32_t u = visit([&](const auto& t) { return t.neighbor(check_node(v), dir); });
-    return u == spatial::kNoNode ? -1 : std::int64_t(u);
+    return index_value(visit([&](const auto& t) { return t.neighbor(check_node(v), dir); }));
   }
 
   PyOrthtree balanced() const {
@@ -129,15 +128,7 @@ class PyOrthtree {
   }
 
   py::dict stats() const {
-    const spatial::OrthtreeStats s = visit([](const auto& t) { return t.stats(); });
-    py::dict d;
-    d["points"] = s.points;
-    d["nodes"] = s.nodes;
-    d["leaves"] = s.leaves;
-    d["empty_leaves"] = s.empty_leaves;
-    d["depth"] = s.depth;
-    d["bytes"] = s.bytes;
-    return d;
+    return stats_dict(visit([](const auto& t) { return t.stats(); }));
   }
 
   // ------------------------------------------------------------ node accessors
@@ -159,23 +150,20 @@ class PyOrthtree {
     return visit([&](const auto& t) { return t.node(check_node(v)).depth; });
   }
   std::int64_t parent(std::int64_t v) const {
-    const std::uint32_t p = visit([&](const auto& t) { return t.node(check_node(v)).parent; });
-    return p == spatial::kNoNode ? -1 : std::int64_t(p);
+    return index_value(visit([&](const auto& t) { return t.node(check_node(v)).parent; }));
   }
   py::array_t<std::int64_t> node_points(std::int64_t v) const {
     return visit([&](const auto& t) {
       const auto& n = t.node(check_node(v));
-      py::array_t<std::int64_t> out(py::ssize_t(n.end - n.begin));
-      std::copy(t.permutation().begin() + n.begin, t.permutation().begin() + n.end, out.mutable_data());
-      return out;
+      return index_array(std::span<const std::uint32_t>(t.permutation()).subspan(n.begin, n.end - n.begin));
     });
   }
   py::array_t<std::int64_t> leaves() const {
     return visit([&](const auto& t) {
-      std::vector<std::int64_t> out;
+      std::vector<std::uint32_t> out;
       for (std::uint32_t v = 0; v < t.nodes().size(); ++v)
         if (t.nodes()[v].leaf()) out.push_back(v);
-      return py::array_t<std::int64_t>(py::ssize_t(out.size()), out.data());
+      return index_array(out);
     });
   }
 
@@ -183,8 +171,7 @@ class PyOrthtree {
   std::int64_t locate(const py::handle& p) const {
     return visit([&](const auto& t) {
       using T = typename std::decay_t<decltype(t)>::Scalar;
-      const std::uint32_t v = t.locate(one_point<T>(p, "locate"));
-      return v == spatial::kNoNode ? std::int64_t(-1) : std::int64_t(v);
+      return index_value(t.locate(one_point<T>(p, "locate")));
     });
   }
 
@@ -198,8 +185,7 @@ class PyOrthtree {
         found = t.query_box(l, h);
         std::sort(found.begin(), found.end());
       }
-      return py::array_t<std::int64_t>(py::ssize_t(found.size()),
-                                       std::vector<std::int64_t>(found.begin(), found.end()).data());
+      return index_array(found);
     });
   }
 
@@ -213,79 +199,40 @@ class PyOrthtree {
   py::tuple query(const py::handle& q, std::size_t k) const {
     return visit([&](const auto& t) {
       using T = typename std::decay_t<decltype(t)>::Scalar;
-      const auto [rows, single] = many_points<T>(q, "query");
-      const std::size_t m = std::size_t(rows.shape(0));
-      py::array_t<double> distances(std::vector<py::ssize_t>{py::ssize_t(m), py::ssize_t(k)});
-      py::array_t<std::int64_t> indices(std::vector<py::ssize_t>{py::ssize_t(m), py::ssize_t(k)});
-      double* d = distances.mutable_data();
-      std::int64_t* idx = indices.mutable_data();
-      std::fill(d, d + m * k, std::numeric_limits<double>::infinity());
-      std::fill(idx, idx + m * k, -1);
-      for (std::size_t i = 0; i < m; ++i) {
-        const auto found = t.query(row<T>(rows, i), k);
-        for (std::size_t j = 0; j < found.size(); ++j) {
-          d[i * k + j] = std::sqrt(double(found[j].squared_distance));
-          idx[i * k + j] = found[j].index;
-        }
+      const PointRows<T> rows = point_rows<T>(q, Dim, std::string(kName) + ".query");
+      std::vector<spatial::Neighbor<T>> result(rows.count * k);  // k per query, missing ones kNoIndex
+      for (std::size_t i = 0; i < rows.count; ++i) {
+        const auto found = t.query(rows.template point<Dim>(i), k);
+        std::copy(found.begin(), found.end(), result.begin() + std::ptrdiff_t(i * k));
       }
-      if (single) return py::make_tuple(distances.reshape({py::ssize_t(k)}), indices.reshape({py::ssize_t(k)}));
-      return py::make_tuple(distances, indices);
+      return neighbor_arrays(std::span<const spatial::Neighbor<T>>(result), rows.count, k, rows.single,
+                             &spatial::Neighbor<T>::index);
     });
   }
 
   py::object query_radius(const py::handle& q, double r) const {
     return visit([&](const auto& t) -> py::object {
       using T = typename std::decay_t<decltype(t)>::Scalar;
-      const auto [rows, single] = many_points<T>(q, "query_radius");
-      py::list out;
-      for (py::ssize_t i = 0; i < rows.shape(0); ++i) {
-        const auto found = t.query_radius(row<T>(rows, std::size_t(i)), r);
-        py::array_t<std::int64_t> idx(py::ssize_t(found.size()));
-        for (std::size_t j = 0; j < found.size(); ++j) idx.mutable_data()[j] = found[j].index;
-        out.append(idx);
-      }
-      if (single) return out[0];
-      return out;
+      const PointRows<T> rows = point_rows<T>(q, Dim, std::string(kName) + ".query_radius");
+      std::vector<std::vector<spatial::Neighbor<T>>> result(rows.count);
+      for (std::size_t i = 0; i < rows.count; ++i) result[i] = t.query_radius(rows.template point<Dim>(i), r);
+      return neighbor_lists(result, rows.single, &spatial::Neighbor<T>::index);
     });
   }
 
  private:
   template <typename T>
   void make(const py::array& points, const spatial::OrthtreeOptions& options) {
-    const auto rows = Rows<T>::ensure(points);
-    if (!rows) throw Error(std::string(kName) + ": points must be numbers");
-    const spatial::PointView<T> view(rows.data(), std::size_t(rows.shape(0)), Dim);
+    const PointRows<T> rows = point_rows<T>(points, Dim, kName, false);
     py::gil_scoped_release release;
-    tree_ = Orthtree<T, Dim>(view, options);  // copies the points
+    tree_ = Orthtree<T, Dim>(rows.view(), options);  // copies the points
   }
 
   static py::array_t<double> vector(const Vec<double, Dim>& v) { return py::array_t<double>(Dim, v.data()); }
 
   template <typename T>
   static Vec<T, Dim> one_point(const py::handle& p, const char* what) {
-    const auto a = Rows<T>::ensure(p);
-    if (!a || a.ndim() != 1 || a.shape(0) != Dim)
-      throw Error(std::string(kName) + "." + what + ": expected a point of shape (" + std::to_string(Dim) + ",)");
-    Vec<T, Dim> v;
-    for (int i = 0; i < Dim; ++i) v[i] = a.data()[i];
-    return v;
-  }
-
-  // (m, Dim) rows, and whether a single (Dim,) point was given.
-  template <typename T>
-  static std::pair<Rows<T>, bool> many_points(const py::handle& q, const char* what) {
-    auto a = Rows<T>::ensure(q);
-    if (a && a.ndim() == 1 && a.shape(0) == Dim) return {a.reshape({py::ssize_t(1), py::ssize_t(Dim)}), true};
-    if (a && a.ndim() == 2 && a.shape(1) == Dim) return {a, false};
-    throw Error(std::string(kName) + "." + what + ": expected shape (" + std::to_string(Dim) + ",) or (m, " +
-                std::to_string(Dim) + ")");
-  }
-
-  template <typename T>
-  static Vec<T, Dim> row(const Rows<T>& rows, std::size_t i) {
-    Vec<T, Dim> v;
-    for (int a = 0; a < Dim; ++a) v[a] = rows.data()[i * Dim + a];
-    return v;
+    return point_of<T, Dim>(p, std::string(kName) + "." + what);
   }
 
   AnyTree tree_;
@@ -296,7 +243,7 @@ void bind_orthtree(py::module_& m, const char* doc) {
   using Py = PyOrthtree<Dim>;
   py::class_<Py>(m, Py::kName, doc)
       .def(py::init<const py::array&, std::size_t, const py::object&, const std::string&>(), py::arg("points"),
-           py::arg("bucket") = 1, py::arg("max_depth") = py::none(), py::arg("build") = "topdown")
+           py::arg("bucket") = 1, py::arg("max_depth") = py::none(), py::arg("build") = "top_down")
       .def("neighbor", &Py::neighbor, py::arg("node"), py::arg("direction"),
            "The deepest node of depth <= depth(node) across the face in `direction` ('N', 'S', 'E', 'W', '+x', "
            "'-x', '+y', '-y', '+z', '-z' or 0..5 = 2 * axis + negative); -1 at the boundary. O(depth).")

@@ -9,59 +9,23 @@
 #include <limits>
 #include <variant>
 
+#include "arrays.hpp"
 #include "bindings.hpp"
 #include "geods/core/error.hpp"
-#include "geods/spatial/kd_tree.hpp"
+#include "geods/spatial/kd_tree_dimensions.hpp"
+#include "geods/spatial/stats_fields.hpp"
+#include "stats_dict.hpp"
 
 namespace py = pybind11;
 
 namespace geods::python {
 namespace {
 
-using spatial::Dynamic;
+using spatial::AnyKdTree;
 using spatial::KdTree;
 
 // float32 points stay float (half the memory, like the caller's array); anything else is float64.
-// Dimensions 2 and 3 get the compile-time trees, others the run-time one.
-using AnyTree = std::variant<KdTree<float, 2>, KdTree<float, 3>, KdTree<float, Dynamic>, KdTree<double, 2>,
-                             KdTree<double, 3>, KdTree<double, Dynamic>>;
-
-template <typename T>
-AnyTree make_tree(spatial::PointView<T> view, std::size_t leaf_size) {
-  if (view.dim == 2) return KdTree<T, 2>(view, leaf_size);
-  if (view.dim == 3) return KdTree<T, 3>(view, leaf_size);
-  return KdTree<T, Dynamic>(view, leaf_size);
-}
-
-template <typename T>
-AnyTree load_tree(const std::filesystem::path& path, std::size_t dim) {
-  if (dim == 2) return KdTree<T, 2>::load(path);
-  if (dim == 3) return KdTree<T, 3>::load(path);
-  return KdTree<T, Dynamic>::load(path);
-}
-
-template <typename T>
-using Rows = py::array_t<T, py::array::c_style | py::array::forcecast>;
-
-// Query points as C-order rows of the tree's scalar type; `single` if given as one point (d,).
-template <typename T>
-struct QueryRows {
-  Rows<T> array;
-  bool single;
-  std::size_t count, dim;
-  const T* data() const { return array.data(); }
-  spatial::PointView<T> view() const { return {array.data(), count, dim}; }
-};
-
-template <typename T>
-QueryRows<T> as_rows(const py::handle& q, std::size_t dim, const char* what) {
-  auto a = Rows<T>::ensure(q);
-  if (!a) throw Error(std::string(what) + ": expected an array of numbers");
-  if (a.ndim() == 1 && std::size_t(a.shape(0)) == dim) return {a, true, 1, dim};
-  if (a.ndim() == 2 && std::size_t(a.shape(1)) == dim) return {a, false, std::size_t(a.shape(0)), dim};
-  throw Error(std::string(what) + ": expected shape (" + std::to_string(dim) + ",) or (m, " + std::to_string(dim) +
-              ") for a tree of dimension " + std::to_string(dim));
-}
+using AnyTree = std::variant<AnyKdTree<float>, AnyKdTree<double>>;
 
 class PyKdTree {
  public:
@@ -79,133 +43,103 @@ class PyKdTree {
   static PyKdTree load(const std::filesystem::path& path) {
     const spatial::KdTreeFileInfo info = spatial::read_kd_tree_info(path);
     py::gil_scoped_release release;
-    return PyKdTree(info.scalar == DType::f32 ? load_tree<float>(path, info.dim) : load_tree<double>(path, info.dim));
+    if (info.scalar == DType::f32) return PyKdTree(AnyTree(spatial::load_kd_tree<float>(path, info.dim)));
+    return PyKdTree(AnyTree(spatial::load_kd_tree<double>(path, info.dim)));
+  }
+
+  // f(tree) with the tree's concrete KdTree<T, Dim>.
+  template <typename F>
+  decltype(auto) visit(F&& f) const {
+    return std::visit([&](const auto& any) -> decltype(auto) { return std::visit(f, any); }, tree_);
   }
 
   std::size_t size() const {
-    return std::visit([](const auto& t) { return t.size(); }, tree_);
+    return visit([](const auto& t) { return t.size(); });
   }
   std::size_t dim() const {
-    return std::visit([](const auto& t) { return t.dim(); }, tree_);
+    return visit([](const auto& t) { return t.dim(); });
   }
   std::size_t leaf_size() const {
-    return std::visit([](const auto& t) { return t.leaf_size(); }, tree_);
+    return visit([](const auto& t) { return t.leaf_size(); });
   }
   py::dtype dtype() const {
-    return std::visit([](const auto& t) { return py::dtype::of<typename std::decay_t<decltype(t)>::Scalar>(); },
-                      tree_);
+    return visit([](const auto& t) { return py::dtype::of<typename std::decay_t<decltype(t)>::Scalar>(); });
   }
 
   py::tuple query(const py::handle& q, std::size_t k, double eps) const {
-    return std::visit(
-        [&](const auto& tree) {
-          using T = typename std::decay_t<decltype(tree)>::Scalar;
-          const QueryRows<T> rows = as_rows<T>(q, tree.dim(), "KdTree.query");
-          const bool single = rows.single;
-          const spatial::PointView<T> view = rows.view();
-          const spatial::KnnRequest request{k, eps};
-          std::vector<spatial::Neighbor<T>> result;
-          {
-            py::gil_scoped_release release;
-            result = tree.query_batch(view, request);
-          }
-          py::array_t<double> distances(std::vector<py::ssize_t>{py::ssize_t(view.count), py::ssize_t(k)});
-          py::array_t<std::int64_t> indices(std::vector<py::ssize_t>{py::ssize_t(view.count), py::ssize_t(k)});
-          double* d = distances.mutable_data();
-          std::int64_t* idx = indices.mutable_data();
-          for (std::size_t i = 0; i < result.size(); ++i) {
-            const bool missing = result[i].index == spatial::kNoIndex;
-            d[i] = missing ? std::numeric_limits<double>::infinity() : std::sqrt(double(result[i].squared_distance));
-            idx[i] = missing ? -1 : std::int64_t(result[i].index);
-          }
-          if (single) return py::make_tuple(distances.reshape({py::ssize_t(k)}), indices.reshape({py::ssize_t(k)}));
-          return py::make_tuple(distances, indices);
-        },
-        tree_);
+    return visit([&](const auto& tree) {
+      using T = typename std::decay_t<decltype(tree)>::Scalar;
+      const PointRows<T> rows = point_rows<T>(q, tree.dim(), "KdTree.query");
+      std::vector<spatial::Neighbor<T>> result;
+      {
+        py::gil_scoped_release release;
+        result = tree.query_batch(rows.view(), spatial::KnnRequest{k, eps});
+      }
+      return neighbor_arrays(std::span<const spatial::Neighbor<T>>(result), rows.count, k, rows.single,
+                             &spatial::Neighbor<T>::index);
+    });
   }
 
   py::object query_radius(const py::handle& q, double r) const {
-    return std::visit(
-        [&](const auto& tree) -> py::object {
-          using T = typename std::decay_t<decltype(tree)>::Scalar;
-          const QueryRows<T> rows = as_rows<T>(q, tree.dim(), "KdTree.query_radius");
-          std::vector<std::vector<spatial::Neighbor<T>>> result;
-          {
-            py::gil_scoped_release release;
-            result = tree.query_radius_batch(rows.view(), r);
-          }
-          py::list out;
-          for (const auto& neighbors : result) {
-            py::array_t<std::int64_t> idx(py::ssize_t(neighbors.size()));
-            std::int64_t* p = idx.mutable_data();
-            for (std::size_t i = 0; i < neighbors.size(); ++i) p[i] = neighbors[i].index;
-            out.append(idx);
-          }
-          if (rows.single) return out[0];
-          return out;
-        },
-        tree_);
+    return visit([&](const auto& tree) -> py::object {
+      using T = typename std::decay_t<decltype(tree)>::Scalar;
+      const PointRows<T> rows = point_rows<T>(q, tree.dim(), "KdTree.query_radius");
+      std::vector<std::vector<spatial::Neighbor<T>>> result;
+      {
+        py::gil_scoped_release release;
+        result = tree.query_radius_batch(rows.view(), r);
+      }
+      return neighbor_lists(result, rows.single, &spatial::Neighbor<T>::index);
+    });
   }
 
   py::array_t<std::int64_t> query_box(const py::handle& lo, const py::handle& hi) const {
-    return std::visit(
-        [&](const auto& tree) {
-          using T = typename std::decay_t<decltype(tree)>::Scalar;
-          const QueryRows<T> l = as_rows<T>(lo, tree.dim(), "KdTree.query_box lo");
-          const QueryRows<T> h = as_rows<T>(hi, tree.dim(), "KdTree.query_box hi");
-          if (!l.single || !h.single) throw Error("KdTree.query_box: lo and hi are single points");
-          std::vector<std::uint32_t> found;
-          {
-            py::gil_scoped_release release;
-            found = tree.query_box(std::span<const T>(l.data(), tree.dim()), std::span<const T>(h.data(), tree.dim()));
-            std::sort(found.begin(), found.end());
-          }
-          return py::array_t<std::int64_t>(py::ssize_t(found.size()),
-                                           std::vector<std::int64_t>(found.begin(), found.end()).data());
-        },
-        tree_);
+    return visit([&](const auto& tree) {
+      using T = typename std::decay_t<decltype(tree)>::Scalar;
+      const PointRows<T> l = point_rows<T>(lo, tree.dim(), "KdTree.query_box lo");
+      const PointRows<T> h = point_rows<T>(hi, tree.dim(), "KdTree.query_box hi");
+      if (!l.single || !h.single) throw Error("KdTree.query_box: lo and hi are single points");
+      std::vector<std::uint32_t> found;
+      {
+        py::gil_scoped_release release;
+        found = tree.query_box(std::span<const T>(l.data(), tree.dim()), std::span<const T>(h.data(), tree.dim()));
+        std::sort(found.begin(), found.end());
+      }
+      return index_array(found);
+    });
   }
 
   py::object count_box(const py::handle& lo, const py::handle& hi) const {
-    return std::visit(
-        [&](const auto& tree) -> py::object {
-          using T = typename std::decay_t<decltype(tree)>::Scalar;
-          const std::size_t d = tree.dim();
-          const QueryRows<T> l = as_rows<T>(lo, d, "KdTree.count_box lo");
-          const QueryRows<T> h = as_rows<T>(hi, d, "KdTree.count_box hi");
-          if (l.count != h.count || l.single != h.single) throw Error("KdTree.count_box: lo and hi differ in shape");
-          const std::size_t m = l.count;
-          std::vector<T> boxes(m * 2 * d);
-          for (std::size_t i = 0; i < m; ++i) {
-            std::copy(l.data() + i * d, l.data() + (i + 1) * d, boxes.begin() + i * 2 * d);
-            std::copy(h.data() + i * d, h.data() + (i + 1) * d, boxes.begin() + i * 2 * d + d);
-          }
-          std::vector<std::size_t> counts;
-          {
-            py::gil_scoped_release release;
-            counts = tree.count_box_batch(spatial::PointView<T>(boxes.data(), m, 2 * d));
-          }
-          if (l.single) return py::int_(counts[0]);
-          return py::array_t<std::int64_t>(py::ssize_t(m), std::vector<std::int64_t>(counts.begin(), counts.end()).data());
-        },
-        tree_);
+    return visit([&](const auto& tree) -> py::object {
+      using T = typename std::decay_t<decltype(tree)>::Scalar;
+      const std::size_t d = tree.dim();
+      const PointRows<T> l = point_rows<T>(lo, d, "KdTree.count_box lo");
+      const PointRows<T> h = point_rows<T>(hi, d, "KdTree.count_box hi");
+      if (l.count != h.count || l.single != h.single) throw Error("KdTree.count_box: lo and hi differ in shape");
+      const std::size_t m = l.count;
+      std::vector<T> boxes(m * 2 * d);
+      for (std::size_t i = 0; i < m; ++i) {
+        std::copy(l.data() + i * d, l.data() + (i + 1) * d, boxes.begin() + i * 2 * d);
+        std::copy(h.data() + i * d, h.data() + (i + 1) * d, boxes.begin() + i * 2 * d + d);
+      }
+      std::vector<std::size_t> counts;
+      {
+        py::gil_scoped_release release;
+        counts = tree.count_box_batch(spatial::PointView<T>(boxes.data(), m, 2 * d));
+      }
+      if (l.single) return py::int_(counts[0]);
+      return index_array(counts);
+    });
   }
 
   py::dict stats() const {
-    const spatial::KdTreeStats s = std::visit([](const auto& t) { return t.stats(); }, tree_);
-    py::dict d;
-    d["points"] = s.points;
-    d["nodes"] = s.nodes;
-    d["leaves"] = s.leaves;
-    d["depth"] = s.depth;
-    d["bytes"] = s.bytes;
-    return d;
+    return stats_dict(visit([](const auto& t) { return t.stats(); }));
   }
   void validate() const {
-    std::visit([](const auto& t) { t.validate(); }, tree_);
+    visit([](const auto& t) { t.validate(); });
   }
   void save(const std::filesystem::path& path) const {
-    std::visit([&](const auto& t) { t.save(path); }, tree_);
+    visit([&](const auto& t) { t.save(path); });
   }
 
  private:
@@ -218,15 +152,14 @@ class PyKdTree {
         points.strides(0) % item == 0 && points.strides(0) >= points.shape(1) * item) {
       rows = py::reinterpret_borrow<py::array_t<T>>(points);
     } else {
-      rows = Rows<T>::ensure(points);
-      if (!rows) throw Error("KdTree: points must be numbers");
+      rows = point_rows<T>(points, std::size_t(points.shape(1)), "KdTree", false).array;
     }
     const std::size_t n = std::size_t(rows.shape(0)), d = std::size_t(rows.shape(1));
     const std::size_t stride = rows.shape(0) > 1 ? std::size_t(rows.strides(0) / item) : d;
     const spatial::PointView<T> view(rows.data(), n, d, std::max(stride, d));
     {
       py::gil_scoped_release release;
-      tree_ = make_tree<T>(view, leaf_size);
+      tree_ = spatial::make_kd_tree<T>(view, leaf_size);
     }
     points_ = rows;  // the tree reads the array in place: keep it alive
   }

@@ -10,13 +10,16 @@
 #include <string>
 #include <vector>
 
+#include "arrays.hpp"
 #include "bindings.hpp"
 #include "geods/core/error.hpp"
 #include "geods/voronoi/circles.hpp"
 #include "geods/voronoi/metric_voronoi.hpp"
 #include "geods/voronoi/post_office.hpp"
 #include "geods/voronoi/proximity.hpp"
+#include "geods/voronoi/stats_fields.hpp"
 #include "geods/voronoi/voronoi2.hpp"
+#include "stats_dict.hpp"
 
 namespace py = pybind11;
 
@@ -24,22 +27,9 @@ namespace geods::python {
 namespace {
 
 using voronoi::Voronoi2;
-using Rows = py::array_t<double, py::array::c_style | py::array::forcecast>;
-
 // An (n, 2) array (or a single point (2,) when `single` is allowed) as points.
 std::vector<Vec2d> to_points(const py::handle& object, const char* what, bool* single = nullptr) {
-  const Rows a = Rows::ensure(object);
-  if (!a) throw Error(std::string(what) + ": expected an array of numbers");
-  if (single && a.ndim() == 1 && a.shape(0) == 2) {
-    *single = true;
-    return {Vec2d(a.at(0), a.at(1))};
-  }
-  if (a.ndim() != 2 || a.shape(1) != 2)
-    throw Error(std::string(what) + ": expected an (n, 2) array" + (single ? " or one point (2,)" : ""));
-  if (single) *single = false;
-  std::vector<Vec2d> p(std::size_t(a.shape(0)));
-  for (std::size_t i = 0; i < p.size(); ++i) p[i] = {a.at(py::ssize_t(i), 0), a.at(py::ssize_t(i), 1)};
-  return p;
+  return points_of<double, 2>(object, what, single);
 }
 
 AABB2d to_box(const py::object& box, const char* what) {
@@ -49,28 +39,25 @@ AABB2d to_box(const py::object& box, const char* what) {
   return AABB2d({v[0], v[1]}, {v[2], v[3]});
 }
 
-py::array_t<double> to_array(const std::vector<Vec2d>& p) {
-  py::array_t<double> out(std::vector<py::ssize_t>{py::ssize_t(p.size()), 2});
-  double* d = out.mutable_data();
-  for (std::size_t i = 0; i < p.size(); ++i) d[2 * i] = p[i][0], d[2 * i + 1] = p[i][1];
-  return out;
-}
-
-template <typename T>
-py::array_t<std::int64_t> to_int_array(const std::vector<T>& v) {
-  py::array_t<std::int64_t> out(py::ssize_t(v.size()));
-  std::int64_t* d = out.mutable_data();
-  for (std::size_t i = 0; i < v.size(); ++i) d[i] = std::int64_t(v[i]);
-  return out;
-}
-
 py::list to_polygons(const std::vector<std::vector<Vec2d>>& cells) {
   py::list out;
-  for (const auto& cell : cells) out.append(to_array(cell));
+  for (const auto& cell : cells) out.append(points_array(cell));
   return out;
 }
 
-std::int64_t index_or_minus_one(std::uint32_t v) { return v == Voronoi2::kInfinity ? -1 : std::int64_t(v); }
+// The nearest site of each query ((m, 2) -> (m,) int64, or (2,) -> int) by a locator.
+template <typename Locator>
+py::object nearest_sites(const Locator& locator, const py::handle& queries, const char* what) {
+  bool single = false;
+  const std::vector<Vec2d> q = to_points(queries, what, &single);
+  std::vector<std::uint32_t> result;
+  {
+    py::gil_scoped_release release;
+    result = locator.nearest_batch(q);
+  }
+  if (single) return py::int_(result[0]);
+  return index_array(result);
+}
 
 class PyVoronoi2 {
  public:
@@ -92,8 +79,8 @@ class PyVoronoi2 {
   }
 
   py::tuple box() const { return py::make_tuple(box_.lo[0], box_.lo[1], box_.hi[0], box_.hi[1]); }
-  py::array_t<double> points() const { return to_array({diagram_->points().begin(), diagram_->points().end()}); }
-  py::array_t<double> vertices() const { return to_array(diagram_->vertices()); }
+  py::array_t<double> points() const { return points_array(diagram_->points()); }
+  py::array_t<double> vertices() const { return points_array(diagram_->vertices()); }
 
   py::list cells() const {
     std::vector<std::vector<Vec2d>> cells;
@@ -107,14 +94,10 @@ class PyVoronoi2 {
   // One row per edge (a pair of twin half-edges): left site, right site, origin, target (-1: infinity).
   py::array_t<std::int64_t> edges() const {
     const auto& e = diagram_->edges();
-    std::vector<std::int64_t> rows;
+    std::vector<std::uint32_t> rows;
     for (std::uint32_t k = 0; k < e.size(); ++k)
-      if (e[k].twin > k)
-        rows.insert(rows.end(), {std::int64_t(e[k].site), std::int64_t(diagram_->opposite_site(k)),
-                                 index_or_minus_one(e[k].origin), index_or_minus_one(e[k].target)});
-    py::array_t<std::int64_t> out(std::vector<py::ssize_t>{py::ssize_t(rows.size() / 4), 4});
-    std::copy(rows.begin(), rows.end(), out.mutable_data());
-    return out;
+      if (e[k].twin > k) rows.insert(rows.end(), {e[k].site, diagram_->opposite_site(k), e[k].origin, e[k].target});
+    return index_array(rows, {py::ssize_t(rows.size() / 4), 4});  // kInfinity becomes -1
   }
 
   // Unit direction from origin to target of each row of edges().
@@ -122,7 +105,7 @@ class PyVoronoi2 {
     std::vector<Vec2d> d;
     for (std::uint32_t k = 0; k < diagram_->edges().size(); ++k)
       if (diagram_->edges()[k].twin > k) d.push_back(diagram_->direction(k));
-    return to_array(d);
+    return points_array(d);
   }
 
   // Each row of edges() clipped to the box: x0, y0, x1, y1 (NaN when outside).
@@ -135,58 +118,40 @@ class PyVoronoi2 {
       rows.insert(rows.end(), s ? std::initializer_list<double>{s->first[0], s->first[1], s->second[0], s->second[1]}
                                 : std::initializer_list<double>{nan, nan, nan, nan});
     }
-    py::array_t<double> out(std::vector<py::ssize_t>{py::ssize_t(rows.size() / 4), 4});
-    std::copy(rows.begin(), rows.end(), out.mutable_data());
-    return out;
+    return copy_array(rows.data(), {py::ssize_t(rows.size() / 4), 4});
   }
 
   py::array_t<std::int64_t> representatives() const {
     std::vector<std::uint32_t> r(diagram_->size());
     for (std::uint32_t i = 0; i < r.size(); ++i) r[i] = diagram_->representative(i);
-    return to_int_array(r);
+    return index_array(r);
   }
 
   py::array_t<std::int64_t> neighbors(std::uint32_t site) const {
     check_index(site);
     const auto n = diagram_->neighbors(diagram_->representative(site));
-    return to_int_array(std::vector<std::uint32_t>(n.begin(), n.end()));
+    return index_array(std::vector<std::uint32_t>(n.begin(), n.end()));
   }
 
+  // method: the locator's name, SlabLocator or WalkLocator, in lower case without "Locator".
   py::object nearest(const py::handle& queries, const std::string& method) {
-    bool single = false;
-    const std::vector<Vec2d> q = to_points(queries, "Voronoi2.nearest", &single);
-    std::vector<std::uint32_t> result;
     if (method == "slab") {
       if (!slab_) slab_ = std::make_unique<voronoi::SlabLocator>(*diagram_);
-      py::gil_scoped_release release;
-      result = slab_->nearest_batch(q);
-    } else if (method == "walk") {
-      py::gil_scoped_release release;
-      result = walk().nearest_batch(q);
-    } else {
-      throw Error("Voronoi2.nearest: method must be 'slab' or 'walk', got '" + method + "'");
+      return nearest_sites(*slab_, queries, "Voronoi2.nearest");
     }
-    if (single) return py::int_(result[0]);
-    return to_int_array(result);
+    if (method == "walk") return nearest_sites(walk(), queries, "Voronoi2.nearest");
+    throw Error("Voronoi2.nearest: method must be 'slab' or 'walk', got '" + method + "'");
   }
 
   py::array_t<std::int64_t> k_nearest(const py::handle& query, std::size_t k) {
     bool single = false;
     const std::vector<Vec2d> q = to_points(query, "Voronoi2.k_nearest", &single);
     if (!single) throw Error("Voronoi2.k_nearest: expected one query point (2,)");
-    return to_int_array(voronoi::k_nearest_sites(walk(), q[0], k));
+    return index_array(voronoi::k_nearest_sites(walk(), q[0], k));
   }
 
   py::dict stats() const {
-    const voronoi::Voronoi2Stats s = diagram_->stats();
-    py::dict d;
-    d["sites"] = s.sites;
-    d["distinct"] = s.distinct;
-    d["vertices"] = s.vertices;
-    d["edges"] = s.edges;
-    d["unbounded_cells"] = s.unbounded_cells;
-    d["bytes"] = s.bytes;
-    return d;
+    return stats_dict(diagram_->stats());
   }
 
   void validate() const { diagram_->validate(); }
@@ -206,6 +171,18 @@ class PyVoronoi2 {
   AABB2d box_;
   std::unique_ptr<voronoi::SlabLocator> slab_;
   std::unique_ptr<voronoi::WalkLocator> walk_;
+};
+
+// geods.SlabLocator and geods.WalkLocator over a Voronoi2, which they keep alive.
+template <typename Locator>
+class PyLocator {
+ public:
+  explicit PyLocator(const PyVoronoi2& v) : locator_(v.diagram()) {}
+  py::object nearest(const py::handle& queries) const { return nearest_sites(locator_, queries, "nearest"); }
+  const Locator& locator() const { return locator_; }
+
+ private:
+  Locator locator_;
 };
 
 class PyMetricVoronoi {
@@ -231,12 +208,10 @@ class PyMetricVoronoi {
       sites.insert(sites.end(), {e.a, e.b});
       segments.insert(segments.end(), {e.p0[0], e.p0[1], e.p1[0], e.p1[1]});
     }
-    py::array_t<std::int64_t> s(std::vector<py::ssize_t>{py::ssize_t(sites.size() / 2), 2});
-    std::copy(sites.begin(), sites.end(), s.mutable_data());
-    py::array_t<double> g(std::vector<py::ssize_t>{py::ssize_t(segments.size() / 4), 4});
-    std::copy(segments.begin(), segments.end(), g.mutable_data());
-    return py::make_tuple(s, g);
+    return py::make_tuple(index_array(sites, {py::ssize_t(sites.size() / 2), 2}),
+                          copy_array(segments.data(), {py::ssize_t(segments.size() / 4), 4}));
   }
+  py::dict stats() const { return stats_dict(diagram_->stats()); }
   void validate() const { diagram_->validate(); }
 
  private:
@@ -269,11 +244,26 @@ void bind_voronoi(py::module_& m) {
       .def_property_readonly("representatives", &PyVoronoi2::representatives, "First occurrence of each point.")
       .def("neighbors", &PyVoronoi2::neighbors, py::arg("i"), "Delaunay neighbours of point i's site.")
       .def("nearest", &PyVoronoi2::nearest, py::arg("queries"), py::arg("method") = "slab",
-           "Index of a nearest site of each query ((m, 2) -> (m,), or (2,) -> int): 'slab' (Theorem 8) or 'walk'.")
+           "Index of a nearest site of each query ((m, 2) -> (m,), or (2,) -> int): 'slab' (SlabLocator, "
+           "Theorem 8) or 'walk' (WalkLocator).")
       .def("k_nearest", &PyVoronoi2::k_nearest, py::arg("query"), py::arg("k"),
            "The k nearest distinct sites of one query point, nearest first.")
-      .def("stats", &PyVoronoi2::stats)
+      .def("stats", &PyVoronoi2::stats, "dict: sites, distinct, vertices, edges, unbounded_cells, bytes")
       .def("validate", &PyVoronoi2::validate);
+
+  py::class_<PyLocator<voronoi::SlabLocator>>(
+      m, "SlabLocator", "The slab structure of seed Theorem 8 over a Voronoi2: O(log n) nearest-site queries.")
+      .def(py::init<const PyVoronoi2&>(), py::arg("voronoi"), py::keep_alive<1, 2>())
+      .def("nearest", &PyLocator<voronoi::SlabLocator>::nearest, py::arg("queries"),
+           "Index of a nearest site of each query ((m, 2) -> (m,), or (2,) -> int).")
+      .def(
+          "stats", [](const PyLocator<voronoi::SlabLocator>& l) { return stats_dict(l.locator().stats()); },
+          "dict: slabs, crossings, max_crossings, bytes");
+  py::class_<PyLocator<voronoi::WalkLocator>>(m, "WalkLocator",
+                                              "Nearest sites by walking in the Delaunay graph of a Voronoi2.")
+      .def(py::init<const PyVoronoi2&>(), py::arg("voronoi"), py::keep_alive<1, 2>())
+      .def("nearest", &PyLocator<voronoi::WalkLocator>::nearest, py::arg("queries"),
+           "Index of a nearest site of each query ((m, 2) -> (m,), or (2,) -> int).");
 
   py::class_<PyMetricVoronoi>(m, "MetricVoronoi",
                               "Voronoi diagram under metric 'l1', 'linf' or 'l2', clipped to box (seed §5.3.3).")
@@ -284,6 +274,7 @@ void bind_voronoi(py::module_& m) {
       .def_property_readonly("cells", &PyMetricVoronoi::cells, "One counter-clockwise (k, 2) polygon per input point.")
       .def_property_readonly("edges", &PyMetricVoronoi::edges,
                              "(sites (m, 2) int64, segments (m, 4) float64): bisector pieces inside the box.")
+      .def("stats", &PyMetricVoronoi::stats, "dict: sites, distinct, edges, cell_vertices, max_candidates")
       .def("validate", &PyMetricVoronoi::validate);
 
   m.def(
@@ -295,10 +286,9 @@ void bind_voronoi(py::module_& m) {
           py::gil_scoped_release release;
           tree = voronoi::emst(p);
         }
-        py::array_t<std::int64_t> edges(std::vector<py::ssize_t>{py::ssize_t(tree.edges.size()), 2});
-        std::int64_t* d = edges.mutable_data();
-        for (std::size_t k = 0; k < tree.edges.size(); ++k) d[2 * k] = tree.edges[k].first, d[2 * k + 1] = tree.edges[k].second;
-        return py::make_tuple(edges, tree.length);
+        std::vector<std::uint32_t> ends;
+        for (const auto& [a, b] : tree.edges) ends.insert(ends.end(), {a, b});
+        return py::make_tuple(index_array(ends, {py::ssize_t(tree.edges.size()), 2}), tree.length);
       },
       py::arg("points"), "Euclidean minimum spanning tree: ((n - 1, 2) int64 edges by increasing length, total length).");
   m.def(
@@ -310,20 +300,20 @@ void bind_voronoi(py::module_& m) {
       py::arg("points"), "The two nearest points: (i, j, distance) with i < j.");
   m.def(
       "all_nearest_neighbors",
-      [](const py::handle& points) { return to_int_array(voronoi::all_nearest_neighbors(to_points(points, "all_nearest_neighbors"))); },
+      [](const py::handle& points) { return index_array(voronoi::all_nearest_neighbors(to_points(points, "all_nearest_neighbors"))); },
       py::arg("points"), "For each point the index of its nearest other point.");
   m.def(
       "largest_empty_circle",
       [](const py::handle& points) {
         const voronoi::Circle c = voronoi::largest_empty_circle(to_points(points, "largest_empty_circle"));
-        return py::make_tuple(to_array({c.center}).reshape({2}), c.radius);
+        return py::make_tuple(points_array(std::vector<Vec2d>{c.center}).reshape({2}), c.radius);
       },
       py::arg("points"), "Largest circle centred in the convex hull with no point inside: (center, radius).");
   m.def(
       "smallest_enclosing_circle",
       [](const py::handle& points, std::uint64_t seed) {
         const voronoi::Circle c = voronoi::smallest_enclosing_circle(to_points(points, "smallest_enclosing_circle"), seed);
-        return py::make_tuple(to_array({c.center}).reshape({2}), c.radius);
+        return py::make_tuple(points_array(std::vector<Vec2d>{c.center}).reshape({2}), c.radius);
       },
       py::arg("points"), py::arg("seed") = 0, "Smallest circle containing every point (Welzl): (center, radius).");
 }

@@ -8,13 +8,15 @@
 namespace geods::bvh {
 namespace {
 
-constexpr std::array<std::pair<std::string_view, Builder>, 7> kBuilders = {{{"sah", Builder::sah},
+// Each name is the enum value's; a later entry for the same value is a deprecated spelling.
+constexpr std::array<std::pair<std::string_view, Builder>, 8> kBuilders = {{{"sah", Builder::sah},
                                                                             {"median", Builder::median},
                                                                             {"pca", Builder::pca},
-                                                                            {"bottomup", Builder::bottom_up},
+                                                                            {"bottom_up", Builder::bottom_up},
                                                                             {"tiling", Builder::tiling},
                                                                             {"insertion", Builder::insertion},
-                                                                            {"boxtree", Builder::boxtree}}};
+                                                                            {"boxtree", Builder::boxtree},
+                                                                            {"bottomup", Builder::bottom_up}}};
 constexpr std::array<std::pair<std::string_view, BoundingVolume>, 8> kVolumes = {{{"aabb", BoundingVolume::aabb},
                                                                                  {"sphere", BoundingVolume::sphere},
                                                                                  {"kdop6", BoundingVolume::kdop6},
@@ -24,10 +26,15 @@ constexpr std::array<std::pair<std::string_view, BoundingVolume>, 8> kVolumes = 
                                                                                  {"obb", BoundingVolume::obb},
                                                                                  {"obb_hull", BoundingVolume::obb_hull}}};
 
+// The current names (deprecated spellings left out).
 template <typename Table>
 std::string names_of(const Table& table) {
   std::string out;
-  for (const auto& [name, value] : table) out += (out.empty() ? "" : ", ") + std::string(name);
+  for (std::size_t i = 0; i < table.size(); ++i) {
+    bool alias = false;
+    for (std::size_t j = 0; j < i; ++j) alias = alias || table[j].second == table[i].second;
+    if (!alias) out += (out.empty() ? "" : ", ") + std::string(table[i].first);
+  }
   return out;
 }
 

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cctype>
 #include <charconv>
+#include <cmath>
 #include <fstream>
 #include <limits>
 
@@ -204,6 +205,28 @@ std::string_view trim(std::string_view s) {
   while (!s.empty() && ws(s.front())) s.remove_prefix(1);
   while (!s.empty() && ws(s.back())) s.remove_suffix(1);
   return s;
+}
+
+std::vector<TextRow> text_rows(std::string_view text, bool commas) {
+  std::vector<TextRow> rows;
+  LineReader lines(text);
+  std::string_view line;
+  while (lines.next(line)) {
+    const std::string_view t = trim(line);
+    if (t.empty() || t[0] == '#') continue;
+    rows.push_back({lines.line_number(), split_fields(t, commas)});
+  }
+  return rows;
+}
+
+double number(const std::filesystem::path& path, const TextRow& row, std::size_t column) {
+  double v = 0;
+  if (column >= row.fields.size())
+    fail(path, "line " + std::to_string(row.line) + ": expected at least " + std::to_string(column + 1) + " numbers");
+  if (!parse_double(row.fields[column], v))
+    fail(path, "line " + std::to_string(row.line) + ": '" + std::string(row.fields[column].substr(0, 40)) + "' is not a number");
+  if (!std::isfinite(v)) fail(path, "line " + std::to_string(row.line) + ": non-finite value");
+  return v;
 }
 
 }  // namespace geods::io::detail

@@ -81,6 +81,19 @@ inline std::string_view as_text(std::span<const std::uint8_t> bytes) {
 
 std::string_view trim(std::string_view s);
 
+/// The fields of a text line, with its line number for messages.
+struct TextRow {
+  std::size_t line;
+  std::vector<std::string_view> fields;
+};
+
+/// The rows of a text file (.xyz, .csv, .edg, .cin...): blank lines and lines
+/// starting with '#' are skipped; fields are split as split_fields does.
+std::vector<TextRow> text_rows(std::string_view text, bool commas);
+
+/// Field `column` of the row as a finite number; fails naming the line otherwise.
+double number(const std::filesystem::path& path, const TextRow& row, std::size_t column);
+
 /// True if the double converts to a finite float (casting one that does not is undefined behaviour).
 inline bool fits_float(double v) { return v >= -3.4028234663852886e38 && v <= 3.4028234663852886e38; }
 

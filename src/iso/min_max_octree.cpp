@@ -12,6 +12,16 @@
 #include "geods/core/progress.hpp"
 
 namespace geods::iso {
+
+VertexSharing parse_vertex_sharing(std::string_view name) {
+  if (name == "block_masks" || name == "blocks") return VertexSharing::block_masks;
+  if (name == "hash_table" || name == "hash") return VertexSharing::hash_table;
+  throw Error("iso: sharing must be 'block_masks' or 'hash_table', not '" + std::string(name) + "'");
+}
+
+std::string_view to_string(VertexSharing sharing) {
+  return sharing == VertexSharing::hash_table ? "hash_table" : "block_masks";
+}
 namespace {
 
 // Open addressing with linear probing and backward-shift deletion, keyed by

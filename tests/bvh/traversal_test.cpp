@@ -28,7 +28,7 @@ TEST(Traversal, UnorderedQueryReachesExactlyTheAcceptedLeaves) {
     options.arity = arity;
     options.builder = arity == 2 ? Builder::insertion : Builder::sah;  // insertion: deep trees, heap stack
     const TriangleBvh bvh = TriangleBvh::build(soup, options);
-    const auto& boxes = std::get<std::vector<AABB3f>>(bvh.volumes());
+    const auto& boxes = std::get<FlatArray<AABB3f>>(bvh.volumes());
     for (int q = 0; q < 30; ++q) {
       const Vec3f c = test::random_point(rng, -1.2f, 1.2f);
       const float r2 = float(rng.uniform(0.0, 0.3));
@@ -62,7 +62,7 @@ TEST(Traversal, OrderedQueryFindsTheNearestAndVisitsLeavesNearFirst) {
     BuildOptions options;
     options.arity = arity;
     const TriangleBvh bvh = TriangleBvh::build(soup, options);
-    const auto& boxes = std::get<std::vector<AABB3f>>(bvh.volumes());
+    const auto& boxes = std::get<FlatArray<AABB3f>>(bvh.volumes());
     TraversalStack<NodeRef> stack(traversal_stack_size(bvh.topology().depth(), arity));
     const int total_leaves = int(bvh.stats().leaves);
     for (int q = 0; q < 50; ++q) {

@@ -218,7 +218,7 @@ void check_shape(Shape shape, std::size_t n, std::size_t bucket, bool all_checks
   const auto points = make_points<T, D>(shape, n, 7 * n + int(shape) + 100 * D);
   const Tree<T, D> tree(points, {.bucket = bucket});
   tree.validate();
-  const Tree<T, D> linear(points, {.bucket = bucket, .build = OrthtreeBuild::Morton});
+  const Tree<T, D> linear(points, {.bucket = bucket, .build = OrthtreeBuild::morton});
   linear.validate();
   ASSERT_EQ(linear.nodes(), tree.nodes());
   ASSERT_EQ(linear.permutation(), tree.permutation());
@@ -308,7 +308,7 @@ TEST(Quadtree, CoincidentPointsAndDepthLimit) {
   const Quadtree<> shallow(points, {.max_depth = 4});
   shallow.validate();
   EXPECT_EQ(shallow.stats().depth, 4u);
-  const Quadtree<> linear(points, {.max_depth = 4, .build = OrthtreeBuild::Morton});
+  const Quadtree<> linear(points, {.max_depth = 4, .build = OrthtreeBuild::morton});
   EXPECT_EQ(linear.nodes(), shallow.nodes());
   const Quadtree<> zero(points, {.max_depth = 0});
   zero.validate();
@@ -325,7 +325,7 @@ TEST(Quadtree, CoincidentPointsAndDepthLimit) {
 TEST(Quadtree, ParallelBuildMatchesSequential) {
   const auto points = make_points<double, 2>(Shape::clustered, 200000, 5);
   const Quadtree<> parallel_td(points, {.bucket = 8});
-  const Quadtree<> parallel_morton(points, {.bucket = 8, .build = OrthtreeBuild::Morton});
+  const Quadtree<> parallel_morton(points, {.bucket = 8, .build = OrthtreeBuild::morton});
   set_num_threads(1);
   const Quadtree<> sequential(points, {.bucket = 8});
   set_num_threads(0);
@@ -446,7 +446,7 @@ TEST(Orthtree, LoadedTreesAnswerLikeTheOriginal) {
       expect_round_trip(Quadtree<double>(p2).balanced(), q2, path);
       const auto p3 = make_points<float, 3>(shape, n, n + 3);
       const auto q3 = make_points<float, 3>(Shape::uniform, 20, n + 4);
-      expect_round_trip(Octree<float>(p3, {.bucket = 2, .max_depth = 8, .build = OrthtreeBuild::Morton}), q3, path);
+      expect_round_trip(Octree<float>(p3, {.bucket = 2, .max_depth = 8, .build = OrthtreeBuild::morton}), q3, path);
     }
   }
   // A non-finite point, a bad parameter, another structure's archive.
@@ -494,7 +494,7 @@ TEST(Orthtree, BadInput) {
   EXPECT_THROW(Quadtree<>(points, {.max_depth = 33}), Error);
   EXPECT_THROW(Octree<>(PointView<double>(points[0].data(), 2, 2)), Error);  // wrong dimension
   const Quadtree<> tree(points);
-  EXPECT_THROW(tree.neighbor(0, Direction::PosZ), Error);
+  EXPECT_THROW(tree.neighbor(0, Direction::pos_z), Error);
   EXPECT_THROW(tree.neighbor(99, kNorth), Error);
   EXPECT_THROW(tree.query(Vec2d(0, 0), 0), Error);
   EXPECT_THROW(tree.query_radius(Vec2d(0, 0), -1), Error);

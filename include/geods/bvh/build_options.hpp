@@ -37,7 +37,8 @@ struct BuildOptions {
   ProgressCallback progress;
 };
 
-/// "sah", "median", "pca", "bottomup", "tiling", "insertion", "boxtree"; throws geods::Error otherwise.
+/// The enum value's name: "sah", "median", "pca", "bottom_up", "tiling", "insertion", "boxtree" ("bottomup":
+/// the deprecated spelling of bottom_up); throws geods::Error otherwise.
 Builder parse_builder(std::string_view name);
 /// "aabb", "sphere", "kdop6", "kdop14", "kdop18", "kdop26", "obb", "obb_hull"; throws geods::Error otherwise.
 BoundingVolume parse_bounding_volume(std::string_view name);

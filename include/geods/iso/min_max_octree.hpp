@@ -50,6 +50,11 @@ enum class VertexSharing {
   hash_table,
 };
 
+/// "block_masks" or "hash_table" (the enum value's name; "blocks" and "hash"
+/// are the deprecated spellings); throws geods::Error otherwise.
+VertexSharing parse_vertex_sharing(std::string_view name);
+std::string_view to_string(VertexSharing sharing);
+
 struct OctreeIsoResult {
   TriMesh mesh;
   std::size_t cells_visited = 0;  // cells whose corners were examined

@@ -59,13 +59,24 @@ namespace geods::spatial {
 inline constexpr std::uint32_t kNoNode = std::numeric_limits<std::uint32_t>::max();
 
 /// Face directions: axis = value / 2, negative side iff value is odd.
-enum class Direction : std::uint8_t { PosX = 0, NegX = 1, PosY = 2, NegY = 3, PosZ = 4, NegZ = 5 };
-inline constexpr Direction kEast = Direction::PosX;
-inline constexpr Direction kWest = Direction::NegX;
-inline constexpr Direction kNorth = Direction::PosY;
-inline constexpr Direction kSouth = Direction::NegY;
+enum class Direction : std::uint8_t {
+  pos_x = 0, neg_x = 1, pos_y = 2, neg_y = 3, pos_z = 4, neg_z = 5,
+  // The spellings before enum values were snake_case everywhere.
+  PosX [[deprecated("use pos_x")]] = pos_x, NegX [[deprecated("use neg_x")]] = neg_x,
+  PosY [[deprecated("use pos_y")]] = pos_y, NegY [[deprecated("use neg_y")]] = neg_y,
+  PosZ [[deprecated("use pos_z")]] = pos_z, NegZ [[deprecated("use neg_z")]] = neg_z,
+};
+inline constexpr Direction kEast = Direction::pos_x;
+inline constexpr Direction kWest = Direction::neg_x;
+inline constexpr Direction kNorth = Direction::pos_y;
+inline constexpr Direction kSouth = Direction::neg_y;
 
-enum class OrthtreeBuild { TopDown, Morton };
+enum class OrthtreeBuild {
+  top_down,
+  morton,
+  TopDown [[deprecated("use top_down")]] = top_down,
+  Morton [[deprecated("use morton")]] = morton,
+};
 
 /// The archive kind and layout version of a saved quadtree or octree (Orthtree::save).
 inline constexpr std::string_view kOrthtreeArchiveKind = "spatial.Orthtree";
@@ -74,7 +85,7 @@ inline constexpr std::uint32_t kOrthtreeArchiveVersion = 1;
 struct OrthtreeOptions {
   std::size_t bucket = 1;  // a leaf holds at most this many points (unless they coincide or max_depth is reached)
   int max_depth = -1;      // -1: the deepest level the 64-bit Morton keys hold (32 in 2D, 21 in 3D)
-  OrthtreeBuild build = OrthtreeBuild::TopDown;
+  OrthtreeBuild build = OrthtreeBuild::top_down;
 };
 
 struct OrthtreeStats {
@@ -487,7 +498,7 @@ class Orthtree {
     root_square();
     std::vector<Node> nodes;
     std::vector<std::uint32_t> perm(n);
-    if (options.build == OrthtreeBuild::Morton) {
+    if (options.build == OrthtreeBuild::morton) {
       const std::vector<std::uint64_t> keys = sorted_morton_keys(perm);
       build_levels(nodes, perm, [&](std::uint32_t v) { split_by_keys(nodes, v, keys); });
     } else {

@@ -1,0 +1,105 @@
+#include "geods/io/table_io.hpp"
+
+#include <cmath>
+#include <cstdint>
+#include <random>
+#include <sstream>
+
+#include "geods/io/npy.hpp"
+#include "geods/io/point_io.hpp"
+#include "io_test_util.hpp"
+
+namespace geods::io {
+namespace {
+
+using test::expect_error;
+using test::TempDir;
+
+TEST(TableIo, AnyColumnCountInEveryTextForm) {
+  TempDir dir;
+  // The oracle: the numbers as written; 5 columns, comments and blank lines in between.
+  std::mt19937 rng(7);
+  std::vector<double> values;
+  std::string xyz = "# five columns\n", csv = "a,b,c,d,e\n", txt = "a b c d e\n";
+  for (int r = 0; r < 20; ++r) {
+    for (int c = 0; c < 5; ++c) {
+      const double v = double(int(rng() % 2001) - 1000) / 8;
+      values.push_back(v);
+      std::ostringstream text;  // k/8 has at most 6 significant digits: printed exactly
+      text << v;
+      const std::string s = text.str();
+      xyz += (c ? " " : "") + s;
+      csv += (c ? "," : "") + s;
+      txt += (c ? (c % 2 ? ", " : " ") : "") + s;  // blanks and commas mixed
+    }
+    xyz += "\n\n";
+    csv += "\n";
+    txt += "\r\n";
+  }
+  test::write_text(dir / "t.xyz", xyz);
+  test::write_text(dir / "t.csv", csv);
+  test::write_text(dir / "t.txt", txt);
+  for (const char* name : {"t.xyz", "t.csv", "t.txt"}) {
+    SCOPED_TRACE(name);
+    const Table t = read_table(dir / name);
+    EXPECT_EQ(t.rows, 20u);
+    EXPECT_EQ(t.cols, 5u);
+    EXPECT_EQ(t.dtype, DType::f64);
+    EXPECT_EQ(t.values, values);
+    EXPECT_EQ(t.row(3)[4], values[19]);
+  }
+}
+
+TEST(TableIo, NpyKeepsItsDtypeAndAnyWidth) {
+  TempDir dir;
+  const std::vector<std::int32_t> ids = {0, 1, 2, 3, 4, 5, 6, 7};
+  write_npy<std::int32_t>(dir / "i.npy", ids, {2, 4});
+  const Table t = read_table(dir / "i.npy");
+  EXPECT_TRUE(t.integer());
+  EXPECT_EQ(t.dtype, DType::i32);
+  EXPECT_EQ((std::vector<double>(t.values)), (std::vector<double>{0, 1, 2, 3, 4, 5, 6, 7}));
+  EXPECT_EQ(t.cols, 4u);
+  // One column and seven columns are tables too.
+  write_npy<float>(dir / "one.npy", std::vector<float>{1.5f, 2.5f}, {2, 1});
+  EXPECT_EQ(read_table(dir / "one.npy").values, (std::vector<double>{1.5, 2.5}));
+  EXPECT_FALSE(read_table(dir / "one.npy").integer());
+  // A segment file of 4 columns reads as segments and as a table alike.
+  write_npy<double>(dir / "s.npy", std::vector<double>{0, 0, 1, 1, 2, 2, 3, 3}, {2, 4});
+  const SegmentMatrix s = read_segments(dir / "s.npy");
+  EXPECT_EQ(std::vector<double>(s.data(), s.data() + s.size()), read_table(dir / "s.npy").values);
+  test::write_text(dir / "s.csv", "x0,y0,x1,y1\n0,0,1,1\n2,2,3,3\n");
+  EXPECT_EQ(read_segments(dir / "s.csv"), s);
+}
+
+TEST(TableIo, PointsAreTheFirstColumnsOfTheTable) {
+  TempDir dir;
+  test::write_text(dir / "p.txt", "x y z nx ny nz\n1,2,3,0,0,1\n4 5 6 0 1 0\n");
+  const Table t = read_table(dir / "p.txt");
+  EXPECT_EQ(t.cols, 6u);
+  EXPECT_EQ(read_points(dir / "p.txt"), (PointMatrix(2, 3) << 1, 2, 3, 4, 5, 6).finished());
+}
+
+TEST(TableIo, BadTablesThrowNamingTheFileAndLine) {
+  TempDir dir;
+  test::write_text(dir / "ragged.csv", "1,2,3\n4,5,6\n7,8\n");
+  expect_error(dir / "ragged.csv", [&] { read_table(dir / "ragged.csv"); }, "line 3");
+  test::write_text(dir / "word.txt", "1 2\n3 y\n");
+  expect_error(dir / "word.txt", [&] { read_table(dir / "word.txt"); }, "line 2");
+  test::write_text(dir / "nan.xyz", "1 2\nnan 3\n");
+  expect_error(dir / "nan.xyz", [&] { read_table(dir / "nan.xyz"); }, "non-finite");
+  test::write_text(dir / "header.xyz", "x y\n1 2\n");  // .xyz has no header line
+  expect_error(dir / "header.xyz", [&] { read_table(dir / "header.xyz"); }, "not a number");
+  test::write_text(dir / "empty.csv", "x,y\n");
+  expect_error(dir / "empty.csv", [&] { read_table(dir / "empty.csv", "point"); }, "no points");
+  write_npy<double>(dir / "inf.npy", std::vector<double>{1, 2, 3, INFINITY}, {2, 2});
+  expect_error(dir / "inf.npy", [&] { read_table(dir / "inf.npy", "query point"); }, "query point 1 has a non-finite");
+  write_npy<double>(dir / "cube.npy", std::vector<double>(8), {2, 2, 2});
+  expect_error(dir / "cube.npy", [&] { read_table(dir / "cube.npy"); }, "2-D");
+  test::write_text(dir / "w.csv", "1,2,3\n");
+  expect_error(dir / "w.csv", [&] { read_table(dir / "w.csv", "box", 4); }, "n x 4");
+  expect_error(dir / "t.obj", [&] { read_table(dir / "t.obj"); }, "unsupported");
+  expect_error(dir / "missing.npy", [&] { read_table(dir / "missing.npy"); }, "no such file");
+}
+
+}  // namespace
+}  // namespace geods::io
