@@ -247,6 +247,22 @@ def accelerator_seeds():
     return {"grid.geods": grid, "octree.geods": octree, "rays5d.geods": rays5d, "bvh_accel.geods": bvh}
 
 
+def delaunay2_seed():
+    """A Delaunay2 of the triangle (0, 0), (1, 0), (0, 1) closed by its three ghost triangles."""
+    ghost = 0xFFFFFFFE
+    xy = struct.pack("<6d", 0, 0, 1, 0, 0, 1)
+    iota = struct.pack("<3I", 0, 1, 2)
+    vert = struct.pack("<12I", 0, 1, 2, 1, 0, ghost, 2, 1, ghost, 0, 2, ghost)
+    twin = struct.pack("<12I", 3, 6, 9, 0, 11, 7, 1, 5, 10, 2, 8, 4)
+    return archive("voronoi.Delaunay2", [
+        value("seed", U64, "<Q", 1), value("location", U32, "<I", 0), value("has_constraints", U8, "<B", 0),
+        value("last_triangle", U32, "<I", 0), ("counters", U64, 8, struct.pack("<3Q", 0, 0, 0)),
+        ("points", F64, 8, xy), ("segments", U32, 4, b""), ("intersections", U32, 4, b""),
+        ("representative", U32, 4, iota), ("coords", F64, 8, xy), ("original_of", U32, 4, iota),
+        ("internal_of", U32, 4, iota), ("vert", U32, 4, vert), ("twin", U32, 4, twin),
+        ("free_triangles", U32, 4, b""), ("fixed", U8, 1, b"")])
+
+
 def main():
     out = Path(sys.argv[1])
     raw = bytes(range(24))
@@ -270,13 +286,11 @@ def main():
         "points": {"p.npy": b"\x00" + npy("<f8", (2, 3), struct.pack("<6d", *range(6))),
                    "p.xyz": b"\x01" + b"0 0 0 0 0 1\n1 2 3 0 1 0\n", "p.csv": b"\x02x,y\n1,2\n3,4\n",
                    "p.ply": b"\x03" + PLY_ASCII, "p.txt": b"\x04x y z w\n1,2,3,4\n5 6 7 8\n"},
-        "archive": archive_seeds(),
+        "archive": {**archive_seeds(), "bvh.geods": archive("bvh.TriangleBvh", bvh_sections()),
+                    "delaunay2.geods": delaunay2_seed(), **accelerator_seeds()},
         "segments": {"s.npy": b"\x00" + npy("<f8", (1, 4), struct.pack("<4d", 0, 0, 1, 1)),
                      "s.edg": b"\x01" + b"2\n0 0 1 1\n1 1 2 0\n", "s.cin": b"\x02" + b"p 0 0\ns 0 0 1 1\ns 1 1 2 0\n",
                      "s.csv": b"\x03" + b"x0,y0,x1,y1\n0,0,1,1\n"},
-        "bvh_archive": {"bvh_structure.geods": b"\x00" + archive("bvh.TriangleBvh", bvh_sections()),
-                        "bvh.geods": b"\x01" + archive("bvh.TriangleBvh", bvh_sections()),
-                        **{name: b"\x02" + data for name, data in accelerator_seeds().items()}},
     }
     for target, files in seeds.items():
         (out / target).mkdir(parents=True, exist_ok=True)

@@ -34,7 +34,7 @@ class BvhCommand : public Command {
     app.add_option("--arity", arity_, "Children per node: 2, 4 or 8");
     app.add_option("--rays", rays_, "Rays, n x 6 (ox oy oz dx dy dz; .npy, .csv)");
     app.add_option("-o,--output", output_, "Output for --rays: float64 n x 2 (t, triangle), inf and -1 on a miss");
-    app.add_option("--save", save_, "Write the hierarchy to this file (geods archive; Bvh.load, TriangleBvh::load)");
+    add_save(app, save_, "the hierarchy", "TriangleBvh.load");
   }
 
   void run(const RunContext& context, Report& report) override {

@@ -38,7 +38,7 @@ class DelaunayCommand : public Command {
                    "Output: int64 m x 3 counter-clockwise triangles, indices into the points (duplicates map to "
                    "their first occurrence)");
     app.add_option("--svg", svg_, "Output: a picture of the triangulation");
-    app.add_option("--save", save_, "Output: the triangulation as a geods archive (Delaunay2.load reads it)");
+    add_save(app, save_, "the triangulation", "Delaunay2.load");
   }
 
   void run(const RunContext&, Report& report) override {

@@ -37,8 +37,7 @@ class IsoCommand : public Command {
                    "Octree: how cells share edge vertices: block_masks (bit masks per leaf, the default) or "
                    "hash_table (the hash table of seed 2.4); blocks and hash are deprecated spellings");
     app.add_flag("--no-normals", no_normals_, "Do not compute vertex normals");
-    app.add_option("--save", save_, "Octree: also write the min/max octree (with its volume) as a geods archive")
-        ->needs("--octree");
+    add_save(app, save_, "the min/max octree of --octree with its volume", "MinMaxOctree.load")->needs("--octree");
   }
 
   void run(const RunContext& context, Report& report) override {

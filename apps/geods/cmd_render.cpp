@@ -48,7 +48,7 @@ class RenderCommand : public Command {
     add_input(app, "mesh", mesh_, "Mesh (PLY, OBJ, OFF, STL, glTF)");
     app.add_option("-o,--output", output_, "Output image (.png)")->required();
     accel_option_ = app.add_option("--accel", accel_, "Accelerator: bvh, grid, octree or rays5d")->default_val(accel_);
-    app.add_option("--save", save_, "Write the accelerator to this file before rendering (geods archive)");
+    add_save(app, save_, "the accelerator (written before rendering)", "--load or Accelerator.load");
     app.add_option("--load", load_, "Render with an accelerator saved by --save over the same mesh (no build)");
     app.add_option("--width", width_, "Image width in pixels")->default_val(width_);
     app.add_option("--height", height_, "Image height in pixels")->default_val(height_);

@@ -27,7 +27,7 @@ class VoronoiCommand : public Command {
     app.add_option("--box", box_, "Clip cells to x0,y0,x1,y1 (default: the points' bounding box grown by 25%)");
     app.add_option("--svg", svg_, "Output: a figure of the cells, edges and sites");
     app.add_option("-o,--output", output_, "Output: JSON with the box, each point's cell polygon and the edges");
-    app.add_option("--save", save_, "Output: the diagram as a geods archive (Voronoi2.load reads it; l2 only)");
+    add_save(app, save_, "the l2 diagram", "Voronoi2.load");
   }
 
   void run(const RunContext&, Report& report) override {

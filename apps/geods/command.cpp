@@ -29,6 +29,10 @@ void add_input(CLI::App& app, const std::string& name, std::string& value, const
   });
 }
 
+CLI::Option* add_save(CLI::App& app, std::string& path, const std::string& what, const std::string& reader) {
+  return app.add_option("--save", path, "Output: " + what + " as a geods archive (" + reader + " reads it)");
+}
+
 namespace {
 
 // The first line of a message: the contract is one line on stderr.

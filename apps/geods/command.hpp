@@ -46,6 +46,11 @@ class Command {
 void add_input(CLI::App& app, const std::string& name, std::string& value, const std::string& description,
                const std::string& alias = "");
 
+/// Declares --save PATH, the option of every command that builds a structure:
+/// it writes `what` there as a geods archive, which `reader` reads back, e.g.
+/// add_save(app, save_, "the triangulation", "Delaunay2.load").
+CLI::Option* add_save(CLI::App& app, std::string& path, const std::string& what, const std::string& reader);
+
 std::vector<std::unique_ptr<Command>>& registered_commands();
 
 template <typename C>

@@ -16,21 +16,10 @@
 namespace geods::cli {
 namespace {
 
-// The volume with one sample of its minimum all around, so that every
-// isosurface closes at the border.
-Grid3<float> padded(const Grid3<float>& v) {
-  const float low = *std::min_element(v.data.begin(), v.data.end());
-  Grid3<float> p(v.dims[0] + 2, v.dims[1] + 2, v.dims[2] + 2, low);
-  p.spacing = v.spacing;
-  p.origin = v.origin - v.spacing;
-  for (std::size_t k = 0; k < v.dims[2]; ++k)
-    for (std::size_t j = 0; j < v.dims[1]; ++j)
-      std::copy_n(&v(0, j, k), v.dims[0], &p(1, j + 1, k + 1));
-  return p;
-}
-
 void run_head(const DemoContext& context, DemoResult& result) {
-  const Grid3<float> volume = padded(io::to_float(io::read_volume(context.data_dir / "t1_head.nii.gz")));
+  // Padded with its minimum, so that every isosurface closes at the border.
+  const Grid3<float> head = io::to_float(io::read_volume(context.data_dir / "t1_head.nii.gz"));
+  const Grid3<float> volume = padded(head, *std::min_element(head.data.begin(), head.data.end()));
   const std::size_t cells = (volume.dims[0] - 1) * (volume.dims[1] - 1) * (volume.dims[2] - 1);
 
   Stopwatch build_watch;

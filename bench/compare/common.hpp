@@ -26,6 +26,7 @@
 #include <cstring>
 #include <fstream>
 #include <functional>
+#include <initializer_list>
 #include <memory>
 #include <sstream>
 #include <stdexcept>
@@ -98,6 +99,17 @@ class ThreadLimit {
  private:
   tbb::global_control control_;
 };
+
+/// The main of a driver with named variants: parses the command line, limits the
+/// threads, and calls run_variant(args, variant) for each variant that --only selects.
+template <class RunVariant>
+int run_variants(int argc, char** argv, std::initializer_list<const char*> variants, RunVariant run_variant) {
+  const Args args = parse_args(argc, argv);
+  const ThreadLimit limit(args.threads);
+  for (const char* variant : variants)
+    if (args.wants(variant)) run_variant(args, variant);
+  return 0;
+}
 
 // ----------------------------------------------------------------------------- timing
 

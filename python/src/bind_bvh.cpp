@@ -22,12 +22,9 @@ namespace py = pybind11;
 namespace geods::python {
 namespace {
 
-template <typename T>
-using CArray = Rows<T>;
-
 class PyBvh {
  public:
-  PyBvh(const CArray<float>& v, const CArray<std::int64_t>& f, const std::string& builder, const std::string& bv,
+  PyBvh(const Rows<float>& v, const Rows<std::int64_t>& f, const std::string& builder, const std::string& bv,
         int leaf_size, int arity) {
     const TriMesh mesh = mesh_from_arrays(v, f, "TriangleBvh");
     bvh::BuildOptions options;
@@ -52,7 +49,7 @@ class PyBvh {
     return PyBvh(bvh::TriangleBvh::load(path));
   }
 
-  py::tuple intersect(const CArray<float>& origins, const CArray<float>& directions, const CArray<float>& tmax) const {
+  py::tuple intersect(const Rows<float>& origins, const Rows<float>& directions, const Rows<float>& tmax) const {
     const std::vector<Ray3f> r = rays_from_arrays(origins, directions, tmax, "TriangleBvh");
     HitArrays hits(r.size());
     {
@@ -62,7 +59,7 @@ class PyBvh {
     return hits.tuple();
   }
 
-  py::array_t<bool> occluded(const CArray<float>& origins, const CArray<float>& directions, const CArray<float>& tmax) const {
+  py::array_t<bool> occluded(const Rows<float>& origins, const Rows<float>& directions, const Rows<float>& tmax) const {
     const std::vector<Ray3f> r = rays_from_arrays(origins, directions, tmax, "TriangleBvh");
     py::array_t<bool> out(py::ssize_t(r.size()));
     bool* po = out.mutable_data();
@@ -111,7 +108,7 @@ class PyBvh {
   }
 
   // planes: (k, 4) rows (nx, ny, nz, offset) of n.x = offset, n pointing into the frustum.
-  py::array_t<std::int64_t> cull_frustum(const CArray<float>& planes) const {
+  py::array_t<std::int64_t> cull_frustum(const Rows<float>& planes) const {
     if (planes.ndim() != 2 || planes.shape(1) != 4)
       throw Error("TriangleBvh.cull_frustum: planes must be a (k, 4) array of rows (nx, ny, nz, offset)");
     std::vector<Plane3f> ps;
@@ -160,7 +157,7 @@ void bind_bvh(py::module_& m) {
   py::class_<PyBvh>(m, "TriangleBvh",
                     "Bounding volume hierarchy over the triangles (V, F) of a mesh (float32): C++ bvh::TriangleBvh. "
                     "geods.Bvh is its deprecated older name.")
-      .def(py::init<const CArray<float>&, const CArray<std::int64_t>&, const std::string&, const std::string&, int, int>(),
+      .def(py::init<const Rows<float>&, const Rows<std::int64_t>&, const std::string&, const std::string&, int, int>(),
            py::arg("V"), py::arg("F"), py::arg("builder") = "sah", py::arg("bv") = "aabb", py::arg("leaf_size") = 8,
            py::arg("arity") = 4,
            "builder: sah, median, pca, bottom_up, tiling, insertion, boxtree ('bottomup': deprecated); "

@@ -25,9 +25,6 @@ namespace {
 
 using std::filesystem::path;
 
-template <typename T>
-using CArray = Rows<T>;
-
 py::tuple read_mesh_py(const path& p) {
   TriMesh mesh;
   {
@@ -37,7 +34,7 @@ py::tuple read_mesh_py(const path& p) {
   return mesh_arrays(mesh, false);
 }
 
-void write_mesh_py(const path& p, const CArray<float>& v, const CArray<std::int64_t>& f, bool binary) {
+void write_mesh_py(const path& p, const Rows<float>& v, const Rows<std::int64_t>& f, bool binary) {
   const TriMesh mesh = mesh_from_arrays(v, f, "write_mesh");
   py::gil_scoped_release release;
   io::write_mesh(p, mesh, binary ? io::MeshEncoding::binary : io::MeshEncoding::ascii);
@@ -84,7 +81,7 @@ py::array_t<double> read_table_py(const path& p) {
   return copy_array(t.values.data(), {py::ssize_t(t.rows), py::ssize_t(t.cols)});
 }
 
-void write_points_py(const path& p, const CArray<double>& a) {
+void write_points_py(const path& p, const Rows<double>& a) {
   if (a.ndim() != 2 || (a.shape(1) != 2 && a.shape(1) != 3)) throw Error("write_points: expected an (n, 2) or (n, 3) array");
   io::PointMatrix m(a.shape(0), a.shape(1));
   if (a.size()) std::memcpy(m.data(), a.data(), std::size_t(a.size()) * sizeof(double));
@@ -110,7 +107,7 @@ py::array_t<std::uint8_t> read_image_py(const path& p) {
   return image_array(im);
 }
 
-void write_png_py(const path& p, const CArray<std::uint8_t>& a) {
+void write_png_py(const path& p, const Rows<std::uint8_t>& a) {
   if (a.ndim() != 2 && a.ndim() != 3) throw Error("write_png: expected an (h, w) or (h, w, c) uint8 array");
   Image<std::uint8_t> im;
   im.height = std::size_t(a.shape(0));

@@ -26,9 +26,6 @@ namespace py = pybind11;
 namespace geods::python {
 namespace {
 
-template <typename T>
-using CArray = Rows<T>;
-
 // The volume of isosurface() and MinMaxOctree(): volume_from_array with a finite, non-zero spacing.
 io::AnyGrid3 volume_from(const py::array& array, const std::array<double, 3>& spacing,
                          const std::array<double, 3>& origin) {
@@ -41,7 +38,7 @@ io::AnyGrid3 volume_from(const py::array& array, const std::array<double, 3>& sp
 // Curvilinear node positions: float (nz, ny, nx, 3), x, y, z per sample.
 std::vector<Vec3f> positions_from(const py::object& coords, const std::array<std::size_t, 3>& dims) {
   if (coords.is_none()) return {};
-  auto a = CArray<float>::ensure(coords);
+  auto a = Rows<float>::ensure(coords);
   if (!a || a.ndim() != 4 || std::size_t(a.shape(0)) != dims[2] || std::size_t(a.shape(1)) != dims[1] ||
       std::size_t(a.shape(2)) != dims[0] || a.shape(3) != 3)
     throw Error("isosurface: coords must be a float array of shape (nz, ny, nx, 3) matching the volume");

@@ -24,12 +24,9 @@ namespace py = pybind11;
 namespace geods::python {
 namespace {
 
-template <typename T>
-using CArray = Rows<T>;
-
 class PyRayAccelerator {
  public:
-  PyRayAccelerator(const CArray<float>& v, const CArray<std::int64_t>& f, const std::string& kind) {
+  PyRayAccelerator(const Rows<float>& v, const Rows<std::int64_t>& f, const std::string& kind) {
     const TriMesh mesh = mesh_from_arrays(v, f, "Accelerator");
     const ray::AcceleratorKind k = ray::parse_accelerator_kind(kind);
     py::gil_scoped_release release;
@@ -43,7 +40,7 @@ class PyRayAccelerator {
     return PyRayAccelerator(ray::load_accelerator(path));
   }
 
-  py::tuple intersect(const CArray<float>& origins, const CArray<float>& directions, const CArray<float>& tmax) const {
+  py::tuple intersect(const Rows<float>& origins, const Rows<float>& directions, const Rows<float>& tmax) const {
     const std::vector<Ray3f> rays = rays_from_arrays(origins, directions, tmax, "Accelerator");
     HitArrays hits(rays.size());
     {
@@ -56,8 +53,8 @@ class PyRayAccelerator {
     return hits.tuple();
   }
 
-  py::array_t<bool> occluded(const CArray<float>& origins, const CArray<float>& directions,
-                             const CArray<float>& tmax) const {
+  py::array_t<bool> occluded(const Rows<float>& origins, const Rows<float>& directions,
+                             const Rows<float>& tmax) const {
     const std::vector<Ray3f> rays = rays_from_arrays(origins, directions, tmax, "Accelerator");
     py::array_t<bool> out(py::ssize_t(rays.size()));
     bool* po = out.mutable_data();
@@ -93,7 +90,7 @@ ray::Camera camera_from_sequence(const std::vector<float>& values) {
   return camera;
 }
 
-py::array_t<std::uint8_t> render_py(const CArray<float>& v, const CArray<std::int64_t>& f, int width, int height,
+py::array_t<std::uint8_t> render_py(const Rows<float>& v, const Rows<std::int64_t>& f, int width, int height,
                                     const std::optional<std::vector<float>>& camera, const std::string& accel,
                                     bool shadows) {
   const TriMesh mesh = mesh_from_arrays(v, f, "render");
@@ -119,13 +116,13 @@ void bind_ray(py::module_& m) {
                                "A ray accelerator over a triangle mesh (C++ ray::Accelerator): 'bvh', 'grid' (uniform "
                                "grid with mailboxes), 'octree' (Revelles' parametric traversal) or 'rays5d' (5D ray "
                                "classification). geods.RayAccelerator is its deprecated older name.")
-      .def(py::init<const CArray<float>&, const CArray<std::int64_t>&, const std::string&>(), py::arg("V"),
+      .def(py::init<const Rows<float>&, const Rows<std::int64_t>&, const std::string&>(), py::arg("V"),
            py::arg("F"), py::arg("kind") = "bvh")
       .def("intersect", &PyRayAccelerator::intersect, py::arg("origins"), py::arg("directions"),
-           py::arg("tmax") = CArray<float>(py::ssize_t(1), &inf),
+           py::arg("tmax") = Rows<float>(py::ssize_t(1), &inf),
            "Closest hits of (n, 3) rays: (t, prim, u, v); t = inf and prim = -1 on a miss. tmax: one value or n.")
       .def("occluded", &PyRayAccelerator::occluded, py::arg("origins"), py::arg("directions"),
-           py::arg("tmax") = CArray<float>(py::ssize_t(1), &inf), "Whether each ray hits anything before tmax.")
+           py::arg("tmax") = Rows<float>(py::ssize_t(1), &inf), "Whether each ray hits anything before tmax.")
       .def("stats", &PyRayAccelerator::stats, "Nodes, leaves, triangle references, depth, bytes, build_s.")
       .def("validate", &PyRayAccelerator::validate, "Checks the structure's invariants; raises ValueError if broken.")
       .def("save", &PyRayAccelerator::save, py::arg("path"),

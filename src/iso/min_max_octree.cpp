@@ -100,17 +100,29 @@ void for_each_in_batches(std::size_t n, bool batched, Progress& progress, double
   }
 }
 
-}  // namespace
-
-// One extraction over one subtree (or the whole tree): its own hash table and output.
-template <typename T>
-struct MinMaxOctree<T>::Query {
-  const MinMaxOctree& tree;
+// What both extractions (hash-table and block-mask vertex sharing) start from:
+// the tree, the iso-value and how a cell is cut at it.
+template <typename Tree, typename T>
+struct Extraction {
+  const Tree& tree;
   double iso;
   detail::Threshold<T> thr;
   detail::VertexPlacer<T> placer;
   bool flip;
   detail::CaseTableView table = detail::case_table_view();
+
+  Extraction(const Tree& t, const Grid3<T>& volume, double iso_value, const IsoOptions& options, bool flip_triangles)
+      : tree(t), iso(iso_value), thr(iso_value), placer(volume, iso_value, options.positions, options.normals),
+        flip(flip_triangles) {}
+};
+
+}  // namespace
+
+// One extraction over one subtree (or the whole tree): its own hash table and output.
+template <typename T>
+struct MinMaxOctree<T>::Query : Extraction<MinMaxOctree<T>, T> {
+  using Base = Extraction<MinMaxOctree<T>, T>;
+  using Base::tree, Base::iso, Base::thr, Base::placer, Base::flip, Base::table;
   EdgeTable edges;
   std::vector<Vec3f> positions, normals;
   static constexpr std::uint64_t kNoEdge = EdgeTable::kEmpty;  // key of a cell-centre vertex
@@ -119,8 +131,7 @@ struct MinMaxOctree<T>::Query {
   std::size_t cells_visited = 0, nodes_visited = 0;
 
   Query(const MinMaxOctree& t, double iso_value, const IsoOptions& options, bool flip_triangles)
-      : tree(t), iso(iso_value), thr(iso_value), placer(t.volume_, iso_value, options.positions, options.normals),
-        flip(flip_triangles) {}
+      : Base(t, t.volume_, iso_value, options, flip_triangles) {}
 
   bool active(std::size_t node) const { return thr.inside(tree.max_[node]) && !thr.inside(tree.min_[node]); }
 
@@ -382,7 +393,7 @@ OctreeIsoResult MinMaxOctree<T>::hash_table_isosurface(double iso, const IsoOpti
 // coordinates) of a leaf's masks is set for each crossed edge it owns; its
 // vertices are numbered in bit order after those of the earlier leaves.
 template <typename T>
-struct MinMaxOctree<T>::BlockQuery {
+struct MinMaxOctree<T>::BlockQuery : Extraction<MinMaxOctree<T>, T> {
   // One crossed leaf: its first cell and sample, cells and owned samples per axis.
   struct Box {
     std::size_t leaf_xyz[3];
@@ -390,13 +401,9 @@ struct MinMaxOctree<T>::BlockQuery {
     std::size_t cells[3], owned[3];
   };
   static constexpr std::uint32_t kUnknown = ~std::uint32_t(0);
+  using Base = Extraction<MinMaxOctree<T>, T>;
+  using Base::tree, Base::iso, Base::thr, Base::placer, Base::flip, Base::table;
 
-  const MinMaxOctree& tree;
-  double iso;
-  detail::Threshold<T> thr;
-  detail::VertexPlacer<T> placer;
-  bool flip;
-  detail::CaseTableView table = detail::case_table_view();
   std::size_t L, S, words;
   std::array<std::size_t, 3> leaf_dims;
   std::size_t corner_offset[8];
@@ -411,9 +418,8 @@ struct MinMaxOctree<T>::BlockQuery {
   std::vector<std::size_t> triangle_first;
 
   BlockQuery(const MinMaxOctree& t, double iso_value, const IsoOptions& options, bool flip_triangles)
-      : tree(t), iso(iso_value), thr(iso_value), placer(t.volume_, iso_value, options.positions, options.normals),
-        flip(flip_triangles), L(t.leaf_cells_), S(t.leaf_cells_ + 1), words((3 * S * S * S + 63) / 64),
-        leaf_dims(t.levels_[0].dims) {
+      : Base(t, t.volume_, iso_value, options, flip_triangles), L(t.leaf_cells_), S(t.leaf_cells_ + 1),
+        words((3 * S * S * S + 63) / 64), leaf_dims(t.levels_[0].dims) {
     const std::size_t sy = t.volume_.dims[0], sz = t.volume_.dims[0] * t.volume_.dims[1];
     const std::size_t offsets[8] = {0, 1, sy, sy + 1, sz, sz + 1, sz + sy, sz + sy + 1};
     std::copy(offsets, offsets + 8, corner_offset);

@@ -126,9 +126,8 @@ void ConstrainedDelaunay::fill_cavity(std::uint32_t a, std::uint32_t b, std::vec
         outer.push_back({key(core.vert[e], core.vert[next(e)]), core.twin[e]});
   for (std::uint32_t t : cavity) core.free_triangle(t);
   const auto emit = [&](std::uint32_t p, std::uint32_t q, std::uint32_t r) {
-    const std::uint32_t t = core.new_triangle();
+    const std::uint32_t t = core.new_triangle(p, q, r);
     grow();
-    core.vert[3 * t] = p, core.vert[3 * t + 1] = q, core.vert[3 * t + 2] = r;
     for (std::uint32_t e = 3 * t; e < 3 * t + 3; ++e) {
       const std::uint32_t from = core.vert[e], to = core.vert[next(e)];
       fixed[e] = 0;

@@ -33,15 +33,17 @@ bool DelaunayCore::make_first_triangle() {
   return true;
 }
 
-std::uint32_t DelaunayCore::new_triangle() {
+std::uint32_t DelaunayCore::new_triangle(std::uint32_t a, std::uint32_t b, std::uint32_t c) {
+  std::uint32_t t;
   if (!free_triangles.empty()) {
-    const std::uint32_t t = free_triangles.back();
+    t = free_triangles.back();
     free_triangles.pop_back();
-    return t;
+  } else {
+    t = std::uint32_t(vert.size() / 3);
+    vert.resize(vert.size() + 3);
+    twin.resize(twin.size() + 3);
   }
-  const std::uint32_t t = std::uint32_t(vert.size() / 3);
-  vert.resize(vert.size() + 3);
-  twin.resize(twin.size() + 3);
+  vert[3 * t] = a, vert[3 * t + 1] = b, vert[3 * t + 2] = c;
   return t;
 }
 

@@ -1,6 +1,7 @@
 // Grid3, Image, Rng, DType, Progress and the parallel helpers.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <atomic>
 #include <numeric>
 #include <set>
@@ -33,6 +34,26 @@ TEST(Grid3, IndexingIsXFastestAndPositionsUseOriginAndSpacing) {
 
 TEST(Grid3, OverflowingDimensionsThrow) {
   EXPECT_THROW(Grid3<double>(std::size_t(1) << 40, std::size_t(1) << 40, 16), Error);
+}
+
+TEST(Grid3, PaddedKeepsEverySampleInPlaceInsideABorder) {
+  for (const std::array<std::size_t, 3> dims : {std::array<std::size_t, 3>{4, 3, 2}, {1, 1, 1}, {0, 0, 0}, {0, 2, 3}}) {
+    Grid3<int> g(dims[0], dims[1], dims[2]);
+    std::iota(g.data.begin(), g.data.end(), 1);
+    g.origin = Vec3f(1, 2, 3);
+    g.spacing = Vec3f(0.5f, 1, 2);
+    const Grid3<int> p = padded(g, -7);
+    ASSERT_EQ(p.dims, (std::array<std::size_t, 3>{dims[0] + 2, dims[1] + 2, dims[2] + 2}));
+    EXPECT_EQ(p.spacing, g.spacing);
+    // Each sample: g's sample one step in from p's, at the same position, or the border.
+    for (std::size_t k = 0; k < p.dims[2]; ++k)
+      for (std::size_t j = 0; j < p.dims[1]; ++j)
+        for (std::size_t i = 0; i < p.dims[0]; ++i) {
+          const bool inside = i >= 1 && i <= dims[0] && j >= 1 && j <= dims[1] && k >= 1 && k <= dims[2];
+          EXPECT_EQ(p(i, j, k), inside ? g(i - 1, j - 1, k - 1) : -7) << i << " " << j << " " << k;
+          if (inside) EXPECT_EQ(p.position(i, j, k), g.position(i - 1, j - 1, k - 1));
+        }
+  }
 }
 
 TEST(Image, ChannelsInterleaved) {

@@ -527,16 +527,11 @@ TEST(Isosurface, DemoHeadVolumePaddedIsClosed) {
   // Pad with the minimum so that the surface closes at the border.
   const float low = *std::min_element(head.data.begin(), head.data.end());
   const float high = *std::max_element(head.data.begin(), head.data.end());
-  Grid3<float> padded(head.dims[0] + 2, head.dims[1] + 2, head.dims[2] + 2, low);
-  padded.spacing = head.spacing;
-  padded.origin = head.origin - head.spacing;
-  for (std::size_t k = 0; k < head.dims[2]; ++k)
-    for (std::size_t j = 0; j < head.dims[1]; ++j)
-      for (std::size_t i = 0; i < head.dims[0]; ++i) padded(i + 1, j + 1, k + 1) = head(i, j, k);
-  const MinMaxOctree<float> tree(padded);
+  const Grid3<float> closed = padded(head, low);
+  const MinMaxOctree<float> tree(closed);
   for (double fraction : {0.1, 0.3}) {
     const double iso = low + fraction * (high - low);
-    const TriMesh mesh = isosurface(padded, iso);
+    const TriMesh mesh = isosurface(closed, iso);
     EXPECT_GT(mesh.num_triangles(), 1000u);
     expect_closed_surface(mesh, "head at " + std::to_string(iso));
     for (VertexSharing sharing : kSharings) expect_same_surface(tree.isosurface(iso, {}, sharing).mesh, mesh, name(sharing));

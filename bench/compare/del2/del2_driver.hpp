@@ -22,29 +22,28 @@ struct Result {
 };
 
 template <class Library>
+void run_variant(const compare::Args& args, const std::string& variant) {
+  std::vector<double> xy = compare::read_raw<double>(args.path("del2_" + variant + ".f64"));
+  const std::size_t n = std::min(xy.size() / 2, args.scaled(xy.size() / 2));
+  xy.resize(2 * n);
+  Result result;
+  const int reps = std::min(args.reps, Library::max_reps);
+  const double build_s = compare::median_time_s(reps, [&] { result = Library::triangulate(xy, n); });
+  const bool euler = result.triangles == 2 * result.vertices - result.hull - 2;
+  const bool all_vertices = result.vertices == n;
+  compare::Record(Library::workload, Library::anchor, variant, args.threads)
+      .timing(build_s, 0.0, n, reps)
+      .set("triangles", static_cast<unsigned long long>(result.triangles))
+      .set("hull", static_cast<unsigned long long>(result.hull))
+      .set("vertices", static_cast<unsigned long long>(result.vertices))
+      .set("euler", euler)
+      .set("all_vertices", all_vertices)
+      .print(euler && all_vertices);
+}
+
+template <class Library>
 int run(int argc, char** argv) {
-  const compare::Args args = compare::parse_args(argc, argv);
-  compare::ThreadLimit limit(args.threads);
-  for (const std::string variant : {"uniform", "grid"}) {
-    if (!args.only.empty() && variant.find(args.only) == std::string::npos) continue;
-    std::vector<double> xy = compare::read_raw<double>(args.path("del2_" + variant + ".f64"));
-    const std::size_t n = std::min(xy.size() / 2, args.scaled(xy.size() / 2));
-    xy.resize(2 * n);
-    Result result;
-    const int reps = std::min(args.reps, Library::max_reps);
-    const double build_s = compare::median_time_s(reps, [&] { result = Library::triangulate(xy, n); });
-    const bool euler = result.triangles == 2 * result.vertices - result.hull - 2;
-    const bool all_vertices = result.vertices == n;
-    compare::Record(Library::workload, Library::anchor, variant, args.threads)
-        .timing(build_s, 0.0, n, reps)
-        .set("triangles", static_cast<unsigned long long>(result.triangles))
-        .set("hull", static_cast<unsigned long long>(result.hull))
-        .set("vertices", static_cast<unsigned long long>(result.vertices))
-        .set("euler", euler)
-        .set("all_vertices", all_vertices)
-        .print(euler && all_vertices);
-  }
-  return 0;
+  return compare::run_variants(argc, argv, {"uniform", "grid"}, run_variant<Library>);
 }
 
 }  // namespace del2

@@ -96,11 +96,7 @@ void run_variant(const Args& args, const std::string& variant) {
 
 template <class Lib>
 int run(int argc, char** argv) {
-  const Args args = parse_args(argc, argv);
-  const ThreadLimit limit(args.threads);
-  for (const char* variant : {"uniform", "clustered"})
-    if (args.wants(variant)) run_variant<Lib>(args, variant);
-  return 0;
+  return run_variants(argc, argv, {"uniform", "clustered"}, run_variant<Lib>);
 }
 
 }  // namespace compare::knn

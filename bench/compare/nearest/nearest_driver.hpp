@@ -74,10 +74,7 @@ void run_uniform(const Args& args) {
 
 template <class Lib>
 int run(int argc, char** argv) {
-  const Args args = parse_args(argc, argv);
-  const ThreadLimit limit(args.threads);
-  if (args.wants("uniform")) run_uniform<Lib>(args);
-  return 0;
+  return run_variants(argc, argv, {"uniform"}, [](const Args& args, const char*) { run_uniform<Lib>(args); });
 }
 
 }  // namespace compare::nearest

@@ -1,5 +1,6 @@
 #pragma once
 // A dense 3D grid of samples (a volume) with origin and spacing.
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <vector>
@@ -49,5 +50,21 @@ struct Grid3 {
     return nxy * nz;
   }
 };
+
+/// The volume grown by one sample of `border` on every side, at the same
+/// spacing (the origin moves one sample back, so every sample keeps its world
+/// position). Each isosurface at an iso-value above (or below) `border` then
+/// closes at the border of the volume.
+template <typename T>
+Grid3<T> padded(const Grid3<T>& volume, T border) {
+  Grid3<T> p(volume.dims[0] + 2, volume.dims[1] + 2, volume.dims[2] + 2, border);
+  p.spacing = volume.spacing;
+  p.origin = volume.origin - volume.spacing;
+  if (volume.size() == 0) return p;
+  for (std::size_t k = 0; k < volume.dims[2]; ++k)
+    for (std::size_t j = 0; j < volume.dims[1]; ++j)
+      std::copy_n(&volume(0, j, k), volume.dims[0], &p(1, j + 1, k + 1));
+  return p;
+}
 
 }  // namespace geods

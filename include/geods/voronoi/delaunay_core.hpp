@@ -78,8 +78,9 @@ class DelaunayCore {
   bool circle_holds(std::uint32_t a, std::uint32_t b, std::uint32_t c, const Vec2d& p) const;
   /// p inside the circle of triangle t: it conflicts with p.
   bool in_conflict(std::uint32_t t, const Vec2d& p) const { return circle_holds(vert[3 * t], vert[3 * t + 1], vert[3 * t + 2], p); }
-  /// A triangle slot: a freed one or three new half-edges.
-  std::uint32_t new_triangle();
+  /// A triangle slot (a freed one or three new half-edges) holding the
+  /// vertices (a, b, c); its twins are for the caller to link.
+  std::uint32_t new_triangle(std::uint32_t a, std::uint32_t b, std::uint32_t c);
   /// Frees triangle t's slot (its vertices become none).
   void free_triangle(std::uint32_t t);
 
@@ -138,14 +139,12 @@ std::uint32_t DelaunayCore::insert_vertex(std::uint32_t i, std::uint32_t start, 
 
 template <class Hooks>
 void DelaunayCore::split_triangle(std::uint32_t t, std::uint32_t p, Hooks& hooks) {
-  const std::uint32_t t1 = new_triangle(), t2 = new_triangle();
-  const std::uint32_t s0 = 3 * t, s1 = s0 + 1, s2 = s0 + 2, u0 = 3 * t1, w0 = 3 * t2;
+  const std::uint32_t s0 = 3 * t, s1 = s0 + 1, s2 = s0 + 2;
   const std::uint32_t a = vert[s0], b = vert[s1], c = vert[s2];
   const std::uint32_t o1 = twin[s1], o2 = twin[s2];
   // t = (a, b, p), t1 = (b, c, p), t2 = (c, a, p)
+  const std::uint32_t t1 = new_triangle(b, c, p), t2 = new_triangle(c, a, p), u0 = 3 * t1, w0 = 3 * t2;
   vert[s2] = p;
-  vert[u0] = b, vert[u0 + 1] = c, vert[u0 + 2] = p;
-  vert[w0] = c, vert[w0 + 1] = a, vert[w0 + 2] = p;
   link(u0, o1);
   link(w0, o2);
   link(s1, u0 + 2);
@@ -160,17 +159,14 @@ void DelaunayCore::split_triangle(std::uint32_t t, std::uint32_t p, Hooks& hooks
 
 template <class Hooks>
 void DelaunayCore::split_edge(std::uint32_t e, std::uint32_t p, Hooks& hooks) {
-  const std::uint32_t n1t = new_triangle(), n2t = new_triangle();
   const std::uint32_t e1 = next(e), e2 = prev(e);
   const std::uint32_t t = twin[e], t1 = next(t), t2 = prev(t);
   const std::uint32_t a = vert[e], b = vert[e1], c = vert[e2], d = vert[t2];
   const std::uint32_t o_e1 = twin[e1], o_t1 = twin[t1];
-  const std::uint32_t n0 = 3 * n1t, m0 = 3 * n2t;
   // (a, b, c) -> (a, p, c) + (p, b, c); (b, a, d) -> (b, p, d) + (p, a, d)
+  const std::uint32_t n1t = new_triangle(p, b, c), n2t = new_triangle(p, a, d), n0 = 3 * n1t, m0 = 3 * n2t;
   vert[e1] = p;
   vert[t1] = p;
-  vert[n0] = p, vert[n0 + 1] = b, vert[n0 + 2] = c;
-  vert[m0] = p, vert[m0 + 1] = a, vert[m0 + 2] = d;
   link(e, m0);
   link(n0, t);
   link(e1, n0 + 2);
