@@ -102,8 +102,13 @@ class ArchiveWriter {
 /// A mapped archive; its sections are read in place.
 class Archive {
  public:
-  /// Whether open() verifies the payload checksums (one pass over the file).
-  enum class Verify { checksums, structure_only };
+  /// What a load verifies. checksums: the payload checksums (one pass over the
+  /// file) and the structure's own cheap checks (index ranges, links); every
+  /// load does at least those checks but the checksums (structure_only). full:
+  /// also the invariants that cost as much as a build to check, for the
+  /// structures that have them (Delaunay2's empty circles, Voronoi2's
+  /// equidistant vertices); the others treat it as checksums.
+  enum class Verify { checksums, structure_only, full };
 
   /// Maps and checks `path`, which must hold a `kind` archive of `kind_version`.
   static Archive open(const std::filesystem::path& path, std::string_view kind, std::uint32_t kind_version,
@@ -130,6 +135,18 @@ class Archive {
     FlatArray<T> a = array<T>(name);
     if (a.size() != expected_count) fail_count(name, a.size(), expected_count);
     return a;
+  }
+  /// The section `name` of `Element`s viewed in place as `T`s of
+  /// sizeof(T) / sizeof(Element) elements each (say coordinate pairs as points).
+  template <typename T, typename Element>
+  FlatArray<T> grouped(std::string_view name) const {
+    static_assert(sizeof(T) % sizeof(Element) == 0 && alignof(T) <= 64, "T is a group of Elements");
+    constexpr std::size_t group = sizeof(T) / sizeof(Element);
+    const FlatArray<Element> elements = array<Element>(name);
+    if (elements.size() % group != 0)
+      throw error(std::string(name) + ": " + std::to_string(elements.size()) + " elements, not groups of " +
+                  std::to_string(group));
+    return FlatArray<T>(std::span<const T>(reinterpret_cast<const T*>(elements.data()), elements.size() / group), file_);
   }
   /// The one element of section `name`.
   template <typename T>
