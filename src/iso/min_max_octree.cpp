@@ -829,7 +829,7 @@ MinMaxOctree<T> MinMaxOctree<T>::load(const std::filesystem::path& path, Archive
   tree.max_ = a.array<T>("max", nodes);
   try {
     detail::check_samples(g);
-    tree.check_nodes(verify == Archive::Verify::full);
+    tree.check_nodes(Archive::checks_everything(verify));
   } catch (const Error& e) {
     throw a.error(std::string("corrupted min/max octree: ") + e.what());
   }

@@ -79,7 +79,7 @@ Delaunay2 Delaunay2::load(const std::filesystem::path& path, Archive::Verify ver
     } else {
       dt.check_triangles();
       dt.publish();
-      if (verify == Archive::Verify::full) dt.validate();
+      if (Archive::checks_everything(verify)) dt.validate();
     }
   } catch (const Error& e) {
     throw a.error(e.what());

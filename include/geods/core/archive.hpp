@@ -103,12 +103,15 @@ class ArchiveWriter {
 class Archive {
  public:
   /// What a load verifies. checksums: the payload checksums (one pass over the
-  /// file) and the structure's own cheap checks (index ranges, links); every
-  /// load does at least those checks but the checksums (structure_only). full:
-  /// also the invariants that cost as much as a build to check, for the
-  /// structures that have them (Delaunay2's empty circles, Voronoi2's
-  /// equidistant vertices); the others treat it as checksums.
+  /// file), which prove the contents are what save() wrote, and the
+  /// structure's own cheap checks (index ranges, links: what keeps queries in
+  /// bounds). structure_only: no checksums, so every check the structure has,
+  /// also those costing as much as a build (Delaunay2's empty circles,
+  /// Voronoi2's equidistant vertices, MinMaxOctree's leaves against the
+  /// samples). full: the checksums and every check.
   enum class Verify { checksums, structure_only, full };
+  /// Whether a load under `verify` runs the checks that the checksums make redundant.
+  static bool checks_everything(Verify verify) { return verify != Verify::checksums; }
 
   /// Maps and checks `path`, which must hold a `kind` archive of `kind_version`.
   static Archive open(const std::filesystem::path& path, std::string_view kind, std::uint32_t kind_version,

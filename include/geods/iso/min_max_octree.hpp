@@ -107,7 +107,8 @@ class MinMaxOctree {
   /// (a Grid3 owns them). Throws geods::Error naming the file for another
   /// sample type, a truncated or corrupt file (checksums, unless `verify` says
   /// structure_only), NaN samples, a leaf with min > max or a node whose
-  /// min/max is not that of its children (O(nodes)); Verify::full runs all of
+  /// min/max is not that of its children (O(nodes)); Verify::full and
+  /// structure_only (no checksums to prove the leaves) run all of
   /// validate(), the leaves against the samples too (a pass like the build).
   static MinMaxOctree load(const std::filesystem::path& path, Archive::Verify verify = Archive::Verify::checksums);
 

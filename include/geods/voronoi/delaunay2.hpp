@@ -173,7 +173,8 @@ class Delaunay2 {
   /// triangulation of its points: indices in range, twins mutual, triangles
   /// counter-clockwise, every representative a vertex (validate()'s checks but
   /// the costly ones, incircle and the segments' paths, which a checksummed
-  /// file written by save() cannot fail; Verify::full runs those too).
+  /// file written by save() cannot fail; Verify::full and structure_only, which
+  /// skips the checksums, run those too).
   static Delaunay2 load(const std::filesystem::path& path, Archive::Verify verify = Archive::Verify::checksums);
 
   Delaunay2Stats stats() const;

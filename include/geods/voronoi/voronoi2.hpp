@@ -117,7 +117,8 @@ class Voronoi2 {
   /// geods::Error naming the file if it is missing, truncated, corrupt, of
   /// another kind or version, or its arrays are not a diagram: indices in
   /// range, twins mutual, `next` a permutation within each cell, so that every
-  /// walk around a cell comes back (O(n) integer work; Verify::full runs all of
+  /// walk around a cell comes back (O(n) integer work; Verify::full and
+  /// structure_only, which skips the checksums, run all of
   /// validate(): one cycle per cell, and the geometry).
   static Voronoi2 load(const std::filesystem::path& path, Archive::Verify verify = Archive::Verify::checksums);
 
