@@ -2,7 +2,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <set>
+#include <string>
 #include <vector>
 
 #include "geods/core/error.hpp"
@@ -69,15 +72,15 @@ TEST(KdTreeBlock, SteppedBuildGivesTheSameTree) {
   whole.validate();
   stepped.validate();
   EXPECT_EQ(stepped.extract(), items);
-  EXPECT_EQ(stepped.tree().permutation(), whole.tree().permutation());
+  EXPECT_EQ(stepped.slots(), whole.slots());
   const double q[3] = {0.5, 1, 0};
   const double lo[3] = {0.2, 0, -1}, hi[3] = {0.6, 2, 1};
   std::vector<std::size_t> a, b;
-  whole.tree().search_box(lo, hi, [&](std::uint32_t slot) { a.push_back(slot); }, whole.dead_slots());
-  stepped.tree().search_box(lo, hi, [&](std::uint32_t slot) { b.push_back(slot); }, stepped.dead_slots());
+  whole.search_box(lo, hi, [&](std::uint32_t slot) { a.push_back(slot); });
+  stepped.search_box(lo, hi, [&](std::uint32_t slot) { b.push_back(slot); });
   EXPECT_EQ(a, b);
   std::vector<std::size_t> near;
-  stepped.tree().search_radius(q, 0.01, [&](std::uint32_t slot, double) { near.push_back(slot); }, stepped.dead_slots());
+  stepped.search_radius(q, 0.01, [&](std::uint32_t slot, double) { near.push_back(slot); });
   std::size_t expected = 0;
   for (const auto& p : items)
     expected += (p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) + (p[2] - q[2]) * (p[2] - q[2]) <= 0.01;
@@ -94,15 +97,69 @@ TEST(KdTreeBlock, WeakDeleteHidesSlots) {
   block.validate();
   const float lo[2] = {0, 0}, hi[2] = {9, 9};
   std::size_t count = 0;
-  block.tree().search_box(
-      lo, hi,
-      [&](std::uint32_t slot) {
-        EXPECT_EQ(slot % 2, 1u);
-        ++count;
-      },
-      block.dead_slots());
+  block.search_box(lo, hi, [&](std::uint32_t slot) {
+    EXPECT_EQ(slot % 2, 1u);
+    ++count;
+  });
   EXPECT_EQ(count, 50u);
   EXPECT_EQ(block.extract().size(), 100u) << "dead slots stay until a rebuild";
+}
+
+// Blocks of at most kLeafSize items keep only their points; their searches
+// answer as the tree of a larger block does, and the two kinds meet at kLeafSize.
+TEST(KdTreeBlock, SmallBlocksAnswerAsTrees) {
+  using Block = KdTreeBlock<double, spatial::Dynamic>;
+  Rng rng(5);
+  for (std::size_t n : {std::size_t(0), std::size_t(1), std::size_t(3), Block::kLeafSize, Block::kLeafSize + 1,
+                        std::size_t(40)}) {
+    SCOPED_TRACE("n=" + std::to_string(n));
+    std::vector<Block::Item> items(n);
+    for (auto& p : items) p = {double(rng.below(3)), rng.uniform(), rng.normal()};  // ties on the first axis
+    Block block = Block::build(items);
+    EXPECT_EQ(block.small(), n <= Block::kLeafSize);
+    for (std::size_t slot = 1; slot < n; slot += 3) block.weak_delete(slot);
+    block.validate();
+    EXPECT_EQ(block.extract(), items);
+    for (std::size_t slot = 0; slot < n; ++slot) {
+      EXPECT_EQ(block.item(slot), items[slot]);
+      EXPECT_EQ(block.is_dead(slot), slot % 3 == 1);
+    }
+    for (int t = 0; t < 20; ++t) {
+      const double q[3] = {double(rng.below(3)), rng.uniform(), rng.normal()};
+      const double lo[3] = {q[0] - 1, q[1] - 0.3, q[2] - 0.5}, hi[3] = {q[0] + 0.5, q[1] + 0.3, q[2] + 1};
+      std::vector<spatial::Neighbor<double>> near, want_near;
+      std::vector<std::uint32_t> box, want_box;
+      std::vector<spatial::Neighbor<double>> best(3);
+      spatial::KnnResultSet<double> result(best.data(), 3, std::numeric_limits<double>::infinity());
+      block.search_nearest(q, result);
+      result.finish();
+      best.resize(result.size());
+      block.search_radius(q, 0.5, [&](std::uint32_t slot, double d) { near.push_back({slot, d}); });
+      block.search_box(lo, hi, [&](std::uint32_t slot) { box.push_back(slot); });
+      std::vector<spatial::Neighbor<double>> all;
+      for (std::uint32_t slot = 0; slot < n; ++slot) {
+        if (slot % 3 == 1) continue;
+        const double d = spatial::squared_distance(q, items[slot].data(), 3);
+        all.push_back({slot, d});
+        if (d <= 0.5) want_near.push_back({slot, d});
+        bool in = true;
+        for (int a = 0; a < 3; ++a) in = in && lo[a] <= items[slot][a] && items[slot][a] <= hi[a];
+        if (in) want_box.push_back(slot);
+      }
+      std::sort(all.begin(), all.end());
+      all.resize(std::min<std::size_t>(3, all.size()));
+      std::sort(near.begin(), near.end());
+      std::sort(want_near.begin(), want_near.end());
+      std::sort(box.begin(), box.end());
+      EXPECT_EQ(best, all);
+      EXPECT_EQ(near, want_near);
+      EXPECT_EQ(box, want_box);
+    }
+  }
+  std::vector<Block::Item> bad = {{0, 0, 0}, {1, std::nan(""), 1}};
+  EXPECT_THROW(Block::build(bad), Error);
+  bad = {{0, 0, 0}, {1, 1}};
+  EXPECT_THROW(Block::build(bad), Error);
 }
 
 TEST(Locator, FindsEveryEntryAcrossGenerations) {

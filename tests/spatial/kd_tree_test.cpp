@@ -519,19 +519,47 @@ void check_stepped_and_filtered(Shape shape, std::size_t n, std::size_t d, std::
   if (n > 100) {
     EXPECT_GE(steps, build.estimated_work() / budget / 4) << "the build runs in many small steps";
   }
-  const KdTree<T, Dim> stepped = build.finish();
+  const auto [stepped, row] = build.finish();
   ASSERT_NO_THROW(stepped.validate());
-  EXPECT_TRUE(stepped.stores_points_in_tree_order());
   EXPECT_EQ(stepped.size(), n);
+  // Its points are numbered in tree order: point i is input row row[i], the permutation is the identity.
+  ASSERT_NO_THROW(require_permutation(row, n, "stepped build rows"));
+  for (std::size_t i = 0; i < n; ++i) {
+    ASSERT_EQ(stepped.permutation()[i], i);
+    ASSERT_TRUE(std::equal(stepped.point(i), stepped.point(i) + d, &pts[row[i] * d]));
+  }
   const KdTree<T, Dim> plain(PointView<T>(pts.data(), n, d), 6);
   EXPECT_EQ(stepped.stats().depth, plain.stats().depth);
   EXPECT_EQ(stepped.nodes().size(), plain.nodes().size());
 
-  std::vector<std::uint8_t> flags(n);
+  std::vector<std::uint8_t> flags(n), stepped_flags(n);  // by input row, by stepped tree point
   Rng rng(3 + n);
   for (std::size_t i = 0; i < n; ++i) flags[i] = i % 3 == 0 || rng.below(4) == 0;
-  const SkipFlagged skip{flags.data()};
+  for (std::size_t i = 0; i < n; ++i) stepped_flags[i] = flags[row[i]];
+  const SkipFlagged skip{flags.data()}, stepped_skip{stepped_flags.data()};
   const auto skip_odd_lambda = [&](std::uint32_t i) { return flags[i] != 0; };
+  // The stepped tree's answers in input rows (ties broken by row, as the plain tree's).
+  auto stepped_query = [&](const T* q, const KnnRequest& request, const auto& skip_points) {
+    std::vector<Neighbor<T>> out(request.k);
+    KnnResultSet<T> best(out.data(), request.k, squared_limit<T>(request.max_distance));
+    struct InRows {
+      KnnResultSet<T>& best;
+      const std::uint32_t* row;
+      T worst() const { return best.worst(); }
+      bool full() const { return best.full(); }
+      void insert(std::uint32_t i, T dist) { best.insert(row[i], dist); }
+    } in_rows{best, row.data()};
+    stepped.search_nearest(q, in_rows, request.eps, skip_points);
+    best.finish();
+    out.resize(best.size());
+    return out;
+  };
+  auto stepped_radius = [&](const T* q, double r, const auto& skip_points) {
+    std::vector<Neighbor<T>> out;
+    for (const auto& nb : stepped.query_radius(std::span<const T>(q, d), r, skip_points)) out.push_back({row[nb.index], nb.squared_distance});
+    std::sort(out.begin(), out.end());
+    return out;
+  };
   const std::vector<T> qs = make_queries(pts, n, d, 20, 7 + n);
   for (std::size_t i = 0; i < 20; ++i) {
     const T* q = &qs[i * d];
@@ -540,22 +568,22 @@ void check_stepped_and_filtered(Shape shape, std::size_t n, std::size_t d, std::
     for (const auto& nb : brute_all(pts, d, q))
       if (!flags[nb.index]) kept.push_back(nb);
     for (std::size_t k : {std::size_t(1), std::size_t(5), std::size_t(23)}) {
-      ASSERT_EQ(stepped.query(qspan, k), plain.query(qspan, k)) << "k=" << k;
+      ASSERT_EQ(stepped_query(q, KnnRequest{k}, KeepAll{}), plain.query(qspan, k)) << "k=" << k;
       const std::vector<Neighbor<T>> want(kept.begin(), kept.begin() + std::min(k, kept.size()));
-      ASSERT_EQ(stepped.query(qspan, KnnRequest{k}, skip), want) << "k=" << k;
+      ASSERT_EQ(stepped_query(q, KnnRequest{k}, stepped_skip), want) << "k=" << k;
       ASSERT_EQ(plain.query(qspan, KnnRequest{k}, skip_odd_lambda), want) << "k=" << k;
     }
     const double r = kept.empty() ? 0.1 : std::sqrt(double(kept[std::min<std::size_t>(3, kept.size() - 1)].squared_distance));
     std::vector<Neighbor<T>> within;
     for (const auto& nb : kept)
       if (nb.squared_distance <= T(r * r)) within.push_back(nb);
-    ASSERT_EQ(stepped.query_radius(qspan, r, skip), within);
+    ASSERT_EQ(stepped_radius(q, r, stepped_skip), within);
     ASSERT_EQ(plain.query_radius(qspan, r, skip), within);
-    ASSERT_EQ(stepped.query_radius(qspan, r), plain.query_radius(qspan, r));
+    ASSERT_EQ(stepped_radius(q, r, KeepAll{}), plain.query_radius(qspan, r));
     // max_distance and (1 + eps) with a filter: fewer than k within the limit, each within the bound.
-    const std::vector<Neighbor<T>> limited = stepped.query(qspan, KnnRequest{8, 0, r}, skip);
+    const std::vector<Neighbor<T>> limited = stepped_query(q, KnnRequest{8, 0, r}, stepped_skip);
     ASSERT_EQ(limited, std::vector<Neighbor<T>>(within.begin(), within.begin() + std::min<std::size_t>(8, within.size())));
-    const std::vector<Neighbor<T>> approx = stepped.query(qspan, KnnRequest{7, 1.0}, skip);
+    const std::vector<Neighbor<T>> approx = stepped_query(q, KnnRequest{7, 1.0}, stepped_skip);
     ASSERT_EQ(approx.size(), std::min<std::size_t>(7, kept.size()));
     for (std::size_t j = 0; j < approx.size(); ++j) {
       ASSERT_FALSE(flags[approx[j].index]);
@@ -571,14 +599,17 @@ void check_stepped_and_filtered(Shape shape, std::size_t n, std::size_t d, std::
       if (in) all_box.push_back(std::uint32_t(j));
       if (in && !flags[j]) want_box.push_back(std::uint32_t(j));
     }
-    for (const KdTree<T, Dim>* tree : {&stepped, &plain}) {
-      std::vector<std::uint32_t> got = tree->query_box(lo, hi, nullptr, skip), all = tree->query_box(lo, hi);
-      std::sort(got.begin(), got.end());
-      std::sort(all.begin(), all.end());
-      ASSERT_EQ(got, want_box);
-      ASSERT_EQ(all, all_box);
-      ASSERT_EQ(tree->count_box(lo, hi, nullptr, skip), want_box.size());
-    }
+    std::vector<std::uint32_t> stepped_box, stepped_all, plain_box = plain.query_box(lo, hi, nullptr, skip),
+                                                   plain_all = plain.query_box(lo, hi);
+    for (std::uint32_t j : stepped.query_box(lo, hi, nullptr, stepped_skip)) stepped_box.push_back(row[j]);
+    for (std::uint32_t j : stepped.query_box(lo, hi)) stepped_all.push_back(row[j]);
+    for (auto* found : {&stepped_box, &stepped_all, &plain_box, &plain_all}) std::sort(found->begin(), found->end());
+    ASSERT_EQ(stepped_box, want_box);
+    ASSERT_EQ(plain_box, want_box);
+    ASSERT_EQ(stepped_all, all_box);
+    ASSERT_EQ(plain_all, all_box);
+    ASSERT_EQ(stepped.count_box(lo, hi, nullptr, stepped_skip), want_box.size());
+    ASSERT_EQ(plain.count_box(lo, hi, nullptr, skip), want_box.size());
   }
 }
 

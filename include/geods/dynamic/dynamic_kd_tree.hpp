@@ -19,6 +19,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <limits>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -38,9 +39,15 @@
 
 namespace geods::dynamic {
 
-/// One block V_i of Dyn(k-d): a spatial::KdTree over its items (point index =
-/// slot), built in steps (KdTreeSteppedBuild), and one flag per slot for the
-/// weak delete (WD_k-d of §7.4), which its queries skip.
+/// One block V_i of Dyn(k-d): a spatial::KdTree over its items, built in steps
+/// (KdTreeSteppedBuild), and one flag per item for the weak delete (WD_k-d of
+/// §7.4), which its searches skip. The tree numbers its points in tree order
+/// (so it stores them once, leaves contiguous); the block maps them to slots.
+///
+/// A block of at most kLeafSize items would be a tree of one leaf: it keeps
+/// only its points, in slot order, and its searches scan them as that leaf
+/// would (same distances). Fifteen of every sixteen builds of Dyn are of such
+/// blocks (its levels 0 to 3), which so skip the tree's arrays.
 template <typename T, int Dim>
 class KdTreeBlock {
  public:
@@ -50,14 +57,18 @@ class KdTreeBlock {
 
   class Builder {
    public:
-    explicit Builder(std::vector<Item> items) : dim_(item_dim(items)), build_(std::move(items), dim_, kLeafSize) {}
-    std::size_t estimated_work() const { return build_.estimated_work(); }
-    bool step(std::size_t work) { return build_.step(work); }
+    explicit Builder(std::vector<Item> items) : dim_(item_dim(items)) {
+      if (items.size() <= kLeafSize)
+        small_ = pack(items, dim_);
+      else
+        build_.emplace(std::move(items), dim_, kLeafSize);
+    }
+    std::size_t estimated_work() const { return build_ ? build_->estimated_work() : small_.size() + 1; }
+    bool step(std::size_t work) { return build_ ? build_->step(work) : true; }
     KdTreeBlock finish() {
-      KdTreeBlock block;
-      block.tree_ = build_.finish();
-      block.dead_.assign(block.tree_.size(), 0);
-      return block;
+      if (!build_) return KdTreeBlock(dim_, std::move(small_));
+      auto [tree, row] = build_->finish();
+      return KdTreeBlock(std::move(tree), FlatArray<std::uint32_t>(std::move(row)));
     }
 
    private:
@@ -68,67 +79,169 @@ class KdTreeBlock {
       else
         return std::size_t(Dim);
     }
+    // A small block's points, checked as KdTreeSteppedBuild checks its rows.
+    static std::vector<T> pack(const std::vector<Item>& items, std::size_t dim) {
+      std::vector<T> packed(items.size() * dim);
+      for (std::size_t i = 0; i < items.size(); ++i) {
+        if (items[i].size() != dim)
+          throw Error("KdTree: point " + std::to_string(i) + " of dimension " + std::to_string(items[i].size()) +
+                      ", expected " + std::to_string(dim));
+        for (std::size_t a = 0; a < dim; ++a)
+          if (!std::isfinite(items[i][a]))
+            throw Error("KdTree: point " + std::to_string(i) + " has a non-finite coordinate (axis " +
+                        std::to_string(a) + ")");
+        std::copy_n(items[i].data(), dim, packed.data() + i * dim);
+      }
+      return packed;
+    }
     std::size_t dim_;
-    spatial::KdTreeSteppedBuild<T, Dim> build_;
+    std::vector<T> small_;
+    std::optional<spatial::KdTreeSteppedBuild<T, Dim>> build_;
   };
 
   static KdTreeBlock build(std::vector<Item> items) { return Builder(std::move(items)).finish(); }
-  /// A block of a tree built elsewhere (read from a file), no slot dead yet.
-  static KdTreeBlock adopt(Tree tree) {
-    KdTreeBlock block;
-    block.tree_ = std::move(tree);
-    if (!block.tree_.stores_points_in_tree_order()) block.tree_.store_points_in_tree_order();
-    block.dead_.assign(block.tree_.size(), 0);
-    return block;
+  /// A block read from a file, no slot dead yet: a tree whose point i is in
+  /// slot slots[i]. Throws geods::Error if slots is not a permutation of the
+  /// tree's points or the tree is small enough to be a small block.
+  static KdTreeBlock adopt(Tree tree, FlatArray<std::uint32_t> slots) {
+    spatial::require_permutation(slots, tree.size(), "KdTreeBlock: slots");
+    if (tree.size() <= kLeafSize) throw Error("KdTreeBlock: a tree of " + std::to_string(tree.size()) + " points");
+    return KdTreeBlock(std::move(tree), std::move(slots));
+  }
+  /// A small block read from a file: at most kLeafSize points (n x dim, in slot order).
+  static KdTreeBlock adopt_small(std::size_t dim, std::span<const T> points) {
+    if (points.size() % dim != 0 || points.size() / dim > kLeafSize)
+      throw Error("KdTreeBlock: " + std::to_string(points.size()) + " coordinates are not a small block");
+    return KdTreeBlock(dim, std::vector<T>(points.begin(), points.end()));
   }
 
   /// Slots, dead ones included.
-  std::size_t size() const { return tree_.size(); }
+  std::size_t size() const { return dead_.size(); }
   std::size_t dead() const { return dead_count_; }
   bool all_dead() const { return dead_count_ == size(); }
+  /// Whether the block keeps only its points (at most kLeafSize), not a tree.
+  bool small() const { return size() <= kLeafSize; }
   /// Every item, dead ones included, in slot order.
   std::vector<Item> extract() const {
-    std::vector<Item> out;
-    out.reserve(size());
-    for (std::size_t slot = 0; slot < size(); ++slot) out.push_back(item(slot));
+    std::vector<Item> out(size());
+    for (std::size_t i = 0; i < size(); ++i) out[small() ? i : slot_[i]] = item_at(i);
     return out;
   }
-  Item item(std::size_t slot) const {
-    const T* p = tree_.point(slot);
-    Item out;
-    if constexpr (Dim == spatial::Dynamic) out.resize(tree_.dim());
-    std::copy(p, p + tree_.dim(), out.begin());
-    return out;
-  }
-  bool is_dead(std::size_t slot) const { return dead_.at(slot) != 0; }
+  Item item(std::size_t slot) const { return item_at(position(slot)); }
+  bool is_dead(std::size_t slot) const { return dead_.at(position(slot)) != 0; }
   void weak_delete(std::size_t slot) {
-    if (slot >= size() || dead_[slot])
+    if (slot >= size() || dead_[position(slot)])
       throw Error("KdTreeBlock::weak_delete: slot " + std::to_string(slot) + " is not a live slot");
-    dead_[slot] = 1;
+    dead_[position(slot)] = 1;
     ++dead_count_;
   }
 
-  /// The tree (point index = slot) and the filter its queries take to skip dead slots.
+  // The tree's searches (spatial::KdTree) over the live slots, reporting slots.
+  /// Feeds result.insert(slot, squared distance) the live points that may improve result.
+  template <typename Result>
+  void search_nearest(const T* q, Result& result, double eps = 0) const {
+    if (small()) {
+      for (std::uint32_t slot = 0; slot < size(); ++slot) {
+        if (dead_[slot]) continue;
+        const T d = spatial::squared_distance(q, point_at(slot), dim());
+        if (d <= result.worst()) result.insert(slot, d);
+      }
+      return;
+    }
+    struct BySlot {
+      Result& result;
+      const std::uint32_t* slot;
+      T worst() const { return result.worst(); }
+      bool full() const { return result.full(); }
+      void insert(std::uint32_t i, T d) { result.insert(slot[i], d); }
+    } by_slot{result, slot_.data()};
+    tree_.search_nearest(q, by_slot, eps, live());
+  }
+  /// Calls f(slot, squared distance) for every live point within squared distance r2 of q.
+  template <typename F>
+  void search_radius(const T* q, T r2, const F& f) const {
+    if (small()) {
+      for (std::uint32_t slot = 0; slot < size(); ++slot) {
+        if (dead_[slot]) continue;
+        const T d = spatial::squared_distance(q, point_at(slot), dim());
+        if (d <= r2) f(slot, d);
+      }
+      return;
+    }
+    tree_.search_radius(q, r2, [&](std::uint32_t i, T d) { f(slot_[i], d); }, live());
+  }
+  /// Calls f(slot) for every live point p with lo <= p <= hi on every axis.
+  template <typename F>
+  void search_box(const T* lo, const T* hi, const F& f) const {
+    if (small()) {
+      for (std::uint32_t slot = 0; slot < size(); ++slot) {
+        const T* p = point_at(slot);
+        bool in = !dead_[slot];
+        for (std::size_t a = 0; a < dim() && in; ++a) in = lo[a] <= p[a] && p[a] <= hi[a];
+        if (in) f(slot);
+      }
+      return;
+    }
+    tree_.search_box(lo, hi, [&](std::uint32_t i) { f(slot_[i]); }, live());
+  }
+
+  /// A block that is not small: its tree, whose point i is in slot slots()[i].
   const Tree& tree() const { return tree_; }
-  spatial::SkipFlagged dead_slots() const { return {dead_.data()}; }
-  /// One byte per slot, 1 if weakly deleted.
-  const std::vector<std::uint8_t>& dead_flags() const { return dead_; }
+  const FlatArray<std::uint32_t>& slots() const { return slot_; }
+  /// A small block: its points, n x dim in slot order.
+  const std::vector<T>& small_points() const { return small_; }
 
   /// Heap bytes held.
-  std::size_t bytes() const { return tree_.bytes() + dead_.capacity(); }
+  std::size_t bytes() const {
+    return tree_.bytes() + small_.capacity() * sizeof(T) +
+           (slot_.size() + position_.capacity()) * sizeof(std::uint32_t) + dead_.capacity();
+  }
 
-  /// The tree's invariants (it keeps its points in tree order too) and the dead flags.
+  /// The tree's invariants (or a small block's size), the slot maps (inverse
+  /// permutations) and the dead flags.
   void validate() const {
-    tree_.validate();
-    if (!tree_.stores_points_in_tree_order()) throw Error("KdTreeBlock::validate: points not in tree order");
-    if (dead_.size() != size()) throw Error("KdTreeBlock::validate: dead flags of the wrong size");
+    if (small()) {
+      if (small_.size() != size() * dim_ || !tree_.empty() || !slot_.empty())
+        throw Error("KdTreeBlock::validate: a small block with a tree or points of the wrong size");
+    } else {
+      tree_.validate();
+      if (tree_.size() != size() || slot_.size() != size() || position_.size() != size())
+        throw Error("KdTreeBlock::validate: tree or slot maps of the wrong size");
+      for (std::size_t i = 0; i < size(); ++i)
+        if (slot_[i] >= size() || position_[slot_[i]] != i) throw Error("KdTreeBlock::validate: slot maps disagree");
+    }
     if (std::size_t(std::count(dead_.begin(), dead_.end(), 1)) != dead_count_)
       throw Error("KdTreeBlock::validate: dead count is wrong");
   }
 
  private:
-  Tree tree_;
-  std::vector<std::uint8_t> dead_;  // by slot
+  KdTreeBlock(Tree tree, FlatArray<std::uint32_t> slots)
+      : dim_(tree.dim()), tree_(std::move(tree)), slot_(std::move(slots)), position_(tree_.size()),
+        dead_(tree_.size(), 0) {
+    for (std::size_t i = 0; i < slot_.size(); ++i) position_[slot_[i]] = std::uint32_t(i);
+  }
+  KdTreeBlock(std::size_t dim, std::vector<T> points)
+      : dim_(dim), small_(std::move(points)), dead_(small_.size() / dim, 0) {}
+
+  // Points are addressed by their place in the tree (a small block's: its slot).
+  std::size_t position(std::size_t slot) const { return small() ? slot : position_.at(slot); }
+  const T* point_at(std::size_t i) const { return small() ? small_.data() + i * dim() : tree_.point(i); }
+  std::size_t dim() const { return Dim == spatial::Dynamic ? dim_ : std::size_t(Dim); }
+  Item item_at(std::size_t i) const {
+    const T* p = point_at(i);
+    Item out;
+    if constexpr (Dim == spatial::Dynamic) out.resize(dim());
+    std::copy(p, p + dim(), out.begin());
+    return out;
+  }
+  spatial::SkipFlagged live() const { return {dead_.data()}; }
+
+  std::size_t dim_ = Dim == spatial::Dynamic ? 1 : std::size_t(Dim);
+  Tree tree_;                            // empty in a small block
+  std::vector<T> small_;                 // a small block's points, by slot
+  FlatArray<std::uint32_t> slot_;        // by tree point: its slot (empty in a small block)
+  std::vector<std::uint32_t> position_;  // by slot: its tree point (empty in a small block)
+  std::vector<std::uint8_t> dead_;       // by tree point (small block: by slot)
   std::size_t dead_count_ = 0;
 };
 
@@ -148,7 +261,7 @@ class DynamicKdTree {
   using Neighbor = spatial::Neighbor<T, Id>;
   /// The archive kind and layout version of a saved tree (save / load).
   static constexpr std::string_view kArchiveKind = "dynamic.KdTree";
-  static constexpr std::uint32_t kArchiveVersion = 1;
+  static constexpr std::uint32_t kArchiveVersion = 2;
 
   explicit DynamicKdTree(DynamizeOptions options = {})
     requires(Dim != spatial::Dynamic)
@@ -229,7 +342,7 @@ class DynamicKdTree {
     tree_.for_each([&](const Block& block, std::span<const Id> ids) {
       if (block.all_dead()) return;
       BlockResult result{best, ids.data()};
-      block.tree().search_nearest(q.data(), result, request.eps, block.dead_slots());
+      block.search_nearest(q.data(), result, request.eps);
     });
     best.finish();
     return best.size();
@@ -259,8 +372,7 @@ class DynamicKdTree {
     std::vector<Neighbor> out;
     tree_.for_each([&](const Block& block, std::span<const Id> ids) {
       if (block.all_dead()) return;
-      block.tree().search_radius(
-          q.data(), r2, [&](std::uint32_t slot, T d) { out.push_back({ids[slot], d}); }, block.dead_slots());
+      block.search_radius(q.data(), r2, [&](std::uint32_t slot, T d) { out.push_back({ids[slot], d}); });
     });
     std::sort(out.begin(), out.end());
     return out;
@@ -276,8 +388,7 @@ class DynamicKdTree {
     std::vector<Id> out;
     tree_.for_each([&](const Block& block, std::span<const Id> ids) {
       if (block.all_dead()) return;
-      block.tree().search_box(
-          lo.data(), hi.data(), [&](std::uint32_t slot) { out.push_back(ids[slot]); }, block.dead_slots());
+      block.search_box(lo.data(), hi.data(), [&](std::uint32_t slot) { out.push_back(ids[slot]); });
     });
     std::sort(out.begin(), out.end());
     return out;
@@ -289,9 +400,10 @@ class DynamicKdTree {
   // ---------------------------------------------------------------- files
   /// Writes the tree as a "dynamic.KdTree" archive (core/archive.hpp): value
   /// sections scalar, dim, variant, max_dead_fraction, next_id, blocks;
-  /// per block k, under the prefix "b<k>.", the k-d tree's sections
-  /// (KdTree::add_sections), its ids (slot -> id, kNoId if deleted) and its
-  /// dead flags. Builds and reconstructions under way are not saved: their
+  /// per block k, under the prefix "b<k>.", its ids (slot -> id, kNoId if
+  /// deleted), then for a small block (KdTreeBlock) its points, for another
+  /// the k-d tree's sections (KdTree::add_sections) and its slots (tree point
+  /// -> slot). Builds and reconstructions under way are not saved: their
   /// items are in the blocks that answer queries, and load() starts them again.
   void save(const std::filesystem::path& path) const {
     ArchiveWriter w(std::string(kArchiveKind), kArchiveVersion);
@@ -303,9 +415,13 @@ class DynamicKdTree {
     std::uint64_t blocks = 0;
     tree_.for_each([&](const Block& block, std::span<const Id> ids) {
       const std::string prefix = "b" + std::to_string(blocks++) + ".";
-      block.tree().add_sections(w, prefix);
       w.add(prefix + "ids", ids);
-      w.add(prefix + "dead", block.dead_flags());
+      if (block.small()) {
+        w.add(prefix + "points", block.small_points());
+      } else {
+        block.tree().add_sections(w, prefix);
+        w.add(prefix + "slots", block.slots());
+      }
     });
     w.add_value("blocks", blocks);
     w.write(path);
@@ -329,13 +445,17 @@ class DynamicKdTree {
     std::vector<std::pair<Block, std::vector<Id>>> parts;
     for (std::uint64_t k = 0; k < blocks; ++k) {
       const std::string prefix = "b" + std::to_string(k) + ".";
-      Block block = Block::adopt(spatial::KdTree<T, Dim>::from_sections(a, prefix, std::size_t(dim)));
-      std::vector<Id> ids = a.array<Id>(prefix + "ids", block.size()).to_vector();
-      const FlatArray<std::uint8_t> dead = a.array<std::uint8_t>(prefix + "dead", block.size());
-      for (std::size_t slot = 0; slot < ids.size(); ++slot)
-        if ((dead[slot] != 0) != (ids[slot] == kNoId))
-          throw a.error("block " + std::to_string(k) + ": dead flags and ids disagree at slot " + std::to_string(slot));
-      parts.emplace_back(std::move(block), std::move(ids));
+      std::vector<Id> ids = a.array<Id>(prefix + "ids").to_vector();
+      std::optional<Block> block;
+      if (ids.size() <= Block::kLeafSize) {
+        const FlatArray<T> points = a.array<T>(prefix + "points", ids.size() * dim);
+        a.check([&] { block.emplace(Block::adopt_small(std::size_t(dim), points)); });
+      } else {
+        spatial::KdTree<T, Dim> tree = spatial::KdTree<T, Dim>::from_sections(a, prefix, std::size_t(dim));
+        FlatArray<std::uint32_t> slots = a.array<std::uint32_t>(prefix + "slots", ids.size());
+        a.check([&] { block.emplace(Block::adopt(std::move(tree), std::move(slots))); });
+      }
+      parts.emplace_back(std::move(*block), std::move(ids));
     }
     try {
       DynamicKdTree tree(std::size_t(dim), options);

@@ -673,14 +673,7 @@ class KdTree {
       throw Error(std::string("KdTree: bad ") + what + " array");
   }
 
-  T squared_distance(const T* q, const T* p) const {
-    T d = 0;
-    for (std::size_t a = 0; a < dim(); ++a) {
-      const T t = q[a] - p[a];
-      d += t * t;
-    }
-    return d;
-  }
+  T squared_distance(const T* q, const T* p) const { return spatial::squared_distance(q, p, dim()); }
 
   // Per-axis squared distances from q to the root box and their sum (Arya & Mount's incremental distance).
   T initial_distances(const T* q, T* dists) const {

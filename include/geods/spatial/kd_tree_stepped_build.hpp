@@ -9,10 +9,12 @@
 // point ranges; each is bounded, then split at its median by quickselect
 // (Hoare partitions around a median of three, which can pause where
 // std::nth_element cannot); a node's low/high are set when its children
-// compute their bounds; last, the permutation and the points in tree order
-// (the tree keeps them, as after store_points_in_tree_order). Run to the end
-// it is an O(n log n) build on one thread; KdTree's constructors build in
-// parallel, and may order points of equal coordinates differently.
+// compute their bounds. Last, the points are renumbered in tree order: the
+// finished tree owns them once, in that order (leaves read them contiguously,
+// its permutation is the identity), and Result::row says which input row each
+// one is. Run to the end it is an O(n log n) build on one thread; KdTree's
+// constructors build in parallel, and may order points of equal coordinates
+// differently.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -20,6 +22,7 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <numeric>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -38,9 +41,15 @@ class KdTreeSteppedBuild {
   /// One input point: std::array<T, Dim>, or std::vector<T> for a run-time dimension.
   using Row = std::conditional_t<Dim == Dynamic, std::vector<T>, std::array<T, Dim>>;
 
-  /// Starts a build over the rows (point i is rows[i]) in O(1). The rows are
-  /// checked during the steps: a row of another dimension or with a NaN/inf
-  /// coordinate makes step() throw geods::Error. The tree owns its points.
+  /// A finished build: tree point i is input row row[i].
+  struct Result {
+    Tree tree;
+    std::vector<std::uint32_t> row;
+  };
+
+  /// Starts a build over the rows in O(1). The rows are checked during the
+  /// steps: a row of another dimension or with a NaN/inf coordinate makes
+  /// step() throw geods::Error.
   explicit KdTreeSteppedBuild(std::vector<Row> rows, std::size_t dim = Dim == Dynamic ? 0 : std::size_t(Dim),
                               std::size_t leaf_size = Tree::kDefaultLeafSize)
       : state_(std::make_unique<State>()) {
@@ -72,10 +81,10 @@ class KdTreeSteppedBuild {
   }
 
   /// Completes the build if needed and hands the tree over.
-  Tree finish() {
+  Result finish() {
     while (!step(std::numeric_limits<std::size_t>::max())) {
     }
-    return std::move(state_->tree);
+    return {std::move(state_->tree), std::move(state_->row)};
   }
 
  private:
@@ -83,11 +92,12 @@ class KdTreeSteppedBuild {
     std::vector<Row> rows;
     std::size_t dim = 0, leaf_size = 0;
     Tree tree;
+    std::vector<std::uint32_t> row;
     std::size_t budget = 0;
   };
-  // What the ranges are partitioned over: copies of the points with their index
+  // What the ranges are partitioned over: copies of the points with their row
   // for a compile-time dimension (they stream through memory, as in KdTree's own
-  // build), point indices for a run-time one.
+  // build), row indices into the packed rows for a run-time one.
   struct Record {
     Row p;
     std::uint32_t index;
@@ -96,12 +106,12 @@ class KdTreeSteppedBuild {
 
   static Steps run(State& s) {
     Tree& tree = s.tree;
-    const std::size_t dim = s.dim;
+    const std::size_t dim = Dim == Dynamic ? s.dim : std::size_t(Dim);  // a constant the loops unroll on
     const std::uint32_t n = std::uint32_t(s.rows.size());
     std::size_t used = 0;
-    std::vector<T> coordinates;  // filled as the rows are read: no pass to zero them first
+    std::vector<T> packed;  // run-time dimension: the rows, which the items index
     std::vector<Item> items;
-    coordinates.reserve(std::size_t(n) * dim);
+    if constexpr (Dim == Dynamic) packed.reserve(std::size_t(n) * dim);
     items.reserve(n);
     for (std::uint32_t i = 0; i < n; ++i) {
       const Row& row = s.rows[i];
@@ -112,29 +122,27 @@ class KdTreeSteppedBuild {
         if (!std::isfinite(row[a]))
           throw Error("KdTree: point " + std::to_string(i) + " has a non-finite coordinate (axis " +
                       std::to_string(a) + ")");
-      coordinates.insert(coordinates.end(), row.begin(), row.end());
-      if constexpr (Dim == Dynamic)
+      if constexpr (Dim == Dynamic) {
+        packed.insert(packed.end(), row.begin(), row.end());
         items.push_back(i);
-      else
+      } else {
         items.push_back(Record{row, i});
+      }
       if (++used >= s.budget) {
         used = 0;
         co_yield Steps::pause;
       }
     }
     s.rows = {};
-    tree.adopt(std::move(coordinates), dim);
     tree.leaf_size_ = s.leaf_size;
-    const T* points = tree.view_.data;
     auto coords = [&](const Item& item) -> const T* {
       if constexpr (Dim == Dynamic)
-        return points + std::size_t(item) * dim;
+        return packed.data() + std::size_t(item) * dim;
       else
         return item.p.data();
     };
     // Built here, handed to the tree at the end.
     std::vector<typename Tree::Node> nodes;
-    std::vector<std::uint32_t> perm(n);
     std::map<std::size_t, std::uint32_t> subtree_nodes;
     if (n > 0) nodes.reserve(tree.count_nodes(n, subtree_nodes));
 
@@ -220,23 +228,24 @@ class KdTreeSteppedBuild {
       stack.push_back({mid, r.end, v, true});
       stack.push_back({r.begin, mid, v, false});
     }
-    auto ordered = std::make_shared<std::vector<T>>();
-    ordered->reserve(std::size_t(n) * dim);
+    std::vector<T> ordered(std::size_t(n) * dim);
+    s.row.resize(n);
     for (std::uint32_t i = 0; i < n; ++i) {
       if constexpr (Dim == Dynamic)
-        perm[i] = items[i];
+        s.row[i] = items[i];
       else
-        perm[i] = items[i].index;
-      const T* p = coords(items[i]);
-      ordered->insert(ordered->end(), p, p + dim);
+        s.row[i] = items[i].index;
+      std::copy_n(coords(items[i]), dim, ordered.data() + std::size_t(i) * dim);
       if (++used >= s.budget) {
         used = 0;
         co_yield Steps::pause;
       }
     }
+    std::vector<std::uint32_t> identity(n);
+    std::iota(identity.begin(), identity.end(), 0u);
     tree.nodes_ = std::move(nodes);
-    tree.perm_ = std::move(perm);
-    tree.ordered_ = std::move(ordered);
+    tree.perm_ = std::move(identity);
+    tree.adopt(std::move(ordered), dim);
   }
 
   std::unique_ptr<State> state_;  // on the heap: the coroutine keeps a reference across moves of the builder

@@ -29,4 +29,17 @@ struct PointView {
   const T* operator[](std::size_t i) const { return data + i * stride; }
 };
 
+/// The squared Euclidean distance of two points of `dim` coordinates, summed
+/// axis by axis: the one formula of the point searches, so that structures
+/// that answer the same query give bit-identical distances.
+template <typename T>
+T squared_distance(const T* q, const T* p, std::size_t dim) {
+  T d = 0;
+  for (std::size_t a = 0; a < dim; ++a) {
+    const T t = q[a] - p[a];
+    d += t * t;
+  }
+  return d;
+}
+
 }  // namespace geods::spatial
