@@ -52,9 +52,14 @@ class KnnCommand : public Command {
         throw Error(fmt::format("{}: queries of dimension {}, but the points ({}) have dimension {}", queries_,
                                 queries.cols, input_.source(), dim));
       stats = tree.stats();
+      using T = typename std::decay_t<decltype(tree)>::Scalar;
+      std::vector<T> rounded;
+      const spatial::PointView<T> at = points_as<T>(queries, rounded);
       Stopwatch query_watch;
-      result = tree.query_batch(spatial::PointView<double>(queries.values.data(), queries.rows, queries.cols), request);
+      const std::vector<spatial::Neighbor<T>> found = tree.query_batch(at, request);
       query_s = query_watch.seconds();
+      result.resize(found.size());
+      for (std::size_t i = 0; i < found.size(); ++i) result[i] = {found[i].index, double(found[i].squared_distance)};
     });
 
     std::vector<std::int64_t> indices(result.size());

@@ -35,8 +35,11 @@ class RangeCommand : public Command {
       if (boxes.cols != 2 * dim)
         throw Error(fmt::format("{}: boxes need 2 x {} = {} columns (low corner, high corner) for the points of {}, got {}",
                                 boxes_, dim, 2 * dim, input_.source(), boxes.cols));
+      using T = typename std::decay_t<decltype(tree)>::Scalar;
+      std::vector<T> rounded;
+      const spatial::PointView<T> corners = points_as<T>(boxes, rounded);
       Stopwatch query_watch;
-      counts = tree.count_box_batch(spatial::PointView<double>(boxes.values.data(), boxes.rows, boxes.cols));
+      counts = tree.count_box_batch(corners);
       query_s = query_watch.seconds();
     });
     const std::vector<std::int64_t> out(counts.begin(), counts.end());

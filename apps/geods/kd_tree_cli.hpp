@@ -1,8 +1,11 @@
 #pragma once
 // What the knn and range commands share: the k-d tree they query, built over the
-// points (the first argument) or loaded from a tree written by --save.
+// points (the first argument) or loaded from a tree written by --save (or by
+// save() in C++ or Python, of float32 or float64 points).
 #include <string>
+#include <type_traits>
 #include <variant>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -22,7 +25,7 @@ struct KdTreeInput {
     CLI::Option* positional = app.add_option("points", points, "Points, n x d (.npy, .csv, .txt, .xyz, .ply)");
     CLI::Option* named = app.add_option("--points", points, "Deprecated: give points as the first argument");
     positional->excludes(named);
-    app.add_option("--tree", tree, "Instead of the points: a k-d tree written by --save (float64 points)")
+    app.add_option("--tree", tree, "Instead of the points: a k-d tree written by --save or save() (float32 or float64 points)")
         ->excludes(positional)
         ->excludes(named);
     app.add_option("--leaf-size", leaf_size, "Points per leaf of the k-d tree")->check(CLI::PositiveNumber);
@@ -31,7 +34,8 @@ struct KdTreeInput {
   /// The file the points come from.
   const std::string& source() const { return tree.empty() ? points : tree; }
 
-  /// Calls fn(tree, build_s) with the tree for its dimension; build_s is 0 for a loaded tree.
+  /// Calls fn(tree, build_s) with the tree for its dimension (and, loaded, its
+  /// scalar type: KdTree<float, *> or KdTree<double, *>); build_s is 0 for a loaded tree.
   template <typename Fn>
   void with_tree(const std::string& command, const Fn& fn) const {
     if (points.empty() == tree.empty()) throw Error(command + ": give the points as the first argument, or --tree");
@@ -40,8 +44,12 @@ struct KdTreeInput {
       fn(t, build_s);
     };
     if (!tree.empty()) {
-      const auto loaded = spatial::load_kd_tree<double>(tree, spatial::read_kd_tree_info(tree).dim);
-      std::visit([&](const auto& t) { use(t, 0.0); }, loaded);
+      const spatial::KdTreeFileInfo info = spatial::read_kd_tree_info(tree);
+      const auto visit = [&](const auto& loaded) { std::visit([&](const auto& t) { use(t, 0.0); }, loaded); };
+      if (info.scalar == DType::f32)
+        visit(spatial::load_kd_tree<float>(tree, info.dim));
+      else
+        visit(spatial::load_kd_tree<double>(tree, info.dim));  // KdTree::load names any other type
       return;
     }
     const io::Table table = io::read_table(points, "point");
@@ -52,5 +60,17 @@ struct KdTreeInput {
     std::visit([&](const auto& t) { use(t, build_s); }, built);
   }
 };
+
+/// The rows of `table` as points of the tree's scalar type T: a view of the
+/// table for double, for float a copy rounded to float kept in `rounded`.
+template <typename T>
+spatial::PointView<T> points_as(const io::Table& table, std::vector<T>& rounded) {
+  if constexpr (std::is_same_v<T, double>) {
+    return spatial::PointView<double>(table.values.data(), table.rows, table.cols);
+  } else {
+    rounded.assign(table.values.begin(), table.values.end());
+    return spatial::PointView<T>(rounded.data(), table.rows, table.cols);
+  }
+}
 
 }  // namespace geods::cli

@@ -154,7 +154,8 @@ new appended point (intersection_points). NaN/inf raise geods.Error (ValueError)
       .def(
           "save", [](const Delaunay2& dt, const std::filesystem::path& path) { dt.save(path); }, py::arg("path"),
           "writes the triangulation to a geods archive")
-      .def_static("load", &Delaunay2::load, py::arg("path"),
+      .def_static(
+          "load", [](const std::filesystem::path& path) { return Delaunay2::load(path); }, py::arg("path"),
                   "reads a triangulation written by save(); insert and remove go on as before")
       .def("validate", &Delaunay2::validate, "checks every invariant; raises geods.Error on a violation")
       .def("stats", [](const Delaunay2& dt) { return stats_dict(dt.stats()); });

@@ -80,7 +80,7 @@ class PyVoronoi2 {
 
   py::tuple box() const { return py::make_tuple(box_.lo[0], box_.lo[1], box_.hi[0], box_.hi[1]); }
   py::array_t<double> points() const { return points_array(diagram_->points()); }
-  py::array_t<double> vertices() const { return points_array(diagram_->vertices()); }
+  py::array_t<double> vertices() const { return points_array(diagram_->vertices().span()); }
 
   py::list cells() const {
     std::vector<std::vector<Vec2d>> cells;

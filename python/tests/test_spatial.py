@@ -233,6 +233,38 @@ def test_cli_knn(cli, workdir):
         assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1, r.stderr
 
 
+@pytest.mark.parametrize("d", [2, 3, 5])
+def test_cli_tree_of_float32_points(cli, workdir, d):
+    # A float32 tree saved from Python answers knn --tree and range --tree as
+    # the float64 path does on the same points (queries and boxes exact in float32).
+    rng = np.random.default_rng(11 + d)
+    pts = rng.random((1500, d)).astype(np.float32)
+    q = rng.random((60, d)).astype(np.float32).astype(np.float64)
+    lo = rng.uniform(0, 0.7, (20, d)).astype(np.float32)
+    boxes = np.hstack([lo, lo + np.float32(0.3)]).astype(np.float64)
+    np.save(workdir / "p.npy", pts)
+    np.save(workdir / "q.npy", q)
+    np.save(workdir / "b.npy", boxes)
+    tree = geods.KdTree(pts)
+    assert tree.dtype == np.float32
+    tree.save(workdir / "p32.geods")
+    r = run(cli, "knn", "p.npy", "--queries", "q.npy", "--k", 4, "--indices", "i64.npy", "--distances", "d64.npy",
+            cwd=workdir)
+    assert r.returncode == 0, r.stderr
+    r = run(cli, "knn", "--tree", "p32.geods", "--queries", "q.npy", "--k", 4, "--indices", "i32.npy", "--distances",
+            "d32.npy", "--json", cwd=workdir)
+    assert r.returncode == 0, r.stderr
+    report = json.loads(r.stdout)
+    assert (report["points"], report["dim"], report["build_s"]) == (1500, d, 0)
+    np.testing.assert_array_equal(np.load(workdir / "i32.npy"), np.load(workdir / "i64.npy"))
+    np.testing.assert_allclose(np.load(workdir / "d32.npy"), np.load(workdir / "d64.npy"), rtol=1e-5)
+    want = [np.sum(np.all((pts >= b[:d]) & (pts <= b[d:]), axis=1)) for b in boxes]
+    for args in (["p.npy"], ["--tree", "p32.geods"]):
+        r = run(cli, "range", *args, "--boxes", "b.npy", "-o", "c.npy", cwd=workdir)
+        assert r.returncode == 0, r.stderr
+        np.testing.assert_array_equal(np.load(workdir / "c.npy"), want)
+
+
 def test_cli_range(cli, workdir, data_dir):
     pts = np.load(data_dir / "land_points.npy")
     rng = np.random.default_rng(8)

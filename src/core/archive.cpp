@@ -176,7 +176,7 @@ Archive Archive::open(const std::filesystem::path& path, std::string_view kind, 
     if (e.offset % kAlign != 0) throw fail("corrupt archive (" + where + " offset)");
     if (e.offset > size || e.count > (size - e.offset) / e.element_bytes)
       throw fail("truncated archive (" + where + ")");
-    if (verify == Verify::checksums && checksum(file->data() + e.offset, e.count * e.element_bytes) != r.checksum)
+    if (verify != Verify::structure_only && checksum(file->data() + e.offset, e.count * e.element_bytes) != r.checksum)
       throw fail("corrupt archive (" + where + " checksum)");
     for (const Entry& other : entries)
       if (other.name == e.name) throw fail("corrupt archive (" + where + " twice)");

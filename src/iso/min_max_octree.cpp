@@ -750,11 +750,21 @@ MinMaxOctreeStats MinMaxOctree<T>::stats() const {
 
 template <typename T>
 void MinMaxOctree<T>::validate() const {
+  check_nodes(true);
+}
+
+template <typename T>
+void MinMaxOctree<T>::check_nodes(bool leaves_against_samples) const {
   auto fail = [](std::size_t level, std::size_t x, std::size_t y, std::size_t z) {
     throw Error("MinMaxOctree: node (" + std::to_string(x) + ", " + std::to_string(y) + ", " + std::to_string(z) +
                 ") of level " + std::to_string(level) + " has a wrong min/max");
   };
-  for (std::size_t level = 0; level < levels_.size(); ++level) {
+  if (!leaves_against_samples && !levels_.empty()) {
+    const std::size_t leaves = levels_.size() > 1 ? levels_[1].offset : min_.size();
+    for (std::size_t n = 0; n < leaves; ++n)
+      if (!(min_[n] <= max_[n])) throw Error("MinMaxOctree: leaf " + std::to_string(n) + " has min > max");
+  }
+  for (std::size_t level = leaves_against_samples ? 0 : 1; level < levels_.size(); ++level) {
     const auto& d = levels_[level].dims;
     for (std::size_t z = 0; z < d[2]; ++z)
       for (std::size_t y = 0; y < d[1]; ++y)
@@ -825,7 +835,7 @@ MinMaxOctree<T> MinMaxOctree<T>::load(const std::filesystem::path& path, Archive
   tree.max_ = a.array<T>("max", nodes);
   try {
     detail::check_samples(g);
-    tree.validate();
+    tree.check_nodes(Archive::checks_everything(verify));
   } catch (const Error& e) {
     throw a.error(std::string("corrupted min/max octree: ") + e.what());
   }

@@ -1,7 +1,7 @@
 #pragma once
 // Sections of the voronoi structures' archives (core/archive.hpp): points as
 // pairs of doubles, and index arrays checked against their range on load, so
-// that a loaded structure never indexes outside its arrays.
+// that a loaded structure never indexes outside its arrays; both viewed in place.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -21,31 +21,27 @@ inline std::span<const double> coordinates_of(std::span<const Vec2d> points) {
   return {points.empty() ? nullptr : points.data()->data(), 2 * points.size()};
 }
 
-/// The points of section `name` (pairs of doubles), checked finite.
-inline std::vector<Vec2d> read_points(const Archive& archive, std::string_view name) {
-  const FlatArray<double> xy = archive.array<double>(name);
-  if (xy.size() % 2) throw archive.error(std::string(name) + ": an odd number of coordinates");
-  std::vector<Vec2d> points(xy.size() / 2);
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    points[i] = Vec2d(xy[2 * i], xy[2 * i + 1]);
+/// The points of section `name` (pairs of doubles) viewed in place, checked finite.
+inline FlatArray<Vec2d> read_points(const Archive& archive, std::string_view name) {
+  FlatArray<Vec2d> points = archive.grouped<Vec2d, double>(name);
+  for (std::size_t i = 0; i < points.size(); ++i)
     if (!std::isfinite(points[i][0]) || !std::isfinite(points[i][1]))
       throw archive.error(std::string(name) + ": point " + std::to_string(i) + " is not finite");
-  }
   return points;
 }
 
-/// The indices of section `name` (of `count` elements unless count is -1),
-/// each below `limit` or one of `special`.
-inline std::vector<std::uint32_t> read_indices(const Archive& archive, std::string_view name, std::uint64_t limit,
-                                               std::initializer_list<std::uint32_t> special = {},
-                                               std::uint64_t count = std::uint64_t(-1)) {
-  const FlatArray<std::uint32_t> a =
+/// The indices of section `name` (of `count` elements unless count is -1)
+/// viewed in place, each below `limit` or one of `special`.
+inline FlatArray<std::uint32_t> read_indices(const Archive& archive, std::string_view name, std::uint64_t limit,
+                                             std::initializer_list<std::uint32_t> special = {},
+                                             std::uint64_t count = std::uint64_t(-1)) {
+  FlatArray<std::uint32_t> a =
       count == std::uint64_t(-1) ? archive.array<std::uint32_t>(name) : archive.array<std::uint32_t>(name, count);
   for (std::size_t k = 0; k < a.size(); ++k)
     if (a[k] >= limit && std::find(special.begin(), special.end(), a[k]) == special.end())
       throw archive.error(std::string(name) + ": entry " + std::to_string(k) + " (" + std::to_string(a[k]) +
                           ") is out of range");
-  return a.to_vector();
+  return a;
 }
 
 }  // namespace geods::voronoi

@@ -446,15 +446,19 @@ Delaunay2Stats Delaunay2::stats() const {
   return s;
 }
 
-// The closed triangulation's combinatorics: twins, vertices, orientation.
+// The closed triangulation's combinatorics: twins, vertices, orientation. The
+// vertices' links to their points are checked once per vertex, not per
+// half-edge: the points are in input order, the vertices in insertion order, so
+// those reads miss the cache (they were most of load()'s time).
 Delaunay2::TriangleCounts Delaunay2::check_triangles() const {
   const auto fail = [](const std::string& what) { throw Error("Delaunay2::validate: " + what); };
-  const std::size_t n = points_.size();
+  const std::size_t n = points_.size(), vertices = core_.coords.size();
   const std::uint32_t half_edges = std::uint32_t(core_.vert.size());
   if (core_.twin.size() != half_edges || half_edges % 3) fail("array sizes");
   if (has_constraints_ && fixed_.size() != half_edges) fail("constraint flags have the wrong size");
+  if (original_of_.size() != vertices) fail("one point per vertex expected");
   std::size_t live = 0, ghosts = 0;
-  std::vector<char> present(n, 0);
+  std::vector<char> used(vertices, 0);
   for (std::uint32_t t = 0; t < half_edges / 3; ++t) {
     if (core_.vert[3 * t] == kNone) continue;
     ++live;
@@ -465,10 +469,8 @@ Delaunay2::TriangleCounts Delaunay2::check_triangles() const {
     for (std::uint32_t e = 3 * t; e < 3 * t + 3; ++e) {
       const std::uint32_t v = core_.vert[e], f = core_.twin[e];
       if (v != kGhost) {
-        const std::uint32_t o = v < core_.coords.size() ? original_of_[v] : kNone;
-        if (o >= n || rep_[o] != o || internal_of_[o] != v || points_[o] != core_.coords[v])
-          fail("triangle " + std::to_string(t) + " uses a vertex that is not a representative");
-        present[o] = 1;
+        if (v >= vertices) fail("triangle " + std::to_string(t) + " uses a vertex that is not a representative");
+        used[v] = 1;
       }
       if (f >= half_edges || core_.twin[f] != e || core_.vert[f] == kNone) fail("twin of half-edge " + std::to_string(e));
       if (core_.vert[f] != core_.vert[next(e)] || core_.vert[next(f)] != v) fail("twins of half-edge " + std::to_string(e) + " do not share their end points");
@@ -476,8 +478,19 @@ Delaunay2::TriangleCounts Delaunay2::check_triangles() const {
     if (!ghost && !(orient2d(core_.at(core_.vert[3 * t]), core_.at(core_.vert[3 * t + 1]), core_.at(core_.vert[3 * t + 2])) > 0))
       fail("triangle " + std::to_string(t) + " is not counter-clockwise");
   }
-  for (std::uint32_t i = 0; i < n; ++i)
-    if (rep_[i] == i && !present[i]) fail("point " + std::to_string(i) + " is in no triangle");
+  // Each vertex in a triangle stands for a representative point at its place,
+  // which maps back to it; each representative has such a vertex.
+  for (std::uint32_t v = 0; v < vertices; ++v) {
+    if (!used[v]) continue;
+    const std::uint32_t o = original_of_[v];
+    if (o >= n || rep_[o] != o || internal_of_[o] != v || points_[o] != core_.coords[v])
+      fail("vertex " + std::to_string(v) + " is not a representative");
+  }
+  for (std::uint32_t i = 0; i < n; ++i) {
+    if (rep_[i] != i) continue;
+    const std::uint32_t v = i < internal_of_.size() ? internal_of_[i] : kNone;
+    if (v >= vertices || !used[v] || original_of_[v] != i) fail("point " + std::to_string(i) + " is in no triangle");
+  }
   return {live, ghosts};
 }
 

@@ -41,8 +41,8 @@ void Delaunay2::save(const std::filesystem::path& path) const {
   w.write(path);
 }
 
-Delaunay2 Delaunay2::load(const std::filesystem::path& path) {
-  const Archive a = Archive::open(path, kKind, kVersion);
+Delaunay2 Delaunay2::load(const std::filesystem::path& path, Archive::Verify verify) {
+  const Archive a = Archive::open(path, kKind, kVersion, verify);
   Delaunay2 dt;
   dt.options_.seed = a.value<std::uint64_t>("seed");
   const std::uint32_t location = a.value<std::uint32_t>("location");
@@ -52,20 +52,20 @@ Delaunay2 Delaunay2::load(const std::filesystem::path& path) {
   const FlatArray<std::uint64_t> counters = a.array<std::uint64_t>("counters", 3);
   dt.core_.flips = counters[0], dt.core_.walk_steps = counters[1], dt.dag_nodes_ = counters[2];
 
-  dt.points_ = read_points(a, "points");
-  dt.core_.coords = read_points(a, "coords");
+  dt.points_ = read_points(a, "points").to_vector();
+  dt.core_.coords = read_points(a, "coords").to_vector();
   const std::uint64_t n = dt.points_.size(), m = dt.core_.coords.size();
-  const std::vector<std::uint32_t> ends = read_indices(a, "segments", n);
+  const FlatArray<std::uint32_t> ends = read_indices(a, "segments", n);
   if (ends.size() % 2) throw a.error("segments: an odd number of end points");
   for (std::size_t k = 0; k < ends.size(); k += 2) dt.segments_.push_back({ends[k], ends[k + 1]});
-  dt.intersections_ = read_indices(a, "intersections", n);
-  dt.rep_ = read_indices(a, "representative", n, {kNone}, n);
-  dt.original_of_ = read_indices(a, "original_of", n, {}, m);
-  dt.internal_of_ = read_indices(a, "internal_of", m, {kNone}, m == 0 ? 0 : n);  // a degenerate set has no internal vertices
-  dt.core_.vert = read_indices(a, "vert", m, {DelaunayCore::ghost, DelaunayCore::none});
+  dt.intersections_ = read_indices(a, "intersections", n).to_vector();
+  dt.rep_ = read_indices(a, "representative", n, {kNone}, n).to_vector();
+  dt.original_of_ = read_indices(a, "original_of", n, {}, m).to_vector();
+  dt.internal_of_ = read_indices(a, "internal_of", m, {kNone}, m == 0 ? 0 : n).to_vector();  // a degenerate set has no internal vertices
+  dt.core_.vert = read_indices(a, "vert", m, {DelaunayCore::ghost, DelaunayCore::none}).to_vector();
   const std::uint64_t half_edges = dt.core_.vert.size();
-  dt.core_.twin = read_indices(a, "twin", half_edges, {}, half_edges);
-  dt.core_.free_triangles = read_indices(a, "free_triangles", half_edges / 3);
+  dt.core_.twin = read_indices(a, "twin", half_edges, {}, half_edges).to_vector();
+  dt.core_.free_triangles = read_indices(a, "free_triangles", half_edges / 3).to_vector();
   dt.core_.last_triangle = read_indices(a, "last_triangle", std::max<std::uint64_t>(half_edges / 3, 1), {}, 1)[0];
   dt.fixed_ = a.array<std::uint8_t>("fixed", dt.has_constraints_ ? half_edges : 0).to_vector();
   for (std::uint32_t t : dt.core_.free_triangles)
@@ -79,6 +79,7 @@ Delaunay2 Delaunay2::load(const std::filesystem::path& path) {
     } else {
       dt.check_triangles();
       dt.publish();
+      if (Archive::checks_everything(verify)) dt.validate();
     }
   } catch (const Error& e) {
     throw a.error(e.what());

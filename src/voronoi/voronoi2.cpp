@@ -87,7 +87,8 @@ Voronoi2::Voronoi2(const Delaunay2& triangulation)
 
 Voronoi2::Voronoi2(std::span<const Vec2d> points, std::span<const std::uint32_t> triangles,
                    std::span<const std::uint32_t> halfedges, std::span<const std::uint32_t> representative)
-    : points_(points.begin(), points.end()), representative_(representative.begin(), representative.end()) {
+    : points_(std::vector<Vec2d>(points.begin(), points.end())),
+      representative_(std::vector<std::uint32_t>(representative.begin(), representative.end())) {
   const std::size_t n = points.size();
   if (n == 0) throw Error("Voronoi2: no points");
   if (n >= kInfinity) throw Error("Voronoi2: 2^32 - 1 points or more");
@@ -109,16 +110,22 @@ Voronoi2::Voronoi2(std::span<const Vec2d> points, std::span<const std::uint32_t>
     if (halfedges[e] != kNoEdge && (halfedges[e] >= triangles.size() || halfedges[halfedges[e]] != e))
       throw Error("Voronoi2: half-edge " + std::to_string(e) + " has an inconsistent twin");
   }
-  cell_edge_.assign(n, kNoEdge);
+  std::vector<Vec2d> vertices;
+  std::vector<Edge> edges;
+  std::vector<std::uint32_t> cell_edge(n, kNoEdge);
   if (triangles.empty()) {
-    build_collinear();
+    build_collinear(edges, cell_edge);
   } else {
-    build_dual(triangles, halfedges);
+    build_dual(triangles, halfedges, vertices, edges, cell_edge);
   }
+  vertices_ = std::move(vertices);
+  edges_ = std::move(edges);
+  cell_edge_ = std::move(cell_edge);
   build_neighbors(triangles);
 }
 
-void Voronoi2::build_dual(std::span<const std::uint32_t> triangles, std::span<const std::uint32_t> halfedges) {
+void Voronoi2::build_dual(std::span<const std::uint32_t> triangles, std::span<const std::uint32_t> halfedges,
+                          std::vector<Vec2d>& vertices, std::vector<Edge>& edges, std::vector<std::uint32_t>& cell_edge) const {
   const auto m = std::uint32_t(triangles.size());
   const std::uint32_t triangle_count = m / 3;
 
@@ -143,8 +150,8 @@ void Voronoi2::build_dual(std::span<const std::uint32_t> triangles, std::span<co
   for (std::uint32_t t = 0; t < triangle_count; ++t) {
     const std::uint32_t r = find_root(parent, t);
     if (vertex_of_root[r] == kInfinity) {
-      vertex_of_root[r] = std::uint32_t(vertices_.size());
-      vertices_.push_back(
+      vertex_of_root[r] = std::uint32_t(vertices.size());
+      vertices.push_back(
           detail::circumcentre(points_[triangles[3 * r]], points_[triangles[3 * r + 1]], points_[triangles[3 * r + 2]]));
     }
     vertex_of[t] = vertex_of_root[r];
@@ -179,22 +186,22 @@ void Voronoi2::build_dual(std::span<const std::uint32_t> triangles, std::span<co
   std::vector<std::uint32_t> new_index(total, kNoEdge);
   for (std::uint32_t e = 0; e < total; ++e)
     if (!degenerate(e)) {
-      new_index[e] = std::uint32_t(edges_.size());
-      edges_.push_back(all[e]);
+      new_index[e] = std::uint32_t(edges.size());
+      edges.push_back(all[e]);
     }
-  for (Edge& edge : edges_) {
+  for (Edge& edge : edges) {
     std::uint32_t next = edge.next;
     while (degenerate(next)) next = all[next].next;
     edge.next = new_index[next];
     edge.twin = new_index[edge.twin];
   }
   for (std::uint32_t e = 0; e < total; ++e)
-    if (new_index[e] != kNoEdge && cell_edge_[all[e].site] == kNoEdge) cell_edge_[all[e].site] = new_index[e];
+    if (new_index[e] != kNoEdge && cell_edge[all[e].site] == kNoEdge) cell_edge[all[e].site] = new_index[e];
   // Hull cells start at the edge that comes in from infinity.
-  for (std::uint32_t g : hull) cell_edge_[triangles[g]] = new_index[g];
+  for (std::uint32_t g : hull) cell_edge[triangles[g]] = new_index[g];
 }
 
-void Voronoi2::build_collinear() {
+void Voronoi2::build_collinear(std::vector<Edge>& edges, std::vector<std::uint32_t>& cell_edge) const {
   std::vector<std::uint32_t> sites;
   for (std::uint32_t i = 0; i < points_.size(); ++i)
     if (representative_[i] == i) sites.push_back(i);
@@ -206,10 +213,10 @@ void Voronoi2::build_collinear() {
     const std::uint32_t left = 2 * k, right = 2 * k + 1;
     // Within a middle cell the two bisector lines follow each other through infinity.
     const std::uint32_t right_next = k + 2 < sites.size() ? 2 * (k + 1) : right;
-    edges_.push_back({sites[k], right, k > 0 ? 2 * (k - 1) + 1 : left, kInfinity, kInfinity});
-    edges_.push_back({sites[k + 1], left, right_next, kInfinity, kInfinity});
-    cell_edge_[sites[k]] = left;
-    cell_edge_[sites[k + 1]] = right;
+    edges.push_back({sites[k], right, k > 0 ? 2 * (k - 1) + 1 : left, kInfinity, kInfinity});
+    edges.push_back({sites[k + 1], left, right_next, kInfinity, kInfinity});
+    cell_edge[sites[k]] = left;
+    cell_edge[sites[k + 1]] = right;
   }
 }
 
@@ -229,11 +236,12 @@ void Voronoi2::build_neighbors(std::span<const std::uint32_t> triangles) {
     pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
   }
   std::sort(pairs.begin(), pairs.end());
-  neighbor_offsets_.assign(n + 1, 0);
-  for (const auto& [a, b] : pairs) ++neighbor_offsets_[a + 1];
-  std::partial_sum(neighbor_offsets_.begin(), neighbor_offsets_.end(), neighbor_offsets_.begin());
-  neighbors_.resize(pairs.size());
-  for (std::size_t i = 0; i < pairs.size(); ++i) neighbors_[i] = pairs[i].second;
+  std::vector<std::uint32_t> offsets(n + 1, 0), neighbors(pairs.size());
+  for (const auto& [a, b] : pairs) ++offsets[a + 1];
+  std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
+  for (std::size_t i = 0; i < pairs.size(); ++i) neighbors[i] = pairs[i].second;
+  neighbor_offsets_ = std::move(offsets);
+  neighbors_ = std::move(neighbors);
 }
 
 bool Voronoi2::bounded(std::uint32_t i) const {
@@ -338,52 +346,66 @@ Voronoi2Stats Voronoi2::stats() const {
   return s;
 }
 
-void Voronoi2::validate() const {
+void Voronoi2::check_cells() const {
   const auto fail = [](const std::string& what) { throw Error("Voronoi2::validate: " + what); };
   const std::size_t m = edges_.size();
-  double scale = 0;
-  for (const Vec2d& p : points_) scale = std::max(scale, p.cwiseAbs().maxCoeff());
   for (std::uint32_t e = 0; e < m; ++e) {
     const Edge& edge = edges_[e];
-    const std::string name = "half-edge " + std::to_string(e);
-    if (edge.twin >= m || edges_[edge.twin].twin != e) fail(name + ": twin is not mutual");
-    if (edge.next >= m) fail(name + ": next out of range");
+    const auto name = [e] { return "half-edge " + std::to_string(e); };  // built only on failure
+    if (edge.twin >= m || edges_[edge.twin].twin != e) fail(name() + ": twin is not mutual");
+    if (edge.next >= m) fail(name() + ": next out of range");
+    if (edge.site >= points_.size()) fail(name() + ": site out of range");
     const Edge& twin = edges_[edge.twin];
-    if (twin.site == edge.site) fail(name + ": same site on both sides");
-    if (twin.origin != edge.target || twin.target != edge.origin) fail(name + ": twin has other end points");
-    if (edges_[edge.next].site != edge.site) fail(name + ": next belongs to another cell");
+    if (twin.site == edge.site) fail(name() + ": same site on both sides");
+    if (twin.origin != edge.target || twin.target != edge.origin) fail(name() + ": twin has other end points");
+    if (edges_[edge.next].site != edge.site) fail(name() + ": next belongs to another cell");
     if ((edge.target == kInfinity) != (edges_[edge.next].origin == kInfinity) ||
         (edge.target != kInfinity && edges_[edge.next].origin != edge.target))
-      fail(name + ": next does not start where this one ends");
-    if (edge.origin != kInfinity && edge.origin == edge.target) fail(name + ": zero length");
-    // The site lies strictly left of its edge's line.
-    const Vec2d d = direction(e), s = points_[edge.site] - line_point(e);
-    if (!(d[0] * s[1] - d[1] * s[0] > 0)) fail(name + ": its site is not on its left");
-    for (std::uint32_t v : {edge.origin, edge.target}) {
-      if (v == kInfinity) continue;
-      if (v >= vertices_.size()) fail(name + ": vertex out of range");
-      const double da = (vertices_[v] - points_[edge.site]).norm(), db = (vertices_[v] - points_[twin.site]).norm();
-      if (std::abs(da - db) > 1e-9 * (da + db + scale)) fail(name + ": vertex not equidistant from its sites");
-    }
+      fail(name() + ": next does not start where this one ends");
+    if (edge.origin != kInfinity && edge.origin == edge.target) fail(name() + ": zero length");
+    for (std::uint32_t v : {edge.origin, edge.target})
+      if (v != kInfinity && v >= vertices_.size()) fail(name() + ": vertex out of range");
   }
-  std::vector<char> seen(m, 0);
+  // next is a permutation, so following it from any half-edge comes back.
+  std::vector<char> entered(m, 0);
+  for (std::uint32_t e = 0; e < m; ++e)
+    if (entered[edges_[e].next]++) fail("half-edge " + std::to_string(edges_[e].next) + " is the next of two");
   for (std::uint32_t i = 0; i < points_.size(); ++i) {
     if (representative_[i] != i) continue;
     const std::uint32_t start = cell_edge_[i];
-    if (start == kNoEdge) {
-      if (m != 0) fail("site " + std::to_string(i) + " has no cell");
-      continue;
-    }
-    std::uint32_t e = start;
-    std::size_t steps = 0;
+    if (start == kNoEdge ? m != 0 : start >= m || edges_[start].site != i) fail("site " + std::to_string(i) + " has no cell");
+  }
+}
+
+void Voronoi2::validate() const {
+  const auto fail = [](const std::string& what) { throw Error("Voronoi2::validate: " + what); };
+  check_cells();
+  // Each cell is one cycle: every half-edge is on the cycle of its site's cell_edge.
+  const std::size_t m = edges_.size();
+  std::vector<char> seen(m, 0);
+  for (std::uint32_t i = 0; i < points_.size(); ++i) {
+    if (representative_[i] != i || cell_edge_[i] == kNoEdge) continue;
+    std::uint32_t e = cell_edge_[i];
     do {
-      if (edges_[e].site != i) fail("the cycle of site " + std::to_string(i) + " leaves its cell");
-      if (seen[e]++) fail("half-edge " + std::to_string(e) + " is on two cycles");
+      seen[e] = 1;
       e = edges_[e].next;
-      if (++steps > m) fail("the cycle of site " + std::to_string(i) + " does not close");
-    } while (e != start);
+    } while (e != cell_edge_[i]);
   }
   if (std::count(seen.begin(), seen.end(), 0) != 0) fail("a half-edge belongs to no cell cycle");
+  double scale = 0;
+  for (const Vec2d& p : points_) scale = std::max(scale, p.cwiseAbs().maxCoeff());
+  for (std::uint32_t e = 0; e < edges_.size(); ++e) {
+    const Edge& edge = edges_[e];
+    const auto name = [e] { return "half-edge " + std::to_string(e); };
+    // The site lies strictly left of its edge's line.
+    const Vec2d d = direction(e), s = points_[edge.site] - line_point(e);
+    if (!(d[0] * s[1] - d[1] * s[0] > 0)) fail(name() + ": its site is not on its left");
+    for (std::uint32_t v : {edge.origin, edge.target}) {
+      if (v == kInfinity) continue;
+      const double da = (vertices_[v] - points_[edge.site]).norm(), db = (vertices_[v] - points_[edges_[edge.twin].site]).norm();
+      if (std::abs(da - db) > 1e-9 * (da + db + scale)) fail(name() + ": vertex not equidistant from its sites");
+    }
+  }
 }
 
 }  // namespace geods::voronoi

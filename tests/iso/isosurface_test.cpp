@@ -636,6 +636,36 @@ TEST(MinMaxOctree, BadFilesThrow) {
   expect_error(patched("leaf_cells", std::uint64_t(3)), "other leaf_cells: the min/max arrays have the wrong size");
   expect_error(patched("dims", std::uint64_t(10)), "dims");
   expect_error(patched("dims", ~std::uint64_t(0)), "dims that overflow");
+  // A leaf whose min lies but stays <= its max and <= its parent's (which a
+  // sibling gives), the checksums right: the checks of every load (O(nodes))
+  // pass; those against the samples (Verify::full, structure_only) see it.
+  {
+    Grid3<float> mostly_zero(9, 9, 9, 0.0f);
+    mostly_zero(0, 0, 0) = 1;
+    const MinMaxOctree<float> small(mostly_zero, 2);
+    ASSERT_EQ(small.node_min()[0], 0.0f);
+    ASSERT_EQ(small.node_max()[0], 1.0f);
+    std::vector<float> min = small.node_min().to_vector();
+    min[0] = 1;
+    ArchiveWriter w("iso.MinMaxOctree", 1);
+    w.add_dtype("scalar", DType::f32);
+    w.add_value("leaf_cells", std::uint64_t(2));
+    const std::vector<std::uint64_t> dims = {9, 9, 9};
+    const std::vector<float> origin = {0, 0, 0}, spacing = {1, 1, 1};
+    w.add("dims", dims);
+    w.add("origin", origin);
+    w.add("spacing", spacing);
+    w.add("samples", mostly_zero.data);
+    w.add("min", min);
+    w.add("max", small.node_max());
+    w.write(bad);
+    EXPECT_EQ(MinMaxOctree<float>::load(bad).node_min()[0], 1.0f);
+    EXPECT_THROW(MinMaxOctree<float>::load(bad, Archive::Verify::full), Error);
+    EXPECT_THROW(MinMaxOctree<float>::load(bad, Archive::Verify::structure_only), Error);
+    min[0] = 2;  // above its max
+    w.write(bad);
+    EXPECT_THROW(MinMaxOctree<float>::load(bad), Error);
+  }
   // Another sample type, with a message that says so; another structure's archive.
   try {
     (void)MinMaxOctree<std::uint8_t>::load(path);

@@ -4,11 +4,13 @@
 // missing files raise geods::Error.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <unistd.h>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "geods/core/archive.hpp"
@@ -128,6 +130,49 @@ void write_bytes(const fs::path& path, const std::string& bytes) {
   std::ofstream(path, std::ios::binary).write(bytes.data(), std::streamsize(bytes.size()));
 }
 
+// A Delaunay2 archive of points `xy` (each its own vertex, in order) and the
+// closed triangulation (vert, twin), written with matching checksums.
+void write_triangulation(const fs::path& path, const std::vector<double>& xy, const std::vector<std::uint32_t>& vert,
+                         const std::vector<std::uint32_t>& twin) {
+  ArchiveWriter w("voronoi.Delaunay2", 1);
+  const std::vector<std::uint32_t> no_indices;
+  std::vector<std::uint32_t> iota(xy.size() / 2);
+  for (std::uint32_t i = 0; i < iota.size(); ++i) iota[i] = i;
+  const std::vector<std::uint64_t> counters = {0, 0, 0};
+  const std::vector<std::uint8_t> no_marks;
+  w.add_value("seed", std::uint64_t(1));
+  w.add_value("location", std::uint32_t(0));
+  w.add_value("has_constraints", std::uint8_t(0));
+  w.add_value("last_triangle", std::uint32_t(0));
+  w.add("counters", counters);
+  w.add("points", xy);
+  w.add("segments", no_indices);
+  w.add("intersections", no_indices);
+  w.add("representative", iota);
+  w.add("coords", xy);
+  w.add("original_of", iota);
+  w.add("internal_of", iota);
+  w.add("vert", vert);
+  w.add("twin", twin);
+  w.add("free_triangles", no_indices);
+  w.add("fixed", no_marks);
+  w.write(path);
+}
+
+// The half-edge arrays of counter-clockwise `triangles` closed by a ghost
+// triangle (b, a, ghost) beyond each hull edge a -> b; `hull` counter-clockwise.
+std::pair<std::vector<std::uint32_t>, std::vector<std::uint32_t>> closed_triangulation(
+    const std::vector<std::array<std::uint32_t, 3>>& triangles, const std::vector<std::uint32_t>& hull) {
+  std::vector<std::array<std::uint32_t, 3>> all = triangles;
+  for (std::size_t k = 0; k < hull.size(); ++k) all.push_back({hull[(k + 1) % hull.size()], hull[k], DelaunayCore::ghost});
+  std::vector<std::uint32_t> vert, twin(3 * all.size(), Delaunay2::no_edge);
+  for (const auto& t : all) vert.insert(vert.end(), t.begin(), t.end());
+  for (std::uint32_t e = 0; e < vert.size(); ++e)
+    for (std::uint32_t f = 0; f < vert.size(); ++f)
+      if (vert[e] == vert[DelaunayCore::next(f)] && vert[DelaunayCore::next(e)] == vert[f]) twin[e] = f;
+  return {vert, twin};
+}
+
 // Every truncation raises geods::Error; so does a flipped byte, unless it was
 // padding (then the file loads to the same structure: saved again, the same bytes).
 template <class Load>
@@ -165,31 +210,38 @@ TEST(Delaunay2Archive, BadFilesRaise) {
   fs::remove(path);
   // A file with the right kind whose triangulation is wrong (checksums made to fit).
   Delaunay2 dt(random_points(50, 8));
-  ArchiveWriter w("voronoi.Delaunay2", 1);
-  const std::vector<std::uint32_t> no_indices;
   const std::vector<double> xy = {0, 0, 1, 0, 0, 1};
   const std::vector<std::uint32_t> vert = {0, 2, 1, 1, 2, DelaunayCore::ghost, 2, 0, DelaunayCore::ghost,
                                            0, 1, DelaunayCore::ghost};  // clockwise
-  const std::vector<std::uint32_t> twin = {3, 9, 6, 0, 11, 7, 2, 5, 10, 1, 8, 4}, iota = {0, 1, 2};
-  const std::vector<std::uint64_t> counters = {0, 0, 0};
-  const std::vector<std::uint8_t> no_marks;
-  w.add_value("seed", std::uint64_t(1));
-  w.add_value("location", std::uint32_t(0));
-  w.add_value("has_constraints", std::uint8_t(0));
-  w.add_value("last_triangle", std::uint32_t(0));
-  w.add("counters", counters);
-  w.add("points", xy);
-  w.add("segments", no_indices);
-  w.add("intersections", no_indices);
-  w.add("representative", iota);
-  w.add("coords", xy);
-  w.add("original_of", iota);
-  w.add("internal_of", iota);
-  w.add("vert", vert);
-  w.add("twin", twin);
-  w.add("free_triangles", no_indices);
-  w.add("fixed", no_marks);
-  w.write(path);
+  const std::vector<std::uint32_t> twin = {3, 9, 6, 0, 11, 7, 2, 5, 10, 1, 8, 4};
+  write_triangulation(path, xy, vert, twin);
+  EXPECT_THROW(Delaunay2::load(path), Error);
+  fs::remove(path);
+}
+
+TEST(Delaunay2Archive, BrokenStructureRaisesAndVerifyFullChecksCircles) {
+  // A kite (0, 0), (2, -1), (4, 0), (2, 1) split along its long diagonal 0-2:
+  // a closed, counter-clockwise triangulation that is not Delaunay (3 lies in
+  // the circle of 0, 1, 2). Its checksums fit, so only the checks see it.
+  const std::vector<double> xy = {0, 0, 2, -1, 4, 0, 2, 1};
+  const auto [vert, twin] = closed_triangulation({{0, 1, 2}, {0, 2, 3}}, {0, 1, 2, 3});
+  const fs::path path = temp_file("kite");
+  write_triangulation(path, xy, vert, twin);
+  const Delaunay2 loaded = Delaunay2::load(path);  // the cheap checks pass
+  EXPECT_EQ(loaded.triangle_count(), 2u);
+  EXPECT_EQ(loaded.locate({2, 0.5}), loaded.locate({3, 0.1}));  // queries answer from what was loaded
+  EXPECT_THROW(loaded.validate(), Error);
+  EXPECT_THROW(Delaunay2::load(path, Archive::Verify::full), Error);
+  // Twins that are not mutual, the checksums right.
+  std::vector<std::uint32_t> bad_twin = twin;
+  std::swap(bad_twin[0], bad_twin[1]);
+  write_triangulation(path, xy, vert, bad_twin);
+  EXPECT_THROW(Delaunay2::load(path), Error);
+  EXPECT_THROW(Delaunay2::load(path, Archive::Verify::structure_only), Error);
+  // A vertex index out of range.
+  std::vector<std::uint32_t> bad_vert = vert;
+  bad_vert[1] = 7;
+  write_triangulation(path, xy, bad_vert, twin);
   EXPECT_THROW(Delaunay2::load(path), Error);
   fs::remove(path);
 }
@@ -216,6 +268,48 @@ TEST(Voronoi2Archive, RoundTripAndBadFiles) {
   }
   expect_bad_files_rejected(path, [](const fs::path& f) { return Voronoi2::load(f); });
   EXPECT_THROW(Delaunay2::load(path), Error);  // another kind
+  fs::remove(path);
+  // Links broken or geometry wrong, the checksums right: the links are checked
+  // on every load, the geometry with Verify::full.
+  const auto write_diagram = [&](std::vector<Voronoi2::Edge> edges, std::vector<Vec2d> vertices) {
+    ArchiveWriter w("voronoi.Voronoi2", 1);
+    std::vector<std::uint32_t> representative(p.size()), cell_edge(p.size()), offsets{0}, neighbors;
+    for (std::uint32_t i = 0; i < p.size(); ++i) {
+      representative[i] = original.representative(i);
+      cell_edge[i] = original.cell_edge(i);
+      const auto nb = original.neighbors(i);
+      neighbors.insert(neighbors.end(), nb.begin(), nb.end());
+      offsets.push_back(std::uint32_t(neighbors.size()));
+    }
+    std::vector<double> sites_xy, vertices_xy;
+    for (const Vec2d& q : p) sites_xy.insert(sites_xy.end(), {q[0], q[1]});
+    for (const Vec2d& q : vertices) vertices_xy.insert(vertices_xy.end(), {q[0], q[1]});
+    w.add("points", sites_xy);
+    w.add("representative", representative);
+    w.add("vertices", vertices_xy);
+    w.add("edges", edges);
+    w.add("cell_edge", cell_edge);
+    w.add("neighbor_offsets", offsets);
+    w.add("neighbors", neighbors);
+    w.write(path);
+  };
+  const std::vector<Voronoi2::Edge> edges(original.edges().begin(), original.edges().end());
+  const std::vector<Vec2d> vertices(original.vertices().begin(), original.vertices().end());
+  write_diagram(edges, vertices);
+  EXPECT_NO_THROW(Voronoi2::load(path, Archive::Verify::full));
+  std::vector<Voronoi2::Edge> bad = edges;
+  bad[bad[0].next].next = bad[0].next;  // a cycle that never comes back to 0: next is no permutation
+  write_diagram(bad, vertices);
+  EXPECT_THROW(Voronoi2::load(path), Error);
+  bad = edges;
+  bad[3].twin = 3;
+  write_diagram(bad, vertices);
+  EXPECT_THROW(Voronoi2::load(path), Error);
+  std::vector<Vec2d> moved = vertices;
+  moved[0] += Vec2d(0.25, 0.25);
+  write_diagram(edges, moved);
+  EXPECT_EQ(Voronoi2::load(path).vertices()[0], moved[0]);
+  EXPECT_THROW(Voronoi2::load(path, Archive::Verify::full), Error);
   fs::remove(path);
   // Collinear sites (no vertices) round trip too.
   const Voronoi2 line(std::vector<Vec2d>{{0, 0}, {1, 1}, {2, 2}});

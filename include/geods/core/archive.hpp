@@ -102,8 +102,16 @@ class ArchiveWriter {
 /// A mapped archive; its sections are read in place.
 class Archive {
  public:
-  /// Whether open() verifies the payload checksums (one pass over the file).
-  enum class Verify { checksums, structure_only };
+  /// What a load verifies. checksums: the payload checksums (one pass over the
+  /// file), which prove the contents are what save() wrote, and the
+  /// structure's own cheap checks (index ranges, links: what keeps queries in
+  /// bounds). structure_only: no checksums, so every check the structure has,
+  /// also those costing as much as a build (Delaunay2's empty circles,
+  /// Voronoi2's equidistant vertices, MinMaxOctree's leaves against the
+  /// samples). full: the checksums and every check.
+  enum class Verify { checksums, structure_only, full };
+  /// Whether a load under `verify` runs the checks that the checksums make redundant.
+  static bool checks_everything(Verify verify) { return verify != Verify::checksums; }
 
   /// Maps and checks `path`, which must hold a `kind` archive of `kind_version`.
   static Archive open(const std::filesystem::path& path, std::string_view kind, std::uint32_t kind_version,
@@ -130,6 +138,18 @@ class Archive {
     FlatArray<T> a = array<T>(name);
     if (a.size() != expected_count) fail_count(name, a.size(), expected_count);
     return a;
+  }
+  /// The section `name` of `Element`s viewed in place as `T`s of
+  /// sizeof(T) / sizeof(Element) elements each (say coordinate pairs as points).
+  template <typename T, typename Element>
+  FlatArray<T> grouped(std::string_view name) const {
+    static_assert(sizeof(T) % sizeof(Element) == 0 && alignof(T) <= 64, "T is a group of Elements");
+    constexpr std::size_t group = sizeof(T) / sizeof(Element);
+    const FlatArray<Element> elements = array<Element>(name);
+    if (elements.size() % group != 0)
+      throw error(std::string(name) + ": " + std::to_string(elements.size()) + " elements, not groups of " +
+                  std::to_string(group));
+    return FlatArray<T>(std::span<const T>(reinterpret_cast<const T*>(elements.data()), elements.size() / group), file_);
   }
   /// The one element of section `name`.
   template <typename T>

@@ -103,10 +103,13 @@ class MinMaxOctree {
   /// origin, spacing (3 x f32); arrays samples, min, max.
   void save(const std::filesystem::path& path) const;
   /// Reads an octree written by save(): the min/max arrays are read in place
-  /// from the mapped file, the samples are copied into volume() (a Grid3 owns
-  /// them). Throws geods::Error naming the file for another sample type, a
-  /// truncated or corrupt file (checksums, unless `verify` says structure_only),
-  /// NaN samples or min/max values that fail validate().
+  /// from the mapped file, not recomputed, the samples are copied into volume()
+  /// (a Grid3 owns them). Throws geods::Error naming the file for another
+  /// sample type, a truncated or corrupt file (checksums, unless `verify` says
+  /// structure_only), NaN samples, a leaf with min > max or a node whose
+  /// min/max is not that of its children (O(nodes)); Verify::full and
+  /// structure_only (no checksums to prove the leaves) run all of
+  /// validate(), the leaves against the samples too (a pass like the build).
   static MinMaxOctree load(const std::filesystem::path& path, Archive::Verify verify = Archive::Verify::checksums);
 
  private:
@@ -137,6 +140,9 @@ class MinMaxOctree {
     return l.offset + x + l.dims[0] * (y + l.dims[1] * z);
   }
   std::array<T, 2> leaf_range(std::size_t x, std::size_t y, std::size_t z) const;
+  // validate(); without leaves_against_samples the leaves are only checked
+  // min <= max (no pass over the volume), the levels above against their children.
+  void check_nodes(bool leaves_against_samples) const;
 
   Grid3<T> volume_;
   std::size_t leaf_cells_ = kDefaultLeafCells;

@@ -34,6 +34,7 @@
 #include <string>
 #include <vector>
 
+#include "geods/core/archive.hpp"
 #include "geods/core/vec.hpp"
 #include "geods/voronoi/delaunay_core.hpp"
 
@@ -169,10 +170,12 @@ class Delaunay2 {
   /// mapped arrays are copied into the triangulation's own); O(n). Throws
   /// geods::Error naming the file if it is missing, truncated, corrupt (the
   /// checksums), of another kind or version, or its arrays are not a closed
-  /// triangulation of its points (validate()'s checks but the geometric ones,
-  /// incircle and the segments' paths, which a checksummed file written by
-  /// save() cannot fail).
-  static Delaunay2 load(const std::filesystem::path& path);
+  /// triangulation of its points: indices in range, twins mutual, triangles
+  /// counter-clockwise, every representative a vertex (validate()'s checks but
+  /// the costly ones, incircle and the segments' paths, which a checksummed
+  /// file written by save() cannot fail; Verify::full and structure_only, which
+  /// skips the checksums, run those too).
+  static Delaunay2 load(const std::filesystem::path& path, Archive::Verify verify = Archive::Verify::checksums);
 
   Delaunay2Stats stats() const;
   /// Checks every invariant; throws geods::Error naming the first violation:

@@ -26,6 +26,8 @@
 #include <vector>
 
 #include "geods/core/aabb.hpp"
+#include "geods/core/archive.hpp"
+#include "geods/core/flat_array.hpp"
 #include "geods/core/vec.hpp"
 
 namespace geods::voronoi {
@@ -75,8 +77,8 @@ class Voronoi2 {
 
   std::span<const Vec2d> points() const { return points_; }
   std::size_t size() const { return points_.size(); }
-  const std::vector<Vec2d>& vertices() const { return vertices_; }
-  const std::vector<Edge>& edges() const { return edges_; }
+  const FlatArray<Vec2d>& vertices() const { return vertices_; }
+  const FlatArray<Edge>& edges() const { return edges_; }
   std::uint32_t representative(std::uint32_t i) const { return representative_[i]; }
 
   /// One half-edge of the cell of point i (of its representative), or kNoEdge
@@ -110,10 +112,15 @@ class Voronoi2 {
   /// Writes the diagram to `path` as a geods archive (core/archive.hpp, kind
   /// "voronoi.Voronoi2"). Throws geods::Error naming the file if it cannot be written.
   void save(const std::filesystem::path& path) const;
-  /// The diagram save()d to `path` (its arrays copied from the mapped file).
-  /// Throws geods::Error naming the file if it is missing, truncated, corrupt,
-  /// of another kind or version, or fails validate().
-  static Voronoi2 load(const std::filesystem::path& path);
+  /// The diagram save()d to `path`, its arrays read in place from the mapped
+  /// file (no copy: a diagram larger than memory can be queried). Throws
+  /// geods::Error naming the file if it is missing, truncated, corrupt, of
+  /// another kind or version, or its arrays are not a diagram: indices in
+  /// range, twins mutual, `next` a permutation within each cell, so that every
+  /// walk around a cell comes back (O(n) integer work; Verify::full and
+  /// structure_only, which skips the checksums, run all of
+  /// validate(): one cycle per cell, and the geometry).
+  static Voronoi2 load(const std::filesystem::path& path, Archive::Verify verify = Archive::Verify::checksums);
 
   Voronoi2Stats stats() const;
   /// Checks twins, next cycles, that each cell's cycle holds only its site,
@@ -122,17 +129,20 @@ class Voronoi2 {
   void validate() const;
 
  private:
+  void check_cells() const;  // validate()'s checks of the links, O(n) with no walks: what load() checks
   Voronoi2() = default;  // for load()
-  void build_dual(std::span<const std::uint32_t> triangles, std::span<const std::uint32_t> halfedges);
-  void build_collinear();
+  void build_dual(std::span<const std::uint32_t> triangles, std::span<const std::uint32_t> halfedges,
+                  std::vector<Vec2d>& vertices, std::vector<Edge>& edges, std::vector<std::uint32_t>& cell_edge) const;
+  void build_collinear(std::vector<Edge>& edges, std::vector<std::uint32_t>& cell_edge) const;
   void build_neighbors(std::span<const std::uint32_t> triangles);
 
-  std::vector<Vec2d> points_;
-  std::vector<std::uint32_t> representative_;
-  std::vector<Vec2d> vertices_;
-  std::vector<Edge> edges_;
-  std::vector<std::uint32_t> cell_edge_;  // per point; only representatives are set
-  std::vector<std::uint32_t> neighbor_offsets_, neighbors_;
+  // Owned when built, views of the file's pages when loaded.
+  FlatArray<Vec2d> points_;
+  FlatArray<std::uint32_t> representative_;
+  FlatArray<Vec2d> vertices_;
+  FlatArray<Edge> edges_;
+  FlatArray<std::uint32_t> cell_edge_;  // per point; only representatives are set
+  FlatArray<std::uint32_t> neighbor_offsets_, neighbors_;
 };
 
 }  // namespace geods::voronoi
