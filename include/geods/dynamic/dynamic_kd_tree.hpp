@@ -83,13 +83,7 @@ class KdTreeBlock {
     static std::vector<T> pack(const std::vector<Item>& items, std::size_t dim) {
       std::vector<T> packed(items.size() * dim);
       for (std::size_t i = 0; i < items.size(); ++i) {
-        if (items[i].size() != dim)
-          throw Error("KdTree: point " + std::to_string(i) + " of dimension " + std::to_string(items[i].size()) +
-                      ", expected " + std::to_string(dim));
-        for (std::size_t a = 0; a < dim; ++a)
-          if (!std::isfinite(items[i][a]))
-            throw Error("KdTree: point " + std::to_string(i) + " has a non-finite coordinate (axis " +
-                        std::to_string(a) + ")");
+        spatial::KdTreeSteppedBuild<T, Dim>::check_row(items[i], i, dim);
         std::copy_n(items[i].data(), dim, packed.data() + i * dim);
       }
       return packed;

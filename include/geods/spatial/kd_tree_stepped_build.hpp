@@ -66,6 +66,17 @@ class KdTreeSteppedBuild {
     run_ = run(*state_);
   }
 
+  /// Throws geods::Error unless row i has `dim` finite coordinates (what step() checks of every row).
+  static void check_row(const Row& row, std::size_t i, std::size_t dim) {
+    if (row.size() != dim)
+      throw Error("KdTree: point " + std::to_string(i) + " of dimension " + std::to_string(row.size()) +
+                  ", expected " + std::to_string(dim));
+    for (std::size_t a = 0; a < dim; ++a)
+      if (!std::isfinite(row[a]))
+        throw Error("KdTree: point " + std::to_string(i) + " has a non-finite coordinate (axis " +
+                    std::to_string(a) + ")");
+  }
+
   /// Element visits a whole build takes, about: one bounds pass and ~3 partition passes per tree level.
   std::size_t estimated_work() const {
     const std::size_t n = state_->rows.size();
@@ -115,13 +126,7 @@ class KdTreeSteppedBuild {
     items.reserve(n);
     for (std::uint32_t i = 0; i < n; ++i) {
       const Row& row = s.rows[i];
-      if (row.size() != dim)
-        throw Error("KdTree: point " + std::to_string(i) + " of dimension " + std::to_string(row.size()) +
-                    ", expected " + std::to_string(dim));
-      for (std::size_t a = 0; a < dim; ++a)
-        if (!std::isfinite(row[a]))
-          throw Error("KdTree: point " + std::to_string(i) + " has a non-finite coordinate (axis " +
-                      std::to_string(a) + ")");
+      check_row(row, i, dim);
       if constexpr (Dim == Dynamic) {
         packed.insert(packed.end(), row.begin(), row.end());
         items.push_back(i);
