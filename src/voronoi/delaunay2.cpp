@@ -1,5 +1,8 @@
 // Delaunay2: the points' bookkeeping (duplicates, removal, insertion order) and
 // the public finite view around DelaunayCore, with its parts (see delaunay2.hpp).
+// A Delaunay2 holds its arrays read only (FlatArray: its own, or views of a
+// mapped file); construction, insert() and remove() change them as vectors in
+// an Editor.
 #include "geods/voronoi/delaunay2.hpp"
 
 #include <algorithm>
@@ -27,12 +30,117 @@ void require_finite(const Vec2d& p, std::size_t i, const char* who) {
     throw Error(std::string(who) + ": point " + std::to_string(i) + " has a NaN or infinite coordinate");
 }
 
+// The hull vertices counter-clockwise (internal numbers), from the first ghost
+// triangle in the arrays: the ghost triangles (x, y, ghost) around the hull,
+// whose hull edge is y -> x, each sharing x with the next. `visit` ends a walk
+// around a corrupt hull by throwing.
+template <class Visit>
+void walk_hull(const DelaunayView& mesh, Visit visit) {
+  std::uint32_t start = kNone;
+  for (std::uint32_t h = 0; h < mesh.vert.size() && start == kNone; ++h)
+    if (mesh.vert[h] == kGhost) start = h;
+  if (start == kNone) return;
+  std::uint32_t g = start;
+  do {
+    visit(mesh.vert[DelaunayView::prev(g)]);
+    g = DelaunayView::next(mesh.twin[g]);  // x -> ghost, then ghost -> z in the next ghost triangle
+  } while (g != start);
+}
+
 }  // namespace
 
-Delaunay2::Delaunay2(std::span<const Vec2d> points, Options options) { init(points, {}, options); }
+// The arrays as vectors while the triangulation changes: an Editor takes them
+// from its Delaunay2 (moves them, or copies the views of a mapped file: the
+// first change after load()) and gives them back when it goes, also when a
+// change throws.
+struct Delaunay2::Editor {
+  explicit Editor(Delaunay2& dt);
+  ~Editor();
+  Editor(const Editor&) = delete;
+  Editor& operator=(const Editor&) = delete;
+
+  void init(std::span<const Vec2d> given, std::span<const Segment> given_segments, Options chosen);
+  std::uint32_t insert(const Vec2d& p);
+  void remove(std::uint32_t v);
+
+  void build();
+  template <class Location>
+  void insert_all(Location& location);
+  void build_degenerate();
+  std::uint32_t add_vertex(std::uint32_t i);  // appends an internal vertex for point i
+  template <class Hooks>
+  void insert_vertex(std::uint32_t k, std::uint32_t start, Hooks& hooks);
+  void insert_constraints();
+  void publish();
+
+  Delaunay2& dt;
+  Options& options;
+  std::vector<Segment>& segments;
+  std::vector<std::uint32_t>& intersections;
+  bool& has_constraints;
+  std::size_t& dag_nodes;
+  std::vector<Vec2d> points;
+  std::vector<std::uint32_t> rep, original_of, internal_of;
+  std::vector<std::uint8_t> fixed;
+  DelaunayCore core;
+  std::vector<std::uint32_t> triangles, halfedges, hull, public_triangle, internal_triangle;
+  std::vector<std::uint8_t> constrained;
+};
+
+Delaunay2::Editor::Editor(Delaunay2& d)
+    : dt(d),
+      options(d.options_),
+      segments(d.segments_),
+      intersections(d.intersections_),
+      has_constraints(d.has_constraints_),
+      dag_nodes(d.dag_nodes_),
+      points(std::move(d.points_).take_vector()),
+      rep(std::move(d.rep_).take_vector()),
+      original_of(std::move(d.original_of_).take_vector()),
+      internal_of(std::move(d.internal_of_).take_vector()),
+      fixed(std::move(d.fixed_).take_vector()),
+      triangles(std::move(d.triangles_).take_vector()),
+      halfedges(std::move(d.halfedges_).take_vector()),
+      hull(std::move(d.hull_).take_vector()),
+      public_triangle(std::move(d.public_triangle_).take_vector()),
+      internal_triangle(std::move(d.internal_triangle_).take_vector()),
+      constrained(std::move(d.constrained_).take_vector()) {
+  core.coords = std::move(d.coords_).take_vector();
+  core.vert = std::move(d.vert_).take_vector();
+  core.twin = std::move(d.twin_).take_vector();
+  core.free_triangles = std::move(d.free_triangles_).take_vector();
+  core.vertex_edge = std::move(d.vertex_edge_).take_vector();
+  core.last_triangle = d.last_triangle_;
+  core.flips = d.flips_;
+  core.walk_steps = d.walk_steps_;
+}
+
+Delaunay2::Editor::~Editor() {
+  dt.points_ = std::move(points);
+  dt.rep_ = std::move(rep);
+  dt.original_of_ = std::move(original_of);
+  dt.internal_of_ = std::move(internal_of);
+  dt.fixed_ = std::move(fixed);
+  dt.triangles_ = std::move(triangles);
+  dt.halfedges_ = std::move(halfedges);
+  dt.hull_ = std::move(hull);
+  dt.public_triangle_ = std::move(public_triangle);
+  dt.internal_triangle_ = std::move(internal_triangle);
+  dt.constrained_ = std::move(constrained);
+  dt.coords_ = std::move(core.coords);
+  dt.vert_ = std::move(core.vert);
+  dt.twin_ = std::move(core.twin);
+  dt.free_triangles_ = std::move(core.free_triangles);
+  dt.vertex_edge_ = std::move(core.vertex_edge);
+  dt.last_triangle_ = core.last_triangle;
+  dt.flips_ = core.flips;
+  dt.walk_steps_ = core.walk_steps;
+}
+
+Delaunay2::Delaunay2(std::span<const Vec2d> points, Options options) { Editor(*this).init(points, {}, options); }
 
 Delaunay2::Delaunay2(std::span<const Vec2d> points, std::span<const Segment> segments, Options options) {
-  init(points, segments, options);
+  Editor(*this).init(points, segments, options);
 }
 
 Delaunay2 Delaunay2::from_segment_ends(std::span<const Vec2d> points, std::span<const std::array<Vec2d, 2>> segments,
@@ -47,113 +155,113 @@ Delaunay2 Delaunay2::from_segment_ends(std::span<const Vec2d> points, std::span<
   return Delaunay2(all, indices, options);
 }
 
-void Delaunay2::init(std::span<const Vec2d> points, std::span<const Segment> segments, Options options) {
-  if (points.size() >= (std::size_t(1) << 30))
-    throw Error("Delaunay2: " + std::to_string(points.size()) + " points, at most 2^30 - 1 are supported");
-  for (std::size_t i = 0; i < points.size(); ++i) require_finite(points[i], i, "Delaunay2");
-  for (std::size_t k = 0; k < segments.size(); ++k) {
-    const Segment& s = segments[k];
-    if (s[0] >= points.size() || s[1] >= points.size())
+void Delaunay2::Editor::init(std::span<const Vec2d> given, std::span<const Segment> given_segments, Options chosen) {
+  if (given.size() >= (std::size_t(1) << 30))
+    throw Error("Delaunay2: " + std::to_string(given.size()) + " points, at most 2^30 - 1 are supported");
+  for (std::size_t i = 0; i < given.size(); ++i) require_finite(given[i], i, "Delaunay2");
+  for (std::size_t k = 0; k < given_segments.size(); ++k) {
+    const Segment& s = given_segments[k];
+    if (s[0] >= given.size() || s[1] >= given.size())
       throw Error("Delaunay2: segment " + std::to_string(k) + " refers to point " +
-                  std::to_string(std::max(s[0], s[1])) + ", but there are " + std::to_string(points.size()) + " points");
+                  std::to_string(std::max(s[0], s[1])) + ", but there are " + std::to_string(given.size()) + " points");
     if (s[0] == s[1])
       throw Error("Delaunay2: segment " + std::to_string(k) + " joins point " + std::to_string(s[0]) + " to itself");
   }
-  points_.assign(points.begin(), points.end());
-  segments_.assign(segments.begin(), segments.end());
-  rep_.resize(points_.size());
-  std::iota(rep_.begin(), rep_.end(), 0u);
-  options_ = options;
-  build(options);
+  points.assign(given.begin(), given.end());
+  segments.assign(given_segments.begin(), given_segments.end());
+  rep.resize(points.size());
+  std::iota(rep.begin(), rep.end(), 0u);
+  options = chosen;
+  build();
 }
 
 // ------------------------------------------------------------------ building
 
-void Delaunay2::build(Options options) {
-  has_constraints_ = false;
-  fixed_.clear();
+void Delaunay2::Editor::build() {
+  has_constraints = false;
+  fixed.clear();
   std::vector<std::uint32_t> active;
-  active.reserve(points_.size());
-  for (std::uint32_t i = 0; i < points_.size(); ++i)
-    if (rep_[i] != kNone) active.push_back(rep_[i] = i);
-  original_of_ = brio_order(points_, active, options.seed);
+  active.reserve(points.size());
+  for (std::uint32_t i = 0; i < points.size(); ++i)
+    if (rep[i] != kNone) active.push_back(rep[i] = i);
+  original_of = brio_order(points, active, options.seed);
   if (options.location == Delaunay2Location::history_dag) {  // a random order instead: the DAG needs no locality
     Rng rng(options.seed);
-    for (std::size_t k = original_of_.size(); k > 1; --k) std::swap(original_of_[k - 1], original_of_[rng.below(k)]);
+    for (std::size_t k = original_of.size(); k > 1; --k) std::swap(original_of[k - 1], original_of[rng.below(k)]);
   }
-  const std::uint32_t m = std::uint32_t(original_of_.size());
-  core_.coords.resize(m);
-  internal_of_.assign(points_.size(), kNone);
+  const std::uint32_t m = std::uint32_t(original_of.size());
+  core.coords.resize(m);
+  internal_of.assign(points.size(), kNone);
   for (std::uint32_t k = 0; k < m; ++k) {
-    core_.coords[k] = points_[original_of_[k]];
-    internal_of_[original_of_[k]] = k;
+    core.coords[k] = points[original_of[k]];
+    internal_of[original_of[k]] = k;
   }
-  if (!core_.make_first_triangle()) {
+  if (!core.make_first_triangle()) {
     build_degenerate();
     return;
   }
   // The DAG serves construction only (updates may shrink the hull, which its cones assume never happens).
   std::optional<HistoryDag> dag;
-  if (options.location == Delaunay2Location::history_dag) dag.emplace(core_, m);
+  if (options.location == Delaunay2Location::history_dag) dag.emplace(core, m);
   if (dag && dag->usable()) {
     insert_all(*dag);
-    dag_nodes_ = dag->nodes();
+    dag_nodes = dag->nodes();
   } else {
-    WalkFromLast walk{{}, &core_};
+    WalkFromLast walk{{}, &core};
     insert_all(walk);
-    dag_nodes_ = 0;
+    dag_nodes = 0;
   }
   // A point renamed to an earlier duplicate leaves a chain of representatives.
-  for (std::uint32_t i = 0; i < rep_.size(); ++i) {
-    std::uint32_t r = rep_[i];
+  for (std::uint32_t i = 0; i < rep.size(); ++i) {
+    std::uint32_t r = rep[i];
     if (r == kNone) continue;
-    while (rep_[r] != r) r = rep_[r];
-    rep_[i] = r;
+    while (rep[r] != r) r = rep[r];
+    rep[i] = r;
   }
   publish();
-  if (!segments_.empty()) insert_constraints();
+  if (!segments.empty()) insert_constraints();
 }
 
 template <class Location>
-void Delaunay2::insert_all(Location& location) {
+void Delaunay2::Editor::insert_all(Location& location) {
   static_assert(InsertionLocation<Location>);
-  const std::uint32_t a = core_.vert[0], b = core_.vert[1], c = core_.vert[2];
-  for (std::uint32_t k = 0; k < core_.coords.size(); ++k)
-    if (k != a && k != b && k != c) insert_vertex(k, location.start(core_.at(k)), location);
+  const std::uint32_t a = core.vert[0], b = core.vert[1], c = core.vert[2];
+  for (std::uint32_t k = 0; k < core.coords.size(); ++k)
+    if (k != a && k != b && k != c) insert_vertex(k, location.start(core.at(k)), location);
 }
 
 template <class Hooks>
-void Delaunay2::insert_vertex(std::uint32_t k, std::uint32_t start, Hooks& hooks) {
-  const std::uint32_t j = core_.insert_vertex(k, start, hooks);
+void Delaunay2::Editor::insert_vertex(std::uint32_t k, std::uint32_t start, Hooks& hooks) {
+  const std::uint32_t j = core.insert_vertex(k, start, hooks);
   if (j == DelaunayCore::none) return;
   // k lies on vertex j: the first occurrence stands for all equal points.
-  const std::uint32_t point = original_of_[k], existing = original_of_[j];
+  const std::uint32_t point = original_of[k], existing = original_of[j];
   if (point < existing) {
-    original_of_[j] = point;
-    rep_[existing] = point;
-    rep_[point] = point;
+    original_of[j] = point;
+    rep[existing] = point;
+    rep[point] = point;
   } else {
-    rep_[point] = existing;
+    rep[point] = existing;
   }
-  internal_of_[point] = j;
+  internal_of[point] = j;
 }
 
-std::uint32_t Delaunay2::add_vertex(std::uint32_t i) {
-  const std::uint32_t k = std::uint32_t(core_.coords.size());
-  core_.coords.push_back(points_[i]);
-  original_of_.push_back(i);
-  internal_of_.push_back(k);
-  core_.vertex_edge.push_back(kNone);
+std::uint32_t Delaunay2::Editor::add_vertex(std::uint32_t i) {
+  const std::uint32_t k = std::uint32_t(core.coords.size());
+  core.coords.push_back(points[i]);
+  original_of.push_back(i);
+  internal_of.push_back(k);
+  core.vertex_edge.push_back(kNone);
   return k;
 }
 
-void Delaunay2::insert_constraints() {
-  has_constraints_ = true;
-  fixed_.assign(core_.vert.size(), 0);
-  ConstrainedDelaunay constraints(core_, fixed_);
+void Delaunay2::Editor::insert_constraints() {
+  has_constraints = true;
+  fixed.assign(core.vert.size(), 0);
+  ConstrainedDelaunay constraints(core, fixed);
   ConstrainedDelaunay::Pending pending;
-  for (auto it = segments_.rbegin(); it != segments_.rend(); ++it)
-    pending.push_back({internal_of_[rep_[(*it)[0]]], internal_of_[rep_[(*it)[1]]]});
+  for (auto it = segments.rbegin(); it != segments.rend(); ++it)
+    pending.push_back({internal_of[rep[(*it)[0]]], internal_of[rep[(*it)[1]]]});
   while (!pending.empty()) {
     const auto [a, b] = pending.back();
     pending.pop_back();
@@ -161,92 +269,85 @@ void Delaunay2::insert_constraints() {
     const auto crossing = constraints.insert_segment(a, b, pending);
     if (!crossing) continue;
     // Both are split at the crossing, a new point; the four pieces are then segments of their own.
-    const std::uint32_t i = std::uint32_t(points_.size());
+    const std::uint32_t i = std::uint32_t(points.size());
     if (i + 1 >= (std::uint32_t(1) << 30)) throw Error("Delaunay2: too many points");
-    points_.push_back(crossing->point);
-    rep_.push_back(i);
+    points.push_back(crossing->point);
+    rep.push_back(i);
     insert_vertex(add_vertex(i), crossing->edge / 3, constraints);
-    intersections_.push_back(i);
-    const std::uint32_t x = internal_of_[i], u = crossing->u, w = crossing->w;
+    intersections.push_back(i);
+    const std::uint32_t x = internal_of[i], u = crossing->u, w = crossing->w;
     for (auto piece : {std::pair{u, x}, std::pair{x, w}, std::pair{x, b}, std::pair{a, x}}) pending.push_back(piece);
   }
   publish();
 }
 
-void Delaunay2::build_degenerate() {
-  core_.vert.clear();
-  core_.twin.clear();
-  core_.free_triangles.clear();
+void Delaunay2::Editor::build_degenerate() {
+  core.vert.clear();
+  core.twin.clear();
+  core.free_triangles.clear();
   std::vector<std::uint32_t> active;
-  for (std::uint32_t i = 0; i < points_.size(); ++i)
-    if (rep_[i] != kNone) active.push_back(i);
-  const auto& p = points_;
+  for (std::uint32_t i = 0; i < points.size(); ++i)
+    if (rep[i] != kNone) active.push_back(i);
+  const auto& p = points;
   std::sort(active.begin(), active.end(), [&](std::uint32_t i, std::uint32_t j) {
     if (p[i][0] != p[j][0]) return p[i][0] < p[j][0];
     if (p[i][1] != p[j][1]) return p[i][1] < p[j][1];
     return i < j;
   });
-  hull_.clear();
+  hull.clear();
   for (std::uint32_t i : active) {
-    if (!hull_.empty() && p[hull_.back()] == p[i]) {
-      rep_[i] = hull_.back();
+    if (!hull.empty() && p[hull.back()] == p[i]) {
+      rep[i] = hull.back();
     } else {
-      rep_[i] = i;
-      hull_.push_back(i);
+      rep[i] = i;
+      hull.push_back(i);
     }
   }
-  triangles_.clear();
-  halfedges_.clear();
-  public_triangle_.clear();
-  internal_triangle_.clear();
-  core_.coords.clear();
-  original_of_.clear();
-  internal_of_.clear();
-  core_.vertex_edge.clear();
+  triangles.clear();
+  halfedges.clear();
+  public_triangle.clear();
+  internal_triangle.clear();
+  core.coords.clear();
+  original_of.clear();
+  internal_of.clear();
+  core.vertex_edge.clear();
 }
 
 // ------------------------------------------------------------------ public view
 
-void Delaunay2::publish() {
-  const std::uint32_t internal = std::uint32_t(core_.vert.size() / 3);
-  public_triangle_.assign(internal, kNone);
-  internal_triangle_.clear();
+void Delaunay2::Editor::publish() {
+  const std::uint32_t internal = std::uint32_t(core.vert.size() / 3);
+  public_triangle.assign(internal, kNone);
+  internal_triangle.clear();
   for (std::uint32_t t = 0; t < internal; ++t) {
-    if (core_.vert[3 * t] == kNone || core_.is_ghost_triangle(t)) continue;
-    public_triangle_[t] = std::uint32_t(internal_triangle_.size());
-    internal_triangle_.push_back(t);
+    if (core.vert[3 * t] == kNone || core.is_ghost_triangle(t)) continue;
+    public_triangle[t] = std::uint32_t(internal_triangle.size());
+    internal_triangle.push_back(t);
   }
-  const std::size_t m = internal_triangle_.size();
-  triangles_.resize(3 * m);
-  halfedges_.resize(3 * m);
+  const std::size_t m = internal_triangle.size();
+  triangles.resize(3 * m);
+  halfedges.resize(3 * m);
   for (std::size_t k = 0; k < m; ++k) {
-    const std::uint32_t t = internal_triangle_[k];
+    const std::uint32_t t = internal_triangle[k];
     for (std::uint32_t s = 0; s < 3; ++s) {
-      triangles_[3 * k + s] = original_of_[core_.vert[3 * t + s]];
-      const std::uint32_t f = core_.twin[3 * t + s], other = public_triangle_[f / 3];
-      halfedges_[3 * k + s] = other == kNone ? kNone : 3 * other + f % 3;
+      triangles[3 * k + s] = original_of[core.vert[3 * t + s]];
+      const std::uint32_t f = core.twin[3 * t + s], other = public_triangle[f / 3];
+      halfedges[3 * k + s] = other == kNone ? kNone : 3 * other + f % 3;
     }
   }
-  constrained_.assign(has_constraints_ ? 3 * m : 0, 0);
-  if (has_constraints_)
+  constrained.assign(has_constraints ? 3 * m : 0, 0);
+  if (has_constraints)
     for (std::size_t k = 0; k < m; ++k)
-      for (std::uint32_t s = 0; s < 3; ++s) constrained_[3 * k + s] = fixed_[3 * internal_triangle_[k] + s];
-  core_.vertex_edge.assign(core_.coords.size(), kNone);
-  for (std::uint32_t h = 0; h < core_.vert.size(); ++h)
-    if (core_.vert[h] != kGhost && core_.vert[h] != kNone) core_.vertex_edge[core_.vert[h]] = h;
-  hull_.clear();
+      for (std::uint32_t s = 0; s < 3; ++s) constrained[3 * k + s] = fixed[3 * internal_triangle[k] + s];
+  core.vertex_edge.assign(core.coords.size(), kNone);
+  for (std::uint32_t h = 0; h < core.vert.size(); ++h)
+    if (core.vert[h] != kGhost && core.vert[h] != kNone) core.vertex_edge[core.vert[h]] = h;
+  hull.clear();
   if (m == 0) return;
-  // Walk the ghost triangles (x, y, ghost) around the hull: the hull edge of
-  // each is y -> x, and the next one shares x.
-  std::uint32_t start = kNone;
-  for (std::uint32_t h = 0; h < core_.vert.size() && start == kNone; ++h)
-    if (core_.vert[h] == kGhost) start = h;
-  std::uint32_t g = start;
-  do {
-    hull_.push_back(original_of_[core_.vert[prev(g)]]);
-    g = next(core_.twin[g]);  // x -> ghost, then ghost -> z in the next ghost triangle
-    if (hull_.size() > points_.size()) throw Error("Delaunay2: corrupt hull");
-  } while (g != start);
+  walk_hull(core.view(), [&](std::uint32_t v) {
+    hull.push_back(original_of[v]);
+    if (hull.size() > points.size()) throw Error("Delaunay2: corrupt hull");
+  });
 }
 
 // ------------------------------------------------------------------ queries
@@ -268,7 +369,7 @@ std::uint32_t Delaunay2::locate(const Vec2d& q, std::uint32_t hint) const {
   if (hint != kNone && hint >= internal_triangle_.size())
     throw Error("Delaunay2::locate: hint " + std::to_string(hint) + " is not a triangle");
   const std::uint32_t start = internal_triangle_[hint != kNone ? hint : internal_triangle_.size() / 2];
-  const DelaunayCore::Location loc = core_.walk(q, start, nullptr);
+  const DelaunayCore::Location loc = view().walk(q, start, nullptr);
   return loc.where == DelaunayCore::Where::outside ? kNone : public_triangle_[loc.edge / 3];
 }
 
@@ -284,15 +385,15 @@ std::vector<std::uint32_t> Delaunay2::neighbors(std::uint32_t v) const {
     return result;
   }
   if (rep_[v] != v) return result;
-  const std::uint32_t e = core_.vertex_edge[internal_of_[v]];
+  const std::uint32_t e = vertex_edge_[internal_of_[v]];
   std::uint32_t h = e;
   std::size_t after_ghost = 0;
   do {
-    if (core_.vert[next(h)] != kGhost)
-      result.push_back(original_of_[core_.vert[next(h)]]);
+    if (vert_[next(h)] != kGhost)
+      result.push_back(original_of_[vert_[next(h)]]);
     else
       after_ghost = result.size();
-    h = core_.twin[prev(h)];
+    h = twin_[prev(h)];
   } while (h != e);
   std::rotate(result.begin(), result.begin() + std::ptrdiff_t(after_ghost), result.end());
   return result;
@@ -306,20 +407,20 @@ std::uint32_t Delaunay2::nearest(const Vec2d& q) const {
       if (best == kNone || (points_[v] - q).squaredNorm() < (points_[best] - q).squaredNorm()) best = v;
     return best;
   }
-  const auto distance = [&](std::uint32_t v) { return (core_.at(v) - q).squaredNorm(); };
-  const DelaunayCore::Location loc = core_.walk(q, internal_triangle_[internal_triangle_.size() / 2], nullptr);
+  const auto distance = [&](std::uint32_t v) { return (coords_[v] - q).squaredNorm(); };
+  const DelaunayCore::Location loc = view().walk(q, internal_triangle_[internal_triangle_.size() / 2], nullptr);
   std::uint32_t best = kNone;
   for (std::uint32_t h = loc.edge / 3 * 3; h < loc.edge / 3 * 3 + 3; ++h)
-    if (core_.vert[h] != kGhost && (best == kNone || distance(core_.vert[h]) < distance(best))) best = core_.vert[h];
+    if (vert_[h] != kGhost && (best == kNone || distance(vert_[h]) < distance(best))) best = vert_[h];
   // Greedy: a vertex with no closer Delaunay neighbour is a nearest one (q
   // lies in its Voronoi cell).
   double best_distance = distance(best);
   for (bool improved = true; improved;) {
     improved = false;
-    const std::uint32_t e = core_.vertex_edge[best];
+    const std::uint32_t e = vertex_edge_[best];
     std::uint32_t h = e;
     do {
-      const std::uint32_t w = core_.vert[next(h)];
+      const std::uint32_t w = vert_[next(h)];
       if (w != kGhost) {
         const double d = distance(w);
         if (d < best_distance) {
@@ -327,7 +428,7 @@ std::uint32_t Delaunay2::nearest(const Vec2d& q) const {
           break;
         }
       }
-      h = core_.twin[prev(h)];
+      h = twin_[prev(h)];
     } while (h != e);
   }
   return original_of_[best];
@@ -335,62 +436,66 @@ std::uint32_t Delaunay2::nearest(const Vec2d& q) const {
 
 // ------------------------------------------------------------------ updates
 
-std::uint32_t Delaunay2::insert(const Vec2d& p) {
-  require_finite(p, points_.size(), "Delaunay2::insert");
-  if (points_.size() + 1 >= (std::size_t(1) << 30)) throw Error("Delaunay2::insert: too many points");
-  const std::uint32_t i = std::uint32_t(points_.size());
-  points_.push_back(p);
-  rep_.push_back(i);
-  if (internal_triangle_.empty()) {
-    build(options_);
+std::uint32_t Delaunay2::Editor::insert(const Vec2d& p) {
+  require_finite(p, points.size(), "Delaunay2::insert");
+  if (points.size() + 1 >= (std::size_t(1) << 30)) throw Error("Delaunay2::insert: too many points");
+  const std::uint32_t i = std::uint32_t(points.size());
+  points.push_back(p);
+  rep.push_back(i);
+  if (internal_triangle.empty()) {
+    build();
   } else {
     const std::uint32_t k = add_vertex(i);
-    if (has_constraints_) {
-      ConstrainedDelaunay constraints(core_, fixed_);
-      insert_vertex(k, core_.last_triangle, constraints);
+    if (has_constraints) {
+      ConstrainedDelaunay constraints(core, fixed);
+      insert_vertex(k, core.last_triangle, constraints);
     } else {
       NoHooks plain;
-      insert_vertex(k, core_.last_triangle, plain);
+      insert_vertex(k, core.last_triangle, plain);
     }
     publish();
   }
   return i;
 }
 
-void Delaunay2::remove(std::uint32_t v) {
-  if (v >= points_.size() || rep_[v] == kNone)
+void Delaunay2::Editor::remove(std::uint32_t v) {
+  if (v >= points.size() || rep[v] == kNone)
     throw Error("Delaunay2::remove: point " + std::to_string(v) + " is not in the triangulation");
-  if (!segments_.empty()) throw Error("Delaunay2::remove: not supported on a constrained triangulation");
-  if (rep_[v] != v) {  // an alias: the triangulation does not change
-    rep_[v] = kNone;
+  if (!segments.empty()) throw Error("Delaunay2::remove: not supported on a constrained triangulation");
+  if (rep[v] != v) {  // an alias: the triangulation does not change
+    rep[v] = kNone;
     return;
   }
   std::uint32_t alias = kNone;
-  for (std::uint32_t i = v + 1; i < rep_.size() && alias == kNone; ++i)
-    if (rep_[i] == v) alias = i;
+  for (std::uint32_t i = v + 1; i < rep.size() && alias == kNone; ++i)
+    if (rep[i] == v) alias = i;
   if (alias != kNone) {  // the next equal point takes v's place
-    for (std::uint32_t i = v + 1; i < rep_.size(); ++i)
-      if (rep_[i] == v) rep_[i] = alias;
-    rep_[v] = kNone;
-    if (internal_triangle_.empty()) {
+    for (std::uint32_t i = v + 1; i < rep.size(); ++i)
+      if (rep[i] == v) rep[i] = alias;
+    rep[v] = kNone;
+    if (internal_triangle.empty()) {
       build_degenerate();
     } else {
-      original_of_[internal_of_[v]] = alias;
-      internal_of_[v] = kNone;
+      original_of[internal_of[v]] = alias;
+      internal_of[v] = kNone;
       publish();
     }
     return;
   }
-  rep_[v] = kNone;
-  const std::uint32_t internal = internal_of_[v];
-  internal_of_[v] = kNone;
-  if (internal_triangle_.empty() || !remove_vertex(core_, internal)) {
-    build(options_);
+  rep[v] = kNone;
+  const std::uint32_t internal = internal_of[v];
+  internal_of[v] = kNone;
+  if (internal_triangle.empty() || !remove_vertex(core, internal)) {
+    build();
     return;
   }
   publish();
-  if (internal_triangle_.empty()) build(options_);  // what is left is collinear
+  if (internal_triangle.empty()) build();  // what is left is collinear
 }
+
+std::uint32_t Delaunay2::insert(const Vec2d& p) { return Editor(*this).insert(p); }
+
+void Delaunay2::remove(std::uint32_t v) { Editor(*this).remove(v); }
 
 std::vector<std::uint8_t> Delaunay2::inside() const {
   // Even-odd: a breadth-first search from the hull, the parity flipping across
@@ -435,14 +540,13 @@ Delaunay2Stats Delaunay2::stats() const {
   }
   s.triangles = triangle_count();
   s.hull = hull_.size();
-  s.flips = core_.flips;
-  s.walk_steps = core_.walk_steps;
+  s.flips = flips_;
+  s.walk_steps = walk_steps_;
   s.dag_nodes = dag_nodes_;
-  s.bytes = (points_.capacity() + core_.coords.capacity()) * sizeof(Vec2d) +
-            sizeof(std::uint32_t) * (rep_.capacity() + original_of_.capacity() + internal_of_.capacity() + core_.vert.capacity() + core_.twin.capacity() +
-                                     core_.free_triangles.capacity() + core_.vertex_edge.capacity() + triangles_.capacity() +
-                                     halfedges_.capacity() + hull_.capacity() + public_triangle_.capacity() +
-                                     internal_triangle_.capacity());
+  s.bytes = (points_.size() + coords_.size()) * sizeof(Vec2d) +
+            sizeof(std::uint32_t) * (rep_.size() + original_of_.size() + internal_of_.size() + vert_.size() + twin_.size() +
+                                     free_triangles_.size() + vertex_edge_.size() + triangles_.size() + halfedges_.size() +
+                                     hull_.size() + public_triangle_.size() + internal_triangle_.size());
   return s;
 }
 
@@ -452,30 +556,30 @@ Delaunay2Stats Delaunay2::stats() const {
 // those reads miss the cache (they were most of load()'s time).
 Delaunay2::TriangleCounts Delaunay2::check_triangles() const {
   const auto fail = [](const std::string& what) { throw Error("Delaunay2::validate: " + what); };
-  const std::size_t n = points_.size(), vertices = core_.coords.size();
-  const std::uint32_t half_edges = std::uint32_t(core_.vert.size());
-  if (core_.twin.size() != half_edges || half_edges % 3) fail("array sizes");
+  const std::size_t n = points_.size(), vertices = coords_.size();
+  const std::uint32_t half_edges = std::uint32_t(vert_.size());
+  if (twin_.size() != half_edges || half_edges % 3) fail("array sizes");
   if (has_constraints_ && fixed_.size() != half_edges) fail("constraint flags have the wrong size");
   if (original_of_.size() != vertices) fail("one point per vertex expected");
   std::size_t live = 0, ghosts = 0;
   std::vector<char> used(vertices, 0);
   for (std::uint32_t t = 0; t < half_edges / 3; ++t) {
-    if (core_.vert[3 * t] == kNone) continue;
+    if (vert_[3 * t] == kNone) continue;
     ++live;
-    const bool ghost = core_.is_ghost_triangle(t);
+    const bool ghost = view().is_ghost_triangle(t);
     ghosts += ghost;
-    if ((core_.vert[3 * t] == kGhost) + (core_.vert[3 * t + 1] == kGhost) + (core_.vert[3 * t + 2] == kGhost) > 1)
+    if ((vert_[3 * t] == kGhost) + (vert_[3 * t + 1] == kGhost) + (vert_[3 * t + 2] == kGhost) > 1)
       fail("triangle " + std::to_string(t) + " has two ghost vertices");
     for (std::uint32_t e = 3 * t; e < 3 * t + 3; ++e) {
-      const std::uint32_t v = core_.vert[e], f = core_.twin[e];
+      const std::uint32_t v = vert_[e], f = twin_[e];
       if (v != kGhost) {
         if (v >= vertices) fail("triangle " + std::to_string(t) + " uses a vertex that is not a representative");
         used[v] = 1;
       }
-      if (f >= half_edges || core_.twin[f] != e || core_.vert[f] == kNone) fail("twin of half-edge " + std::to_string(e));
-      if (core_.vert[f] != core_.vert[next(e)] || core_.vert[next(f)] != v) fail("twins of half-edge " + std::to_string(e) + " do not share their end points");
+      if (f >= half_edges || twin_[f] != e || vert_[f] == kNone) fail("twin of half-edge " + std::to_string(e));
+      if (vert_[f] != vert_[next(e)] || vert_[next(f)] != v) fail("twins of half-edge " + std::to_string(e) + " do not share their end points");
     }
-    if (!ghost && !(orient2d(core_.at(core_.vert[3 * t]), core_.at(core_.vert[3 * t + 1]), core_.at(core_.vert[3 * t + 2])) > 0))
+    if (!ghost && !(orient2d(coords_[vert_[3 * t]], coords_[vert_[3 * t + 1]], coords_[vert_[3 * t + 2]]) > 0))
       fail("triangle " + std::to_string(t) + " is not counter-clockwise");
   }
   // Each vertex in a triangle stands for a representative point at its place,
@@ -483,7 +587,7 @@ Delaunay2::TriangleCounts Delaunay2::check_triangles() const {
   for (std::uint32_t v = 0; v < vertices; ++v) {
     if (!used[v]) continue;
     const std::uint32_t o = original_of_[v];
-    if (o >= n || rep_[o] != o || internal_of_[o] != v || points_[o] != core_.coords[v])
+    if (o >= n || rep_[o] != o || internal_of_[o] != v || points_[o] != coords_[v])
       fail("vertex " + std::to_string(v) + " is not a representative");
   }
   for (std::uint32_t i = 0; i < n; ++i) {
@@ -527,20 +631,21 @@ void Delaunay2::validate() const {
     return;
   }
   const auto [live, ghosts] = check_triangles();
-  const std::uint32_t half_edges = std::uint32_t(core_.vert.size());
+  check_public_view(live - ghosts);
+  const std::uint32_t half_edges = std::uint32_t(vert_.size());
   // Locally Delaunay: the vertex opposite each edge is not inside the circle
   // (half-plane for a ghost triangle) of the triangle on the other side. With
   // ghost triangles this also says that the hull is convex.
   for (std::uint32_t e = 0; e < half_edges; ++e) {
-    if (core_.vert[e] == kNone) continue;
-    const std::uint32_t opposite = core_.vert[prev(core_.twin[e])];
+    if (vert_[e] == kNone) continue;
+    const std::uint32_t opposite = vert_[prev(twin_[e])];
     if (opposite == kGhost || (has_constraints_ && fixed_[e])) continue;
-    if (core_.in_conflict(e / 3, core_.at(opposite)))
-      fail("edge " + std::to_string(core_.vert[e]) + "-" + std::to_string(core_.vert[next(e)]) + " is not locally Delaunay");
+    if (view().in_conflict(e / 3, coords_[opposite]))
+      fail("edge " + std::to_string(vert_[e]) + "-" + std::to_string(vert_[next(e)]) + " is not locally Delaunay");
   }
   if (has_constraints_) {
     for (std::uint32_t e = 0; e < half_edges; ++e)
-      if (core_.vert[e] != kNone && fixed_[e] != fixed_[core_.twin[e]]) fail("constraint flags of twins differ");
+      if (vert_[e] != kNone && fixed_[e] != fixed_[twin_[e]]) fail("constraint flags of twins differ");
     // Every input segment is a path of constrained edges through vertices on
     // it or through intersection points (rounded, so slightly off it).
     std::vector<std::uint32_t> crossings = intersections_;
@@ -549,20 +654,20 @@ void Delaunay2::validate() const {
       const std::uint32_t a = internal_of_[rep_[seg[0]]], b = internal_of_[rep_[seg[1]]];
       if (a == kNone || b == kNone) fail("a segment end point is not a vertex");
       std::vector<std::uint32_t> queue{a};
-      std::vector<char> seen(core_.coords.size(), 0);
+      std::vector<char> seen(coords_.size(), 0);
       seen[a] = 1;
       for (std::size_t k = 0; k < queue.size() && !seen[b]; ++k) {
-        const std::uint32_t start = core_.vertex_edge[queue[k]];
+        const std::uint32_t start = vertex_edge_[queue[k]];
         std::uint32_t h = start;
         do {
-          const std::uint32_t w = core_.vert[next(h)];
+          const std::uint32_t w = vert_[next(h)];
           if (fixed_[h] && w != kGhost && !seen[w] &&
               (w == b || std::binary_search(crossings.begin(), crossings.end(), original_of_[w]) ||
-               (orient2d(core_.at(a), core_.at(b), core_.at(w)) == 0 && DelaunayCore::strictly_between(core_.at(a), core_.at(b), core_.at(w))))) {
+               (orient2d(coords_[a], coords_[b], coords_[w]) == 0 && DelaunayCore::strictly_between(coords_[a], coords_[b], coords_[w])))) {
             seen[w] = 1;
             queue.push_back(w);
           }
-          h = core_.twin[prev(h)];
+          h = twin_[prev(h)];
         } while (h != start);
       }
       if (!seen[b]) fail("segment " + std::to_string(seg[0]) + "-" + std::to_string(seg[1]) + " is not present");
@@ -573,21 +678,52 @@ void Delaunay2::validate() const {
   if (live != 2 * (vertices + 1) - 4) fail("Euler's formula fails for the closed triangulation");
   if (finite != 2 * vertices - hull_.size() - 2) fail("t = 2n - h - 2 fails");
   if (hull_.size() != ghosts) fail("hull size differs from the number of hull edges");
-  // The public arrays.
+}
+
+// The public view against the closed triangulation: each array is what
+// publish() computes from it (finite triangles numbered in internal order).
+void Delaunay2::check_public_view(std::size_t finite) const {
+  const auto fail = [](const std::string& what) { throw Error("Delaunay2::validate: " + what); };
+  const std::uint32_t half_edges = std::uint32_t(vert_.size()), vertices = std::uint32_t(coords_.size());
+  if (public_triangle_.size() != half_edges / 3 || internal_triangle_.size() != finite) fail("triangle maps have the wrong size");
   if (triangles_.size() != 3 * finite || halfedges_.size() != triangles_.size()) fail("public arrays have the wrong size");
-  for (std::size_t k = 0; k < finite; ++k) {
+  if (constrained_.size() != (has_constraints_ ? triangles_.size() : 0)) fail("public constraint flags have the wrong size");
+  if (vertex_edge_.size() != vertices) fail("one half-edge per vertex expected");
+  std::uint32_t k = 0;
+  for (std::uint32_t t = 0; t < half_edges / 3; ++t) {
+    if (vert_[3 * t] == kNone || view().is_ghost_triangle(t)) {
+      if (public_triangle_[t] != kNone) fail("triangle " + std::to_string(t) + " is public but not finite");
+      continue;
+    }
+    if (k >= finite || internal_triangle_[k] != t || public_triangle_[t] != k)
+      fail("public triangle " + std::to_string(k) + " is not internal triangle " + std::to_string(t));
+    ++k;
+  }
+  for (k = 0; k < finite; ++k) {
     const std::uint32_t t = internal_triangle_[k];
     for (std::uint32_t s = 0; s < 3; ++s) {
-      const std::uint32_t e = std::uint32_t(3 * k + s);
-      if (triangles_[e] != original_of_[core_.vert[3 * t + s]]) fail("public triangle " + std::to_string(k) + " differs");
-      const std::uint32_t h = halfedges_[e];
-      if (h == kNone) {
-        if (!core_.is_ghost_triangle(core_.twin[3 * t + s] / 3)) fail("public hull edge inside the triangulation");
-      } else if (h >= halfedges_.size() || halfedges_[h] != e) {
-        fail("public halfedges are not symmetric");
-      }
+      const std::uint32_t e = 3 * k + s, f = twin_[3 * t + s], other = public_triangle_[f / 3];
+      if (triangles_[e] != original_of_[vert_[3 * t + s]]) fail("public triangle " + std::to_string(k) + " differs");
+      if (halfedges_[e] != (other == kNone ? kNone : 3 * other + f % 3)) fail("public half-edge " + std::to_string(e) + " differs");
+      if (has_constraints_ && constrained_[e] != fixed_[3 * t + s]) fail("public constraint flag " + std::to_string(e) + " differs");
     }
   }
+  // vertex_edge: the last half-edge leaving each vertex, none for a vertex in no triangle.
+  for (std::uint32_t h = 0; h < half_edges; ++h) {
+    const std::uint32_t v = vert_[h];
+    if (v != kGhost && v != kNone && (vertex_edge_[v] == kNone || vertex_edge_[v] < h))
+      fail("vertex " + std::to_string(v) + " has the wrong half-edge");
+  }
+  for (std::uint32_t v = 0; v < vertices; ++v)
+    if (vertex_edge_[v] != kNone && (vertex_edge_[v] >= half_edges || vert_[vertex_edge_[v]] != v))
+      fail("vertex " + std::to_string(v) + " has a half-edge that does not leave it");
+  std::size_t h = 0;
+  if (finite > 0)
+    walk_hull(view(), [&](std::uint32_t v) {
+      if (h >= hull_.size() || hull_[h] != original_of_[v]) fail("hull vertex " + std::to_string(h) + " differs");
+      ++h;
+    });
+  if (h != hull_.size()) fail("the hull has " + std::to_string(hull_.size()) + " vertices, expected " + std::to_string(h));
 }
 
 }  // namespace geods::voronoi

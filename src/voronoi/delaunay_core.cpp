@@ -1,4 +1,4 @@
-// The non-template steps of DelaunayCore: the first triangle, the walk, triangle slots.
+// The non-template steps of DelaunayCore (the first triangle, triangle slots) and DelaunayView's walk.
 #include "geods/voronoi/delaunay_core.hpp"
 
 namespace geods::voronoi {
@@ -52,7 +52,7 @@ void DelaunayCore::free_triangle(std::uint32_t t) {
   free_triangles.push_back(t);
 }
 
-DelaunayCore::Location DelaunayCore::walk(const Vec2d& p, std::uint32_t t, std::size_t* steps) const {
+DelaunayView::Location DelaunayView::walk(const Vec2d& p, std::uint32_t t, std::size_t* steps) const {
   if (is_ghost_triangle(t))  // start from the finite triangle beside it
     for (std::uint32_t e = 3 * t; e < 3 * t + 3; ++e)
       if (vert[e] != ghost && vert[next(e)] != ghost) {

@@ -80,6 +80,14 @@ class FlatArray {
   std::size_t owned_bytes() const { return mapped_ ? 0 : size_ * sizeof(T); }
   /// A copy of the elements that the caller may change.
   std::vector<T> to_vector() const { return {begin(), end()}; }
+  /// The elements as a vector the caller may change, leaving the array empty:
+  /// moved out when the array owns them in a std::vector, copied when they are
+  /// viewed (so a structure that changes after loading copies once).
+  std::vector<T> take_vector() && {
+    std::vector<T> elements = owner_ || mapped_ ? to_vector() : std::move(owned_);
+    *this = FlatArray();
+    return elements;
+  }
 
   /// Element-wise equality, whether owned or viewed.
   friend bool operator==(const FlatArray& a, const FlatArray& b)

@@ -14,7 +14,8 @@
 // flip). Constrained edges, the history DAG and removal are parts of their own
 // beside the core (src/voronoi/constrained_delaunay, history_dag,
 // vertex_removal). The public arrays are the finite triangles only, renumbered
-// densely after each construction, insert() and remove().
+// densely after each construction, insert() and remove(). Every array is a
+// FlatArray: the triangulation's own, or after load() a view into the file.
 //
 // Order of insertion: BRIO (biased randomized insertion order: random rounds of
 // doubling size, each sorted along a Hilbert curve); each point is located by a
@@ -35,6 +36,7 @@
 #include <vector>
 
 #include "geods/core/archive.hpp"
+#include "geods/core/flat_array.hpp"
 #include "geods/core/vec.hpp"
 #include "geods/voronoi/delaunay_core.hpp"
 
@@ -103,17 +105,17 @@ class Delaunay2 {
   /// The input points (and inserted ones), indexed as given.
   std::span<const Vec2d> points() const { return points_; }
   /// Finite triangles, three counter-clockwise vertex indices each.
-  const std::vector<std::uint32_t>& triangles() const { return triangles_; }
+  const FlatArray<std::uint32_t>& triangles() const { return triangles_; }
   /// The opposite half-edge of each half-edge, no_edge on the hull.
-  const std::vector<std::uint32_t>& halfedges() const { return halfedges_; }
+  const FlatArray<std::uint32_t>& halfedges() const { return halfedges_; }
   /// Hull vertices counter-clockwise, collinear hull points included; for a
   /// degenerate set the distinct points sorted by (x, y).
-  const std::vector<std::uint32_t>& hull() const { return hull_; }
+  const FlatArray<std::uint32_t>& hull() const { return hull_; }
   std::size_t triangle_count() const { return triangles_.size() / 3; }
 
   /// Constrained triangulations: per half-edge of triangles(), 1 if it lies on
   /// a segment (empty without segments).
-  const std::vector<std::uint8_t>& constrained() const { return constrained_; }
+  const FlatArray<std::uint8_t>& constrained() const { return constrained_; }
   /// The constrained edges, each once, as point index pairs.
   std::vector<Segment> constrained_edges() const;
   /// The input segments as given.
@@ -162,18 +164,23 @@ class Delaunay2 {
   void remove(std::uint32_t v);
 
   /// Writes the triangulation to `path` as a geods archive (core/archive.hpp,
-  /// kind "voronoi.Delaunay2"): points, segments and the internal arrays.
+  /// kind "voronoi.Delaunay2", version 2): points, segments, the internal
+  /// arrays and the public ones (triangles(), halfedges(), hull()...).
   /// Throws geods::Error naming the file if it cannot be written.
   void save(const std::filesystem::path& path) const;
   /// A triangulation equal to the one save()d to `path`: the same arrays, the
-  /// same answers, and insert() and remove() go on as they would have (the
-  /// mapped arrays are copied into the triangulation's own); O(n). Throws
-  /// geods::Error naming the file if it is missing, truncated, corrupt (the
-  /// checksums), of another kind or version, or its arrays are not a closed
-  /// triangulation of its points: indices in range, twins mutual, triangles
-  /// counter-clockwise, every representative a vertex (validate()'s checks but
-  /// the costly ones, incircle and the segments' paths, which a checksummed
-  /// file written by save() cannot fail; Verify::full and structure_only, which
+  /// same answers, and insert() and remove() go on as they would have. The
+  /// arrays are views of the mapped file (FlatArray::mapped()): queries read
+  /// its pages in place, nothing is rebuilt; the first insert() or remove()
+  /// copies them into arrays of the triangulation's own. O(n) for the checks.
+  /// Throws geods::Error naming the file if it is missing, truncated, corrupt
+  /// (the checksums), of another kind or version (version 1 files, written
+  /// before the public arrays were saved, too: save them again), or its arrays
+  /// are not a closed triangulation of its points: indices in range, twins
+  /// mutual, triangles counter-clockwise, every representative a vertex, the
+  /// public arrays what the internal ones give (validate()'s checks but the
+  /// costly ones, incircle and the segments' paths, which a checksummed file
+  /// written by save() cannot fail; Verify::full and structure_only, which
   /// skips the checksums, run those too).
   static Delaunay2 load(const std::filesystem::path& path, Archive::Verify verify = Archive::Verify::checksums);
 
@@ -185,44 +192,42 @@ class Delaunay2 {
   void validate() const;
 
  private:
-  void init(std::span<const Vec2d> points, std::span<const Segment> segments, Options options);
-  void build(Options options);
-  template <class Location>
-  void insert_all(Location& location);
-  void build_degenerate();
-  std::uint32_t add_vertex(std::uint32_t i);  // appends an internal vertex for point i
-  template <class Hooks>
-  void insert_vertex(std::uint32_t k, std::uint32_t start, Hooks& hooks);
-  void insert_constraints();
-  void publish();
+  struct Editor;  // the arrays as vectors while they change (delaunay2.cpp)
+  DelaunayView view() const { return {{}, coords_, vert_, twin_}; }
   struct TriangleCounts {
     std::size_t live, ghosts;
   };
-  // validate()'s first parts, safe on any arrays of the right sizes: what load() checks.
+  // validate()'s cheap parts, safe on any arrays of the right sizes: what load() checks.
   std::size_t check_representatives() const;  // returns the number of distinct vertices
   TriangleCounts check_triangles() const;
+  void check_public_view(std::size_t finite) const;  // for `finite` triangles: every public array is what publish() makes
 
+  // Every array is read only (its own after a construction or a change, a
+  // view into the file after load()); Editor changes them.
   Options options_;
-  std::vector<Vec2d> points_;
+  FlatArray<Vec2d> points_;
   std::vector<Segment> segments_;
   std::vector<std::uint32_t> intersections_;
-  std::vector<std::uint32_t> rep_;  // representative per point, no_edge when removed
+  FlatArray<std::uint32_t> rep_;  // representative per point, no_edge when removed
 
-  // The closed triangulation. Its vertices are numbered in insertion order,
-  // their coordinates copied in that order, so that the spatially sorted
-  // insertion reads memory sequentially.
-  DelaunayCore core_;
-  std::vector<std::uint32_t> original_of_;  // internal vertex -> the point it stands for
-  std::vector<std::uint32_t> internal_of_;  // point -> its internal vertex, no_edge if removed
-  std::vector<std::uint8_t> fixed_;         // per internal half-edge: on a segment (only with segments)
+  // The closed triangulation: DelaunayCore's arrays. Its vertices are numbered
+  // in insertion order, their coordinates copied in that order, so that the
+  // spatially sorted insertion reads memory sequentially.
+  FlatArray<Vec2d> coords_;
+  FlatArray<std::uint32_t> vert_, twin_, free_triangles_, vertex_edge_;
+  std::uint32_t last_triangle_ = 0;
+  std::size_t flips_ = 0, walk_steps_ = 0;
+  FlatArray<std::uint32_t> original_of_;  // internal vertex -> the point it stands for
+  FlatArray<std::uint32_t> internal_of_;  // point -> its internal vertex, no_edge if removed
+  FlatArray<std::uint8_t> fixed_;         // per internal half-edge: on a segment (only with segments)
   bool has_constraints_ = false;
   std::size_t dag_nodes_ = 0;
 
   // The public, finite-only view.
-  std::vector<std::uint32_t> triangles_, halfedges_, hull_;
-  std::vector<std::uint8_t> constrained_;
-  std::vector<std::uint32_t> public_triangle_;  // internal triangle -> public index or no_edge
-  std::vector<std::uint32_t> internal_triangle_;  // public -> internal
+  FlatArray<std::uint32_t> triangles_, halfedges_, hull_;
+  FlatArray<std::uint8_t> constrained_;
+  FlatArray<std::uint32_t> public_triangle_;    // internal triangle -> public index or no_edge
+  FlatArray<std::uint32_t> internal_triangle_;  // public -> internal
 };
 
 }  // namespace geods::voronoi

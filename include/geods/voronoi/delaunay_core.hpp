@@ -16,6 +16,7 @@
 // calls them, and legalize() asks them which edges must not flip. NoHooks is
 // the plain path; the calls compile away.
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "geods/core/predicates.hpp"
@@ -31,8 +32,9 @@ struct NoHooks {
   bool fixed(std::uint32_t /*e*/) const { return false; }
 };
 
-class DelaunayCore {
- public:
+/// The vocabulary of the closed half-edge arrays, shared by the core that
+/// builds them and the view that queries them.
+struct DelaunayHalfEdges {
   static constexpr std::uint32_t none = std::uint32_t(-1);
   static constexpr std::uint32_t ghost = std::uint32_t(-2);    // the vertex at infinity
   static constexpr std::uint32_t ghost_bit = 1u << 31;         // set in ghost, never in a vertex
@@ -51,7 +53,29 @@ class DelaunayCore {
     std::uint32_t edge;  // inside: any half-edge of the triangle; on_edge: the edge;
                          // on_vertex: a half-edge leaving the vertex; outside: the ghost triangle's hull half-edge
   };
+};
 
+/// The closed triangulation read only, as spans: what the walk and the circle
+/// tests read. DelaunayCore views its vectors through it while building;
+/// Delaunay2 views its arrays (its own, or a mapped file's) for the queries.
+struct DelaunayView : DelaunayHalfEdges {
+  std::span<const Vec2d> coords;              // per internal vertex
+  std::span<const std::uint32_t> vert, twin;  // per half-edge
+
+  const Vec2d& at(std::uint32_t v) const { return coords[v]; }
+  bool is_ghost_triangle(std::uint32_t t) const { return ((vert[3 * t] | vert[3 * t + 1] | vert[3 * t + 2]) & ghost_bit) != 0; }
+  /// The triangle, edge or vertex of p, by a stochastic visibility walk from
+  /// triangle `start`; adds the triangles visited to *steps (when given).
+  Location walk(const Vec2d& p, std::uint32_t start, std::size_t* steps) const;
+  /// p inside the circle of the counter-clockwise triangle (a, b, c) (with a
+  /// ghost vertex: the open half-plane beyond its finite edge, plus the open edge).
+  bool circle_holds(std::uint32_t a, std::uint32_t b, std::uint32_t c, const Vec2d& p) const;
+  /// p inside the circle of triangle t: it conflicts with p.
+  bool in_conflict(std::uint32_t t, const Vec2d& p) const { return circle_holds(vert[3 * t], vert[3 * t + 1], vert[3 * t + 2], p); }
+};
+
+class DelaunayCore : public DelaunayHalfEdges {
+ public:
   std::vector<Vec2d> coords;                  // per internal vertex
   std::vector<std::uint32_t> vert, twin;      // per half-edge: origin vertex (or ghost; none in a freed slot), opposite
   std::vector<std::uint32_t> free_triangles;  // freed slots, reused by new_triangle()
@@ -59,8 +83,15 @@ class DelaunayCore {
   std::uint32_t last_triangle = 0;            // where the next walk starts: the triangle of the last change
   std::size_t flips = 0, walk_steps = 0;
 
+  /// The arrays as they are now (until they grow).
+  DelaunayView view() const { return {{}, coords, vert, twin}; }
   const Vec2d& at(std::uint32_t v) const { return coords[v]; }
-  bool is_ghost_triangle(std::uint32_t t) const { return ((vert[3 * t] | vert[3 * t + 1] | vert[3 * t + 2]) & ghost_bit) != 0; }
+  bool is_ghost_triangle(std::uint32_t t) const { return view().is_ghost_triangle(t); }
+  Location walk(const Vec2d& p, std::uint32_t start, std::size_t* steps) const { return view().walk(p, start, steps); }
+  bool circle_holds(std::uint32_t a, std::uint32_t b, std::uint32_t c, const Vec2d& p) const {
+    return view().circle_holds(a, b, c, p);
+  }
+  bool in_conflict(std::uint32_t t, const Vec2d& p) const { return view().in_conflict(t, p); }
   void link(std::uint32_t a, std::uint32_t b) {
     twin[a] = b;
     twin[b] = a;
@@ -70,20 +101,11 @@ class DelaunayCore {
   /// vertices that are not collinear, the earliest in coords, with its three
   /// ghost triangles. False if there is none (the set is degenerate).
   bool make_first_triangle();
-  /// The triangle, edge or vertex of p, by a stochastic visibility walk from
-  /// triangle `start`; adds the triangles visited to *steps.
-  Location walk(const Vec2d& p, std::uint32_t start, std::size_t* steps) const;
-  /// p inside the circle of the counter-clockwise triangle (a, b, c) (with a
-  /// ghost vertex: the open half-plane beyond its finite edge, plus the open edge).
-  bool circle_holds(std::uint32_t a, std::uint32_t b, std::uint32_t c, const Vec2d& p) const;
-  /// p inside the circle of triangle t: it conflicts with p.
-  bool in_conflict(std::uint32_t t, const Vec2d& p) const { return circle_holds(vert[3 * t], vert[3 * t + 1], vert[3 * t + 2], p); }
   /// A triangle slot (a freed one or three new half-edges) holding the
   /// vertices (a, b, c); its twins are for the caller to link.
   std::uint32_t new_triangle(std::uint32_t a, std::uint32_t b, std::uint32_t c);
   /// Frees triangle t's slot (its vertices become none).
   void free_triangle(std::uint32_t t);
-
   /// Inserts vertex i (coords[i] set): walk from `start`, split, legalize.
   /// Returns none, or the vertex at the same place (then nothing changes).
   template <class Hooks>
@@ -107,7 +129,7 @@ class DelaunayCore {
 
 // ------------------------------------------------------------------ the steps
 
-inline bool DelaunayCore::circle_holds(std::uint32_t a, std::uint32_t b, std::uint32_t c, const Vec2d& p) const {
+inline bool DelaunayView::circle_holds(std::uint32_t a, std::uint32_t b, std::uint32_t c, const Vec2d& p) const {
   if (((a | b | c) & ghost_bit) == 0) [[likely]]
     return incircle(at(a), at(b), at(c), p) > 0;
   // The circle of a ghost triangle (x, y, ghost) is the open half-plane left of
