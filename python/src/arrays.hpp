@@ -181,7 +181,7 @@ std::int64_t index_value(I i) {
 }
 
 /// 0/1 flags as a bool array.
-inline py::array_t<bool> bool_array(const std::vector<std::uint8_t>& flags) {
+inline py::array_t<bool> bool_array(std::span<const std::uint8_t> flags) {
   py::array_t<bool> out(py::ssize_t(flags.size()));
   bool* o = out.mutable_data();
   for (std::size_t i = 0; i < flags.size(); ++i) o[i] = flags[i] != 0;

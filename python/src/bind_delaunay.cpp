@@ -91,14 +91,14 @@ new appended point (intersection_points). NaN/inf raise geods.Error (ValueError)
           "(n, 2) float64: the input points, then intersection and inserted points")
       .def_property_readonly(
           "triangles",
-          [](const Delaunay2& dt) { return index_array(dt.triangles(), {py::ssize_t(dt.triangle_count()), 3}); },
+          [](const Delaunay2& dt) { return index_array(dt.triangles().span(), {py::ssize_t(dt.triangle_count()), 3}); },
           "(m, 3) int64: counter-clockwise vertex indices (first occurrences of duplicates)")
       .def_property_readonly(
-          "halfedges", [](const Delaunay2& dt) { return index_array(dt.halfedges()); },
+          "halfedges", [](const Delaunay2& dt) { return index_array(dt.halfedges().span()); },
           "(3m,) int64: the opposite half-edge of half-edge e (from triangles.flat[e] to the next vertex "
           "of its triangle), -1 on the hull")
       .def_property_readonly(
-          "hull", [](const Delaunay2& dt) { return index_array(dt.hull()); },
+          "hull", [](const Delaunay2& dt) { return index_array(dt.hull().span()); },
           "hull vertices counter-clockwise (for a degenerate set: the distinct points sorted by x, y)")
       .def_property_readonly("degenerate", &Delaunay2::degenerate, "True when there are no triangles")
       .def_property_readonly(

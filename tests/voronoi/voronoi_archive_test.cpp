@@ -130,16 +130,33 @@ void write_bytes(const fs::path& path, const std::string& bytes) {
   std::ofstream(path, std::ios::binary).write(bytes.data(), std::streamsize(bytes.size()));
 }
 
-// A Delaunay2 archive of points `xy` (each its own vertex, in order) and the
-// closed triangulation (vert, twin), written with matching checksums.
+// A Delaunay2 archive of points `xy` (each its own vertex, in order), the
+// closed triangulation (vert, twin) and its public view (finite triangles in
+// order, `hull` as given), written with matching checksums.
 void write_triangulation(const fs::path& path, const std::vector<double>& xy, const std::vector<std::uint32_t>& vert,
-                         const std::vector<std::uint32_t>& twin) {
-  ArchiveWriter w("voronoi.Delaunay2", 1);
+                         const std::vector<std::uint32_t>& twin, const std::vector<std::uint32_t>& hull = {}) {
+  constexpr std::uint32_t none = Delaunay2::no_edge;
+  ArchiveWriter w("voronoi.Delaunay2", 2);
   const std::vector<std::uint32_t> no_indices;
   std::vector<std::uint32_t> iota(xy.size() / 2);
   for (std::uint32_t i = 0; i < iota.size(); ++i) iota[i] = i;
   const std::vector<std::uint64_t> counters = {0, 0, 0};
   const std::vector<std::uint8_t> no_marks;
+  std::vector<std::uint32_t> public_triangle(vert.size() / 3, none), internal_triangle, triangles, halfedges;
+  std::vector<std::uint32_t> vertex_edge(iota.size(), none);
+  for (std::uint32_t t = 0; t < vert.size() / 3; ++t)
+    if (vert[3 * t] < iota.size() && vert[3 * t + 1] < iota.size() && vert[3 * t + 2] < iota.size()) {
+      public_triangle[t] = std::uint32_t(internal_triangle.size());
+      internal_triangle.push_back(t);
+    }
+  for (std::uint32_t t : internal_triangle)
+    for (std::uint32_t e = 3 * t; e < 3 * t + 3; ++e) {
+      triangles.push_back(vert[e]);
+      const std::uint32_t f = twin[e] < vert.size() ? twin[e] : 0, other = public_triangle[f / 3];
+      halfedges.push_back(other == none ? none : 3 * other + f % 3);
+    }
+  for (std::uint32_t h = 0; h < vert.size(); ++h)
+    if (vert[h] < iota.size()) vertex_edge[vert[h]] = h;
   w.add_value("seed", std::uint64_t(1));
   w.add_value("location", std::uint32_t(0));
   w.add_value("has_constraints", std::uint8_t(0));
@@ -155,7 +172,14 @@ void write_triangulation(const fs::path& path, const std::vector<double>& xy, co
   w.add("vert", vert);
   w.add("twin", twin);
   w.add("free_triangles", no_indices);
+  w.add("vertex_edge", vertex_edge);
   w.add("fixed", no_marks);
+  w.add("triangles", triangles);
+  w.add("halfedges", halfedges);
+  w.add("hull", hull);
+  w.add("constrained", no_marks);
+  w.add("public_triangle", public_triangle);
+  w.add("internal_triangle", internal_triangle);
   w.write(path);
 }
 
@@ -226,7 +250,7 @@ TEST(Delaunay2Archive, BrokenStructureRaisesAndVerifyFullChecksCircles) {
   const std::vector<double> xy = {0, 0, 2, -1, 4, 0, 2, 1};
   const auto [vert, twin] = closed_triangulation({{0, 1, 2}, {0, 2, 3}}, {0, 1, 2, 3});
   const fs::path path = temp_file("kite");
-  write_triangulation(path, xy, vert, twin);
+  write_triangulation(path, xy, vert, twin, {0, 1, 2, 3});
   const Delaunay2 loaded = Delaunay2::load(path);  // the cheap checks pass
   EXPECT_EQ(loaded.triangle_count(), 2u);
   EXPECT_EQ(loaded.locate({2, 0.5}), loaded.locate({3, 0.1}));  // queries answer from what was loaded
@@ -235,13 +259,13 @@ TEST(Delaunay2Archive, BrokenStructureRaisesAndVerifyFullChecksCircles) {
   // Twins that are not mutual, the checksums right.
   std::vector<std::uint32_t> bad_twin = twin;
   std::swap(bad_twin[0], bad_twin[1]);
-  write_triangulation(path, xy, vert, bad_twin);
+  write_triangulation(path, xy, vert, bad_twin, {0, 1, 2, 3});
   EXPECT_THROW(Delaunay2::load(path), Error);
   EXPECT_THROW(Delaunay2::load(path, Archive::Verify::structure_only), Error);
   // A vertex index out of range.
   std::vector<std::uint32_t> bad_vert = vert;
   bad_vert[1] = 7;
-  write_triangulation(path, xy, bad_vert, twin);
+  write_triangulation(path, xy, bad_vert, twin, {0, 1, 2, 3});
   EXPECT_THROW(Delaunay2::load(path), Error);
   fs::remove(path);
 }
