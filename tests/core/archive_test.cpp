@@ -70,6 +70,24 @@ TEST(FlatArray, OwnsOrViewsAndCopiesKeepTheirOwnData) {
   EXPECT_EQ(w[3], 7);
 }
 
+TEST(FlatArray, TakeVectorMovesWhatItOwnsAndCopiesAView) {
+  std::vector<int> elements = {1, 2, 3};
+  const int* buffer = elements.data();
+  FlatArray<int> a(std::move(elements));
+  std::vector<int> taken = std::move(a).take_vector();
+  EXPECT_EQ(taken.data(), buffer);  // moved out, not copied
+  EXPECT_EQ(taken, (std::vector<int>{1, 2, 3}));
+  EXPECT_TRUE(a.empty());  // NOLINT(bugprone-use-after-move): left empty on purpose
+
+  static const int backing[3] = {4, 5, 6};
+  FlatArray<int> v(std::span<const int>(backing), std::make_shared<int>(0));
+  taken = std::move(v).take_vector();
+  EXPECT_NE(taken.data(), backing);  // a copy the caller may change
+  EXPECT_EQ(taken, (std::vector<int>{4, 5, 6}));
+  EXPECT_TRUE(v.empty());  // NOLINT(bugprone-use-after-move)
+  EXPECT_TRUE(std::move(FlatArray<int>()).take_vector().empty());
+}
+
 // An allocator other than std::allocator (as HugePageAllocator is).
 template <typename T>
 struct CountingAllocator {

@@ -121,6 +121,66 @@ TEST(Delaunay2Archive, ConstrainedRoundTrip) {
   expect_same(original, loaded);
 }
 
+TEST(Delaunay2Archive, LoadedArraysAreViewsUntilTheFirstChange) {
+  const Delaunay2 original(random_points(1000, 11));
+  const fs::path path = temp_file("mapped");
+  original.save(path);
+  Delaunay2 loaded = Delaunay2::load(path);
+  fs::remove(path);  // the mapping outlives the name
+  EXPECT_TRUE(loaded.triangles().mapped());
+  EXPECT_TRUE(loaded.halfedges().mapped());
+  EXPECT_TRUE(loaded.hull().mapped());
+  EXPECT_FALSE(original.triangles().mapped());
+  expect_same(original, loaded);
+  const Voronoi2 from_loaded(loaded), from_original(original);  // the dual, built from the views
+  EXPECT_EQ(from_loaded.vertices(), from_original.vertices());
+  const Delaunay2 copy = loaded;  // copies share the views
+  EXPECT_TRUE(copy.triangles().mapped());
+  Delaunay2 changed = original;
+  const Vec2d p(0.25, 0.75);
+  EXPECT_EQ(changed.insert(p), loaded.insert(p));  // copies the views into arrays of its own
+  EXPECT_FALSE(loaded.triangles().mapped());
+  EXPECT_FALSE(loaded.halfedges().mapped());
+  EXPECT_TRUE(copy.triangles().mapped());  // the copy still reads the file
+  loaded.validate();
+  expect_same(changed, loaded);
+  expect_same(original, copy);
+}
+
+TEST(Delaunay2Archive, SmallAndDegenerateSetsRoundTrip) {
+  const std::vector<std::vector<Vec2d>> sets = {
+      {{0.5, 0.5}},                                          // one point
+      {{0, 0}, {1, 1}},                                      // two
+      {{2, 2}, {2, 2}, {2, 2}},                              // one point three times
+      {{0, 0}, {1, 0}, {0, 1}},                              // one triangle
+      {{0, 0}, {1, 0}, {0, 1}, {1, 0}, {0, 0}},              // one triangle with duplicates
+      {{0, 0}, {1, 0}, {1, 1}, {0, 1}, {0.5, 0.5}, {1, 1}},  // co-circular square, its centre, a duplicate
+  };
+  for (std::size_t k = 0; k < sets.size(); ++k) {
+    SCOPED_TRACE("set " + std::to_string(k));
+    Delaunay2 original(sets[k]);
+    Delaunay2 loaded = round_trip(original, "small" + std::to_string(k));
+    EXPECT_EQ(loaded.degenerate(), original.degenerate());
+    expect_same(original, loaded);
+    for (const Vec2d& p : {Vec2d(0.3, 0.2), Vec2d(2, 2), Vec2d(-1, 0.5)}) EXPECT_EQ(original.insert(p), loaded.insert(p));
+    expect_same(original, loaded);
+    original.remove(0);
+    loaded.remove(0);
+    loaded.validate();
+    expect_same(original, loaded);
+  }
+  // Co-circular grid points with many duplicates, then removals after loading.
+  Delaunay2 grid(random_points(400, 12, true));
+  Delaunay2 loaded = round_trip(grid, "grid_remove");
+  for (std::uint32_t v = 0; v < 400; v += 3)
+    if (grid.representative(v) != Delaunay2::no_edge) {
+      grid.remove(v);
+      loaded.remove(v);
+    }
+  loaded.validate();
+  expect_same(grid, loaded);
+}
+
 std::string read_bytes(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
   return {std::istreambuf_iterator<char>(in), {}};
@@ -226,6 +286,73 @@ void expect_bad_files_rejected(const fs::path& good, Load load) {
   EXPECT_THROW(load(temp_file("missing")), Error);
 }
 
+// Writes the Delaunay2 archive at `from` again to `to` with entry `at` of the
+// index section `name` changed to `value` (the checksums made to fit).
+void rewrite_index(const fs::path& from, const fs::path& to, const std::string& name, std::size_t at, std::uint32_t value) {
+  const Archive a = Archive::open(from, "voronoi.Delaunay2", 2);
+  ArchiveWriter w("voronoi.Delaunay2", 2);
+  std::vector<std::vector<std::uint32_t>> indices;
+  indices.reserve(32);
+  for (const char* section : {"seed", "counters"}) w.add(section, a.array<std::uint64_t>(section));
+  for (const char* section : {"has_constraints", "fixed", "constrained"}) w.add(section, a.array<std::uint8_t>(section));
+  for (const char* section : {"points", "coords"}) w.add(section, a.array<double>(section));
+  for (const char* section : {"location", "last_triangle", "segments", "intersections", "representative", "original_of",
+                              "internal_of", "vert", "twin", "free_triangles", "vertex_edge", "triangles", "halfedges",
+                              "hull", "public_triangle", "internal_triangle"}) {
+    std::vector<std::uint32_t>& v = indices.emplace_back(a.array<std::uint32_t>(section).to_vector());
+    if (section == name) v.at(at) = value;
+    w.add(section, v);
+  }
+  w.write(to);
+}
+
+TEST(Delaunay2Archive, PublicArraysThatDisagreeRaise) {
+  std::vector<Vec2d> p = random_points(100, 13);
+  for (Vec2d q : {Vec2d(0.1, 0.1), Vec2d(0.9, 0.2), Vec2d(0.5, 0.9)}) p.push_back(q);
+  const std::vector<Delaunay2::Segment> segments = {{100, 101}, {101, 102}};
+  const Delaunay2 dt(p, segments);
+  const fs::path good = temp_file("public_good"), bad = temp_file("public_bad");
+  dt.save(good);
+  const std::uint32_t t0 = dt.triangles()[0], h0 = dt.halfedges()[0], e0 = 3 * std::uint32_t(dt.triangle_count()) - 1;
+  rewrite_index(good, bad, "triangles", 0, t0);  // unchanged: the rewrite itself loads
+  expect_same(dt, Delaunay2::load(bad));
+  const struct {
+    const char* section;
+    std::size_t at;
+    std::uint32_t value;
+  } tampered[] = {
+      {"triangles", 0, t0 == 0 ? 1u : 0u},
+      {"triangles", 1, t0},
+      {"halfedges", 0, h0 == Delaunay2::no_edge ? 0 : Delaunay2::no_edge},
+      {"halfedges", e0, e0},
+      {"hull", 0, dt.hull()[1]},
+      {"public_triangle", 0, Delaunay2::no_edge},
+      {"internal_triangle", 0, 1},
+      {"vertex_edge", 0, Delaunay2::no_edge},
+      {"vertex_edge", 1, 0},
+  };
+  for (const auto& [section, at, value] : tampered) {
+    rewrite_index(good, bad, section, at, value);
+    EXPECT_THROW(Delaunay2::load(bad), Error) << section << "[" << at << "] = " << value;
+  }
+  fs::remove(good);
+  fs::remove(bad);
+}
+
+TEST(Delaunay2Archive, VersionOneFilesAreRefused) {
+  const fs::path path = temp_file("version1");
+  ArchiveWriter w("voronoi.Delaunay2", 1);
+  w.add_value("seed", std::uint64_t(1));
+  w.write(path);
+  try {
+    Delaunay2::load(path);
+    ADD_FAILURE() << "a version 1 file loaded";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("version 1"), std::string::npos) << e.what();
+  }
+  fs::remove(path);
+}
+
 TEST(Delaunay2Archive, BadFilesRaise) {
   const fs::path path = temp_file("good");
   Delaunay2(random_points(100, 6)).save(path);
@@ -262,6 +389,13 @@ TEST(Delaunay2Archive, BrokenStructureRaisesAndVerifyFullChecksCircles) {
   write_triangulation(path, xy, vert, bad_twin, {0, 1, 2, 3});
   EXPECT_THROW(Delaunay2::load(path), Error);
   EXPECT_THROW(Delaunay2::load(path, Archive::Verify::structure_only), Error);
+  // A public view that is not the one of the triangulation: a hull that starts
+  // elsewhere, runs the other way or misses a vertex.
+  for (const std::vector<std::uint32_t>& bad_hull :
+       {std::vector<std::uint32_t>{1, 2, 3, 0}, std::vector<std::uint32_t>{0, 3, 2, 1}, std::vector<std::uint32_t>{0, 1, 2}}) {
+    write_triangulation(path, xy, vert, twin, bad_hull);
+    EXPECT_THROW(Delaunay2::load(path), Error);
+  }
   // A vertex index out of range.
   std::vector<std::uint32_t> bad_vert = vert;
   bad_vert[1] = 7;
