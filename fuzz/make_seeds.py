@@ -250,6 +250,7 @@ def accelerator_seeds():
 def delaunay2_seed():
     """A Delaunay2 of the triangle (0, 0), (1, 0), (0, 1) closed by its three ghost triangles."""
     ghost = 0xFFFFFFFE
+    none = 0xFFFFFFFF
     xy = struct.pack("<6d", 0, 0, 1, 0, 0, 1)
     iota = struct.pack("<3I", 0, 1, 2)
     vert = struct.pack("<12I", 0, 1, 2, 1, 0, ghost, 2, 1, ghost, 0, 2, ghost)
@@ -260,7 +261,11 @@ def delaunay2_seed():
         ("points", F64, 8, xy), ("segments", U32, 4, b""), ("intersections", U32, 4, b""),
         ("representative", U32, 4, iota), ("coords", F64, 8, xy), ("original_of", U32, 4, iota),
         ("internal_of", U32, 4, iota), ("vert", U32, 4, vert), ("twin", U32, 4, twin),
-        ("free_triangles", U32, 4, b""), ("fixed", U8, 1, b"")])
+        ("free_triangles", U32, 4, b""), ("vertex_edge", U32, 4, struct.pack("<3I", 9, 7, 10)),
+        ("fixed", U8, 1, b""), ("triangles", U32, 4, iota),
+        ("halfedges", U32, 4, struct.pack("<3I", none, none, none)), ("hull", U32, 4, struct.pack("<3I", 0, 1, 2)),
+        ("constrained", U8, 1, b""), ("public_triangle", U32, 4, struct.pack("<4I", 0, none, none, none)),
+        ("internal_triangle", U32, 4, struct.pack("<I", 0))], version=2)
 
 
 def main():

@@ -175,6 +175,15 @@ def test_save_load_round_trip_and_bad_files(cli, tmp_path):
     queries = rng.random((50, 2))
     assert [loaded.locate(q) for q in queries] == [dt.locate(q) for q in queries]
     assert [loaded.nearest(q) for q in queries] == [dt.nearest(q) for q in queries]
+    assert all(np.array_equal(loaded.neighbors(v), dt.neighbors(v)) for v in range(0, 400, 9))
+    # Degenerate sets (collinear with a duplicate; one point) load too.
+    for few in (np.array([[0.0, 0.0], [2, 2], [1, 1], [1, 1]]), np.array([[0.5, 0.5]])):
+        small = geods.Delaunay2(few)
+        small.save(tmp_path / "few.geods")
+        back = geods.Delaunay2.load(tmp_path / "few.geods")
+        back.validate()
+        assert np.array_equal(back.hull, small.hull) and len(back.triangles) == 0
+        assert back.nearest([0.9, 1.2]) == small.nearest([0.9, 1.2])
     # Updates go on as on the original.
     plain = geods.Delaunay2(pts)
     plain.save(path)
