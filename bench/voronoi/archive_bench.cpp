@@ -43,6 +43,39 @@ void BM_Delaunay2Load(benchmark::State& state) {
 }
 BENCHMARK(BM_Delaunay2Load)->Arg(1 << 20)->Unit(benchmark::kMillisecond);
 
+// Queries on a triangulation of 2^20 uniform points, random query points.
+// Arg: 0 on the built triangulation, 1 on the same loaded (read from the mapped file).
+template <class Query>
+void run_delaunay2_queries(benchmark::State& state, Query query) {
+  const std::size_t n = std::size_t(1) << 20;
+  voronoi::Delaunay2 dt(uniform(n));
+  if (state.range(0) == 1) {
+    const std::filesystem::path path = saved("delaunay2_queries", n);
+    dt.save(path);
+    dt = voronoi::Delaunay2::load(path);
+    std::filesystem::remove(path);
+  }
+  Rng rng(2);
+  std::vector<Vec2d> q(4096);
+  for (Vec2d& v : q) v = {rng.uniform(), rng.uniform()};
+  std::size_t i = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(query(dt, q[i]));
+    if (++i == q.size()) i = 0;
+  }
+  state.SetItemsProcessed(std::int64_t(state.iterations()));
+}
+
+void BM_Delaunay2Locate(benchmark::State& state) {
+  run_delaunay2_queries(state, [](const voronoi::Delaunay2& dt, const Vec2d& q) { return dt.locate(q); });
+}
+BENCHMARK(BM_Delaunay2Locate)->Arg(0)->Arg(1);
+
+void BM_Delaunay2Nearest(benchmark::State& state) {
+  run_delaunay2_queries(state, [](const voronoi::Delaunay2& dt, const Vec2d& q) { return dt.nearest(q); });
+}
+BENCHMARK(BM_Delaunay2Nearest)->Arg(0)->Arg(1);
+
 void BM_Voronoi2Build(benchmark::State& state) {
   const std::vector<Vec2d> p = uniform(std::size_t(state.range(0)));
   for (auto _ : state) benchmark::DoNotOptimize(voronoi::Voronoi2(p).vertices().size());
