@@ -550,21 +550,27 @@ Delaunay2Stats Delaunay2::stats() const {
   return s;
 }
 
-// The closed triangulation's combinatorics: twins, vertices, orientation. The
-// vertices' links to their points are checked once per vertex, not per
-// half-edge: the points are in input order, the vertices in insertion order, so
-// those reads miss the cache (they were most of load()'s time).
-Delaunay2::TriangleCounts Delaunay2::check_triangles() const {
+// The closed triangulation's combinatorics: twins, vertices, orientation, and
+// vertex_edge (the last half-edge leaving each vertex, none for a vertex in no
+// triangle: publish() keeps it so), which also tells which vertices are used.
+// The vertices' links to their points are checked once per vertex, not per
+// half-edge (the points are in input order, the vertices in insertion order, so
+// those reads miss the cache); that each representative has a vertex follows
+// by counting, since a vertex maps back to one representative of its own.
+Delaunay2::TriangleCounts Delaunay2::check_triangles(std::size_t representatives) const {
   const auto fail = [](const std::string& what) { throw Error("Delaunay2::validate: " + what); };
   const std::size_t n = points_.size(), vertices = coords_.size();
   const std::uint32_t half_edges = std::uint32_t(vert_.size());
   if (twin_.size() != half_edges || half_edges % 3) fail("array sizes");
   if (has_constraints_ && fixed_.size() != half_edges) fail("constraint flags have the wrong size");
   if (original_of_.size() != vertices) fail("one point per vertex expected");
+  if (vertex_edge_.size() != vertices) fail("one half-edge per vertex expected");
   std::size_t live = 0, ghosts = 0;
-  std::vector<char> used(vertices, 0);
   for (std::uint32_t t = 0; t < half_edges / 3; ++t) {
-    if (vert_[3 * t] == kNone) continue;
+    if (vert_[3 * t] == kNone) {
+      if (vert_[3 * t + 1] != kNone || vert_[3 * t + 2] != kNone) fail("triangle " + std::to_string(t) + " is partly free");
+      continue;
+    }
     ++live;
     const bool ghost = view().is_ghost_triangle(t);
     ghosts += ghost;
@@ -574,7 +580,7 @@ Delaunay2::TriangleCounts Delaunay2::check_triangles() const {
       const std::uint32_t v = vert_[e], f = twin_[e];
       if (v != kGhost) {
         if (v >= vertices) fail("triangle " + std::to_string(t) + " uses a vertex that is not a representative");
-        used[v] = 1;
+        if (vertex_edge_[v] == kNone || vertex_edge_[v] < e) fail("vertex " + std::to_string(v) + " has the wrong half-edge");
       }
       if (f >= half_edges || twin_[f] != e || vert_[f] == kNone) fail("twin of half-edge " + std::to_string(e));
       if (vert_[f] != vert_[next(e)] || vert_[next(f)] != v) fail("twins of half-edge " + std::to_string(e) + " do not share their end points");
@@ -582,19 +588,20 @@ Delaunay2::TriangleCounts Delaunay2::check_triangles() const {
     if (!ghost && !(orient2d(coords_[vert_[3 * t]], coords_[vert_[3 * t + 1]], coords_[vert_[3 * t + 2]]) > 0))
       fail("triangle " + std::to_string(t) + " is not counter-clockwise");
   }
-  // Each vertex in a triangle stands for a representative point at its place,
-  // which maps back to it; each representative has such a vertex.
+  // Each vertex in a triangle (its half-edge leaves it) stands for a
+  // representative point at its place, which maps back to it.
+  std::size_t used = 0;
   for (std::uint32_t v = 0; v < vertices; ++v) {
-    if (!used[v]) continue;
+    const std::uint32_t h = vertex_edge_[v];
+    if (h == kNone) continue;
+    if (h >= half_edges || vert_[h] != v) fail("vertex " + std::to_string(v) + " has a half-edge that does not leave it");
     const std::uint32_t o = original_of_[v];
     if (o >= n || rep_[o] != o || internal_of_[o] != v || points_[o] != coords_[v])
       fail("vertex " + std::to_string(v) + " is not a representative");
+    ++used;
   }
-  for (std::uint32_t i = 0; i < n; ++i) {
-    if (rep_[i] != i) continue;
-    const std::uint32_t v = i < internal_of_.size() ? internal_of_[i] : kNone;
-    if (v >= vertices || !used[v] || original_of_[v] != i) fail("point " + std::to_string(i) + " is in no triangle");
-  }
+  if (used != representatives)
+    fail(std::to_string(representatives - std::min(used, representatives)) + " points are in no triangle");
   return {live, ghosts};
 }
 
@@ -630,7 +637,7 @@ void Delaunay2::validate() const {
     }
     return;
   }
-  const auto [live, ghosts] = check_triangles();
+  const auto [live, ghosts] = check_triangles(vertices);
   check_public_view(live - ghosts);
   const std::uint32_t half_edges = std::uint32_t(vert_.size());
   // Locally Delaunay: the vertex opposite each edge is not inside the circle
@@ -684,11 +691,10 @@ void Delaunay2::validate() const {
 // publish() computes from it (finite triangles numbered in internal order).
 void Delaunay2::check_public_view(std::size_t finite) const {
   const auto fail = [](const std::string& what) { throw Error("Delaunay2::validate: " + what); };
-  const std::uint32_t half_edges = std::uint32_t(vert_.size()), vertices = std::uint32_t(coords_.size());
+  const std::uint32_t half_edges = std::uint32_t(vert_.size());
   if (public_triangle_.size() != half_edges / 3 || internal_triangle_.size() != finite) fail("triangle maps have the wrong size");
   if (triangles_.size() != 3 * finite || halfedges_.size() != triangles_.size()) fail("public arrays have the wrong size");
   if (constrained_.size() != (has_constraints_ ? triangles_.size() : 0)) fail("public constraint flags have the wrong size");
-  if (vertex_edge_.size() != vertices) fail("one half-edge per vertex expected");
   std::uint32_t k = 0;
   for (std::uint32_t t = 0; t < half_edges / 3; ++t) {
     if (vert_[3 * t] == kNone || view().is_ghost_triangle(t)) {
@@ -708,15 +714,6 @@ void Delaunay2::check_public_view(std::size_t finite) const {
       if (has_constraints_ && constrained_[e] != fixed_[3 * t + s]) fail("public constraint flag " + std::to_string(e) + " differs");
     }
   }
-  // vertex_edge: the last half-edge leaving each vertex, none for a vertex in no triangle.
-  for (std::uint32_t h = 0; h < half_edges; ++h) {
-    const std::uint32_t v = vert_[h];
-    if (v != kGhost && v != kNone && (vertex_edge_[v] == kNone || vertex_edge_[v] < h))
-      fail("vertex " + std::to_string(v) + " has the wrong half-edge");
-  }
-  for (std::uint32_t v = 0; v < vertices; ++v)
-    if (vertex_edge_[v] != kNone && (vertex_edge_[v] >= half_edges || vert_[vertex_edge_[v]] != v))
-      fail("vertex " + std::to_string(v) + " has a half-edge that does not leave it");
   std::size_t h = 0;
   if (finite > 0)
     walk_hull(view(), [&](std::uint32_t v) {

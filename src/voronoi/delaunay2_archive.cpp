@@ -89,11 +89,11 @@ Delaunay2 Delaunay2::load(const std::filesystem::path& path, Archive::Verify ver
     if (dt.vert_[3 * t] != kNone) throw a.error("free_triangles: triangle " + std::to_string(t) + " is in use");
 
   a.check([&] {
-    dt.check_representatives();
+    const std::size_t representatives = dt.check_representatives();
     if (half_edges == 0) {
       dt.validate();  // cheap without triangles
     } else {
-      const TriangleCounts counts = dt.check_triangles();
+      const TriangleCounts counts = dt.check_triangles(representatives);
       dt.check_public_view(counts.live - counts.ghosts);
       if (Archive::checks_everything(verify)) dt.validate();
     }

@@ -199,7 +199,7 @@ class Delaunay2 {
   };
   // validate()'s cheap parts, safe on any arrays of the right sizes: what load() checks.
   std::size_t check_representatives() const;  // returns the number of distinct vertices
-  TriangleCounts check_triangles() const;
+  TriangleCounts check_triangles(std::size_t representatives) const;
   void check_public_view(std::size_t finite) const;  // for `finite` triangles: every public array is what publish() makes
 
   // Every array is read only (its own after a construction or a change, a
