@@ -6,6 +6,7 @@
 #include "geods/voronoi/delaunay2.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numeric>
 #include <optional>
@@ -13,6 +14,7 @@
 #include "brio_order.hpp"
 #include "constrained_delaunay.hpp"
 #include "geods/core/error.hpp"
+#include "geods/core/parallel.hpp"
 #include "geods/core/predicates.hpp"
 #include "geods/core/rng.hpp"
 #include "history_dag.hpp"
@@ -45,6 +47,34 @@ void walk_hull(const DelaunayView& mesh, Visit visit) {
     visit(mesh.vert[DelaunayView::prev(g)]);
     g = DelaunayView::next(mesh.twin[g]);  // x -> ghost, then ghost -> z in the next ghost triangle
   } while (g != start);
+}
+
+// Runs check(first, last), which returns two counts, over the blocks of [0,
+// count) in parallel and returns the counts summed. The geods::Error of the
+// first block that fails is thrown again: the first violation in index order,
+// however the threads ran.
+template <class Check>
+std::array<std::size_t, 2> check_in_blocks(std::size_t count, const Check& check) {
+  constexpr std::size_t kBlock = std::size_t(1) << 15;
+  const std::size_t blocks = (count + kBlock - 1) / kBlock;
+  std::vector<std::array<std::size_t, 2>> counts(blocks, {0, 0});
+  std::vector<std::optional<Error>> errors(blocks);
+  parallel_for_each_index(
+      0, blocks,
+      [&](std::size_t b) {
+        try {
+          counts[b] = check(b * kBlock, std::min(count, (b + 1) * kBlock));
+        } catch (const Error& e) {
+          errors[b] = e;
+        }
+      },
+      1);
+  std::array<std::size_t, 2> total = {0, 0};
+  for (std::size_t b = 0; b < blocks; ++b) {
+    if (errors[b]) throw *errors[b];
+    total[0] += counts[b][0], total[1] += counts[b][1];
+  }
+  return total;
 }
 
 }  // namespace
@@ -565,41 +595,62 @@ Delaunay2::TriangleCounts Delaunay2::check_triangles(std::size_t representatives
   if (has_constraints_ && fixed_.size() != half_edges) fail("constraint flags have the wrong size");
   if (original_of_.size() != vertices) fail("one point per vertex expected");
   if (vertex_edge_.size() != vertices) fail("one half-edge per vertex expected");
-  std::size_t live = 0, ghosts = 0;
-  for (std::uint32_t t = 0; t < half_edges / 3; ++t) {
-    if (vert_[3 * t] == kNone) {
-      if (vert_[3 * t + 1] != kNone || vert_[3 * t + 2] != kNone) fail("triangle " + std::to_string(t) + " is partly free");
-      continue;
-    }
-    ++live;
-    const bool ghost = view().is_ghost_triangle(t);
-    ghosts += ghost;
-    if ((vert_[3 * t] == kGhost) + (vert_[3 * t + 1] == kGhost) + (vert_[3 * t + 2] == kGhost) > 1)
-      fail("triangle " + std::to_string(t) + " has two ghost vertices");
+  // The twins and the vertices' half-edges are read at random (the checks are
+  // bound by those misses): ask for them a few triangles ahead.
+  const auto prefetch_twins = [&](std::uint32_t t) {
+    if (t >= half_edges / 3) return;
     for (std::uint32_t e = 3 * t; e < 3 * t + 3; ++e) {
-      const std::uint32_t v = vert_[e], f = twin_[e];
-      if (v != kGhost) {
-        if (v >= vertices) fail("triangle " + std::to_string(t) + " uses a vertex that is not a representative");
-        if (vertex_edge_[v] == kNone || vertex_edge_[v] < e) fail("vertex " + std::to_string(v) + " has the wrong half-edge");
-      }
-      if (f >= half_edges || twin_[f] != e || vert_[f] == kNone) fail("twin of half-edge " + std::to_string(e));
-      if (vert_[f] != vert_[next(e)] || vert_[next(f)] != v) fail("twins of half-edge " + std::to_string(e) + " do not share their end points");
+      const std::uint32_t f = twin_[e], v = vert_[e];
+      if (f < half_edges) __builtin_prefetch(&twin_[f]), __builtin_prefetch(&vert_[f]);
+      if (v < vertices) __builtin_prefetch(&vertex_edge_[v]);
     }
-    if (!ghost && !(orient2d(coords_[vert_[3 * t]], coords_[vert_[3 * t + 1]], coords_[vert_[3 * t + 2]]) > 0))
-      fail("triangle " + std::to_string(t) + " is not counter-clockwise");
-  }
+  };
+  const auto [live, ghosts] = check_in_blocks(half_edges / 3, [&](std::uint32_t first, std::uint32_t last) {
+    std::array<std::size_t, 2> counts = {0, 0};  // live, ghosts
+    for (std::uint32_t t = first; t < last; ++t) {
+      prefetch_twins(t + 8);
+      if (vert_[3 * t] == kNone) {
+        if (vert_[3 * t + 1] != kNone || vert_[3 * t + 2] != kNone) fail("triangle " + std::to_string(t) + " is partly free");
+        continue;
+      }
+      ++counts[0];
+      const bool ghost = view().is_ghost_triangle(t);
+      counts[1] += ghost;
+      if ((vert_[3 * t] == kGhost) + (vert_[3 * t + 1] == kGhost) + (vert_[3 * t + 2] == kGhost) > 1)
+        fail("triangle " + std::to_string(t) + " has two ghost vertices");
+      for (std::uint32_t e = 3 * t; e < 3 * t + 3; ++e) {
+        const std::uint32_t v = vert_[e], f = twin_[e];
+        if (v != kGhost) {
+          if (v >= vertices) fail("triangle " + std::to_string(t) + " uses a vertex that is not a representative");
+          if (vertex_edge_[v] == kNone || vertex_edge_[v] < e) fail("vertex " + std::to_string(v) + " has the wrong half-edge");
+        }
+        if (f >= half_edges || twin_[f] != e || vert_[f] == kNone) fail("twin of half-edge " + std::to_string(e));
+        if (vert_[f] != vert_[next(e)] || vert_[next(f)] != v) fail("twins of half-edge " + std::to_string(e) + " do not share their end points");
+      }
+      if (!ghost && !(orient2d(coords_[vert_[3 * t]], coords_[vert_[3 * t + 1]], coords_[vert_[3 * t + 2]]) > 0))
+        fail("triangle " + std::to_string(t) + " is not counter-clockwise");
+    }
+    return counts;
+  });
   // Each vertex in a triangle (its half-edge leaves it) stands for a
   // representative point at its place, which maps back to it.
-  std::size_t used = 0;
-  for (std::uint32_t v = 0; v < vertices; ++v) {
-    const std::uint32_t h = vertex_edge_[v];
-    if (h == kNone) continue;
-    if (h >= half_edges || vert_[h] != v) fail("vertex " + std::to_string(v) + " has a half-edge that does not leave it");
-    const std::uint32_t o = original_of_[v];
-    if (o >= n || rep_[o] != o || internal_of_[o] != v || points_[o] != coords_[v])
-      fail("vertex " + std::to_string(v) + " is not a representative");
-    ++used;
-  }
+  const std::size_t used = check_in_blocks(vertices, [&](std::uint32_t first, std::uint32_t last) {
+    std::array<std::size_t, 2> counts = {0, 0};  // used vertices
+    for (std::uint32_t v = first; v < last; ++v) {
+      if (const std::uint32_t ahead = v + 16; ahead < last && original_of_[ahead] < n) {  // the points are read at random
+        __builtin_prefetch(&rep_[original_of_[ahead]]), __builtin_prefetch(&internal_of_[original_of_[ahead]]);
+        __builtin_prefetch(&points_[original_of_[ahead]]);
+      }
+      const std::uint32_t h = vertex_edge_[v];
+      if (h == kNone) continue;
+      if (h >= half_edges || vert_[h] != v) fail("vertex " + std::to_string(v) + " has a half-edge that does not leave it");
+      const std::uint32_t o = original_of_[v];
+      if (o >= n || rep_[o] != o || internal_of_[o] != v || points_[o] != coords_[v])
+        fail("vertex " + std::to_string(v) + " is not a representative");
+      ++counts[0];
+    }
+    return counts;
+  })[0];
   if (used != representatives)
     fail(std::to_string(representatives - std::min(used, representatives)) + " points are in no triangle");
   return {live, ghosts};
@@ -695,25 +746,32 @@ void Delaunay2::check_public_view(std::size_t finite) const {
   if (public_triangle_.size() != half_edges / 3 || internal_triangle_.size() != finite) fail("triangle maps have the wrong size");
   if (triangles_.size() != 3 * finite || halfedges_.size() != triangles_.size()) fail("public arrays have the wrong size");
   if (constrained_.size() != (has_constraints_ ? triangles_.size() : 0)) fail("public constraint flags have the wrong size");
-  std::uint32_t k = 0;
-  for (std::uint32_t t = 0; t < half_edges / 3; ++t) {
-    if (vert_[3 * t] == kNone || view().is_ghost_triangle(t)) {
-      if (public_triangle_[t] != kNone) fail("triangle " + std::to_string(t) + " is public but not finite");
-      continue;
+  // Each finite triangle has a public number that maps back to it, and the
+  // numbers follow the internal order: the numbering publish() makes.
+  check_in_blocks(half_edges / 3, [&](std::uint32_t first, std::uint32_t last) {
+    for (std::uint32_t t = first; t < last; ++t) {
+      const std::uint32_t k = public_triangle_[t];
+      if (vert_[3 * t] == kNone || view().is_ghost_triangle(t)) {
+        if (k != kNone) fail("triangle " + std::to_string(t) + " is public but not finite");
+      } else if (k >= finite || internal_triangle_[k] != t) {
+        fail("internal triangle " + std::to_string(t) + " has no public number of its own");
+      }
     }
-    if (k >= finite || internal_triangle_[k] != t || public_triangle_[t] != k)
-      fail("public triangle " + std::to_string(k) + " is not internal triangle " + std::to_string(t));
-    ++k;
-  }
-  for (k = 0; k < finite; ++k) {
-    const std::uint32_t t = internal_triangle_[k];
-    for (std::uint32_t s = 0; s < 3; ++s) {
-      const std::uint32_t e = 3 * k + s, f = twin_[3 * t + s], other = public_triangle_[f / 3];
-      if (triangles_[e] != original_of_[vert_[3 * t + s]]) fail("public triangle " + std::to_string(k) + " differs");
-      if (halfedges_[e] != (other == kNone ? kNone : 3 * other + f % 3)) fail("public half-edge " + std::to_string(e) + " differs");
-      if (has_constraints_ && constrained_[e] != fixed_[3 * t + s]) fail("public constraint flag " + std::to_string(e) + " differs");
+    return std::array<std::size_t, 2>{0, 0};
+  });
+  check_in_blocks(finite, [&](std::uint32_t first, std::uint32_t last) {
+    for (std::uint32_t k = first; k < last; ++k) {
+      const std::uint32_t t = internal_triangle_[k];
+      if (k > 0 && internal_triangle_[k - 1] >= t) fail("public triangle " + std::to_string(k) + " is out of order");
+      for (std::uint32_t s = 0; s < 3; ++s) {
+        const std::uint32_t e = 3 * k + s, f = twin_[3 * t + s], other = public_triangle_[f / 3];
+        if (triangles_[e] != original_of_[vert_[3 * t + s]]) fail("public triangle " + std::to_string(k) + " differs");
+        if (halfedges_[e] != (other == kNone ? kNone : 3 * other + f % 3)) fail("public half-edge " + std::to_string(e) + " differs");
+        if (has_constraints_ && constrained_[e] != fixed_[3 * t + s]) fail("public constraint flag " + std::to_string(e) + " differs");
+      }
     }
-  }
+    return std::array<std::size_t, 2>{0, 0};
+  });
   std::size_t h = 0;
   if (finite > 0)
     walk_hull(view(), [&](std::uint32_t v) {
