@@ -111,12 +111,13 @@ class MinMaxOctree {
   void save(const std::filesystem::path& path) const;
   /// Reads an octree written by save(): the samples and the min/max arrays are
   /// read in place from the mapped file (no parse, no copy; min/max not
-  /// recomputed), which the octree keeps mapped while it lives. Throws geods::Error naming the file for another
-  /// sample type, a truncated or corrupt file (checksums, unless `verify` says
-  /// structure_only), NaN samples, a leaf with min > max or a node whose
-  /// min/max is not that of its children (O(nodes)); Verify::full and
-  /// structure_only (no checksums to prove the leaves) run all of
-  /// validate(), the leaves against the samples too (a pass like the build).
+  /// recomputed), which stays mapped while the octree lives. Throws
+  /// geods::Error naming the file for another sample type, a truncated or
+  /// corrupt file (checksums, unless `verify` says structure_only), NaN samples
+  /// (a pass over them), a leaf with min > max or a node whose min/max is not
+  /// that of its children (O(nodes)); Verify::full and structure_only (no
+  /// checksums to prove the leaves) run all of validate(), the leaves against
+  /// the samples too (a pass like the build).
   static MinMaxOctree load(const std::filesystem::path& path, Archive::Verify verify = Archive::Verify::checksums);
 
  private:
