@@ -57,6 +57,8 @@ void query_min_max_octree(const Path& p) {
   for (double iso : {0.5, 13.0})
     for (auto sharing : {geods::iso::VertexSharing::block_masks, geods::iso::VertexSharing::hash_table})
       tree.isosurface(iso, {}, sharing);
+  // The scan over the mapped samples in place.
+  geods::iso::isosurface(tree.volume(), 0.5);
 }
 
 geods::Ray3f probe_ray() {

@@ -19,12 +19,14 @@ namespace {
 void run_head(const DemoContext& context, DemoResult& result) {
   // Padded with its minimum, so that every isosurface closes at the border.
   const Grid3<float> head = io::to_float(io::read_volume(context.data_dir / "t1_head.nii.gz"));
-  const Grid3<float> volume = padded(head, *std::min_element(head.data.begin(), head.data.end()));
-  const std::size_t cells = (volume.dims[0] - 1) * (volume.dims[1] - 1) * (volume.dims[2] - 1);
+  Grid3<float> padded_head = padded(head, *std::min_element(head.data.begin(), head.data.end()));
 
   Stopwatch build_watch;
-  const iso::MinMaxOctree<float> tree(volume);
+  const iso::MinMaxOctree<float> tree(std::move(padded_head));  // takes the samples, no copy
   result.timing("build the min/max octree", build_watch.seconds());
+  // The scan reads the octree's samples in place.
+  const Grid3View<float> volume = tree.volume();
+  const std::size_t cells = (volume.dims[0] - 1) * (volume.dims[1] - 1) * (volume.dims[2] - 1);
 
   struct Surface {
     double iso;

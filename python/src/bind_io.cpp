@@ -11,6 +11,7 @@
 
 #include "bindings.hpp"
 #include "arrays.hpp"
+#include "without_gil.hpp"
 #include "geods/core/error.hpp"
 #include "geods/io/image_io.hpp"
 #include "geods/io/mesh_io.hpp"
@@ -26,11 +27,7 @@ namespace {
 using std::filesystem::path;
 
 py::tuple read_mesh_py(const path& p) {
-  TriMesh mesh;
-  {
-    py::gil_scoped_release release;
-    mesh = io::read_mesh(p);
-  }
+  const TriMesh mesh = without_gil([&] { return io::read_mesh(p); });
   return mesh_arrays(mesh, false);
 }
 
@@ -41,11 +38,7 @@ void write_mesh_py(const path& p, const Rows<float>& v, const Rows<std::int64_t>
 }
 
 py::object read_volume_py(const path& p, bool with_meta) {
-  io::AnyGrid3 grid;
-  {
-    py::gil_scoped_release release;
-    grid = io::read_volume(p);
-  }
+  const io::AnyGrid3 grid = without_gil([&] { return io::read_volume(p); });
   return std::visit(
       [&](const auto& g) -> py::object {
         const py::array a = copy_array(g.data.data(), {py::ssize_t(g.dims[2]), py::ssize_t(g.dims[1]), py::ssize_t(g.dims[0])});
@@ -64,20 +57,12 @@ void write_volume_py(const path& p, const py::array& array, const std::array<dou
 }
 
 py::array_t<double> read_points_py(const path& p) {
-  io::PointMatrix m;
-  {
-    py::gil_scoped_release release;
-    m = io::read_points(p);
-  }
+  const io::PointMatrix m = without_gil([&] { return io::read_points(p); });
   return copy_array(m.data(), {py::ssize_t(m.rows()), py::ssize_t(m.cols())});
 }
 
 py::array_t<double> read_table_py(const path& p) {
-  io::Table t;
-  {
-    py::gil_scoped_release release;
-    t = io::read_table(p);
-  }
+  const io::Table t = without_gil([&] { return io::read_table(p); });
   return copy_array(t.values.data(), {py::ssize_t(t.rows), py::ssize_t(t.cols)});
 }
 
@@ -90,20 +75,12 @@ void write_points_py(const path& p, const Rows<double>& a) {
 }
 
 py::array_t<double> read_segments_py(const path& p) {
-  io::SegmentMatrix m;
-  {
-    py::gil_scoped_release release;
-    m = io::read_segments(p);
-  }
+  const io::SegmentMatrix m = without_gil([&] { return io::read_segments(p); });
   return copy_array(m.data(), {py::ssize_t(m.rows()), py::ssize_t(4)});
 }
 
 py::array_t<std::uint8_t> read_image_py(const path& p) {
-  Image<std::uint8_t> im;
-  {
-    py::gil_scoped_release release;
-    im = io::read_image(p);
-  }
+  const Image<std::uint8_t> im = without_gil([&] { return io::read_image(p); });
   return image_array(im);
 }
 

@@ -176,8 +176,9 @@ cell per leaf, the textbook octree).)doc")
       .def("save", &PyOctree::save, py::arg("path"),
            "Writes the octree and its volume to a geods archive (the file format of every structure).")
       .def_static("load", &PyOctree::load, py::arg("path"),
-                  "Reads an octree written by save() (any sample type): the min/max arrays are read in place\n"
-                  "from the file, the volume is copied. Raises ValueError for a truncated, corrupt or other file.");
+                  "Reads an octree written by save() (any sample type): the samples and the min/max arrays are\n"
+                  "read in place from the mapped file (no copy). Raises ValueError for a truncated, corrupt or\n"
+                  "other file.");
 }
 
 }  // namespace geods::python

@@ -12,6 +12,7 @@
 
 #include "bindings.hpp"
 #include "arrays.hpp"
+#include "without_gil.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"
 #include "geods/ray/accelerator.hpp"
@@ -100,11 +101,7 @@ py::array_t<std::uint8_t> render_py(const Rows<float>& v, const Rows<std::int64_
   options.shadows = shadows;
   options.accel = ray::parse_accelerator_kind(accel);
   if (camera) options.camera = camera_from_sequence(*camera);
-  ray::RenderResult result;
-  {
-    py::gil_scoped_release release;
-    result = ray::render(mesh, options);
-  }
+  const ray::RenderResult result = without_gil([&] { return ray::render(mesh, options); });
   return image_array(result.image);
 }
 

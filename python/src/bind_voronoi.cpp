@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "arrays.hpp"
+#include "without_gil.hpp"
 #include "bindings.hpp"
 #include "geods/core/error.hpp"
 #include "geods/voronoi/circles.hpp"
@@ -50,11 +51,7 @@ template <typename Locator>
 py::object nearest_sites(const Locator& locator, const py::handle& queries, const char* what) {
   bool single = false;
   const std::vector<Vec2d> q = to_points(queries, what, &single);
-  std::vector<std::uint32_t> result;
-  {
-    py::gil_scoped_release release;
-    result = locator.nearest_batch(q);
-  }
+  const std::vector<std::uint32_t> result = without_gil([&] { return locator.nearest_batch(q); });
   if (single) return py::int_(result[0]);
   return index_array(result);
 }
@@ -83,11 +80,7 @@ class PyVoronoi2 {
   py::array_t<double> vertices() const { return points_array(diagram_->vertices().span()); }
 
   py::list cells() const {
-    std::vector<std::vector<Vec2d>> cells;
-    {
-      py::gil_scoped_release release;
-      cells = diagram_->cell_polygons(box_);
-    }
+    const std::vector<std::vector<Vec2d>> cells = without_gil([&] { return diagram_->cell_polygons(box_); });
     return to_polygons(cells);
   }
 
@@ -281,11 +274,7 @@ void bind_voronoi(py::module_& m) {
       "emst",
       [](const py::handle& points) {
         const std::vector<Vec2d> p = to_points(points, "emst");
-        voronoi::SpanningTree tree;
-        {
-          py::gil_scoped_release release;
-          tree = voronoi::emst(p);
-        }
+        const voronoi::SpanningTree tree = without_gil([&] { return voronoi::emst(p); });
         std::vector<std::uint32_t> ends;
         for (const auto& [a, b] : tree.edges) ends.insert(ends.end(), {a, b});
         return py::make_tuple(index_array(ends, {py::ssize_t(tree.edges.size()), 2}), tree.length);

@@ -126,7 +126,7 @@ inline constexpr double kEdgeMargin = 1e-3;
 template <typename T>
 class VertexPlacer {
  public:
-  VertexPlacer(const Grid3<T>& volume, double iso, std::span<const Vec3f> positions, bool normals)
+  VertexPlacer(const Grid3View<T>& volume, double iso, std::span<const Vec3f> positions, bool normals)
       : g_(volume), iso_(iso), positions_(positions), normals_(normals) {
     stride_[0] = 1;
     stride_[1] = volume.dims[0];
@@ -212,7 +212,7 @@ class VertexPlacer {
     return (positions_[b] - positions_[a]).cast<double>();
   }
 
-  const Grid3<T>& g_;
+  Grid3View<T> g_;
   double iso_;
   std::span<const Vec3f> positions_;
   bool normals_;
@@ -221,7 +221,7 @@ class VertexPlacer {
 
 /// Checks the options that do not depend on the sample type.
 template <typename T>
-void check_positions(const Grid3<T>& volume, std::span<const Vec3f> positions) {
+void check_positions(const Grid3View<T>& volume, std::span<const Vec3f> positions) {
   if (positions.empty()) return;
   if (positions.size() != volume.size())
     throw Error("isosurface: " + std::to_string(positions.size()) + " node positions for a volume of " +
@@ -234,7 +234,7 @@ void check_positions(const Grid3<T>& volume, std::span<const Vec3f> positions) {
 /// (negative Jacobian at the first cell): triangles are then flipped so that
 /// they stay oriented from inside to outside.
 template <typename T>
-bool mirrored(const Grid3<T>& volume, std::span<const Vec3f> positions) {
+bool mirrored(const Grid3View<T>& volume, std::span<const Vec3f> positions) {
   if (positions.empty()) {
     const int negative = (volume.spacing[0] < 0) + (volume.spacing[1] < 0) + (volume.spacing[2] < 0);
     return negative % 2 == 1;
@@ -249,7 +249,7 @@ bool mirrored(const Grid3<T>& volume, std::span<const Vec3f> positions) {
 
 /// Throws if a floating-point volume holds a NaN (it could be neither inside nor outside).
 template <typename T>
-void check_samples(const Grid3<T>& volume) {
+void check_samples(const Grid3View<T>& volume) {
   if constexpr (std::is_floating_point_v<T>) {
     bool nan = false;
     for (const T v : volume.data) nan |= (v != v);

@@ -32,7 +32,7 @@ constexpr std::uint8_t kEdgeArray[12] = {0, 0, 1, 1, 2, 2, 3, 3, 4, 4, 4, 4};
 template <typename T>
 class SlabScan {
  public:
-  SlabScan(const Grid3<T>& g, double iso, const IsoOptions& options, bool flip)
+  SlabScan(const Grid3View<T>& g, double iso, const IsoOptions& options, bool flip)
       : g_(g), iso_(iso), thr_(iso), placer_(g, iso, options.positions, options.normals), flip_(flip),
         table_(detail::case_table_view()), nx_(g.dims[0]), ny_(g.dims[1]) {
     // Left uninitialized: an id is read only for a crossed edge, which was written first.
@@ -205,7 +205,7 @@ class SlabScan {
     }
   }
 
-  const Grid3<T>& g_;
+  Grid3View<T> g_;
   double iso_;
   detail::Threshold<T> thr_;
   detail::VertexPlacer<T> placer_;
@@ -220,7 +220,7 @@ class SlabScan {
 }  // namespace
 
 template <typename T>
-TriMesh isosurface(const Grid3<T>& volume, double iso, const IsoOptions& options, std::size_t* cells_visited) {
+TriMesh isosurface(const Grid3View<T>& volume, double iso, const IsoOptions& options, std::size_t* cells_visited) {
   if (cells_visited) *cells_visited = 0;
   const detail::Threshold<T> check_iso(iso);  // throws for a non-finite iso-value
   detail::check_positions(volume, options.positions);
@@ -313,10 +313,10 @@ TriMesh isosurface(const Grid3<T>& volume, double iso, const IsoOptions& options
   return mesh;
 }
 
-template TriMesh isosurface(const Grid3<std::uint8_t>&, double, const IsoOptions&, std::size_t*);
-template TriMesh isosurface(const Grid3<std::uint16_t>&, double, const IsoOptions&, std::size_t*);
-template TriMesh isosurface(const Grid3<std::int16_t>&, double, const IsoOptions&, std::size_t*);
-template TriMesh isosurface(const Grid3<float>&, double, const IsoOptions&, std::size_t*);
-template TriMesh isosurface(const Grid3<double>&, double, const IsoOptions&, std::size_t*);
+template TriMesh isosurface(const Grid3View<std::uint8_t>&, double, const IsoOptions&, std::size_t*);
+template TriMesh isosurface(const Grid3View<std::uint16_t>&, double, const IsoOptions&, std::size_t*);
+template TriMesh isosurface(const Grid3View<std::int16_t>&, double, const IsoOptions&, std::size_t*);
+template TriMesh isosurface(const Grid3View<float>&, double, const IsoOptions&, std::size_t*);
+template TriMesh isosurface(const Grid3View<double>&, double, const IsoOptions&, std::size_t*);
 
 }  // namespace geods::iso

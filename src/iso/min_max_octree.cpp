@@ -101,19 +101,20 @@ void for_each_in_batches(std::size_t n, bool batched, Progress& progress, double
 }
 
 // What both extractions (hash-table and block-mask vertex sharing) start from:
-// the tree, the iso-value and how a cell is cut at it.
+// the tree and its volume, the iso-value and how a cell is cut at it.
 template <typename Tree, typename T>
 struct Extraction {
   const Tree& tree;
+  Grid3View<T> volume;
   double iso;
   detail::Threshold<T> thr;
   detail::VertexPlacer<T> placer;
   bool flip;
   detail::CaseTableView table = detail::case_table_view();
 
-  Extraction(const Tree& t, const Grid3<T>& volume, double iso_value, const IsoOptions& options, bool flip_triangles)
-      : tree(t), iso(iso_value), thr(iso_value), placer(volume, iso_value, options.positions, options.normals),
-        flip(flip_triangles) {}
+  Extraction(const Tree& t, double iso_value, const IsoOptions& options, bool flip_triangles)
+      : tree(t), volume(t.volume()), iso(iso_value), thr(iso_value),
+        placer(volume, iso_value, options.positions, options.normals), flip(flip_triangles) {}
 };
 
 }  // namespace
@@ -122,7 +123,7 @@ struct Extraction {
 template <typename T>
 struct MinMaxOctree<T>::Query : Extraction<MinMaxOctree<T>, T> {
   using Base = Extraction<MinMaxOctree<T>, T>;
-  using Base::tree, Base::iso, Base::thr, Base::placer, Base::flip, Base::table;
+  using Base::tree, Base::volume, Base::iso, Base::thr, Base::placer, Base::flip, Base::table;
   EdgeTable edges;
   std::vector<Vec3f> positions, normals;
   static constexpr std::uint64_t kNoEdge = EdgeTable::kEmpty;  // key of a cell-centre vertex
@@ -131,7 +132,7 @@ struct MinMaxOctree<T>::Query : Extraction<MinMaxOctree<T>, T> {
   std::size_t cells_visited = 0, nodes_visited = 0;
 
   Query(const MinMaxOctree& t, double iso_value, const IsoOptions& options, bool flip_triangles)
-      : Base(t, t.volume_, iso_value, options, flip_triangles) {}
+      : Base(t, iso_value, options, flip_triangles) {}
 
   bool active(std::size_t node) const { return thr.inside(tree.max_[node]) && !thr.inside(tree.min_[node]); }
 
@@ -153,7 +154,7 @@ struct MinMaxOctree<T>::Query : Extraction<MinMaxOctree<T>, T> {
   }
 
   void march_leaf(std::size_t bx, std::size_t by, std::size_t bz) {
-    const Grid3<T>& g = tree.volume_;
+    const Grid3View<T>& g = volume;
     const std::size_t L = tree.leaf_cells_;
     const std::size_t x0 = bx * L, y0 = by * L, z0 = bz * L;
     const std::size_t x1 = std::min(x0 + L, tree.cells_[0]), y1 = std::min(y0 + L, tree.cells_[1]),
@@ -198,7 +199,7 @@ struct MinMaxOctree<T>::Query : Extraction<MinMaxOctree<T>, T> {
   // The vertex on cube edge e of cell (i, j, k): from the table if an earlier
   // cell made it (removed at its last visit), else new.
   std::uint32_t edge_vertex(std::size_t i, std::size_t j, std::size_t k, int e) {
-    const Grid3<T>& g = tree.volume_;
+    const Grid3View<T>& g = volume;
     const int lo = detail::kEdgeCorners[e][0], axis = e / 4;
     const std::size_t p[3] = {i + (lo & 1), j + ((lo >> 1) & 1), k + ((lo >> 2) & 1)};
     const std::uint64_t key = 3 * std::uint64_t(g.index(p[0], p[1], p[2])) + std::uint64_t(axis);
@@ -225,8 +226,8 @@ std::size_t MinMaxOctree<T>::make_levels() {
   levels_.clear();
   cells_ = {0, 0, 0};
   for (int d = 0; d < 3; ++d)
-    if (volume_.dims[d] < 2) return 0;  // no cells
-  for (int d = 0; d < 3; ++d) cells_[d] = volume_.dims[d] - 1;
+    if (grid_.dims[d] < 2) return 0;  // no cells
+  for (int d = 0; d < 3; ++d) cells_[d] = grid_.dims[d] - 1;
   std::array<std::size_t, 3> dims;
   for (int d = 0; d < 3; ++d) dims[d] = (cells_[d] + leaf_cells_ - 1) / leaf_cells_;
   std::size_t total = 0;
@@ -241,11 +242,11 @@ std::size_t MinMaxOctree<T>::make_levels() {
 
 template <typename T>
 MinMaxOctree<T>::MinMaxOctree(Grid3<T> volume, std::size_t leaf_cells)
-    : volume_(std::move(volume)), leaf_cells_(leaf_cells) {
+    : grid_(volume), samples_(std::move(volume.data)), leaf_cells_(leaf_cells) {
   if (leaf_cells_ == 0 || leaf_cells_ > kMaxLeafCells)
     throw Error("MinMaxOctree: leaf_cells must be in [1, " + std::to_string(kMaxLeafCells) + "], not " +
                 std::to_string(leaf_cells_));
-  detail::check_samples(volume_);
+  detail::check_samples(this->volume());
   const std::size_t total = make_levels();
   if (total == 0) return;
   std::vector<T> min(total), max(total);
@@ -288,10 +289,10 @@ std::array<T, 2> MinMaxOctree<T>::leaf_range(std::size_t x, std::size_t y, std::
   const std::size_t x0 = x * L, y0 = y * L, z0 = z * L;
   const std::size_t x1 = std::min(x0 + L, cells_[0]), y1 = std::min(y0 + L, cells_[1]),
                     z1 = std::min(z0 + L, cells_[2]);
-  T lo = volume_(x0, y0, z0), hi = lo;
+  T lo = samples_[grid_.index(x0, y0, z0)], hi = lo;
   for (std::size_t k = z0; k <= z1; ++k)
     for (std::size_t j = y0; j <= y1; ++j) {
-      const T* row = volume_.data.data() + volume_.index(0, j, k);
+      const T* row = samples_.data() + grid_.index(0, j, k);
       for (std::size_t i = x0; i <= x1; ++i) lo = std::min(lo, row[i]), hi = std::max(hi, row[i]);
     }
   return {lo, hi};
@@ -329,12 +330,12 @@ std::vector<typename MinMaxOctree<T>::SubtreeRoot> MinMaxOctree<T>::subtree_root
 template <typename T>
 OctreeIsoResult MinMaxOctree<T>::isosurface(double iso, const IsoOptions& options, VertexSharing sharing) const {
   const detail::Threshold<T> thr(iso);  // throws for a non-finite iso-value
-  detail::check_positions(volume_, options.positions);
+  detail::check_positions(volume(), options.positions);
   if (levels_.empty()) {
     Progress(options.progress, "isosurface", 1).finish();
     return {};
   }
-  const bool flip = detail::mirrored(volume_, options.positions);
+  const bool flip = detail::mirrored(volume(), options.positions);
   return sharing == VertexSharing::hash_table ? hash_table_isosurface(iso, options, flip)
                                               : block_isosurface(iso, options, flip);
 }
@@ -402,7 +403,7 @@ struct MinMaxOctree<T>::BlockQuery : Extraction<MinMaxOctree<T>, T> {
   };
   static constexpr std::uint32_t kUnknown = ~std::uint32_t(0);
   using Base = Extraction<MinMaxOctree<T>, T>;
-  using Base::tree, Base::iso, Base::thr, Base::placer, Base::flip, Base::table;
+  using Base::tree, Base::volume, Base::iso, Base::thr, Base::placer, Base::flip, Base::table;
 
   std::size_t L, S, words;
   std::array<std::size_t, 3> leaf_dims;
@@ -418,9 +419,9 @@ struct MinMaxOctree<T>::BlockQuery : Extraction<MinMaxOctree<T>, T> {
   std::vector<std::size_t> triangle_first;
 
   BlockQuery(const MinMaxOctree& t, double iso_value, const IsoOptions& options, bool flip_triangles)
-      : Base(t, t.volume_, iso_value, options, flip_triangles), L(t.leaf_cells_), S(t.leaf_cells_ + 1),
+      : Base(t, iso_value, options, flip_triangles), L(t.leaf_cells_), S(t.leaf_cells_ + 1),
         words((3 * S * S * S + 63) / 64), leaf_dims(t.levels_[0].dims) {
-    const std::size_t sy = t.volume_.dims[0], sz = t.volume_.dims[0] * t.volume_.dims[1];
+    const std::size_t sy = volume.dims[0], sz = volume.dims[0] * volume.dims[1];
     const std::size_t offsets[8] = {0, 1, sy, sy + 1, sz, sz + 1, sz + sy, sz + sy + 1};
     std::copy(offsets, offsets + 8, corner_offset);
   }
@@ -458,7 +459,7 @@ struct MinMaxOctree<T>::BlockQuery : Extraction<MinMaxOctree<T>, T> {
 
   // rows[z * S + y], bit x: sample (x, y, z) of the box is inside.
   void inside_rows(const Box& b, std::uint64_t* rows) const {
-    const Grid3<T>& g = tree.volume_;
+    const Grid3View<T>& g = volume;
     for (std::size_t z = 0; z <= b.cells[2]; ++z)
       for (std::size_t y = 0; y <= b.cells[1]; ++y) {
         const T* r = g.data.data() + g.index(b.origin[0], b.origin[1] + y, b.origin[2] + z);
@@ -491,7 +492,7 @@ struct MinMaxOctree<T>::BlockQuery : Extraction<MinMaxOctree<T>, T> {
   std::size_t entry(const Box& b, std::size_t x, std::size_t y, std::size_t z, unsigned c) const {
     std::uint8_t joined = 0;
     if (const std::uint8_t amb = table.ambiguous[c]) {
-      const T* s = tree.volume_.data.data() + tree.volume_.index(b.origin[0] + x, b.origin[1] + y, b.origin[2] + z);
+      const T* s = volume.data.data() + volume.index(b.origin[0] + x, b.origin[1] + y, b.origin[2] + z);
       joined = detail::decide_faces(amb, iso, [&](int q) { return s[corner_offset[q]]; });
     }
     return std::size_t(c) * 64 + joined;
@@ -795,11 +796,11 @@ void MinMaxOctree<T>::save(const std::filesystem::path& path) const {
   ArchiveWriter w(std::string(kMinMaxOctreeArchiveKind), kMinMaxOctreeArchiveVersion);
   w.add_dtype("scalar", dtype_of<T>());
   w.add_value("leaf_cells", std::uint64_t(leaf_cells_));
-  const std::array<std::uint64_t, 3> dims{volume_.dims[0], volume_.dims[1], volume_.dims[2]};
+  const std::array<std::uint64_t, 3> dims{grid_.dims[0], grid_.dims[1], grid_.dims[2]};
   w.add("dims", std::span<const std::uint64_t>(dims));
-  w.add("origin", std::span<const float>(volume_.origin.data(), 3));
-  w.add("spacing", std::span<const float>(volume_.spacing.data(), 3));
-  w.add("samples", volume_.data);
+  w.add("origin", std::span<const float>(grid_.origin.data(), 3));
+  w.add("spacing", std::span<const float>(grid_.spacing.data(), 3));
+  w.add("samples", samples_);
   w.add("min", min_);
   w.add("max", max_);
   w.write(path);
@@ -815,7 +816,7 @@ MinMaxOctree<T> MinMaxOctree<T>::load(const std::filesystem::path& path, Archive
   tree.leaf_cells_ = std::size_t(leaf_cells);
   const FlatArray<std::uint64_t> dims = a.array<std::uint64_t>("dims", 3);
   const FlatArray<float> origin = a.array<float>("origin", 3), spacing = a.array<float>("spacing", 3);
-  const FlatArray<T> samples = a.array<T>("samples");
+  FlatArray<T> samples = a.array<T>("samples");
   bool sized = false;
   try {
     sized = Grid3<T>::checked_size(dims[0], dims[1], dims[2]) == samples.size();
@@ -825,16 +826,16 @@ MinMaxOctree<T> MinMaxOctree<T>::load(const std::filesystem::path& path, Archive
     throw a.error(std::to_string(samples.size()) + " samples for a volume of " + std::to_string(dims[0]) + " x " +
                   std::to_string(dims[1]) + " x " + std::to_string(dims[2]));
   }
-  Grid3<T>& g = tree.volume_;
+  Grid3Geometry& g = tree.grid_;
   g.dims = {dims[0], dims[1], dims[2]};
   g.origin = Vec3f(origin[0], origin[1], origin[2]);
   g.spacing = Vec3f(spacing[0], spacing[1], spacing[2]);
-  g.data = samples.to_vector();
+  tree.samples_ = std::move(samples);
   const std::size_t nodes = tree.make_levels();
   tree.min_ = a.array<T>("min", nodes);
   tree.max_ = a.array<T>("max", nodes);
   try {
-    detail::check_samples(g);
+    detail::check_samples(tree.volume());
     tree.check_nodes(Archive::checks_everything(verify));
   } catch (const Error& e) {
     throw a.error(std::string("corrupted min/max octree: ") + e.what());

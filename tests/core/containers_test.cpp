@@ -32,6 +32,29 @@ TEST(Grid3, IndexingIsXFastestAndPositionsUseOriginAndSpacing) {
   EXPECT_TRUE(Grid3<float>().bounds().empty());
 }
 
+TEST(Grid3, ViewReadsTheSamplesInPlaceWithTheSameGeometry) {
+  for (const std::array<std::size_t, 3> dims : {std::array<std::size_t, 3>{4, 3, 2}, {1, 1, 1}, {0, 0, 0}, {0, 2, 3}}) {
+    Grid3<int> g(dims[0], dims[1], dims[2]);
+    std::iota(g.data.begin(), g.data.end(), 1);
+    g.origin = Vec3f(1, 2, 3);
+    g.spacing = Vec3f(0.5f, -1, 2);
+    const Grid3View<int> v = g.view();
+    EXPECT_EQ(v.data.data(), g.data.data());  // no copy
+    EXPECT_EQ(v.size(), g.size());
+    EXPECT_EQ(v.dims, g.dims);
+    EXPECT_EQ(v.bounds(), g.bounds());
+    if (g.size() == 0) EXPECT_TRUE(v.bounds().empty());
+    std::size_t n = 0;
+    for (std::size_t k = 0; k < dims[2]; ++k)
+      for (std::size_t j = 0; j < dims[1]; ++j)
+        for (std::size_t i = 0; i < dims[0]; ++i, ++n) {
+          EXPECT_EQ(v.index(i, j, k), n);  // x fastest, as Grid3
+          EXPECT_EQ(&v(i, j, k), &g(i, j, k));
+          EXPECT_EQ(v.position(i, j, k), g.position(i, j, k));
+        }
+  }
+}
+
 TEST(Grid3, OverflowingDimensionsThrow) {
   EXPECT_THROW(Grid3<double>(std::size_t(1) << 40, std::size_t(1) << 40, 16), Error);
 }

@@ -568,12 +568,17 @@ void expect_round_trip(const MinMaxOctree<T>& tree, std::initializer_list<double
   EXPECT_EQ(loaded.volume().dims, tree.volume().dims);
   EXPECT_EQ(loaded.volume().origin, tree.volume().origin);
   EXPECT_EQ(loaded.volume().spacing, tree.volume().spacing);
-  EXPECT_EQ(loaded.volume().data, tree.volume().data);
+  EXPECT_EQ(loaded.samples(), tree.samples());
+  EXPECT_TRUE(std::ranges::equal(loaded.volume().data, tree.volume().data));
   EXPECT_EQ(loaded.node_min(), tree.node_min());
   EXPECT_EQ(loaded.node_max(), tree.node_max());
-  EXPECT_TRUE(loaded.node_min().mapped());  // read in place
+  EXPECT_TRUE(loaded.samples().mapped());  // read in place
+  EXPECT_TRUE(loaded.node_min().mapped());
   EXPECT_TRUE(loaded.node_max().mapped());
+  EXPECT_EQ(loaded.volume().data.data(), loaded.samples().data());  // the view is of the mapped samples
+  EXPECT_FALSE(tree.samples().mapped());
   EXPECT_FALSE(tree.node_min().mapped());
+  EXPECT_EQ(loaded.stats().bytes, tree.stats().bytes);
   EXPECT_EQ(loaded.stats().nodes, tree.stats().nodes);
   EXPECT_EQ(loaded.stats().leaf_cells, tree.stats().leaf_cells);
   for (double iso : isos)
@@ -586,6 +591,13 @@ void expect_round_trip(const MinMaxOctree<T>& tree, std::initializer_list<double
       EXPECT_EQ(a.nodes_visited, b.nodes_visited) << what;
       EXPECT_EQ(a.cells_visited, b.cells_visited) << what;
     }
+  // The scan reads the mapped samples in place and gives what it gives on the built octree's.
+  for (double iso : isos) {
+    const TriMesh a = isosurface(tree.volume(), iso), b = isosurface(loaded.volume(), iso);
+    EXPECT_EQ(a.vertices, b.vertices) << "scan, iso " << iso;
+    EXPECT_EQ(a.normals, b.normals) << "scan, iso " << iso;
+    EXPECT_EQ(a.triangles, b.triangles) << "scan, iso " << iso;
+  }
 }
 
 TEST(MinMaxOctree, SaveLoadGivesTheSameSurfaces) {
@@ -608,6 +620,24 @@ TEST(MinMaxOctree, SaveLoadGivesTheSameSurfaces) {
   expect_round_trip(MinMaxOctree<float>(cell), {0.5});
   expect_round_trip(MinMaxOctree<float>(Grid3<float>(1, 1, 1, 0.0f)), {0.5});
   expect_round_trip(MinMaxOctree<float>(Grid3<float>(5, 0, 3)), {0.5});
+}
+
+TEST(MinMaxOctree, TakesTheSamplesOfItsVolumeWithoutACopy) {
+  Grid3<float> volume = noise<float>(9, 6, 3);
+  volume.origin = Vec3f(1, -2, 3);
+  volume.spacing = Vec3f(0.5f, 2, 1);
+  const Grid3<float> copy = volume;
+  const float* samples = volume.data.data();
+  const MinMaxOctree<float> tree(std::move(volume), 2);
+  EXPECT_EQ(tree.samples().data(), samples);
+  EXPECT_FALSE(tree.samples().mapped());
+  const Grid3View<float> v = tree.volume();
+  EXPECT_EQ(v.data.data(), samples);
+  EXPECT_EQ(v.dims, copy.dims);
+  EXPECT_EQ(v.origin, copy.origin);
+  EXPECT_EQ(v.spacing, copy.spacing);
+  EXPECT_TRUE(std::ranges::equal(v.data, copy.data));
+  tree.validate();
 }
 
 TEST(MinMaxOctree, BadFilesThrow) {

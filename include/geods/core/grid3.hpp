@@ -1,8 +1,10 @@
 #pragma once
-// A dense 3D grid of samples (a volume) with origin and spacing.
+// A dense 3D grid of samples (a volume) with origin and spacing: owned (Grid3) or
+// viewed in place (Grid3View), with one geometry and index arithmetic (Grid3Geometry).
 #include <algorithm>
 #include <array>
 #include <cstddef>
+#include <span>
 #include <vector>
 
 #include "geods/core/aabb.hpp"
@@ -10,36 +12,62 @@
 
 namespace geods {
 
-/// Samples in C order [z][y][x] (x fastest): sample (i, j, k) sits at
-/// origin + (i, j, k) * spacing in world space.
-template <typename T>
-struct Grid3 {
-  using value_type = T;
-
+/// Where the samples of a volume sit and in which order, shared by Grid3 (which
+/// owns its samples) and Grid3View (which reads them where they are): samples in
+/// C order [z][y][x] (x fastest), sample (i, j, k) at origin + (i, j, k) * spacing
+/// in world space.
+struct Grid3Geometry {
   std::array<std::size_t, 3> dims{0, 0, 0};  // nx, ny, nz
   Vec3f origin = Vec3f::Zero();
   Vec3f spacing = Vec3f::Ones();
+
+  std::size_t index(std::size_t i, std::size_t j, std::size_t k) const {
+    return i + dims[0] * (j + dims[1] * k);
+  }
+  Vec3f position(std::size_t i, std::size_t j, std::size_t k) const {
+    return origin + Vec3f(float(i), float(j), float(k)).cwiseProduct(spacing);
+  }
+  /// World-space box spanned by the sample positions (empty without samples).
+  AABB3f bounds() const {
+    if (dims[0] == 0 || dims[1] == 0 || dims[2] == 0) return {};
+    return {origin, position(dims[0] - 1, dims[1] - 1, dims[2] - 1)};
+  }
+};
+
+/// A read-only volume whose samples live elsewhere (in a Grid3, in a mapped
+/// file): what the extractions read, so that a loaded MinMaxOctree gives its
+/// mapped samples without a copy. Copying it copies no samples; they must
+/// outlive it.
+template <typename T>
+struct Grid3View : Grid3Geometry {
+  using value_type = T;
+
+  std::span<const T> data;  // dims[0] * dims[1] * dims[2] samples
+
+  Grid3View() = default;
+  Grid3View(const Grid3Geometry& geometry, std::span<const T> samples) : Grid3Geometry(geometry), data(samples) {}
+
+  std::size_t size() const { return data.size(); }
+  const T& operator()(std::size_t i, std::size_t j, std::size_t k) const { return data[index(i, j, k)]; }
+};
+
+/// A volume that owns its samples.
+template <typename T>
+struct Grid3 : Grid3Geometry {
+  using value_type = T;
+
   std::vector<T> data;
 
   Grid3() = default;
   Grid3(std::size_t nx, std::size_t ny, std::size_t nz, T fill = T{})
-      : dims{nx, ny, nz}, data(checked_size(nx, ny, nz), fill) {}
+      : Grid3Geometry{{nx, ny, nz}}, data(checked_size(nx, ny, nz), fill) {}
 
   std::size_t size() const { return data.size(); }
-  std::size_t index(std::size_t i, std::size_t j, std::size_t k) const {
-    return i + dims[0] * (j + dims[1] * k);
-  }
   T& operator()(std::size_t i, std::size_t j, std::size_t k) { return data[index(i, j, k)]; }
   const T& operator()(std::size_t i, std::size_t j, std::size_t k) const { return data[index(i, j, k)]; }
 
-  Vec3f position(std::size_t i, std::size_t j, std::size_t k) const {
-    return origin + Vec3f(float(i), float(j), float(k)).cwiseProduct(spacing);
-  }
-  /// World-space box spanned by the sample positions.
-  AABB3f bounds() const {
-    if (size() == 0) return {};
-    return {origin, position(dims[0] - 1, dims[1] - 1, dims[2] - 1)};
-  }
+  /// The samples in place (valid while this grid is neither changed in size nor destroyed).
+  Grid3View<T> view() const { return {*this, data}; }
 
   /// nx * ny * nz, or geods::Error if it overflows.
   static std::size_t checked_size(std::size_t nx, std::size_t ny, std::size_t nz) {

@@ -44,7 +44,14 @@ struct IsoOptions {
 /// If `cells_visited` is given, it receives the number of cells whose corners
 /// were examined (those in the trimmed row ranges).
 template <typename T>
-TriMesh isosurface(const Grid3<T>& volume, double iso, const IsoOptions& options = {},
+TriMesh isosurface(const Grid3View<T>& volume, double iso, const IsoOptions& options = {},
                    std::size_t* cells_visited = nullptr);
+
+/// The same over the samples of a Grid3, in place.
+template <typename T>
+TriMesh isosurface(const Grid3<T>& volume, double iso, const IsoOptions& options = {},
+                   std::size_t* cells_visited = nullptr) {
+  return isosurface(volume.view(), iso, options, cells_visited);
+}
 
 }  // namespace geods::iso

@@ -66,7 +66,9 @@ struct OctreeIsoResult {
 /// min array and one max array level by level, each node holding the min and
 /// max of the samples of its cells. A leaf covers leaf_cells^3 cells (1 gives
 /// the textbook octree with one cell per leaf; larger leaves save memory and
-/// node tests). The octree owns its volume.
+/// node tests). The octree holds its volume's samples in a FlatArray: owned
+/// after a build (moved in from the Grid3), read in place from the mapped file
+/// after load(), so that a loaded volume larger than RAM can be queried.
 ///
 /// isosurface(iso) descends from the root into the children with
 /// min < iso <= max (a cell is crossed iff some corner is >= iso and some is
@@ -81,14 +83,19 @@ class MinMaxOctree {
   static constexpr std::size_t kDefaultLeafCells = 4;
   static constexpr std::size_t kMaxLeafCells = 32;
 
-  /// Throws geods::Error for a NaN sample or leaf_cells outside [1, 32]. O(samples), parallel.
+  /// Takes the volume's samples without copying them. Throws geods::Error for a
+  /// NaN sample or leaf_cells outside [1, 32]. O(samples), parallel.
   explicit MinMaxOctree(Grid3<T> volume, std::size_t leaf_cells = kDefaultLeafCells);
 
   /// Thread-safe. Throws geods::Error for a non-finite iso or bad positions.
   OctreeIsoResult isosurface(double iso, const IsoOptions& options = {},
                              VertexSharing sharing = VertexSharing::block_masks) const;
 
-  const Grid3<T>& volume() const { return volume_; }
+  /// The volume, viewed in place (mapped from the file for a loaded octree);
+  /// valid while the octree lives. iso::isosurface() scans it without a copy.
+  Grid3View<T> volume() const { return {grid_, samples_}; }
+  /// The samples, owned or mapped (samples().mapped() after load()).
+  const FlatArray<T>& samples() const { return samples_; }
   /// The min and max sample of every node, level by level from the leaves (read
   /// in place from the file for a loaded octree).
   const FlatArray<T>& node_min() const { return min_; }
@@ -102,14 +109,15 @@ class MinMaxOctree {
   /// (core/archive.hpp): value sections scalar, leaf_cells, dims (3 x u64),
   /// origin, spacing (3 x f32); arrays samples, min, max.
   void save(const std::filesystem::path& path) const;
-  /// Reads an octree written by save(): the min/max arrays are read in place
-  /// from the mapped file, not recomputed, the samples are copied into volume()
-  /// (a Grid3 owns them). Throws geods::Error naming the file for another
-  /// sample type, a truncated or corrupt file (checksums, unless `verify` says
-  /// structure_only), NaN samples, a leaf with min > max or a node whose
-  /// min/max is not that of its children (O(nodes)); Verify::full and
-  /// structure_only (no checksums to prove the leaves) run all of
-  /// validate(), the leaves against the samples too (a pass like the build).
+  /// Reads an octree written by save(): the samples and the min/max arrays are
+  /// read in place from the mapped file (no parse, no copy; min/max not
+  /// recomputed), which stays mapped while the octree lives. Throws
+  /// geods::Error naming the file for another sample type, a truncated or
+  /// corrupt file (checksums, unless `verify` says structure_only), NaN samples
+  /// (a pass over them), a leaf with min > max or a node whose min/max is not
+  /// that of its children (O(nodes)); Verify::full and structure_only (no
+  /// checksums to prove the leaves) run all of validate(), the leaves against
+  /// the samples too (a pass like the build).
   static MinMaxOctree load(const std::filesystem::path& path, Archive::Verify verify = Archive::Verify::checksums);
 
  private:
@@ -144,7 +152,8 @@ class MinMaxOctree {
   // min <= max (no pass over the volume), the levels above against their children.
   void check_nodes(bool leaves_against_samples) const;
 
-  Grid3<T> volume_;
+  Grid3Geometry grid_;
+  FlatArray<T> samples_;  // in the order of grid_
   std::size_t leaf_cells_ = kDefaultLeafCells;
   std::array<std::size_t, 3> cells_{0, 0, 0};
   std::vector<Level> levels_;  // levels_[0]: leaves, back(): the root
