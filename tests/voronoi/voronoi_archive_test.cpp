@@ -339,6 +339,22 @@ TEST(Delaunay2Archive, PublicArraysThatDisagreeRaise) {
   fs::remove(bad);
 }
 
+TEST(Delaunay2Archive, FreedTrianglesInUseRaise) {
+  Delaunay2 dt(random_points(200, 14));
+  for (std::uint32_t v = 0; v < 40; v += 2) dt.remove(v);
+  const fs::path good = temp_file("freed_good"), bad = temp_file("freed_bad");
+  dt.save(good);
+  const std::uint32_t freed = Archive::open(good, "voronoi.Delaunay2", 2).array<std::uint32_t>("free_triangles").front();
+  expect_same(dt, Delaunay2::load(good));
+  const std::uint32_t v = dt.triangles()[0];
+  rewrite_index(good, bad, "vert", 3 * freed + 1, v);  // a freed slot that names a vertex
+  EXPECT_THROW(Delaunay2::load(bad), Error);
+  rewrite_index(good, bad, "vertex_edge", 3, 3 * freed);  // a vertex whose half-edge is in a freed slot
+  EXPECT_THROW(Delaunay2::load(bad), Error);
+  fs::remove(good);
+  fs::remove(bad);
+}
+
 TEST(Delaunay2Archive, VersionOneFilesAreRefused) {
   const fs::path path = temp_file("version1");
   ArchiveWriter w("voronoi.Delaunay2", 1);
