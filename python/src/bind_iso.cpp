@@ -14,6 +14,7 @@
 #include <variant>
 
 #include "arrays.hpp"
+#include "without_gil.hpp"
 #include "bindings.hpp"
 #include "geods/core/error.hpp"
 #include "geods/iso/marching_cubes.hpp"
@@ -50,14 +51,11 @@ py::tuple isosurface_py(const py::array& volume, double iso, const std::array<do
   const io::AnyGrid3 grid = volume_from(volume, spacing, origin);
   const auto dims = std::visit([](const auto& g) { return g.dims; }, grid);
   const std::vector<Vec3f> positions = positions_from(coords, dims);
-  TriMesh mesh;
-  {
-    py::gil_scoped_release release;
-    iso::IsoOptions options;
-    options.normals = normals;
-    options.positions = positions;
-    mesh = std::visit([&](const auto& g) { return iso::isosurface(g, iso, options); }, grid);
-  }
+  iso::IsoOptions options;
+  options.normals = normals;
+  options.positions = positions;
+  const TriMesh mesh =
+      without_gil([&] { return std::visit([&](const auto& g) { return iso::isosurface(g, iso, options); }, grid); });
   return mesh_arrays(mesh, true);
 }
 
