@@ -3,7 +3,7 @@
 
     /usr/bin/python3 bench/compare/run.py --out docs/PERFORMANCE.md [--only predicates,knn]
         [--threads 1,2] [--rounds 1] [--reps 3] [--scale 1] [--jobs N] [--data DIR]
-        [--no-setup] [--no-micro]
+        [--no-setup] [--no-micro] [--before DIR[=LABEL]]
 
 Steps: (a) scripts/setup.sh --bench (installs the anchor packages, bench/compare/anchor-packages.txt),
 (b) bench/compare/gen_workloads.py (generates the workloads of anchors/WORKLOADS.md once, checks
@@ -13,6 +13,11 @@ geods, anchor, ... for --rounds rounds) with one thread and with all threads, co
 JSON lines, (e) runs the Google Benchmark programs build/release/bin/geods_*_bench if present,
 (f) writes the report (--out), the raw JSON lines beside it (performance.jsonl) and when and how
 each workload was measured (performance-runs.json).
+
+With --before DIR=LABEL (DIR: the build/compare/bin of an older checkout, LABEL: its revision), every
+geods program found there is run too, interleaved with the others, as anchor "<anchor>@before"; its
+ratio column is then its time / the same program's time now (> 1: faster now), so that a change
+shows before/after ratios measured in one run.
 
 With --only W --update, only W is re-run; the other workloads (and, with --no-micro, the micro
 benchmarks) keep their earlier results from performance.jsonl / performance-runs.json, and each
@@ -93,6 +98,20 @@ def discover():
     return comps
 
 
+BEFORE = "@before"  # anchor suffix of a program run from an older build (--before)
+
+
+def add_before(comps, bin_dir, label):
+    """Adds every geods program of each comparison again, run from bin_dir (an older build), as <anchor>@before."""
+    for c in comps:
+        c["programs"] += [{"anchor": p["anchor"] + BEFORE, "before": label,
+                           "command": [os.path.join(bin_dir, p["program"])],
+                           "label": f"{p.get('label', p['anchor'])} before ({label})"}
+                          for p in c["programs"]
+                          if p["anchor"].startswith("geods") and "program" in p
+                          and os.access(os.path.join(bin_dir, p["program"]), os.X_OK)]
+
+
 # ----------------------------------------------------------------------------- steps a-c
 def run_cmd(cmd, **kw):
     log("$", " ".join(shlex.quote(str(x)) for x in cmd))
@@ -170,7 +189,7 @@ def run_comparison(c, bin_dir, data_dir, threads_list, rounds, reps, scale, stat
             for p in c["programs"]:
                 if "command" in p:
                     cmd = [a.format(python=PY, dir=c["dir"], bin=bin_dir) for a in p["command"]]
-                    prog = os.path.splitext(os.path.basename(cmd[-1]))[0]
+                    prog = os.path.splitext(os.path.basename(cmd[-1]))[0] + (BEFORE if "before" in p else "")
                 else:
                     prog = p["program"]
                     if status.get(prog):
@@ -200,6 +219,9 @@ def run_comparison(c, bin_dir, data_dir, threads_list, rounds, reps, scale, stat
                         rec = json.loads(line)
                     except json.JSONDecodeError:
                         continue
+                    if "before" in p:  # the older program names itself like the current one
+                        rec["anchor"], rec["before"] = p["anchor"], p["before"]
+                        line = json.dumps(rec)
                     raw.append(line)
                     rec["_round"] = rnd
                     records.append(rec)
@@ -306,6 +328,12 @@ def tabulate(c, records):
     anchors = [p["anchor"] for p in c["programs"]]
     base = anchors[0]
     labels = {p["anchor"]: p.get("label", p["anchor"]) for p in c["programs"]}
+    for r in records:  # older builds' records kept by --update without --before
+        a = str(r.get("anchor"))
+        if a.endswith(BEFORE) and a not in labels:
+            anchors.append(a)
+            now = a[: -len(BEFORE)]
+            labels[a] = f"{labels.get(now, now)} before" + (f" ({r['before']})" if r.get("before") else "")
     groups = {}  # (variant, threads) -> anchor -> [records]
     order = []
     for r in records:
@@ -317,6 +345,10 @@ def tabulate(c, records):
     first = {k: i for i, k in enumerate(order)}
     order.sort(key=lambda k: (k[1], first[k]))
     present = [a for a in anchors if any(a in g for g in groups.values())]
+
+    def reference(a):  # what an anchor's ratio divides by: geods, or for X@before, X now
+        now = a[: -len(BEFORE)]
+        return now if a.endswith(BEFORE) and now in present else base
     metrics = [m for m in c["metrics"]
                if any(isinstance(r.get(m), (int, float)) and r.get(m) > 0 for r in records)]
     agree = c.get("agree")
@@ -324,7 +356,7 @@ def tabulate(c, records):
     for a in present:
         head.append(a)
         if a != base:
-            head.append(f"{a} / {base}")
+            head.append(f"{a} / {reference(a)}")
     if agree:
         head.append(agree.get("label", f"{agree['field']} agrees"))
     head.append("ok")
@@ -337,7 +369,6 @@ def tabulate(c, records):
                 vals = [r.get(m) for r in g.get(a, []) if isinstance(r.get(m), (int, float))]
                 return statistics.median(vals) if vals else None
             row = [f"`{key[0]}`", str(key[1])] + ([m] if len(metrics) > 1 else [])
-            bt = med(base)
             for a in present:
                 t = med(a)
                 cell = fmt_time(t) if t else "–"  # 0: the program has no such phase
@@ -347,6 +378,7 @@ def tabulate(c, records):
                         cell += f" ({fmt_rate(cnt / t * c['rate'].get('scale', 1))} {c['rate'].get('unit', '/s')})"
                 row.append(cell)
                 if a != base:
+                    bt = med(reference(a))
                     if t and bt:
                         ratio = t / bt
                         ratios.setdefault((a, key[1]), []).append(ratio)
@@ -471,7 +503,8 @@ def write_report(out, jsonl, cmdline, info, versions, verify, comps, results, st
     # summary
     L.append("## Summary\n")
     L.append("Geometric mean, over the variants (and metrics) of each workload, of anchor time / geods time "
-             "(> 1: geods is faster).\n")
+             "(> 1: geods is faster); for a program run from an older build (`--before`, anchor `...@before`): "
+             "its time / the same program's time now (> 1: faster now).\n")
     L.append("| workload | anchor | threads | geomean ratio |")
     L.append("|---|---|---|---|")
     sections = []
@@ -556,6 +589,8 @@ def main():
     ap.add_argument("--build-dir", default=os.path.join(REPO, "build", "compare"))
     ap.add_argument("--no-setup", action="store_true", help="skip scripts/setup.sh --bench")
     ap.add_argument("--no-micro", action="store_true", help="skip the Google Benchmark programs")
+    ap.add_argument("--before", metavar="DIR[=LABEL]", help="also run the geods programs of an older build "
+                    "(its build/compare/bin) as <anchor>@before, interleaved; LABEL names its revision")
     ap.add_argument("--update", action="store_true", help="with --only: keep the other workloads' "
                     "earlier results (and the micro benchmarks with --no-micro) in the report")
     args = ap.parse_args()
@@ -580,6 +615,9 @@ def main():
             raise SystemExit(f"unknown workload(s): {', '.join(sorted(unknown))}; "
                              f"known: {', '.join(c['workload'] for c in comps)}")
         comps = [c for c in comps if c["workload"] in want]
+    if args.before:
+        before_dir, _, label = args.before.partition("=")
+        add_before(comps, os.path.abspath(before_dir), label or before_dir)
     log("comparisons:", ", ".join(c["workload"] for c in comps))
 
     setup_problem = None if args.no_setup else setup()  # (a)
