@@ -9,6 +9,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <iterator>
 #include <stdexcept>
 #include <string>
@@ -81,6 +82,18 @@ void expect_bad_copies_refused(const std::filesystem::path& saved, Load&& load, 
   write_bytes(bad, version);
   EXPECT_THROW(load(bad), Error) << "another kind version";
   std::filesystem::remove(bad);
+}
+
+/// load(path) must throw geods::Error whose message holds each of `parts`.
+template <typename Load>
+void expect_load_error(const std::filesystem::path& path, Load&& load, std::initializer_list<std::string_view> parts) {
+  try {
+    load(path);
+    ADD_FAILURE() << path << " loaded; expected an error";
+  } catch (const Error& e) {
+    for (std::string_view part : parts)
+      EXPECT_NE(std::string_view(e.what()).find(part), std::string_view::npos) << e.what() << " lacks " << part;
+  }
 }
 
 }  // namespace geods::test
