@@ -79,6 +79,13 @@ Image<std::uint8_t> read_image(const fs::path& path) { return decode<std::uint8_
 
 Image<std::uint16_t> read_image16(const fs::path& path) { return decode<std::uint16_t>(path); }
 
+int image_bit_depth(const fs::path& path) {
+  const std::vector<std::uint8_t> bytes = detail::read_file(path);
+  if (bytes.empty()) fail(path, "empty file");
+  if (bytes.size() > std::size_t(INT_MAX)) fail(path, "image file larger than 2 GiB");
+  return stbi_is_16_bit_from_memory(bytes.data(), int(bytes.size())) ? 16 : 8;
+}
+
 void write_png(const fs::path& path, const Image<std::uint8_t>& image) {
   if (image.channels < 1 || image.channels > 4)
     fail(path, "cannot write PNG with " + std::to_string(image.channels) + " channels (1 to 4)");

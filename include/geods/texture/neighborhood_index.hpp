@@ -1,0 +1,92 @@
+#pragma once
+// The nearest-neighbour search of texture synthesis (seed §5.5: line 2 of the
+// loop "is exactly a nearest-neighbor search"): the candidate neighbourhoods
+// of a sample, and for a query neighbourhood the candidate nearest to it in
+// Euclidean distance, ties broken by the smaller candidate index.
+//
+// Distances are between 8-bit vectors, so squared distances are exact
+// integers and every method agrees bit for bit on what "nearest" means.
+//
+// - brute: every candidate (the reference).
+// - exact: a k-d tree (spatial::KdTree) over the candidates projected on
+//   their first principal components. The projection is orthonormal, so the
+//   projected distance is a lower bound of the full one: the descent computes
+//   the full distance of each leaf candidate it reaches and prunes by the best
+//   full distance so far. The answer is brute force's, candidate for candidate.
+// - approx: the same descent with the k-d tree's (1 + eps) pruning: a subtree
+//   is skipped when its projected lower bound exceeds best / (1 + eps), so the
+//   distance found is within (1 + eps) of the nearest, in the full space.
+//   Few principal components make the tree shallow and the bound loose (more
+//   full distances); many make the tree slow in high dimension. This is the
+//   role of Wei and Levoy's PCA-reduced tree-structured vector quantization,
+//   with a guarantee.
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <string_view>
+#include <vector>
+
+#include "geods/spatial/kd_tree.hpp"
+
+namespace geods::texture {
+
+enum class NeighborSearch { brute, exact, approx };
+
+/// Parses "brute", "exact" or "approx"; throws geods::Error naming the choices.
+NeighborSearch parse_neighbor_search(std::string_view name);
+std::string_view neighbor_search_name(NeighborSearch search);
+
+struct NeighborhoodIndexStats {
+  std::size_t candidates = 0;
+  std::size_t dimension = 0;          // values per neighbourhood
+  std::size_t reduced_dimension = 0;  // principal components in the k-d tree (0: brute force only)
+  double explained_variance = 0;      // fraction of the candidates' variance the components keep
+  std::size_t bytes = 0;
+};
+
+class NeighborhoodIndex {
+ public:
+  struct Match {
+    std::uint32_t candidate = std::numeric_limits<std::uint32_t>::max();
+    std::uint32_t squared_distance = std::numeric_limits<std::uint32_t>::max();
+  };
+
+  /// `vectors` holds the candidates row by row, `dimension` values each
+  /// (dimension * 255^2 < 2^32). reduced_dimension: principal components the
+  /// k-d tree uses (clamped to the dimension); 0 builds no tree (brute force
+  /// only). Throws geods::Error for no candidates or a bad dimension.
+  NeighborhoodIndex(std::vector<std::uint8_t> vectors, std::size_t dimension, std::size_t reduced_dimension);
+
+  std::size_t size() const { return count_; }
+  std::size_t dimension() const { return dim_; }
+  std::size_t reduced_dimension() const { return reduced_; }
+  const std::uint8_t* candidate(std::size_t i) const { return vectors_.data() + i * dim_; }
+  NeighborhoodIndexStats stats() const;
+
+  /// The exact squared distance of a query to candidate i.
+  std::uint32_t squared_distance(const std::uint8_t* query, std::size_t i) const;
+
+  /// Per-thread buffers of nearest(), reused across queries.
+  struct Scratch {
+    std::vector<double> projected;
+    std::size_t full_distances = 0;  // full distances computed, summed over queries
+  };
+
+  /// The candidate nearest to `query` (dimension() values). eps >= 0 is used by
+  /// approx only. exact/approx need a tree (reduced_dimension > 0).
+  Match nearest(const std::uint8_t* query, NeighborSearch search, double eps, Scratch& scratch) const;
+
+ private:
+  Match brute_force(const std::uint8_t* query, Scratch& scratch) const;
+
+  std::vector<std::uint8_t> vectors_;
+  std::size_t count_ = 0, dim_ = 0, reduced_ = 0;
+  double explained_ = 0;
+  std::vector<double> mean_;       // dim_
+  std::vector<double> basis_;      // reduced_ rows of dim_: the principal directions
+  std::vector<double> projected_;  // count_ rows of reduced_
+  std::unique_ptr<spatial::KdTree<double>> tree_;
+};
+
+}  // namespace geods::texture
