@@ -68,15 +68,7 @@ NeighborhoodIndex::NeighborhoodIndex(std::vector<std::uint8_t> vectors, std::siz
   explained_ = total > 0 ? kept / total : 1;
 
   projected_.resize(count_ * reduced_);
-  parallel_for_each_index(0, count_, [&](std::size_t i) {
-    const std::uint8_t* v = candidate(i);
-    for (std::size_t r = 0; r < reduced_; ++r) {
-      const double* b = basis_.data() + r * dim_;
-      double s = 0;
-      for (std::size_t a = 0; a < dim_; ++a) s += b[a] * (double(v[a]) - mean_[a]);
-      projected_[i * reduced_ + r] = s;
-    }
-  }, 64);
+  parallel_for_each_index(0, count_, [&](std::size_t i) { project(candidate(i), projected_.data() + i * reduced_); }, 64);
   tree_ = std::make_unique<spatial::KdTree<double>>(spatial::PointView<double>(projected_.data(), count_, reduced_));
 }
 
@@ -89,6 +81,15 @@ NeighborhoodIndexStats NeighborhoodIndex::stats() const {
   s.bytes = vectors_.size() + (mean_.size() + basis_.size() + projected_.size()) * sizeof(double);
   if (tree_) s.bytes += tree_->stats().bytes;
   return s;
+}
+
+void NeighborhoodIndex::project(const std::uint8_t* v, double* out) const {
+  for (std::size_t r = 0; r < reduced_; ++r) {
+    const double* b = basis_.data() + r * dim_;
+    double s = 0;
+    for (std::size_t a = 0; a < dim_; ++a) s += b[a] * (double(v[a]) - mean_[a]);
+    out[r] = s;
+  }
 }
 
 std::uint32_t NeighborhoodIndex::squared_distance(const std::uint8_t* query, std::size_t i) const {
@@ -119,12 +120,7 @@ NeighborhoodIndex::Match NeighborhoodIndex::nearest(const std::uint8_t* query, N
   if (!(eps >= 0) || std::isinf(eps)) throw Error("NeighborhoodIndex: eps must be finite and >= 0");
 
   scratch.projected.resize(reduced_);
-  for (std::size_t r = 0; r < reduced_; ++r) {
-    const double* b = basis_.data() + r * dim_;
-    double s = 0;
-    for (std::size_t a = 0; a < dim_; ++a) s += b[a] * (double(query[a]) - mean_[a]);
-    scratch.projected[r] = s;
-  }
+  project(query, scratch.projected.data());
 
   // The k-d tree's result policy (KdTree::search_nearest): every candidate the
   // descent reaches gets its full distance; the pruning bound is the best full

@@ -18,9 +18,9 @@ namespace {
 
 constexpr std::size_t kMaxLevels = 4;
 constexpr std::size_t kMaxOutputPixels = std::size_t(1) << 30;
-// Principal components in the k-d tree when the caller leaves it to us:
-// measured on the data/ textures (docs/texture.md), fewer make the lower bound
-// too loose, more make the tree slow.
+// Principal components in the k-d tree when the caller leaves it to us (not
+// tuned yet): fewer make the lower bound looser (more full distances), more
+// make the tree slower in high dimension.
 constexpr std::size_t kDefaultReducedDimension = 16;
 
 std::string size_text(std::size_t w, std::size_t h) { return std::to_string(w) + "x" + std::to_string(h); }
@@ -128,12 +128,11 @@ struct LevelSynthesis {
     const std::size_t h1 = std::size_t(shape.fine_half) + 1;
     query.clear();
     for (const Offset o : shape.fine) {
-      const std::ptrdiff_t qx = std::ptrdiff_t(x) + o.dx, qy = std::ptrdiff_t(y) + o.dy;
-      const std::size_t at = canvas.at(qx, qy);
+      const std::size_t at = canvas.at(std::ptrdiff_t(x) + o.dx, std::ptrdiff_t(y) + o.dy);
       const std::uint8_t* value = source.data() + at;
-      if (t && canvas.wrap) {
-        const std::size_t ix = at / c % canvas.width, iy = at / c / canvas.width;
-        if (canvas.unknown[canvas.interior(ix, iy)] && ix + h1 * iy >= *t) value = canvas.noise.data() + at;
+      if (t && canvas.wrap) {  // a wrapped canvas stores the interior only: at / c is the pixel's index
+        const std::size_t i = at / c;
+        if (canvas.unknown[i] && i % canvas.width + h1 * (i / canvas.width) >= *t) value = canvas.noise.data() + at;
       }
       query.insert(query.end(), value, value + c);
     }
@@ -294,26 +293,33 @@ SynthesisStats run(const std::vector<Image8>& sample, const std::vector<Image8>*
                       sample_mask && !top ? &(*sample_mask)[l + 1] : nullptr};
     Canvas& canvas = canvases[l];
     const Canvas* parent = top ? nullptr : &canvases[l + 1];
-    for (std::size_t pass = 0; pass <= options.refinement_passes; ++pass) {
-      const NeighborhoodShape& shape = pass == 0 ? (top ? causal_top : causal_fine) : (top ? full_top : full_fine);
-      const Candidates candidates = gather_candidates(level, shape, reduced);
+    // The candidates of each window shape, built once per level (every refinement pass shares the full window's).
+    auto candidates_for = [&](const NeighborhoodShape& shape) {
+      Candidates candidates = gather_candidates(level, shape, reduced);
       if (!candidates.index)
         throw Error("texture: the sample (" + size_text(sample[0].width, sample[0].height) + ", " +
                     size_text(sample[l].width, sample[l].height) + " at pyramid level " + std::to_string(l) +
                     ") is too small for a " + std::to_string(options.neighborhood) + "x" +
                     std::to_string(options.neighborhood) + " neighborhood" +
                     (sample_mask ? " away from the hole" : "") + "; use fewer levels or a smaller neighborhood");
-      if (pass == 0) {
-        fill_noise(canvas, level, candidates, Rng(options.seed * 31 + l));
-        start_from_noise(canvas);
-      }
-      LevelSynthesis s{shape, candidates, canvas, parent, options, l == 0 && pass == options.refinement_passes ? &distances : nullptr, {}};
-      if (pass == 0) {
+      return candidates;
+    };
+    const Candidates causal = candidates_for(top ? causal_top : causal_fine);
+    const std::optional<Candidates> full =
+        options.refinement_passes ? std::optional(candidates_for(top ? full_top : full_fine)) : std::nullopt;
+    fill_noise(canvas, level, causal, Rng(options.seed * 31 + l));
+    start_from_noise(canvas);
+    for (std::size_t pass = 0; pass <= options.refinement_passes; ++pass) {
+      const bool last = pass == options.refinement_passes;
+      const NeighborhoodShape& shape = pass == 0 ? (top ? causal_top : causal_fine) : (top ? full_top : full_fine);
+      const Candidates& candidates = pass == 0 ? causal : *full;
+      LevelSynthesis s{shape, candidates, canvas, parent, options, l == 0 && last ? &distances : nullptr, {}};
+      if (pass == 0)
         causal_pass(s, progress, done);
-      } else
+      else
         refinement_pass(s, progress, done);
       stats.full_distances += s.full_distances();
-      if (l == 0 && pass == options.refinement_passes) {
+      if (l == 0 && last) {
         const NeighborhoodIndexStats is = candidates.index->stats();
         stats.candidates = is.candidates;
         stats.dimension = is.dimension;

@@ -79,6 +79,9 @@ class NeighborhoodIndex {
 
  private:
   Match brute_force(const std::uint8_t* query, Scratch& scratch) const;
+  // The coordinates of v (dimension() values) on the principal directions: reduced_dimension() values.
+  // Candidates and queries go through this one computation, so equal vectors project bit-identically.
+  void project(const std::uint8_t* v, double* out) const;
 
   std::vector<std::uint8_t> vectors_;
   std::size_t count_ = 0, dim_ = 0, reduced_ = 0;
