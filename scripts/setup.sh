@@ -13,12 +13,12 @@ packages=(
   libcli11-dev nlohmann-json3-dev libfmt-dev
   libgtest-dev libbenchmark-dev libgmp-dev
   python3 python3-dev python3-numpy python3-pytest pybind11-dev
+  python3-scipy  # the oracle of python/tests/test_convex_hull.py (Qhull)
 )
 for arg in "$@"; do
   case "$arg" in
     --fuzz) packages+=(clang libclang-rt-14-dev) ;;
     --bench)
-      packages+=(python3-scipy)
       # The workload generator runs `npm pack`; any npm will do (a NodeSource
       # nodejs ships its own and conflicts with Debian's npm package).
       command -v npm >/dev/null || packages+=(npm)
