@@ -4,7 +4,9 @@
 Usage: /usr/bin/python3 scripts/import_data.py SHARED_DATA_DIR
 SHARED_DATA_DIR is the folder of original data sets (shared/data in the
 workplace). Conversions are lossless: JS arrays -> PLY/OBJ, npz -> npy,
-TopoJSON arcs -> points and segments (dequantized to degrees).
+TopoJSON arcs -> points and segments (dequantized to degrees). The hole-filling
+example (brick_hole*.png) is cut out of brick.png with the geods Python module
+of a build (PYTHONPATH=build/release/python).
 """
 import gzip
 import io
@@ -64,13 +66,26 @@ def land_arcs():
     return arcs
 
 
+def write_hole_example():
+    """brick.png[128:256, 128:256] with a 40 x 48 hole blacked out, and the hole's mask."""
+    import geods
+    brick = geods.read_image(os.path.join(DST, "brick.png"))[128:256, 128:256].copy()
+    mask = np.zeros((128, 128), np.uint8)
+    mask[44:84, 40:88] = 255
+    brick[mask > 0] = 0
+    geods.write_png(os.path.join(DST, "brick_hole.png"), brick)
+    geods.write_png(os.path.join(DST, "brick_hole_mask.png"), mask)
+
+
 def main():
     os.makedirs(DST, exist_ok=True)
     V, F = npm_arrays("meshes/bunny-1.0.1.tgz", "package/index.js")
     write_ply(os.path.join(DST, "bunny.ply"), V, F)
     V, F = npm_arrays("meshes/teapot-1.0.0.tgz", "package/teapot.js")
     write_obj(os.path.join(DST, "teapot.obj"), V, F, "Utah teapot (npm teapot 1.0.0), not watertight")
-    shutil.copy(os.path.join(SRC, "textures/brick.png"), os.path.join(DST, "brick.png"))
+    for texture in ("brick", "grass", "gravel"):
+        shutil.copy(os.path.join(SRC, f"textures/{texture}.png"), os.path.join(DST, f"{texture}.png"))
+    write_hole_example()
     shutil.copy(os.path.join(SRC, "volumes/KmeansTest_T1UCharRaw.nii.gz"), os.path.join(DST, "t1_head.nii.gz"))
     dem = np.load(os.path.join(SRC, "heightfields/jacksboro_fault_dem.npz"))
     np.save(os.path.join(DST, "jacksboro_dem.npy"), np.ascontiguousarray(dem["elevation"]))

@@ -32,10 +32,11 @@ class TextureCommand : public Command {
     app.add_option("--eps", options_.eps, "approx: matches within (1 + eps) of the nearest (default 2)");
     app.add_option("--reduced-dimension", options_.reduced_dimension,
                    "Principal components in the k-d tree (default 16)");
-    app.add_option("--refine", options_.refinement_passes, "Refinement passes with the whole window (default 0)");
+    app.add_option("--refinement-passes,--refine", options_.refinement_passes,
+                   "Passes over the output with the whole window, after the causal pass (default 0)");
     app.add_option("--seed", options_.seed, "Seed of the initial noise");
     app.add_flag("--tile", tile_, "Toroidal output: the result tiles without seams");
-    app.add_option("--image", image_, "Fill a hole in this image (needs --mask); SAMPLE is the texture to fill it from");
+    app.add_option("--image", image_, "Fill a hole in this image (needs --mask) from SAMPLE, or from its own known part if SAMPLE is the image");
     app.add_option("--mask", mask_, "Hole mask, the image's size: nonzero (first channel) = pixel to synthesize")
         ->needs("--image");
   }
@@ -59,7 +60,10 @@ class TextureCommand : public Command {
       result = texture::synthesize_texture(sample, request);
     } else {
       if (tile_) throw Error("texture: --tile does not go with --image");
-      result = texture::fill_hole(read_8_bit(image_), read_8_bit(mask_), options_, &sample);
+      const Image8 image = read_8_bit(image_), mask = read_8_bit(mask_);
+      // SAMPLE = the image itself: its windows that do not touch the hole are the candidates.
+      const bool own = std::filesystem::equivalent(sample_, image_);
+      result = texture::fill_hole(image, mask, options_, own ? nullptr : &sample);
     }
     io::write_png(output_, result.image);
 

@@ -37,6 +37,8 @@ declares them with geods_compare_program(), and a compare.json read here:
               the same arguments and must print the same JSON lines.
   threads     "all": run with every --threads count; "1": single thread only
   metrics     timing fields to tabulate, e.g. ["build_s", "query_s"]
+  values      optional fields that are not times (an error, say), tabulated after the metrics with
+              the same ratio columns but left out of the geometric means
   rate        optional {"unit": "Mcalls/s", "scale": 1e-6, "metric": "query_s"}: also show
               count / time * scale in the rows of that metric (default query_s)
   agree       optional {"field": "sign_hash", "anchors": ["geods", "cgal"], "label": "..."}:
@@ -349,7 +351,8 @@ def tabulate(c, records):
     def reference(a):  # what an anchor's ratio divides by: geods, or for X@before, X now
         now = a[: -len(BEFORE)]
         return now if a.endswith(BEFORE) and now in present else base
-    metrics = [m for m in c["metrics"]
+    values = c.get("values", [])
+    metrics = [m for m in c["metrics"] + values
                if any(isinstance(r.get(m), (int, float)) and r.get(m) > 0 for r in records)]
     agree = c.get("agree")
     head = ["variant", "threads"] + (["metric"] if len(metrics) > 1 else [])
@@ -371,7 +374,7 @@ def tabulate(c, records):
             row = [f"`{key[0]}`", str(key[1])] + ([m] if len(metrics) > 1 else [])
             for a in present:
                 t = med(a)
-                cell = fmt_time(t) if t else "–"  # 0: the program has no such phase
+                cell = (f"{t:.4g}" if m in values else fmt_time(t)) if t else "–"  # 0: no such phase
                 if t and c.get("rate") and g.get(a) and m == c["rate"].get("metric", "query_s"):
                     cnt = g[a][0].get("count")
                     if cnt:
@@ -381,7 +384,8 @@ def tabulate(c, records):
                     bt = med(reference(a))
                     if t and bt:
                         ratio = t / bt
-                        ratios.setdefault((a, key[1]), []).append(ratio)
+                        if m not in values:
+                            ratios.setdefault((a, key[1]), []).append(ratio)
                         row.append(f"**{ratio:.2f}**")
                     else:
                         row.append("–")

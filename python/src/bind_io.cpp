@@ -85,12 +85,7 @@ py::array_t<std::uint8_t> read_image_py(const path& p) {
 }
 
 void write_png_py(const path& p, const Rows<std::uint8_t>& a) {
-  if (a.ndim() != 2 && a.ndim() != 3) throw Error("write_png: expected an (h, w) or (h, w, c) uint8 array");
-  Image<std::uint8_t> im;
-  im.height = std::size_t(a.shape(0));
-  im.width = std::size_t(a.shape(1));
-  im.channels = a.ndim() == 3 ? std::size_t(a.shape(2)) : 1;
-  im.data.assign(a.data(), a.data() + a.size());
+  const Image<std::uint8_t> im = image_from_array(a, "write_png");
   py::gil_scoped_release release;
   io::write_png(p, im);
 }

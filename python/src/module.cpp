@@ -16,4 +16,5 @@ PYBIND11_MODULE(_geods, m) {
   geods::python::bind_delaunay(m);
   geods::python::bind_ray(m);
   geods::python::bind_iso(m);
+  geods::python::bind_texture(m);
 }

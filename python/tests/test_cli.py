@@ -115,3 +115,50 @@ def test_demo_writes_gallery_with_every_step(cli, tmp_path, data_dir):
         assert f'id="{s["module"]}-{s["name"]}"' in html
     assert (out / "morton_order.svg").read_text().lstrip().startswith("<")
     assert_bad_input(run(cli, "demo", "--out", out, "--only", "nothing"), "demo")
+
+
+def png_bytes(width, height, color_type, bit_depth, rows, palette=None):
+    """A PNG written by hand (zlib + struct), for the kinds geods does not write: 16-bit, palette."""
+    import struct
+    import zlib
+
+    def chunk(kind, data):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+    raw = b"".join(b"\0" + row for row in rows)
+    out = b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, bit_depth, color_type, 0, 0, 0))
+    if palette:
+        out += chunk(b"PLTE", bytes(c for rgb in palette for c in rgb))
+    return out + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b"")
+
+
+def test_texture_json_and_bad_input(cli, data_dir, tmp_path):
+    import numpy as np
+    r = run(cli, "texture", data_dir / "brick.png", "-o", tmp_path / "t.png", "--size", "40,32", "--levels", "2",
+            "--search", "exact", "--seed", "5", "--json")
+    assert r.returncode == 0, r.stderr
+    j = json.loads(r.stdout)
+    assert (j["width"], j["height"], j["levels"], j["search"]) == (40, 32, 2, "exact")
+    assert j["mean_neighborhood_distance"] > 0 and j["compute_s"] > 0
+    assert (tmp_path / "t.png").exists()
+
+    # A palette PNG is expanded to RGB; stripes of period 4 in it.
+    rows = [bytes((x // 2) % 2 for x in range(48)) for _ in range(48)]
+    (tmp_path / "palette.png").write_bytes(png_bytes(48, 48, 3, 8, rows, palette=[(200, 30, 30), (20, 20, 220)]))
+    r = run(cli, "texture", tmp_path / "palette.png", "-o", tmp_path / "p.png", "--size", "32,32", "--neighborhood",
+            "5", "--json")
+    assert r.returncode == 0, r.stderr
+    assert json.loads(r.stdout)["channels"] == 3
+
+    sixteen = [np.arange(32, dtype=">u2").tobytes() * 1 for _ in range(32)]
+    (tmp_path / "16.png").write_bytes(png_bytes(32, 32, 0, 16, sixteen))
+    assert_bad_input(run(cli, "texture", tmp_path / "16.png", "-o", tmp_path / "o.png", "--size", "8,8"), "16-bit")
+    (tmp_path / "tiny.png").write_bytes(png_bytes(1, 1, 0, 8, [b"\x80"]))
+    assert_bad_input(run(cli, "texture", tmp_path / "tiny.png", "-o", tmp_path / "o.png", "--size", "8,8"), "sample")
+    (tmp_path / "junk.png").write_bytes(b"not a png")
+    assert_bad_input(run(cli, "texture", tmp_path / "junk.png", "-o", tmp_path / "o.png", "--size", "8,8"), "junk.png")
+    brick = data_dir / "brick.png"
+    assert_bad_input(run(cli, "texture", brick, "-o", tmp_path / "o.png", "--size", "0,8"), "size")
+    assert_bad_input(run(cli, "texture", brick, "-o", tmp_path / "o.png", "--size", "100000,100000"), "2^30")
+    assert_bad_input(run(cli, "texture", brick, "-o", tmp_path / "o.jpg", "--size", "8,8"), ".png")
+    assert_bad_input(run(cli, "texture", brick, "-o", tmp_path / "o.png", "--size", "8,8", "--search", "kd"), "approx")
+    assert_bad_input(run(cli, "texture", brick, "-o", tmp_path / "o.png", "--image", brick), "mask")
