@@ -72,7 +72,7 @@ py::object fill_hole_py(const Rows<std::uint8_t>& image, const Rows<std::uint8_t
 void bind_texture(py::module_& m) {
   m.def("synthesize_texture", &synthesize_texture_py, py::arg("sample"), py::arg("size"), py::arg("neighborhood") = 9,
         py::arg("parent_neighborhood") = 0, py::arg("levels") = 0, py::arg("search") = "approx",
-        py::arg("eps") = 2.0, py::arg("reduced_dimension") = 0, py::arg("refinement_passes") = 0,
+        py::arg("eps") = texture::SynthesisOptions{}.eps, py::arg("reduced_dimension") = 0, py::arg("refinement_passes") = 0,
         py::arg("seed") = 0, py::arg("tile") = false, py::arg("stats") = false,
         R"doc(A texture of size (width, height) like `sample` (Wei-Levoy, seed §5.5).
 
@@ -81,14 +81,14 @@ its channels, shape (height, width[, c]). Each pixel takes the sample pixel
 whose neighbourhood (causal neighborhood x neighborhood window, and a
 parent_neighborhood window one pyramid level coarser; 0: neighborhood/2
 rounded up to odd) is nearest. search: 'approx' ((1 + eps) k-d tree over
-reduced_dimension principal components; 0: 16), 'exact' (the same tree,
+reduced_dimension principal components; 0: 8), 'exact' (the same tree,
 exact) or 'brute'. levels: pyramid levels (0: from the sample size, at most
 4). tile=True: a toroidal output that tiles without seams. The same seed
 gives the same bytes on any thread count. stats=True returns (image, stats).
 Raises geods.Error for a sample too small for the windows or bad options.)doc");
   m.def("fill_hole", &fill_hole_py, py::arg("image"), py::arg("mask"), py::arg("sample") = py::none(),
         py::arg("neighborhood") = 9, py::arg("parent_neighborhood") = 0, py::arg("levels") = 0,
-        py::arg("search") = "approx", py::arg("eps") = 2.0, py::arg("reduced_dimension") = 0,
+        py::arg("search") = "approx", py::arg("eps") = texture::SynthesisOptions{}.eps, py::arg("reduced_dimension") = 0,
         py::arg("refinement_passes") = 0, py::arg("seed") = 0, py::arg("stats") = false,
         R"doc(`image` with the pixels where `mask` is nonzero synthesized to match their surroundings.
 

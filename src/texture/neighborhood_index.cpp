@@ -63,13 +63,17 @@ NeighborhoodIndex::NeighborhoodIndex(std::vector<std::uint8_t> vectors, std::siz
   for (std::size_t r = 0; r < reduced_; ++r) {
     const Eigen::Index column = Eigen::Index(dim_ - 1 - r);
     kept += std::max(values(column), 0.0);
-    for (std::size_t a = 0; a < dim_; ++a) basis_[r * dim_ + a] = solver.eigenvectors()(Eigen::Index(a), column);
+    for (std::size_t a = 0; a < dim_; ++a) basis_[a * reduced_ + r] = solver.eigenvectors()(Eigen::Index(a), column);
   }
   explained_ = total > 0 ? kept / total : 1;
 
-  projected_.resize(count_ * reduced_);
-  parallel_for_each_index(0, count_, [&](std::size_t i) { project(candidate(i), projected_.data() + i * reduced_); }, 64);
-  tree_ = std::make_unique<spatial::KdTree<double>>(spatial::PointView<double>(projected_.data(), count_, reduced_));
+  const std::size_t tree_dim = reduced_ + 1;
+  projected_.resize(count_ * tree_dim);
+  parallel_for(0, count_, 64, [&](std::size_t begin, std::size_t end) {
+    std::vector<double> centred;
+    for (std::size_t i = begin; i < end; ++i) project(candidate(i), projected_.data() + i * tree_dim, centred);
+  });
+  tree_ = std::make_unique<spatial::KdTree<double>>(spatial::PointView<double>(projected_.data(), count_, tree_dim));
 }
 
 NeighborhoodIndexStats NeighborhoodIndex::stats() const {
@@ -83,13 +87,22 @@ NeighborhoodIndexStats NeighborhoodIndex::stats() const {
   return s;
 }
 
-void NeighborhoodIndex::project(const std::uint8_t* v, double* out) const {
-  for (std::size_t r = 0; r < reduced_; ++r) {
-    const double* b = basis_.data() + r * dim_;
-    double s = 0;
-    for (std::size_t a = 0; a < dim_; ++a) s += b[a] * (double(v[a]) - mean_[a]);
-    out[r] = s;
+void NeighborhoodIndex::project(const std::uint8_t* v, double* out, std::vector<double>& centred) const {
+  centred.resize(dim_);
+  double norm = 0;
+  for (std::size_t a = 0; a < dim_; ++a) {
+    centred[a] = double(v[a]) - mean_[a];
+    norm += centred[a] * centred[a];
   }
+  // One pass over the values, all components at once (independent sums, which vectorize).
+  std::fill_n(out, reduced_, 0.0);
+  for (std::size_t a = 0; a < dim_; ++a) {
+    const double* b = basis_.data() + a * reduced_;
+    for (std::size_t r = 0; r < reduced_; ++r) out[r] += b[r] * centred[a];
+  }
+  double kept = 0;
+  for (std::size_t r = 0; r < reduced_; ++r) kept += out[r] * out[r];
+  out[reduced_] = std::sqrt(std::max(norm - kept, 0.0));
 }
 
 std::uint32_t NeighborhoodIndex::squared_distance(const std::uint8_t* query, std::size_t i) const {
@@ -114,19 +127,24 @@ NeighborhoodIndex::Match NeighborhoodIndex::brute_force(const std::uint8_t* quer
 
 NeighborhoodIndex::Match NeighborhoodIndex::nearest(const std::uint8_t* query, NeighborSearch search, double eps,
                                                     Scratch& scratch) const {
+  return nearest(query, search, eps, scratch, Match{});
+}
+
+NeighborhoodIndex::Match NeighborhoodIndex::nearest(const std::uint8_t* query, NeighborSearch search, double eps,
+                                                    Scratch& scratch, Match start) const {
   if (search == NeighborSearch::brute) return brute_force(query, scratch);
   if (!tree_) throw Error("NeighborhoodIndex: exact and approx search need reduced_dimension > 0");
   if (search == NeighborSearch::exact) eps = 0;
   if (!(eps >= 0) || std::isinf(eps)) throw Error("NeighborhoodIndex: eps must be finite and >= 0");
 
-  scratch.projected.resize(reduced_);
-  project(query, scratch.projected.data());
+  scratch.projected.resize(reduced_ + 1);
+  project(query, scratch.projected.data(), scratch.centred);
 
   // The k-d tree's result policy (KdTree::search_nearest): every candidate the
   // descent reaches gets its full distance; the pruning bound is the best full
-  // distance, widened so that rounding in the projection never makes the
-  // projected distance exceed the full one (full distances are integers, so
-  // the absolute term only costs a few visits).
+  // distance plus half a unit: full distances are integers, so rounding in the
+  // projection can never prune a candidate as near as the best, and the
+  // (1 + eps) guarantee still holds.
   struct Refine {
     const NeighborhoodIndex& index;
     const std::uint8_t* query;
@@ -138,12 +156,14 @@ NeighborhoodIndex::Match NeighborhoodIndex::nearest(const std::uint8_t* query, N
     void insert(std::uint32_t i, double) {
       ++evaluations;
       const std::uint32_t d = index.squared_distance(query, i);
-      if (d < best.squared_distance || (d == best.squared_distance && i < best.candidate)) {
-        best = {i, d};
-        bound = double(d) * (1 + 1e-9) + 1e-6;
-      }
+      if (d < best.squared_distance || (d == best.squared_distance && i < best.candidate)) set(i, d);
+    }
+    void set(std::uint32_t i, std::uint32_t d) {
+      best = {i, d};
+      bound = double(d) + 0.5;
     }
   } refine{*this, query, scratch.full_distances, {}};
+  if (start.candidate < count_) refine.set(start.candidate, start.squared_distance);
   tree_->search_nearest(scratch.projected.data(), refine, eps);
   return refine.best;
 }

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <string>
 
@@ -17,11 +18,15 @@ namespace geods::texture {
 namespace {
 
 constexpr std::size_t kMaxLevels = 4;
+constexpr std::uint32_t kNoSource = std::numeric_limits<std::uint32_t>::max();
+// The causal neighbours whose patches the coherent start continues.
+constexpr Offset kCoherenceOffsets[] = {{-1, 0}, {-1, -1}, {0, -1}, {1, -1}};
 constexpr std::size_t kMaxOutputPixels = std::size_t(1) << 30;
-// Principal components in the k-d tree when the caller leaves it to us (not
-// tuned yet): fewer make the lower bound looser (more full distances), more
-// make the tree slower in high dimension.
-constexpr std::size_t kDefaultReducedDimension = 16;
+// Principal components in the k-d tree when the caller leaves it to us: fewer
+// make the lower bound looser (more full distances), more make the tree slower
+// (a tree of a few thousand candidates splits only about 9 axes). 8 was the
+// fastest at the same error on 64^2 to 512^2 samples (docs/texture.md).
+constexpr std::size_t kDefaultReducedDimension = 8;
 
 std::string size_text(std::size_t w, std::size_t h) { return std::to_string(w) + "x" + std::to_string(h); }
 
@@ -34,6 +39,9 @@ struct Canvas {
   bool wrap = false;
   std::vector<std::uint8_t> values, noise;
   std::vector<std::uint8_t> unknown;  // interior pixels, 1 = synthesized here
+  // Interior pixels: the sample pixel (y * width + x of the sample level) whose
+  // value each holds, kNoSource for noise and for known pixels of another image.
+  std::vector<std::uint32_t> source;
 
   std::size_t row() const { return width + 2 * pad; }
   std::size_t interior(std::size_t x, std::size_t y) const { return y * width + x; }
@@ -54,6 +62,9 @@ struct Canvas {
 // the search index, and the value each one gives.
 struct Candidates {
   std::vector<std::uint8_t> values;  // channels per candidate
+  std::vector<std::uint32_t> pixel;  // per candidate: its sample pixel, y * width + x
+  std::vector<std::uint32_t> at;     // per sample pixel: its candidate, or kNoSource
+  std::size_t width = 0, height = 0;  // of the sample level
   std::optional<NeighborhoodIndex> index;
 };
 
@@ -75,6 +86,9 @@ Candidates gather_candidates(const Level& level, const NeighborhoodShape& shape,
     return !mask || !(*mask)(std::size_t(x), std::size_t(y), 0);
   };
   Candidates out;
+  out.at.assign(s.width * s.height, kNoSource);
+  out.width = s.width;
+  out.height = s.height;
   std::vector<std::uint8_t> vectors;
   for (std::size_t y = 0; y < s.height; ++y)
     for (std::size_t x = 0; x < s.width; ++x) {
@@ -93,6 +107,8 @@ Candidates gather_candidates(const Level& level, const NeighborhoodShape& shape,
         for (std::size_t k = 0; k < c; ++k)
           vectors.push_back((*level.sample_parent)(std::size_t(px / 2 + o.dx), std::size_t(py / 2 + o.dy), k));
       for (std::size_t k = 0; k < c; ++k) out.values.push_back(s(x, y, k));
+      out.at[y * s.width + x] = std::uint32_t(out.pixel.size());
+      out.pixel.push_back(std::uint32_t(y * s.width + x));
     }
   if (vectors.empty()) return out;
   out.index.emplace(std::move(vectors), dim, reduced_dimension);
@@ -143,12 +159,50 @@ struct LevelSynthesis {
     }
   }
 
+  // The coherent candidate (Ashikhmin 2001): each already synthesized
+  // neighbour q = p + o copied sample pixel s(q), so s(q) - o continues that
+  // patch at p. The nearest of these few is a start for the tree search,
+  // which then prunes from its first node. Only in the causal pass, where the
+  // neighbours are final (a later t, across the wrap, is not read).
+  NeighborhoodIndex::Match coherent_start(std::size_t x, std::size_t y, std::size_t t,
+                                          const std::uint8_t* query) const {
+    const NeighborhoodIndex& index = *candidates.index;
+    const std::size_t h1 = std::size_t(shape.fine_half) + 1;
+    NeighborhoodIndex::Match best;
+    for (const Offset o : kCoherenceOffsets) {
+      std::ptrdiff_t qx = std::ptrdiff_t(x) + o.dx, qy = std::ptrdiff_t(y) + o.dy;
+      const auto w = std::ptrdiff_t(canvas.width), h = std::ptrdiff_t(canvas.height);
+      if (canvas.wrap) {
+        qx = (qx + w) % w, qy = (qy + h) % h;
+      } else if (qx < 0 || qy < 0 || qx >= w || qy >= h) {
+        continue;
+      }
+      const std::size_t q = canvas.interior(std::size_t(qx), std::size_t(qy));
+      if (canvas.unknown[q] && std::size_t(qx) + h1 * std::size_t(qy) >= t) continue;
+      const std::uint32_t from = canvas.source[q];
+      if (from == kNoSource) continue;
+      const std::ptrdiff_t sx = std::ptrdiff_t(from % candidates.width) - o.dx,
+                           sy = std::ptrdiff_t(from / candidates.width) - o.dy;
+      if (sx < 0 || sy < 0 || sx >= std::ptrdiff_t(candidates.width) || sy >= std::ptrdiff_t(candidates.height))
+        continue;
+      const std::uint32_t i = candidates.at[std::size_t(sy) * candidates.width + std::size_t(sx)];
+      if (i == kNoSource) continue;
+      const std::uint32_t d = index.squared_distance(query, i);
+      if (d < best.squared_distance || (d == best.squared_distance && i < best.candidate)) best = {i, d};
+    }
+    return best;
+  }
+
   void synthesize(std::size_t x, std::size_t y, const std::vector<std::uint8_t>& source,
                   std::optional<std::size_t> t) {
     Worker& w = workers.local();
     gather(x, y, source, t, w.query);
     const NeighborhoodIndex& index = *candidates.index;
-    const auto match = index.nearest(w.query.data(), options.search, options.eps, w.scratch);
+    const NeighborhoodIndex::Match start = t && options.search != NeighborSearch::brute
+                                               ? coherent_start(x, y, *t, w.query.data())
+                                               : NeighborhoodIndex::Match{};
+    const auto match = index.nearest(w.query.data(), options.search, options.eps, w.scratch, start);
+    canvas.source[canvas.interior(x, y)] = candidates.pixel[match.candidate];
     const std::size_t c = canvas.channels;
     std::copy_n(candidates.values.data() + std::size_t(match.candidate) * c, c, canvas.values.data() + canvas.at(std::ptrdiff_t(x), std::ptrdiff_t(y)));
     if (distances)
@@ -349,6 +403,7 @@ Canvas make_canvas(std::size_t width, std::size_t height, std::size_t channels, 
   c.values.assign(n, 0);
   c.noise.assign(n, 0);
   c.unknown.assign(width * height, 1);
+  c.source.assign(width * height, kNoSource);
   return c;
 }
 
@@ -414,6 +469,7 @@ SynthesisResult fill_hole(const Image8& image, const Image8& mask, const Synthes
     for (std::size_t y = 0; y < level.height; ++y)
       for (std::size_t x = 0; x < level.width; ++x) {
         c.unknown[c.interior(x, y)] = masks[l](x, y, 0) ? 1 : 0;
+        if (!sample && !c.unknown[c.interior(x, y)]) c.source[c.interior(x, y)] = std::uint32_t(y * level.width + x);
         std::copy_n(&level(x, y, 0), level.channels, c.values.data() + c.at(std::ptrdiff_t(x), std::ptrdiff_t(y)));
       }
     canvases.push_back(std::move(c));

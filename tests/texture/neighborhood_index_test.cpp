@@ -105,6 +105,32 @@ TEST(NeighborhoodIndex, ApproxIsWithinOnePlusEpsOfTheNearest) {
   EXPECT_LT(exact_tree.full_distances, 400u * 2000u);
 }
 
+TEST(NeighborhoodIndex, AStartingMatchKeepsTheGuarantees) {
+  // From any start (a random candidate, or brute force's answer itself), exact
+  // still ends at brute force's candidate and approx within (1 + eps) of it.
+  const std::size_t dim = 40;
+  const auto vectors = clustered(1500, dim, 21);
+  const auto queries = clustered(300, dim, 22);
+  const NeighborhoodIndex index(vectors, dim, 8);
+  NeighborhoodIndex::Scratch scratch;
+  Rng rng(23);
+  for (std::size_t q = 0; q < 300; ++q) {
+    const std::uint8_t* query = queries.data() + q * dim;
+    const auto brute = index.nearest(query, NeighborSearch::brute, 0, scratch);
+    const auto i = std::uint32_t(rng.below(1500));
+    for (const NeighborhoodIndex::Match start : {NeighborhoodIndex::Match{i, index.squared_distance(query, i)}, brute}) {
+      const auto exact = index.nearest(query, NeighborSearch::exact, 0, scratch, start);
+      ASSERT_EQ(exact.candidate, brute.candidate) << "query " << q;
+      for (const double eps : {0.5, 8.0}) {
+        const auto approx = index.nearest(query, NeighborSearch::approx, eps, scratch, start);
+        ASSERT_EQ(approx.squared_distance, index.squared_distance(query, approx.candidate));
+        ASSERT_LE(std::sqrt(double(approx.squared_distance)),
+                  (1 + eps) * std::sqrt(double(brute.squared_distance)) + 1e-9);
+      }
+    }
+  }
+}
+
 TEST(NeighborhoodIndex, StatsAndBadInput) {
   const NeighborhoodIndex index(clustered(100, 10, 1), 10, 40);
   const auto s = index.stats();

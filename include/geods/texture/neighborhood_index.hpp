@@ -9,8 +9,10 @@
 //
 // - brute: every candidate (the reference).
 // - exact: a k-d tree (spatial::KdTree) over the candidates projected on
-//   their first principal components. The projection is orthonormal, so the
-//   projected distance is a lower bound of the full one: the descent computes
+//   their first principal components, plus one coordinate: the norm of the
+//   residual (the part of the centred vector the components leave out). The
+//   projection is orthonormal and | |Rq| - |Rc| | <= |R(q - c)|, so the
+//   distance in the tree is a lower bound of the full one: the descent computes
 //   the full distance of each leaf candidate it reaches and prunes by the best
 //   full distance so far. The answer is brute force's, candidate for candidate.
 // - approx: the same descent with the k-d tree's (1 + eps) pruning: a subtree
@@ -69,26 +71,31 @@ class NeighborhoodIndex {
 
   /// Per-thread buffers of nearest(), reused across queries.
   struct Scratch {
-    std::vector<double> projected;
+    std::vector<double> projected, centred;
     std::size_t full_distances = 0;  // full distances computed, summed over queries
   };
 
   /// The candidate nearest to `query` (dimension() values). eps >= 0 is used by
   /// approx only. exact/approx need a tree (reduced_dimension > 0).
+  /// `start`, if it names a candidate, is a known match (with its exact
+  /// squared distance) the tree search starts from: a good one prunes from
+  /// the first node on. The guarantees are the same: exact finds brute
+  /// force's candidate, approx one within (1 + eps) of the nearest.
+  Match nearest(const std::uint8_t* query, NeighborSearch search, double eps, Scratch& scratch, Match start) const;
   Match nearest(const std::uint8_t* query, NeighborSearch search, double eps, Scratch& scratch) const;
 
  private:
   Match brute_force(const std::uint8_t* query, Scratch& scratch) const;
   // The coordinates of v (dimension() values) on the principal directions: reduced_dimension() values.
   // Candidates and queries go through this one computation, so equal vectors project bit-identically.
-  void project(const std::uint8_t* v, double* out) const;
+  void project(const std::uint8_t* v, double* out, std::vector<double>& centred) const;
 
   std::vector<std::uint8_t> vectors_;
   std::size_t count_ = 0, dim_ = 0, reduced_ = 0;
   double explained_ = 0;
   std::vector<double> mean_;       // dim_
-  std::vector<double> basis_;      // reduced_ rows of dim_: the principal directions
-  std::vector<double> projected_;  // count_ rows of reduced_
+  std::vector<double> basis_;      // dim_ rows of reduced_: the principal directions are its columns
+  std::vector<double> projected_;  // count_ rows of reduced_ + 1 (the components, the residual norm)
   std::unique_ptr<spatial::KdTree<double>> tree_;
 };
 
