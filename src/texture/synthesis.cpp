@@ -123,6 +123,9 @@ struct LevelSynthesis {
   const Canvas* parent;  // the coarser level's finished canvas, or null
   const SynthesisOptions& options;
   std::vector<float>* distances;  // per interior pixel, at the finest level only
+  // Offsets of the window pixels from the centre in a padded canvas's values
+  // (a toroidal canvas wraps instead, through Canvas::at).
+  std::vector<std::ptrdiff_t> fine_delta, parent_delta;
 
   struct Worker {
     std::vector<std::uint8_t> query;
@@ -142,6 +145,17 @@ struct LevelSynthesis {
               std::vector<std::uint8_t>& query) const {
     const std::size_t c = canvas.channels;
     const std::size_t h1 = std::size_t(shape.fine_half) + 1;
+    if (!canvas.wrap) {  // the common case, without a branch per value
+      query.resize(shape.dimension(c));
+      std::uint8_t* out = query.data();
+      const std::uint8_t* centre = source.data() + canvas.at(std::ptrdiff_t(x), std::ptrdiff_t(y));
+      for (const std::ptrdiff_t d : fine_delta) out = std::copy_n(centre + d, c, out);
+      if (parent) {
+        const std::uint8_t* up = parent->values.data() + parent->at(std::ptrdiff_t(x / 2), std::ptrdiff_t(y / 2));
+        for (const std::ptrdiff_t d : parent_delta) out = std::copy_n(up + d, c, out);
+      }
+      return;
+    }
     query.clear();
     for (const Offset o : shape.fine) {
       const std::size_t at = canvas.at(std::ptrdiff_t(x) + o.dx, std::ptrdiff_t(y) + o.dy);
@@ -209,6 +223,13 @@ struct LevelSynthesis {
       (*distances)[canvas.interior(x, y)] = float(std::sqrt(double(match.squared_distance) / double(index.dimension())));
   }
 };
+
+// Window offsets as offsets in a padded canvas's values (see LevelSynthesis).
+std::vector<std::ptrdiff_t> deltas(const Canvas& c, const std::vector<Offset>& offsets) {
+  std::vector<std::ptrdiff_t> out;
+  for (const Offset o : offsets) out.push_back((std::ptrdiff_t(c.row()) * o.dy + o.dx) * std::ptrdiff_t(c.channels));
+  return out;
+}
 
 // The scan-line pass, one anti-diagonal t = x + (h + 1) y at a time (see synthesis.hpp).
 void causal_pass(LevelSynthesis& s, Progress& progress, std::size_t& done) {
@@ -367,7 +388,9 @@ SynthesisStats run(const std::vector<Image8>& sample, const std::vector<Image8>*
       const bool last = pass == options.refinement_passes;
       const NeighborhoodShape& shape = pass == 0 ? (top ? causal_top : causal_fine) : (top ? full_top : full_fine);
       const Candidates& candidates = pass == 0 ? causal : *full;
-      LevelSynthesis s{shape, candidates, canvas, parent, options, l == 0 && last ? &distances : nullptr, {}};
+      LevelSynthesis s{shape,   candidates, canvas, parent, options, l == 0 && last ? &distances : nullptr,
+                       deltas(canvas, shape.fine), parent ? deltas(*parent, shape.parent) : std::vector<std::ptrdiff_t>{},
+                       {}};
       if (pass == 0)
         causal_pass(s, progress, done);
       else
