@@ -149,11 +149,15 @@ struct LevelSynthesis {
       query.resize(shape.dimension(c));
       std::uint8_t* out = query.data();
       const std::uint8_t* centre = source.data() + canvas.at(std::ptrdiff_t(x), std::ptrdiff_t(y));
-      for (const std::ptrdiff_t d : fine_delta) out = std::copy_n(centre + d, c, out);
-      if (parent) {
-        const std::uint8_t* up = parent->values.data() + parent->at(std::ptrdiff_t(x / 2), std::ptrdiff_t(y / 2));
-        for (const std::ptrdiff_t d : parent_delta) out = std::copy_n(up + d, c, out);
+      const std::uint8_t* up =
+          parent ? parent->values.data() + parent->at(std::ptrdiff_t(x / 2), std::ptrdiff_t(y / 2)) : nullptr;
+      if (c == 1) {  // grey: one byte per offset, not a memmove call each
+        for (const std::ptrdiff_t d : fine_delta) *out++ = centre[d];
+        for (const std::ptrdiff_t d : parent_delta) *out++ = up[d];
+        return;
       }
+      for (const std::ptrdiff_t d : fine_delta) out = std::copy_n(centre + d, c, out);
+      for (const std::ptrdiff_t d : parent_delta) out = std::copy_n(up + d, c, out);
       return;
     }
     query.clear();
