@@ -70,10 +70,11 @@ py::object fill_hole_py(const Rows<std::uint8_t>& image, const Rows<std::uint8_t
 }  // namespace
 
 void bind_texture(py::module_& m) {
-  m.def("synthesize_texture", &synthesize_texture_py, py::arg("sample"), py::arg("size"), py::arg("neighborhood") = 9,
-        py::arg("parent_neighborhood") = 0, py::arg("levels") = 0, py::arg("search") = "approx",
-        py::arg("eps") = texture::SynthesisOptions{}.eps, py::arg("reduced_dimension") = 0, py::arg("refinement_passes") = 0,
-        py::arg("seed") = 0, py::arg("tile") = false, py::arg("stats") = false,
+  const texture::SynthesisOptions d;  // the defaults, stated once in C++
+  m.def("synthesize_texture", &synthesize_texture_py, py::arg("sample"), py::arg("size"), py::arg("neighborhood") = d.neighborhood,
+        py::arg("parent_neighborhood") = d.parent_neighborhood, py::arg("levels") = d.levels, py::arg("search") = "approx",
+        py::arg("eps") = d.eps, py::arg("reduced_dimension") = d.reduced_dimension, py::arg("refinement_passes") = d.refinement_passes,
+        py::arg("seed") = d.seed, py::arg("tile") = false, py::arg("stats") = false,
         R"doc(A texture of size (width, height) like `sample` (Wei-Levoy, seed §5.5).
 
 sample: uint8 (h, w) grey or (h, w, c) with 1 to 4 channels; the result has
@@ -87,9 +88,9 @@ exact) or 'brute'. levels: pyramid levels (0: from the sample size, at most
 gives the same bytes on any thread count. stats=True returns (image, stats).
 Raises geods.Error for a sample too small for the windows or bad options.)doc");
   m.def("fill_hole", &fill_hole_py, py::arg("image"), py::arg("mask"), py::arg("sample") = py::none(),
-        py::arg("neighborhood") = 9, py::arg("parent_neighborhood") = 0, py::arg("levels") = 0,
-        py::arg("search") = "approx", py::arg("eps") = texture::SynthesisOptions{}.eps, py::arg("reduced_dimension") = 0,
-        py::arg("refinement_passes") = 0, py::arg("seed") = 0, py::arg("stats") = false,
+        py::arg("neighborhood") = d.neighborhood, py::arg("parent_neighborhood") = d.parent_neighborhood, py::arg("levels") = d.levels,
+        py::arg("search") = "approx", py::arg("eps") = d.eps, py::arg("reduced_dimension") = d.reduced_dimension,
+        py::arg("refinement_passes") = d.refinement_passes, py::arg("seed") = d.seed, py::arg("stats") = false,
         R"doc(`image` with the pixels where `mask` is nonzero synthesized to match their surroundings.
 
 mask: uint8 (h, w) (or (h, w, c): its first channel) of the image's size.
