@@ -156,7 +156,7 @@ NeighborhoodIndex::Match NeighborhoodIndex::nearest(const std::uint8_t* query, N
     void insert(std::uint32_t i, double) {
       ++evaluations;
       const std::uint32_t d = index.squared_distance(query, i);
-      if (d < best.squared_distance || (d == best.squared_distance && i < best.candidate)) set(i, d);
+      if (Match{i, d}.before(best)) set(i, d);
     }
     void set(std::uint32_t i, std::uint32_t d) {
       best = {i, d};

@@ -205,8 +205,8 @@ struct LevelSynthesis {
         continue;
       const std::uint32_t i = candidates.at[std::size_t(sy) * candidates.width + std::size_t(sx)];
       if (i == kNoSource) continue;
-      const std::uint32_t d = index.squared_distance(query, i);
-      if (d < best.squared_distance || (d == best.squared_distance && i < best.candidate)) best = {i, d};
+      const NeighborhoodIndex::Match m{i, index.squared_distance(query, i)};
+      if (m.before(best)) best = m;
     }
     return best;
   }

@@ -52,6 +52,10 @@ class NeighborhoodIndex {
   struct Match {
     std::uint32_t candidate = std::numeric_limits<std::uint32_t>::max();
     std::uint32_t squared_distance = std::numeric_limits<std::uint32_t>::max();
+    /// The order of "nearest": smaller distance, then smaller candidate index.
+    bool before(const Match& o) const {
+      return squared_distance < o.squared_distance || (squared_distance == o.squared_distance && candidate < o.candidate);
+    }
   };
 
   /// `vectors` holds the candidates row by row, `dimension` values each
