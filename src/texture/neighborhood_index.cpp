@@ -14,6 +14,10 @@ namespace {
 // spread: the principal directions only need to be good, not exact (the
 // searches stay exact whatever the basis, as long as it is orthonormal).
 constexpr std::size_t kCovarianceSamples = 2048;
+// Candidates per k-d tree leaf: smaller leaves mean fewer full distances and
+// a longer descent. Of 4, 6, 8, 10, 16 and 32 on 64^2 samples, 8 was the
+// fastest at the same error (4 is about 10 % faster, its matches 4 % worse).
+constexpr std::size_t kLeafSize = 8;
 
 }  // namespace
 
@@ -73,7 +77,8 @@ NeighborhoodIndex::NeighborhoodIndex(std::vector<std::uint8_t> vectors, std::siz
     std::vector<double> centred;
     for (std::size_t i = begin; i < end; ++i) project(candidate(i), projected_.data() + i * tree_dim, centred);
   });
-  tree_ = std::make_unique<spatial::KdTree<double>>(spatial::PointView<double>(projected_.data(), count_, tree_dim));
+  tree_ = std::make_unique<spatial::KdTree<double>>(spatial::PointView<double>(projected_.data(), count_, tree_dim),
+                                                     kLeafSize);
 }
 
 NeighborhoodIndexStats NeighborhoodIndex::stats() const {
@@ -88,21 +93,15 @@ NeighborhoodIndexStats NeighborhoodIndex::stats() const {
 }
 
 void NeighborhoodIndex::project(const std::uint8_t* v, double* out, std::vector<double>& centred) const {
+  // Eigen's vectorized kernels: basis_ holds one column of reduced_ component
+  // weights per value, so the product sums whole columns at once.
   centred.resize(dim_);
-  double norm = 0;
-  for (std::size_t a = 0; a < dim_; ++a) {
-    centred[a] = double(v[a]) - mean_[a];
-    norm += centred[a] * centred[a];
-  }
-  // One pass over the values, all components at once (independent sums, which vectorize).
-  std::fill_n(out, reduced_, 0.0);
-  for (std::size_t a = 0; a < dim_; ++a) {
-    const double* b = basis_.data() + a * reduced_;
-    for (std::size_t r = 0; r < reduced_; ++r) out[r] += b[r] * centred[a];
-  }
-  double kept = 0;
-  for (std::size_t r = 0; r < reduced_; ++r) kept += out[r] * out[r];
-  out[reduced_] = std::sqrt(std::max(norm - kept, 0.0));
+  Eigen::Map<Eigen::VectorXd> c(centred.data(), Eigen::Index(dim_));
+  c = Eigen::Map<const Eigen::Matrix<std::uint8_t, Eigen::Dynamic, 1>>(v, Eigen::Index(dim_)).cast<double>() -
+      Eigen::Map<const Eigen::VectorXd>(mean_.data(), Eigen::Index(dim_));
+  Eigen::Map<Eigen::VectorXd> components(out, Eigen::Index(reduced_));
+  components.noalias() = Eigen::Map<const Eigen::MatrixXd>(basis_.data(), Eigen::Index(reduced_), Eigen::Index(dim_)) * c;
+  out[reduced_] = std::sqrt(std::max(c.squaredNorm() - components.squaredNorm(), 0.0));
 }
 
 std::uint32_t NeighborhoodIndex::squared_distance(const std::uint8_t* query, std::size_t i) const {
