@@ -439,10 +439,29 @@ def micro_table(micro):
     return "\n".join(lines)
 
 
-def run_record(cmdline, info, started):
-    """When and how one workload (or the micro benchmarks) was measured."""
+def run_record(cmdline, info, started, machine):
+    """When, how and on what one workload (or the micro benchmarks) was measured: kept with its
+    section by --update, so a later run on another machine does not relabel it."""
     return {"date": started.strftime("%Y-%m-%d %H:%M UTC"), "git": info["git"],
-            "load": [round(x, 2) for x in info["load"]], "command": cmdline}
+            "load": [round(x, 2) for x in info["load"]], "command": cmdline, "machine": machine}
+
+
+def machine_summary(info, versions):
+    """One line: the machine, compiler and installed anchor packages of a run."""
+    installed = [f"{p} {v}" for p, v in versions if v != "not installed"]
+    return (f"{info['cpu']}, {info['cores']} logical cores, {info['memory']}; {info['os']}, kernel "
+            f"{info['kernel']}; {info['compiler']}, `{info['flags']}`; anchor packages: "
+            + (", ".join(installed) or "none installed"))
+
+
+def programs_line(c, status):
+    """The programs of comparison c and their labels, with why any was unavailable."""
+    progs = []
+    for p in c["programs"]:
+        pname = p.get("program") or " ".join(p["command"]).replace("{python} ", "").replace("{dir}/", "")
+        st = status.get(pname)
+        progs.append(f"`{pname}` = {p.get('label', p['anchor'])}" + (f" (**{st}**)" if st else ""))
+    return "; ".join(progs)
 
 
 def load_previous(jsonl, comps):
@@ -528,13 +547,9 @@ def write_report(out, jsonl, cmdline, info, versions, verify, comps, results, st
         if run:
             s.append(f"Measured {run['date']} on geods `{run['git']}`, load average "
                      f"{' / '.join(f'{x:.2f}' for x in run['load'])}: `{run['command']}`\n")
-        progs = []
-        for p in c["programs"]:
-            pname = p.get("program") or " ".join(p["command"]).replace("{python} ", "").replace("{dir}/", "")
-            st = status.get(pname)
-            progs.append(f"`{pname}` = {p.get('label', p['anchor'])}"
-                         + (f" (**{st}**)" if st else ""))
-        s.append("Programs: " + "; ".join(progs) + ".\n")
+            if run.get("machine"):
+                s.append(f"Machine: {run['machine']}.\n")
+        s.append("Programs: " + ((run or {}).get("programs") or programs_line(c, status)) + ".\n")
         s.append(table + "\n")
         if problems:
             s.append("Problems: " + "; ".join(problems) + "\n")
@@ -550,7 +565,9 @@ def write_report(out, jsonl, cmdline, info, versions, verify, comps, results, st
     if micro:
         L.append("`build/release/bin/geods_*_bench --benchmark_format=json` (geods only, no anchor).\n")
         if runs.get("micro"):
-            L.append(f"Measured {runs['micro']['date']} on geods `{runs['micro']['git']}`.\n")
+            machine = runs["micro"].get("machine")
+            L.append(f"Measured {runs['micro']['date']} on geods `{runs['micro']['git']}`."
+                     + (f" Machine: {machine}." if machine else "") + "\n")
         L.append(micro_table(micro))
     else:
         L.append("None found (`build/release/bin/geods_*_bench`; `make release` builds them).\n")
@@ -641,9 +658,12 @@ def main():
                                                 log_dir)
     micro = [] if args.no_micro else run_micro()  # (e)
     info = machine_info(build_dir)
-    runs = {c["workload"]: run_record(cmdline, info, started) for c in comps}
+    versions = anchor_versions()
+    machine = machine_summary(info, versions)
+    runs = {c["workload"]: run_record(cmdline, info, started, machine) | {"programs": programs_line(c, status)}
+            for c in comps}
     if micro:
-        runs["micro"] = run_record(cmdline, info, started)
+        runs["micro"] = run_record(cmdline, info, started, machine)
     if args.update:
         previous, previous_runs = load_previous(jsonl, all_comps)
         for c in all_comps:
@@ -656,7 +676,7 @@ def main():
             micro = previous_runs["micro_results"]
             runs["micro"] = previous_runs.get("micro", {"date": "an earlier run", "git": "unknown"})
         comps = [c for c in all_comps if c["workload"] in results]
-    problems = write_report(out, jsonl, cmdline, info, anchor_versions(), verify,  # (f)
+    problems = write_report(out, jsonl, cmdline, info, versions, verify,  # (f)
                             comps, results, status, micro, rel(data_dir) if data_dir.startswith(REPO) else data_dir,
                             args.rounds, args.reps, threads_list, started, runs,
                             [setup_problem] if setup_problem else [])

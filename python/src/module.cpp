@@ -17,4 +17,5 @@ PYBIND11_MODULE(_geods, m) {
   geods::python::bind_ray(m);
   geods::python::bind_iso(m);
   geods::python::bind_texture(m);
+  geods::python::bind_field(m);
 }
