@@ -138,7 +138,7 @@ TEST(Edt, SameResultOnAnyThreadCount) {
 TEST(Edt, RefusesBadSpacingsAndInconsistentViews) {
   const auto m = random_mask(4, 4, 4, 0.5, 3);
   const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
-  for (const auto& s : {std::array<double, 3>{0, 1, 1}, {1, -1, 1}, {1, 1, nan}, {inf, 1, 1}})
+  for (const auto& s : {std::array<double, 3>{0, 1, 1}, {1, -1, 1}, {1, 1, nan}, {inf, 1, 1}, {1e200, 1, 1}, {1, 1e-200, 1}})
     EXPECT_THROW(edt(m.view(), {s}), Error);
   Grid3View<std::uint8_t> short_view(m, std::span<const std::uint8_t>(m.data).first(10));
   EXPECT_THROW(edt(short_view), Error);

@@ -53,7 +53,9 @@ struct EdtResult {
 
 /// The distance transform of `mask` (nonzero = foreground). Time O(samples)
 /// per axis, memory one double (and with features one index) per sample.
-/// Throws geods::Error for a spacing that is not finite and positive.
+/// Throws geods::Error for a spacing that is not finite and positive, or so
+/// small or large that squared distances would underflow or overflow
+/// (below 1e-150, or above 1e150 times the side).
 EdtResult edt(const Grid3View<std::uint8_t>& mask, const EdtRequest& request = {});
 
 }  // namespace geods::field
