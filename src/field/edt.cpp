@@ -143,15 +143,14 @@ void first_pass(const Grid3View<std::uint8_t>& mask, double s, std::vector<doubl
 EdtResult edt(const Grid3View<std::uint8_t>& mask, const EdtRequest& request) {
   std::array<double, 3> spacing{double(mask.spacing[0]), double(mask.spacing[1]), double(mask.spacing[2])};
   if (request.spacing) spacing = *request.spacing;
-  for (int a = 0; a < 3; ++a)
-    if (!std::isfinite(spacing[a]) || !(spacing[a] > 0))
-      throw Error("edt: spacing must be finite and > 0, got " + std::to_string(spacing[a]) + " along " +
-                  std::string(1, char('x' + a)));
-  // Squared distances of up to (spacing * side)^2 per axis must neither overflow nor underflow.
-  for (int a = 0; a < 3; ++a)
+  for (int a = 0; a < 3; ++a) {
+    const std::string where = std::to_string(spacing[a]) + " along " + std::string(1, char('x' + a));
+    if (!std::isfinite(spacing[a]) || !(spacing[a] > 0)) throw Error("edt: spacing must be finite and > 0, got " + where);
+    // Squared distances of up to (spacing * side)^2 must neither underflow nor overflow.
     if (spacing[a] < 1e-150 || spacing[a] * double(mask.dims[a]) > 1e150)
-      throw Error("edt: spacing " + std::to_string(spacing[a]) + " along " + std::string(1, char('x' + a)) +
-                  " is out of range (squared distances would underflow or overflow; rescale the spacing)");
+      throw Error("edt: spacing " + where + " is out of range (squared distances would underflow or overflow; "
+                  "rescale the spacing)");
+  }
   const std::size_t size = Grid3<double>::checked_size(mask.dims[0], mask.dims[1], mask.dims[2]);
   if (mask.data.size() != size) throw Error("edt: the mask holds " + std::to_string(mask.data.size()) +
                                             " samples, its dims say " + std::to_string(size));
