@@ -90,14 +90,15 @@ struct Threshold {
   }
   bool inside(T v) const { return Compare(v) >= value; }
 
-  /// How many of the n samples are inside; throws for a NaN among them.
+  /// How many of the n samples are inside; throws for a NaN or infinite one
+  /// among them (v - v is NaN exactly for those).
   std::uint32_t count_inside(const T* v, std::size_t n) const {
-    std::uint32_t count = 0, nan = 0;
+    std::uint32_t count = 0, bad = 0;
     for (std::size_t i = 0; i < n; ++i) {
       count += std::uint32_t(Compare(v[i]) >= value);
-      if constexpr (std::is_floating_point_v<T>) nan += std::uint32_t(v[i] != v[i]);
+      if constexpr (std::is_floating_point_v<T>) bad += std::uint32_t(v[i] - v[i] != 0);
     }
-    if (nan) throw Error("isosurface: the volume has a NaN sample");
+    if (bad) throw Error("isosurface: the volume has a NaN or infinite sample");
     return count;
   }
 };
@@ -247,16 +248,18 @@ bool mirrored(const Grid3View<T>& volume, std::span<const Vec3f> positions) {
   return jac.determinant() < 0;
 }
 
-/// Throws if a floating-point volume holds a NaN (it could be neither inside nor outside).
+/// Throws if a floating-point volume holds a NaN (it could be neither inside
+/// nor outside) or an infinity (the vertices on its edges would be NaN).
 template <typename T>
 void check_samples(const Grid3View<T>& volume) {
   if constexpr (std::is_floating_point_v<T>) {
-    bool nan = false;
-    for (const T v : volume.data) nan |= (v != v);
-    if (nan) {
+    bool bad = false;
+    for (const T v : volume.data) bad |= (v - v != 0);
+    if (bad) {
       for (std::size_t i = 0; i < volume.size(); ++i)
-        if (volume.data[i] != volume.data[i])
-          throw Error("isosurface: sample " + std::to_string(i) + " of the volume is NaN");
+        if (!std::isfinite(volume.data[i]))
+          throw Error("isosurface: sample " + std::to_string(i) + " of the volume is " +
+                      (volume.data[i] != volume.data[i] ? "NaN" : "infinite"));
     }
   }
 }

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "exact_compare.hpp"
+#include "geods/core/coordinate_range.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/predicates.hpp"
 #include "geods/core/rng.hpp"
@@ -69,6 +70,7 @@ void check_points(std::span<const Vec2d> points, const char* what) {
   for (std::size_t i = 0; i < points.size(); ++i)
     if (!std::isfinite(points[i][0]) || !std::isfinite(points[i][1]))
       throw Error(std::string(what) + ": non-finite coordinates at point " + std::to_string(i));
+  check_coordinate_range(points.front().data(), points.size(), 2, 2, 3, what);
 }
 
 // The convex hull of the sites, counter-clockwise: the next hull site after a

@@ -2,6 +2,7 @@
 #include "constrained_delaunay.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "geods/core/error.hpp"
 
@@ -180,9 +181,19 @@ ConstrainedDelaunay::Crossing ConstrainedDelaunay::split_crossing(std::uint32_t 
   // Segment a-b crosses the constrained edge u-w at x (rounded into the edge's box).
   const DelaunayCore& core = *core_;
   const std::uint32_t u = core.vert[crossing], w = core.vert[next(crossing)];
+  // The determinants are quadratic in the coordinates: they are computed on the
+  // four points scaled by one power of two (exact) to a largest coordinate near
+  // 1, so that they neither overflow (1e300) nor underflow (1e-300).
   const Vec2d &pu = core.at(u), &pw = core.at(w);
-  const double du = orient2d(core.at(a), core.at(b), pu), dw = orient2d(core.at(a), core.at(b), pw);
-  Vec2d x = (pu * dw - pw * du) / (dw - du);
+  double largest = 0;
+  for (const Vec2d& p : {core.at(a), core.at(b), pu, pw}) largest = std::max(largest, p.cwiseAbs().maxCoeff());
+  int exponent = 0;
+  std::frexp(largest, &exponent);
+  const auto scaled = [&](const Vec2d& p) { return Vec2d(std::ldexp(p[0], -exponent), std::ldexp(p[1], -exponent)); };
+  const Vec2d sa = scaled(core.at(a)), sb = scaled(core.at(b)), su = scaled(pu), sw = scaled(pw);
+  const double du = orient2d(sa, sb, su), dw = orient2d(sa, sb, sw);
+  const Vec2d sx = (su * dw - sw * du) / (dw - du);
+  Vec2d x(std::ldexp(sx[0], exponent), std::ldexp(sx[1], exponent));
   for (int k = 0; k < 2; ++k) x[k] = std::clamp(x[k], std::min(pu[k], pw[k]), std::max(pu[k], pw[k]));
   (*marks_)[crossing] = (*marks_)[core.twin[crossing]] = 0;
   return {crossing, u, w, x};

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "exact_compare.hpp"
+#include "geods/core/coordinate_range.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/morton.hpp"
 #include "geods/core/parallel.hpp"
@@ -18,7 +19,8 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 
 void check_query(const Vec2d& q) {
   if (!std::isfinite(q[0]) || !std::isfinite(q[1]))
-    throw Error("nearest site: non-finite query point (" + std::to_string(q[0]) + ", " + std::to_string(q[1]) + ")");
+    throw Error("nearest site: non-finite query point (" + short_number(q[0]) + ", " + short_number(q[1]) + ")");
+  check_query_range(std::span<const double>(q.data(), 2), 2, "nearest site");
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <numeric>
 #include <string>
 
+#include "geods/core/coordinate_range.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"
 #include "geods/core/predicates.hpp"
@@ -95,6 +96,8 @@ Voronoi2::Voronoi2(std::span<const Vec2d> points, std::span<const std::uint32_t>
   for (std::size_t i = 0; i < n; ++i)
     if (!std::isfinite(points[i][0]) || !std::isfinite(points[i][1]))
       throw Error("Voronoi2: non-finite coordinates at point " + std::to_string(i));
+  // Circumcentres are cubic in the coordinates: refuse what they cannot hold.
+  check_coordinate_range(points.front().data(), n, 2, 2, 3, "Voronoi2");
   if (representative.size() != n)
     throw Error("Voronoi2: " + std::to_string(representative.size()) + " representatives for " + std::to_string(n) +
                 " points");

@@ -313,6 +313,15 @@ TEST(Isosurface, BadInputThrows) {
   g(2, 1, 3) = std::nanf("");
   EXPECT_THROW(isosurface(g, 0.5), Error);
   EXPECT_THROW(MinMaxOctree<float>{g}, Error);
+  // An infinite sample would put NaN vertices on its edges.
+  for (float inf : {INFINITY, -INFINITY}) {
+    g(2, 1, 3) = inf;
+    EXPECT_THROW(isosurface(g, 0.5), Error);
+    EXPECT_THROW(MinMaxOctree<float>{g}, Error);
+    Grid3<double> flat(5, 5, 1, 0.0);  // no cells: checked all the same
+    flat(1, 1, 0) = double(inf);
+    EXPECT_THROW(isosurface(flat, 0.5), Error);
+  }
   g(2, 1, 3) = 1;
   std::vector<Vec3f> few(10);
   IsoOptions options;

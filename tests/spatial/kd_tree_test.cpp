@@ -661,5 +661,52 @@ TEST(KdTree, BadInputThrows) {
   EXPECT_EQ(tree.count_box(inverted_lo, inverted_hi), 0u);  // an empty box is no error
 }
 
+
+// Points scaled by a power of two give the same neighbours, with squared
+// distances scaled exactly, as long as they stay in the range where squared
+// distances neither overflow nor underflow; beyond it the tree refuses them
+// (1e300 used to give infinite distances and arbitrary neighbours).
+template <typename T>
+void check_scaled_copies(const std::vector<int>& good_exponents, const std::vector<T>& bad_scales) {
+  const std::size_t n = 300, d = 3;
+  const std::vector<T> unit = make_points<T>(Shape::uniform, n, d, 21);
+  const std::vector<T> queries = make_points<T>(Shape::uniform, 30, d, 22);
+  const KdTree<T, 3> reference(unit, d);
+  for (int e : good_exponents) {
+    std::vector<T> p = unit, q = queries;
+    for (T& x : p) x = std::ldexp(x, e);
+    for (T& x : q) x = std::ldexp(x, e);
+    const KdTree<T, 3> tree(p, d);
+    for (std::size_t i = 0; i < 30; ++i) {
+      const auto want = reference.query(std::span<const T>(&queries[i * d], d), 5);
+      const auto got = tree.query(std::span<const T>(&q[i * d], d), 5);
+      ASSERT_EQ(got.size(), want.size());
+      for (std::size_t j = 0; j < got.size(); ++j) {
+        EXPECT_EQ(got[j].index, want[j].index) << "2^" << e;
+        EXPECT_EQ(got[j].squared_distance, std::ldexp(want[j].squared_distance, 2 * e)) << "2^" << e;
+      }
+    }
+  }
+  for (T s : bad_scales) {
+    std::vector<T> p = unit;
+    for (T& x : p) x *= s;
+    EXPECT_THROW((KdTree<T, 3>(p, d)), Error) << s;
+    // A far query against unit points overflows the same way.
+    const std::vector<T> far{s, 0, 0};
+    if (s > 1) EXPECT_THROW(reference.query(std::span<const T>(far), 1), Error) << s;
+    if (s > 1) EXPECT_THROW(reference.query_radius(std::span<const T>(far), 1.0), Error) << s;
+  }
+}
+
+TEST(KdTree, ExtremeScalesAreExactOrRefused) {
+  check_scaled_copies<double>({-440, -300, 300, 490}, {1e300, 1e-300, 1e155, 1e-140});
+  check_scaled_copies<float>({-30, 40}, {1e20f, 1e-20f, 1e30f});
+  // Boxes are not distances: a box far out still counts (nothing).
+  const std::vector<double> unit = make_points<double>(Shape::uniform, 50, 3, 23);
+  const KdTree<double, 3> tree(unit, 3);
+  const std::vector<double> lo{-1e300, -1e300, -1e300}, hi{1e300, 1e300, 1e300};
+  EXPECT_EQ(tree.count_box(std::span<const double>(lo), std::span<const double>(hi)), 50u);
+}
+
 }  // namespace
 }  // namespace geods::spatial

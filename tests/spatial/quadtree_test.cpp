@@ -501,5 +501,40 @@ TEST(Orthtree, BadInput) {
   EXPECT_THROW(tree.locate(Vec2d(0, std::numeric_limits<double>::quiet_NaN())), Error);
 }
 
+
+// Coordinates so large that the root square's side overflows (used to give
+// NaN bounds and index 4294967295), or a set so small that its distances
+// underflow, are refused; scaled copies inside the range answer the same.
+TEST(Quadtree, ExtremeScalesAreExactOrRefused) {
+  Rng rng(5);
+  std::vector<Vec2d> unit(200);
+  for (Vec2d& p : unit) p = Vec2d(rng.uniform(), rng.uniform());
+  const Quadtree<> reference(unit);
+  for (double s : {1.7e308, 1e300, 1e-300}) {
+    std::vector<Vec2d> p = unit;
+    for (Vec2d& x : p) x *= s;
+    p[0] = Vec2d(-s, -s);
+    EXPECT_THROW(Quadtree<>{p}, Error) << s;
+  }
+  EXPECT_THROW(reference.query(Vec2d(1e300, 0), 1), Error);
+  EXPECT_THROW(reference.query_radius(Vec2d(0, -1e300), 1), Error);
+  for (int e : {-400, 400}) {
+    std::vector<Vec2d> p = unit;
+    for (Vec2d& x : p) x = Vec2d(std::ldexp(x[0], e), std::ldexp(x[1], e));
+    const Quadtree<> tree(p);
+    tree.validate();
+    for (int i = 0; i < 20; ++i) {
+      const Vec2d q(rng.uniform(), rng.uniform());
+      const auto want = reference.query(q, 3);
+      const auto got = tree.query(Vec2d(std::ldexp(q[0], e), std::ldexp(q[1], e)), 3);
+      ASSERT_EQ(got.size(), want.size());
+      for (std::size_t j = 0; j < got.size(); ++j) {
+        EXPECT_EQ(got[j].index, want[j].index) << e;
+        EXPECT_EQ(got[j].squared_distance, std::ldexp(want[j].squared_distance, 2 * e)) << e;
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace geods::spatial

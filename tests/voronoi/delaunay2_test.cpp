@@ -523,6 +523,30 @@ TEST(Delaunay2Constrained, ManyRandomCrossingSegments) {
   EXPECT_GT(dt.intersection_points().size(), 0u);
 }
 
+// Crossing points used to be computed from determinants that overflow at
+// 1e300 ("internal error") and underflow at 1e-300 (a lost segment): scaled by
+// a power of two, the triangulation is the same and the crossings scale exactly.
+TEST(Delaunay2Constrained, CrossingsAtExtremeScales) {
+  Rng rng(6);
+  std::vector<Vec2d> p;
+  for (int i = 0; i < 60; ++i) p.emplace_back(rng.uniform(), rng.uniform());
+  std::vector<Delaunay2::Segment> segments;
+  for (int k = 0; k < 6; ++k) segments.push_back({std::uint32_t(2 * k), std::uint32_t(2 * k + 30)});
+  const Delaunay2 reference(p, segments);
+  ASSERT_GT(reference.intersection_points().size(), 0u);
+  for (int e : {-1060, -1000, 1000, 1020}) {
+    std::vector<Vec2d> q = p;
+    for (Vec2d& x : q) x = Vec2d(std::ldexp(x[0], e), std::ldexp(x[1], e));
+    const Delaunay2 dt(q, segments);
+    if (e > -1060) check_constrained(dt);  // 2^-1060: subnormal inputs; valid, checked below
+    ASSERT_NO_THROW(dt.validate()) << e;
+    if (e == -1060) continue;
+    EXPECT_EQ(dt.triangles().to_vector(), reference.triangles().to_vector()) << e;
+    for (std::uint32_t x : reference.intersection_points())
+      EXPECT_EQ(dt.points()[x], Vec2d(std::ldexp(reference.points()[x][0], e), std::ldexp(reference.points()[x][1], e)));
+  }
+}
+
 TEST(Delaunay2Constrained, SegmentThroughVerticesIsSplit) {
   std::vector<Vec2d> p = {{0, 0}, {4, 0}, {1, 0}, {3, 0}, {2, 3}, {2, -3}, {2, 0.5}, {2, -0.5}};
   const std::vector<Delaunay2::Segment> segments = {{0, 1}};

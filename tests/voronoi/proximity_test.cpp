@@ -10,6 +10,7 @@
 #include "brute_delaunay.hpp"
 #include "geods/core/error.hpp"
 #include "geods/voronoi/circles.hpp"
+#include "geods/voronoi/post_office.hpp"
 #include "geods/voronoi/proximity.hpp"
 
 namespace geods::voronoi {
@@ -202,7 +203,7 @@ TEST(Circles, SmallestEnclosingCircleAgainstBruteForce) {
   sets.push_back({{0, 0}, {1, 0}, {0, 1}, {1, 1}, {0.5, 0.5}});            // co-circular square
   sets.push_back({{0, 0}, {2, 2}, {1, 1}, {3, 3}, {3, 3}});                // collinear, duplicate
   sets.push_back({{1, 1}, {1, 1}, {1, 1}});                                // one point
-  sets.push_back({{1e-300, 0}, {-1e-300, 0}, {0, 1e-300}});                // tiny
+  sets.push_back({{1e-80, 0}, {-1e-80, 0}, {0, 1e-80}});                   // tiny (1e-300: refused)
   std::vector<Vec2d> circle;
   for (int k = 0; k < 16; ++k) circle.push_back({std::cos(k * M_PI / 8) * 1e8, std::sin(k * M_PI / 8) * 1e8});
   sets.push_back(circle);
@@ -222,6 +223,64 @@ TEST(Proximity, TooFewPoints) {
   EXPECT_THROW(closest_pair(v), Error);
   EXPECT_THROW(all_nearest_neighbors(v), Error);
   EXPECT_TRUE(emst(v).edges.empty());
+}
+
+
+// Every application is invariant under scaling by a power of two, which is
+// exact in floating point: inside the range where their cubic circumcentres
+// and squared distances stay finite and normal, scaled copies give the same
+// answers scaled exactly; beyond it they refuse (at 1e300 they used to answer
+// (0, 0, 0) and infinite radii with exit 0).
+TEST(Applications, ExtremeScalesAreExactOrRefused) {
+  const std::vector<Vec2d> unit = uniform_points(60, 11);
+  auto scaled = [&](int e) {
+    std::vector<Vec2d> p = unit;
+    for (Vec2d& x : p) x = Vec2d(std::ldexp(x[0], e), std::ldexp(x[1], e));
+    return p;
+  };
+  const ClosestPair pair = closest_pair(unit);
+  const auto nn = all_nearest_neighbors(unit);
+  const SpanningTree tree = emst(unit);
+  const Circle enclosing = smallest_enclosing_circle(unit), empty = largest_empty_circle(unit);
+  for (int e : {-280, -100, 100, 330}) {
+    const std::vector<Vec2d> p = scaled(e);
+    const ClosestPair got = closest_pair(p);
+    EXPECT_EQ(std::pair(got.i, got.j), std::pair(pair.i, pair.j)) << e;
+    EXPECT_EQ(got.distance, std::ldexp(pair.distance, e)) << e;
+    EXPECT_EQ(all_nearest_neighbors(p), nn) << e;
+    const SpanningTree t = emst(p);
+    EXPECT_EQ(t.edges, tree.edges) << e;
+    EXPECT_DOUBLE_EQ(t.length, std::ldexp(tree.length, e)) << e;
+    for (const auto& [want, got_circle] : {std::pair(enclosing, smallest_enclosing_circle(p)),
+                                           std::pair(empty, largest_empty_circle(p))}) {
+      EXPECT_EQ(got_circle.radius, std::ldexp(want.radius, e)) << e;
+      EXPECT_EQ(got_circle.center, Vec2d(std::ldexp(want.center[0], e), std::ldexp(want.center[1], e))) << e;
+    }
+    const Voronoi2 diagram(p);
+    diagram.validate();
+    const WalkLocator walk(diagram);
+    const SlabLocator slabs(diagram);
+    for (std::size_t i = 0; i < unit.size(); ++i) {
+      const Vec2d q = 0.5 * (p[i] + p[(i + 7) % p.size()]);
+      std::uint32_t best = 0;
+      for (std::uint32_t j = 1; j < p.size(); ++j)
+        if ((p[j] - q).squaredNorm() < (p[best] - q).squaredNorm()) best = j;
+      EXPECT_EQ((p[walk.nearest(q)] - q).squaredNorm(), (p[best] - q).squaredNorm()) << e;
+      EXPECT_EQ((p[slabs.nearest(q)] - q).squaredNorm(), (p[best] - q).squaredNorm()) << e;
+    }
+    EXPECT_THROW(walk.nearest(Vec2d(1e200, 0)), Error);
+    EXPECT_THROW(slabs.nearest(Vec2d(0, -1e200)), Error);
+  }
+  for (double s : {1e300, 1e-300, 1e101, 1e-90}) {
+    std::vector<Vec2d> p = unit;
+    for (Vec2d& x : p) x *= s;
+    EXPECT_THROW(closest_pair(p), Error) << s;
+    EXPECT_THROW(all_nearest_neighbors(p), Error) << s;
+    EXPECT_THROW(emst(p), Error) << s;
+    EXPECT_THROW(smallest_enclosing_circle(p), Error) << s;
+    EXPECT_THROW(largest_empty_circle(p), Error) << s;
+    EXPECT_THROW(Voronoi2{p}, Error) << s;
+  }
 }
 
 }  // namespace

@@ -111,12 +111,19 @@ TEST(VoronoiFromDelaunay, CoCircularCentreIsOneVertexOfDegree12) {
 }
 
 TEST(VoronoiFromDelaunay, HugeTinyAndOffsetCoordinates) {
-  for (double scale : {1e100, 1e-100}) {
+  // The range in which circumcentres, cubic in the coordinates, keep every
+  // resolvable difference: up to 3.5e100, extents down to 4e-87.
+  for (double scale : {1e100, 1e-80}) {
     std::vector<Vec2d> p = uniform_points(500, 4);
     for (Vec2d& x : p) x *= scale;
     const Voronoi2 v(p);
     v.validate();
     check_nearest(v, 5, 200);
+  }
+  for (double scale : {1e101, 1e-100}) {
+    std::vector<Vec2d> p = uniform_points(500, 4);
+    for (Vec2d& x : p) x *= scale;
+    EXPECT_THROW(Voronoi2{p}, Error) << scale;
   }
   std::vector<Vec2d> p = uniform_points(500, 6);
   for (Vec2d& x : p) x = x * 1e-3 + Vec2d(1e6, -1e6);  // small spread far from the origin

@@ -39,7 +39,7 @@ struct IsoOptions {
 /// edges does), with the vertices of the current slab in flat arrays. Slabs run
 /// in parallel and are merged so that the output (vertex and triangle order
 /// included) is the same for any number of threads. O(samples + output).
-/// Throws geods::Error for a non-finite iso-value, a NaN sample, or positions
+/// Throws geods::Error for a non-finite iso-value, a NaN or infinite sample, or positions
 /// of the wrong count or not finite. T: uint8, uint16, int16, float, double.
 /// If `cells_visited` is given, it receives the number of cells whose corners
 /// were examined (those in the trimmed row ranges).

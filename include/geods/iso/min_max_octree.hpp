@@ -84,7 +84,7 @@ class MinMaxOctree {
   static constexpr std::size_t kMaxLeafCells = 32;
 
   /// Takes the volume's samples without copying them. Throws geods::Error for a
-  /// NaN sample or leaf_cells outside [1, 32]. O(samples), parallel.
+  /// NaN or infinite sample or leaf_cells outside [1, 32]. O(samples), parallel.
   explicit MinMaxOctree(Grid3<T> volume, std::size_t leaf_cells = kDefaultLeafCells);
 
   /// Thread-safe. Throws geods::Error for a non-finite iso or bad positions.
@@ -113,7 +113,7 @@ class MinMaxOctree {
   /// read in place from the mapped file (no parse, no copy; min/max not
   /// recomputed), which stays mapped while the octree lives. Throws
   /// geods::Error naming the file for another sample type, a truncated or
-  /// corrupt file (checksums, unless `verify` says structure_only), NaN samples
+  /// corrupt file (checksums, unless `verify` says structure_only), NaN or infinite samples
   /// (a pass over them), a leaf with min > max or a node whose min/max is not
   /// that of its children (O(nodes)); Verify::full and structure_only (no
   /// checksums to prove the leaves) run all of validate(), the leaves against

@@ -42,6 +42,7 @@
 
 #include "geods/core/aabb.hpp"
 #include "geods/core/archive.hpp"
+#include "geods/core/coordinate_range.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/flat_array.hpp"
 #include "geods/core/parallel.hpp"
@@ -175,6 +176,7 @@ class KdTree {
                          const Skip& skip = {}) const {
     const std::size_t k = check_request(request, "KdTree::query");
     check_point(query, "query point");
+    check_query_range(query, 2, "KdTree");
     KnnResultSet<T> result(out, k, squared_limit<T>(request.max_distance));
     search_nearest(query.data(), result, request.eps, skip);
     result.finish();
@@ -186,6 +188,7 @@ class KdTree {
   template <typename Skip = KeepAll>
   std::vector<Neighbor<T>> query_radius(std::span<const T> query, double radius, const Skip& skip = {}) const {
     check_point(query, "query point");
+    check_query_range(query, 2, "KdTree");
     if (!(radius >= 0)) throw Error("KdTree::query_radius: radius must be >= 0, got " + std::to_string(radius));
     std::vector<Neighbor<T>> out;
     search_radius(query.data(), squared_limit<T>(radius), [&](std::uint32_t i, T d) { out.push_back({i, d}); }, skip);
@@ -548,6 +551,7 @@ class KdTree {
           throw Error("KdTree: point " + std::to_string(i) + " has a non-finite coordinate (axis " +
                       std::to_string(a) + ")");
     }
+    check_coordinate_range(view_.data, n, dim(), view_.stride, 2, "KdTree");
     std::vector<std::uint32_t> perm(n);
     if (n == 0) return;
     // The size of every subtree depends only on its point count, so each one

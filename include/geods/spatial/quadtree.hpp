@@ -44,6 +44,7 @@
 
 #include "geods/core/aabb.hpp"
 #include "geods/core/archive.hpp"
+#include "geods/core/coordinate_range.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/flat_array.hpp"
 #include "geods/core/morton.hpp"
@@ -224,6 +225,7 @@ class Orthtree {
   std::vector<Neighbor<T>> query(const VecT& q, std::size_t k) const {
     if (k == 0) throw Error("Orthtree::query: k must be >= 1");
     check_point(q, "query point");
+    check_query_range(std::span<const T>(q.data(), Dim), 2, "Orthtree");
     std::vector<Neighbor<T>> out(std::min(k, size()));
     if (out.empty()) return out;
     KnnResultSet<T> result(out.data(), out.size(), std::numeric_limits<T>::infinity());
@@ -235,6 +237,7 @@ class Orthtree {
   /// Every point within distance `radius` of q (inclusive), sorted like query().
   std::vector<Neighbor<T>> query_radius(const VecT& q, double radius) const {
     check_point(q, "query point");
+    check_query_range(std::span<const T>(q.data(), Dim), 2, "Orthtree");
     if (!(radius >= 0)) throw Error("Orthtree::query_radius: radius must be >= 0, got " + std::to_string(radius));
     std::vector<Neighbor<T>> out;
     if (nodes_.empty()) return out;
@@ -493,6 +496,7 @@ class Orthtree {
         points[i * Dim + a] = x;
       }
     }
+    check_coordinate_range(points.data(), n, Dim, Dim, 2, "Orthtree");
     points_ = std::make_shared<const FlatArray<T>>(std::move(points));
     if (n == 0) return;
     root_square();

@@ -1,0 +1,81 @@
+#pragma once
+// The coordinates a floating-point computation on points can take. Distances,
+// circumcentres and the like are polynomials in coordinate differences: one of
+// degree k overflows when the coordinates reach about 2^(max_exponent / k), and
+// loses the differences of a point set whose extent E is so small that
+// (E * 2^-digits)^k falls below the smallest normal number. Structures that
+// compute such polynomials in T check their input here and refuse, with a
+// clear geods::Error, what they would otherwise answer wrongly (points scaled
+// by 1e300 or 1e-300). The exact predicates need no such range.
+#include <cmath>
+#include <cstddef>
+#include <limits>
+#include <span>
+#include <string>
+
+#include "geods/core/error.hpp"
+
+namespace geods {
+
+/// The largest |coordinate| for which polynomials of the given degree in
+/// coordinate differences (summed over up to 2^16 terms) stay finite in T:
+/// 2^502 (1.3e151) for distances in double, 2^54 (1.8e16) in float, 2^334
+/// (3.5e100) for circumcentres in double.
+template <typename T>
+T coordinate_limit(int degree) {
+  return std::ldexp(T(1), (std::numeric_limits<T>::max_exponent - 18) / degree - 1);
+}
+
+/// The smallest extent of a point set whose resolvable differences
+/// (extent * 2^-digits) still have a normal k-th power in T: 2^-458 for
+/// distances in double, 2^-39 in float.
+template <typename T>
+T extent_floor(int degree) {
+  const int min_exponent = std::numeric_limits<T>::min_exponent - 1;
+  return std::ldexp(T(1), -(-min_exponent / degree) + std::numeric_limits<T>::digits);
+}
+
+/// A number for a message: six significant digits ("1e+300", not 300 digits).
+std::string short_number(double value);
+
+/// Checks that n points of `dim` coordinates (row i at coords[i * stride])
+/// fit the range of polynomials of `degree` in T: every |coordinate| at most
+/// coordinate_limit, and the bounding box's largest extent zero or at least
+/// extent_floor. Throws geods::Error "<what>: ..." saying which and why.
+/// Non-finite coordinates are the caller's to refuse (with their own message).
+template <typename T>
+void check_coordinate_range(const T* coords, std::size_t n, std::size_t dim, std::size_t stride, int degree,
+                            const std::string& what) {
+  if (n == 0 || dim == 0) return;
+  const T limit = coordinate_limit<T>(degree);
+  T extent = 0;
+  for (std::size_t a = 0; a < dim; ++a) {
+    T lo = coords[a], hi = coords[a];
+    for (std::size_t i = 0; i < n; ++i) {
+      const T x = coords[i * stride + a];
+      if (std::abs(x) > limit)
+        throw Error(what + ": coordinate " + short_number(double(x)) + " of point " + std::to_string(i) +
+                    " is beyond +-" + short_number(double(limit)) + ", where its distances would overflow; " +
+                    "scale the input");
+      lo = x < lo ? x : lo;
+      hi = x > hi ? x : hi;
+    }
+    extent = hi - lo > extent ? hi - lo : extent;
+  }
+  if (extent > 0 && extent < extent_floor<T>(degree))
+    throw Error(what + ": the points span only " + short_number(double(extent)) + " (below " +
+                short_number(double(extent_floor<T>(degree))) + "), where their distances underflow; scale the input");
+}
+
+/// Checks one query point against coordinate_limit (a far query's distances
+/// overflow like a far point's).
+template <typename T>
+void check_query_range(std::span<const T> q, int degree, const char* what) {
+  const T limit = coordinate_limit<T>(degree);
+  for (T x : q)
+    if (std::abs(x) > limit)
+      throw Error(std::string(what) + ": query coordinate " + short_number(double(x)) + " is beyond +-" +
+                  short_number(double(limit)) + ", where its distances would overflow");
+}
+
+}  // namespace geods

@@ -1,0 +1,72 @@
+// The coordinate range of distance computations: the limits are where the
+// polynomials really overflow or underflow, and the checks refuse just that.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "geods/core/coordinate_range.hpp"
+
+namespace geods {
+namespace {
+
+TEST(CoordinateRange, LimitsAreWhereSquaredDistancesOverflowAndUnderflow) {
+  EXPECT_EQ(coordinate_limit<double>(2), std::ldexp(1.0, 502));
+  EXPECT_EQ(coordinate_limit<float>(2), std::ldexp(1.0f, 54));
+  EXPECT_EQ(coordinate_limit<double>(3), std::ldexp(1.0, 334));
+  EXPECT_EQ(extent_floor<double>(2), std::ldexp(1.0, -458));
+  EXPECT_EQ(extent_floor<float>(2), std::ldexp(1.0f, -39));
+  // At the limit, 2^16 squared differences of opposite corners still sum to a finite value.
+  for (int degree : {2, 3}) {
+    const double m = coordinate_limit<double>(degree);
+    const double term = std::pow(2 * m, degree);
+    EXPECT_TRUE(std::isfinite(term * 65536)) << degree;
+  }
+  const float mf = coordinate_limit<float>(2);
+  EXPECT_TRUE(std::isfinite((2 * mf) * (2 * mf) * 65536.0f));
+  // At the floor, the smallest resolvable difference of the extent still has a normal square.
+  const double e = extent_floor<double>(2) * std::ldexp(1.0, -53);
+  EXPECT_GE(e * e, std::numeric_limits<double>::min());
+  const float ef = extent_floor<float>(2) * std::ldexp(1.0f, -24);
+  EXPECT_GE(ef * ef, std::numeric_limits<float>::min());
+}
+
+TEST(CoordinateRange, RefusesPointsBeyondTheRangeAndNothingElse) {
+  const std::vector<double> unit{0, 0, 1, 0, 0, 1};
+  EXPECT_NO_THROW(check_coordinate_range(unit.data(), 3, 2, 2, 2, "test"));
+  for (double s : {1e300, 1e-300, 1e152, 1e-140}) {
+    std::vector<double> scaled = unit;
+    for (double& x : scaled) x *= s;
+    EXPECT_THROW(check_coordinate_range(scaled.data(), 3, 2, 2, 2, "test"), Error) << s;
+  }
+  for (double s : {1e150, 1e-130}) {
+    std::vector<double> scaled = unit;
+    for (double& x : scaled) x *= s;
+    EXPECT_NO_THROW(check_coordinate_range(scaled.data(), 3, 2, 2, 2, "test")) << s;
+  }
+  // Far from the origin but spread out: fine; all points equal: fine (no distances to lose).
+  const std::vector<double> far{1e100, 1e100, 1e100 + 1e90, 1e100};
+  EXPECT_NO_THROW(check_coordinate_range(far.data(), 2, 2, 2, 2, "test"));
+  const std::vector<double> same{1e-300, 1e-300, 1e-300, 1e-300};
+  EXPECT_NO_THROW(check_coordinate_range(same.data(), 2, 2, 2, 2, "test"));
+  // Stride skips the values between rows.
+  const std::vector<double> strided{0, 1e300, 1, 1e300};
+  EXPECT_NO_THROW(check_coordinate_range(strided.data(), 2, 1, 2, 2, "test"));
+  // The message names the caller and the value briefly.
+  try {
+    const std::vector<float> big{0, 1e20f};
+    check_coordinate_range(big.data(), 2, 1, 1, 2, "KdTree");
+    FAIL();
+  } catch (const Error& e) {
+    const std::string m = e.what();
+    EXPECT_EQ(m.rfind("KdTree: coordinate 1e+20 of point 1", 0), 0u) << m;
+    EXPECT_LT(m.size(), 160u) << m;
+  }
+  const std::vector<double> q{3e200, 0};
+  EXPECT_THROW(check_query_range(std::span<const double>(q), 2, "test"), Error);
+  EXPECT_NO_THROW(check_query_range(std::span<const double>(q).subspan(1), 2, "test"));
+}
+
+}  // namespace
+}  // namespace geods
