@@ -463,6 +463,10 @@ class KdTree {
     tree.root_hi_ = a.array<T>(prefix + "bounds_hi", n > 0 ? dim : 0).to_vector();
     try {
       tree.validate();
+      // The range of build(), on the root box that validate() found to hold every point.
+      std::vector<T> corners = tree.root_lo_;
+      corners.insert(corners.end(), tree.root_hi_.begin(), tree.root_hi_.end());
+      check_coordinate_range(corners.data(), n > 0 ? 2 : 0, dim, dim, 2, "KdTree");
     } catch (const Error& e) {
       throw a.error(std::string("corrupted k-d tree: ") + e.what());
     }
