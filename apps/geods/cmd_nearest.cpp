@@ -27,8 +27,9 @@ class NearestCommand : public Command {
     add_input(app, "sites", sites_, "Sites, n x 2 (.npy, .csv, .txt, .xyz, .ply)", "--sites");
     app.add_option("--queries", queries_, "Query points, m x 2")->required();
     app.add_option("-o,--output", output_, "Output: int64 (m,) index of the nearest site (first occurrence of duplicates)");
-    app.add_option("--method", method_, "slab (SlabLocator, the default), walk (WalkLocator) or kd_tree (KdTree); "
-                                        "kdtree is the deprecated spelling of kd_tree")
+    app.add_option("--method", method_, "walk (WalkLocator, the default: O(n) memory), slab (SlabLocator: "
+                                        "O(n^1.5) memory in the worst case) or kd_tree (KdTree); kdtree is the "
+                                        "deprecated spelling of kd_tree")
         ->check(CLI::IsMember({"slab", "walk", "kd_tree", "kdtree"}));
   }
 
@@ -84,7 +85,7 @@ class NearestCommand : public Command {
   }
 
  private:
-  std::string sites_, queries_, output_, method_ = "slab";
+  std::string sites_, queries_, output_, method_ = "walk";
 };
 
 const bool registered = register_command<NearestCommand>();

@@ -236,9 +236,9 @@ void bind_voronoi(py::module_& m) {
                              "(m, 4) each edge clipped to box: x0, y0, x1, y1 (NaN if outside).")
       .def_property_readonly("representatives", &PyVoronoi2::representatives, "First occurrence of each point.")
       .def("neighbors", &PyVoronoi2::neighbors, py::arg("i"), "Delaunay neighbours of point i's site.")
-      .def("nearest", &PyVoronoi2::nearest, py::arg("queries"), py::arg("method") = "slab",
-           "Index of a nearest site of each query ((m, 2) -> (m,), or (2,) -> int): 'slab' (SlabLocator, "
-           "Theorem 8) or 'walk' (WalkLocator).")
+      .def("nearest", &PyVoronoi2::nearest, py::arg("queries"), py::arg("method") = "walk",
+           "Index of a nearest site of each query ((m, 2) -> (m,), or (2,) -> int): 'walk' (WalkLocator, "
+           "O(n) memory) or 'slab' (SlabLocator, Theorem 8: O(log n) queries, up to O(n^1.5) memory).")
       .def("k_nearest", &PyVoronoi2::k_nearest, py::arg("query"), py::arg("k"),
            "The k nearest distinct sites of one query point, nearest first.")
       .def("stats", &PyVoronoi2::stats, "dict: sites, distinct, vertices, edges, unbounded_cells, bytes")

@@ -187,3 +187,20 @@ def test_voronoi2_save_load(cli, workdir):
     bad = subprocess.run([cli, "voronoi", "p2.npy", "--metric", "l1", "--save", "x.geods"], cwd=workdir,
                          capture_output=True, text=True)
     assert bad.returncode == 2 and bad.stderr.count("\n") == 1
+
+
+def test_cli_nearest_default_method_and_no_sites(cli, workdir):
+    import json
+    import subprocess
+
+    np.save(workdir / "p.npy", uniform(50, 12))
+    np.save(workdir / "none.npy", np.zeros((0, 2)))
+    out = subprocess.run([cli, "nearest", "p.npy", "--queries", "p.npy", "-o", "i.npy", "--json"], cwd=workdir,
+                         capture_output=True, text=True, check=True)
+    assert json.loads(out.stdout)["method"] == "walk"  # O(n) memory; slab can take O(n^1.5)
+    np.testing.assert_array_equal(np.load(workdir / "i.npy"), np.arange(50))
+    assert geods.Voronoi2(uniform(50, 12)).nearest(uniform(50, 12)[:3]).tolist() == [0, 1, 2]
+    for method in ("walk", "slab", "kd_tree"):
+        bad = subprocess.run([cli, "nearest", "none.npy", "--queries", "p.npy", "-o", "i.npy", "--method", method],
+                             cwd=workdir, capture_output=True, text=True)
+        assert bad.returncode == 2 and bad.stderr.count("\n") == 1, bad.stderr
