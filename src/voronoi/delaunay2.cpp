@@ -13,6 +13,7 @@
 
 #include "brio_order.hpp"
 #include "constrained_delaunay.hpp"
+#include "exact_compare.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"
 #include "geods/core/predicates.hpp"
@@ -434,17 +435,20 @@ std::uint32_t Delaunay2::nearest(const Vec2d& q) const {
   if (internal_triangle_.empty()) {
     std::uint32_t best = kNone;
     for (std::uint32_t v : hull_)
-      if (best == kNone || (points_[v] - q).squaredNorm() < (points_[best] - q).squaredNorm()) best = v;
+      if (best == kNone || detail::WideSquaredNorm(points_[v] - q) < detail::WideSquaredNorm(points_[best] - q))
+        best = v;
     return best;
   }
-  const auto distance = [&](std::uint32_t v) { return (coords_[v] - q).squaredNorm(); };
+  // Distances that neither overflow nor underflow: the triangulation takes
+  // any finite coordinates, so its nearest vertex must too.
+  const auto distance = [&](std::uint32_t v) { return detail::WideSquaredNorm(coords_[v] - q); };
   const DelaunayCore::Location loc = view().walk(q, internal_triangle_[internal_triangle_.size() / 2], nullptr);
   std::uint32_t best = kNone;
   for (std::uint32_t h = loc.edge / 3 * 3; h < loc.edge / 3 * 3 + 3; ++h)
     if (vert_[h] != kGhost && (best == kNone || distance(vert_[h]) < distance(best))) best = vert_[h];
   // Greedy: a vertex with no closer Delaunay neighbour is a nearest one (q
   // lies in its Voronoi cell).
-  double best_distance = distance(best);
+  detail::WideSquaredNorm best_distance = distance(best);
   for (bool improved = true; improved;) {
     improved = false;
     const std::uint32_t e = vertex_edge_[best];
@@ -452,7 +456,7 @@ std::uint32_t Delaunay2::nearest(const Vec2d& q) const {
     do {
       const std::uint32_t w = vert_[next(h)];
       if (w != kGhost) {
-        const double d = distance(w);
+        const detail::WideSquaredNorm d = distance(w);
         if (d < best_distance) {
           best = w, best_distance = d, improved = true;
           break;

@@ -4,6 +4,7 @@
 // a query; is a point inside a diametral circle). A floating-point filter
 // decides almost every call; the rest are evaluated exactly with Shewchuk's
 // expansions (exact while coordinates stay within about 1e-140..1e140).
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -49,6 +50,29 @@ inline int dot_difference_sign(const Vec2d& a, const Vec2d& b, const Vec2d& c, c
 inline int compare_distance(const Vec2d& q, const Vec2d& a, const Vec2d& b) {
   return dot_difference_sign(q, a, q, a, q, b, q, b);
 }
+
+/// |d|^2 as mantissa * 2^exponent: finite and normal for any finite d, where
+/// squaring the components of a 1e300 or 1e-300 difference directly overflows
+/// or underflows. Its order is that of d.squaredNorm() wherever that is exact
+/// in range (the scaling by a power of two commutes with the rounding).
+struct WideSquaredNorm {
+  double mantissa = 0;  // in [1, 8), or 0 for d = 0
+  int exponent = 0;
+
+  explicit WideSquaredNorm(const Vec2d& d) {
+    const double m = std::max(std::abs(d[0]), std::abs(d[1]));
+    if (m == 0) return;
+    const int e = std::ilogb(m);
+    const double x = std::ldexp(d[0], -e), y = std::ldexp(d[1], -e);
+    mantissa = x * x + y * y;
+    exponent = 2 * e;
+  }
+  friend bool operator<(const WideSquaredNorm& a, const WideSquaredNorm& b) {
+    if (a.mantissa == 0 || b.mantissa == 0) return a.mantissa < b.mantissa;
+    if (a.exponent == b.exponent) return a.mantissa < b.mantissa;
+    return std::ldexp(a.mantissa, a.exponent - b.exponent) < b.mantissa;  // saturates to 0 or inf: still ordered
+  }
+};
 
 /// Sign of (p - a).(p - b): <= 0 exactly when p lies in the closed disc with diameter ab. Exact.
 inline int diametral_sign(const Vec2d& p, const Vec2d& a, const Vec2d& b) {

@@ -326,6 +326,30 @@ TEST(Delaunay2, LocateAndNearestAgreeWithBruteForce) {
   }
 }
 
+// The triangulation takes any finite coordinates, and so does its nearest
+// vertex: squared distances of 1e300 or 1e-300 differences used to overflow
+// to inf or underflow to 0 and pick an arbitrary vertex.
+TEST(Delaunay2, NearestAtExtremeScales) {
+  const std::vector<Vec2d> p = make_points(Shape::uniform, 300, 8);
+  Rng rng(10);
+  std::vector<Vec2d> queries;
+  for (int i = 0; i < 100; ++i) queries.emplace_back(rng.uniform(-0.5, 4.5), rng.uniform(-0.5, 3.5));
+  std::vector<std::uint32_t> want;
+  for (const Vec2d& q : queries) {
+    std::uint32_t best = 0;
+    for (std::uint32_t i = 1; i < p.size(); ++i)
+      if ((p[i] - q).squaredNorm() < (p[best] - q).squaredNorm()) best = i;
+    want.push_back(best);
+  }
+  for (int e : {-1020, -1000, 1000, 1020}) {
+    const auto scaled = [&](const Vec2d& x) { return Vec2d(std::ldexp(x[0], e), std::ldexp(x[1], e)); };
+    std::vector<Vec2d> q = p;
+    for (Vec2d& x : q) x = scaled(x);
+    const Delaunay2 dt(q);
+    for (std::size_t i = 0; i < queries.size(); ++i) EXPECT_EQ(dt.nearest(scaled(queries[i])), want[i]) << e;
+  }
+}
+
 TEST(Delaunay2, NeighborsAreTheEdges) {
   const std::vector<Vec2d> p = make_points(Shape::uniform, 500, 3);
   const Delaunay2 dt(p);
