@@ -84,10 +84,43 @@ py::array_t<std::uint8_t> read_image_py(const path& p) {
   return image_array(im);
 }
 
-void write_png_py(const path& p, const Rows<std::uint8_t>& a) {
-  const Image<std::uint8_t> im = image_from_array(a, "write_png");
-  py::gil_scoped_release release;
-  io::write_png(p, im);
+// By dtype: uint8 and bool as 8-bit, uint16 as 16-bit, floats in [0, 1] as
+// round(255 v), other integers if every value is in 0..255; anything else is refused.
+void write_png_py(const path& p, const py::array& a) {
+  const py::dtype dt = a.dtype();
+  if (dt.is(py::dtype::of<std::uint8_t>()) || dt.kind() == 'b') {
+    const Image<std::uint8_t> im = image_from_array(Rows<std::uint8_t>::ensure(a), "write_png");
+    py::gil_scoped_release release;
+    return io::write_png(p, im);
+  }
+  if (dt.is(py::dtype::of<std::uint16_t>())) {
+    const Image<std::uint16_t> im = image_from_array(Rows<std::uint16_t>::ensure(a), "write_png");
+    py::gil_scoped_release release;
+    return io::write_png(p, im);
+  }
+  if (dt.kind() == 'f') {
+    const Image<double> im = image_from_array(Rows<double>::ensure(a), "write_png");
+    py::gil_scoped_release release;
+    return io::write_png(p, im);
+  }
+  if (dt.kind() == 'i' || dt.kind() == 'u') {
+    // Compared as they are (uint64 above 2^63 included), then narrowed.
+    const auto wide = py::array_t<std::uint64_t, py::array::c_style | py::array::forcecast>::ensure(a);
+    const auto signed_values = Rows<std::int64_t>::ensure(a);
+    for (py::ssize_t i = 0; i < a.size(); ++i) {
+      const bool negative = dt.kind() == 'i' && signed_values.data()[i] < 0;
+      if (negative || wide.data()[i] > 255)
+        throw Error(p.string() + ": cannot write PNG: value " +
+                    (negative ? std::to_string(signed_values.data()[i]) : std::to_string(wide.data()[i])) +
+                    " of the " + std::string(py::str(py::object(dt))) +
+                    " image is outside 0..255 (8-bit PNG); give uint16 for a 16-bit PNG or floats in [0, 1]");
+    }
+    const Image<std::uint8_t> im = image_from_array(Rows<std::uint8_t>::ensure(a), "write_png");
+    py::gil_scoped_release release;
+    return io::write_png(p, im);
+  }
+  throw Error(p.string() + ": cannot write PNG from an array of " + std::string(py::str(py::object(dt))) +
+              " (uint8, bool, uint16, other integers in 0..255, or floats in [0, 1])");
 }
 
 }  // namespace
@@ -144,7 +177,12 @@ geods.Error naming the file and line for malformed files, NaN/inf values or no r
   m.def("read_image", &read_image_py, py::arg("path"),
         R"doc(Reads a PNG, JPEG or BMP as uint8: (h, w) for grey, (h, w, c) for 2 to 4 channels.)doc");
   m.def("write_png", &write_png_py, py::arg("path"), py::arg("image"),
-        R"doc(Writes a uint8 (h, w) or (h, w, c) array (c = 1 to 4) as an 8-bit PNG.)doc");
+        R"doc(Writes an (h, w) or (h, w, c) array (c = 1 to 4) as a PNG, by its dtype:
+
+uint8 and bool: 8-bit; uint16: 16-bit; floats: values in [0, 1] written as
+round(255 v) in 8 bits; other integers: 8-bit if every value is in 0..255.
+Anything else (NaN, floats outside [0, 1], integers outside 0..255, other
+dtypes) raises geods.Error: nothing is clamped or wrapped.)doc");
 }
 
 }  // namespace geods::python

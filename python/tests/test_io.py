@@ -1,5 +1,6 @@
 """geods io bindings: round trips, the real files of data/, malformed files."""
 import gzip
+import re
 
 import numpy as np
 import pytest
@@ -80,6 +81,68 @@ def test_images(tmp_path, data_dir):
         a = (np.arange(np.prod(shape)) % 251).astype(np.uint8).reshape(shape)
         geods.write_png(tmp_path / "a.png", a)
         np.testing.assert_array_equal(geods.read_image(tmp_path / "a.png"), a)
+
+
+def test_write_png_by_dtype(tmp_path):
+    rng = np.random.default_rng(3)
+    # Floats in [0, 1] are scaled to 0..255 (white stays white, not black).
+    f = rng.random((6, 5, 3))
+    f[0, 0] = [0.0, 1.0, 0.5]
+    geods.write_png(tmp_path / "f.png", f)
+    np.testing.assert_array_equal(geods.read_image(tmp_path / "f.png"), np.rint(f * 255).astype(np.uint8))
+    geods.write_png(tmp_path / "f32.png", f.astype(np.float32))
+    assert geods.read_image(tmp_path / "f32.png")[0, 0, 1] == 255
+    # uint16 is a 16-bit PNG (read back through numpy from the raw PNG rows).
+    u = rng.integers(0, 65536, size=(4, 7), dtype=np.uint16)
+    u[0, :2] = [0, 65535]
+    geods.write_png(tmp_path / "u16.png", u)
+    assert png_16_bit_rows(tmp_path / "u16.png", 4, 7, 1).tolist() == u.tolist()
+    # Other integers and bools are written as 8-bit when every value is in 0..255.
+    i = rng.integers(0, 256, size=(3, 4), dtype=np.int64)
+    geods.write_png(tmp_path / "i.png", i)
+    np.testing.assert_array_equal(geods.read_image(tmp_path / "i.png"), i)
+    geods.write_png(tmp_path / "b.png", np.eye(3, dtype=bool))
+    np.testing.assert_array_equal(geods.read_image(tmp_path / "b.png"), np.eye(3))
+
+
+def png_16_bit_rows(path, h, w, c):
+    """The samples of a 16-bit PNG written with filter 0 rows, decoded here with zlib (an independent reader)."""
+    import struct
+    import zlib
+    data = path.read_bytes()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n"
+    pos, idat, ihdr = 8, b"", None
+    while pos < len(data):
+        (n,) = struct.unpack(">I", data[pos:pos + 4])
+        kind, body = data[pos + 4:pos + 8], data[pos + 8:pos + 8 + n]
+        assert zlib.crc32(kind + body) == struct.unpack(">I", data[pos + 8 + n:pos + 12 + n])[0]
+        if kind == b"IHDR":
+            ihdr = struct.unpack(">IIBB", body[:10])
+        elif kind == b"IDAT":
+            idat += body
+        pos += 12 + n
+    assert ihdr[:3] == (w, h, 16)
+    raw = np.frombuffer(zlib.decompress(idat), dtype=np.uint8).reshape(h, 1 + 2 * w * c)
+    assert (raw[:, 0] == 0).all()
+    return raw[:, 1:].copy().view(">u2").reshape(h, w * c)
+
+
+@pytest.mark.parametrize("image,message", [
+    (np.array([[0.5, 1.5]]), "outside [0, 1]"),
+    (np.array([[0.5, -0.01]], dtype=np.float32), "outside [0, 1]"),
+    (np.array([[0.5, np.nan]]), "outside [0, 1]"),
+    (np.array([[0.5, np.inf]]), "outside [0, 1]"),
+    (np.array([[255.0, 0.0]]), "outside [0, 1]"),   # 0..255 floats are refused, not clamped to white
+    (np.array([[1, 256]], dtype=np.int64), "outside 0..255"),
+    (np.array([[1, -1]], dtype=np.int16), "outside 0..255"),
+    (np.array([[1, 2**64 - 1]], dtype=np.uint64), "outside 0..255"),
+    (np.array([[1, 70000]], dtype=np.uint32), "outside 0..255"),
+    (np.array([[1 + 1j]]), "cannot write PNG"),
+])
+def test_write_png_refuses_values_it_would_change(tmp_path, image, message):
+    with pytest.raises(ValueError, match=re.escape(message)):
+        geods.write_png(tmp_path / "x.png", image)
+    assert not (tmp_path / "x.png").exists()
 
 
 @pytest.mark.parametrize("name,reader,content", [
