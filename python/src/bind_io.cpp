@@ -31,8 +31,19 @@ py::tuple read_mesh_py(const path& p) {
   return mesh_arrays(mesh, false);
 }
 
-void write_mesh_py(const path& p, const Rows<float>& v, const Rows<std::int64_t>& f, bool binary) {
-  const TriMesh mesh = mesh_from_arrays(v, f, "write_mesh");
+// V is checked in its own dtype before the cast to float (1e300 would become inf,
+// which write_mesh refuses anyway, under a less clear name); F must hold integers
+// (a float F would be truncated to other indices).
+void write_mesh_py(const path& p, const py::array& v, const py::array& f, bool binary) {
+  const auto v64 = Rows<double>::ensure(v);
+  if (!v64) throw Error("write_mesh: V must be an (n, 3) array of numbers");
+  for (py::ssize_t i = 0; i < v64.size(); ++i)
+    if (!(std::abs(v64.data()[i]) <= double(std::numeric_limits<float>::max())))
+      throw Error(p.string() + ": cannot write mesh: vertex " + std::to_string(i / 3) + " has a non-finite coordinate " +
+                  "or one outside the float range (" + format_number(v64.data()[i]) + ")");
+  if (f.dtype().kind() != 'i' && f.dtype().kind() != 'u' && f.size() > 0)
+    throw Error("write_mesh: F must be an integer array of vertex indices, not " + std::string(py::str(py::object(f.dtype()))));
+  const TriMesh mesh = mesh_from_arrays(Rows<float>::ensure(v), Rows<std::int64_t>::ensure(f), "write_mesh");
   py::gil_scoped_release release;
   io::write_mesh(p, mesh, binary ? io::MeshEncoding::binary : io::MeshEncoding::ascii);
 }

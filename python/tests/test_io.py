@@ -145,6 +145,41 @@ def test_write_png_refuses_values_it_would_change(tmp_path, image, message):
     assert not (tmp_path / "x.png").exists()
 
 
+@pytest.mark.parametrize("ext", [".ply", ".obj", ".stl"])
+def test_write_mesh_refuses_what_read_mesh_refuses(tmp_path, ext):
+    v, f = cube()
+    out = tmp_path / ("x" + ext)
+    for bad in (np.nan, np.inf, -np.inf, 1e300):
+        w = v.astype(np.float64)
+        w[5, 1] = bad
+        with pytest.raises(ValueError, match="vertex 5 has a non-finite coordinate"):
+            geods.write_mesh(out, w, f)
+        assert not out.exists()
+    for bad_index in (8, -1, 2**40):
+        g = f.copy()
+        g[3, 1] = bad_index
+        with pytest.raises(ValueError, match="out of range"):
+            geods.write_mesh(out, v, g)
+        assert not out.exists()
+    with pytest.raises(ValueError, match="integer array"):
+        geods.write_mesh(out, v, f + 0.5)   # would be truncated to other indices
+    assert not out.exists()
+    geods.write_mesh(out, v, f)
+    rv, rf = geods.read_mesh(out)
+    assert len(rf) == 12
+
+
+@pytest.mark.parametrize("ext", [".npy", ".xyz", ".csv", ".ply", ".txt"])
+def test_write_points_refuses_non_finite(tmp_path, ext):
+    p = np.random.default_rng(2).normal(size=(6, 3))
+    for bad in (np.nan, np.inf, -np.inf):
+        q = p.copy()
+        q[4, 2] = bad
+        with pytest.raises(ValueError, match="point 4 has a non-finite coordinate"):
+            geods.write_points(tmp_path / ("p" + ext), q)
+        assert not (tmp_path / ("p" + ext)).exists()
+
+
 @pytest.mark.parametrize("name,reader,content", [
     ("missing.ply", geods.read_mesh, None),
     ("empty.obj", geods.read_mesh, b""),

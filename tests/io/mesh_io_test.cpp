@@ -3,6 +3,7 @@
 #include <zlib.h>
 
 #include <cmath>
+#include <limits>
 
 #include "io_test_util.hpp"
 
@@ -190,6 +191,24 @@ TEST(MeshIo, WriterRejectsBadMeshes) {
   expect_error(dir / "x.ply", [&] { write_mesh(dir / "x.ply", m); }, "out of range");
   expect_error(dir / "x.off", [&] { write_mesh(dir / "x.off", cube()); }, "unsupported");
   expect_error(dir / "nodir" / "x.ply", [&] { write_mesh(dir / "nodir" / "x.ply", cube()); });
+  // Meshes read_mesh would refuse are refused before anything is written, in every format.
+  const float inf = std::numeric_limits<float>::infinity();
+  for (const char* name : {"x.ply", "x.obj", "x.stl"}) {
+    for (const Vec3f bad : {Vec3f(0, std::nanf(""), 0), Vec3f(inf, 0, 0), Vec3f(0, 0, -inf)}) {
+      TriMesh nan = cube();
+      nan.vertices[5] = bad;
+      expect_error(dir / name, [&] { write_mesh(dir / name, nan); }, "vertex 5 has a non-finite coordinate");
+      EXPECT_FALSE(std::filesystem::exists(dir / name));
+    }
+    TriMesh normals = cube();
+    normals.normals.assign(8, Vec3f(0, 0, 1));
+    normals.normals[2].x() = std::nanf("");
+    expect_error(dir / name, [&] { write_mesh(dir / name, normals); }, "normal 2");
+    TriMesh index = cube();
+    index.triangles[3][1] = 8;
+    expect_error(dir / name, [&] { write_mesh(dir / name, index, MeshEncoding::ascii); }, "out of range");
+    EXPECT_FALSE(std::filesystem::exists(dir / name));
+  }
 }
 
 }  // namespace
