@@ -1,6 +1,6 @@
 #pragma once
-// NumPy .npy arrays (format versions 1.0-3.0, C order, little- or big-endian in,
-// little-endian out).
+// NumPy .npy arrays (format versions 1.0-3.0, C or Fortran order and little- or
+// big-endian in; C order, little-endian out).
 #include <cstdint>
 #include <filesystem>
 #include <span>
@@ -22,8 +22,9 @@ struct NpyArray {
   template <typename T> std::vector<T> to_vector() const;
 };
 
-/// Reads dtypes u1..u8, i1..i8, f4, f8 in any byte order and bool (as u8).
-/// Throws geods::Error naming the file for malformed headers, Fortran order,
+/// Reads dtypes u1..u8, i1..i8, f4, f8 in any byte order and bool (as u8);
+/// a Fortran-order array is rearranged into C order (same shape, same values).
+/// Throws geods::Error naming the file for malformed headers,
 /// structured or unsupported dtypes, shapes whose size overflows, and data
 /// that does not exactly fill the rest of the file (checked before allocating).
 NpyArray read_npy(const std::filesystem::path& path);
