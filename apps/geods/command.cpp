@@ -33,6 +33,24 @@ CLI::Option* add_save(CLI::App& app, std::string& path, const std::string& what,
   return app.add_option("--save", path, "Output: " + what + " as a geods archive (" + reader + " reads it)");
 }
 
+CLI::Option* add_output(CLI::App& app, const std::string& name, std::string& path, const std::string& description,
+                        io::OutputKind kind) {
+  std::string accepted;
+  for (const std::string& e : io::output_extensions(kind)) accepted += (accepted.empty() ? "" : ", ") + e;
+  if (io::standard_output_allowed(kind)) accepted += "; - for standard output";
+  return app.add_option(name, path, description + " (" + accepted + ")")
+      ->check(CLI::Validator(
+          [kind](std::string& value) {
+            try {
+              io::check_output_extension(value, kind);
+            } catch (const Error& e) {
+              return std::string(e.what());
+            }
+            return std::string();
+          },
+          "", "output name"));
+}
+
 namespace {
 
 // The first line of a message: the contract is one line on stderr.
@@ -97,10 +115,12 @@ int run_cli(int argc, char** argv) {
     } catch (const std::exception& e) {
       return fail(entry.command->name(), std::string("internal error: ") + e.what());
     }
+    // An output written to standard output ("-") keeps it for itself.
+    std::ostream& out = io::standard_output_used() ? std::cerr : std::cout;
     if (context.json) {
-      std::cout << report.json.dump() << "\n";
+      out << report.json.dump() << "\n";
     } else {
-      for (const std::string& line : report.lines) std::cout << line << "\n";
+      for (const std::string& line : report.lines) out << line << "\n";
     }
     return status;
   }

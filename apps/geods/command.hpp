@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "geods/core/progress.hpp"
+#include "geods/io/output.hpp"
 
 namespace geods::cli {
 
@@ -50,6 +51,14 @@ void add_input(CLI::App& app, const std::string& name, std::string& value, const
 /// it writes `what` there as a geods archive, which `reader` reads back, e.g.
 /// add_save(app, save_, "the triangulation", "Delaunay2.load").
 CLI::Option* add_save(CLI::App& app, std::string& path, const std::string& what, const std::string& reader);
+
+/// Declares an output option (e.g. "-o,--output") of the given kind: its file
+/// name must have an extension `kind` can be written as (io::check_output_extension),
+/// checked while the command line is parsed, before anything is read or
+/// computed; the help ends with the accepted extensions. "-" is standard output
+/// where the kind allows it, and the command's report then goes to standard error.
+CLI::Option* add_output(CLI::App& app, const std::string& name, std::string& path, const std::string& description,
+                        io::OutputKind kind);
 
 std::vector<std::unique_ptr<Command>>& registered_commands();
 

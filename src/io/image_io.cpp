@@ -29,6 +29,7 @@
 
 #include "file_util.hpp"
 #include "geods/io/image_io.hpp"
+#include "geods/io/output.hpp"
 
 namespace geods::io {
 
@@ -95,6 +96,7 @@ namespace {
 
 template <typename T>
 void check_writable(const fs::path& path, const Image<T>& image) {
+  check_output_extension(path, OutputKind::image);
   if (image.channels < 1 || image.channels > 4)
     fail(path, "cannot write PNG with " + std::to_string(image.channels) + " channels (1 to 4)");
   if (image.width == 0 || image.height == 0) fail(path, "cannot write an empty image");

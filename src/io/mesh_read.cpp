@@ -331,6 +331,12 @@ TriMesh convert(const fs::path& path, const aiScene& scene) {
 
 }  // namespace
 
+bool is_mesh_name(const fs::path& path) {
+  std::string ext = detail::extension(path);
+  detail::is_gzip_name(path, &ext);
+  return supported(ext);
+}
+
 TriMesh read_mesh(const fs::path& path) {
   std::string ext = detail::extension(path);
   const bool gz = detail::is_gzip_name(path, &ext);

@@ -141,6 +141,7 @@ void write_stl(const fs::path& path, const TriMesh& mesh, MeshEncoding encoding)
 }  // namespace
 
 void write_mesh(const fs::path& path, const TriMesh& mesh, MeshEncoding encoding) {
+  if (detail::is_standard_stream(path)) fail(path, "meshes are written to files (.ply, .obj or .stl), not to standard output");
   check_writable(path, mesh);
   const std::string ext = detail::extension(path);
   if (ext == ".ply") write_ply(path, mesh, encoding);

@@ -48,7 +48,7 @@ void write_points(const fs::path& path, const PointMatrix& points) {
       if (!std::isfinite(points(Eigen::Index(i), Eigen::Index(c))))
         fail(path, fmt::format("cannot write points: point {} has a non-finite coordinate ({:g} in column {})", i,
                                points(Eigen::Index(i), Eigen::Index(c)), c));
-  const std::string ext = detail::extension(path);
+  const std::string ext = detail::output_extension(path);
   if (ext == ".npy") {
     write_npy<double>(path, std::span<const double>(points.data(), n * dim), {n, dim});
     return;

@@ -71,6 +71,12 @@ TEST(MeshIo, ReadsRealFiles) {
   EXPECT_TRUE(teapot.validate().valid());
 }
 
+TEST(MeshIo, MeshNamesIncludeEveryGzipMesh) {
+  for (const char* name : {"a.ply", "a.OBJ", "a.stl", "a.off", "a.gltf", "a.glb", "a.stl.gz", "a.obj.gz", "a.ply.gz", "a.off.gz"})
+    EXPECT_TRUE(is_mesh_name(name)) << name;
+  for (const char* name : {"a.nii.gz", "a.gz", "a.npy", "a.png", "a", "a.csv"}) EXPECT_FALSE(is_mesh_name(name)) << name;
+}
+
 TEST(MeshIo, ReadsOffGzipAndGltf) {
   TempDir dir;
   const std::string off = "OFF\n# a square\n4 1 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n";

@@ -28,7 +28,8 @@ struct NpyArray {
 /// structured or unsupported dtypes, shapes whose size overflows, and data
 /// that does not exactly fill the rest of the file (checked before allocating).
 NpyArray read_npy(const std::filesystem::path& path);
-/// Writes format 1.0 (2.0 for huge headers), little-endian, C order.
+/// Writes format 1.0 (2.0 for huge headers), little-endian, C order, to a
+/// path ending in .npy, or to standard output for "-"; another name is an error.
 void write_npy(const std::filesystem::path& path, const NpyArray& array);
 
 /// Writes `data` with the given shape; T is any type with a dtype_of<T>().
