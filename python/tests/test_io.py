@@ -215,3 +215,35 @@ def test_gzip_mesh_and_bad_arguments(tmp_path):
     with pytest.raises(ValueError):
         geods.write_volume(tmp_path / "x.nrrd", np.zeros((2, 2)))
     assert issubclass(geods.Error, ValueError)
+
+
+def test_fortran_order_npy_reads_as_its_values(tmp_path):
+    rng = np.random.default_rng(4)
+    t = rng.normal(size=(7, 3))
+    np.save(tmp_path / "t.npy", np.asfortranarray(t))
+    np.testing.assert_array_equal(geods.read_table(tmp_path / "t.npy"), t)
+    np.testing.assert_array_equal(geods.read_points(tmp_path / "t.npy"), t)
+    v = rng.integers(0, 1000, size=(4, 5, 6)).astype(np.uint16)
+    np.save(tmp_path / "v.npy", np.asfortranarray(v))
+    np.testing.assert_array_equal(geods.read_volume(tmp_path / "v.npy"), v)
+
+
+def test_csv_header_only_when_no_field_is_a_number(tmp_path):
+    (tmp_path / "h.csv").write_text("x,y\n1,2\n3,4\n")
+    np.testing.assert_array_equal(geods.read_table(tmp_path / "h.csv"), [[1, 2], [3, 4]])
+    for first in ("0x10,2", "x,2", "1_000,2", "0b1,2"):
+        (tmp_path / "b.csv").write_text(first + "\n3,4\n")
+        with pytest.raises(ValueError, match="line 1: .* is not a number"):
+            geods.read_table(tmp_path / "b.csv")
+
+
+def test_off_variants(tmp_path):
+    v, f = cube()
+    body = f"{len(v)} {len(f)} 0\n"
+    for keyword, extra in (("COFF", " 255 0 0 255"), ("NOFF", " 0 0 1"), ("CNOFF", " 0 0 1 0.5 0.5 0.5 1")):
+        text = keyword + "\n" + body + "".join(f"{a} {b} {c}{extra}\n" for a, b, c in v) \
+            + "".join(f"3 {a} {b} {c} 10 20 30\n" for a, b, c in f)
+        (tmp_path / "c.off").write_text(text)
+        rv, rf = geods.read_mesh(tmp_path / "c.off")
+        np.testing.assert_array_equal(rv, v)
+        np.testing.assert_array_equal(rf, f)

@@ -33,9 +33,13 @@ Table read_text_table(const fs::path& path, bool commas, bool blank_or_comma, bo
   std::string text(detail::as_text(bytes));
   if (blank_or_comma) std::replace(text.begin(), text.end(), ',', ' ');
   std::vector<detail::TextRow> rows = detail::text_rows(text, commas);
+  // A header is a first row none of whose fields is a number: "x,y" is one;
+  // "0x10,2" is a row with a bad number, reported, not dropped.
   if (header && !rows.empty()) {
     double v = 0;
-    if (!detail::parse_double(rows[0].fields[0], v)) rows.erase(rows.begin());
+    const auto& fields = rows[0].fields;
+    if (std::none_of(fields.begin(), fields.end(), [&](std::string_view f) { return detail::parse_double(f, v); }))
+      rows.erase(rows.begin());
   }
   if (rows.empty()) fail(path, "no " + row_name + "s");
   Table t;

@@ -71,6 +71,37 @@ TEST(MeshIo, ReadsRealFiles) {
   EXPECT_TRUE(teapot.validate().valid());
 }
 
+// COFF, NOFF, CNOFF and STOFF carry values after x y z; faces may end in a colour.
+// The oracle: the same square as plain OFF, read by the strict parser.
+TEST(MeshIo, ReadsOffVariantsIgnoringColoursAndNormals) {
+  TempDir dir;
+  test::write_text(dir / "plain.off", "OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n");
+  const TriMesh plain = read_mesh(dir / "plain.off");
+  const std::pair<const char*, const char*> variants[] = {
+      {"COFF", "0 0 0 255 0 0 255\n1 0 0 0 255 0 255\n1 1 0 0 0 255 255\n0 1 0 9 9 9 255\n"},
+      {"NOFF", "0 0 0 0 0 1\n1 0 0 0 0 1\n1 1 0 0 0 1\n0 1 0 0 0 1\n"},
+      {"CNOFF", "0 0 0 0 0 1 1 0 0 1\n1 0 0 0 0 1 1 0 0 1\n1 1 0 0 0 1 1 0 0 1\n0 1 0 0 0 1 1 0 0 1\n"},
+      {"STOFF", "0 0 0 0 0\n1 0 0 1 0\n1 1 0 1 1\n0 1 0 0 1\n"},
+  };
+  for (const auto& [keyword, vertices] : variants) {
+    // Face colours (3 or 4 values, ints or floats) end the face lines.
+    test::write_text(dir / "v.off", std::string(keyword) + "\n4 2 0\n" + vertices + "3 0 1 2 255 0 0\n3 0 2 3 0.5 0.5 0.5 1\n");
+    const TriMesh m = read_mesh(dir / "v.off");
+    EXPECT_EQ(m.vertices, plain.vertices) << keyword;
+    EXPECT_EQ(m.triangles, plain.triangles) << keyword;
+  }
+  // Plain OFF with face colours: the colours used to be read as the next face's size.
+  test::write_text(dir / "fc.off", "OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2 3 1 2\n3 0 2 3 200 200 200\n");
+  EXPECT_EQ(read_mesh(dir / "fc.off").triangles, plain.triangles);
+  test::write_text(dir / "4d.off", "4OFF\n3 1 0\n0 0 0 0\n1 0 0 0\n0 1 0 0\n3 0 1 2\n");
+  expect_error(dir / "4d.off", [&] { read_mesh(dir / "4d.off"); }, "4OFF");
+  test::write_text(dir / "b.off", "OFF BINARY\n");
+  expect_error(dir / "b.off", [&] { read_mesh(dir / "b.off"); }, "binary OFF");
+  // A COFF whose vertex lines are short is an error, not a shifted mesh.
+  test::write_text(dir / "short.off", "COFF\n3 1 0\n0 0\n1 0 0 1 1 1\n0 1 0 1 1 1\n3 0 1 2\n");
+  expect_error(dir / "short.off", [&] { read_mesh(dir / "short.off"); });
+}
+
 TEST(MeshIo, MeshNamesIncludeEveryGzipMesh) {
   for (const char* name : {"a.ply", "a.OBJ", "a.stl", "a.off", "a.gltf", "a.glb", "a.stl.gz", "a.obj.gz", "a.ply.gz", "a.off.gz"})
     EXPECT_TRUE(is_mesh_name(name)) << name;

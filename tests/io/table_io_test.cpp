@@ -82,6 +82,24 @@ TEST(TableIo, PointsAreTheFirstColumnsOfTheTable) {
   EXPECT_EQ(read_points(dir / "p.txt"), (PointMatrix(2, 3) << 1, 2, 3, 4, 5, 6).finished());
 }
 
+// A header is a first row none of whose fields is a number; any other first row is data.
+TEST(TableIo, HeaderOnlyWhenNoFieldIsANumber) {
+  TempDir dir;
+  test::write_text(dir / "h.csv", "x,y\n1,2\n3,4\n");
+  EXPECT_EQ(read_table(dir / "h.csv").rows, 2u);
+  test::write_text(dir / "h.txt", "x y z\n1 2 3\n");
+  EXPECT_EQ(read_table(dir / "h.txt").rows, 1u);
+  // "0x10,2" is a row of data with a number geods does not read: an error naming it, not a dropped row.
+  test::write_text(dir / "hex.csv", "0x10,2\n3,4\n");
+  expect_error(dir / "hex.csv", [&] { read_table(dir / "hex.csv"); }, "'0x10' is not a number");
+  test::write_text(dir / "mixed.csv", "x,2\n3,4\n");
+  expect_error(dir / "mixed.csv", [&] { read_table(dir / "mixed.csv"); }, "'x' is not a number");
+  test::write_text(dir / "nan.csv", "nan,2\n3,4\n");
+  expect_error(dir / "nan.csv", [&] { read_table(dir / "nan.csv"); }, "non-finite");
+  test::write_text(dir / "hex.txt", "0x1p3 5\n");
+  expect_error(dir / "hex.txt", [&] { read_table(dir / "hex.txt"); }, "not a number");
+}
+
 // write_table: every accepted format reads back to the same values (the oracle: read_table and the input).
 TEST(TableIo, WriteTableRoundTripsAndRefusesOtherNames) {
   TempDir dir;
