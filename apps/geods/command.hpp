@@ -60,6 +60,15 @@ CLI::Option* add_save(CLI::App& app, std::string& path, const std::string& what,
 CLI::Option* add_output(CLI::App& app, const std::string& name, std::string& path, const std::string& description,
                         io::OutputKind kind);
 
+/// A check for integer options: "must be an integer >= 1, got 0" (CLI11's
+/// PositiveNumber prints its range with 300 digits).
+CLI::Validator at_least(long long minimum);
+
+/// A message as the CLI prints it: one line, without a leading "<command>: "
+/// (the CLI adds "geods <command>: " itself), fixed-notation numbers of more
+/// than 12 digits before or after the point shortened to %g ("1.79769e+308").
+std::string user_message(const std::string& command, const std::string& message);
+
 std::vector<std::unique_ptr<Command>>& registered_commands();
 
 template <typename C>

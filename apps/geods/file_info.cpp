@@ -199,6 +199,7 @@ Report describe_file(const fs::path& path, const std::optional<RawVolumeSpec>& r
   const bool standard_input = path == "-";
   if (!standard_input && !fs::exists(path)) throw Error(path.string() + ": no such file");
   if (fs::is_directory(path)) throw Error(path.string() + ": is a directory, not a file");
+  if (!standard_input && !fs::is_regular_file(path)) throw Error(path.string() + ": not a regular file");
   Report report;
   report.json["file"] = path.string();
   if (!standard_input) report.json["bytes"] = fs::file_size(path);

@@ -147,7 +147,8 @@ inline io::AnyGrid3 volume_from_array(const py::array& array, const std::array<d
 /// `what` names the caller in the geods::Error raised for another shape.
 template <typename T = std::uint8_t>
 Image<T> image_from_array(const Rows<T>& a, const std::string& what) {
-  if (a.ndim() != 2 && a.ndim() != 3) throw Error(what + ": expected an (h, w) or (h, w, c) array");
+  if (a.ndim() != 2 && a.ndim() != 3)
+    throw Error(what + ": expected an (h, w) or (h, w, c) " + std::string(py::str(py::object(py::dtype::of<T>()))) + " array");
   Image<T> im;
   im.height = std::size_t(a.shape(0));
   im.width = std::size_t(a.shape(1));

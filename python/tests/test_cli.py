@@ -289,3 +289,37 @@ def test_info_reads_every_mesh_render_reads(cli, tmp_path, data_dir):
         assert json.loads(r.stdout)["triangles"] == len(f)
         r = run(cli, "render", packed, "-o", tmp_path / "r.png", "--width", "8", "--height", "8")
         assert r.returncode == 0, r.stderr
+
+
+def test_messages_are_short_and_speak_the_users_language(cli, tmp_path, data_dir):
+    import re
+    import numpy as np
+    np.save(tmp_path / "p.npy", np.random.default_rng(1).random((20, 2)))
+    np.save(tmp_path / "b.npy", np.array([[0.0, 0.0, 1.0, 1.0]]))
+    np.save(tmp_path / "m.npy", np.ones((4, 4)))
+    cases = [
+        (["range", "p.npy", "--boxes", "b.npy", "--leaf-size", "0"], "must be an integer >= 1, got '0'"),
+        (["range", "p.npy", "--boxes", "b.npy", "--threads", "-2"], "must be an integer >= 0"),
+        (["edt", "m.npy", "-o", "d.npy", "--spacing", "1e-300,1"], "spacing 1e-300 along x"),
+        (["edt", "m.npy", "-o", "d.npy", "--spacing", "1e300,1"], "spacing 1e+300 along x"),
+        (["edt", "m.npy", "-o", "d.npy", "--spacing", "0,1"], "got 0 along x"),
+        (["bvh", data_dir / "bunny.ply", "--leaf-size", "0"], "leaf_size must be in 1..255"),
+        (["info", "/dev/null"], "/dev/null: not a regular file"),
+        (["texture", data_dir / "brick.png", "-o", "t.png", "--size", "8,8", "--eps", "-1"], "eps must be"),
+    ]
+    for args, words in cases:
+        r = run(cli, *args, cwd=tmp_path)
+        assert_bad_input(r, words)
+        line = r.stderr.strip()
+        assert not re.search(r"\d{13,}|\d\.\d{7,}", line), line          # no 300-digit numbers
+        assert "internal error" not in line and "::" not in line and "<" not in line, line
+        command = str(args[0])
+        assert not line.startswith(f"geods {command}: {command}:"), line  # the command is named once
+
+
+def test_library_messages_print_short_numbers():
+    import numpy as np
+    import geods
+    mask = np.ones((3, 3), dtype=bool)
+    with pytest.raises(ValueError, match=r"spacing 1e-300 along x"):   # was "0.000000"
+        geods.edt(mask, spacing=(1e-300, 1))

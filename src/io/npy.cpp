@@ -28,7 +28,7 @@ T convert_element(S v, std::size_t index, DType from) {
   if constexpr (std::is_floating_point_v<T>) {
     if constexpr (sizeof(T) < sizeof(S) && std::is_floating_point_v<S>) {
       if (std::isfinite(v) && !detail::fits_float(double(v)))
-        throw Error("npy: element " + std::to_string(index) + " (" + std::to_string(double(v)) + ") of dtype " +
+        throw Error("npy: element " + std::to_string(index) + " (" + format_number(double(v)) + ") of dtype " +
                     std::string(dtype_name(from)) + " does not fit " + std::string(dtype_name(dtype_of<T>())));
     }
     return static_cast<T>(v);
@@ -36,7 +36,7 @@ T convert_element(S v, std::size_t index, DType from) {
     constexpr double lo = double(std::numeric_limits<T>::min());
     constexpr double hi = double(std::numeric_limits<T>::max()) + 1.0;  // exact: a power of two
     if (!(double(v) >= lo && double(v) < hi))
-      throw Error("npy: element " + std::to_string(index) + " (" + std::to_string(double(v)) + ") of dtype " +
+      throw Error("npy: element " + std::to_string(index) + " (" + format_number(double(v)) + ") of dtype " +
                   std::string(dtype_name(from)) + " does not fit " + std::string(dtype_name(dtype_of<T>())));
     return static_cast<T>(v);
   } else {
