@@ -323,3 +323,13 @@ def test_library_messages_print_short_numbers():
     mask = np.ones((3, 3), dtype=bool)
     with pytest.raises(ValueError, match=r"spacing 1e-300 along x"):   # was "0.000000"
         geods.edt(mask, spacing=(1e-300, 1))
+
+
+def test_knn_and_nearest_never_write_npy_bytes_under_another_name(cli, points_and_boxes):
+    d = points_and_boxes[0]
+    for args in (["knn", "p.npy", "--queries", "p.npy", "--k", "2", "--indices", "i.csv"],
+                 ["knn", "p.npy", "--queries", "p.npy", "--k", "2", "--distances", "x.ply"],
+                 ["nearest", "p.npy", "--queries", "p.npy", "-o", "n.txt"]):
+        r = run(cli, *args, cwd=d)
+        assert_bad_input(r, "accepted: .npy")
+        assert not (d / args[-1]).exists()

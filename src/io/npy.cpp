@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "file_util.hpp"
+#include "geods/io/output.hpp"
 
 namespace geods::io {
 
@@ -286,8 +287,7 @@ NpyArray read_npy(const fs::path& path) {
 
 void write_npy(const fs::path& path, const NpyArray& array) {
   // Another name would hold .npy bytes under a name that says otherwise.
-  if (detail::output_extension(path) != ".npy")
-    fail(path, "write_npy writes .npy files, not '" + detail::extension(path) + "' (io::write_table writes .csv and .txt)");
+  check_output_extension(path, OutputKind::array);
   std::size_t count = 1;
   for (std::size_t s : array.shape) count = detail::checked_mul(path, count, s);
   if (count * dtype_size(array.dtype) != array.bytes.size())

@@ -128,7 +128,7 @@ TEST(TableIo, WriteTableRoundTripsAndRefusesOtherNames) {
   expect_error(dir / "s.npy", [&] { write_table(dir / "s.npy", std::span<const double>(d), {2, 2}); }, "shape");
   expect_error(dir / "s.npy", [&] { write_table(dir / "s.npy", std::span<const double>(d), {1, 2, 3}); }, "dimensions");
   // write_npy writes .npy files only.
-  expect_error(dir / "n.csv", [&] { write_npy<double>(dir / "n.csv", d, {6}); }, "write_npy writes .npy");
+  expect_error(dir / "n.csv", [&] { write_npy<double>(dir / "n.csv", d, {6}); }, "cannot write an array as '.csv' (accepted: .npy;");
   EXPECT_FALSE(std::filesystem::exists(dir / "n.csv"));
 }
 
