@@ -327,9 +327,9 @@ def test_library_messages_print_short_numbers():
 
 def test_knn_and_nearest_never_write_npy_bytes_under_another_name(cli, points_and_boxes):
     d = points_and_boxes[0]
-    for args in (["knn", "p.npy", "--queries", "p.npy", "--k", "2", "--indices", "i.csv"],
+    for args in (["knn", "p.npy", "--queries", "p.npy", "--k", "2", "--indices", "i.jpg"],
                  ["knn", "p.npy", "--queries", "p.npy", "--k", "2", "--distances", "x.ply"],
-                 ["nearest", "p.npy", "--queries", "p.npy", "-o", "n.txt"]):
+                 ["nearest", "p.npy", "--queries", "p.npy", "-o", "n.png"]):
         r = run(cli, *args, cwd=d)
         assert_bad_input(r, "accepted: .npy")
         assert not (d / args[-1]).exists()
