@@ -11,7 +11,6 @@
 #include "geods/bvh/triangle_bvh.hpp"
 #include "geods/core/parallel.hpp"
 #include "geods/io/mesh_io.hpp"
-#include "geods/io/npy.hpp"
 #include "geods/bvh/stats_fields.hpp"
 #include "geods/io/table_io.hpp"
 #include "stats_json.hpp"
@@ -33,7 +32,8 @@ class BvhCommand : public Command {
     app.add_option("--leaf-size", leaf_size_, "Most triangles per leaf (1..255)");
     app.add_option("--arity", arity_, "Children per node: 2, 4 or 8");
     app.add_option("--rays", rays_, "Rays, n x 6 (ox oy oz dx dy dz; .npy, .csv)");
-    app.add_option("-o,--output", output_, "Output for --rays: float64 n x 2 (t, triangle), inf and -1 on a miss");
+    add_output(app, "-o,--output", output_, "Output for --rays: float64 n x 2 (t, triangle), inf and -1 on a miss",
+               io::OutputKind::table);
     add_save(app, save_, "the hierarchy", "TriangleBvh.load");
   }
 
@@ -76,7 +76,7 @@ class BvhCommand : public Command {
       }, 256);
       query_s = query_watch.seconds();
       for (std::size_t i = 0; i < rays.rows; ++i) hits += out[2 * i + 1] >= 0;
-      if (!output_.empty()) io::write_npy<double>(output_, out, {rays.rows, 2});
+      if (!output_.empty()) io::write_table(output_, std::span<const double>(out), {rays.rows, 2});
     }
 
     Json& j = report.json;

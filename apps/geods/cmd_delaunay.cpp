@@ -8,7 +8,6 @@
 #include "command.hpp"
 #include "geods/core/aabb.hpp"
 #include "geods/core/error.hpp"
-#include "geods/io/npy.hpp"
 #include "geods/io/point_io.hpp"
 #include "geods/io/table_io.hpp"
 #include "geods/io/svg.hpp"
@@ -34,10 +33,11 @@ class DelaunayCommand : public Command {
     app.add_option("--segments", segments_,
                    "Constraints: int m x 2 point indices (.npy), or m x 4 end coordinates x0 y0 x1 y1 "
                    "(.npy/.edg/.cin; the end points are appended to the points)");
-    app.add_option("-o,--output", output_,
-                   "Output: int64 m x 3 counter-clockwise triangles, indices into the points (duplicates map to "
-                   "their first occurrence)");
-    app.add_option("--svg", svg_, "Output: a picture of the triangulation");
+    add_output(app, "-o,--output", output_,
+               "Output: int64 m x 3 counter-clockwise triangles, indices into the points (duplicates map to "
+               "their first occurrence)",
+               io::OutputKind::table);
+    add_output(app, "--svg", svg_, "Output: a picture of the triangulation", io::OutputKind::svg);
     add_save(app, save_, "the triangulation", "Delaunay2.load");
   }
 
@@ -57,7 +57,7 @@ class DelaunayCommand : public Command {
 
     if (!output_.empty()) {
       std::vector<std::int64_t> tri(dt.triangles().begin(), dt.triangles().end());
-      io::write_npy<std::int64_t>(output_, tri, {dt.triangle_count(), 3});
+      io::write_table(output_, std::span<const std::int64_t>(tri), {dt.triangle_count(), 3});
     }
     if (!svg_.empty()) write_svg(dt);
     if (!save_.empty()) dt.save(save_);

@@ -34,19 +34,17 @@ class EdtCommand : public Command {
     add_input(app, "mask", mask_,
               "Mask: .npy (1-, 2- or 3-D, any numeric dtype), .nrrd/.nhdr, .nii/.nii.gz, or an image "
               "(.png, .bmp, .jpg: the first channel); nonzero = foreground");
-    app.add_option("-o,--output", output_, "Distances as float64 .npy of the mask's shape")->required();
+    add_output(app, "-o,--output", output_, "Distances as float64 of the mask's shape", io::OutputKind::array)->required();
     app.add_option("--spacing", spacing_,
                    "Sample spacing along x, y(, z) (default: the file's, 1 for .npy and images)")
         ->delimiter(',');
     app.add_flag("--squared", squared_, "Write squared distances");
-    app.add_option("--indices", indices_,
-                   "Also write the flat (C-order) index of each sample's nearest zero sample, int64 .npy (-1: none)");
+    add_output(app, "--indices", indices_,
+               "Also write the flat (C-order) index of each sample's nearest zero sample, int64 (-1: none)",
+               io::OutputKind::array);
   }
 
   void run(const RunContext&, Report& report) override {
-    for (const std::string& path : {output_, indices_})
-      if (!path.empty() && std::filesystem::path(path).extension() != ".npy")
-        throw Error("edt: outputs are .npy files, got " + path);
     const Mask mask = read_mask();
     const std::size_t axes = mask.shape.size();
     field::EdtRequest request;

@@ -25,7 +25,7 @@ class IsoCommand : public Command {
   void add_options(CLI::App& app) override {
     add_input(app, "volume", volume_, "Volume: .npy (z, y, x), .nrrd, .nii/.nii.gz, or raw with --dims/--dtype");
     app.add_option("--iso", iso_, "Iso-value: samples >= it are inside")->required();
-    app.add_option("-o,--output", output_, "Output mesh (.ply, .obj, .stl) with normals where the format has them");
+    add_output(app, "-o,--output", output_, "Output mesh, with normals where the format has them", io::OutputKind::mesh);
     app.add_option("--dims", dims_, "Raw input: samples along x, y, z (x fastest)")->delimiter(',')->expected(3);
     app.add_option("--dtype", dtype_, "Raw input: f32, u8, u16 or i16 (little-endian)");
     app.add_option("--coords", coords_,

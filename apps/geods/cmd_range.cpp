@@ -4,7 +4,6 @@
 #include <cstdint>
 
 #include "command.hpp"
-#include "geods/io/npy.hpp"
 #include "geods/io/table_io.hpp"
 #include "kd_tree_cli.hpp"
 #include "stopwatch.hpp"
@@ -19,7 +18,7 @@ class RangeCommand : public Command {
   void add_options(CLI::App& app) override {
     input_.add_options(app);
     app.add_option("--boxes", boxes_, "Boxes, m x 2d: the low corner, then the high corner (closed)")->required();
-    app.add_option("-o,--output", output_, "Output: int64 counts, one per box");
+    add_output(app, "-o,--output", output_, "Output: int64 counts, one per box", io::OutputKind::table);
   }
 
   void run(const RunContext&, Report& report) override {
@@ -43,7 +42,7 @@ class RangeCommand : public Command {
       query_s = query_watch.seconds();
     });
     const std::vector<std::int64_t> out(counts.begin(), counts.end());
-    if (!output_.empty()) io::write_npy<std::int64_t>(output_, out, {boxes.rows});
+    if (!output_.empty()) io::write_table(output_, std::span<const std::int64_t>(out), {boxes.rows});
     std::size_t total = 0;
     for (std::size_t c : counts) total += c;
 

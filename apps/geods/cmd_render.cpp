@@ -46,7 +46,7 @@ class RenderCommand : public Command {
   }
   void add_options(CLI::App& app) override {
     add_input(app, "mesh", mesh_, "Mesh (PLY, OBJ, OFF, STL, glTF)");
-    app.add_option("-o,--output", output_, "Output image (.png)")->required();
+    add_output(app, "-o,--output", output_, "Output image", io::OutputKind::image)->required();
     accel_option_ = app.add_option("--accel", accel_, "Accelerator: bvh, grid, octree or rays5d")->default_val(accel_);
     add_save(app, save_, "the accelerator (written before rendering)", "--load or Accelerator.load");
     app.add_option("--load", load_, "Render with an accelerator saved by --save over the same mesh (no build)");

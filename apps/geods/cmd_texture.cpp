@@ -22,7 +22,7 @@ class TextureCommand : public Command {
   }
   void add_options(CLI::App& app) override {
     add_input(app, "sample", sample_, "Sample image: 8-bit PNG, JPEG or BMP, grey, grey+alpha, RGB or RGBA");
-    app.add_option("-o,--output", output_, "Output image (.png)")->required();
+    add_output(app, "-o,--output", output_, "Output image", io::OutputKind::image)->required();
     app.add_option("--size", size_, "Output width,height (not with --image: the image's size)")->delimiter(',')->expected(2);
     app.add_option("--neighborhood", options_.neighborhood, "Odd side of the window at each level (default 9)");
     app.add_option("--parent-neighborhood", options_.parent_neighborhood,
@@ -42,7 +42,6 @@ class TextureCommand : public Command {
   }
 
   void run(const RunContext& context, Report& report) override {
-    if (std::filesystem::path(output_).extension() != ".png") throw Error("texture: the output must be a .png file");
     if (!image_.empty() && mask_.empty()) throw Error("texture: --image needs --mask");
     if (!image_.empty() && !size_.empty()) throw Error("texture: --size does not go with --image (the image's size is used)");
     if (image_.empty() && size_.empty()) throw Error("texture: --size W,H is required (or --image and --mask)");

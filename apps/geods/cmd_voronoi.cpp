@@ -1,7 +1,6 @@
 // geods voronoi: the Voronoi diagram of 2D points under L2, L1 or L-infinity, as an SVG and/or cells in JSON.
 #include <fmt/format.h>
 
-#include <fstream>
 #include <optional>
 
 #include "command.hpp"
@@ -25,8 +24,9 @@ class VoronoiCommand : public Command {
     add_input(app, "points", points_, "Points, n x 2 (.npy, .csv, .txt, .xyz, .ply)");
     app.add_option("--metric", metric_, "l2 (default), l1 or linf");
     app.add_option("--box", box_, "Clip cells to x0,y0,x1,y1 (default: the points' bounding box grown by 25%)");
-    app.add_option("--svg", svg_, "Output: a figure of the cells, edges and sites");
-    app.add_option("-o,--output", output_, "Output: JSON with the box, each point's cell polygon and the edges");
+    add_output(app, "--svg", svg_, "Output: a figure of the cells, edges and sites", io::OutputKind::svg);
+    add_output(app, "-o,--output", output_, "Output: JSON with the box, each point's cell polygon and the edges",
+               io::OutputKind::json);
     add_save(app, save_, "the l2 diagram", "Voronoi2.load");
   }
 
@@ -93,10 +93,7 @@ class VoronoiCommand : public Command {
                              {"from", {edges[k].first[0], edges[k].first[1]}},
                              {"to", {edges[k].second[0], edges[k].second[1]}}});
       out["edges"] = std::move(edge_list);
-      std::ofstream file(output_);
-      if (!file) throw Error(output_ + ": cannot write");
-      file << out.dump() << '\n';
-      if (!file) throw Error(output_ + ": write failed");
+      io::write_text(output_, out.dump() + '\n');
     }
 
     Json& j = report.json;

@@ -1,8 +1,12 @@
 #include "command.hpp"
 
+#include <charconv>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
+#include <filesystem>
 #include <iostream>
+#include <regex>
 
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"
@@ -33,13 +37,56 @@ CLI::Option* add_save(CLI::App& app, std::string& path, const std::string& what,
   return app.add_option("--save", path, "Output: " + what + " as a geods archive (" + reader + " reads it)");
 }
 
+CLI::Option* add_output(CLI::App& app, const std::string& name, std::string& path, const std::string& description,
+                        io::OutputKind kind) {
+  std::string accepted;
+  for (const std::string& e : io::output_extensions(kind)) accepted += (accepted.empty() ? "" : ", ") + e;
+  if (io::standard_output_allowed(kind)) accepted += "; - for standard output";
+  return app.add_option(name, path, description + " (" + accepted + ")")
+      ->check(CLI::Validator(
+          [kind](std::string& value) {
+            try {
+              io::check_output_extension(value, kind);
+            } catch (const Error& e) {
+              return std::string(e.what());
+            }
+            return std::string();
+          },
+          "", "output name"));
+}
+
+CLI::Validator at_least(long long minimum) {
+  return CLI::Validator(
+      [minimum](std::string& value) {
+        long long v = 0;
+        const auto [end, ec] = std::from_chars(value.data(), value.data() + value.size(), v);
+        if (ec != std::errc() || end != value.data() + value.size() || v < minimum)
+          return "must be an integer >= " + std::to_string(minimum) + ", got '" + value + "'";
+        return std::string();
+      },
+      "INT>=" + std::to_string(minimum), "at least");
+}
+
+std::string user_message(const std::string& command, const std::string& message) {
+  std::string line = message.substr(0, message.find('\n'));  // the contract is one line on stderr
+  if (line.starts_with(command + ": ")) line.erase(0, command.size() + 2);
+  // Long fixed-notation numbers (a double through std::to_string or CLI11) become %g.
+  static const std::regex long_number(R"(-?\d{13,}\.\d+|-?\d+\.\d{13,})");
+  std::string out;
+  auto begin = std::sregex_iterator(line.begin(), line.end(), long_number);
+  std::size_t last = 0;
+  for (auto it = begin; it != std::sregex_iterator(); ++it) {
+    out += line.substr(last, std::size_t(it->position()) - last);
+    out += format_number(std::strtod(it->str().c_str(), nullptr));
+    last = std::size_t(it->position() + it->length());
+  }
+  return out + line.substr(last);
+}
+
 namespace {
 
-// The first line of a message: the contract is one line on stderr.
-std::string first_line(const std::string& text) { return text.substr(0, text.find('\n')); }
-
 int fail(const std::string& command, const std::string& message) {
-  std::cerr << "geods " << command << ": " << first_line(message) << "\n";
+  std::cerr << "geods " << command << ": " << user_message(command, message) << "\n";
   return 2;
 }
 
@@ -61,7 +108,7 @@ int run_cli(int argc, char** argv) {
     CLI::App* sub = app.add_subcommand(command->name(), command->summary());
     sub->add_flag("--json", context.json, "Print one JSON object instead of the summary");
     sub->add_option("--threads", context.threads, "Worker threads (default: all cores; 1: single-threaded)")
-        ->check(CLI::NonNegativeNumber);
+        ->check(at_least(0));
     command->add_options(*sub);
     entries.push_back({command.get(), sub});
   }
@@ -76,7 +123,7 @@ int run_cli(int argc, char** argv) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     const std::string where = app.get_subcommands().empty() ? "" : app.get_subcommands().front()->get_name();
-    std::cerr << "geods" << (where.empty() ? "" : " " + where) << ": " << first_line(e.what())
+    std::cerr << "geods" << (where.empty() ? "" : " " + where) << ": " << user_message(where, e.what())
               << " (see --help)\n";
     return 2;
   }
@@ -94,13 +141,17 @@ int run_cli(int argc, char** argv) {
       return fail(entry.command->name(), e.what());
     } catch (const std::bad_alloc&) {
       return fail(entry.command->name(), "out of memory");
+    } catch (const std::filesystem::filesystem_error& e) {
+      return fail(entry.command->name(), e.path1().string() + ": " + e.code().message());
     } catch (const std::exception& e) {
-      return fail(entry.command->name(), std::string("internal error: ") + e.what());
+      return fail(entry.command->name(), std::string("unexpected failure (please report it): ") + e.what());
     }
+    // An output written to standard output ("-") keeps it for itself.
+    std::ostream& out = io::standard_output_used() ? std::cerr : std::cout;
     if (context.json) {
-      std::cout << report.json.dump() << "\n";
+      out << report.json.dump() << "\n";
     } else {
-      for (const std::string& line : report.lines) std::cout << line << "\n";
+      for (const std::string& line : report.lines) out << line << "\n";
     }
     return status;
   }

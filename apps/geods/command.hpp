@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "geods/core/progress.hpp"
+#include "geods/io/output.hpp"
 
 namespace geods::cli {
 
@@ -50,6 +51,23 @@ void add_input(CLI::App& app, const std::string& name, std::string& value, const
 /// it writes `what` there as a geods archive, which `reader` reads back, e.g.
 /// add_save(app, save_, "the triangulation", "Delaunay2.load").
 CLI::Option* add_save(CLI::App& app, std::string& path, const std::string& what, const std::string& reader);
+
+/// Declares an output option (e.g. "-o,--output") of the given kind: its file
+/// name must have an extension `kind` can be written as (io::check_output_extension),
+/// checked while the command line is parsed, before anything is read or
+/// computed; the help ends with the accepted extensions. "-" is standard output
+/// where the kind allows it, and the command's report then goes to standard error.
+CLI::Option* add_output(CLI::App& app, const std::string& name, std::string& path, const std::string& description,
+                        io::OutputKind kind);
+
+/// A check for integer options: "must be an integer >= 1, got 0" (CLI11's
+/// PositiveNumber prints its range with 300 digits).
+CLI::Validator at_least(long long minimum);
+
+/// A message as the CLI prints it: one line, without a leading "<command>: "
+/// (the CLI adds "geods <command>: " itself), fixed-notation numbers of more
+/// than 12 digits before or after the point shortened to %g ("1.79769e+308").
+std::string user_message(const std::string& command, const std::string& message);
 
 std::vector<std::unique_ptr<Command>>& registered_commands();
 

@@ -11,6 +11,7 @@
 #include "geods/io/mesh_io.hpp"
 #include "geods/io/npy.hpp"
 #include "geods/io/point_io.hpp"
+#include "geods/io/table_io.hpp"
 #include "geods/io/volume_io.hpp"
 #include "stopwatch.hpp"
 
@@ -182,28 +183,41 @@ void describe_npy(const fs::path& path, Report& report) {
   }
 }
 
+// Standard input ("-") has no name: a PLY there is a mesh if it has triangles, else points.
+void describe_standard_input_ply(Report& report) {
+  try {
+    describe_mesh("-", report);
+  } catch (const Error& e) {
+    if (std::string(e.what()).find("no triangles") == std::string::npos) throw;
+    describe_points("-", report);
+  }
+}
+
 }  // namespace
 
 Report describe_file(const fs::path& path, const std::optional<RawVolumeSpec>& raw) {
-  if (!fs::exists(path)) throw Error(path.string() + ": no such file");
+  const bool standard_input = path == "-";
+  if (!standard_input && !fs::exists(path)) throw Error(path.string() + ": no such file");
   if (fs::is_directory(path)) throw Error(path.string() + ": is a directory, not a file");
+  if (!standard_input && !fs::is_regular_file(path)) throw Error(path.string() + ": not a regular file");
   Report report;
   report.json["file"] = path.string();
-  report.json["bytes"] = fs::file_size(path);
+  if (!standard_input) report.json["bytes"] = fs::file_size(path);
   Stopwatch watch;
-  const std::string ext = full_extension(path);
+  // Standard input: the format its bytes show (.npy, .ply, .off or a .txt table).
+  const std::string ext = standard_input ? io::input_format(path) : full_extension(path);
   if (raw) {
     describe_volume(path, io::read_raw_volume(path, raw->dims, raw->dtype), report);
   } else if (ext == ".ply") {
-    ply_has_faces(path) ? describe_mesh(path, report) : describe_points(path, report);
-  } else if (ext == ".obj" || ext == ".stl" || ext == ".off" || ext == ".gltf" || ext == ".glb" ||
-             ext == ".ply.gz" || ext == ".off.gz") {
+    standard_input ? describe_standard_input_ply(report)
+                   : ply_has_faces(path) ? describe_mesh(path, report) : describe_points(path, report);
+  } else if (io::is_mesh_name(path) || (standard_input && ext == ".off")) {
     describe_mesh(path, report);
   } else if (ext == ".nii" || ext == ".nii.gz" || ext == ".nrrd" || ext == ".nhdr" || ext == ".nrrd.gz") {
     describe_volume(path, io::read_volume(path), report);
   } else if (ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".bmp") {
     describe_image(path, report);
-  } else if (ext == ".xyz" || ext == ".csv") {
+  } else if (ext == ".xyz" || ext == ".csv" || ext == ".txt") {
     describe_points(path, report);
   } else if (ext == ".edg" || ext == ".cin") {
     describe_segments(path, report);
@@ -213,8 +227,8 @@ Report describe_file(const fs::path& path, const std::optional<RawVolumeSpec>& r
     throw Error(path.string() + ": a raw volume needs --dims X,Y,Z and --dtype");
   } else {
     throw Error(path.string() + ": unknown file type '" + ext +
-                "' (meshes .ply .obj .stl .off .gltf .glb; volumes .nii .nii.gz .nrrd .npy .raw; images .png "
-                ".jpg .bmp; points .xyz .csv .ply .npy; segments .edg .cin .npy)");
+                "' (meshes .ply .obj .stl .off .gltf .glb, also .gz; volumes .nii .nii.gz .nrrd .npy .raw; images .png "
+                ".jpg .bmp; points .xyz .csv .txt .ply .npy; segments .edg .cin .npy; - for standard input)");
   }
   report.json["compute_s"] = watch.seconds();
   return report;

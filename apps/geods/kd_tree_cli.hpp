@@ -9,6 +9,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "command.hpp"
 #include "geods/core/error.hpp"
 #include "geods/io/table_io.hpp"
 #include "geods/spatial/kd_tree_dimensions.hpp"
@@ -28,7 +29,7 @@ struct KdTreeInput {
     app.add_option("--tree", tree, "Instead of the points: a k-d tree written by --save or save() (float32 or float64 points)")
         ->excludes(positional)
         ->excludes(named);
-    app.add_option("--leaf-size", leaf_size, "Points per leaf of the k-d tree")->check(CLI::PositiveNumber);
+    app.add_option("--leaf-size", leaf_size, "Points per leaf of the k-d tree")->check(at_least(1));
     app.add_option("--save", save, "Output: the k-d tree and its points as a geods archive, for --tree");
   }
   /// The file the points come from.

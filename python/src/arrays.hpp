@@ -145,9 +145,11 @@ inline io::AnyGrid3 volume_from_array(const py::array& array, const std::array<d
 
 /// An (h, w) or (h, w, c) uint8 array as an image of c channels (a copy);
 /// `what` names the caller in the geods::Error raised for another shape.
-inline Image<std::uint8_t> image_from_array(const Rows<std::uint8_t>& a, const std::string& what) {
-  if (a.ndim() != 2 && a.ndim() != 3) throw Error(what + ": expected an (h, w) or (h, w, c) uint8 array");
-  Image<std::uint8_t> im;
+template <typename T = std::uint8_t>
+Image<T> image_from_array(const Rows<T>& a, const std::string& what) {
+  if (a.ndim() != 2 && a.ndim() != 3)
+    throw Error(what + ": expected an (h, w) or (h, w, c) " + std::string(py::str(py::object(py::dtype::of<T>()))) + " array");
+  Image<T> im;
   im.height = std::size_t(a.shape(0));
   im.width = std::size_t(a.shape(1));
   im.channels = a.ndim() == 3 ? std::size_t(a.shape(2)) : 1;

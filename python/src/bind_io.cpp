@@ -31,8 +31,19 @@ py::tuple read_mesh_py(const path& p) {
   return mesh_arrays(mesh, false);
 }
 
-void write_mesh_py(const path& p, const Rows<float>& v, const Rows<std::int64_t>& f, bool binary) {
-  const TriMesh mesh = mesh_from_arrays(v, f, "write_mesh");
+// V is checked in its own dtype before the cast to float (1e300 would become inf,
+// which write_mesh refuses anyway, under a less clear name); F must hold integers
+// (a float F would be truncated to other indices).
+void write_mesh_py(const path& p, const py::array& v, const py::array& f, bool binary) {
+  const auto v64 = Rows<double>::ensure(v);
+  if (!v64) throw Error("write_mesh: V must be an (n, 3) array of numbers");
+  for (py::ssize_t i = 0; i < v64.size(); ++i)
+    if (!(std::abs(v64.data()[i]) <= double(std::numeric_limits<float>::max())))
+      throw Error(p.string() + ": cannot write mesh: vertex " + std::to_string(i / 3) + " has a non-finite coordinate " +
+                  "or one outside the float range (" + format_number(v64.data()[i]) + ")");
+  if (f.dtype().kind() != 'i' && f.dtype().kind() != 'u' && f.size() > 0)
+    throw Error("write_mesh: F must be an integer array of vertex indices, not " + std::string(py::str(py::object(f.dtype()))));
+  const TriMesh mesh = mesh_from_arrays(Rows<float>::ensure(v), Rows<std::int64_t>::ensure(f), "write_mesh");
   py::gil_scoped_release release;
   io::write_mesh(p, mesh, binary ? io::MeshEncoding::binary : io::MeshEncoding::ascii);
 }
@@ -84,10 +95,43 @@ py::array_t<std::uint8_t> read_image_py(const path& p) {
   return image_array(im);
 }
 
-void write_png_py(const path& p, const Rows<std::uint8_t>& a) {
-  const Image<std::uint8_t> im = image_from_array(a, "write_png");
-  py::gil_scoped_release release;
-  io::write_png(p, im);
+// By dtype: uint8 and bool as 8-bit, uint16 as 16-bit, floats in [0, 1] as
+// round(255 v), other integers if every value is in 0..255; anything else is refused.
+void write_png_py(const path& p, const py::array& a) {
+  const py::dtype dt = a.dtype();
+  if (dt.is(py::dtype::of<std::uint8_t>()) || dt.kind() == 'b') {
+    const Image<std::uint8_t> im = image_from_array(Rows<std::uint8_t>::ensure(a), "write_png");
+    py::gil_scoped_release release;
+    return io::write_png(p, im);
+  }
+  if (dt.is(py::dtype::of<std::uint16_t>())) {
+    const Image<std::uint16_t> im = image_from_array(Rows<std::uint16_t>::ensure(a), "write_png");
+    py::gil_scoped_release release;
+    return io::write_png(p, im);
+  }
+  if (dt.kind() == 'f') {
+    const Image<double> im = image_from_array(Rows<double>::ensure(a), "write_png");
+    py::gil_scoped_release release;
+    return io::write_png(p, im);
+  }
+  if (dt.kind() == 'i' || dt.kind() == 'u') {
+    // Compared as they are (uint64 above 2^63 included), then narrowed.
+    const auto wide = py::array_t<std::uint64_t, py::array::c_style | py::array::forcecast>::ensure(a);
+    const auto signed_values = Rows<std::int64_t>::ensure(a);
+    for (py::ssize_t i = 0; i < a.size(); ++i) {
+      const bool negative = dt.kind() == 'i' && signed_values.data()[i] < 0;
+      if (negative || wide.data()[i] > 255)
+        throw Error(p.string() + ": cannot write PNG: value " +
+                    (negative ? std::to_string(signed_values.data()[i]) : std::to_string(wide.data()[i])) +
+                    " of the " + std::string(py::str(py::object(dt))) +
+                    " image is outside 0..255 (8-bit PNG); give uint16 for a 16-bit PNG or floats in [0, 1]");
+    }
+    const Image<std::uint8_t> im = image_from_array(Rows<std::uint8_t>::ensure(a), "write_png");
+    py::gil_scoped_release release;
+    return io::write_png(p, im);
+  }
+  throw Error(p.string() + ": cannot write PNG from an array of " + std::string(py::str(py::object(dt))) +
+              " (uint8, bool, uint16, other integers in 0..255, or floats in [0, 1])");
 }
 
 }  // namespace
@@ -144,7 +188,12 @@ geods.Error naming the file and line for malformed files, NaN/inf values or no r
   m.def("read_image", &read_image_py, py::arg("path"),
         R"doc(Reads a PNG, JPEG or BMP as uint8: (h, w) for grey, (h, w, c) for 2 to 4 channels.)doc");
   m.def("write_png", &write_png_py, py::arg("path"), py::arg("image"),
-        R"doc(Writes a uint8 (h, w) or (h, w, c) array (c = 1 to 4) as an 8-bit PNG.)doc");
+        R"doc(Writes an (h, w) or (h, w, c) array (c = 1 to 4) as a PNG, by its dtype:
+
+uint8 and bool: 8-bit; uint16: 16-bit; floats: values in [0, 1] written as
+round(255 v) in 8 bits; other integers: 8-bit if every value is in 0..255.
+Anything else (NaN, floats outside [0, 1], integers outside 0..255, other
+dtypes) raises geods.Error: nothing is clamped or wrapped.)doc");
 }
 
 }  // namespace geods::python

@@ -162,3 +162,174 @@ def test_texture_json_and_bad_input(cli, data_dir, tmp_path):
     assert_bad_input(run(cli, "texture", brick, "-o", tmp_path / "o.jpg", "--size", "8,8"), ".png")
     assert_bad_input(run(cli, "texture", brick, "-o", tmp_path / "o.png", "--size", "8,8", "--search", "kd"), "approx")
     assert_bad_input(run(cli, "texture", brick, "-o", tmp_path / "o.png", "--image", brick), "mask")
+
+
+# ---------------------------------------------------------------- output names and standard streams
+
+def run_bytes(cli, *args, stdin=b"", cwd=None):
+    return subprocess.run([str(cli), *map(str, args)], input=stdin, capture_output=True, timeout=300, cwd=cwd)
+
+
+def npy_from_bytes(data):
+    import io
+    import numpy as np
+    return np.load(io.BytesIO(data))
+
+
+@pytest.fixture
+def points_and_boxes(tmp_path):
+    import numpy as np
+    rng = np.random.default_rng(5)
+    p = rng.random((300, 2))
+    lo = rng.random((20, 2)) * 0.7
+    boxes = np.hstack([lo, lo + rng.random((20, 2)) * 0.5])
+    np.save(tmp_path / "p.npy", p)
+    np.save(tmp_path / "b.npy", boxes)
+    # The oracle: brute-force counts (closed boxes).
+    counts = np.array([np.all((p >= b[:2]) & (p <= b[2:]), axis=1).sum() for b in boxes])
+    return tmp_path, p, boxes, counts
+
+
+def test_table_outputs_are_written_in_the_format_their_name_says(cli, points_and_boxes):
+    import numpy as np
+    d, p, boxes, counts = points_and_boxes
+    for name, load in (("c.npy", np.load), ("c.csv", lambda f: np.loadtxt(f, delimiter=",")),
+                       ("c.txt", np.loadtxt), ("C.CSV", lambda f: np.loadtxt(f, delimiter=","))):
+        r = run(cli, "range", d / "p.npy", "--boxes", d / "b.npy", "-o", d / name)
+        assert r.returncode == 0, r.stderr
+        np.testing.assert_array_equal(load(d / name), counts)
+    for name in ("t.npy", "t.csv", "t.txt"):
+        assert run(cli, "delaunay", d / "p.npy", "-o", d / name).returncode == 0
+    tri = np.load(d / "t.npy")
+    assert tri.shape[1] == 3 and tri.dtype == np.int64
+    np.testing.assert_array_equal(np.loadtxt(d / "t.csv", delimiter=",", dtype=np.int64), tri)
+    np.testing.assert_array_equal(np.loadtxt(d / "t.txt", dtype=np.int64), tri)
+    # geods reads back what it writes.
+    assert run(cli, "info", d / "t.csv", "--json").returncode == 0
+
+
+@pytest.mark.parametrize("args,accepted", [
+    (["range", "p.npy", "--boxes", "b.npy", "-o", "c.jpg"], ".npy, .csv, .txt"),
+    (["range", "p.npy", "--boxes", "b.npy", "-o", "c"], ".npy, .csv, .txt"),
+    (["delaunay", "p.npy", "-o", "t.ply"], ".npy, .csv, .txt"),
+    (["delaunay", "p.npy", "--svg", "d.png"], ".svg"),
+    (["voronoi", "p.npy", "-o", "v.csv"], ".json"),
+    (["voronoi", "p.npy", "--svg", "v.json"], ".svg"),
+    (["edt", "m.npy", "-o", "d.csv"], ".npy"),
+    (["edt", "m.npy", "-o", "d.npy", "--indices", "i.txt"], ".npy"),
+    (["iso", "v.npy", "--iso", "0.5", "-o", "m.off"], ".ply, .obj, .stl"),
+    (["iso", "v.npy", "--iso", "0.5", "-o", "-"], ".ply, .obj, .stl"),
+    (["render", "m.ply", "-o", "r.jpg"], ".png"),
+    (["render", "m.ply", "-o", "-"], ".png"),
+    (["texture", "s.png", "--size", "8,8", "-o", "t.bmp"], ".png"),
+    (["bvh", "m.ply", "--rays", "r.npy", "-o", "h.ply"], ".npy, .csv, .txt"),
+])
+def test_unwritable_output_names_are_refused_before_any_work(cli, tmp_path, args, accepted):
+    # The inputs do not exist: the output name is refused first, before any input is read.
+    r = run(cli, *args, cwd=tmp_path)
+    assert_bad_input(r, "accepted: " + accepted)
+    assert not any(tmp_path.iterdir())
+
+
+def test_standard_output_and_input(cli, points_and_boxes, data_dir):
+    import numpy as np
+    d, p, boxes, counts = points_and_boxes
+    # "-o -": .npy bytes on stdout, the report on stderr.
+    r = run_bytes(cli, "range", d / "p.npy", "--boxes", d / "b.npy", "-o", "-")
+    assert r.returncode == 0, r.stderr
+    np.testing.assert_array_equal(npy_from_bytes(r.stdout), counts)
+    assert b"range:" in r.stderr
+    # "-" as input: .npy, CSV text (with a header) or PLY, told apart by their bytes.
+    csv = "x,y\n" + "".join(f"{x!r},{y!r}\n" for x, y in p)
+    for stdin in ((d / "p.npy").read_bytes(), csv.encode()):
+        r = run_bytes(cli, "range", "-", "--boxes", d / "b.npy", "-o", "-", stdin=stdin)
+        assert r.returncode == 0, r.stderr
+        np.testing.assert_array_equal(npy_from_bytes(r.stdout), counts)
+        r = run_bytes(cli, "info", "-", "--json", stdin=stdin)
+        assert r.returncode == 0, r.stderr
+        report = json.loads(r.stdout)
+        assert (report["kind"], report["count"], report["dim"]) == ("points", 300, 2)
+    r = run_bytes(cli, "info", "-", "--json", stdin=(data_dir / "bunny.ply").read_bytes())
+    assert json.loads(r.stdout)["triangles"] == 3674
+    # A pipeline: delaunay of stdin to stdout equals delaunay of the file.
+    r = run_bytes(cli, "delaunay", "-", "-o", "-", stdin=(d / "p.npy").read_bytes())
+    assert r.returncode == 0, r.stderr
+    assert run(cli, "delaunay", d / "p.npy", "-o", d / "t.npy").returncode == 0
+    np.testing.assert_array_equal(npy_from_bytes(r.stdout), np.load(d / "t.npy"))
+    # knn and nearest read "-" too (queries from stdin), and write .npy to "-".
+    q = p[:7] + 1e-3
+    np.save(d / "q.npy", q)
+    r = run_bytes(cli, "knn", d / "p.npy", "--queries", "-", "--k", "2", "--indices", "-", stdin=(d / "q.npy").read_bytes())
+    assert r.returncode == 0, r.stderr
+    brute = np.argsort(((q[:, None, :] - p[None, :, :]) ** 2).sum(-1), axis=1)[:, :2]
+    np.testing.assert_array_equal(npy_from_bytes(r.stdout), brute)
+    # Two outputs cannot share stdout; an empty stdin is an error, not an empty result.
+    r = run_bytes(cli, "delaunay", d / "p.npy", "-o", "-", "--svg", "-")
+    assert r.returncode == 2 and b"standard output already holds another output" in r.stderr
+    r = run_bytes(cli, "range", "-", "--boxes", d / "b.npy", stdin=b"")
+    assert r.returncode == 2 and b"standard input is empty" in r.stderr
+
+
+def test_info_reads_every_mesh_render_reads(cli, tmp_path, data_dir):
+    import gzip
+    import numpy as np
+    import geods
+    v, f = geods.read_mesh(data_dir / "bunny.ply")
+    for ext in (".stl", ".obj", ".ply", ".off"):
+        plain = tmp_path / ("m" + ext)
+        if ext == ".off":
+            plain.write_text(f"OFF\n{len(v)} {len(f)} 0\n" + "".join(f"{a} {b} {c}\n" for a, b, c in v)
+                             + "".join(f"3 {a} {b} {c}\n" for a, b, c in f))
+        else:
+            geods.write_mesh(plain, v, f)
+        packed = tmp_path / ("m" + ext + ".gz")
+        packed.write_bytes(gzip.compress(plain.read_bytes()))
+        r = run(cli, "info", packed, "--json")
+        assert r.returncode == 0, r.stderr
+        assert json.loads(r.stdout)["triangles"] == len(f)
+        r = run(cli, "render", packed, "-o", tmp_path / "r.png", "--width", "8", "--height", "8")
+        assert r.returncode == 0, r.stderr
+
+
+def test_messages_are_short_and_speak_the_users_language(cli, tmp_path, data_dir):
+    import re
+    import numpy as np
+    np.save(tmp_path / "p.npy", np.random.default_rng(1).random((20, 2)))
+    np.save(tmp_path / "b.npy", np.array([[0.0, 0.0, 1.0, 1.0]]))
+    np.save(tmp_path / "m.npy", np.ones((4, 4)))
+    cases = [
+        (["range", "p.npy", "--boxes", "b.npy", "--leaf-size", "0"], "must be an integer >= 1, got '0'"),
+        (["range", "p.npy", "--boxes", "b.npy", "--threads", "-2"], "must be an integer >= 0"),
+        (["edt", "m.npy", "-o", "d.npy", "--spacing", "1e-300,1"], "spacing 1e-300 along x"),
+        (["edt", "m.npy", "-o", "d.npy", "--spacing", "1e300,1"], "spacing 1e+300 along x"),
+        (["edt", "m.npy", "-o", "d.npy", "--spacing", "0,1"], "got 0 along x"),
+        (["bvh", data_dir / "bunny.ply", "--leaf-size", "0"], "leaf_size must be in 1..255"),
+        (["info", "/dev/null"], "/dev/null: not a regular file"),
+        (["texture", data_dir / "brick.png", "-o", "t.png", "--size", "8,8", "--eps", "-1"], "eps must be"),
+    ]
+    for args, words in cases:
+        r = run(cli, *args, cwd=tmp_path)
+        assert_bad_input(r, words)
+        line = r.stderr.strip()
+        assert not re.search(r"\d{13,}|\d\.\d{7,}", line), line          # no 300-digit numbers
+        assert "internal error" not in line and "::" not in line and "<" not in line, line
+        command = str(args[0])
+        assert not line.startswith(f"geods {command}: {command}:"), line  # the command is named once
+
+
+def test_library_messages_print_short_numbers():
+    import numpy as np
+    import geods
+    mask = np.ones((3, 3), dtype=bool)
+    with pytest.raises(ValueError, match=r"spacing 1e-300 along x"):   # was "0.000000"
+        geods.edt(mask, spacing=(1e-300, 1))
+
+
+def test_knn_and_nearest_never_write_npy_bytes_under_another_name(cli, points_and_boxes):
+    d = points_and_boxes[0]
+    for args in (["knn", "p.npy", "--queries", "p.npy", "--k", "2", "--indices", "i.jpg"],
+                 ["knn", "p.npy", "--queries", "p.npy", "--k", "2", "--distances", "x.ply"],
+                 ["nearest", "p.npy", "--queries", "p.npy", "-o", "n.png"]):
+        r = run(cli, *args, cwd=d)
+        assert_bad_input(r, "accepted: .npy")
+        assert not (d / args[-1]).exists()

@@ -1,5 +1,6 @@
 """geods io bindings: round trips, the real files of data/, malformed files."""
 import gzip
+import re
 
 import numpy as np
 import pytest
@@ -82,6 +83,103 @@ def test_images(tmp_path, data_dir):
         np.testing.assert_array_equal(geods.read_image(tmp_path / "a.png"), a)
 
 
+def test_write_png_by_dtype(tmp_path):
+    rng = np.random.default_rng(3)
+    # Floats in [0, 1] are scaled to 0..255 (white stays white, not black).
+    f = rng.random((6, 5, 3))
+    f[0, 0] = [0.0, 1.0, 0.5]
+    geods.write_png(tmp_path / "f.png", f)
+    np.testing.assert_array_equal(geods.read_image(tmp_path / "f.png"), np.rint(f * 255).astype(np.uint8))
+    geods.write_png(tmp_path / "f32.png", f.astype(np.float32))
+    assert geods.read_image(tmp_path / "f32.png")[0, 0, 1] == 255
+    # uint16 is a 16-bit PNG (read back through numpy from the raw PNG rows).
+    u = rng.integers(0, 65536, size=(4, 7), dtype=np.uint16)
+    u[0, :2] = [0, 65535]
+    geods.write_png(tmp_path / "u16.png", u)
+    assert png_16_bit_rows(tmp_path / "u16.png", 4, 7, 1).tolist() == u.tolist()
+    # Other integers and bools are written as 8-bit when every value is in 0..255.
+    i = rng.integers(0, 256, size=(3, 4), dtype=np.int64)
+    geods.write_png(tmp_path / "i.png", i)
+    np.testing.assert_array_equal(geods.read_image(tmp_path / "i.png"), i)
+    geods.write_png(tmp_path / "b.png", np.eye(3, dtype=bool))
+    np.testing.assert_array_equal(geods.read_image(tmp_path / "b.png"), np.eye(3))
+
+
+def png_16_bit_rows(path, h, w, c):
+    """The samples of a 16-bit PNG written with filter 0 rows, decoded here with zlib (an independent reader)."""
+    import struct
+    import zlib
+    data = path.read_bytes()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n"
+    pos, idat, ihdr = 8, b"", None
+    while pos < len(data):
+        (n,) = struct.unpack(">I", data[pos:pos + 4])
+        kind, body = data[pos + 4:pos + 8], data[pos + 8:pos + 8 + n]
+        assert zlib.crc32(kind + body) == struct.unpack(">I", data[pos + 8 + n:pos + 12 + n])[0]
+        if kind == b"IHDR":
+            ihdr = struct.unpack(">IIBB", body[:10])
+        elif kind == b"IDAT":
+            idat += body
+        pos += 12 + n
+    assert ihdr[:3] == (w, h, 16)
+    raw = np.frombuffer(zlib.decompress(idat), dtype=np.uint8).reshape(h, 1 + 2 * w * c)
+    assert (raw[:, 0] == 0).all()
+    return raw[:, 1:].copy().view(">u2").reshape(h, w * c)
+
+
+@pytest.mark.parametrize("image,message", [
+    (np.array([[0.5, 1.5]]), "outside [0, 1]"),
+    (np.array([[0.5, -0.01]], dtype=np.float32), "outside [0, 1]"),
+    (np.array([[0.5, np.nan]]), "outside [0, 1]"),
+    (np.array([[0.5, np.inf]]), "outside [0, 1]"),
+    (np.array([[255.0, 0.0]]), "outside [0, 1]"),   # 0..255 floats are refused, not clamped to white
+    (np.array([[1, 256]], dtype=np.int64), "outside 0..255"),
+    (np.array([[1, -1]], dtype=np.int16), "outside 0..255"),
+    (np.array([[1, 2**64 - 1]], dtype=np.uint64), "outside 0..255"),
+    (np.array([[1, 70000]], dtype=np.uint32), "outside 0..255"),
+    (np.array([[1 + 1j]]), "cannot write PNG"),
+])
+def test_write_png_refuses_values_it_would_change(tmp_path, image, message):
+    with pytest.raises(ValueError, match=re.escape(message)):
+        geods.write_png(tmp_path / "x.png", image)
+    assert not (tmp_path / "x.png").exists()
+
+
+@pytest.mark.parametrize("ext", [".ply", ".obj", ".stl"])
+def test_write_mesh_refuses_what_read_mesh_refuses(tmp_path, ext):
+    v, f = cube()
+    out = tmp_path / ("x" + ext)
+    for bad in (np.nan, np.inf, -np.inf, 1e300):
+        w = v.astype(np.float64)
+        w[5, 1] = bad
+        with pytest.raises(ValueError, match="vertex 5 has a non-finite coordinate"):
+            geods.write_mesh(out, w, f)
+        assert not out.exists()
+    for bad_index in (8, -1, 2**40):
+        g = f.copy()
+        g[3, 1] = bad_index
+        with pytest.raises(ValueError, match="out of range"):
+            geods.write_mesh(out, v, g)
+        assert not out.exists()
+    with pytest.raises(ValueError, match="integer array"):
+        geods.write_mesh(out, v, f + 0.5)   # would be truncated to other indices
+    assert not out.exists()
+    geods.write_mesh(out, v, f)
+    rv, rf = geods.read_mesh(out)
+    assert len(rf) == 12
+
+
+@pytest.mark.parametrize("ext", [".npy", ".xyz", ".csv", ".ply", ".txt"])
+def test_write_points_refuses_non_finite(tmp_path, ext):
+    p = np.random.default_rng(2).normal(size=(6, 3))
+    for bad in (np.nan, np.inf, -np.inf):
+        q = p.copy()
+        q[4, 2] = bad
+        with pytest.raises(ValueError, match="point 4 has a non-finite coordinate"):
+            geods.write_points(tmp_path / ("p" + ext), q)
+        assert not (tmp_path / ("p" + ext)).exists()
+
+
 @pytest.mark.parametrize("name,reader,content", [
     ("missing.ply", geods.read_mesh, None),
     ("empty.obj", geods.read_mesh, b""),
@@ -117,3 +215,35 @@ def test_gzip_mesh_and_bad_arguments(tmp_path):
     with pytest.raises(ValueError):
         geods.write_volume(tmp_path / "x.nrrd", np.zeros((2, 2)))
     assert issubclass(geods.Error, ValueError)
+
+
+def test_fortran_order_npy_reads_as_its_values(tmp_path):
+    rng = np.random.default_rng(4)
+    t = rng.normal(size=(7, 3))
+    np.save(tmp_path / "t.npy", np.asfortranarray(t))
+    np.testing.assert_array_equal(geods.read_table(tmp_path / "t.npy"), t)
+    np.testing.assert_array_equal(geods.read_points(tmp_path / "t.npy"), t)
+    v = rng.integers(0, 1000, size=(4, 5, 6)).astype(np.uint16)
+    np.save(tmp_path / "v.npy", np.asfortranarray(v))
+    np.testing.assert_array_equal(geods.read_volume(tmp_path / "v.npy"), v)
+
+
+def test_csv_header_only_when_no_field_is_a_number(tmp_path):
+    (tmp_path / "h.csv").write_text("x,y\n1,2\n3,4\n")
+    np.testing.assert_array_equal(geods.read_table(tmp_path / "h.csv"), [[1, 2], [3, 4]])
+    for first in ("0x10,2", "x,2", "1_000,2", "0b1,2"):
+        (tmp_path / "b.csv").write_text(first + "\n3,4\n")
+        with pytest.raises(ValueError, match="line 1: .* is not a number"):
+            geods.read_table(tmp_path / "b.csv")
+
+
+def test_off_variants(tmp_path):
+    v, f = cube()
+    body = f"{len(v)} {len(f)} 0\n"
+    for keyword, extra in (("COFF", " 255 0 0 255"), ("NOFF", " 0 0 1"), ("CNOFF", " 0 0 1 0.5 0.5 0.5 1")):
+        text = keyword + "\n" + body + "".join(f"{a} {b} {c}{extra}\n" for a, b, c in v) \
+            + "".join(f"3 {a} {b} {c} 10 20 30\n" for a, b, c in f)
+        (tmp_path / "c.off").write_text(text)
+        rv, rf = geods.read_mesh(tmp_path / "c.off")
+        np.testing.assert_array_equal(rv, v)
+        np.testing.assert_array_equal(rf, f)

@@ -144,7 +144,7 @@ EdtResult edt(const Grid3View<std::uint8_t>& mask, const EdtRequest& request) {
   std::array<double, 3> spacing{double(mask.spacing[0]), double(mask.spacing[1]), double(mask.spacing[2])};
   if (request.spacing) spacing = *request.spacing;
   for (int a = 0; a < 3; ++a) {
-    const std::string where = std::to_string(spacing[a]) + " along " + std::string(1, char('x' + a));
+    const std::string where = format_number(spacing[a]) + " along " + std::string(1, char('x' + a));
     if (!std::isfinite(spacing[a]) || !(spacing[a] > 0)) throw Error("edt: spacing must be finite and > 0, got " + where);
     // Squared distances of up to (spacing * side)^2 must neither underflow nor overflow.
     if (spacing[a] < 1e-150 || spacing[a] * double(mask.dims[a]) > 1e150)

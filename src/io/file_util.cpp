@@ -3,8 +3,10 @@
 #include <zlib.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cctype>
 #include <charconv>
+#include <cstdio>
 #include <cmath>
 #include <fstream>
 #include <limits>
@@ -15,7 +17,43 @@ namespace fs = std::filesystem;
 
 void fail(const fs::path& path, const std::string& message) { throw Error(path.string() + ": " + message); }
 
+namespace {
+
+std::atomic<bool> stdout_used{false};
+
+const std::vector<std::uint8_t>& standard_input() {
+  static const std::vector<std::uint8_t> bytes = [] {
+    std::vector<std::uint8_t> b;
+    std::uint8_t buffer[1 << 16];
+    std::size_t n = 0;
+    while ((n = std::fread(buffer, 1, sizeof(buffer), stdin)) > 0) b.insert(b.end(), buffer, buffer + n);
+    if (std::ferror(stdin)) throw Error("-: read error on standard input");
+    return b;
+  }();
+  return bytes;
+}
+
+std::string sniff(std::span<const std::uint8_t> bytes) {
+  const std::string_view text = as_text(bytes);
+  if (text.starts_with("\x93NUMPY")) return ".npy";
+  if (bytes.size() >= 2 && bytes[0] == 0x1f && bytes[1] == 0x8b) return ".gz";
+  if (text.starts_with("ply\n") || text.starts_with("ply\r\n")) return ".ply";
+  const std::string_view head = trim(text.substr(0, 64));
+  const std::string_view word = head.substr(0, head.find_first_of(" \t\r\n"));
+  if (word.size() >= 3 && word.size() <= 5 && word.ends_with("OFF")) return ".off";
+  return ".txt";
+}
+
+}  // namespace
+
+bool standard_output_used() { return stdout_used.load(); }
+
 std::vector<std::uint8_t> read_file(const fs::path& path) {
+  if (is_standard_stream(path)) {
+    const std::vector<std::uint8_t>& bytes = standard_input();
+    if (bytes.empty()) fail(path, "standard input is empty");
+    return bytes;
+  }
   std::error_code ec;
   const fs::file_status status = fs::status(path, ec);
   if (!fs::exists(status)) fail(path, "no such file");
@@ -42,6 +80,12 @@ std::vector<std::uint8_t> read_file(const fs::path& path) {
 }
 
 void write_file(const fs::path& path, std::span<const std::uint8_t> bytes) {
+  if (is_standard_stream(path)) {
+    if (stdout_used.exchange(true)) fail(path, "standard output already holds another output; give a file name");
+    if (std::fwrite(bytes.data(), 1, bytes.size(), stdout) != bytes.size() || std::fflush(stdout) != 0)
+      fail(path, "write error on standard output");
+    return;
+  }
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   if (!out) fail(path, "cannot open for writing");
   out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
@@ -54,12 +98,16 @@ void write_file(const fs::path& path, std::string_view text) {
 }
 
 std::string extension(const fs::path& path) {
+  if (is_standard_stream(path)) return sniff(standard_input());
   std::string ext = path.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
   return ext;
 }
 
+std::string output_extension(const fs::path& path) { return is_standard_stream(path) ? ".npy" : extension(path); }
+
 bool is_gzip_name(const fs::path& path, std::string* inner) {
+  if (is_standard_stream(path)) return false;
   if (extension(path) != ".gz") return false;
   if (inner) *inner = extension(path.stem());
   return true;

@@ -17,14 +17,27 @@ namespace geods::io::detail {
 /// Throws geods::Error "<path>: <message>".
 [[noreturn]] void fail(const std::filesystem::path& path, const std::string& message);
 
+/// True for the path "-": standard input for a reader, standard output for a writer.
+inline bool is_standard_stream(const std::filesystem::path& path) { return path.native() == "-"; }
+
 /// The whole file; throws for missing, unreadable or non-regular files.
+/// "-" is standard input, read to its end once and kept, so that every
+/// reader of "-" in a process sees the same bytes.
 std::vector<std::uint8_t> read_file(const std::filesystem::path& path);
-/// Writes the bytes, replacing the file; throws if it cannot.
+/// Writes the bytes, replacing the file; throws if it cannot. "-" writes to
+/// standard output, once per process (a second output there is an error).
 void write_file(const std::filesystem::path& path, std::span<const std::uint8_t> bytes);
 void write_file(const std::filesystem::path& path, std::string_view text);
+/// True once write_file wrote to standard output.
+bool standard_output_used();
 
 /// Lower-case extension with the dot (".ply"); for "x.ply.gz" it is ".gz".
+/// For "-" (standard input) the format its bytes show: ".npy" (numpy magic),
+/// ".ply" ("ply" line), ".off" (first word ending in OFF), ".gz" (gzip magic),
+/// else ".txt" (a text table).
 std::string extension(const std::filesystem::path& path);
+/// The extension a writer dispatches on: extension(path), and ".npy" for "-".
+std::string output_extension(const std::filesystem::path& path);
 /// True for a ".gz" file name; `inner` receives the extension below it (".ply").
 bool is_gzip_name(const std::filesystem::path& path, std::string* inner = nullptr);
 

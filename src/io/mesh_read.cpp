@@ -99,13 +99,25 @@ TriMesh mesh_from_off(const fs::path& path, std::string_view text) {
   Tokens tokens(text, true);
   std::string_view t;
   if (!tokens.next(t) || t.size() < 3 || t.substr(t.size() - 3) != "OFF") fail(path, "not an OFF file (wrong magic)");
-  if (t != "OFF") fail(path, "unsupported OFF variant '" + std::string(t.substr(0, 20)) + "' (plain OFF only)");
+  // Variants: ST (texture coordinates), C (colours) and N (normals) before OFF
+  // add values after each vertex's x y z, which are skipped with the rest of
+  // its line. 4OFF and nOFF (other dimensions) and binary OFF are refused.
+  const std::string_view prefix = t.substr(0, t.size() - 3);
+  const bool variant = !prefix.empty();
+  if (variant && prefix != "C" && prefix != "N" && prefix != "NC" && prefix != "CN" && prefix != "ST" &&
+      prefix != "STC" && prefix != "STN" && prefix != "STNC" && prefix != "STCN")
+    fail(path, "unsupported OFF variant '" + std::string(t.substr(0, 20)) +
+                   "' (OFF, COFF, NOFF, CNOFF and STOFF are read; 4OFF and nOFF are not)");
   auto count = [&](const std::string& what) {
     std::size_t v = 0;
     if (!tokens.next(t)) fail(path, "truncated: file ends before the " + what);
     if (!detail::parse_size(t, v)) fail(path, "malformed " + what);
     return v;
   };
+  {
+    Tokens peek = tokens;
+    if (peek.next(t) && t == "BINARY") fail(path, "binary OFF is not supported (ascii OFF only)");
+  }
   const std::size_t nv = count("vertex count"), nf = count("face count");
   count("edge count");
   // Every number takes a digit and a separator: the counts are bounded by the bytes left.
@@ -124,6 +136,7 @@ TriMesh mesh_from_off(const fs::path& path, std::string_view text) {
       mesh.vertices[i][c] = float(v);
     }
     if (!mesh.vertices[i].allFinite()) fail(path, "vertex " + std::to_string(i) + " has a non-finite coordinate");
+    if (variant) tokens.skip_line();  // normals, colours, texture coordinates
   }
   for (std::size_t f = 0; f < nf; ++f) {
     const std::size_t k = count("size of face " + std::to_string(f) + " of " + std::to_string(nf));
@@ -139,8 +152,8 @@ TriMesh mesh_from_off(const fs::path& path, std::string_view text) {
       else if (j >= 2) mesh.triangles.push_back({first, prev, std::uint32_t(v)});
       prev = std::uint32_t(v);
     }
+    tokens.skip_line();  // a face's colour, if any, ends its line: not kept
   }
-  // Anything after the faces (per-face colours) is not kept.
   if (mesh.triangles.empty()) fail(path, "no triangles");
   return mesh;
 }
@@ -330,6 +343,12 @@ TriMesh convert(const fs::path& path, const aiScene& scene) {
 }
 
 }  // namespace
+
+bool is_mesh_name(const fs::path& path) {
+  std::string ext = detail::extension(path);
+  detail::is_gzip_name(path, &ext);
+  return supported(ext);
+}
 
 TriMesh read_mesh(const fs::path& path) {
   std::string ext = detail::extension(path);

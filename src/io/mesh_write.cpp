@@ -21,8 +21,16 @@ void put(std::vector<std::uint8_t>& out, T v) {
   out.insert(out.end(), b, b + sizeof(T));
 }
 
+// Everything write_mesh refuses is found here, before a byte is written: the
+// files it writes are files read_mesh reads back.
 void check_writable(const fs::path& path, const TriMesh& mesh) {
   const std::size_t n = mesh.vertices.size();
+  for (std::size_t v = 0; v < n; ++v)
+    if (!mesh.vertices[v].allFinite())
+      fail(path, fmt::format("cannot write mesh: vertex {} has a non-finite coordinate ({:g}, {:g}, {:g})", v,
+                             mesh.vertices[v].x(), mesh.vertices[v].y(), mesh.vertices[v].z()));
+  for (std::size_t v = 0; v < mesh.normals.size(); ++v)
+    if (!mesh.normals[v].allFinite()) fail(path, fmt::format("cannot write mesh: normal {} is not finite", v));
   for (std::size_t f = 0; f < mesh.triangles.size(); ++f)
     for (std::uint32_t i : mesh.triangles[f])
       if (i >= n)
@@ -133,6 +141,7 @@ void write_stl(const fs::path& path, const TriMesh& mesh, MeshEncoding encoding)
 }  // namespace
 
 void write_mesh(const fs::path& path, const TriMesh& mesh, MeshEncoding encoding) {
+  if (detail::is_standard_stream(path)) fail(path, "meshes are written to files (.ply, .obj or .stl), not to standard output");
   check_writable(path, mesh);
   const std::string ext = detail::extension(path);
   if (ext == ".ply") write_ply(path, mesh, encoding);

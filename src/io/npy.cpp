@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <utility>
 
 #include "file_util.hpp"
+#include "geods/io/output.hpp"
 
 namespace geods::io {
 
@@ -27,7 +29,7 @@ T convert_element(S v, std::size_t index, DType from) {
   if constexpr (std::is_floating_point_v<T>) {
     if constexpr (sizeof(T) < sizeof(S) && std::is_floating_point_v<S>) {
       if (std::isfinite(v) && !detail::fits_float(double(v)))
-        throw Error("npy: element " + std::to_string(index) + " (" + std::to_string(double(v)) + ") of dtype " +
+        throw Error("npy: element " + std::to_string(index) + " (" + format_number(double(v)) + ") of dtype " +
                     std::string(dtype_name(from)) + " does not fit " + std::string(dtype_name(dtype_of<T>())));
     }
     return static_cast<T>(v);
@@ -35,7 +37,7 @@ T convert_element(S v, std::size_t index, DType from) {
     constexpr double lo = double(std::numeric_limits<T>::min());
     constexpr double hi = double(std::numeric_limits<T>::max()) + 1.0;  // exact: a power of two
     if (!(double(v) >= lo && double(v) < hi))
-      throw Error("npy: element " + std::to_string(index) + " (" + std::to_string(double(v)) + ") of dtype " +
+      throw Error("npy: element " + std::to_string(index) + " (" + format_number(double(v)) + ") of dtype " +
                   std::string(dtype_name(from)) + " does not fit " + std::string(dtype_name(dtype_of<T>())));
     return static_cast<T>(v);
   } else {
@@ -170,6 +172,31 @@ std::string descr_of(DType t) {
   return "";
 }
 
+// The elements of a Fortran-order (first index fastest) array rearranged in C
+// order (last index fastest), each `width` bytes.
+std::vector<std::uint8_t> fortran_to_c_order(const std::vector<std::uint8_t>& bytes, const std::vector<std::size_t>& shape,
+                                             std::size_t width) {
+  if (shape.size() < 2 || bytes.empty()) return bytes;
+  const std::size_t k = shape.size();
+  std::vector<std::size_t> stride(k), index(k, 0);  // Fortran strides in elements
+  stride[0] = 1;
+  for (std::size_t j = 1; j < k; ++j) stride[j] = stride[j - 1] * shape[j - 1];
+  std::vector<std::uint8_t> out(bytes.size());
+  std::size_t from = 0;  // Fortran offset of `index`
+  for (std::size_t to = 0; to < bytes.size(); to += width) {
+    std::memcpy(out.data() + to, bytes.data() + from * width, width);
+    for (std::size_t j = k; j-- > 0;) {  // next C-order index: the last one fastest
+      if (++index[j] < shape[j]) {
+        from += stride[j];
+        break;
+      }
+      from -= (shape[j] - 1) * stride[j];
+      index[j] = 0;
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 template <typename T>
@@ -239,7 +266,6 @@ NpyArray read_npy(const fs::path& path) {
     }
   }
   if (!have_descr || !have_order || !have_shape) fail(path, "malformed npy header: needs descr, fortran_order and shape");
-  if (fortran) fail(path, "Fortran-order npy arrays are not supported (save with C order, e.g. np.ascontiguousarray)");
   const Descr d = parse_descr(path, descr);
   a.dtype = d.dtype;
 
@@ -255,10 +281,13 @@ NpyArray read_npy(const fs::path& path) {
   file.erase(file.begin(), file.begin() + std::ptrdiff_t(data_start));
   a.bytes = std::move(file);
   if (d.big_endian) detail::swap_bytes(a.bytes, dtype_size(a.dtype));
+  if (fortran) a.bytes = fortran_to_c_order(a.bytes, a.shape, dtype_size(a.dtype));
   return a;
 }
 
 void write_npy(const fs::path& path, const NpyArray& array) {
+  // Another name would hold .npy bytes under a name that says otherwise.
+  check_output_extension(path, OutputKind::array);
   std::size_t count = 1;
   for (std::size_t s : array.shape) count = detail::checked_mul(path, count, s);
   if (count * dtype_size(array.dtype) != array.bytes.size())

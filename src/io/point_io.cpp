@@ -43,7 +43,12 @@ PointMatrix read_points(const fs::path& path) {
 void write_points(const fs::path& path, const PointMatrix& points) {
   const std::size_t n = std::size_t(points.rows()), dim = std::size_t(points.cols());
   if (dim != 2 && dim != 3) fail(path, "points must have 2 or 3 coordinates, not " + std::to_string(dim));
-  const std::string ext = detail::extension(path);
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t c = 0; c < dim; ++c)
+      if (!std::isfinite(points(Eigen::Index(i), Eigen::Index(c))))
+        fail(path, fmt::format("cannot write points: point {} has a non-finite coordinate ({:g} in column {})", i,
+                               points(Eigen::Index(i), Eigen::Index(c)), c));
+  const std::string ext = detail::output_extension(path);
   if (ext == ".npy") {
     write_npy<double>(path, std::span<const double>(points.data(), n * dim), {n, dim});
     return;

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "file_util.hpp"
+#include "geods/io/output.hpp"
 
 namespace geods::io {
 
@@ -128,6 +129,9 @@ std::string SvgWriter::str() const {
   return s;
 }
 
-void SvgWriter::save(const std::filesystem::path& path) const { detail::write_file(path, str()); }
+void SvgWriter::save(const std::filesystem::path& path) const {
+  check_output_extension(path, OutputKind::svg);
+  detail::write_file(path, str());
+}
 
 }  // namespace geods::io

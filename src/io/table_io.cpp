@@ -1,11 +1,14 @@
 #include "geods/io/table_io.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 
 #include "file_util.hpp"
 #include "geods/core/error.hpp"
 #include "geods/io/npy.hpp"
+#include "geods/io/output.hpp"
 #include "ply.hpp"
 
 namespace geods::io {
@@ -30,9 +33,13 @@ Table read_text_table(const fs::path& path, bool commas, bool blank_or_comma, bo
   std::string text(detail::as_text(bytes));
   if (blank_or_comma) std::replace(text.begin(), text.end(), ',', ' ');
   std::vector<detail::TextRow> rows = detail::text_rows(text, commas);
+  // A header is a first row none of whose fields is a number: "x,y" is one;
+  // "0x10,2" is a row with a bad number, reported, not dropped.
   if (header && !rows.empty()) {
     double v = 0;
-    if (!detail::parse_double(rows[0].fields[0], v)) rows.erase(rows.begin());
+    const auto& fields = rows[0].fields;
+    if (std::none_of(fields.begin(), fields.end(), [&](std::string_view f) { return detail::parse_double(f, v); }))
+      rows.erase(rows.begin());
   }
   if (rows.empty()) fail(path, "no " + row_name + "s");
   Table t;
@@ -84,7 +91,39 @@ Table read_ply_table(const fs::path& path, const std::string& row_name, std::siz
   return t;
 }
 
+template <typename T>
+void write_any_table(const fs::path& path, std::span<const T> values, const std::vector<std::size_t>& shape) {
+  check_output_extension(path, OutputKind::table);
+  if (shape.empty() || shape.size() > 2)
+    fail(path, "cannot write a table of " + std::to_string(shape.size()) + " dimensions (1 or 2)");
+  const std::size_t rows = shape[0], cols = shape.size() == 2 ? shape[1] : 1;
+  if (detail::checked_mul(path, rows, cols) != values.size())
+    fail(path, "table shape holds " + std::to_string(rows * cols) + " values, given " + std::to_string(values.size()));
+  const std::string ext = detail::output_extension(path);
+  if (ext == ".npy") return write_npy<T>(path, values, shape);
+  const char separator = ext == ".csv" ? ',' : ' ';
+  fmt::memory_buffer out;
+  for (std::size_t i = 0; i < rows; ++i) {
+    for (std::size_t c = 0; c < cols; ++c) {
+      if (c) out.push_back(separator);
+      fmt::format_to(std::back_inserter(out), "{}", values[i * cols + c]);  // shortest exact round trip
+    }
+    out.push_back('\n');
+  }
+  detail::write_file(path, std::string_view(out.data(), out.size()));
+}
+
 }  // namespace
+
+std::string input_format(const fs::path& path) { return detail::extension(path); }
+
+void write_table(const fs::path& path, std::span<const double> values, const std::vector<std::size_t>& shape) {
+  write_any_table(path, values, shape);
+}
+
+void write_table(const fs::path& path, std::span<const std::int64_t> values, const std::vector<std::size_t>& shape) {
+  write_any_table(path, values, shape);
+}
 
 Table read_table(const fs::path& path, const std::string& row_name, std::size_t cols) {
   const std::string ext = detail::extension(path);

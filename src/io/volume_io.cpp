@@ -172,7 +172,7 @@ void write_volume(const fs::path& path, const AnyGrid3& grid) {
   if (dims[0] * dims[1] * dims[2] == 0 || detail::grid_bytes(grid).size() != dims[0] * dims[1] * dims[2] * dtype_size(grid_dtype(grid)))
     fail(path, "cannot write a volume whose data does not match its dimensions " + std::to_string(dims[0]) + "x" +
                    std::to_string(dims[1]) + "x" + std::to_string(dims[2]));
-  std::string ext = detail::extension(path);
+  std::string ext = detail::output_extension(path);
   if (detail::is_gzip_name(path, &ext) && ext == ".nii") return detail::write_nifti(path, grid);
   if (ext == ".npy") return write_npy_volume(path, grid);
   if (ext == ".nrrd") return detail::write_nrrd(path, grid);

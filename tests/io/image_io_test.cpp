@@ -2,6 +2,8 @@
 
 #include <zlib.h>
 
+#include <cmath>
+
 #include "io_test_util.hpp"
 
 namespace geods::io {
@@ -57,6 +59,45 @@ TEST(ImageIo, PngRoundTripEveryChannelCount) {
     ASSERT_EQ(r16.size(), im.size());
     for (std::size_t i = 0; i < im.size(); ++i) EXPECT_EQ(r16.data[i], im.data[i] * 257);
   }
+}
+
+TEST(ImageIo, SixteenBitPngRoundTripEveryChannelCount) {
+  TempDir dir;
+  for (std::size_t c = 1; c <= 4; ++c) {
+    Image<std::uint16_t> im(9, 4, c);
+    // Every byte value in both halves of the samples, and the extremes.
+    for (std::size_t i = 0; i < im.size(); ++i) im.data[i] = std::uint16_t(i * 40503u % 65536u);
+    im.data[0] = 0;
+    im.data[1] = 65535;
+    write_png(dir / "p16.png", im);
+    EXPECT_EQ(image_bit_depth(dir / "p16.png"), 16);
+    const auto r = read_image16(dir / "p16.png");
+    EXPECT_EQ(r.width, 9u);
+    EXPECT_EQ(r.height, 4u);
+    EXPECT_EQ(r.channels, c);
+    EXPECT_EQ(r.data, im.data);
+  }
+}
+
+TEST(ImageIo, FloatPngScalesTheUnitIntervalAndRefusesTheRest) {
+  TempDir dir;
+  Image<float> im(5, 3, 2);
+  for (std::size_t i = 0; i < im.size(); ++i) im.data[i] = float(i) / float(im.size() - 1);
+  write_png(dir / "f.png", im);
+  const auto r = read_image(dir / "f.png");
+  ASSERT_EQ(r.size(), im.size());
+  for (std::size_t i = 0; i < im.size(); ++i) EXPECT_EQ(r.data[i], std::lround(double(im.data[i]) * 255.0)) << i;
+  EXPECT_EQ(r.data.back(), 255);  // 1.0 is white, not black
+  Image<double> d(2, 1, 1);
+  d.data = {0.5, 1.0};
+  write_png(dir / "d.png", d);
+  EXPECT_EQ(read_image(dir / "d.png").data, (std::vector<std::uint8_t>{128, 255}));
+  for (const double bad : {1.0000001, -1e-300, std::nan(""), 255.0, 1e300}) {
+    d.data = {0.25, bad};
+    expect_error(dir / "bad.png", [&] { write_png(dir / "bad.png", d); }, "outside [0, 1]");
+    EXPECT_FALSE(std::filesystem::exists(dir / "bad.png"));
+  }
+  expect_error(dir / "bad.png", [&] { write_png(dir / "bad.png", Image<float>(2, 2, 5)); }, "channels");
 }
 
 TEST(ImageIo, ReadsSixteenBitPngAndRealFile) {

@@ -3,6 +3,7 @@
 #include <zlib.h>
 
 #include <cmath>
+#include <limits>
 
 #include "io_test_util.hpp"
 
@@ -68,6 +69,43 @@ TEST(MeshIo, ReadsRealFiles) {
   const TriMesh teapot = read_mesh(test::data_file("teapot.obj"));
   EXPECT_EQ(teapot.num_triangles(), 992u);
   EXPECT_TRUE(teapot.validate().valid());
+}
+
+// COFF, NOFF, CNOFF and STOFF carry values after x y z; faces may end in a colour.
+// The oracle: the same square as plain OFF, read by the strict parser.
+TEST(MeshIo, ReadsOffVariantsIgnoringColoursAndNormals) {
+  TempDir dir;
+  test::write_text(dir / "plain.off", "OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n");
+  const TriMesh plain = read_mesh(dir / "plain.off");
+  const std::pair<const char*, const char*> variants[] = {
+      {"COFF", "0 0 0 255 0 0 255\n1 0 0 0 255 0 255\n1 1 0 0 0 255 255\n0 1 0 9 9 9 255\n"},
+      {"NOFF", "0 0 0 0 0 1\n1 0 0 0 0 1\n1 1 0 0 0 1\n0 1 0 0 0 1\n"},
+      {"CNOFF", "0 0 0 0 0 1 1 0 0 1\n1 0 0 0 0 1 1 0 0 1\n1 1 0 0 0 1 1 0 0 1\n0 1 0 0 0 1 1 0 0 1\n"},
+      {"STOFF", "0 0 0 0 0\n1 0 0 1 0\n1 1 0 1 1\n0 1 0 0 1\n"},
+  };
+  for (const auto& [keyword, vertices] : variants) {
+    // Face colours (3 or 4 values, ints or floats) end the face lines.
+    test::write_text(dir / "v.off", std::string(keyword) + "\n4 2 0\n" + vertices + "3 0 1 2 255 0 0\n3 0 2 3 0.5 0.5 0.5 1\n");
+    const TriMesh m = read_mesh(dir / "v.off");
+    EXPECT_EQ(m.vertices, plain.vertices) << keyword;
+    EXPECT_EQ(m.triangles, plain.triangles) << keyword;
+  }
+  // Plain OFF with face colours: the colours used to be read as the next face's size.
+  test::write_text(dir / "fc.off", "OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2 3 1 2\n3 0 2 3 200 200 200\n");
+  EXPECT_EQ(read_mesh(dir / "fc.off").triangles, plain.triangles);
+  test::write_text(dir / "4d.off", "4OFF\n3 1 0\n0 0 0 0\n1 0 0 0\n0 1 0 0\n3 0 1 2\n");
+  expect_error(dir / "4d.off", [&] { read_mesh(dir / "4d.off"); }, "4OFF");
+  test::write_text(dir / "b.off", "OFF BINARY\n");
+  expect_error(dir / "b.off", [&] { read_mesh(dir / "b.off"); }, "binary OFF");
+  // A COFF whose vertex lines are short is an error, not a shifted mesh.
+  test::write_text(dir / "short.off", "COFF\n3 1 0\n0 0\n1 0 0 1 1 1\n0 1 0 1 1 1\n3 0 1 2\n");
+  expect_error(dir / "short.off", [&] { read_mesh(dir / "short.off"); });
+}
+
+TEST(MeshIo, MeshNamesIncludeEveryGzipMesh) {
+  for (const char* name : {"a.ply", "a.OBJ", "a.stl", "a.off", "a.gltf", "a.glb", "a.stl.gz", "a.obj.gz", "a.ply.gz", "a.off.gz"})
+    EXPECT_TRUE(is_mesh_name(name)) << name;
+  for (const char* name : {"a.nii.gz", "a.gz", "a.npy", "a.png", "a", "a.csv"}) EXPECT_FALSE(is_mesh_name(name)) << name;
 }
 
 TEST(MeshIo, ReadsOffGzipAndGltf) {
@@ -190,6 +228,24 @@ TEST(MeshIo, WriterRejectsBadMeshes) {
   expect_error(dir / "x.ply", [&] { write_mesh(dir / "x.ply", m); }, "out of range");
   expect_error(dir / "x.off", [&] { write_mesh(dir / "x.off", cube()); }, "unsupported");
   expect_error(dir / "nodir" / "x.ply", [&] { write_mesh(dir / "nodir" / "x.ply", cube()); });
+  // Meshes read_mesh would refuse are refused before anything is written, in every format.
+  const float inf = std::numeric_limits<float>::infinity();
+  for (const char* name : {"x.ply", "x.obj", "x.stl"}) {
+    for (const Vec3f bad : {Vec3f(0, std::nanf(""), 0), Vec3f(inf, 0, 0), Vec3f(0, 0, -inf)}) {
+      TriMesh nan = cube();
+      nan.vertices[5] = bad;
+      expect_error(dir / name, [&] { write_mesh(dir / name, nan); }, "vertex 5 has a non-finite coordinate");
+      EXPECT_FALSE(std::filesystem::exists(dir / name));
+    }
+    TriMesh normals = cube();
+    normals.normals.assign(8, Vec3f(0, 0, 1));
+    normals.normals[2].x() = std::nanf("");
+    expect_error(dir / name, [&] { write_mesh(dir / name, normals); }, "normal 2");
+    TriMesh index = cube();
+    index.triangles[3][1] = 8;
+    expect_error(dir / name, [&] { write_mesh(dir / name, index, MeshEncoding::ascii); }, "out of range");
+    EXPECT_FALSE(std::filesystem::exists(dir / name));
+  }
 }
 
 }  // namespace

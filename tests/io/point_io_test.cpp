@@ -1,5 +1,8 @@
 #include "geods/io/point_io.hpp"
 
+#include <cmath>
+#include <limits>
+
 #include "geods/io/npy.hpp"
 #include "io_test_util.hpp"
 
@@ -129,6 +132,15 @@ TEST(PointIo, MalformedFilesThrowNamingTheFile) {
   PointMatrix four(1, 4);
   four.setZero();
   expect_error(dir / "four.xyz", [&] { write_points(dir / "four.xyz", four); }, "2 or 3");
+  // Non-finite points are refused before anything is written (read_points would refuse the file).
+  for (const char* name : {"out.npy", "out.xyz", "out.csv", "out.ply", "out.txt"}) {
+    for (const double bad : {std::nan(""), std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()}) {
+      PointMatrix p = sample(2);
+      p(3, 1) = bad;
+      expect_error(dir / name, [&] { write_points(dir / name, p); }, "point 3 has a non-finite coordinate");
+      EXPECT_FALSE(std::filesystem::exists(dir / name));
+    }
+  }
 }
 
 }  // namespace

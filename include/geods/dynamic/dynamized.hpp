@@ -106,7 +106,7 @@ class Dynamized {
     if (options.variant == Variant::worst_case && !SteppedBuild<S>)
       throw Error("Dynamized: the worst-case variant needs a structure whose build runs in steps");
     if (!(options.max_dead_fraction > 0 && options.max_dead_fraction < 1))
-      throw Error("Dynamized: max_dead_fraction must lie in (0, 1), got " + std::to_string(options.max_dead_fraction));
+      throw Error("Dynamized: max_dead_fraction must lie in (0, 1), got " + format_number(options.max_dead_fraction));
   }
 
   const DynamizeOptions& options() const { return options_; }

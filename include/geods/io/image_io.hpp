@@ -1,5 +1,5 @@
 #pragma once
-// Reading and writing images (stb).
+// Reading and writing images (stb; 16-bit PNG written with zlib).
 #include <cstdint>
 #include <filesystem>
 
@@ -18,5 +18,12 @@ Image<std::uint16_t> read_image16(const std::filesystem::path& path);
 
 /// Writes an 8-bit PNG with 1 to 4 channels.
 void write_png(const std::filesystem::path& path, const Image<std::uint8_t>& image);
+/// Writes a 16-bit PNG with 1 to 4 channels (samples as they are, 0..65535).
+void write_png(const std::filesystem::path& path, const Image<std::uint16_t>& image);
+/// Writes an 8-bit PNG of samples in [0, 1]: each is written as round(v * 255).
+/// Throws geods::Error naming the first sample that is NaN or outside [0, 1]
+/// (nothing is clamped; scale or clip the image first).
+void write_png(const std::filesystem::path& path, const Image<float>& image);
+void write_png(const std::filesystem::path& path, const Image<double>& image);
 
 }  // namespace geods::io

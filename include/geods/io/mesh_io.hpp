@@ -15,6 +15,11 @@ namespace geods::io {
 /// coordinates); counts are checked against the file size before allocating.
 TriMesh read_mesh(const std::filesystem::path& path);
 
+/// True if read_mesh reads `path` by its name: .ply, .obj, .stl, .off, .gltf,
+/// .glb, or one of them gzip-compressed (.stl.gz). `geods info` and every
+/// command that reads meshes decide with it.
+bool is_mesh_name(const std::filesystem::path& path);
+
 enum class MeshEncoding { binary, ascii };
 
 /// Writes PLY, OBJ or STL by the file's extension. PLY and STL honour the

@@ -45,7 +45,7 @@ class SvgWriter {
   double width() const { return width_; }
   double height() const { return height_; }
   std::string str() const;
-  void save(const std::filesystem::path& path) const;
+  void save(const std::filesystem::path& path) const;  // a .svg file, or "-" for standard output
 
  private:
   Vec2d map(const Vec2d& p) const;

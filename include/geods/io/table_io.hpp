@@ -2,6 +2,7 @@
 // Tables of numbers, n rows of d columns: the one reader behind read_points,
 // read_segments and every input of the CLI.
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <span>
 #include <string>
@@ -24,9 +25,11 @@ struct Table {
 };
 
 /// Reads a table by extension: .npy (a 2-D array of any numeric dtype), .csv
-/// (comma-separated; a first line that does not start with a number is a
-/// header), .txt (numbers separated by blanks or commas, a header allowed),
-/// .xyz (separated by blanks) or .ply (the vertices' x, y and z if present).
+/// (comma-separated; a first line none of whose fields is a number is a
+/// header, skipped), .txt (numbers separated by blanks or commas, a header
+/// allowed), .xyz (separated by blanks) or .ply (the vertices' x, y and z if
+/// present); "-" reads standard input in the format input_format sniffs.
+/// Numbers are decimal or scientific ("12", "-1.5e-3"): "0x10" is not one.
 /// In text files blank lines and lines starting with '#' are skipped and
 /// every row has as many numbers as the first. `row_name` names a row in
 /// messages ("point" gives "no points", "point 3 has a non-finite value").
@@ -34,5 +37,21 @@ struct Table {
 /// Throws geods::Error naming the file (and the line) for malformed input,
 /// non-finite values or no rows.
 Table read_table(const std::filesystem::path& path, const std::string& row_name = "row", std::size_t cols = 0);
+
+/// The lower-case extension readers dispatch on (".ply"; ".gz" for "x.ply.gz");
+/// for "-", standard input, the format its bytes show: ".npy" (numpy magic),
+/// ".ply" (a "ply" line), ".off" (an OFF keyword), ".gz" (gzip magic), else
+/// ".txt" (a text table: blanks or commas, a header line allowed).
+std::string input_format(const std::filesystem::path& path);
+
+/// Writes a 1-D (n,) or 2-D (n, d) array of the given shape by extension: .npy
+/// (float64 or int64, as given), .csv (comma-separated, no header) or .txt
+/// (blank-separated), one row per line; "-" writes .npy to standard output.
+/// Text holds each value's shortest exact form, "inf" for infinities. Any
+/// other extension is an error naming the accepted ones (io::check_output_extension
+/// with OutputKind::table checks a name before the work that fills the table).
+void write_table(const std::filesystem::path& path, std::span<const double> values, const std::vector<std::size_t>& shape);
+void write_table(const std::filesystem::path& path, std::span<const std::int64_t> values,
+                 const std::vector<std::size_t>& shape);
 
 }  // namespace geods::io
