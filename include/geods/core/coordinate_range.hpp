@@ -35,9 +35,6 @@ T extent_floor(int degree) {
   return std::ldexp(T(1), -(-min_exponent / degree) + std::numeric_limits<T>::digits);
 }
 
-/// A number for a message: six significant digits ("1e+300", not 300 digits).
-std::string short_number(double value);
-
 /// Checks that n points of `dim` coordinates (row i at coords[i * stride])
 /// fit the range of polynomials of `degree` in T: every |coordinate| at most
 /// coordinate_limit, and the bounding box's largest extent zero or at least
@@ -54,8 +51,8 @@ void check_coordinate_range(const T* coords, std::size_t n, std::size_t dim, std
     for (std::size_t i = 0; i < n; ++i) {
       const T x = coords[i * stride + a];
       if (std::abs(x) > limit)
-        throw Error(what + ": coordinate " + short_number(double(x)) + " of point " + std::to_string(i) +
-                    " is beyond +-" + short_number(double(limit)) + ", where its distances would overflow; " +
+        throw Error(what + ": coordinate " + format_number(double(x)) + " of point " + std::to_string(i) +
+                    " is beyond +-" + format_number(double(limit)) + ", where its distances would overflow; " +
                     "scale the input");
       lo = x < lo ? x : lo;
       hi = x > hi ? x : hi;
@@ -63,8 +60,8 @@ void check_coordinate_range(const T* coords, std::size_t n, std::size_t dim, std
     extent = hi - lo > extent ? hi - lo : extent;
   }
   if (extent > 0 && extent < extent_floor<T>(degree))
-    throw Error(what + ": the points span only " + short_number(double(extent)) + " (below " +
-                short_number(double(extent_floor<T>(degree))) + "), where their distances underflow; scale the input");
+    throw Error(what + ": the points span only " + format_number(double(extent)) + " (below " +
+                format_number(double(extent_floor<T>(degree))) + "), where their distances underflow; scale the input");
 }
 
 /// Checks one query point against coordinate_limit (a far query's distances
@@ -74,8 +71,8 @@ void check_query_range(std::span<const T> q, int degree, const char* what) {
   const T limit = coordinate_limit<T>(degree);
   for (T x : q)
     if (std::abs(x) > limit)
-      throw Error(std::string(what) + ": query coordinate " + short_number(double(x)) + " is beyond +-" +
-                  short_number(double(limit)) + ", where its distances would overflow");
+      throw Error(std::string(what) + ": query coordinate " + format_number(double(x)) + " is beyond +-" +
+                  format_number(double(limit)) + ", where its distances would overflow");
 }
 
 }  // namespace geods
