@@ -1,6 +1,8 @@
 #pragma once
 // Reading and writing triangle meshes.
+#include <cstdint>
 #include <filesystem>
+#include <span>
 
 #include "geods/core/tri_mesh.hpp"
 
@@ -14,6 +16,15 @@ namespace geods::io {
 /// malformed, truncated, no triangles, out-of-range indices, non-finite
 /// coordinates); counts are checked against the file size before allocating.
 TriMesh read_mesh(const std::filesystem::path& path);
+
+/// Reads a mesh from the bytes of a file called `name` (say a member of a zip
+/// archive): its extension picks the format as in read_mesh, and errors name
+/// it. Side files (OBJ materials, glTF buffers) are not looked for; the
+/// geometry of an OBJ does not need them.
+TriMesh read_mesh_from_memory(std::span<const std::uint8_t> bytes, const std::filesystem::path& name);
+
+/// Whether read_mesh reads files of this name (by its extension, .gz allowed).
+bool is_mesh_file(const std::filesystem::path& path);
 
 enum class MeshEncoding { binary, ascii };
 
