@@ -232,12 +232,12 @@ std::vector<float> shape_distribution(const TriMesh& mesh, ShapeFunction f, cons
 
 // ---------------------------------------------------------------- similarity
 
-double distance(std::span<const float> a, std::span<const float> b, Metric metric, std::size_t block) {
+double histogram_distance(std::span<const float> a, std::span<const float> b, Metric metric, std::size_t block) {
   if (a.size() != b.size())
-    throw Error(fmt::format("shape::distance: histograms of {} and {} bins", a.size(), b.size()));
+    throw Error(fmt::format("shape::histogram_distance: histograms of {} and {} bins", a.size(), b.size()));
   if (block == 0) block = a.size();
   if (!a.empty() && a.size() % block != 0)
-    throw Error(fmt::format("shape::distance: blocks of {} do not divide {} bins", block, a.size()));
+    throw Error(fmt::format("shape::histogram_distance: blocks of {} do not divide {} bins", block, a.size()));
   double sum = 0;
   switch (metric) {
     case Metric::l1:
@@ -262,7 +262,7 @@ double distance(std::span<const float> a, std::span<const float> b, Metric metri
       return sum;
     }
   }
-  throw Error("shape::distance: bad metric");
+  throw Error("shape::histogram_distance: bad metric");
 }
 
 // ---------------------------------------------------------------- descriptors

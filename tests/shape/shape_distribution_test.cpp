@@ -23,7 +23,7 @@ using testing::cube;
 using testing::cylinder;
 using testing::icosphere;
 
-double l1(const std::vector<float>& a, const std::vector<float>& b) { return distance(a, b, Metric::l1); }
+double l1(const std::vector<float>& a, const std::vector<float>& b) { return histogram_distance(a, b, Metric::l1); }
 
 // ---------------------------------------------------------------- oracle: analytic surfaces
 using Sampler = std::function<Vec3d(std::mt19937_64&)>;
@@ -258,16 +258,16 @@ TEST(ShapeDistribution, InvariantToRigidMotionScaleAndTessellation) {
 // ---------------------------------------------------------------- distances
 TEST(Distance, DefinitionsOnSmallHistograms) {
   const std::vector<float> a{0.5f, 0.25f, 0.25f, 0.0f}, b{0.0f, 0.25f, 0.25f, 0.5f};
-  EXPECT_NEAR(distance(a, b, Metric::l1), 1.0, 1e-7);
-  EXPECT_NEAR(distance(a, b, Metric::l2), std::sqrt(0.5), 1e-7);
-  EXPECT_NEAR(distance(a, b, Metric::chi2), 0.25 / 0.5 + 0.25 / 0.5, 1e-7);
+  EXPECT_NEAR(histogram_distance(a, b, Metric::l1), 1.0, 1e-7);
+  EXPECT_NEAR(histogram_distance(a, b, Metric::l2), std::sqrt(0.5), 1e-7);
+  EXPECT_NEAR(histogram_distance(a, b, Metric::chi2), 0.25 / 0.5 + 0.25 / 0.5, 1e-7);
   // Half the mass moves 3 bins: EMD 1.5 bins.
-  EXPECT_NEAR(distance(a, b, Metric::emd), 1.5, 1e-7);
-  EXPECT_EQ(distance(a, a, Metric::emd), 0.0);
+  EXPECT_NEAR(histogram_distance(a, b, Metric::emd), 1.5, 1e-7);
+  EXPECT_EQ(histogram_distance(a, a, Metric::emd), 0.0);
   // Blocks: two distributions of two bins; each moves all its mass one bin.
-  EXPECT_NEAR(distance(std::vector<float>{1, 0, 1, 0}, std::vector<float>{0, 1, 0, 1}, Metric::emd, 2), 2.0, 1e-7);
-  EXPECT_THROW(distance(a, std::vector<float>{1, 0}, Metric::l1), Error);
-  EXPECT_THROW(distance(a, b, Metric::emd, 3), Error);
+  EXPECT_NEAR(histogram_distance(std::vector<float>{1, 0, 1, 0}, std::vector<float>{0, 1, 0, 1}, Metric::emd, 2), 2.0, 1e-7);
+  EXPECT_THROW(histogram_distance(a, std::vector<float>{1, 0}, Metric::l1), Error);
+  EXPECT_THROW(histogram_distance(a, b, Metric::emd, 3), Error);
   EXPECT_THROW(parse_metric("cosine"), Error);
 }
 
@@ -301,7 +301,7 @@ TEST(Distance, EmdEqualsOptimalTransportOnRandomHistograms) {
     std::vector<float> fa(n), fb(n);
     for (std::size_t i = 0; i < n; ++i) a[i] /= sa, b[i] /= sb, fa[i] = float(a[i]), fb[i] = float(b[i]);
     std::vector<double> da(fa.begin(), fa.end()), db(fb.begin(), fb.end());
-    EXPECT_NEAR(distance(fa, fb, Metric::emd), transport_cost(da, db), 1e-5) << "trial " << trial;
+    EXPECT_NEAR(histogram_distance(fa, fb, Metric::emd), transport_cost(da, db), 1e-5) << "trial " << trial;
   }
 }
 

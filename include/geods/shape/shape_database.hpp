@@ -5,10 +5,12 @@
 // in the Euclidean distance of the feature vectors.
 //
 // The vectors live in a dynamic::DynamicKdTree (the logarithmic method over
-// static spatial::KdTree blocks, seed §7): a batch of shapes added at once is
-// one block built in parallel (add with many meshes, or add_descriptors), and
-// shapes added later go through the dynamization (O(log^2 n) amortized per
-// shape) rather than a rebuild. Ids are 0, 1, 2, ... in the order of adding.
+// static spatial::KdTree blocks, seed §7): a batch of shapes added at once
+// (add with many meshes, or add_descriptors) is described in parallel and
+// inserted in one go (the blocks of the binary representation of its size, the
+// large ones built in parallel); shapes added later go through the
+// dynamization (O(log^2 n) amortized per shape) rather than a rebuild. Ids are
+// 0, 1, 2, ... in the order of adding.
 //
 // Files: save() writes a "shape.ShapeDatabase" archive (core/archive.hpp): the
 // descriptor options, names and labels, and the dynamic tree's sections under

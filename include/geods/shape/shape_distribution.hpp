@@ -119,7 +119,7 @@ Metric parse_metric(std::string_view name);
 /// cumulative histograms (in bins). For a combined descriptor give `block`, the
 /// bins per distribution: the cumulative sums restart at every block. Throws
 /// geods::Error for different lengths or a block that does not divide them.
-double distance(std::span<const float> a, std::span<const float> b, Metric metric, std::size_t block = 0);
+double histogram_distance(std::span<const float> a, std::span<const float> b, Metric metric, std::size_t block = 0);
 
 // ---------------------------------------------------------------- descriptors
 
