@@ -368,3 +368,28 @@ TEST(ShapeDistribution, BadInputThrows) {
 
 }  // namespace
 }  // namespace geods::shape
+
+namespace geods::shape {
+namespace {
+
+TEST(AnalyticShapes, ClosedManifoldsOfTheRightArea) {
+  const double pi = std::numbers::pi;
+  const struct {
+    const char* name;
+    TriMesh mesh;
+    double area, tolerance;
+  } shapes[] = {{"icosphere", icosphere(4, 2), 4 * pi * 4, 0.01},
+                {"box", box_mesh(1, 2, 3), 2 * (2 + 6 + 3), 1e-6},
+                {"cylinder", cylinder_mesh(256, 1, 2), 2 * pi * 2 + 2 * pi, 0.001},
+                {"torus", torus_mesh(3, 1, 128, 64), 4 * pi * pi * 3, 0.002}};
+  for (const auto& s : shapes) {
+    EXPECT_TRUE(s.mesh.validate().closed_manifold()) << s.name;
+    EXPECT_GT(s.mesh.signed_volume(), 0) << s.name << " is inside out";
+    EXPECT_NEAR(s.mesh.surface_area() / s.area, 1.0, s.tolerance) << s.name;
+  }
+  EXPECT_THROW(cylinder_mesh(2), Error);
+  EXPECT_THROW(torus_mesh(1, 0.5f, 2, 8), Error);
+}
+
+}  // namespace
+}  // namespace geods::shape

@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "geods/core/tri_mesh.hpp"
+#include "geods/shape/analytic_shapes.hpp"
 
 namespace geods::shape::testing {
 
@@ -31,49 +32,9 @@ inline TriMesh subdivide(const TriMesh& m) {
   return out;
 }
 
-// Icosahedron subdivided `levels` times, vertices pushed onto the sphere of radius r.
-inline TriMesh icosphere(int levels, float r = 1) {
-  const float p = (1 + std::sqrt(5.0f)) / 2;
-  TriMesh m;
-  m.vertices = {{-1, p, 0}, {1, p, 0}, {-1, -p, 0}, {1, -p, 0}, {0, -1, p}, {0, 1, p},
-                {0, -1, -p}, {0, 1, -p}, {p, 0, -1}, {p, 0, 1}, {-p, 0, -1}, {-p, 0, 1}};
-  m.triangles = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
-                 {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
-                 {3, 8, 9},  {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
-  for (int i = 0; i < levels; ++i) m = subdivide(m);
-  for (auto& v : m.vertices) v = v.normalized() * r;
-  return m;
-}
-
-// Axis-aligned cube [0, s]^3 of 12 triangles.
-inline TriMesh cube(float s = 1) {
-  TriMesh m;
-  for (int i = 0; i < 8; ++i) m.vertices.push_back({s * float(i & 1), s * float((i >> 1) & 1), s * float((i >> 2) & 1)});
-  m.triangles = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
-                 {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
-  return m;
-}
-
-// Closed cylinder of radius r and height h around the z axis, `segments` facets.
-inline TriMesh cylinder(int segments, float r = 1, float h = 2) {
-  TriMesh m;
-  for (int i = 0; i < segments; ++i) {
-    const float a = 2 * std::numbers::pi_v<float> * float(i) / float(segments);
-    m.vertices.push_back({r * std::cos(a), r * std::sin(a), 0});
-    m.vertices.push_back({r * std::cos(a), r * std::sin(a), h});
-  }
-  const auto bottom = std::uint32_t(m.vertices.size());
-  m.vertices.push_back({0, 0, 0});
-  m.vertices.push_back({0, 0, h});
-  for (int i = 0; i < segments; ++i) {
-    const auto a = std::uint32_t(2 * i), b = std::uint32_t(2 * ((i + 1) % segments));
-    m.triangles.push_back({a, b, a + 1});
-    m.triangles.push_back({b, b + 1, a + 1});
-    m.triangles.push_back({bottom, b, a});
-    m.triangles.push_back({bottom + 1, a + 1, b + 1});
-  }
-  return m;
-}
+using shape::icosphere;
+inline TriMesh cube(float s = 1) { return shape::box_mesh(s, s, s); }
+inline TriMesh cylinder(int segments, float r = 1, float h = 2) { return shape::cylinder_mesh(segments, r, h); }
 
 // x -> scale * R x + t.
 inline TriMesh transformed(TriMesh m, const Eigen::Matrix3f& rotation, const Vec3f& t, float scale) {
