@@ -90,24 +90,35 @@ SurfaceSampler::SurfaceSampler(const TriMesh& mesh) {
   if (n >= std::numeric_limits<std::uint32_t>::max()) throw Error("shape: too many triangles");
   for (std::size_t i = 0; i < nv; ++i)
     if (!mesh.vertices[i].allFinite()) throw Error(fmt::format("shape: vertex {} has a non-finite coordinate", i));
-  a_.resize(n);
-  ab_.resize(n);
-  ac_.resize(n);
+  corners_.resize(n);
   std::vector<double> weight(n);
+  std::vector<char> bad(n, 0);
+  // Per triangle in parallel (independent); the sums below run in order, so the result is deterministic.
+  parallel_for(0, n, 4096, [&](std::size_t b, std::size_t e) {
+    for (std::size_t t = b; t < e; ++t) {
+      const auto& tri = mesh.triangles[t];
+      if (tri[0] >= nv || tri[1] >= nv || tri[2] >= nv) {
+        bad[t] = 1;
+        continue;
+      }
+      const Vec3f& a = mesh.vertices[tri[0]];
+      corners_[t] = {a, mesh.vertices[tri[1]] - a, mesh.vertices[tri[2]] - a};
+      const Vec3d ab = (mesh.vertices[tri[1]].cast<double>() - a.cast<double>());
+      const Vec3d ac = (mesh.vertices[tri[2]].cast<double>() - a.cast<double>());
+      weight[t] = 0.5 * ab.cross(ac).norm();
+    }
+  });
+  if (const auto it = std::find(bad.begin(), bad.end(), 1); it != bad.end()) {
+    const std::size_t t = std::size_t(it - bad.begin());
+    const auto& tri = mesh.triangles[t];
+    const std::uint32_t corner = tri[0] >= nv ? tri[0] : tri[1] >= nv ? tri[1] : tri[2];
+    throw Error(fmt::format("shape: triangle {} has corner {} out of range ({} vertices)", t, corner, nv));
+  }
   Vec3d weighted = Vec3d::Zero();
   for (std::size_t t = 0; t < n; ++t) {
-    const auto& tri = mesh.triangles[t];
-    for (int c = 0; c < 3; ++c)
-      if (tri[c] >= nv)
-        throw Error(fmt::format("shape: triangle {} has corner {} out of range ({} vertices)", t, tri[c], nv));
-    const Vec3d a = mesh.vertices[tri[0]].cast<double>(), b = mesh.vertices[tri[1]].cast<double>(),
-                c = mesh.vertices[tri[2]].cast<double>();
-    a_[t] = a;
-    ab_[t] = b - a;
-    ac_[t] = c - a;
-    weight[t] = 0.5 * ab_[t].cross(ac_[t]).norm();
+    const auto& c = corners_[t];
     area_ += weight[t];
-    weighted += weight[t] * (a + b + c) / 3.0;
+    weighted += weight[t] * (c.a.cast<double>() + (c.ab.cast<double>() + c.ac.cast<double>()) / 3.0);
   }
   if (!(area_ > 0) || !std::isfinite(area_)) throw Error("shape: the mesh's surface has zero area");
   centroid_ = weighted / area_;
@@ -146,7 +157,8 @@ Vec3d SurfaceSampler::sample(Rng& rng) const {
   std::size_t t = std::min(std::size_t(u), prob_.size() - 1);
   if (u - double(t) >= prob_[t]) t = alias_[t];
   const double s = std::sqrt(rng.uniform()), r2 = rng.uniform();
-  return a_[t] + s * (1.0 - r2) * ab_[t] + s * r2 * ac_[t];
+  const Corner& c = corners_[t];
+  return c.a.cast<double>() + s * (1.0 - r2) * c.ab.cast<double>() + s * r2 * c.ac.cast<double>();
 }
 
 std::uint64_t chunk_seed(std::uint64_t seed, std::uint64_t chunk) {
