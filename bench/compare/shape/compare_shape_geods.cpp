@@ -11,14 +11,13 @@ namespace {
 
 using namespace geods;
 
-void describe_variant(const compare::Args& args, const shape_bench::Size& size) {
-  const TriMesh mesh = shape_bench::torus(size);
+void describe_variant(const compare::Args& args, const std::string& variant, const TriMesh& mesh) {
   const shape::DescriptorOptions options;  // d2, 65536 samples, 64 bins
   std::vector<float> d;
   const double s = compare::median_time_s(args.reps, [&] { d = shape::describe(mesh, options); });
   double sum = 0;
   for (float v : d) sum += v;
-  compare::Record("shape", "geods", size.variant, args.threads)
+  compare::Record("shape", "geods", variant, args.threads)
       .timing(0, s, 1, args.reps)
       .set("triangles", static_cast<unsigned long long>(mesh.triangles.size()))
       .print(std::abs(sum - 1) < 1e-4);
@@ -127,8 +126,7 @@ void query_variants(const compare::Args& args) {
 int main(int argc, char** argv) {
   const compare::Args args = compare::parse_args(argc, argv);
   const compare::ThreadLimit limit(args.threads);
-  for (const auto& size : shape_bench::kSizes)
-    if (args.wants(size.variant)) describe_variant(args, size);
+  for (const auto& [variant, mesh] : shape_bench::describe_meshes(args)) describe_variant(args, variant, mesh);
   if (args.wants("retrieval_d2")) retrieval_variant(args, "retrieval_d2", "d2");
   if (args.wants("retrieval_combined")) retrieval_variant(args, "retrieval_combined", "combined");
   if (args.wants("query")) query_variants(args);

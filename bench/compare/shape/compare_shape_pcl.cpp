@@ -38,14 +38,12 @@ std::vector<float> esf(const TriMesh& mesh) {
 int main(int argc, char** argv) {
   const compare::Args args = compare::parse_args(argc, argv);
   const compare::ThreadLimit limit(args.threads);
-  for (const auto& size : shape_bench::kSizes) {
-    if (!args.wants(size.variant)) continue;
-    const TriMesh mesh = shape_bench::torus(size);
+  for (const auto& [variant, mesh] : shape_bench::describe_meshes(args)) {
     std::vector<float> d;
     const double s = compare::median_time_s(args.reps, [&] { d = esf(mesh); });
     double sum = 0;
     for (float v : d) sum += v;
-    compare::Record("shape", "pcl", size.variant, args.threads)
+    compare::Record("shape", "pcl", variant, args.threads)
         .timing(0, s, 1, args.reps)
         .set("triangles", static_cast<unsigned long long>(mesh.triangles.size()))
         .print(sum > 0 && std::isfinite(sum));

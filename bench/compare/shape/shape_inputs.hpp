@@ -26,6 +26,28 @@ inline constexpr Size kSizes[] = {{"describe_1k", 25, 20}, {"describe_10k", 100,
 
 inline geods::TriMesh torus(const Size& s) { return geods::shape::torus_mesh(2.0f, 0.7f, s.nu, s.nv); }
 
+/// The subdivided bunnies of WORKLOADS.md (58,784 and 940,544 triangles): variants describe_bunny_100k, _1m.
+inline constexpr std::pair<const char*, const char*> kBunnies[] = {{"describe_bunny_100k", "mesh_100k.ply"},
+                                                                   {"describe_bunny_1m", "mesh_1m.ply"}};
+inline geods::TriMesh workload_mesh(const compare::Args& args, const char* file) {
+  const compare::PlyMesh ply = compare::read_ply(args.path(file));
+  geods::TriMesh m;
+  for (std::size_t i = 0; i < ply.vertices(); ++i) m.vertices.emplace_back(ply.xyz[3 * i], ply.xyz[3 * i + 1], ply.xyz[3 * i + 2]);
+  for (std::size_t i = 0; i < ply.triangles(); ++i)
+    m.triangles.push_back({std::uint32_t(ply.tris[3 * i]), std::uint32_t(ply.tris[3 * i + 1]), std::uint32_t(ply.tris[3 * i + 2])});
+  return m;
+}
+
+/// Every mesh of the descriptor-time variants: (variant, mesh) for those --only selects.
+inline std::vector<std::pair<std::string, geods::TriMesh>> describe_meshes(const compare::Args& args) {
+  std::vector<std::pair<std::string, geods::TriMesh>> out;
+  for (const Size& s : kSizes)
+    if (args.wants(s.variant)) out.emplace_back(s.variant, torus(s));
+  for (const auto& [variant, file] : kBunnies)
+    if (args.wants(variant)) out.emplace_back(variant, workload_mesh(args, file));
+  return out;
+}
+
 /// The labelled collection: $GEODS_SHAPE_DB, else ../shared/data/shape_db/BlendSwap-CC-0.sh3f
 /// beside the checkout (or beside its worktree folder).
 inline std::filesystem::path collection_path() {
