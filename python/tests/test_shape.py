@@ -175,6 +175,16 @@ def test_cli_index_query_evaluate(cli, tmp_path):
         assert key in j
     assert j["shapes"] == 14
     assert j["nn_rate"] == pytest.approx(geods.evaluate_retrieval(db, k=3)["nn_rate"])
+    # --append adds a directory through the dynamization, with the database's own descriptor options.
+    (tmp_path / "more").mkdir()
+    geods.write_mesh(str(tmp_path / "more" / "bunny.ply"), V, F)
+    r = run(cli, "shapes", "index", tmp_path / "more", "-o", out, "--append", "--json")
+    assert r.returncode == 0, r.stderr
+    j = json.loads(r.stdout)
+    assert j["shapes"] == 15 and j["append"] and j["dimension"] == 32
+    grown = geods.ShapeDatabase.load(str(out))
+    assert grown.names[:14] == db.names and grown.names[14] == "bunny.ply"
+    assert grown.query(V, F, k=1)[0]["name"] == "bunny.ply"
 
 
 def test_cli_skips_unreadable_members_by_name_and_refuses_bad_input(cli, tmp_path):
