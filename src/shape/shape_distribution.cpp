@@ -103,11 +103,20 @@ SurfaceSampler::SurfaceSampler(const TriMesh& mesh) {
       }
       const Vec3f& a = mesh.vertices[tri[0]];
       corners_[t] = {a, mesh.vertices[tri[1]] - a, mesh.vertices[tri[2]] - a};
+      // Edges are stored in float: corners more than the float range apart would give infinite points.
+      if (!corners_[t].ab.allFinite() || !corners_[t].ac.allFinite()) {
+        bad[t] = 2;
+        continue;
+      }
       const Vec3d ab = (mesh.vertices[tri[1]].cast<double>() - a.cast<double>());
       const Vec3d ac = (mesh.vertices[tri[2]].cast<double>() - a.cast<double>());
       weight[t] = 0.5 * ab.cross(ac).norm();
     }
   });
+  if (const auto it = std::find(bad.begin(), bad.end(), 2); it != bad.end() && std::find(bad.begin(), it, 1) == it)
+    throw Error(fmt::format("shape: triangle {} spans more than the float range (coordinates near +-3.4e38); "
+                            "scale the input",
+                            it - bad.begin()));
   if (const auto it = std::find(bad.begin(), bad.end(), 1); it != bad.end()) {
     const std::size_t t = std::size_t(it - bad.begin());
     const auto& tri = mesh.triangles[t];

@@ -362,6 +362,19 @@ TEST(ShapeDistribution, BadInputThrows) {
   square.triangles = {{0, 1, 2}, {0, 2, 3}};
   EXPECT_THROW(shape_distribution(square, ShapeFunction::d4), Error);
   EXPECT_NO_THROW(shape_distribution(square, ShapeFunction::d2));
+  // Extreme but finite coordinates: corners 6e38 apart overflow float edges, so refused; 1e-30 and
+  // 1e30 scaled copies (polynomials of degree 3 stay inside double's range) give the unit
+  // histograms up to float rounding at bin edges.
+  TriMesh huge = sphere;
+  huge.vertices[huge.triangles[0][0]].x() = -3e38f;
+  huge.vertices[huge.triangles[0][1]].x() = 3e38f;
+  EXPECT_THROW(d2(huge), Error);
+  for (float scale : {1e-30f, 1e30f})
+    for (ShapeFunction f : {ShapeFunction::d2, ShapeFunction::d4}) {
+      DistributionOptions o{.samples = 4096, .bins = 16};
+      const auto scaled = testing::transformed(sphere, Eigen::Matrix3f::Identity(), Vec3f::Zero(), scale);
+      EXPECT_LT(l1(shape_distribution(scaled, f, o), shape_distribution(sphere, f, o)), 0.01) << scale;
+    }
   EXPECT_THROW(parse_shape_function("d6"), Error);
   EXPECT_THROW(parse_normalization("max"), Error);
 }
