@@ -17,5 +17,5 @@ configure_package_config_file(cmake/geodsConfig.cmake.in
 write_basic_package_version_file(${PROJECT_BINARY_DIR}/geodsConfigVersion.cmake
   COMPATIBILITY SameMinorVersion)
 install(FILES ${PROJECT_BINARY_DIR}/geodsConfig.cmake ${PROJECT_BINARY_DIR}/geodsConfigVersion.cmake
-              cmake/Nifti.cmake
+              cmake/Nifti.cmake cmake/Libzip.cmake
         DESTINATION ${GEODS_CMAKE_DIR})

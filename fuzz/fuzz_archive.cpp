@@ -1,6 +1,6 @@
 // libFuzzer target: the input loaded as each structure that saves to a geods
 // archive (k-d tree, quadtree/octree, min/max octree, TriangleBvh, the ray
-// accelerators, Delaunay2, Voronoi2, the dynamic k-d tree), then queried.
+// accelerators, Delaunay2, Voronoi2, the dynamic k-d tree, the shape database), then queried.
 // Where a load can skip the checksums (Archive::Verify::structure_only) it is
 // also tried that way, so that mutated payloads reach the structures' own
 // checks: whatever loads must answer queries without crashing.
@@ -14,6 +14,7 @@
 #include "geods/dynamic/dynamic_kd_tree.hpp"
 #include "geods/iso/min_max_octree.hpp"
 #include "geods/ray/accelerator.hpp"
+#include "geods/shape/shape_database.hpp"
 #include "geods/spatial/kd_tree.hpp"
 #include "geods/spatial/quadtree.hpp"
 #include "geods/voronoi/delaunay2.hpp"
@@ -109,6 +110,13 @@ void query_dynamic_kd_tree(const Path& p) {
   tree.query(std::span<const double>(q), 3);
 }
 
+void query_shape_database(const Path& p) {
+  const geods::shape::ShapeDatabase db = geods::shape::ShapeDatabase::load(p);
+  const std::vector<float> q(db.dimension(), 0.5f);
+  db.query_descriptor(q, 3);
+  db.query_descriptor(q, 2, 0.5);
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -118,7 +126,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
                       query_kd_tree<KdTree<double, Dynamic>>, query_orthtree<Quadtree<double>>,
                       query_orthtree<Octree<float>>, query_min_max_octree<std::uint8_t>, query_min_max_octree<float>,
                       query_bvh_structure, query_bvh, query_accelerator, query_delaunay2, query_voronoi2,
-                      query_dynamic_kd_tree<geods::dynamic::DynamicKdTree<double, 2>>}) {
+                      query_dynamic_kd_tree<geods::dynamic::DynamicKdTree<double, 2>>, query_shape_database}) {
       try {
         load(p);
       } catch (const geods::Error&) {

@@ -268,6 +268,23 @@ def delaunay2_seed():
         ("internal_triangle", U32, 4, struct.pack("<I", 0))], version=2)
 
 
+def sh3f():
+    """A Sweet Home 3D furniture library of one OBJ model (a zip), and a plain zip of one mesh."""
+    import io as _io
+    import zipfile
+    obj = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n"
+    out = []
+    for catalog in (True, False):
+        buffer = _io.BytesIO()
+        with zipfile.ZipFile(buffer, "w", zipfile.ZIP_DEFLATED) as z:
+            if catalog:
+                z.writestr("PluginFurnitureCatalog.properties",
+                           "id#1=t\nname#1=Tetra\\u00e9dre\ncategory#1=Misc\nmodel#1=/t/t.obj\n")
+            z.writestr("t/t.obj", obj)
+        out.append(buffer.getvalue())
+    return out
+
+
 def main():
     out = Path(sys.argv[1])
     raw = bytes(range(24))
@@ -293,6 +310,8 @@ def main():
                    "p.ply": b"\x03" + PLY_ASCII, "p.txt": b"\x04x y z w\n1,2,3,4\n5 6 7 8\n"},
         "archive": {**archive_seeds(), "bvh.geods": archive("bvh.TriangleBvh", bvh_sections()),
                     "delaunay2.geods": delaunay2_seed(), **accelerator_seeds()},
+        "shape": dict(zip(("furniture.sh3f", "meshes.zip"), sh3f()),
+                      **{"labels.csv": b"path,label\nt/t.obj,Misc\n\"a,b.ply\",\"x \"\"y\"\"\"\n"}),
         "segments": {"s.npy": b"\x00" + npy("<f8", (1, 4), struct.pack("<4d", 0, 0, 1, 1)),
                      "s.edg": b"\x01" + b"2\n0 0 1 1\n1 1 2 0\n", "s.cin": b"\x02" + b"p 0 0\ns 0 0 1 1\ns 1 1 2 0\n",
                      "s.csv": b"\x03" + b"x0,y0,x1,y1\n0,0,1,1\n"},

@@ -77,6 +77,30 @@ def write_hole_example():
     geods.write_png(os.path.join(DST, "brick_hole_mask.png"), mask)
 
 
+# The models of data/furniture.sh3f: small ones of four categories of the Blend Swap CC-0 library.
+FURNITURE = ["rock1", "rock2", "rock3", "lantern", "stoneLantern", "upperCabinet", "lowerCabinet",
+             "lowerCornerCabinet", "upperCornerCabinet", "ammoBox", "crate", "box", "pallet", "JapaneseLantern"]
+
+
+def write_furniture_subset():
+    """data/furniture.sh3f: the OBJ models of FURNITURE and their catalog entries, unchanged (no materials)."""
+    import zipfile
+    src = zipfile.ZipFile(os.path.join(SRC, "shape_db/BlendSwap-CC-0.sh3f"))
+    catalog = src.read("PluginFurnitureCatalog.properties").decode("latin-1").splitlines()
+    keep = set()
+    for line in catalog:
+        m = re.match(r"model#(\d+)=/blendswap-cc-0/([^/]+)/", line)
+        if m and m.group(2) in FURNITURE:
+            keep.add(m.group(1))
+    lines = [l for l in catalog if not re.match(r"\w+#(\d+)=", l) or re.match(r"\w+#(\d+)=", l).group(1) in keep]
+    with zipfile.ZipFile(os.path.join(DST, "furniture.sh3f"), "w", zipfile.ZIP_DEFLATED) as out:
+        out.writestr("PluginFurnitureCatalog.properties", "\n".join(lines) + "\n")
+        out.writestr("LICENSE.TXT", src.read("LICENSE.TXT"))
+        for name in FURNITURE:
+            member = f"blendswap-cc-0/{name}/{name}.obj"
+            out.writestr(member, src.read(member))
+
+
 def main():
     os.makedirs(DST, exist_ok=True)
     V, F = npm_arrays("meshes/bunny-1.0.1.tgz", "package/index.js")
@@ -94,6 +118,7 @@ def main():
     segments = np.concatenate([np.hstack([a[:-1], a[1:]]) for a in arcs if len(a) > 1])
     np.save(os.path.join(DST, "land_points.npy"), points.astype(np.float64))
     np.save(os.path.join(DST, "land_segments.npy"), segments.astype(np.float64))
+    write_furniture_subset()
 
 
 if __name__ == "__main__":

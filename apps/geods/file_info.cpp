@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <fstream>
+#include <map>
 #include <string>
 
 #include "geods/core/error.hpp"
@@ -13,6 +14,7 @@
 #include "geods/io/point_io.hpp"
 #include "geods/io/table_io.hpp"
 #include "geods/io/volume_io.hpp"
+#include "geods/shape/collection.hpp"
 #include "stopwatch.hpp"
 
 namespace geods::cli {
@@ -193,6 +195,25 @@ void describe_standard_input_ply(Report& report) {
   }
 }
 
+// A shape collection (.sh3f furniture library, zip of meshes): members and labels, without reading the meshes.
+void describe_collection(const fs::path& path, Report& report) {
+  const shape::ShapeCollection c = shape::ShapeCollection::open(path);
+  std::map<std::string, std::size_t> labels;
+  for (const auto& e : c.entries())
+    if (!e.label.empty()) ++labels[e.label];
+  report.json["kind"] = "collection";
+  report.json["format"] = c.kind() == shape::CollectionKind::sh3f ? "sh3f" : "zip";
+  report.json["meshes"] = c.size();
+  report.json["labels"] = labels;
+  std::string classes;
+  for (const auto& [label, count] : labels) classes += fmt::format("{}{} {}", classes.empty() ? "" : ", ", label, count);
+  report.lines.push_back(fmt::format("{}: shape collection ({}), {} meshes", path.filename().string(),
+                                     c.kind() == shape::CollectionKind::sh3f ? "Sweet Home 3D library" : "zip",
+                                     c.size()));
+  if (!labels.empty()) report.lines.push_back("  labels: " + classes);
+  for (const std::string& w : c.warnings()) report.lines.push_back("  problem: " + w);
+}
+
 }  // namespace
 
 Report describe_file(const fs::path& path, const std::optional<RawVolumeSpec>& raw) {
@@ -223,12 +244,15 @@ Report describe_file(const fs::path& path, const std::optional<RawVolumeSpec>& r
     describe_segments(path, report);
   } else if (ext == ".npy") {
     describe_npy(path, report);
+  } else if (ext == ".sh3f" || ext == ".zip") {
+    describe_collection(path, report);
   } else if (ext == ".raw") {
     throw Error(path.string() + ": a raw volume needs --dims X,Y,Z and --dtype");
   } else {
     throw Error(path.string() + ": unknown file type '" + ext +
                 "' (meshes .ply .obj .stl .off .gltf .glb, also .gz; volumes .nii .nii.gz .nrrd .npy .raw; images .png "
-                ".jpg .bmp; points .xyz .csv .txt .ply .npy; segments .edg .cin .npy; - for standard input)");
+                ".jpg .bmp; points .xyz .csv .txt .ply .npy; segments .edg .cin .npy; shape collections .sh3f .zip; "
+                "- for standard input)");
   }
   report.json["compute_s"] = watch.seconds();
   return report;

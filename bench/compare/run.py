@@ -371,6 +371,8 @@ def tabulate(c, records):
             def med(a):
                 vals = [r.get(m) for r in g.get(a, []) if isinstance(r.get(m), (int, float))]
                 return statistics.median(vals) if vals else None
+            if not any(med(a) for a in present):
+                continue  # no program measured this in this variant (or only a phase of 0)
             row = [f"`{key[0]}`", str(key[1])] + ([m] if len(metrics) > 1 else [])
             for a in present:
                 t = med(a)

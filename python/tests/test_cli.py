@@ -36,6 +36,7 @@ def test_bad_arguments_exit_2_with_one_line(cli):
 @pytest.mark.parametrize("name,kind", [
     ("bunny.ply", "mesh"), ("teapot.obj", "mesh"), ("brick.png", "image"), ("t1_head.nii.gz", "volume"),
     ("jacksboro_dem.npy", "array"), ("land_points.npy", "points"), ("land_segments.npy", "segments"),
+    ("furniture.sh3f", "collection"),
 ])
 def test_info_json_on_every_data_file(cli, data_dir, name, kind):
     r = run(cli, "info", data_dir / name, "--json")

@@ -344,18 +344,16 @@ TriMesh convert(const fs::path& path, const aiScene& scene) {
 
 }  // namespace
 
-bool is_mesh_name(const fs::path& path) {
-  std::string ext = detail::extension(path);
-  detail::is_gzip_name(path, &ext);
-  return supported(ext);
-}
+namespace {
 
-TriMesh read_mesh(const fs::path& path) {
+// A mesh from the bytes of a file named `path` (its extension picks the format,
+// and it names the file in errors); from_disk: side files (OBJ materials, glTF
+// buffers) resolve next to it, otherwise the bytes are parsed in memory.
+TriMesh mesh_from_bytes(const fs::path& path, std::vector<std::uint8_t> bytes, bool from_disk) {
   std::string ext = detail::extension(path);
   const bool gz = detail::is_gzip_name(path, &ext);
   if (!supported(ext))
     fail(path, "unsupported mesh format '" + ext + "' (expected .ply, .obj, .stl, .off, .gltf or .glb, optionally .gz)");
-  std::vector<std::uint8_t> bytes = detail::read_file(path);
   if (bytes.empty()) fail(path, "empty file");
   if (gz) bytes = detail::gunzip(path, bytes, max_inflated_mesh);
   if (bytes.empty()) fail(path, "empty file");
@@ -371,14 +369,35 @@ TriMesh read_mesh(const fs::path& path) {
   const aiScene* scene = nullptr;
   try {
     // In memory for .gz; otherwise from the path so that side files resolve next to it.
-    scene = gz ? importer.ReadFileFromMemory(bytes.data(), bytes.size(), flags, ext.c_str() + 1)
-               : importer.ReadFile(path.string(), flags);
+    scene = gz || !from_disk ? importer.ReadFileFromMemory(bytes.data(), bytes.size(), flags, ext.c_str() + 1)
+                             : importer.ReadFile(path.string(), flags);
   } catch (const std::exception& e) {
     fail(path, std::string("cannot read mesh: ") + e.what());
   }
   if (!scene) fail(path, std::string("cannot read mesh: ") + importer.GetErrorString());
   if (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) fail(path, "cannot read mesh: incomplete scene");
   return convert(path, *scene);
+}
+
+}  // namespace
+
+TriMesh read_mesh(const fs::path& path) {
+  std::string ext = detail::extension(path);
+  detail::is_gzip_name(path, &ext);
+  if (!supported(ext))
+    fail(path, "unsupported mesh format '" + ext + "' (expected .ply, .obj, .stl, .off, .gltf or .glb, optionally .gz)");
+  // Standard input ("-") has no folder for side files: parsed in memory.
+  return mesh_from_bytes(path, detail::read_file(path), !detail::is_standard_stream(path));
+}
+
+TriMesh read_mesh_from_memory(std::span<const std::uint8_t> bytes, const fs::path& name) {
+  return mesh_from_bytes(name, std::vector<std::uint8_t>(bytes.begin(), bytes.end()), false);
+}
+
+bool is_mesh_name(const fs::path& path) {
+  std::string ext = detail::extension(path);
+  detail::is_gzip_name(path, &ext);
+  return supported(ext);
 }
 
 }  // namespace geods::io

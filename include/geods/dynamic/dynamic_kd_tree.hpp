@@ -401,24 +401,32 @@ class DynamicKdTree {
   /// items are in the blocks that answer queries, and load() starts them again.
   void save(const std::filesystem::path& path) const {
     ArchiveWriter w(std::string(kArchiveKind), kArchiveVersion);
-    w.add_dtype("scalar", dtype_of<T>());
-    w.add_value("dim", std::uint64_t(dim_));
-    w.add_value("variant", std::uint32_t(tree_.options().variant));
-    w.add_value("max_dead_fraction", tree_.options().max_dead_fraction);
-    w.add_value("next_id", std::uint64_t(tree_.next_id()));
+    add_sections(w, "");
+    w.write(path);
+  }
+
+  /// Adds the tree's sections (those save() writes) to an archive under names
+  /// that start with `prefix`, so that another structure's archive can hold
+  /// it (shape.ShapeDatabase). The blocks are not copied: the tree must live
+  /// until w.write().
+  void add_sections(ArchiveWriter& w, const std::string& prefix) const {
+    w.add_dtype(prefix + "scalar", dtype_of<T>());
+    w.add_value(prefix + "dim", std::uint64_t(dim_));
+    w.add_value(prefix + "variant", std::uint32_t(tree_.options().variant));
+    w.add_value(prefix + "max_dead_fraction", tree_.options().max_dead_fraction);
+    w.add_value(prefix + "next_id", std::uint64_t(tree_.next_id()));
     std::uint64_t blocks = 0;
     tree_.for_each([&](const Block& block, std::span<const Id> ids) {
-      const std::string prefix = "b" + std::to_string(blocks++) + ".";
-      w.add(prefix + "ids", ids);
+      const std::string block_prefix = prefix + "b" + std::to_string(blocks++) + ".";
+      w.add(block_prefix + "ids", ids);
       if (block.small()) {
-        w.add(prefix + "points", block.small_points());
+        w.add(block_prefix + "points", block.small_points());
       } else {
-        block.tree().add_sections(w, prefix);
-        w.add(prefix + "slots", block.slots());
+        block.tree().add_sections(w, block_prefix);
+        w.add(block_prefix + "slots", block.slots());
       }
     });
-    w.add_value("blocks", blocks);
-    w.write(path);
+    w.add_value(prefix + "blocks", blocks);
   }
 
   /// Reads a tree written by save(): same ids, points, deletions and answers;
@@ -426,34 +434,39 @@ class DynamicKdTree {
   /// Throws geods::Error naming the file for another scalar type or
   /// dimension, a truncated or corrupt file or contents that fail validate().
   static DynamicKdTree load(const std::filesystem::path& path) {
-    const Archive a = Archive::open(path, kArchiveKind, kArchiveVersion);
-    a.require_dtype<T>("scalar", "dynamic k-d tree");
-    const std::uint64_t dim = a.value<std::uint64_t>("dim");
+    return from_sections(Archive::open(path, kArchiveKind, kArchiveVersion), "");
+  }
+
+  /// The tree add_sections wrote under `prefix`; the blocks' k-d trees are
+  /// read in place from the mapped file (KdTree::from_sections). Throws as load().
+  static DynamicKdTree from_sections(const Archive& a, const std::string& prefix) {
+    a.require_dtype<T>(prefix + "scalar", "dynamic k-d tree");
+    const std::uint64_t dim = a.value<std::uint64_t>(prefix + "dim");
     if (dim == 0 || dim > (1u << 16) || (Dim != spatial::Dynamic && dim != std::uint64_t(Dim)))
       throw a.error("a dynamic k-d tree of dimension " + std::to_string(dim) + ", expected " +
                     (Dim == spatial::Dynamic ? std::string("1 to 65536") : std::to_string(Dim)));
-    const std::uint32_t variant = a.value<std::uint32_t>("variant");
+    const std::uint32_t variant = a.value<std::uint32_t>(prefix + "variant");
     if (variant > std::uint32_t(Variant::worst_case)) throw a.error("bad variant " + std::to_string(variant));
-    const DynamizeOptions options{Variant(variant), a.value<double>("max_dead_fraction")};
-    const std::uint64_t blocks = a.value<std::uint64_t>("blocks");
+    const DynamizeOptions options{Variant(variant), a.value<double>(prefix + "max_dead_fraction")};
+    const std::uint64_t blocks = a.value<std::uint64_t>(prefix + "blocks");
     std::vector<std::pair<Block, std::vector<Id>>> parts;
     for (std::uint64_t k = 0; k < blocks; ++k) {
-      const std::string prefix = "b" + std::to_string(k) + ".";
-      std::vector<Id> ids = a.array<Id>(prefix + "ids").to_vector();
+      const std::string block_prefix = prefix + "b" + std::to_string(k) + ".";
+      std::vector<Id> ids = a.array<Id>(block_prefix + "ids").to_vector();
       std::optional<Block> block;
       if (ids.size() <= Block::kLeafSize) {
-        const FlatArray<T> points = a.array<T>(prefix + "points", ids.size() * dim);
+        const FlatArray<T> points = a.array<T>(block_prefix + "points", ids.size() * dim);
         a.check([&] { block.emplace(Block::adopt_small(std::size_t(dim), points)); });
       } else {
-        spatial::KdTree<T, Dim> tree = spatial::KdTree<T, Dim>::from_sections(a, prefix, std::size_t(dim));
-        FlatArray<std::uint32_t> slots = a.array<std::uint32_t>(prefix + "slots", ids.size());
+        spatial::KdTree<T, Dim> tree = spatial::KdTree<T, Dim>::from_sections(a, block_prefix, std::size_t(dim));
+        FlatArray<std::uint32_t> slots = a.array<std::uint32_t>(block_prefix + "slots", ids.size());
         a.check([&] { block.emplace(Block::adopt(std::move(tree), std::move(slots))); });
       }
       parts.emplace_back(std::move(*block), std::move(ids));
     }
     try {
       DynamicKdTree tree(std::size_t(dim), options);
-      tree.tree_ = Dynamized<Block>::restore(options, std::move(parts), a.value<std::uint64_t>("next_id"));
+      tree.tree_ = Dynamized<Block>::restore(options, std::move(parts), a.value<std::uint64_t>(prefix + "next_id"));
       tree.validate();
       return tree;
     } catch (const Error& e) {

@@ -1,6 +1,8 @@
 #pragma once
 // Reading and writing triangle meshes.
+#include <cstdint>
 #include <filesystem>
+#include <span>
 
 #include "geods/core/tri_mesh.hpp"
 
@@ -19,6 +21,12 @@ TriMesh read_mesh(const std::filesystem::path& path);
 /// .glb, or one of them gzip-compressed (.stl.gz). `geods info` and every
 /// command that reads meshes decide with it.
 bool is_mesh_name(const std::filesystem::path& path);
+
+/// Reads a mesh from the bytes of a file called `name` (say a member of a zip
+/// archive): its extension picks the format as in read_mesh, and errors name
+/// it. Side files (OBJ materials, glTF buffers) are not looked for; the
+/// geometry of an OBJ does not need them.
+TriMesh read_mesh_from_memory(std::span<const std::uint8_t> bytes, const std::filesystem::path& name);
 
 enum class MeshEncoding { binary, ascii };
 

@@ -34,12 +34,23 @@
 
 namespace geods::spatial {
 
+/// std::array<T, Dim>, or std::vector<T> for Dynamic. A specialization rather
+/// than std::conditional_t, which would name std::array<T, -1> (clang rejects it).
+template <typename T, int Dim>
+struct RowOf {
+  using type = std::array<T, std::size_t(Dim)>;
+};
+template <typename T>
+struct RowOf<T, Dynamic> {
+  using type = std::vector<T>;
+};
+
 template <typename T, int Dim>
 class KdTreeSteppedBuild {
  public:
   using Tree = KdTree<T, Dim>;
   /// One input point: std::array<T, Dim>, or std::vector<T> for a run-time dimension.
-  using Row = std::conditional_t<Dim == Dynamic, std::vector<T>, std::array<T, Dim>>;
+  using Row = typename RowOf<T, Dim>::type;
 
   /// A finished build: tree point i is input row row[i].
   struct Result {
