@@ -49,6 +49,7 @@ MeshDistance MeshDistance::build(const TriMesh& mesh, const bvh::BuildOptions& o
   mesh.require_valid("signed distance");
   MeshDistance md;
   md.bvh_ = bvh::TriangleBvh::build(mesh, options);
+  md.depth_ = md.bvh_.topology().depth();
   md.faces_ = mesh.triangles;
   md.fit_normals(mesh);
   md.fit_moments();
@@ -147,7 +148,7 @@ double MeshDistance::winding_number(const Vec3f& p) const {
   const auto& tris = bvh_.triangles();
   const Vec3d q = p.cast<double>();
   double omega = 0;
-  bvh::TraversalStack<bvh::NodeRef> stack(bvh::traversal_stack_size(topo.depth(), bvh_.options().arity));
+  bvh::TraversalStack<bvh::NodeRef> stack(stack_size());
   bvh::traverse_topology<false>(
       topo, 0, stack,
       [&](std::uint32_t node, float&) {
@@ -223,7 +224,7 @@ MeshPointDistance MeshDistance::query(const Vec3f& p, SignMethod sign, float max
   const auto& ids = bvh_.triangle_ids();
   std::visit(
       [&](const auto& volumes) {
-        bvh::TraversalStack<bvh::NodeRef> stack(bvh::traversal_stack_size(topo.depth(), bvh_.options().arity));
+        bvh::TraversalStack<bvh::NodeRef> stack(stack_size());
         bvh::traverse_topology<true>(
             topo, 0, stack,
             [&](std::uint32_t node, float& d2) GEODS_BVH_INLINE_LAMBDA {

@@ -6,6 +6,7 @@
 #include <array>
 #include <atomic>
 #include <cmath>
+#include <cstring>
 #include <string>
 
 #include <fmt/format.h>
@@ -43,10 +44,127 @@ struct SampleBox {
 struct Closest {
   float d2 = kInf;
   std::uint32_t leaf = kNoIndex;  // leaf-order index
-  std::uint32_t slot = 0;                    // position in the list
   TriangleRegion region = TriangleRegion::face;
   Vec3f point = Vec3f::Zero();
 };
+
+// Triangles prepared for squared distances to many points, one array per
+// quantity (structure of arrays) so that the loop over them vectorizes: the
+// corner a, the edges ab and ac, the normal n, the terms of the projection's
+// barycentric coordinates, and the reciprocal squared lengths (0 for a
+// degenerate edge or face, which then never claims a point).
+struct Packed {
+  enum Field { ax, ay, az, bx, by, bz, cx, cy, cz, nx, ny, nz, d00, d01, d11, inv_den, inv_nn, inv_ab, inv_ac, inv_bc, kFields };
+  using Arrays = std::array<std::vector<float>, kFields>;
+  Arrays f;
+  std::vector<std::uint32_t> leaf;  // leaf-order triangle of each entry
+  std::vector<std::int32_t> face;   // its face index (padded as the arrays)
+  std::size_t size = 0;
+
+  void clear() { size = 0, leaf.clear(); }
+  // Room for n entries, rounded up to whole vectors (the tail is never read as a result).
+  void reserve(std::size_t n) {
+    const std::size_t padded = (n + 15) & ~std::size_t(15);
+    if (f[0].size() < padded) {
+      for (auto& a : f) a.resize(padded, 0.0f);
+      face.resize(padded, 0);
+    }
+  }
+  void push(const Packed& from, std::size_t i) {
+    reserve(size + 1);
+    for (int k = 0; k < kFields; ++k) f[k][size] = from.f[k][i];
+    face[size] = from.face[i];
+    leaf.push_back(from.leaf[i]);
+    ++size;
+  }
+};
+
+// d2[i] = squared distance from p to entry i of t, for i < t.size rounded up
+// to 16: the face's plane distance where p projects inside it, else the
+// nearest of the three edges. Eight entries at a time, without branches
+// (GCC vector extensions: AVX2 where the CPU has it, picked at run time,
+// else two SSE halves).
+#pragma GCC diagnostic ignored "-Wpsabi"  // 32-byte vectors in inlined helpers, never across a call
+using V8 = float __attribute__((vector_size(32)));
+
+__attribute__((always_inline)) inline V8 load8(const float* p) {
+  V8 v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+
+// Entries [i, i + 8) of t.
+__attribute__((always_inline)) inline V8 distance8(const Packed::Arrays& f, std::size_t i, V8 px, V8 py, V8 pz) {
+  const V8 zero = V8{}, one = V8{} + 1.0f;
+  const auto clamp01 = [&](V8 s) {
+    s = s < zero ? zero : s;
+    return s > one ? one : s;
+  };
+  const auto at = [&](int k) { return load8(f[k].data() + i); };
+  const V8 bx = at(Packed::bx), by = at(Packed::by), bz = at(Packed::bz);
+  const V8 cx = at(Packed::cx), cy = at(Packed::cy), cz = at(Packed::cz);
+  const V8 qx = px - at(Packed::ax), qy = py - at(Packed::ay), qz = pz - at(Packed::az);  // p - a
+  const V8 e1 = bx * qx + by * qy + bz * qz;  // ab . (p - a)
+  const V8 e2 = cx * qx + cy * qy + cz * qz;  // ac . (p - a)
+  const V8 d01 = at(Packed::d01), inv_den = at(Packed::inv_den), inv_nn = at(Packed::inv_nn);
+  const V8 v = (at(Packed::d11) * e1 - d01 * e2) * inv_den;
+  const V8 w = (at(Packed::d00) * e2 - d01 * e1) * inv_den;
+  const V8 h = at(Packed::nx) * qx + at(Packed::ny) * qy + at(Packed::nz) * qz;
+  const V8 face = h * h * inv_nn;
+  const auto inside = (v >= zero) & (w >= zero) & (v + w <= one) & (inv_nn > zero);
+  // Edge ab from a, edge ac from a, edge bc from b.
+  V8 s = clamp01(e1 * at(Packed::inv_ab));
+  V8 rx = qx - s * bx, ry = qy - s * by, rz = qz - s * bz;
+  const V8 dab = rx * rx + ry * ry + rz * rz;
+  s = clamp01(e2 * at(Packed::inv_ac));
+  rx = qx - s * cx, ry = qy - s * cy, rz = qz - s * cz;
+  const V8 dac = rx * rx + ry * ry + rz * rz;
+  const V8 ux = qx - bx, uy = qy - by, uz = qz - bz;  // p - b
+  const V8 wx = cx - bx, wy = cy - by, wz = cz - bz;  // bc
+  s = clamp01((ux * wx + uy * wy + uz * wz) * at(Packed::inv_bc));
+  rx = ux - s * wx, ry = uy - s * wy, rz = uz - s * wz;
+  const V8 dbc = rx * rx + ry * ry + rz * rz;
+  V8 edge = dab < dac ? dab : dac;
+  edge = dbc < edge ? dbc : edge;
+  return inside ? face : edge;
+}
+
+__attribute__((target_clones("avx2", "default"))) void squared_distances(const Packed& t, const Vec3f& p, float* d2) {
+  const std::size_t n = (t.size + 15) & ~std::size_t(15);
+  const V8 px = V8{} + p.x(), py = V8{} + p.y(), pz = V8{} + p.z();
+  for (std::size_t i = 0; i < n; i += 8) {
+    const V8 r = distance8(t.f, i, px, py, pz);
+    std::memcpy(d2 + i, &r, sizeof r);
+  }
+}
+
+using I8 = std::int32_t __attribute__((vector_size(32)));
+
+// The entry of t nearest to p and its squared distance; of equally near
+// ones, the one of the smallest face index.
+__attribute__((target_clones("avx2", "default"))) std::size_t nearest(const Packed& t, const Vec3f& p, float& d2) {
+  const std::size_t n = (t.size + 7) & ~std::size_t(7);
+  const V8 px = V8{} + p.x(), py = V8{} + p.y(), pz = V8{} + p.z();
+  V8 best = V8{} + kInf;
+  I8 at = I8{}, best_face = I8{} + std::numeric_limits<std::int32_t>::max(), lane = I8{0, 1, 2, 3, 4, 5, 6, 7};
+  const I8 size = I8{} + std::int32_t(t.size);
+  for (std::size_t i = 0; i < n; i += 8, lane += 8) {
+    V8 r = distance8(t.f, i, px, py, pz);
+    r = lane < size ? r : V8{} + kInf;  // the padding
+    I8 face;
+    std::memcpy(&face, t.face.data() + i, sizeof face);
+    const auto closer = (r < best) | ((r == best) & (face < best_face));
+    best = closer ? r : best;
+    best_face = closer ? face : best_face;
+    at = closer ? lane : at;
+  }
+  std::size_t index = 0;
+  d2 = kInf;
+  std::int32_t face = std::numeric_limits<std::int32_t>::max();
+  for (int l = 0; l < 8; ++l)
+    if (best[l] < d2 || (best[l] == d2 && best_face[l] < face)) d2 = best[l], face = best_face[l], index = std::size_t(at[l]);
+  return index;
+}
 
 class GridSolver {
  public:
@@ -55,11 +173,25 @@ class GridSolver {
         ids_(mesh.bvh().triangle_ids().data()) {
     const std::size_t n = mesh.triangles().size();
     spheres_.resize(n);
+    all_.reserve(n);
+    all_.size = n;
+    all_.leaf.resize(n);
+    if (n >= std::size_t(std::numeric_limits<std::int32_t>::max())) throw Error("sdf grid: too many faces");
     parallel_for_each_index(0, n, [&](std::size_t i) {
       const BvhTriangle& t = tris_[i];
       const Vec3f c = (t.a + t.b + t.c) / 3.0f;
       const float r = std::sqrt(std::max({(t.a - c).squaredNorm(), (t.b - c).squaredNorm(), (t.c - c).squaredNorm()}));
       spheres_[i] = Vec4f(c.x(), c.y(), c.z(), r * (1 + 1e-6f) + 1e-30f);
+      const Vec3f ab = t.b - t.a, ac = t.c - t.a, bc = t.c - t.b, nn = ab.cross(ac);
+      const float d00 = ab.dot(ab), d01 = ab.dot(ac), d11 = ac.dot(ac), den = d00 * d11 - d01 * d01;
+      const float nn2 = nn.squaredNorm();
+      const float values[Packed::kFields] = {
+          t.a.x(), t.a.y(), t.a.z(), ab.x(), ab.y(), ab.z(), ac.x(), ac.y(), ac.z(), nn.x(), nn.y(), nn.z(), d00, d01,
+          d11, den > 0 ? 1 / den : 0.0f, nn2 > 0 && den > 0 ? 1 / nn2 : 0.0f, d00 > 0 ? 1 / d00 : 0.0f,
+          d11 > 0 ? 1 / d11 : 0.0f, bc.squaredNorm() > 0 ? 1 / bc.squaredNorm() : 0.0f};
+      for (int k = 0; k < Packed::kFields; ++k) all_.f[k][i] = std::isfinite(values[k]) ? values[k] : 0.0f;
+      all_.leaf[i] = std::uint32_t(i);
+      all_.face[i] = std::int32_t(ids_[i]);
     });
     // Float rounding of distances is below this (relative to the scene's size).
     const AABB3f mb = std::visit([](const auto& v) { return bvh::bounds(v[0]); }, mesh.bvh().volumes());
@@ -74,7 +206,7 @@ class GridSolver {
   // One tile: the samples of [lo, hi) into out (and faces).
   void tile(const SampleBox& box, float* out, std::uint32_t* faces, SdfGridStats& stats) const {
     const MeshPointDistance centre = mesh_.query(box.centre, SignMethod::none);
-    const std::size_t nx = box.hi[0] - box.lo[0], ny = box.hi[1] - box.lo[1], nz = box.hi[2] - box.lo[2];
+    const std::size_t nx = box.hi[0] - box.lo[0], ny = box.hi[1] - box.lo[1];
     std::array<float, kTile * kTile * kTile> ud;  // unsigned distances (inf: outside the band)
     std::array<Closest, kTile * kTile * kTile> best;
     ud.fill(kInf);
@@ -82,24 +214,23 @@ class GridSolver {
       return (i - box.lo[0]) + nx * ((j - box.lo[1]) + ny * (k - box.lo[2]));
     };
     if (!(centre.distance - box.radius > band_ + margin_)) {
-      std::vector<std::uint32_t> tile_list, block_list;
+      Packed tile_list, block_list;
       gather(box, centre.closest, tile_list);
+      std::vector<float> d2(tile_list.f[0].size()), pass(tile_list.f[0].size());
       for (std::size_t bz = box.lo[2]; bz < box.hi[2]; bz += kBlock)
         for (std::size_t by = box.lo[1]; by < box.hi[1]; by += kBlock)
           for (std::size_t bx = box.lo[0]; bx < box.hi[0]; bx += kBlock) {
             const SampleBox block(grid_, {bx, by, bz},
                                   {std::min(bx + kBlock, box.hi[0]), std::min(by + kBlock, box.hi[1]),
                                    std::min(bz + kBlock, box.hi[2])});
-            const Closest c = closest_in(tile_list, block.centre, 0);
+            const Closest c = closest_in(tile_list, block.centre);
             if (std::sqrt(c.d2) - block.radius > band_ + margin_) continue;
-            filter(tile_list, block, c.point, block_list);
-            stats.candidates_per_sample += double(block_list.size()) * double(block.samples());
-            std::uint32_t seed = 0;  // the previous sample's closest face
+            filter(tile_list, block, c.point, block_list, d2.data(), pass.data());
+            stats.candidates_per_sample += double(block_list.size) * double(block.samples());
             for (std::size_t k = block.lo[2]; k < block.hi[2]; ++k)
               for (std::size_t j = block.lo[1]; j < block.hi[1]; ++j)
                 for (std::size_t i = block.lo[0]; i < block.hi[0]; ++i) {
-                  const Closest s = closest_in(block_list, grid_.position(i, j, k), seed);
-                  seed = s.slot;
+                  const Closest s = closest_in(block_list, grid_.position(i, j, k));
                   const float d = std::sqrt(s.d2);
                   if (d > band_) continue;
                   ud[local(i, j, k)] = d;
@@ -110,7 +241,6 @@ class GridSolver {
     } else {
       ++stats.tiles_outside;
     }
-
     // Signs, in scan order, each from an earlier neighbour in the tile when no surface can lie between them.
     const bool propagate = options_.sign == SignMethod::none || mesh_.closed();
     std::array<std::uint8_t, kTile * kTile * kTile> inside{};
@@ -146,24 +276,10 @@ class GridSolver {
           inside[l] = in;
           out[g] = in ? -d : d;
         }
-    (void)nz;
   }
 
  private:
-  // Whether leaf triangle t may be closest to a point of the box whose corners
-  // are each at most sqrt(bound2[k]) from the surface point the bounds come from.
-  bool may_be_closest(std::uint32_t t, const std::array<Vec3f, 8>& corners, const std::array<float, 8>& bound2) const {
-    const Vec4f& s = spheres_[t];
-    const BvhTriangle& tri = tris_[t];
-    for (int k = 0; k < 8; ++k) {
-      const float lb = (corners[k] - s.head<3>()).norm() - s.w();
-      if (lb > 0 && lb * lb > bound2[k]) continue;
-      if ((closest_point_on_triangle(corners[k], tri.a, tri.b, tri.c) - corners[k]).squaredNorm() <= bound2[k])
-        return true;
-    }
-    return false;
-  }
-
+  // Squared distance bounds at a box's corners from a surface point q.
   std::array<float, 8> bounds_from(const SampleBox& box, const Vec3f& q) const {
     std::array<float, 8> bound2;
     for (int k = 0; k < 8; ++k) {
@@ -173,15 +289,17 @@ class GridSolver {
     return bound2;
   }
 
-  // The faces that may be closest to a sample of the box, q being a surface point.
-  void gather(const SampleBox& box, const Vec3f& q, std::vector<std::uint32_t>& out) const {
-    out.clear();
+  // The faces that may be closest to a sample of the box, q being a surface
+  // point: the hierarchy's nodes and then its triangles pass if they are no
+  // farther than q from one of the box's corners (a triangle's bounding
+  // sphere first), in leaf order.
+  void gather(const SampleBox& box, const Vec3f& q, Packed& out) const {
     const std::array<float, 8> bound2 = bounds_from(box, q);
     const bvh::Topology& topo = mesh_.bvh().topology();
+    std::vector<std::uint32_t> found;
     std::visit(
         [&](const auto& volumes) {
-          bvh::TraversalStack<bvh::NodeRef> stack(
-              bvh::traversal_stack_size(topo.depth(), mesh_.bvh().options().arity));
+          bvh::TraversalStack<bvh::NodeRef> stack(mesh_.stack_size());
           bvh::traverse_topology<false>(
               topo, 0, stack,
               [&](std::uint32_t node, float&) {
@@ -190,47 +308,52 @@ class GridSolver {
                 return false;
               },
               [&](const bvh::TopoNode& node) {
-                for (std::uint32_t i = node.prim_first; i < node.prim_first + node.prim_count; ++i)
-                  if (may_be_closest(i, box.corners, bound2)) out.push_back(i);
+                for (std::uint32_t i = node.prim_first; i < node.prim_first + node.prim_count; ++i) {
+                  const Vec4f& s = spheres_[i];
+                  const BvhTriangle& tri = tris_[i];
+                  for (int k = 0; k < 8; ++k) {
+                    const float lb = (box.corners[k] - s.head<3>()).norm() - s.w();
+                    if (lb > 0 && lb * lb > bound2[k]) continue;
+                    if ((closest_point_on_triangle(box.corners[k], tri.a, tri.b, tri.c) - box.corners[k]).squaredNorm() <=
+                        bound2[k]) {
+                      found.push_back(i);
+                      break;
+                    }
+                  }
+                }
               },
               [](float) { return true; });
         },
         mesh_.bvh().volumes());
-  }
-
-  void filter(const std::vector<std::uint32_t>& in, const SampleBox& box, const Vec3f& q,
-              std::vector<std::uint32_t>& out) const {
     out.clear();
-    const std::array<float, 8> bound2 = bounds_from(box, q);
-    for (const std::uint32_t t : in)
-      if (may_be_closest(t, box.corners, bound2)) out.push_back(t);
+    out.reserve(found.size());
+    for (const std::uint32_t t : found) out.push(all_, t);
   }
 
-  // The closest face of `list` to p (ties: the smallest face index), starting
-  // from list[seed]: a face whose bounding sphere is farther than the best
-  // distance so far is skipped.
-  Closest closest_in(const std::vector<std::uint32_t>& list, const Vec3f& p, std::uint32_t seed) const {
-    Closest best;
-    if (list.empty()) return best;
-    const auto test = [&](std::uint32_t slot) {
-      const std::uint32_t t = list[slot];
-      const BvhTriangle& tri = tris_[t];
-      TriangleRegion region;
-      const Vec3f q = closest_point_on_triangle(p, tri.a, tri.b, tri.c, region);
-      const float d2 = (q - p).squaredNorm();
-      if (d2 < best.d2 || (d2 == best.d2 && (best.leaf == kNoIndex || ids_[t] < ids_[best.leaf])))
-        best = {d2, t, slot, region, q};
-    };
-    test(seed < list.size() ? seed : 0);
-    float reach = std::sqrt(best.d2);
-    for (std::uint32_t slot = 0; slot < list.size(); ++slot) {
-      const Vec4f& s = spheres_[list[slot]];
-      const float r = reach + s.w();
-      if ((p - s.head<3>()).squaredNorm() > r * r) continue;
-      const float before = best.d2;
-      test(slot);
-      if (best.d2 != before) reach = std::sqrt(best.d2);
+  // The entries of `in` that may be closest to a sample of the box (see gather).
+  void filter(const Packed& in, const SampleBox& box, const Vec3f& q, Packed& out, float* d2, float* pass) const {
+    const std::array<float, 8> bound2 = bounds_from(box, q);
+    std::fill_n(pass, in.size, 0.0f);
+    for (int k = 0; k < 8; ++k) {
+      squared_distances(in, box.corners[k], d2);
+      for (std::size_t i = 0; i < in.size; ++i) pass[i] = d2[i] <= bound2[k] ? 1.0f : pass[i];
     }
+    out.clear();
+    for (std::size_t i = 0; i < in.size; ++i)
+      if (pass[i] != 0) out.push(in, i);
+  }
+
+  // The closest entry of `list` to p (ties: the smallest face index), with
+  // its exact closest point and region.
+  Closest closest_in(const Packed& list, const Vec3f& p) const {
+    Closest best;
+    if (list.size == 0) return best;
+    float nearest_d2;
+    const std::size_t i = nearest(list, p, nearest_d2);
+    const BvhTriangle& tri = tris_[list.leaf[i]];
+    best.leaf = list.leaf[i];
+    best.point = closest_point_on_triangle(p, tri.a, tri.b, tri.c, best.region);
+    best.d2 = (best.point - p).squaredNorm();
     return best;
   }
 
@@ -240,6 +363,7 @@ class GridSolver {
   const BvhTriangle* tris_;
   const std::uint32_t* ids_;
   std::vector<Vec4f> spheres_;  // per leaf triangle: centroid and radius
+  Packed all_;                  // every triangle, in leaf order
   float margin_ = 0;
   float band_ = kInf;
 };

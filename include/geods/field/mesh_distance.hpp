@@ -28,6 +28,7 @@
 #include <span>
 #include <vector>
 
+#include "geods/bvh/traversal.hpp"
 #include "geods/bvh/triangle_bvh.hpp"
 #include "geods/core/tri_mesh.hpp"
 #include "geods/core/triangle.hpp"
@@ -85,6 +86,8 @@ class MeshDistance {
   bool closed() const { return closed_; }
 
   const bvh::TriangleBvh& bvh() const { return bvh_; }
+  /// Entries a TraversalStack needs for a traversal of bvh().
+  std::size_t stack_size() const { return bvh::traversal_stack_size(depth_, bvh_.options().arity); }
   std::size_t num_faces() const { return faces_.size(); }
   /// The hierarchy's triangles in leaf order; leaf triangle i is face face_of(i) of the mesh.
   const FlatArray<bvh::BvhTriangle>& triangles() const { return bvh_.triangles(); }
@@ -113,6 +116,7 @@ class MeshDistance {
   std::vector<Vec3f> edge_normals_;            // 3 per face: edge i from corner i to i + 1
   std::vector<Vec3f> vertex_normals_;          // per mesh vertex: angle-weighted (welded copies share)
   std::vector<Moment> moments_;                // per topology node
+  int depth_ = 0;                              // of the hierarchy
   bool closed_ = false;
 };
 
