@@ -44,6 +44,30 @@ std::vector<std::uint32_t> weld(const std::vector<Vec3f>& vertices) {
 
 }  // namespace
 
+SignMethod parse_sign_method(std::string_view name) {
+  for (const SignMethod s : {SignMethod::winding, SignMethod::pseudonormal, SignMethod::none})
+    if (name == to_string(s)) return s;
+  throw Error("signed distance: unknown sign method '" + std::string(name) + "' (winding, pseudonormal or none)");
+}
+
+std::string_view to_string(SignMethod sign) {
+  switch (sign) {
+    case SignMethod::winding: return "winding";
+    case SignMethod::pseudonormal: return "pseudonormal";
+    case SignMethod::none: break;
+  }
+  return "none";
+}
+
+std::string_view to_string(Feature feature) {
+  switch (feature) {
+    case Feature::vertex: return "vertex";
+    case Feature::edge: return "edge";
+    case Feature::face: break;
+  }
+  return "face";
+}
+
 MeshDistance MeshDistance::build(const TriMesh& mesh, const bvh::BuildOptions& options) {
   if (mesh.num_triangles() == 0) throw Error("signed distance: the mesh has no faces");
   mesh.require_valid("signed distance");

@@ -26,6 +26,7 @@
 #include <cstdint>
 #include <limits>
 #include <span>
+#include <string_view>
 #include <vector>
 
 #include "geods/bvh/traversal.hpp"
@@ -42,6 +43,11 @@ enum class SignMethod : std::uint8_t { winding, pseudonormal, none };
 
 /// The feature of the closest face that holds the closest point.
 enum class Feature : std::uint8_t { vertex, edge, face };
+
+/// "winding", "pseudonormal", "none"; geods::Error naming the choices otherwise.
+SignMethod parse_sign_method(std::string_view name);
+std::string_view to_string(SignMethod sign);
+std::string_view to_string(Feature feature);
 
 /// Distance of one point to the mesh.
 struct MeshPointDistance {

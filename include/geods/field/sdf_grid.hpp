@@ -60,6 +60,9 @@ struct SdfGrid {
   SdfGridStats stats;
 };
 
+/// Samples of margin sdf_grid_geometry leaves beyond the box on each side unless told otherwise.
+inline constexpr double kDefaultPadding = 3;
+
 /// The grid about a box (usually the mesh's bounds): samples `spacing`
 /// apart, or, if spacing is 0, `res` samples along the box's longest side
 /// (padding included); `padding` samples of margin on each side; the grid is
@@ -67,7 +70,8 @@ struct SdfGrid {
 /// `padding` samples larger on each side. Throws geods::Error for an empty
 /// or non-finite box, res < 1 + 2 padding... (nothing to sample), a
 /// non-finite or non-positive spacing, or a grid of more than 2^40 samples.
-Grid3Geometry sdf_grid_geometry(const AABB3f& box, std::size_t res, double spacing = 0, double padding = 3);
+Grid3Geometry sdf_grid_geometry(const AABB3f& box, std::size_t res, double spacing = 0,
+                                double padding = kDefaultPadding);
 
 /// The signed distance field of the mesh at the samples of `grid` (any
 /// origin and positive spacing, also anisotropic). Throws geods::Error for
