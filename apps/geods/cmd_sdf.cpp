@@ -10,8 +10,10 @@
 #include "command.hpp"
 #include "geods/core/error.hpp"
 #include "geods/field/sdf_grid.hpp"
+#include "geods/field/stats_fields.hpp"
 #include "geods/io/mesh_io.hpp"
 #include "geods/io/npy.hpp"
+#include "stats_json.hpp"
 #include "stopwatch.hpp"
 
 namespace geods::cli {
@@ -81,13 +83,10 @@ class SdfCommand : public Command {
     j["origin"] = std::vector<double>{grid.origin.x(), grid.origin.y(), grid.origin.z()};
     j["sign"] = sign_;
     if (band_) j["band"] = *band_;
-    j["samples"] = r.stats.samples;
-    j["in_band"] = r.stats.in_band;
+    put_stats(j, r.stats);
     j["inside"] = std::count_if(r.distance.data.begin(), r.distance.data.end(), [](float d) { return d < 0; });
     j["min_distance"] = lo;
     j["max_distance"] = hi;
-    j["candidates_per_sample"] = r.stats.candidates_per_sample;
-    j["winding_numbers"] = r.stats.winding_numbers;
     j["build_s"] = build_s;
     j["grid_s"] = grid_s;
     j["compute_s"] = build_s + grid_s;
