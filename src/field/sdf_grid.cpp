@@ -44,6 +44,7 @@ struct SampleBox {
 struct Closest {
   float d2 = kInf;
   std::uint32_t leaf = kNoIndex;  // leaf-order index
+  std::size_t slot = 0;           // position in the list
   TriangleRegion region = TriangleRegion::face;
   Vec3f point = Vec3f::Zero();
 };
@@ -54,7 +55,9 @@ struct Closest {
 // barycentric coordinates, and the reciprocal squared lengths (0 for a
 // degenerate edge or face, which then never claims a point).
 struct Packed {
-  enum Field { ax, ay, az, bx, by, bz, cx, cy, cz, nx, ny, nz, d00, d01, d11, inv_den, inv_nn, inv_ab, inv_ac, inv_bc, kFields };
+  // k0..k7: in a block's list, the squared distances from the block's 8 corners.
+  enum Field { ax, ay, az, bx, by, bz, cx, cy, cz, nx, ny, nz, d00, d01, d11, inv_den, inv_nn, inv_ab, inv_ac, inv_bc,
+               k0, k1, k2, k3, k4, k5, k6, k7, kFields };
   using Arrays = std::array<std::vector<float>, kFields>;
   Arrays f;
   std::vector<std::uint32_t> leaf;  // leaf-order triangle of each entry
@@ -70,12 +73,17 @@ struct Packed {
       face.resize(padded, 0);
     }
   }
-  void push(const Packed& from, std::size_t i) {
-    reserve(size + 1);
-    for (int k = 0; k < kFields; ++k) f[k][size] = from.f[k][i];
-    face[size] = from.face[i];
-    leaf.push_back(from.leaf[i]);
-    ++size;
+  // Entries idx of `from`, in that order, replacing this list's.
+  void assign(const Packed& from, const std::vector<std::uint32_t>& idx) {
+    clear();
+    reserve(idx.size());
+    for (int k = 0; k < kFields; ++k) {
+      const float* in = from.f[k].data();
+      float* o = f[k].data();
+      for (std::size_t j = 0; j < idx.size(); ++j) o[j] = in[idx[j]];
+    }
+    for (std::size_t j = 0; j < idx.size(); ++j) face[j] = from.face[idx[j]], leaf.push_back(from.leaf[idx[j]]);
+    size = idx.size();
   }
 };
 
@@ -140,17 +148,87 @@ __attribute__((target_clones("avx2", "default"))) void squared_distances(const P
 
 using I8 = std::int32_t __attribute__((vector_size(32)));
 
+// The smallest of 8 lanes, in three halving steps.
+__attribute__((always_inline)) inline float min8(V8 v) {
+  using M = std::int32_t __attribute__((vector_size(32)));
+  v = v < __builtin_shuffle(v, M{4, 5, 6, 7, 0, 1, 2, 3}) ? v : __builtin_shuffle(v, M{4, 5, 6, 7, 0, 1, 2, 3});
+  v = v < __builtin_shuffle(v, M{2, 3, 0, 1, 6, 7, 4, 5}) ? v : __builtin_shuffle(v, M{2, 3, 0, 1, 6, 7, 4, 5});
+  v = v < __builtin_shuffle(v, M{1, 0, 3, 2, 5, 4, 7, 6}) ? v : __builtin_shuffle(v, M{1, 0, 3, 2, 5, 4, 7, 6});
+  return v[0];
+}
+
+// Where a sample sits in its block: its trilinear weights (the fractions of
+// the block's extent along x, y, z) and the spread sum_k w_k |v_k - p|^2 of
+// the corners about it.
+struct InBlock {
+  float wx, wy, wz, spread;
+};
+
 // The entry of t nearest to p and its squared distance; of equally near
-// ones, the one of the smallest face index.
-__attribute__((target_clones("avx2", "default"))) std::size_t nearest(const Packed& t, const Vec3f& p, float& d2) {
-  const std::size_t n = (t.size + 7) & ~std::size_t(7);
+// ones, the one of the smallest face index. t is a block's list with the
+// squared distances from the block's corners (k0..k7): by concavity,
+// dist^2(p, f) >= sum_k w_k dist^2(v_k, f) - sum_k w_k |v_k - p|^2 (the
+// trilinear interpolation of the corner values, less the spread), so a group
+// of 8 entries whose bounds all exceed the best distance so far is skipped
+// without computing its distances. The group `seed` (that of a neighbour's
+// nearest: within the neighbour's distance + the spacing) is searched first.
+// `slack` covers the float rounding of the bound.
+__attribute__((target_clones("avx2", "default"))) std::size_t nearest(const Packed& t, const Vec3f& p,
+                                                                       const InBlock& at_p, float slack,
+                                                                       std::size_t seed, float& d2) {
   const V8 px = V8{} + p.x(), py = V8{} + p.y(), pz = V8{} + p.z();
+  const V8 wx = V8{} + at_p.wx, wy = V8{} + at_p.wy, wz = V8{} + at_p.wz;
   V8 best = V8{} + kInf;
-  I8 at = I8{}, best_face = I8{} + std::numeric_limits<std::int32_t>::max(), lane = I8{0, 1, 2, 3, 4, 5, 6, 7};
-  const I8 size = I8{} + std::int32_t(t.size);
-  for (std::size_t i = 0; i < n; i += 8, lane += 8) {
+  I8 at = I8{}, best_face = I8{} + std::numeric_limits<std::int32_t>::max();
+  const I8 size = I8{} + std::int32_t(t.size), lanes = I8{0, 1, 2, 3, 4, 5, 6, 7};
+  float reach2 = kInf;  // the best squared distance so far
+  const auto group = [&](std::size_t c) __attribute__((always_inline)) {  // inlined: compiled for the clone's target
+    const std::size_t i = 8 * c;
+    const I8 lane = lanes + std::int32_t(i);
     V8 r = distance8(t.f, i, px, py, pz);
     r = lane < size ? r : V8{} + kInf;  // the padding
+    I8 face;
+    std::memcpy(&face, t.face.data() + i, sizeof face);
+    const auto closer = (r < best) | ((r == best) & (face < best_face));
+    best = closer ? r : best;
+    best_face = closer ? face : best_face;
+    at = closer ? lane : at;
+    reach2 = std::min(reach2, min8(r));
+  };
+  const auto lower = [&](std::size_t c) __attribute__((always_inline)) {  // the smallest bound of group c
+    const std::size_t i = 8 * c;
+    const auto k = [&](int n) { return load8(t.f[Packed::k0 + n].data() + i); };
+    const V8 x0 = k(0) + wx * (k(1) - k(0)), x1 = k(2) + wx * (k(3) - k(2));
+    const V8 x2 = k(4) + wx * (k(5) - k(4)), x3 = k(6) + wx * (k(7) - k(6));
+    const V8 y0 = x0 + wy * (x1 - x0), y1 = x2 + wy * (x3 - x2);
+    const V8 z = y0 + wz * (y1 - y0);
+    return min8(z) * (1 - 1e-4f) - at_p.spread - slack;
+  };
+  const std::size_t groups = (t.size + 7) / 8;
+  if (seed >= groups) seed = 0;
+  group(seed);
+  for (std::size_t c = 0; c < groups; ++c) {
+    if (c == seed || lower(c) > reach2 * (1 + 1e-4f)) continue;
+    group(c);
+  }
+  std::size_t index = 0;
+  d2 = kInf;
+  std::int32_t face = std::numeric_limits<std::int32_t>::max();
+  for (int l = 0; l < 8; ++l)
+    if (best[l] < d2 || (best[l] == d2 && best_face[l] < face)) d2 = best[l], face = best_face[l], index = std::size_t(at[l]);
+  return index;
+}
+
+// The same over a list without corner distances (a tile's): every group is searched.
+__attribute__((target_clones("avx2", "default"))) std::size_t nearest_all(const Packed& t, const Vec3f& p, float& d2) {
+  const V8 px = V8{} + p.x(), py = V8{} + p.y(), pz = V8{} + p.z();
+  V8 best = V8{} + kInf;
+  I8 at = I8{}, best_face = I8{} + std::numeric_limits<std::int32_t>::max();
+  const I8 size = I8{} + std::int32_t(t.size), lanes = I8{0, 1, 2, 3, 4, 5, 6, 7};
+  for (std::size_t i = 0; i < t.size; i += 8) {
+    const I8 lane = lanes + std::int32_t(i);
+    V8 r = distance8(t.f, i, px, py, pz);
+    r = lane < size ? r : V8{} + kInf;
     I8 face;
     std::memcpy(&face, t.face.data() + i, sizeof face);
     const auto closer = (r < best) | ((r == best) & (face < best_face));
@@ -172,16 +250,12 @@ class GridSolver {
       : mesh_(mesh), grid_(grid), options_(options), tris_(mesh.triangles().data()),
         ids_(mesh.bvh().triangle_ids().data()) {
     const std::size_t n = mesh.triangles().size();
-    spheres_.resize(n);
     all_.reserve(n);
     all_.size = n;
     all_.leaf.resize(n);
     if (n >= std::size_t(std::numeric_limits<std::int32_t>::max())) throw Error("sdf grid: too many faces");
     parallel_for_each_index(0, n, [&](std::size_t i) {
       const BvhTriangle& t = tris_[i];
-      const Vec3f c = (t.a + t.b + t.c) / 3.0f;
-      const float r = std::sqrt(std::max({(t.a - c).squaredNorm(), (t.b - c).squaredNorm(), (t.c - c).squaredNorm()}));
-      spheres_[i] = Vec4f(c.x(), c.y(), c.z(), r * (1 + 1e-6f) + 1e-30f);
       const Vec3f ab = t.b - t.a, ac = t.c - t.a, bc = t.c - t.b, nn = ab.cross(ac);
       const float d00 = ab.dot(ab), d01 = ab.dot(ac), d11 = ac.dot(ac), den = d00 * d11 - d01 * d01;
       const float nn2 = nn.squaredNorm();
@@ -199,6 +273,7 @@ class GridSolver {
     const float scale = std::max({mb.lo.cwiseAbs().maxCoeff(), mb.hi.cwiseAbs().maxCoeff(), gb.lo.cwiseAbs().maxCoeff(),
                                   gb.hi.cwiseAbs().maxCoeff(), 1e-30f});
     margin_ = 1e-6f * scale;
+    slack_ = 4 * margin_ * scale;  // float rounding of squared distances up to the scene's size
     const float h = grid.spacing.minCoeff();
     band_ = std::isfinite(options.band) ? float(options.band) * h : kInf;
   }
@@ -214,9 +289,10 @@ class GridSolver {
       return (i - box.lo[0]) + nx * ((j - box.lo[1]) + ny * (k - box.lo[2]));
     };
     if (!(centre.distance - box.radius > band_ + margin_)) {
-      Packed tile_list, block_list;
-      gather(box, centre.closest, tile_list);
-      std::vector<float> d2(tile_list.f[0].size()), pass(tile_list.f[0].size());
+      Packed tile_list, block_list, near;
+      std::vector<float> d2, pass;
+      std::vector<std::uint32_t> keep;
+      gather(box, centre.closest, tile_list, near, keep, d2, pass);
       for (std::size_t bz = box.lo[2]; bz < box.hi[2]; bz += kBlock)
         for (std::size_t by = box.lo[1]; by < box.hi[1]; by += kBlock)
           for (std::size_t bx = box.lo[0]; bx < box.hi[0]; bx += kBlock) {
@@ -225,14 +301,30 @@ class GridSolver {
                                    std::min(bz + kBlock, box.hi[2])});
             const Closest c = closest_in(tile_list, block.centre);
             if (std::sqrt(c.d2) - block.radius > band_ + margin_) continue;
-            filter(tile_list, block, c.point, block_list, d2.data(), pass.data());
-            stats.candidates_per_sample += double(block_list.size) * double(block.samples());
+            filter(tile_list, block, c.point, block_list, d2, pass, keep);
+            std::size_t seed = 0;  // the group of the previous sample's nearest face
+            const Vec3f extent = block.corners[7] - block.corners[0];
             for (std::size_t k = block.lo[2]; k < block.hi[2]; ++k)
               for (std::size_t j = block.lo[1]; j < block.hi[1]; ++j)
                 for (std::size_t i = block.lo[0]; i < block.hi[0]; ++i) {
-                  const Closest s = closest_in(block_list, grid_.position(i, j, k));
+                  const Vec3f p = grid_.position(i, j, k);
+                  InBlock at_p;
+                  const auto weight = [&](int a) {
+                    return extent[a] > 0 ? std::clamp((p[a] - block.corners[0][a]) / extent[a], 0.0f, 1.0f) : 0.0f;
+                  };
+                  at_p.wx = weight(0), at_p.wy = weight(1), at_p.wz = weight(2);
+                  // sum_k w_k |v_k - p|^2 of the box's corners, one axis at a time (rounded up).
+                  at_p.spread = 0;
+                  for (int a = 0; a < 3; ++a) {
+                    const float w = a == 0 ? at_p.wx : a == 1 ? at_p.wy : at_p.wz;
+                    at_p.spread += extent[a] * extent[a] * w * (1 - w);
+                  }
+                  at_p.spread = at_p.spread * (1 + 1e-4f) + margin_ * margin_;
+                  const Closest s = closest_in(block_list, p, &at_p, seed);
+                  seed = s.slot / 8;
                   const float d = std::sqrt(s.d2);
                   if (d > band_) continue;
+                  stats.candidates_per_sample += double(block_list.size);
                   ud[local(i, j, k)] = d;
                   best[local(i, j, k)] = s;
                   ++stats.in_band;
@@ -290,13 +382,14 @@ class GridSolver {
   }
 
   // The faces that may be closest to a sample of the box, q being a surface
-  // point: the hierarchy's nodes and then its triangles pass if they are no
-  // farther than q from one of the box's corners (a triangle's bounding
-  // sphere first), in leaf order.
-  void gather(const SampleBox& box, const Vec3f& q, Packed& out) const {
+  // point: the hierarchy's nodes pass if they are no farther than q from one
+  // of the box's corners, then their triangles the same test (filter), in
+  // leaf order.
+  void gather(const SampleBox& box, const Vec3f& q, Packed& out, Packed& near, std::vector<std::uint32_t>& found,
+              std::vector<float>& d2, std::vector<float>& pass) const {
     const std::array<float, 8> bound2 = bounds_from(box, q);
     const bvh::Topology& topo = mesh_.bvh().topology();
-    std::vector<std::uint32_t> found;
+    found.clear();
     std::visit(
         [&](const auto& volumes) {
           bvh::TraversalStack<bvh::NodeRef> stack(mesh_.stack_size());
@@ -308,50 +401,49 @@ class GridSolver {
                 return false;
               },
               [&](const bvh::TopoNode& node) {
-                for (std::uint32_t i = node.prim_first; i < node.prim_first + node.prim_count; ++i) {
-                  const Vec4f& s = spheres_[i];
-                  const BvhTriangle& tri = tris_[i];
-                  for (int k = 0; k < 8; ++k) {
-                    const float lb = (box.corners[k] - s.head<3>()).norm() - s.w();
-                    if (lb > 0 && lb * lb > bound2[k]) continue;
-                    if ((closest_point_on_triangle(box.corners[k], tri.a, tri.b, tri.c) - box.corners[k]).squaredNorm() <=
-                        bound2[k]) {
-                      found.push_back(i);
-                      break;
-                    }
-                  }
-                }
+                for (std::uint32_t i = node.prim_first; i < node.prim_first + node.prim_count; ++i) found.push_back(i);
               },
               [](float) { return true; });
         },
         mesh_.bvh().volumes());
-    out.clear();
-    out.reserve(found.size());
-    for (const std::uint32_t t : found) out.push(all_, t);
+    near.assign(all_, found);
+    filter(near, box, q, out, d2, pass, found);
   }
 
-  // The entries of `in` that may be closest to a sample of the box (see gather).
-  void filter(const Packed& in, const SampleBox& box, const Vec3f& q, Packed& out, float* d2, float* pass) const {
+  // The list keeps each entry's squared distances from the 8 corners (k0..k7).
+  void filter(const Packed& in, const SampleBox& box, const Vec3f& q, Packed& out, std::vector<float>& d2,
+              std::vector<float>& pass, std::vector<std::uint32_t>& keep) const {
     const std::array<float, 8> bound2 = bounds_from(box, q);
-    std::fill_n(pass, in.size, 0.0f);
+    const std::size_t stride = in.f[0].size();
+    d2.resize(8 * stride);
+    pass.assign(in.size, 0.0f);
     for (int k = 0; k < 8; ++k) {
-      squared_distances(in, box.corners[k], d2);
-      for (std::size_t i = 0; i < in.size; ++i) pass[i] = d2[i] <= bound2[k] ? 1.0f : pass[i];
+      float* dk = d2.data() + std::size_t(k) * stride;
+      squared_distances(in, box.corners[k], dk);
+      for (std::size_t i = 0; i < in.size; ++i) pass[i] = dk[i] <= bound2[k] ? 1.0f : pass[i];
     }
-    out.clear();
+    keep.clear();
     for (std::size_t i = 0; i < in.size; ++i)
-      if (pass[i] != 0) out.push(in, i);
+      if (pass[i] != 0) keep.push_back(std::uint32_t(i));
+    out.assign(in, keep);
+    for (int k = 0; k < 8; ++k) {
+      const float* dk = d2.data() + std::size_t(k) * stride;
+      float* o = out.f[Packed::k0 + k].data();
+      for (std::size_t j = 0; j < keep.size(); ++j) o[j] = dk[keep[j]];
+    }
   }
 
   // The closest entry of `list` to p (ties: the smallest face index), with
   // its exact closest point and region.
-  Closest closest_in(const Packed& list, const Vec3f& p) const {
+  // With `at_p`, the list is a block's (with corner distances) and p is in the block.
+  Closest closest_in(const Packed& list, const Vec3f& p, const InBlock* at_p = nullptr, std::size_t seed = 0) const {
     Closest best;
     if (list.size == 0) return best;
     float nearest_d2;
-    const std::size_t i = nearest(list, p, nearest_d2);
+    const std::size_t i = at_p ? nearest(list, p, *at_p, slack_, seed, nearest_d2) : nearest_all(list, p, nearest_d2);
     const BvhTriangle& tri = tris_[list.leaf[i]];
     best.leaf = list.leaf[i];
+    best.slot = i;
     best.point = closest_point_on_triangle(p, tri.a, tri.b, tri.c, best.region);
     best.d2 = (best.point - p).squaredNorm();
     return best;
@@ -362,9 +454,9 @@ class GridSolver {
   const SdfGridOptions& options_;
   const BvhTriangle* tris_;
   const std::uint32_t* ids_;
-  std::vector<Vec4f> spheres_;  // per leaf triangle: centroid and radius
   Packed all_;                  // every triangle, in leaf order
   float margin_ = 0;
+  float slack_ = 0;
   float band_ = kInf;
 };
 
