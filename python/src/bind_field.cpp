@@ -10,6 +10,7 @@
 #include "arrays.hpp"
 #include "bindings.hpp"
 #include "geods/core/parallel.hpp"
+#include "geods/field/chamfer.hpp"
 #include "geods/field/edt.hpp"
 #include "geods/field/sdf_grid.hpp"
 #include "without_gil.hpp"
@@ -19,14 +20,14 @@ namespace {
 
 // A 1-, 2- or 3-D array as a mask volume (nonzero = foreground; C order, the
 // last axis x) and the array's shape.
-Grid3<std::uint8_t> mask_from(const py::object& mask, std::vector<py::ssize_t>& shape) {
+Grid3<std::uint8_t> mask_from(const py::object& mask, std::vector<py::ssize_t>& shape, const std::string& what) {
   const py::module_ np = py::module_::import("numpy");
   const py::array a = np.attr("asarray")(mask);
-  if (a.ndim() < 1 || a.ndim() > 3) throw Error("edt: the mask must be a 1-, 2- or 3-D array");
+  if (a.ndim() < 1 || a.ndim() > 3) throw Error(what + ": the mask must be a 1-, 2- or 3-D array");
   const char kind = a.dtype().kind();
   if (kind != 'b' && kind != 'i' && kind != 'u' && kind != 'f')
-    throw Error("edt: the mask must hold numbers or booleans, got " + py::cast<std::string>(py::repr(a.dtype())));
-  if (kind == 'f' && py::cast<bool>(np.attr("isnan")(a).attr("any")())) throw Error("edt: the mask holds NaN");
+    throw Error(what + ": the mask must hold numbers or booleans, got " + py::cast<std::string>(py::repr(a.dtype())));
+  if (kind == 'f' && py::cast<bool>(np.attr("isnan")(a).attr("any")())) throw Error(what + ": the mask holds NaN");
   const Rows<std::uint8_t> flags = Rows<std::uint8_t>::ensure(np.attr("not_equal")(a, 0));
   shape.assign(a.shape(), a.shape() + a.ndim());
   Grid3<std::uint8_t> g;
@@ -36,25 +37,29 @@ Grid3<std::uint8_t> mask_from(const py::object& mask, std::vector<py::ssize_t>& 
   return g;
 }
 
+// One spacing or one per axis of the mask (x first), as 3 values; none: unset.
+std::optional<std::array<double, 3>> spacing_from(const py::object& spacing, std::size_t axes, const std::string& what) {
+  if (spacing.is_none()) return std::nullopt;
+  std::array<double, 3> s{1, 1, 1};
+  if (py::isinstance<py::float_>(spacing) || py::isinstance<py::int_>(spacing)) {
+    s.fill(py::cast<double>(spacing));
+  } else {
+    const auto values = py::cast<std::vector<double>>(spacing);
+    if (values.size() != axes)
+      throw Error(what + ": spacing needs one value per axis (x first), " + std::to_string(axes) + " for this mask, got " +
+                  std::to_string(values.size()));
+    std::copy(values.begin(), values.end(), s.begin());
+  }
+  return s;
+}
+
 py::object edt_py(const py::object& mask, const py::object& spacing, bool return_indices, bool squared) {
   std::vector<py::ssize_t> shape;
-  const Grid3<std::uint8_t> grid = mask_from(mask, shape);
+  const Grid3<std::uint8_t> grid = mask_from(mask, shape, "edt");
   field::EdtRequest request;
   request.squared = squared;
   request.features = return_indices;
-  if (!spacing.is_none()) {
-    std::array<double, 3> s{1, 1, 1};
-    if (py::isinstance<py::float_>(spacing) || py::isinstance<py::int_>(spacing)) {
-      s.fill(py::cast<double>(spacing));
-    } else {
-      const auto values = py::cast<std::vector<double>>(spacing);
-      if (values.size() != shape.size())
-        throw Error("edt: spacing needs one value per axis (x first), " + std::to_string(shape.size()) +
-                    " for this mask, got " + std::to_string(values.size()));
-      std::copy(values.begin(), values.end(), s.begin());
-    }
-    request.spacing = s;
-  }
+  request.spacing = spacing_from(spacing, shape.size(), "edt");
   const field::EdtResult r = without_gil([&] { return field::edt(grid.view(), request); });
   py::array_t<double> distance = copy_array(r.distance.data.data(), shape);
   if (!return_indices) return distance;
@@ -136,6 +141,16 @@ py::tuple sdf_grid_py(const Rows<float>& v, const Rows<std::int64_t>& f, const p
   return py::make_tuple(d, o, s);
 }
 
+py::array_t<double> chamfer_py(const py::object& mask, int size, const py::object& spacing) {
+  std::vector<py::ssize_t> shape;
+  const Grid3<std::uint8_t> grid = mask_from(mask, shape, "chamfer");
+  field::ChamferRequest request;
+  request.size = size;
+  request.spacing = spacing_from(spacing, shape.size(), "chamfer");
+  const Grid3<double> d = without_gil([&] { return field::chamfer(grid.view(), request); });
+  return copy_array(d.data.data(), shape);
+}
+
 }  // namespace
 
 void bind_field(py::module_& m) {
@@ -149,6 +164,15 @@ void bind_field(py::module_& m) {
         "squared: squared distances. Felzenszwalb-Huttenlocher, parallel; equal to brute force bit for bit\n"
         "with integer spacings.");
 
+  m.def("chamfer", &chamfer_py, py::arg("mask"), py::arg("size") = field::ChamferRequest{}.size,
+        py::arg("spacing") = py::none(),
+        "Chamfer distance transform of a 1-, 2- or 3-D mask (nonzero = foreground; edt's convention): the\n"
+        "distance to the nearest zero sample approximated by a forward and a backward scan with the\n"
+        "3x3x3 (size=3) or 5x5x5 (size=5) matrix of Euclidean step lengths (seed Figure 61), float64 of\n"
+        "the mask's shape. Never below the exact distance, at most chamfer_max_error(size) above it\n"
+        "relatively (unit spacing): 12.8 % for size 3, 4.9 % for size 5. spacing as in edt.");
+  m.def("chamfer_max_error", &field::chamfer_max_error, py::arg("size"),
+        "Largest relative overestimate of geods.chamfer(size=size) with unit spacing (measured over offsets up to 47).");
   m.def("signed_distance", &signed_distance_py, py::arg("V"), py::arg("F"), py::arg("points"),
         py::arg("sign") = "winding", py::arg("return_feature") = false,
         "Exact signed distance of points (n, 3) to the triangle mesh (V, F), negative inside:\n"

@@ -259,3 +259,64 @@ def test_cli_sdf(cli, data_dir, tmp_path, bunny):
         assert r.returncode == 2 and words in r.stderr and len(r.stderr.strip().splitlines()) == 1, (args, r.stderr)
     r = run(cli, "sdf", tmp_path / "missing.ply", "-o", tmp_path / "x.npy", "--res", 8)
     assert r.returncode == 2 and "missing.ply" in r.stderr
+
+
+# ---------------------------------------------------------------- chamfer propagation
+
+
+def dijkstra_chamfer(mask, size, spacing=(1.0, 1.0, 1.0)):
+    """Shortest paths of matrix steps from the zeros (3-D mask, numpy order; spacing x first)."""
+    import heapq
+    import itertools
+    import math
+    r = size // 2
+    steps = [m for m in itertools.product(range(-r, r + 1), repeat=3)
+             if math.gcd(math.gcd(abs(m[0]), abs(m[1])), abs(m[2])) == 1]
+    sz, sy, sx = spacing[2], spacing[1], spacing[0]
+    d = np.full(mask.shape, np.inf)
+    heap = [(0.0, idx) for idx in zip(*np.nonzero(mask == 0))]
+    for _, idx in heap:
+        d[idx] = 0
+    heapq.heapify(heap)
+    while heap:
+        dist, (z, y, x) = heapq.heappop(heap)
+        if dist > d[z, y, x]:
+            continue
+        for dz, dy, dx in steps:
+            c = (z + dz, y + dy, x + dx)
+            if all(0 <= c[a] < mask.shape[a] for a in range(3)):
+                nd = dist + math.sqrt((sz * dz) ** 2 + (sy * dy) ** 2 + (sx * dx) ** 2)
+                if nd < d[c]:
+                    d[c] = nd
+                    heapq.heappush(heap, (nd, c))
+    return d
+
+
+@pytest.mark.parametrize("size", [3, 5])
+def test_chamfer_is_the_shortest_path_of_steps_and_within_its_bound(size):
+    rng = np.random.default_rng(size)
+    mask = rng.random((6, 7, 8)) < 0.93
+    mask[0, 0, 0] = False
+    np.testing.assert_allclose(geods.chamfer(mask, size=size), dijkstra_chamfer(mask, size), atol=1e-9)
+    np.testing.assert_allclose(geods.chamfer(mask, size=size, spacing=(1, 2, 0.5)),
+                               dijkstra_chamfer(mask, size, (1, 2, 0.5)), atol=1e-9)
+    big = rng.random((30, 40, 50)) < 0.995
+    big[0, 0, 0] = False
+    exact = geods.edt(big)
+    approx = geods.chamfer(big, size=size)
+    e = geods.chamfer_max_error(size)
+    assert (approx >= exact * (1 - 1e-12)).all() and (approx <= exact * (1 + e) + 1e-12).all()
+    assert e < (0.13 if size == 3 else 0.05)
+
+
+def test_chamfer_2d_and_bad_input():
+    stripes = np.ones((8, 9), bool)
+    stripes[::4] = False
+    assert geods.chamfer(stripes)[:4, 0].tolist() == [0, 1, 2, 1]
+    assert np.isinf(geods.chamfer(np.ones((3, 4)))).all()
+    with pytest.raises(geods.Error, match="size 3 or 5"):
+        geods.chamfer(stripes, size=4)
+    with pytest.raises(geods.Error, match="NaN"):
+        geods.chamfer(np.array([0.0, np.nan]))
+    with pytest.raises(geods.Error, match="spacing"):
+        geods.chamfer(stripes, spacing=(1, 0))
