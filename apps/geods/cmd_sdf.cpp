@@ -39,6 +39,10 @@ class SdfCommand : public Command {
     app.add_option("--sign", sign_, "Inside by generalized winding number, by pseudonormals (closed meshes), or none")
         ->check(CLI::IsMember({"winding", "pseudonormal", "none"}))
         ->capture_default_str();
+    app.add_option("--method", method_,
+                   "exact, or propagation (exact on a shell about the surface, passed on to neighbours by two scans)")
+        ->check(CLI::IsMember({"exact", "propagation"}))
+        ->capture_default_str();
     app.add_option("--faces", faces_, "Also the closest face of each sample, int64 .npy (-1 outside the band)");
   }
 
@@ -52,6 +56,7 @@ class SdfCommand : public Command {
     field::SdfGridOptions options;
     options.sign = field::parse_sign_method(sign_);
     options.faces = !faces_.empty();
+    options.method = field::parse_sdf_method(method_);
     if (band_) options.band = *band_;
     // The grid is checked (and refused if too large) before the hierarchy is built.
     const Grid3Geometry grid = field::sdf_grid_geometry(mesh.bounds(), res_, spacing_, padding_);
@@ -82,6 +87,7 @@ class SdfCommand : public Command {
     j["spacing"] = std::vector<double>{grid.spacing.x(), grid.spacing.y(), grid.spacing.z()};
     j["origin"] = std::vector<double>{grid.origin.x(), grid.origin.y(), grid.origin.z()};
     j["sign"] = sign_;
+    j["method"] = method_;
     if (band_) j["band"] = *band_;
     put_stats(j, r.stats);
     j["inside"] = std::count_if(r.distance.data.begin(), r.distance.data.end(), [](float d) { return d < 0; });
@@ -103,7 +109,7 @@ class SdfCommand : public Command {
   }
 
  private:
-  std::string mesh_, output_, faces_, sign_ = "winding";
+  std::string mesh_, output_, faces_, sign_ = "winding", method_ = "exact";
   std::size_t res_ = 0;
   double spacing_ = 0, padding_ = field::kDefaultPadding;
   std::optional<double> band_;

@@ -320,3 +320,22 @@ def test_chamfer_2d_and_bad_input():
         geods.chamfer(np.array([0.0, np.nan]))
     with pytest.raises(geods.Error, match="spacing"):
         geods.chamfer(stripes, spacing=(1, 0))
+
+
+def test_sdf_grid_propagation_is_an_upper_bound(bunny, cli, data_dir, tmp_path):
+    V, F = bunny
+    exact, _, spacing = geods.sdf_grid(V, F, 32, sign="pseudonormal")
+    approx, _, _ = geods.sdf_grid(V, F, 32, sign="pseudonormal", method="propagation")
+    h = spacing[0]
+    assert (np.abs(approx) >= np.abs(exact) - 1e-5).all()
+    shell = np.abs(exact) <= 1.7 * h
+    np.testing.assert_allclose(approx[shell], exact[shell], atol=1e-5)
+    assert ((approx < 0) == (exact < 0))[np.abs(exact) > 1e-5].all()
+    assert (np.abs(approx) - np.abs(exact)).max() < 1.5 * h
+    with pytest.raises(geods.Error, match="method"):
+        geods.sdf_grid(V, F, 8, method="sweep")
+    r = run(cli, "sdf", data_dir / "bunny.ply", "-o", tmp_path / "p.npy", "--res", 32, "--sign", "pseudonormal",
+            "--method", "propagation", "--json")
+    assert r.returncode == 0, r.stderr
+    np.testing.assert_array_equal(np.load(tmp_path / "p.npy"), approx)
+    assert json.loads(r.stdout)["method"] == "propagation"

@@ -492,6 +492,95 @@ Grid3Geometry sdf_grid_geometry(const AABB3f& box, std::size_t res, double spaci
   return g;
 }
 
+SdfMethod parse_sdf_method(std::string_view name) {
+  for (const SdfMethod m : {SdfMethod::exact, SdfMethod::propagation})
+    if (name == to_string(m)) return m;
+  throw Error("sdf grid: unknown method '" + std::string(name) + "' (exact or propagation)");
+}
+
+std::string_view to_string(SdfMethod method) { return method == SdfMethod::exact ? "exact" : "propagation"; }
+
+namespace {
+
+// §6.1.1's vector propagation: the exact shell, then two scans passing
+// closest points to neighbours (see SdfMethod::propagation).
+void propagate(const MeshDistance& mesh, const Grid3Geometry& grid, const SdfGridOptions& options, SdfGrid& result) {
+  constexpr double kShell = 1.7321;  // samples: the 3^3 neighbourhood of the surface
+  SdfGridOptions shell_options;
+  shell_options.sign = SignMethod::none;
+  shell_options.band = kShell;
+  shell_options.faces = true;
+  SdfGrid shell = sdf_grid(mesh, grid, shell_options);
+  const std::size_t n = shell.distance.size();
+  const auto& tris = mesh.triangles();
+  std::vector<std::uint32_t> leaf_of(tris.size());
+  for (std::uint32_t i = 0; i < tris.size(); ++i) leaf_of[mesh.face_of(i)] = i;
+  std::vector<Vec3f> q(n, Vec3f::Constant(kInf));
+  std::vector<std::uint32_t>& face = shell.faces;
+  std::vector<float>& d2 = shell.distance.data;
+  parallel_for_each_index(0, n, [&](std::size_t s) {
+    if (face[s] == kNoIndex) return d2[s] = kInf, void();
+    const Vec3f p = grid.position(s % grid.dims[0], s / grid.dims[0] % grid.dims[1], s / (grid.dims[0] * grid.dims[1]));
+    const bvh::BvhTriangle& t = tris[leaf_of[face[s]]];
+    q[s] = closest_point_on_triangle(p, t.a, t.b, t.c);
+    d2[s] = (q[s] - p).squaredNorm();
+  }, 4096);
+  // The 13 neighbours before a sample in the forward scan (z, y, x increasing).
+  struct Step {
+    int dx, dy, dz;
+  };
+  std::vector<Step> steps;
+  for (int dz = -1; dz <= 1; ++dz)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx)
+        if (dz < 0 || (dz == 0 && (dy < 0 || (dy == 0 && dx < 0)))) steps.push_back({dx, dy, dz});
+  const auto [nx, ny, nz] = grid.dims;
+  const auto scan = [&](int sign) {
+    for (std::size_t kk = 0; kk < nz; ++kk)
+      for (std::size_t jj = 0; jj < ny; ++jj)
+        for (std::size_t ii = 0; ii < nx; ++ii) {
+          const std::size_t i = sign > 0 ? ii : nx - 1 - ii, j = sign > 0 ? jj : ny - 1 - jj,
+                            k = sign > 0 ? kk : nz - 1 - kk;
+          const std::size_t s = grid.index(i, j, k);
+          const Vec3f p = grid.position(i, j, k);
+          for (const Step& st : steps) {
+            const long a = long(i) + sign * st.dx, b = long(j) + sign * st.dy, c = long(k) + sign * st.dz;
+            if (a < 0 || b < 0 || c < 0 || a >= long(nx) || b >= long(ny) || c >= long(nz)) continue;
+            const std::size_t m = grid.index(std::size_t(a), std::size_t(b), std::size_t(c));
+            if (face[m] == kNoIndex) continue;
+            const float e = (q[m] - p).squaredNorm();
+            if (e < d2[s]) d2[s] = e, q[s] = q[m], face[s] = face[m];
+          }
+        }
+  };
+  scan(1);
+  scan(-1);
+  // Each sample: the exact distance to its face (at most that to the point it got), and the sign.
+  std::atomic<std::size_t> windings{0};
+  parallel_for_each_index(0, n, [&](std::size_t s) {
+    const Vec3f p = grid.position(s % nx, s / nx % ny, s / (nx * ny));
+    if (face[s] == kNoIndex) return d2[s] = kInf, void();  // no shell at all (a grid far from the mesh)
+    const bvh::BvhTriangle& t = tris[leaf_of[face[s]]];
+    TriangleRegion region;
+    const Vec3f c = closest_point_on_triangle(p, t.a, t.b, t.c, region);
+    float d = (c - p).norm();
+    bool inside = false;
+    if (options.sign == SignMethod::pseudonormal) {
+      inside = (p - c).dot(mesh.pseudonormal(face[s], region)) < 0;
+    } else if (options.sign == SignMethod::winding) {
+      inside = mesh.winding_number(p) > 0.5;
+      ++windings;
+    }
+    d2[s] = inside ? -d : d;
+  }, 1024);
+  result.distance = std::move(shell.distance);
+  if (options.faces) result.faces = std::move(face);
+  result.stats.in_band = n;
+  result.stats.winding_numbers = windings;
+}
+
+}  // namespace
+
 SdfGrid sdf_grid(const MeshDistance& mesh, const Grid3Geometry& grid, const SdfGridOptions& options) {
   for (int a = 0; a < 3; ++a) {
     if (!std::isfinite(grid.spacing[a]) || !(grid.spacing[a] > 0))
@@ -515,6 +604,11 @@ SdfGrid sdf_grid(const MeshDistance& mesh, const Grid3Geometry& grid, const SdfG
   if (options.faces) result.faces.resize(n);
   result.stats.samples = n;
   if (n == 0) return result;
+  if (options.method == SdfMethod::propagation) {
+    if (std::isfinite(options.band)) throw Error("sdf grid: the propagation method computes the whole grid (no band)");
+    propagate(mesh, grid, options, result);
+    return result;
+  }
   const GridSolver solver(mesh, grid, options);
   std::array<std::size_t, 3> tiles;
   for (int a = 0; a < 3; ++a) tiles[a] = (grid.dims[a] + kTile - 1) / kTile;

@@ -17,13 +17,15 @@
 //   every point of the box and is nobody's closest face there. q is the
 //   closest point to the box's centre: for far boxes the test then passes
 //   only faces within a small fraction of a sample of the true distance.
-// - Neighbour starts (§6.1.1): a sample's search starts from the face that
-//   was closest to the sample before it, which is within the neighbour's
-//   distance + the spacing; a face whose bounding sphere is farther is
-//   skipped without computing its distance.
-// - Sign: the mesh's SignMethod. With winding numbers on a closed mesh, the
-//   sign of a sample whose neighbour (earlier in the tile) is farther from it
-//   than d(p) + d(neighbour) can't differ from the neighbour's (the segment
+// - Samples (§6.1.1's neighbour start): a sample's search starts from the
+//   group of 8 faces that held its predecessor's closest face (within the
+//   neighbour's distance + the spacing); by the same concavity, dist^2(p, f)
+//   is at least the trilinear interpolation of f's distances from the
+//   block's corners less the spread of the corners about p, so a group
+//   whose bounds all exceed the best distance so far is skipped.
+// - Sign: the mesh's SignMethod. With winding numbers on a closed mesh, a
+//   sample whose distance and that of a neighbour earlier in the tile add up
+//   to more than their separation takes the neighbour's sign (the segment
 //   between them meets no surface); only samples near the surface compute
 //   their own winding number (on open meshes every sample does).
 #include <cstdint>
@@ -35,11 +37,25 @@
 
 namespace geods::field {
 
+/// How the samples' distances are found: exact (the default), or by the
+/// vector propagation of §6.1.1: exact closest points on a shell of samples
+/// within sqrt 3 samples of the surface, then each sample takes the closest
+/// of its 26 neighbours' closest points in a forward and a backward scan
+/// (and the exact distance to that point's face). Never below the exact
+/// distance, exact on the shell; elsewhere an upper bound whose error
+/// docs/field.md measures.
+enum class SdfMethod : std::uint8_t { exact, propagation };
+
+/// "exact", "propagation"; geods::Error otherwise.
+SdfMethod parse_sdf_method(std::string_view name);
+std::string_view to_string(SdfMethod method);
+
 struct SdfGridOptions {
+  SdfMethod method = SdfMethod::exact;
   SignMethod sign = SignMethod::winding;
   /// Half-width of the narrow band in samples (of the smallest spacing): a
   /// sample farther from the surface gets +-infinity (the sign of its side).
-  /// Infinity: the whole grid.
+  /// Infinity: the whole grid. (Exact method only.)
   double band = std::numeric_limits<double>::infinity();
   /// Also the closest face of every sample (kNoIndex outside the band).
   bool faces = false;
