@@ -172,10 +172,12 @@ struct InBlock {
 // of 8 entries whose bounds all exceed the best distance so far is skipped
 // without computing its distances. The group `seed` (that of a neighbour's
 // nearest: within the neighbour's distance + the spacing) is searched first.
-// `slack` covers the float rounding of the bound.
+// `slack` covers the float rounding of the bound. Without `in_block` (a
+// tile's list, without corner distances) every group is searched.
 __attribute__((target_clones("avx2", "default"))) std::size_t nearest(const Packed& t, const Vec3f& p,
-                                                                       const InBlock& at_p, float slack,
+                                                                       const InBlock* in_block, float slack,
                                                                        std::size_t seed, float& d2) {
+  const InBlock at_p = in_block ? *in_block : InBlock{};
   const V8 px = V8{} + p.x(), py = V8{} + p.y(), pz = V8{} + p.z();
   const V8 wx = V8{} + at_p.wx, wy = V8{} + at_p.wy, wz = V8{} + at_p.wz;
   V8 best = V8{} + kInf;
@@ -208,33 +210,8 @@ __attribute__((target_clones("avx2", "default"))) std::size_t nearest(const Pack
   if (seed >= groups) seed = 0;
   group(seed);
   for (std::size_t c = 0; c < groups; ++c) {
-    if (c == seed || lower(c) > reach2 * (1 + 1e-4f)) continue;
+    if (c == seed || (in_block && lower(c) > reach2 * (1 + 1e-4f))) continue;
     group(c);
-  }
-  std::size_t index = 0;
-  d2 = kInf;
-  std::int32_t face = std::numeric_limits<std::int32_t>::max();
-  for (int l = 0; l < 8; ++l)
-    if (best[l] < d2 || (best[l] == d2 && best_face[l] < face)) d2 = best[l], face = best_face[l], index = std::size_t(at[l]);
-  return index;
-}
-
-// The same over a list without corner distances (a tile's): every group is searched.
-__attribute__((target_clones("avx2", "default"))) std::size_t nearest_all(const Packed& t, const Vec3f& p, float& d2) {
-  const V8 px = V8{} + p.x(), py = V8{} + p.y(), pz = V8{} + p.z();
-  V8 best = V8{} + kInf;
-  I8 at = I8{}, best_face = I8{} + std::numeric_limits<std::int32_t>::max();
-  const I8 size = I8{} + std::int32_t(t.size), lanes = I8{0, 1, 2, 3, 4, 5, 6, 7};
-  for (std::size_t i = 0; i < t.size; i += 8) {
-    const I8 lane = lanes + std::int32_t(i);
-    V8 r = distance8(t.f, i, px, py, pz);
-    r = lane < size ? r : V8{} + kInf;
-    I8 face;
-    std::memcpy(&face, t.face.data() + i, sizeof face);
-    const auto closer = (r < best) | ((r == best) & (face < best_face));
-    best = closer ? r : best;
-    best_face = closer ? face : best_face;
-    at = closer ? lane : at;
   }
   std::size_t index = 0;
   d2 = kInf;
@@ -440,7 +417,7 @@ class GridSolver {
     Closest best;
     if (list.size == 0) return best;
     float nearest_d2;
-    const std::size_t i = at_p ? nearest(list, p, *at_p, slack_, seed, nearest_d2) : nearest_all(list, p, nearest_d2);
+    const std::size_t i = nearest(list, p, at_p, slack_, seed, nearest_d2);
     const BvhTriangle& tri = tris_[list.leaf[i]];
     best.leaf = list.leaf[i];
     best.slot = i;
