@@ -1,6 +1,7 @@
 #pragma once
 // Small helpers on a single triangle (a, b, c).
 #include <algorithm>
+#include <cstdint>
 
 #include "geods/core/aabb.hpp"
 
@@ -40,34 +41,46 @@ Vec<T, 3> barycentric(const Vec<T, 3>& p, const Vec<T, 3>& a, const Vec<T, 3>& b
   return {T(1) - v - w, v, w};
 }
 
+/// Where on a triangle (a, b, c) a closest point lies: a corner, the inside of
+/// an edge, or the inside of the face.
+enum class TriangleRegion : std::uint8_t { vertex_a, vertex_b, vertex_c, edge_ab, edge_bc, edge_ca, face };
+
 /// Closest point of the triangle to p (Ericson, Real-Time Collision Detection
-/// 5.1.5): the Voronoi regions of vertices, edges and face in turn. Works for
-/// degenerate triangles too (it then returns a point on an edge or vertex).
+/// 5.1.5): the Voronoi regions of vertices, edges and face in turn; `region`
+/// says which one holds it. Works for degenerate triangles too (it then
+/// returns a point on an edge or vertex).
 template <typename T>
 Vec<T, 3> closest_point_on_triangle(const Vec<T, 3>& p, const Vec<T, 3>& a, const Vec<T, 3>& b,
-                                    const Vec<T, 3>& c) {
+                                    const Vec<T, 3>& c, TriangleRegion& region) {
+  using R = TriangleRegion;
   const Vec<T, 3> ab = b - a, ac = c - a, ap = p - a;
   const T d1 = ab.dot(ap), d2 = ac.dot(ap);
+  region = R::vertex_a;
   if (d1 <= T(0) && d2 <= T(0)) return a;
   const Vec<T, 3> bp = p - b;
   const T d3 = ab.dot(bp), d4 = ac.dot(bp);
+  region = R::vertex_b;
   if (d3 >= T(0) && d4 <= d3) return b;
   const T vc = d1 * d4 - d3 * d2;
   if (vc <= T(0) && d1 >= T(0) && d3 <= T(0)) {
     const T denom = d1 - d3;
+    region = denom > T(0) ? R::edge_ab : R::vertex_a;
     return denom > T(0) ? Vec<T, 3>(a + (d1 / denom) * ab) : a;
   }
   const Vec<T, 3> cp = p - c;
   const T d5 = ab.dot(cp), d6 = ac.dot(cp);
+  region = R::vertex_c;
   if (d6 >= T(0) && d5 <= d6) return c;
   const T vb = d5 * d2 - d1 * d6;
   if (vb <= T(0) && d2 >= T(0) && d6 <= T(0)) {
     const T denom = d2 - d6;
+    region = denom > T(0) ? R::edge_ca : R::vertex_a;
     return denom > T(0) ? Vec<T, 3>(a + (d2 / denom) * ac) : a;
   }
   const T va = d3 * d6 - d5 * d4;
   if (va <= T(0) && (d4 - d3) >= T(0) && (d5 - d6) >= T(0)) {
     const T denom = (d4 - d3) + (d5 - d6);
+    region = denom > T(0) ? R::edge_bc : R::vertex_b;
     return denom > T(0) ? Vec<T, 3>(b + ((d4 - d3) / denom) * (c - b)) : b;
   }
   const T sum = va + vb + vc;
@@ -80,12 +93,23 @@ Vec<T, 3> closest_point_on_triangle(const Vec<T, 3>& p, const Vec<T, 3>& a, cons
       return Vec<T, 3>(s + t * d);
     };
     Vec<T, 3> best = on_segment(a, b);
-    for (const Vec<T, 3>& q : {on_segment(b, c), on_segment(c, a)})
-      if ((q - p).squaredNorm() < (best - p).squaredNorm()) best = q;
+    region = R::edge_ab;
+    const Vec<T, 3> q_bc = on_segment(b, c), q_ca = on_segment(c, a);
+    if ((q_bc - p).squaredNorm() < (best - p).squaredNorm()) best = q_bc, region = R::edge_bc;
+    if ((q_ca - p).squaredNorm() < (best - p).squaredNorm()) best = q_ca, region = R::edge_ca;
     return best;
   }
   const T v = vb / sum, w = vc / sum;
+  region = R::face;
   return a + ab * v + ac * w;
+}
+
+/// The same without the region.
+template <typename T>
+Vec<T, 3> closest_point_on_triangle(const Vec<T, 3>& p, const Vec<T, 3>& a, const Vec<T, 3>& b,
+                                    const Vec<T, 3>& c) {
+  TriangleRegion region;
+  return closest_point_on_triangle(p, a, b, c, region);
 }
 
 }  // namespace geods

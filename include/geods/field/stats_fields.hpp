@@ -1,0 +1,14 @@
+#pragma once
+// The fields of SdfGridStats, named once (see spatial/stats_fields.hpp).
+#include "geods/field/sdf_grid.hpp"
+
+namespace geods::field {
+
+/// Calls f(name, value) for each field, in declaration order.
+template <typename F>
+void for_each_field(const SdfGridStats& s, F&& f) {
+  f("samples", s.samples), f("in_band", s.in_band), f("tiles", s.tiles), f("tiles_outside", s.tiles_outside),
+      f("candidates_per_sample", s.candidates_per_sample), f("winding_numbers", s.winding_numbers);
+}
+
+}  // namespace geods::field

@@ -1,0 +1,302 @@
+#include "geods/field/mesh_distance.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <numbers>
+#include <string>
+#include <tuple>
+
+#include "geods/bvh/traversal.hpp"
+#include "geods/core/error.hpp"
+#include "geods/core/parallel.hpp"
+
+namespace geods::field {
+namespace {
+
+// A node seen from farther than kDipoleRatio x its radius contributes its dipole.
+constexpr double kDipoleRatio = 2.0;
+
+// The solid angle of triangle (a, b, c) seen from p (Van Oosterom and
+// Strackee 1983): positive when the triangle turns counter-clockwise seen from p.
+double solid_angle(const Vec3d& p, const Vec3f& a, const Vec3f& b, const Vec3f& c) {
+  const Vec3d u = a.cast<double>() - p, v = b.cast<double>() - p, w = c.cast<double>() - p;
+  const double lu = u.norm(), lv = v.norm(), lw = w.norm();
+  const double det = u.dot(v.cross(w));
+  const double den = lu * lv * lw + u.dot(v) * lw + v.dot(w) * lu + w.dot(u) * lv;
+  return 2 * std::atan2(det, den);
+}
+
+// Vertex ids after welding vertices at equal positions: each vertex maps to
+// the smallest index of its position (deterministic).
+std::vector<std::uint32_t> weld(const std::vector<Vec3f>& vertices) {
+  std::vector<std::uint32_t> order(vertices.size());
+  std::iota(order.begin(), order.end(), 0u);
+  const auto key = [&](std::uint32_t i) { return std::tuple(vertices[i].x(), vertices[i].y(), vertices[i].z()); };
+  std::sort(order.begin(), order.end(), [&](std::uint32_t i, std::uint32_t j) {
+    return std::pair(key(i), i) < std::pair(key(j), j);
+  });
+  std::vector<std::uint32_t> id(vertices.size());
+  for (std::size_t k = 0; k < order.size(); ++k)
+    id[order[k]] = k > 0 && key(order[k]) == key(order[k - 1]) ? id[order[k - 1]] : order[k];
+  return id;
+}
+
+}  // namespace
+
+SignMethod parse_sign_method(std::string_view name) {
+  for (const SignMethod s : {SignMethod::winding, SignMethod::pseudonormal, SignMethod::none})
+    if (name == to_string(s)) return s;
+  throw Error("signed distance: unknown sign method '" + std::string(name) + "' (winding, pseudonormal or none)");
+}
+
+std::string_view to_string(SignMethod sign) {
+  switch (sign) {
+    case SignMethod::winding: return "winding";
+    case SignMethod::pseudonormal: return "pseudonormal";
+    case SignMethod::none: break;
+  }
+  return "none";
+}
+
+std::string_view to_string(Feature feature) {
+  switch (feature) {
+    case Feature::vertex: return "vertex";
+    case Feature::edge: return "edge";
+    case Feature::face: break;
+  }
+  return "face";
+}
+
+MeshDistance MeshDistance::build(const TriMesh& mesh, const bvh::BuildOptions& options) {
+  if (mesh.num_triangles() == 0) throw Error("signed distance: the mesh has no faces");
+  mesh.require_valid("signed distance");
+  MeshDistance md;
+  md.bvh_ = bvh::TriangleBvh::build(mesh, options);
+  md.depth_ = md.bvh_.topology().depth();
+  md.faces_ = mesh.triangles;
+  md.fit_normals(mesh);
+  md.fit_moments();
+  return md;
+}
+
+void MeshDistance::fit_normals(const TriMesh& mesh) {
+  const std::size_t n = faces_.size();
+  const std::vector<std::uint32_t> id = weld(mesh.vertices);
+  std::vector<Vec3d> normals(n);
+  face_normals_.resize(n);
+  std::vector<Vec3d> at_vertex(mesh.num_vertices(), Vec3d::Zero());
+  for (std::size_t f = 0; f < n; ++f) {
+    Vec3d v[3];
+    for (int i = 0; i < 3; ++i) v[i] = mesh.vertices[faces_[f][i]].cast<double>();
+    const Vec3d nn = (v[1] - v[0]).cross(v[2] - v[0]);
+    const double len = nn.norm();
+    normals[f] = len > 0 ? Vec3d(nn / len) : Vec3d::Zero();
+    face_normals_[f] = normals[f].cast<float>();
+    for (int i = 0; i < 3; ++i) {  // the angle at corner i weights the normal at its vertex
+      const Vec3d e1 = v[(i + 1) % 3] - v[i], e2 = v[(i + 2) % 3] - v[i];
+      const double angle = std::atan2(e1.cross(e2).norm(), e1.dot(e2));
+      at_vertex[id[faces_[f][i]]] += angle * normals[f];
+    }
+  }
+  vertex_normals_.resize(mesh.num_vertices());
+  for (std::size_t v = 0; v < vertex_normals_.size(); ++v) vertex_normals_[v] = at_vertex[id[v]].cast<float>();
+
+  // Edges by their welded ends: the normals of the faces on each are summed,
+  // and each direction is counted (closed: as often one way as the other).
+  struct EdgeUse {
+    std::uint32_t lo, hi, face;
+    std::uint8_t corner;
+    bool forward;
+  };
+  std::vector<EdgeUse> uses;
+  uses.reserve(3 * n);
+  for (std::size_t f = 0; f < n; ++f)
+    for (std::uint8_t i = 0; i < 3; ++i) {
+      const std::uint32_t a = id[faces_[f][i]], b = id[faces_[f][(i + 1) % 3]];
+      uses.push_back({std::min(a, b), std::max(a, b), std::uint32_t(f), i, a < b});
+    }
+  std::sort(uses.begin(), uses.end(), [](const EdgeUse& x, const EdgeUse& y) {
+    return std::tie(x.lo, x.hi, x.face, x.corner) < std::tie(y.lo, y.hi, y.face, y.corner);
+  });
+  edge_normals_.assign(3 * n, Vec3f::Zero());
+  closed_ = true;
+  for (std::size_t b = 0; b < uses.size();) {
+    std::size_t e = b;
+    Vec3d sum = Vec3d::Zero();
+    long balance = 0;
+    for (; e < uses.size() && uses[e].lo == uses[b].lo && uses[e].hi == uses[b].hi; ++e) {
+      sum += normals[uses[e].face];
+      balance += uses[e].forward ? 1 : -1;
+    }
+    // An edge between welded copies of one vertex belongs to a degenerate face: no boundary.
+    if (balance != 0 && uses[b].lo != uses[b].hi) closed_ = false;
+    for (std::size_t k = b; k < e; ++k) edge_normals_[3 * uses[k].face + uses[k].corner] = sum.cast<float>();
+    b = e;
+  }
+}
+
+void MeshDistance::fit_moments() {
+  const bvh::Topology& topo = bvh_.topology();
+  const auto& tris = bvh_.triangles();
+  moments_.assign(topo.nodes.size(), Moment{});
+  // Each node from its own range of triangles (O(n log n) in all).
+  parallel_for_each_index(
+      0, topo.nodes.size(),
+      [&](std::size_t k) {
+        const bvh::TopoNode& node = topo.nodes[k];
+        Moment m;
+        double area = 0;
+        Vec3d box_lo = Vec3d::Constant(INFINITY), box_hi = Vec3d::Constant(-INFINITY);
+        for (std::uint32_t i = node.prim_first; i < node.prim_first + node.prim_count; ++i) {
+          const Vec3d a = tris[i].a.cast<double>(), b = tris[i].b.cast<double>(), c = tris[i].c.cast<double>();
+          const Vec3d na = 0.5 * (b - a).cross(c - a);
+          m.normal_area += na;
+          const double ai = na.norm();
+          area += ai;
+          m.centroid += ai * (a + b + c) / 3;
+          for (const Vec3d* v : {&a, &b, &c}) box_lo = box_lo.cwiseMin(*v), box_hi = box_hi.cwiseMax(*v);
+        }
+        m.centroid = area > 0 ? Vec3d(m.centroid / area) : Vec3d(0.5 * (box_lo + box_hi));
+        for (std::uint32_t i = node.prim_first; i < node.prim_first + node.prim_count; ++i)
+          for (const Vec3f* v : {&tris[i].a, &tris[i].b, &tris[i].c})
+            m.radius = std::max(m.radius, (v->cast<double>() - m.centroid).norm());
+        moments_[k] = m;
+      },
+      16);
+}
+
+double MeshDistance::winding_number(const Vec3f& p) const {
+  if (!p.allFinite()) throw Error("winding number: the query point is not finite");
+  const bvh::Topology& topo = bvh_.topology();
+  const auto& tris = bvh_.triangles();
+  const Vec3d q = p.cast<double>();
+  double omega = 0;
+  bvh::TraversalStack<bvh::NodeRef> stack(stack_size());
+  bvh::traverse_topology<false>(
+      topo, 0, stack,
+      [&](std::uint32_t node, float&) {
+        const Moment& m = moments_[node];
+        const Vec3d r = m.centroid - q;
+        const double d2 = r.squaredNorm();
+        if (d2 > kDipoleRatio * kDipoleRatio * m.radius * m.radius) {
+          omega += m.normal_area.dot(r) / (d2 * std::sqrt(d2));
+          return false;
+        }
+        return true;
+      },
+      [&](const bvh::TopoNode& node) {
+        for (std::uint32_t i = node.prim_first; i < node.prim_first + node.prim_count; ++i)
+          omega += solid_angle(q, tris[i].a, tris[i].b, tris[i].c);
+      },
+      [](float) { return true; });
+  return omega / (4 * std::numbers::pi);
+}
+
+void MeshDistance::feature_of(std::uint32_t face, TriangleRegion region, Feature& feature,
+                              std::uint32_t& index) const {
+  using R = TriangleRegion;
+  switch (region) {
+    case R::vertex_a: case R::vertex_b: case R::vertex_c:
+      feature = Feature::vertex;
+      index = faces_[face][int(region) - int(R::vertex_a)];
+      return;
+    case R::edge_ab: case R::edge_bc: case R::edge_ca:
+      feature = Feature::edge;
+      index = std::uint32_t(int(region) - int(R::edge_ab));
+      return;
+    case R::face:
+      feature = Feature::face;
+      index = face;
+      return;
+  }
+}
+
+Vec3f MeshDistance::pseudonormal(std::uint32_t face, TriangleRegion region) const {
+  using R = TriangleRegion;
+  switch (region) {
+    case R::vertex_a: case R::vertex_b: case R::vertex_c:
+      return vertex_normals_[faces_[face][int(region) - int(R::vertex_a)]];
+    case R::edge_ab: case R::edge_bc: case R::edge_ca:
+      return edge_normals_[3 * face + (int(region) - int(R::edge_ab))];
+    case R::face:
+      break;
+  }
+  return face_normals_[face];
+}
+
+bool MeshDistance::inside_by_pseudonormal(const Vec3f& p, const MeshPointDistance& q) const {
+  if (q.face == kNoIndex) return false;
+  TriangleRegion region = TriangleRegion::face;
+  if (q.feature == Feature::vertex) {
+    for (int i = 0; i < 3; ++i)
+      if (faces_[q.face][i] == q.feature_index) region = TriangleRegion(int(TriangleRegion::vertex_a) + i);
+  } else if (q.feature == Feature::edge) {
+    region = TriangleRegion(int(TriangleRegion::edge_ab) + int(q.feature_index));
+  }
+  return (p - q.closest).cast<double>().dot(pseudonormal(q.face, region).cast<double>()) < 0;
+}
+
+MeshPointDistance MeshDistance::query(const Vec3f& p, SignMethod sign, float max_distance) const {
+  if (!p.allFinite()) throw Error("signed distance: the query point is not finite");
+  MeshPointDistance out;
+  float best_d2 = max_distance * max_distance;
+  std::uint32_t best = kNoIndex;  // leaf-order index
+  TriangleRegion best_region = TriangleRegion::face;
+  const bvh::Topology& topo = bvh_.topology();
+  const auto& tris = bvh_.triangles();
+  const auto& ids = bvh_.triangle_ids();
+  std::visit(
+      [&](const auto& volumes) {
+        bvh::TraversalStack<bvh::NodeRef> stack(stack_size());
+        bvh::traverse_topology<true>(
+            topo, 0, stack,
+            [&](std::uint32_t node, float& d2) GEODS_BVH_INLINE_LAMBDA {
+              d2 = bvh::squared_distance(volumes[node], p);
+              return d2 <= best_d2;
+            },
+            [&](const bvh::TopoNode& node) GEODS_BVH_INLINE_LAMBDA {
+              for (std::uint32_t i = node.prim_first; i < node.prim_first + node.prim_count; ++i) {
+                TriangleRegion region;
+                const Vec3f q = closest_point_on_triangle(p, tris[i].a, tris[i].b, tris[i].c, region);
+                const float d2 = (q - p).squaredNorm();
+                // Ties go to the smallest face index, as brute force over the faces in order.
+                if (d2 < best_d2 || (d2 == best_d2 && (best == kNoIndex || ids[i] < ids[best]))) {
+                  best_d2 = d2;
+                  best = i;
+                  best_region = region;
+                  out.closest = q;
+                }
+              }
+            },
+            [&](float d2) GEODS_BVH_INLINE_LAMBDA { return d2 <= best_d2; });
+      },
+      bvh_.volumes());
+  if (best == kNoIndex) {
+    out.closest = Vec3f::Constant(std::numeric_limits<float>::quiet_NaN());
+    if (sign == SignMethod::winding && winding_number(p) > 0.5) out.distance = -out.distance;
+    return out;
+  }
+  out.face = ids[best];
+  out.distance = std::sqrt(best_d2);
+  feature_of(out.face, best_region, out.feature, out.feature_index);
+  if ((sign == SignMethod::winding && winding_number(p) > 0.5) ||
+      (sign == SignMethod::pseudonormal && inside_by_pseudonormal(p, out)))
+    out.distance = -out.distance;
+  return out;
+}
+
+std::vector<MeshPointDistance> signed_distance(const MeshDistance& mesh, std::span<const Vec3f> points,
+                                               SignMethod sign) {
+  for (std::size_t i = 0; i < points.size(); ++i)
+    if (!points[i].allFinite()) throw Error("signed distance: point " + std::to_string(i) + " is not finite");
+  std::vector<MeshPointDistance> out(points.size());
+  parallel_for_each_index(0, points.size(), [&](std::size_t i) { out[i] = mesh.query(points[i], sign); }, 64);
+  return out;
+}
+
+std::vector<MeshPointDistance> signed_distance(const TriMesh& mesh, std::span<const Vec3f> points, SignMethod sign) {
+  return signed_distance(MeshDistance::build(mesh), points, sign);
+}
+
+}  // namespace geods::field

@@ -1,0 +1,622 @@
+#include "geods/field/sdf_grid.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cmath>
+#include <cstring>
+#include <string>
+
+#include <fmt/format.h>
+
+#include "geods/bvh/traversal.hpp"
+#include "geods/core/error.hpp"
+#include "geods/core/parallel.hpp"
+
+namespace geods::field {
+namespace {
+
+constexpr std::size_t kTile = 8;   // samples along a tile's side
+constexpr std::size_t kBlock = 4;  // samples along a block's side (within a tile)
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+using bvh::BvhTriangle;
+
+// A box of samples [lo, hi) of the grid, its 8 corners (sample positions) and centre.
+struct SampleBox {
+  std::array<std::size_t, 3> lo, hi;
+  std::array<Vec3f, 8> corners;
+  Vec3f centre;
+  float radius;  // half the diagonal
+
+  SampleBox(const Grid3Geometry& grid, std::array<std::size_t, 3> l, std::array<std::size_t, 3> h) : lo(l), hi(h) {
+    const Vec3f a = grid.position(lo[0], lo[1], lo[2]), b = grid.position(hi[0] - 1, hi[1] - 1, hi[2] - 1);
+    for (int k = 0; k < 8; ++k) corners[k] = Vec3f(k & 1 ? b.x() : a.x(), k & 2 ? b.y() : a.y(), k & 4 ? b.z() : a.z());
+    centre = 0.5f * (a + b);
+    radius = 0.5f * (b - a).norm();
+  }
+  std::size_t samples() const { return (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]); }
+};
+
+// The closest face of a list to a point.
+struct Closest {
+  float d2 = kInf;
+  std::uint32_t leaf = kNoIndex;  // leaf-order index
+  std::size_t slot = 0;           // position in the list
+  TriangleRegion region = TriangleRegion::face;
+  Vec3f point = Vec3f::Zero();
+};
+
+// Triangles prepared for squared distances to many points, one array per
+// quantity (structure of arrays) so that the loop over them vectorizes: the
+// corner a, the edges ab and ac, the normal n, the terms of the projection's
+// barycentric coordinates, and the reciprocal squared lengths (0 for a
+// degenerate edge or face, which then never claims a point).
+struct Packed {
+  // k0..k7: in a block's list, the squared distances from the block's 8 corners.
+  enum Field { ax, ay, az, bx, by, bz, cx, cy, cz, nx, ny, nz, d00, d01, d11, inv_den, inv_nn, inv_ab, inv_ac, inv_bc,
+               k0, k1, k2, k3, k4, k5, k6, k7, kFields };
+  using Arrays = std::array<std::vector<float>, kFields>;
+  Arrays f;
+  std::vector<std::uint32_t> leaf;  // leaf-order triangle of each entry
+  std::vector<std::int32_t> face;   // its face index (padded as the arrays)
+  std::size_t size = 0;
+
+  void clear() { size = 0, leaf.clear(); }
+  // Room for n entries, rounded up to whole vectors (the tail is never read as a result).
+  void reserve(std::size_t n) {
+    const std::size_t padded = (n + 15) & ~std::size_t(15);
+    if (f[0].size() < padded) {
+      for (auto& a : f) a.resize(padded, 0.0f);
+      face.resize(padded, 0);
+    }
+  }
+  // Entries idx of `from`, in that order, replacing this list's.
+  void assign(const Packed& from, const std::vector<std::uint32_t>& idx) {
+    clear();
+    reserve(idx.size());
+    for (int k = 0; k < kFields; ++k) {
+      const float* in = from.f[k].data();
+      float* o = f[k].data();
+      for (std::size_t j = 0; j < idx.size(); ++j) o[j] = in[idx[j]];
+    }
+    for (std::size_t j = 0; j < idx.size(); ++j) face[j] = from.face[idx[j]], leaf.push_back(from.leaf[idx[j]]);
+    size = idx.size();
+  }
+};
+
+// d2[i] = squared distance from p to entry i of t, for i < t.size rounded up
+// to 16: the face's plane distance where p projects inside it, else the
+// nearest of the three edges. Eight entries at a time, without branches
+// (GCC vector extensions: AVX2 where the CPU has it, picked at run time,
+// else two SSE halves).
+#pragma GCC diagnostic ignored "-Wpsabi"  // 32-byte vectors in inlined helpers, never across a call
+using V8 = float __attribute__((vector_size(32)));
+
+__attribute__((always_inline)) inline V8 load8(const float* p) {
+  V8 v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+
+// Entries [i, i + 8) of t.
+__attribute__((always_inline)) inline V8 distance8(const Packed::Arrays& f, std::size_t i, V8 px, V8 py, V8 pz) {
+  const V8 zero = V8{}, one = V8{} + 1.0f;
+  const auto clamp01 = [&](V8 s) {
+    s = s < zero ? zero : s;
+    return s > one ? one : s;
+  };
+  const auto at = [&](int k) { return load8(f[k].data() + i); };
+  const V8 bx = at(Packed::bx), by = at(Packed::by), bz = at(Packed::bz);
+  const V8 cx = at(Packed::cx), cy = at(Packed::cy), cz = at(Packed::cz);
+  const V8 qx = px - at(Packed::ax), qy = py - at(Packed::ay), qz = pz - at(Packed::az);  // p - a
+  const V8 e1 = bx * qx + by * qy + bz * qz;  // ab . (p - a)
+  const V8 e2 = cx * qx + cy * qy + cz * qz;  // ac . (p - a)
+  const V8 d01 = at(Packed::d01), inv_den = at(Packed::inv_den), inv_nn = at(Packed::inv_nn);
+  const V8 v = (at(Packed::d11) * e1 - d01 * e2) * inv_den;
+  const V8 w = (at(Packed::d00) * e2 - d01 * e1) * inv_den;
+  const V8 h = at(Packed::nx) * qx + at(Packed::ny) * qy + at(Packed::nz) * qz;
+  const V8 face = h * h * inv_nn;
+  const auto inside = (v >= zero) & (w >= zero) & (v + w <= one) & (inv_nn > zero);
+  // Edge ab from a, edge ac from a, edge bc from b.
+  V8 s = clamp01(e1 * at(Packed::inv_ab));
+  V8 rx = qx - s * bx, ry = qy - s * by, rz = qz - s * bz;
+  const V8 dab = rx * rx + ry * ry + rz * rz;
+  s = clamp01(e2 * at(Packed::inv_ac));
+  rx = qx - s * cx, ry = qy - s * cy, rz = qz - s * cz;
+  const V8 dac = rx * rx + ry * ry + rz * rz;
+  const V8 ux = qx - bx, uy = qy - by, uz = qz - bz;  // p - b
+  const V8 wx = cx - bx, wy = cy - by, wz = cz - bz;  // bc
+  s = clamp01((ux * wx + uy * wy + uz * wz) * at(Packed::inv_bc));
+  rx = ux - s * wx, ry = uy - s * wy, rz = uz - s * wz;
+  const V8 dbc = rx * rx + ry * ry + rz * rz;
+  V8 edge = dab < dac ? dab : dac;
+  edge = dbc < edge ? dbc : edge;
+  return inside ? face : edge;
+}
+
+__attribute__((target_clones("avx2", "default"))) void squared_distances(const Packed& t, const Vec3f& p, float* d2) {
+  const std::size_t n = (t.size + 15) & ~std::size_t(15);
+  const V8 px = V8{} + p.x(), py = V8{} + p.y(), pz = V8{} + p.z();
+  for (std::size_t i = 0; i < n; i += 8) {
+    const V8 r = distance8(t.f, i, px, py, pz);
+    std::memcpy(d2 + i, &r, sizeof r);
+  }
+}
+
+using I8 = std::int32_t __attribute__((vector_size(32)));
+
+// The smallest of 8 lanes, in three halving steps.
+__attribute__((always_inline)) inline float min8(V8 v) {
+  using M = std::int32_t __attribute__((vector_size(32)));
+  v = v < __builtin_shuffle(v, M{4, 5, 6, 7, 0, 1, 2, 3}) ? v : __builtin_shuffle(v, M{4, 5, 6, 7, 0, 1, 2, 3});
+  v = v < __builtin_shuffle(v, M{2, 3, 0, 1, 6, 7, 4, 5}) ? v : __builtin_shuffle(v, M{2, 3, 0, 1, 6, 7, 4, 5});
+  v = v < __builtin_shuffle(v, M{1, 0, 3, 2, 5, 4, 7, 6}) ? v : __builtin_shuffle(v, M{1, 0, 3, 2, 5, 4, 7, 6});
+  return v[0];
+}
+
+// Where a sample sits in its block: its trilinear weights (the fractions of
+// the block's extent along x, y, z) and the spread sum_k w_k |v_k - p|^2 of
+// the corners about it.
+struct InBlock {
+  float wx, wy, wz, spread;
+};
+
+// The entry of t nearest to p and its squared distance; of equally near
+// ones, the one of the smallest face index. t is a block's list with the
+// squared distances from the block's corners (k0..k7): by concavity,
+// dist^2(p, f) >= sum_k w_k dist^2(v_k, f) - sum_k w_k |v_k - p|^2 (the
+// trilinear interpolation of the corner values, less the spread), so a group
+// of 8 entries whose bounds all exceed the best distance so far is skipped
+// without computing its distances. The group `seed` (that of a neighbour's
+// nearest: within the neighbour's distance + the spacing) is searched first.
+// `slack` covers the float rounding of the bound. Without `in_block` (a
+// tile's list, without corner distances) every group is searched.
+__attribute__((target_clones("avx2", "default"))) std::size_t nearest(const Packed& t, const Vec3f& p,
+                                                                       const InBlock* in_block, float slack,
+                                                                       std::size_t seed, float& d2) {
+  const InBlock at_p = in_block ? *in_block : InBlock{};
+  const V8 px = V8{} + p.x(), py = V8{} + p.y(), pz = V8{} + p.z();
+  const V8 wx = V8{} + at_p.wx, wy = V8{} + at_p.wy, wz = V8{} + at_p.wz;
+  V8 best = V8{} + kInf;
+  I8 at = I8{}, best_face = I8{} + std::numeric_limits<std::int32_t>::max();
+  const I8 size = I8{} + std::int32_t(t.size), lanes = I8{0, 1, 2, 3, 4, 5, 6, 7};
+  float reach2 = kInf;  // the best squared distance so far
+  const auto group = [&](std::size_t c) __attribute__((always_inline)) {  // inlined: compiled for the clone's target
+    const std::size_t i = 8 * c;
+    const I8 lane = lanes + std::int32_t(i);
+    V8 r = distance8(t.f, i, px, py, pz);
+    r = lane < size ? r : V8{} + kInf;  // the padding
+    I8 face;
+    std::memcpy(&face, t.face.data() + i, sizeof face);
+    const auto closer = (r < best) | ((r == best) & (face < best_face));
+    best = closer ? r : best;
+    best_face = closer ? face : best_face;
+    at = closer ? lane : at;
+    reach2 = std::min(reach2, min8(r));
+  };
+  const auto lower = [&](std::size_t c) __attribute__((always_inline)) {  // the smallest bound of group c
+    const std::size_t i = 8 * c;
+    const auto k = [&](int n) { return load8(t.f[Packed::k0 + n].data() + i); };
+    const V8 x0 = k(0) + wx * (k(1) - k(0)), x1 = k(2) + wx * (k(3) - k(2));
+    const V8 x2 = k(4) + wx * (k(5) - k(4)), x3 = k(6) + wx * (k(7) - k(6));
+    const V8 y0 = x0 + wy * (x1 - x0), y1 = x2 + wy * (x3 - x2);
+    const V8 z = y0 + wz * (y1 - y0);
+    return min8(z) * (1 - 1e-4f) - at_p.spread - slack;
+  };
+  const std::size_t groups = (t.size + 7) / 8;
+  if (seed >= groups) seed = 0;
+  group(seed);
+  for (std::size_t c = 0; c < groups; ++c) {
+    if (c == seed || (in_block && lower(c) > reach2 * (1 + 1e-4f))) continue;
+    group(c);
+  }
+  std::size_t index = 0;
+  d2 = kInf;
+  std::int32_t face = std::numeric_limits<std::int32_t>::max();
+  for (int l = 0; l < 8; ++l)
+    if (best[l] < d2 || (best[l] == d2 && best_face[l] < face)) d2 = best[l], face = best_face[l], index = std::size_t(at[l]);
+  return index;
+}
+
+class GridSolver {
+ public:
+  GridSolver(const MeshDistance& mesh, const Grid3Geometry& grid, const SdfGridOptions& options)
+      : mesh_(mesh), grid_(grid), options_(options), tris_(mesh.triangles().data()),
+        ids_(mesh.bvh().triangle_ids().data()) {
+    const std::size_t n = mesh.triangles().size();
+    all_.reserve(n);
+    all_.size = n;
+    all_.leaf.resize(n);
+    if (n >= std::size_t(std::numeric_limits<std::int32_t>::max())) throw Error("sdf grid: too many faces");
+    parallel_for_each_index(0, n, [&](std::size_t i) {
+      const BvhTriangle& t = tris_[i];
+      const Vec3f ab = t.b - t.a, ac = t.c - t.a, bc = t.c - t.b, nn = ab.cross(ac);
+      const float d00 = ab.dot(ab), d01 = ab.dot(ac), d11 = ac.dot(ac), den = d00 * d11 - d01 * d01;
+      const float nn2 = nn.squaredNorm();
+      const float values[Packed::kFields] = {
+          t.a.x(), t.a.y(), t.a.z(), ab.x(), ab.y(), ab.z(), ac.x(), ac.y(), ac.z(), nn.x(), nn.y(), nn.z(), d00, d01,
+          d11, den > 0 ? 1 / den : 0.0f, nn2 > 0 && den > 0 ? 1 / nn2 : 0.0f, d00 > 0 ? 1 / d00 : 0.0f,
+          d11 > 0 ? 1 / d11 : 0.0f, bc.squaredNorm() > 0 ? 1 / bc.squaredNorm() : 0.0f};
+      for (int k = 0; k < Packed::kFields; ++k) all_.f[k][i] = std::isfinite(values[k]) ? values[k] : 0.0f;
+      all_.leaf[i] = std::uint32_t(i);
+      all_.face[i] = std::int32_t(ids_[i]);
+    });
+    // Float rounding of distances is below this (relative to the scene's size).
+    const AABB3f mb = std::visit([](const auto& v) { return bvh::bounds(v[0]); }, mesh.bvh().volumes());
+    const AABB3f gb = grid.bounds();
+    const float scale = std::max({mb.lo.cwiseAbs().maxCoeff(), mb.hi.cwiseAbs().maxCoeff(), gb.lo.cwiseAbs().maxCoeff(),
+                                  gb.hi.cwiseAbs().maxCoeff(), 1e-30f});
+    margin_ = 1e-6f * scale;
+    slack_ = 4 * margin_ * scale;  // float rounding of squared distances up to the scene's size
+    const float h = grid.spacing.minCoeff();
+    band_ = std::isfinite(options.band) ? float(options.band) * h : kInf;
+  }
+
+  // One tile: the samples of [lo, hi) into out (and faces).
+  void tile(const SampleBox& box, float* out, std::uint32_t* faces, SdfGridStats& stats) const {
+    const MeshPointDistance centre = mesh_.query(box.centre, SignMethod::none);
+    const std::size_t nx = box.hi[0] - box.lo[0], ny = box.hi[1] - box.lo[1];
+    std::array<float, kTile * kTile * kTile> ud;  // unsigned distances (inf: outside the band)
+    std::array<Closest, kTile * kTile * kTile> best;
+    ud.fill(kInf);
+    const auto local = [&](std::size_t i, std::size_t j, std::size_t k) {
+      return (i - box.lo[0]) + nx * ((j - box.lo[1]) + ny * (k - box.lo[2]));
+    };
+    if (!(centre.distance - box.radius > band_ + margin_)) {
+      Packed tile_list, block_list, near;
+      std::vector<float> d2, pass;
+      std::vector<std::uint32_t> keep;
+      gather(box, centre.closest, tile_list, near, keep, d2, pass);
+      for (std::size_t bz = box.lo[2]; bz < box.hi[2]; bz += kBlock)
+        for (std::size_t by = box.lo[1]; by < box.hi[1]; by += kBlock)
+          for (std::size_t bx = box.lo[0]; bx < box.hi[0]; bx += kBlock) {
+            const SampleBox block(grid_, {bx, by, bz},
+                                  {std::min(bx + kBlock, box.hi[0]), std::min(by + kBlock, box.hi[1]),
+                                   std::min(bz + kBlock, box.hi[2])});
+            const Closest c = closest_in(tile_list, block.centre);
+            if (std::sqrt(c.d2) - block.radius > band_ + margin_) continue;
+            filter(tile_list, block, c.point, block_list, d2, pass, keep);
+            std::size_t seed = 0;  // the group of the previous sample's nearest face
+            const Vec3f extent = block.corners[7] - block.corners[0];
+            for (std::size_t k = block.lo[2]; k < block.hi[2]; ++k)
+              for (std::size_t j = block.lo[1]; j < block.hi[1]; ++j)
+                for (std::size_t i = block.lo[0]; i < block.hi[0]; ++i) {
+                  const Vec3f p = grid_.position(i, j, k);
+                  InBlock at_p;
+                  const auto weight = [&](int a) {
+                    return extent[a] > 0 ? std::clamp((p[a] - block.corners[0][a]) / extent[a], 0.0f, 1.0f) : 0.0f;
+                  };
+                  at_p.wx = weight(0), at_p.wy = weight(1), at_p.wz = weight(2);
+                  // sum_k w_k |v_k - p|^2 of the box's corners, one axis at a time (rounded up).
+                  at_p.spread = 0;
+                  for (int a = 0; a < 3; ++a) {
+                    const float w = a == 0 ? at_p.wx : a == 1 ? at_p.wy : at_p.wz;
+                    at_p.spread += extent[a] * extent[a] * w * (1 - w);
+                  }
+                  at_p.spread = at_p.spread * (1 + 1e-4f) + margin_ * margin_;
+                  const Closest s = closest_in(block_list, p, &at_p, seed);
+                  seed = s.slot / 8;
+                  const float d = std::sqrt(s.d2);
+                  if (d > band_) continue;
+                  stats.candidates_per_sample += double(block_list.size);
+                  ud[local(i, j, k)] = d;
+                  best[local(i, j, k)] = s;
+                  ++stats.in_band;
+                }
+          }
+    } else {
+      ++stats.tiles_outside;
+    }
+    // Signs, in scan order, each from an earlier neighbour in the tile when no surface can lie between them.
+    const bool propagate = options_.sign == SignMethod::none || mesh_.closed();
+    std::array<std::uint8_t, kTile * kTile * kTile> inside{};
+    const float hx = grid_.spacing.x(), hy = grid_.spacing.y(), hz = grid_.spacing.z();
+    for (std::size_t k = box.lo[2]; k < box.hi[2]; ++k)
+      for (std::size_t j = box.lo[1]; j < box.hi[1]; ++j)
+        for (std::size_t i = box.lo[0]; i < box.hi[0]; ++i) {
+          const std::size_t l = local(i, j, k), g = grid_.index(i, j, k);
+          const float d = ud[l];
+          const Closest& c = best[l];
+          if (faces) faces[g] = d < kInf ? ids_[c.leaf] : kNoIndex;
+          bool in = false;
+          const auto apart = [&](std::size_t n, float h) { return d + ud[n] > h * (1 + 1e-5f) + 2 * margin_; };
+          if (options_.sign == SignMethod::none) {
+          } else if (options_.sign == SignMethod::pseudonormal && d < kInf) {
+            const std::uint32_t face = ids_[c.leaf];
+            in = (grid_.position(i, j, k) - c.point).dot(mesh_.pseudonormal(face, c.region)) < 0;
+          } else if (propagate && i > box.lo[0] && apart(l - 1, hx)) {
+            in = inside[l - 1];
+          } else if (propagate && j > box.lo[1] && apart(l - nx, hy)) {
+            in = inside[l - nx];
+          } else if (propagate && k > box.lo[2] && apart(l - nx * ny, hz)) {
+            in = inside[l - nx * ny];
+          } else {
+            const Vec3f p = grid_.position(i, j, k);
+            if (options_.sign == SignMethod::winding) {
+              in = mesh_.winding_number(p) > 0.5;
+              ++stats.winding_numbers;
+            } else {
+              in = mesh_.inside_by_pseudonormal(p, mesh_.query(p, SignMethod::none));
+            }
+          }
+          inside[l] = in;
+          out[g] = in ? -d : d;
+        }
+  }
+
+ private:
+  // Squared distance bounds at a box's corners from a surface point q.
+  std::array<float, 8> bounds_from(const SampleBox& box, const Vec3f& q) const {
+    std::array<float, 8> bound2;
+    for (int k = 0; k < 8; ++k) {
+      const float b = (box.corners[k] - q).norm() * (1 + 1e-5f) + margin_;
+      bound2[k] = b * b;
+    }
+    return bound2;
+  }
+
+  // The faces that may be closest to a sample of the box, q being a surface
+  // point: the hierarchy's nodes pass if they are no farther than q from one
+  // of the box's corners, then their triangles the same test (filter), in
+  // leaf order.
+  void gather(const SampleBox& box, const Vec3f& q, Packed& out, Packed& near, std::vector<std::uint32_t>& found,
+              std::vector<float>& d2, std::vector<float>& pass) const {
+    const std::array<float, 8> bound2 = bounds_from(box, q);
+    const bvh::Topology& topo = mesh_.bvh().topology();
+    found.clear();
+    std::visit(
+        [&](const auto& volumes) {
+          bvh::TraversalStack<bvh::NodeRef> stack(mesh_.stack_size());
+          bvh::traverse_topology<false>(
+              topo, 0, stack,
+              [&](std::uint32_t node, float&) {
+                for (int k = 0; k < 8; ++k)
+                  if (bvh::squared_distance(volumes[node], box.corners[k]) <= bound2[k]) return true;
+                return false;
+              },
+              [&](const bvh::TopoNode& node) {
+                for (std::uint32_t i = node.prim_first; i < node.prim_first + node.prim_count; ++i) found.push_back(i);
+              },
+              [](float) { return true; });
+        },
+        mesh_.bvh().volumes());
+    near.assign(all_, found);
+    filter(near, box, q, out, d2, pass, found);
+  }
+
+  // The list keeps each entry's squared distances from the 8 corners (k0..k7).
+  void filter(const Packed& in, const SampleBox& box, const Vec3f& q, Packed& out, std::vector<float>& d2,
+              std::vector<float>& pass, std::vector<std::uint32_t>& keep) const {
+    const std::array<float, 8> bound2 = bounds_from(box, q);
+    const std::size_t stride = in.f[0].size();
+    d2.resize(8 * stride);
+    pass.assign(in.size, 0.0f);
+    for (int k = 0; k < 8; ++k) {
+      float* dk = d2.data() + std::size_t(k) * stride;
+      squared_distances(in, box.corners[k], dk);
+      for (std::size_t i = 0; i < in.size; ++i) pass[i] = dk[i] <= bound2[k] ? 1.0f : pass[i];
+    }
+    keep.clear();
+    for (std::size_t i = 0; i < in.size; ++i)
+      if (pass[i] != 0) keep.push_back(std::uint32_t(i));
+    out.assign(in, keep);
+    for (int k = 0; k < 8; ++k) {
+      const float* dk = d2.data() + std::size_t(k) * stride;
+      float* o = out.f[Packed::k0 + k].data();
+      for (std::size_t j = 0; j < keep.size(); ++j) o[j] = dk[keep[j]];
+    }
+  }
+
+  // The closest entry of `list` to p (ties: the smallest face index), with
+  // its exact closest point and region.
+  // With `at_p`, the list is a block's (with corner distances) and p is in the block.
+  Closest closest_in(const Packed& list, const Vec3f& p, const InBlock* at_p = nullptr, std::size_t seed = 0) const {
+    Closest best;
+    if (list.size == 0) return best;
+    float nearest_d2;
+    const std::size_t i = nearest(list, p, at_p, slack_, seed, nearest_d2);
+    const BvhTriangle& tri = tris_[list.leaf[i]];
+    best.leaf = list.leaf[i];
+    best.slot = i;
+    best.point = closest_point_on_triangle(p, tri.a, tri.b, tri.c, best.region);
+    best.d2 = (best.point - p).squaredNorm();
+    return best;
+  }
+
+  const MeshDistance& mesh_;
+  const Grid3Geometry& grid_;
+  const SdfGridOptions& options_;
+  const BvhTriangle* tris_;
+  const std::uint32_t* ids_;
+  Packed all_;                  // every triangle, in leaf order
+  float margin_ = 0;
+  float slack_ = 0;
+  float band_ = kInf;
+};
+
+}  // namespace
+
+Grid3Geometry sdf_grid_geometry(const AABB3f& box, std::size_t res, double spacing, double padding) {
+  if (box.empty() || !box.lo.allFinite() || !box.hi.allFinite())
+    throw Error("sdf grid: the box to sample is empty or not finite");
+  if (!std::isfinite(padding) || padding < 0) throw Error(fmt::format("sdf grid: padding must be >= 0, got {}", padding));
+  const Vec3d ext = (box.hi - box.lo).cast<double>();
+  const double longest = ext.maxCoeff();
+  double h = spacing;
+  if (spacing == 0) {
+    if (double(res) <= 2 * padding)
+      throw Error(fmt::format("sdf grid: {} samples leave nothing inside a padding of {} on each side", res, padding));
+    if (!(longest > 0)) throw Error("sdf grid: the box has no extent; give a spacing instead of a resolution");
+    h = longest / (double(res) - 2 * padding);
+  }
+  if (!std::isfinite(h) || !(h > 0)) throw Error(fmt::format("sdf grid: spacing must be finite and > 0, got {}", h));
+  Grid3Geometry g;
+  const Vec3d centre = 0.5 * (box.lo + box.hi).cast<double>();
+  double samples = 1;
+  for (int a = 0; a < 3; ++a) {
+    const double n = std::max(1.0, std::ceil((ext[a] + 2 * padding * h) / h - 1e-6));
+    if (n > double(1u << 30)) throw Error(fmt::format("sdf grid: {} samples along an axis is too many", n));
+    samples *= n;
+    g.dims[a] = std::size_t(n);
+    g.origin[a] = float(centre[a] - 0.5 * n * h + 0.5 * h);
+  }
+  if (samples > double(std::size_t(1) << 40))
+    throw Error(fmt::format("sdf grid: {} samples is too many", samples));
+  g.spacing = Vec3f::Constant(float(h));
+  return g;
+}
+
+SdfMethod parse_sdf_method(std::string_view name) {
+  for (const SdfMethod m : {SdfMethod::exact, SdfMethod::propagation})
+    if (name == to_string(m)) return m;
+  throw Error("sdf grid: unknown method '" + std::string(name) + "' (exact or propagation)");
+}
+
+std::string_view to_string(SdfMethod method) { return method == SdfMethod::exact ? "exact" : "propagation"; }
+
+namespace {
+
+// §6.1.1's vector propagation: the exact shell, then two scans passing
+// closest points to neighbours (see SdfMethod::propagation).
+void propagate(const MeshDistance& mesh, const Grid3Geometry& grid, const SdfGridOptions& options, SdfGrid& result) {
+  constexpr double kShell = 1.7321;  // samples: the 3^3 neighbourhood of the surface
+  SdfGridOptions shell_options;
+  shell_options.sign = SignMethod::none;
+  shell_options.band = kShell;
+  shell_options.faces = true;
+  SdfGrid shell = sdf_grid(mesh, grid, shell_options);
+  const std::size_t n = shell.distance.size();
+  const auto& tris = mesh.triangles();
+  std::vector<std::uint32_t> leaf_of(tris.size());
+  for (std::uint32_t i = 0; i < tris.size(); ++i) leaf_of[mesh.face_of(i)] = i;
+  std::vector<Vec3f> q(n, Vec3f::Constant(kInf));
+  std::vector<std::uint32_t>& face = shell.faces;
+  std::vector<float>& d2 = shell.distance.data;
+  parallel_for_each_index(0, n, [&](std::size_t s) {
+    if (face[s] == kNoIndex) return d2[s] = kInf, void();
+    const Vec3f p = grid.position(s % grid.dims[0], s / grid.dims[0] % grid.dims[1], s / (grid.dims[0] * grid.dims[1]));
+    const bvh::BvhTriangle& t = tris[leaf_of[face[s]]];
+    q[s] = closest_point_on_triangle(p, t.a, t.b, t.c);
+    d2[s] = (q[s] - p).squaredNorm();
+  }, 4096);
+  // The 13 neighbours before a sample in the forward scan (z, y, x increasing).
+  struct Step {
+    int dx, dy, dz;
+  };
+  std::vector<Step> steps;
+  for (int dz = -1; dz <= 1; ++dz)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx)
+        if (dz < 0 || (dz == 0 && (dy < 0 || (dy == 0 && dx < 0)))) steps.push_back({dx, dy, dz});
+  const auto [nx, ny, nz] = grid.dims;
+  const auto scan = [&](int sign) {
+    for (std::size_t kk = 0; kk < nz; ++kk)
+      for (std::size_t jj = 0; jj < ny; ++jj)
+        for (std::size_t ii = 0; ii < nx; ++ii) {
+          const std::size_t i = sign > 0 ? ii : nx - 1 - ii, j = sign > 0 ? jj : ny - 1 - jj,
+                            k = sign > 0 ? kk : nz - 1 - kk;
+          const std::size_t s = grid.index(i, j, k);
+          const Vec3f p = grid.position(i, j, k);
+          for (const Step& st : steps) {
+            const long a = long(i) + sign * st.dx, b = long(j) + sign * st.dy, c = long(k) + sign * st.dz;
+            if (a < 0 || b < 0 || c < 0 || a >= long(nx) || b >= long(ny) || c >= long(nz)) continue;
+            const std::size_t m = grid.index(std::size_t(a), std::size_t(b), std::size_t(c));
+            if (face[m] == kNoIndex) continue;
+            const float e = (q[m] - p).squaredNorm();
+            if (e < d2[s]) d2[s] = e, q[s] = q[m], face[s] = face[m];
+          }
+        }
+  };
+  scan(1);
+  scan(-1);
+  // Each sample: the exact distance to its face (at most that to the point it got), and the sign.
+  std::atomic<std::size_t> windings{0};
+  parallel_for_each_index(0, n, [&](std::size_t s) {
+    const Vec3f p = grid.position(s % nx, s / nx % ny, s / (nx * ny));
+    if (face[s] == kNoIndex) return d2[s] = kInf, void();  // no shell at all (a grid far from the mesh)
+    const bvh::BvhTriangle& t = tris[leaf_of[face[s]]];
+    TriangleRegion region;
+    const Vec3f c = closest_point_on_triangle(p, t.a, t.b, t.c, region);
+    float d = (c - p).norm();
+    bool inside = false;
+    if (options.sign == SignMethod::pseudonormal) {
+      inside = (p - c).dot(mesh.pseudonormal(face[s], region)) < 0;
+    } else if (options.sign == SignMethod::winding) {
+      inside = mesh.winding_number(p) > 0.5;
+      ++windings;
+    }
+    d2[s] = inside ? -d : d;
+  }, 1024);
+  result.distance = std::move(shell.distance);
+  if (options.faces) result.faces = std::move(face);
+  result.stats.in_band = n;
+  result.stats.winding_numbers = windings;
+}
+
+}  // namespace
+
+SdfGrid sdf_grid(const MeshDistance& mesh, const Grid3Geometry& grid, const SdfGridOptions& options) {
+  for (int a = 0; a < 3; ++a) {
+    if (!std::isfinite(grid.spacing[a]) || !(grid.spacing[a] > 0))
+      throw Error(fmt::format("sdf grid: spacing must be finite and > 0, got {} along {}", grid.spacing[a], char('x' + a)));
+    if (!std::isfinite(grid.origin[a])) throw Error("sdf grid: the origin is not finite");
+  }
+  if (std::isnan(options.band) || !(options.band >= 0))
+    throw Error(fmt::format("sdf grid: the band must be >= 0 samples, got {}", options.band));
+  if (!grid.bounds().hi.allFinite()) throw Error("sdf grid: the grid reaches beyond float range");
+  const std::size_t n = Grid3<float>::checked_size(grid.dims[0], grid.dims[1], grid.dims[2]);
+  // Refuse before allocating what the machine cannot hold.
+  const double bytes = double(n) * (options.faces ? 8.0 : 4.0);
+  const double memory = double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGE_SIZE));
+  if (memory > 0 && bytes > memory)
+    throw Error(fmt::format("sdf grid: {} x {} x {} samples need {:.1f} GB, more than this machine's {:.1f} GB",
+                            grid.dims[0], grid.dims[1], grid.dims[2], bytes / 1e9, memory / 1e9));
+
+  SdfGrid result;
+  static_cast<Grid3Geometry&>(result.distance) = grid;
+  result.distance.data.resize(n);
+  if (options.faces) result.faces.resize(n);
+  result.stats.samples = n;
+  if (n == 0) return result;
+  if (options.method == SdfMethod::propagation) {
+    if (std::isfinite(options.band)) throw Error("sdf grid: the propagation method computes the whole grid (no band)");
+    propagate(mesh, grid, options, result);
+    return result;
+  }
+  const GridSolver solver(mesh, grid, options);
+  std::array<std::size_t, 3> tiles;
+  for (int a = 0; a < 3; ++a) tiles[a] = (grid.dims[a] + kTile - 1) / kTile;
+  const std::size_t num_tiles = tiles[0] * tiles[1] * tiles[2];
+  result.stats.tiles = num_tiles;
+  std::atomic<std::size_t> in_band{0}, outside{0}, windings{0};
+  std::atomic<std::uint64_t> candidates{0};
+  parallel_for_each_index(
+      0, num_tiles,
+      [&](std::size_t t) {
+        const std::array<std::size_t, 3> c{t % tiles[0], t / tiles[0] % tiles[1], t / (tiles[0] * tiles[1])};
+        std::array<std::size_t, 3> lo, hi;
+        for (int a = 0; a < 3; ++a) lo[a] = c[a] * kTile, hi[a] = std::min(lo[a] + kTile, grid.dims[a]);
+        SdfGridStats s;
+        solver.tile(SampleBox(grid, lo, hi), result.distance.data.data(), options.faces ? result.faces.data() : nullptr,
+                    s);
+        in_band += s.in_band;
+        outside += s.tiles_outside;
+        windings += s.winding_numbers;
+        candidates += std::uint64_t(s.candidates_per_sample);
+      },
+      1);
+  result.stats.in_band = in_band;
+  result.stats.tiles_outside = outside;
+  result.stats.winding_numbers = windings;
+  result.stats.candidates_per_sample = in_band ? double(candidates) / double(in_band) : 0.0;
+  return result;
+}
+
+SdfGrid sdf_grid(const TriMesh& mesh, const Grid3Geometry& grid, const SdfGridOptions& options) {
+  return sdf_grid(MeshDistance::build(mesh), grid, options);
+}
+
+}  // namespace geods::field
