@@ -1,0 +1,124 @@
+#pragma once
+// Delaunay tetrahedralization of points in space (seed §5.3.1): Bowyer-Watson
+// cavity insertion with exact predicates and a symbolic perturbation, so that
+// every input, cospherical, coplanar or with duplicates, gives a valid result.
+//
+// Representation: flat arrays, per tetrahedron four vertex ids and four
+// neighbour ids; neighbour i is across the face opposite vertex i. Every
+// tetrahedron is positively oriented: det(b - a, c - a, d - a) > 0, which is
+// geods::orient3d(a, b, c, d) < 0 in Shewchuk's convention. Internally the
+// convex hull is closed by an infinite ("ghost") vertex: each hull triangle has
+// a ghost tetrahedron on its outer side, so insertion outside the hull and
+// inside are the same steps. The public arrays hold the finite tetrahedra only,
+// over input point indices, with kNoIndex across the hull.
+//
+// Construction: BRIO (random rounds of doubling size, each sorted along a 3D
+// Hilbert curve); each point is located by a stochastic visibility walk from
+// the last tetrahedron created, the tetrahedra whose circumsphere holds it (the
+// cavity, found by a breadth-first search from the one it lies in) are
+// replaced by the tetrahedra joining it to the cavity's boundary. Expected
+// O(n log n), near linear for uniform points.
+//
+// Degeneracies: in_sphere == 0 is decided by the symbolic perturbation of
+// CGAL's Delaunay_triangulation_3 (Devillers-Teillaud, "Perturbations and
+// vertex removal in a 3D Delaunay triangulation", 2003): the points are
+// ranked lexicographically and lifted by infinitesimals in that order, so the
+// triangulation is unique whatever the insertion order. A ghost tetrahedron
+// holds a point strictly beyond its hull face, and a point on the face's plane
+// when the finite tetrahedron behind the face holds it.
+//
+// Lower-dimensional input: duplicates are merged (representative(i) is the
+// first occurrence; duplicate_count()). If the distinct points are fewer than
+// four or all coplanar there are no tetrahedra: dimension() says 0 (all equal),
+// 1 (collinear) or 2 (coplanar), and -1 for no points. NaN or infinite
+// coordinates raise geods::Error.
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "geods/core/vec.hpp"
+
+namespace geods::voronoi {
+
+struct Delaunay3Stats {
+  std::size_t points = 0;          // input points
+  std::size_t vertices = 0;        // distinct points, vertices of the tetrahedralization
+  std::size_t duplicates = 0;      // points merged into an earlier equal point
+  std::size_t tetrahedra = 0;      // finite tetrahedra
+  std::size_t hull_triangles = 0;  // triangles of the convex hull
+  std::size_t dimension = 0;       // affine dimension of the points (0 for none)
+  std::size_t walk_steps = 0;      // tetrahedra visited by point location while inserting
+  std::size_t conflicts = 0;       // tetrahedra replaced by insertions (cavity sizes summed)
+  std::size_t bytes = 0;           // memory of all arrays
+};
+
+struct Delaunay3Options {
+  std::uint64_t seed = 0x5eed;  // of the randomized insertion order (the result does not depend on it)
+};
+
+class Delaunay3 {
+ public:
+  static constexpr std::uint32_t no_index = std::uint32_t(-1);
+  using Options = Delaunay3Options;
+  using Triangle = std::array<std::uint32_t, 3>;
+
+  /// An empty tetrahedralization (dimension() == -1).
+  Delaunay3() = default;
+  /// Tetrahedralizes the points; throws geods::Error for NaN/inf coordinates
+  /// or 2^31 points or more.
+  explicit Delaunay3(std::span<const Vec3d> points, Options options = {});
+
+  /// The input points, indexed as given.
+  std::span<const Vec3d> points() const { return points_; }
+  /// Finite tetrahedra, four positively oriented vertex indices each.
+  const std::vector<std::uint32_t>& tetrahedra() const { return tetrahedra_; }
+  /// Per tetrahedron, the four neighbouring tetrahedra: neighbour i shares
+  /// the face opposite vertex i; no_index on the convex hull.
+  const std::vector<std::uint32_t>& neighbors() const { return neighbors_; }
+  std::size_t tetrahedron_count() const { return tetrahedra_.size() / 4; }
+  /// Affine dimension of the points: -1 none, 0 all equal, 1 collinear,
+  /// 2 coplanar (no tetrahedra in these cases), 3 a solid.
+  int dimension() const { return dimension_; }
+  /// The triangles of the convex hull (dimension 3), counter-clockwise seen
+  /// from outside, over point indices.
+  std::vector<Triangle> hull() const;
+
+  /// The vertex that stands for point i: i itself or the first occurrence of an equal point.
+  std::uint32_t representative(std::uint32_t i) const { return rep_[i]; }
+  std::size_t duplicate_count() const;
+
+  Delaunay3Stats stats() const;
+  /// Checks every invariant; throws geods::Error naming the first violation:
+  /// neighbours mutual and sharing their face, every finite tetrahedron
+  /// positively oriented (exact orient3d), every face locally Delaunay: the
+  /// opposite vertex of each neighbour lies outside or on the circumsphere
+  /// (exact insphere) and outside after the perturbation; the hull locally
+  /// convex; every representative a vertex; the public arrays what the
+  /// internal ones give.
+  void validate() const;
+
+ private:
+  // The closed tetrahedralization, over internal vertex numbers (insertion
+  // order, their coordinates copied in that order): per slot four vertices
+  // (kGhost for the infinite one, no_index in a free slot) and four
+  // adjacencies, 4 * neighbour + the face's index in the neighbour.
+  void build(Options options);
+  void publish();
+
+  Options options_;
+  std::vector<Vec3d> points_;
+  std::vector<std::uint32_t> rep_;  // representative per point
+  int dimension_ = -1;
+
+  std::vector<Vec3d> coords_;               // per internal vertex
+  std::vector<std::uint32_t> original_of_;  // internal vertex -> the point it stands for
+  std::vector<std::uint32_t> internal_of_;  // representative point -> internal vertex (no_index for others)
+  std::vector<std::uint32_t> tet_vertices_, tet_adjacency_, free_slots_;
+  std::size_t walk_steps_ = 0, conflicts_ = 0;
+
+  std::vector<std::uint32_t> tetrahedra_, neighbors_;  // public, finite only
+  std::vector<std::uint32_t> public_of_;               // internal slot -> public tetrahedron (no_index: ghost or free)
+};
+
+}  // namespace geods::voronoi

@@ -1,0 +1,509 @@
+// Delaunay3: Bowyer-Watson insertion over flat tetrahedron arrays closed by a
+// ghost vertex, exact predicates with the lexicographic symbolic perturbation
+// (see delaunay3.hpp).
+#include "geods/voronoi/delaunay3.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <optional>
+#include <string>
+
+#include "brio_order.hpp"
+#include "delaunay3_mesh.hpp"
+#include "geods/core/error.hpp"
+#include "geods/core/parallel.hpp"
+
+namespace geods::voronoi {
+namespace {
+
+constexpr std::uint32_t kNone = Delaunay3::no_index;
+
+bool same(const Vec3d& a, const Vec3d& b) { return a[0] == b[0] && a[1] == b[1] && a[2] == b[2]; }
+
+// Exact collinearity: the cross product's components are the three projected orientations.
+bool collinear(const Vec3d& a, const Vec3d& b, const Vec3d& c) {
+  for (int axis = 0; axis < 3; ++axis) {
+    const int i = (axis + 1) % 3, j = (axis + 2) % 3;
+    const double pa[2] = {a[i], a[j]}, pb[2] = {b[i], b[j]}, pc[2] = {c[i], c[j]};
+    if (orient2d(pa, pb, pc) != 0) return false;
+  }
+  return true;
+}
+
+std::string tet_name(std::uint32_t t) { return "tetrahedron slot " + std::to_string(t); }
+
+}  // namespace
+
+// ------------------------------------------------------------------ Mesh steps
+
+bool Tet3Mesh::perturbed_inside(const Vec3d* const q[4], const Vec3d& p) {
+  // Devillers-Teillaud / CGAL: rank the five points lexicographically; the
+  // sign of the perturbed determinant is that of the first non-zero term, the
+  // orientation of the tetrahedron with the highest-ranked point replaced by p.
+  const Vec3d* ranked[5] = {q[0], q[1], q[2], q[3], &p};
+  std::sort(ranked, ranked + 5, [](const Vec3d* a, const Vec3d* b) { return lex_less(*a, *b); });
+  for (int r = 4; r >= 0; --r) {
+    if (ranked[r] == &p) return false;
+    for (int j = 0; j < 4; ++j)
+      if (ranked[r] == q[j]) {
+        const Vec3d* s[4] = {q[0], q[1], q[2], q[3]};
+        s[j] = &p;
+        const double o = orient(*s[0], *s[1], *s[2], *s[3]);
+        if (o != 0) return o > 0;
+      }
+  }
+  return false;
+}
+
+bool Tet3Mesh::in_conflict(std::uint32_t t, const Vec3d& p) const {
+  const std::uint32_t* v = &vertices[4 * std::size_t(t)];
+  const int g = ghost_index(t);
+  if (g < 0) {
+    const Vec3d* q[4] = {&coords[v[0]], &coords[v[1]], &coords[v[2]], &coords[v[3]]};
+    const double s = in_sphere(*q[0], *q[1], *q[2], *q[3], p);
+    if (s != 0) return s > 0;
+    return perturbed_inside(q, p);
+  }
+  const Vec3d* q[4];
+  for (int k = 0; k < 4; ++k) q[k] = k == g ? &p : &coords[v[k]];
+  const double o = orient(*q[0], *q[1], *q[2], *q[3]);
+  if (o != 0) return o > 0;
+  return in_conflict(adjacency[4 * std::size_t(t) + g] >> 2, p);  // on the hull face's plane: as the tetrahedron behind it
+}
+
+std::uint32_t Tet3Mesh::walk(const Vec3d& p, std::uint32_t t, std::size_t& steps, std::uint32_t& random) const {
+  if (const int g = ghost_index(t); g >= 0) t = adjacency[4 * std::size_t(t) + g] >> 2;
+  std::uint32_t from = 4;  // the face we entered through: p lies strictly beyond it
+  for (;;) {
+    ++steps;
+    const std::uint32_t* v = &vertices[4 * std::size_t(t)];
+    const Vec3d* q[4] = {&coords[v[0]], &coords[v[1]], &coords[v[2]], &coords[v[3]]};
+    random ^= random << 13, random ^= random >> 17, random ^= random << 5;
+    const std::uint32_t first = random & 3;
+    std::uint32_t next = kNone;
+    for (std::uint32_t k = 0; k < 4; ++k) {
+      const std::uint32_t f = (first + k) & 3;
+      if (f == from) continue;
+      const Vec3d* saved = q[f];
+      q[f] = &p;
+      const double o = orient(*q[0], *q[1], *q[2], *q[3]);
+      q[f] = saved;
+      if (o < 0) {
+        next = adjacency[4 * std::size_t(t) + f];
+        break;
+      }
+    }
+    if (next == kNone) return t;
+    t = next >> 2;
+    from = next & 3;
+    if (is_ghost(t)) return t;
+  }
+}
+
+std::uint32_t Tet3Mesh::new_slot() {
+  if (!free_slots.empty()) {
+    const std::uint32_t s = free_slots.back();
+    free_slots.pop_back();
+    return s;
+  }
+  const std::uint32_t s = std::uint32_t(vertices.size() / 4);
+  vertices.resize(vertices.size() + 4);
+  adjacency.resize(adjacency.size() + 4);
+  mark.push_back(0);
+  return s;
+}
+
+void Tet3Mesh::free_slot(std::uint32_t s) {
+  vertices[4 * std::size_t(s)] = vertices[4 * std::size_t(s) + 1] = vertices[4 * std::size_t(s) + 2] =
+      vertices[4 * std::size_t(s) + 3] = kNone;
+  free_slots.push_back(s);
+}
+
+void Tet3Mesh::make_first(std::uint32_t a, std::uint32_t b, std::uint32_t c, std::uint32_t d) {
+  vertices.clear();
+  adjacency.clear();
+  free_slots.clear();
+  mark.clear();
+  if (orient(coords[a], coords[b], coords[c], coords[d]) < 0) std::swap(a, b);
+  const std::uint32_t v[4] = {a, b, c, d};
+  for (std::uint32_t s = 0; s < 5; ++s) new_slot();
+  std::copy(v, v + 4, vertices.begin());
+  // Ghost tetrahedron 1 + i behind face i: v with v[i] replaced by the ghost,
+  // then two other entries swapped (an odd permutation: the ghost's side).
+  for (int i = 0; i < 4; ++i) {
+    std::uint32_t* g = &vertices[4 * std::size_t(1 + i)];
+    std::copy(v, v + 4, g);
+    g[i] = kGhost;
+    std::swap(g[(i + 1) % 4], g[(i + 2) % 4]);
+  }
+  // Link every pair of the five tetrahedra that share a face.
+  for (std::uint32_t s = 0; s < 5; ++s)
+    for (std::uint32_t f = 0; f < 4; ++f) {
+      const std::uint32_t* vs = &vertices[4 * s];
+      for (std::uint32_t t = 0; t < 5; ++t) {
+        if (t == s) continue;
+        const std::uint32_t* vt = &vertices[4 * t];
+        // t shares s's face f if it holds the three other vertices of s
+        int shared = 0;
+        std::uint32_t missing = 4;
+        for (std::uint32_t k = 0; k < 4; ++k) {
+          if (std::find(vs, vs + 4, vt[k]) != vs + 4 && vt[k] != vs[f])
+            ++shared;
+          else
+            missing = k;
+        }
+        if (shared == 3) adjacency[4 * s + f] = 4 * t + missing;
+      }
+    }
+  last = 0;
+}
+
+std::uint32_t Tet3Mesh::insert(std::uint32_t pv) {
+  const Vec3d& p = coords[pv];
+  const std::uint32_t t = walk(p, last, walk_steps, random);
+  if (!is_ghost(t))
+    for (int k = 0; k < 4; ++k) {
+      const std::uint32_t u = vertices[4 * std::size_t(t) + k];
+      if (same(coords[u], p)) {
+        last = t;
+        return u;
+      }
+    }
+  // The cavity: the tetrahedra in conflict with p, breadth first from t.
+  ++epoch;
+  const std::uint32_t in = 2 * epoch + 1, out = 2 * epoch;
+  stack.clear();
+  cavity.clear();
+  boundary.clear();
+  stack.push_back(t);
+  mark[t] = in;
+  while (!stack.empty()) {
+    const std::uint32_t c = stack.back();
+    stack.pop_back();
+    cavity.push_back(c);
+    for (std::uint32_t f = 0; f < 4; ++f) {
+      const std::uint32_t a = adjacency[4 * std::size_t(c) + f], n = a >> 2;
+      if (mark[n] == in) continue;
+      if (mark[n] != out) {
+        if (in_conflict(n, p)) {
+          mark[n] = in;
+          stack.push_back(n);
+          continue;
+        }
+        mark[n] = out;
+      }
+      Boundary b;
+      std::copy_n(&vertices[4 * std::size_t(c)], 4, b.v);
+      b.v[f] = pv;
+      b.face = f;
+      b.outer = a;
+      boundary.push_back(b);
+    }
+  }
+  conflicts += cavity.size();
+  // The new tetrahedra: each boundary face joined to p, in the cavity's slots first.
+  edges.begin(boundary.size());
+  std::uint32_t newest = kNone;
+  for (std::size_t i = 0; i < boundary.size(); ++i) {
+    const Boundary& b = boundary[i];
+    const std::uint32_t s = i < cavity.size() ? cavity[i] : new_slot();
+    std::copy_n(b.v, 4, &vertices[4 * std::size_t(s)]);
+    adjacency[4 * std::size_t(s) + b.face] = b.outer;
+    adjacency[b.outer] = 4 * s + b.face;
+    for (std::uint32_t j = 0; j < 4; ++j) {
+      if (j == b.face) continue;
+      // face j holds p and the edge of the two vertices other than b.face and j
+      std::uint32_t u = kNone, w = kNone;
+      for (std::uint32_t k = 0; k < 4; ++k)
+        if (k != j && k != b.face) (u == kNone ? u : w) = b.v[k];
+      const std::uint32_t other = edges.match(u < w ? (std::uint64_t(u) << 32 | w) : (std::uint64_t(w) << 32 | u),
+                                              4 * s + j);
+      if (other != kNone) {
+        adjacency[4 * std::size_t(s) + j] = other;
+        adjacency[other] = 4 * s + j;
+      }
+    }
+    if (newest == kNone || ((b.v[0] | b.v[1] | b.v[2] | b.v[3]) & kGhostBit) == 0) newest = s;
+  }
+  for (std::size_t i = boundary.size(); i < cavity.size(); ++i) free_slot(cavity[i]);
+  last = newest;
+  return kNone;
+}
+
+void Tet3Mesh::EdgeTable::begin(std::size_t faces) {
+  std::size_t want = 64;
+  while (want < 4 * faces) want *= 2;
+  if (want > keys.size()) {
+    keys.assign(want, 0);
+    values.assign(want, 0);
+    stamps.assign(want, 0);
+  }
+  mask = std::min(want, keys.size()) - 1;
+  ++stamp;
+}
+
+std::uint32_t Tet3Mesh::EdgeTable::match(std::uint64_t key, std::uint32_t value) {
+  std::size_t h = std::size_t((key * 0x9E3779B97F4A7C15ull) >> 40) & mask;
+  for (;; h = (h + 1) & mask) {
+    if (stamps[h] != stamp) {
+      stamps[h] = stamp;
+      keys[h] = key;
+      values[h] = value;
+      return kNone;
+    }
+    if (keys[h] == key) return values[h];  // each edge is shared by exactly two new tetrahedra
+  }
+}
+
+// ------------------------------------------------------------------ Delaunay3
+
+Delaunay3::Delaunay3(std::span<const Vec3d> points, Options options) : options_(options) {
+  if (points.size() >= (std::size_t(1) << 31))
+    throw Error("Delaunay3: " + std::to_string(points.size()) + " points, at most 2^31 - 1 are supported");
+  for (std::size_t i = 0; i < points.size(); ++i)
+    if (!std::isfinite(points[i][0]) || !std::isfinite(points[i][1]) || !std::isfinite(points[i][2]))
+      throw Error("Delaunay3: point " + std::to_string(i) + " has a NaN or infinite coordinate");
+  points_.assign(points.begin(), points.end());
+  build(options);
+  publish();
+}
+
+void Delaunay3::build(Options options) {
+  const std::size_t n = points_.size();
+  rep_.resize(n);
+  std::iota(rep_.begin(), rep_.end(), 0u);
+  internal_of_.assign(n, kNone);
+  coords_.clear();
+  original_of_.clear();
+  tet_vertices_.clear();
+  tet_adjacency_.clear();
+  free_slots_.clear();
+  if (n == 0) {
+    dimension_ = -1;
+    return;
+  }
+  std::vector<std::uint32_t> all(n);
+  std::iota(all.begin(), all.end(), 0u);
+  const std::vector<std::uint32_t> order = brio_order(std::span<const Vec3d>(points_), all, options.seed);
+
+  // The first tetrahedron: the earliest four affinely independent points in the order.
+  const auto at = [&](std::size_t k) -> const Vec3d& { return points_[order[k]]; };
+  std::size_t kb = 1, kc, kd;
+  while (kb < n && same(at(kb), at(0))) ++kb;
+  for (kc = kb + 1; kc < n && collinear(at(0), at(kb), at(kc)); ++kc) {
+  }
+  for (kd = kc + 1; kd < n && Tet3Mesh::orient(at(0), at(kb), at(kc), at(kd)) == 0; ++kd) {
+  }
+  dimension_ = kb >= n ? 0 : kc >= n ? 1 : kd >= n ? 2 : 3;
+  if (dimension_ < 3) {
+    // No tetrahedra: merge duplicates by sorting.
+    std::vector<std::uint32_t> sorted = all;
+    std::sort(sorted.begin(), sorted.end(), [&](std::uint32_t a, std::uint32_t b) {
+      return Tet3Mesh::lex_less(points_[a], points_[b]) || (same(points_[a], points_[b]) && a < b);
+    });
+    for (std::size_t k = 0; k < n; ++k) {
+      const std::uint32_t i = sorted[k];
+      if (k > 0 && same(points_[i], points_[sorted[k - 1]])) {
+        rep_[i] = rep_[sorted[k - 1]];
+      } else {
+        rep_[i] = i;
+        internal_of_[i] = std::uint32_t(coords_.size());
+        coords_.push_back(points_[i]);
+        original_of_.push_back(i);
+      }
+    }
+    for (std::size_t i = 0; i < n; ++i) internal_of_[i] = internal_of_[rep_[i]];
+    return;
+  }
+
+  Tet3Mesh mesh(coords_, tet_vertices_, tet_adjacency_, free_slots_);
+  coords_.reserve(n);
+  original_of_.reserve(n);
+  tet_vertices_.reserve(4 * 7 * n + 64);
+  tet_adjacency_.reserve(4 * 7 * n + 64);
+  mesh.mark.reserve(7 * n + 16);
+  const std::size_t first[4] = {0, kb, kc, kd};
+  for (std::size_t k : first) {
+    internal_of_[order[k]] = std::uint32_t(coords_.size());
+    coords_.push_back(at(k));
+    original_of_.push_back(order[k]);
+  }
+  mesh.make_first(0, 1, 2, 3);
+  for (std::size_t k = 1; k < n; ++k) {
+    if (k == kb || k == kc || k == kd) continue;
+    const std::uint32_t i = order[k];
+    const std::uint32_t v = std::uint32_t(coords_.size());
+    coords_.push_back(points_[i]);
+    const std::uint32_t existing = mesh.insert(v);
+    if (existing == kNone) {
+      original_of_.push_back(i);
+      internal_of_[i] = v;
+    } else {
+      coords_.pop_back();
+      internal_of_[i] = existing;
+      original_of_[existing] = std::min(original_of_[existing], i);  // the first occurrence stands for all
+    }
+  }
+  for (std::size_t i = 0; i < n; ++i) rep_[i] = original_of_[internal_of_[i]];
+  walk_steps_ = mesh.walk_steps;
+  conflicts_ = mesh.conflicts;
+}
+
+void Delaunay3::publish() {
+  const std::size_t slots = tet_vertices_.size() / 4;
+  public_of_.assign(slots, kNone);
+  std::size_t count = 0;
+  for (std::size_t s = 0; s < slots; ++s) {
+    const std::uint32_t* v = &tet_vertices_[4 * s];
+    if (((v[0] | v[1] | v[2] | v[3]) & Tet3Mesh::kGhostBit) == 0) public_of_[s] = std::uint32_t(count++);
+  }
+  tetrahedra_.resize(4 * count);
+  neighbors_.resize(4 * count);
+  parallel_for(0, slots, 1 << 14, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t s = begin; s < end; ++s) {
+      const std::uint32_t t = public_of_[s];
+      if (t == kNone) continue;
+      for (int k = 0; k < 4; ++k) {
+        tetrahedra_[4 * std::size_t(t) + k] = original_of_[tet_vertices_[4 * s + k]];
+        neighbors_[4 * std::size_t(t) + k] = public_of_[tet_adjacency_[4 * s + k] >> 2];
+      }
+    }
+  });
+}
+
+std::vector<Delaunay3::Triangle> Delaunay3::hull() const {
+  std::vector<Triangle> out;
+  const std::size_t slots = tet_vertices_.size() / 4;
+  for (std::size_t s = 0; s < slots; ++s) {
+    const std::uint32_t* v = &tet_vertices_[4 * s];
+    if (v[0] == kNone) continue;
+    for (int g = 0; g < 4; ++g)
+      if (v[g] == Tet3Mesh::kGhost) {
+        // The face opposite the ghost, oriented towards it (outwards of the hull).
+        const std::array<int, 3> f = Tet3Mesh::face_towards(g);
+        out.push_back({original_of_[v[f[0]]], original_of_[v[f[1]]], original_of_[v[f[2]]]});
+      }
+  }
+  return out;
+}
+
+std::size_t Delaunay3::duplicate_count() const {
+  std::size_t count = 0;
+  for (std::size_t i = 0; i < rep_.size(); ++i) count += rep_[i] != i;
+  return count;
+}
+
+Delaunay3Stats Delaunay3::stats() const {
+  Delaunay3Stats s;
+  s.points = points_.size();
+  s.duplicates = duplicate_count();
+  s.vertices = s.points - s.duplicates;
+  s.tetrahedra = tetrahedron_count();
+  for (const std::uint32_t v : tet_vertices_) s.hull_triangles += v == Tet3Mesh::kGhost;
+  s.dimension = dimension_ < 0 ? 0 : std::size_t(dimension_);
+  s.walk_steps = walk_steps_;
+  s.conflicts = conflicts_;
+  const auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
+  s.bytes = bytes(points_) + bytes(rep_) + bytes(coords_) + bytes(original_of_) + bytes(internal_of_) +
+            bytes(tet_vertices_) + bytes(tet_adjacency_) + bytes(free_slots_) + bytes(tetrahedra_) +
+            bytes(neighbors_) + bytes(public_of_);
+  return s;
+}
+
+void Delaunay3::validate() const {
+  const std::size_t n = points_.size();
+  if (rep_.size() != n || internal_of_.size() != n) throw Error("Delaunay3: per-point arrays of the wrong size");
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint32_t r = rep_[i], v = internal_of_[i];
+    if (r > i || rep_[r] != r) throw Error("Delaunay3: point " + std::to_string(i) + " has a bad representative");
+    if (v >= coords_.size() || original_of_[v] != r || !same(coords_[v], points_[i]))
+      throw Error("Delaunay3: point " + std::to_string(i) + " is not at its vertex");
+  }
+  if (dimension_ < 3) {
+    if (!tetrahedra_.empty()) throw Error("Delaunay3: a lower-dimensional set has tetrahedra");
+    return;
+  }
+  const std::size_t slots = tet_vertices_.size() / 4;
+  if (tet_adjacency_.size() != tet_vertices_.size()) throw Error("Delaunay3: adjacency of the wrong size");
+  Tet3Mesh mesh(const_cast<std::vector<Vec3d>&>(coords_), const_cast<std::vector<std::uint32_t>&>(tet_vertices_),
+                const_cast<std::vector<std::uint32_t>&>(tet_adjacency_),
+                const_cast<std::vector<std::uint32_t>&>(free_slots_));
+  const std::size_t vertex_count = coords_.size();
+  std::vector<std::uint8_t> used(vertex_count, 0);
+  constexpr std::size_t kBlock = 1 << 14;
+  const std::size_t blocks = (slots + kBlock - 1) / kBlock;
+  std::vector<std::optional<Error>> errors(blocks);
+  std::vector<std::size_t> finite(blocks, 0);
+  parallel_for_each_index(
+      0, blocks,
+      [&](std::size_t block) {
+        try {
+          for (std::size_t s = block * kBlock; s < std::min(slots, (block + 1) * kBlock); ++s) {
+            const std::uint32_t* v = &tet_vertices_[4 * s];
+            if (v[0] == kNone) continue;
+            int ghosts = 0;
+            for (int k = 0; k < 4; ++k) {
+              if (v[k] == Tet3Mesh::kGhost)
+                ++ghosts;
+              else if (v[k] >= vertex_count)
+                throw Error("Delaunay3: " + tet_name(std::uint32_t(s)) + " has a vertex out of range");
+              else
+                used[v[k]] = 1;  // benign race: every writer stores 1
+            }
+            if (ghosts > 1) throw Error("Delaunay3: " + tet_name(std::uint32_t(s)) + " has two ghost vertices");
+            for (std::uint32_t f = 0; f < 4; ++f) {
+              const std::uint32_t a = tet_adjacency_[4 * s + f];
+              if ((a >> 2) >= slots || tet_vertices_[(a & ~3u)] == kNone || tet_adjacency_[a] != 4 * s + f)
+                throw Error("Delaunay3: " + tet_name(std::uint32_t(s)) + " face " + std::to_string(f) +
+                            ": neighbour not mutual");
+              for (std::uint32_t k = 0; k < 4; ++k) {
+                if (k == f) continue;
+                const std::uint32_t* w = &tet_vertices_[a & ~3u];
+                if (std::find(w, w + 4, v[k]) == w + 4 || w[a & 3] == v[k])
+                  throw Error("Delaunay3: " + tet_name(std::uint32_t(s)) + " face " + std::to_string(f) +
+                              ": neighbour does not share the face");
+              }
+              const std::uint32_t opposite = tet_vertices_[a];
+              if (opposite == Tet3Mesh::kGhost) continue;
+              const Vec3d& p = coords_[opposite];
+              if (ghosts == 0) {
+                const double s_exact = mesh.in_sphere(coords_[v[0]], coords_[v[1]], coords_[v[2]], coords_[v[3]], p);
+                if (s_exact > 0)
+                  throw Error("Delaunay3: " + tet_name(std::uint32_t(s)) +
+                              ": the opposite vertex of a neighbour is inside its circumsphere");
+              }
+              if (mesh.in_conflict(std::uint32_t(s), p))
+                throw Error("Delaunay3: " + tet_name(std::uint32_t(s)) + " face " + std::to_string(f) +
+                            (ghosts ? ": the hull is not convex there" : ": not Delaunay after the perturbation"));
+            }
+            if (ghosts == 0) {
+              if (Tet3Mesh::orient(coords_[v[0]], coords_[v[1]], coords_[v[2]], coords_[v[3]]) <= 0)
+                throw Error("Delaunay3: " + tet_name(std::uint32_t(s)) + " is not positively oriented");
+              ++finite[block];
+            }
+          }
+        } catch (const Error& e) {
+          errors[block] = e;
+        }
+      },
+      1);
+  std::size_t total = 0;
+  for (std::size_t b = 0; b < blocks; ++b) {
+    if (errors[b]) throw *errors[b];
+    total += finite[b];
+  }
+  for (std::size_t u = 0; u < vertex_count; ++u)
+    if (!used[u]) throw Error("Delaunay3: vertex of point " + std::to_string(original_of_[u]) + " is in no tetrahedron");
+  if (total != tetrahedron_count()) throw Error("Delaunay3: the public tetrahedra are not the finite ones");
+  for (std::size_t s = 0; s < slots; ++s) {
+    const std::uint32_t t = public_of_[s];
+    if (t == kNone) continue;
+    for (int k = 0; k < 4; ++k)
+      if (tetrahedra_[4 * std::size_t(t) + k] != original_of_[tet_vertices_[4 * s + k]] ||
+          neighbors_[4 * std::size_t(t) + k] != public_of_[tet_adjacency_[4 * s + k] >> 2])
+        throw Error("Delaunay3: public tetrahedron " + std::to_string(t) + " differs from its slot");
+  }
+}
+
+}  // namespace geods::voronoi
