@@ -31,6 +31,14 @@ bool collinear(const Vec3d& a, const Vec3d& b, const Vec3d& c) {
   return true;
 }
 
+// kEdgeOf[f][j]: the two indices of a tetrahedron other than f and j.
+constexpr std::uint8_t kEdgeOf[4][4][2] = {
+    {{0, 0}, {2, 3}, {1, 3}, {1, 2}},
+    {{2, 3}, {0, 0}, {0, 3}, {0, 2}},
+    {{1, 3}, {0, 3}, {0, 0}, {0, 1}},
+    {{1, 2}, {0, 2}, {0, 1}, {0, 0}},
+};
+
 std::string tet_name(std::uint32_t t) { return "tetrahedron slot " + std::to_string(t); }
 
 }  // namespace
@@ -56,28 +64,25 @@ bool Tet3Mesh::perturbed_inside(const Vec3d* const q[4], const Vec3d& p) {
   return false;
 }
 
-bool Tet3Mesh::in_conflict(std::uint32_t t, const Vec3d& p) const {
-  const std::uint32_t* v = &vertices[4 * std::size_t(t)];
-  const int g = ghost_index(t);
-  if (g < 0) {
-    const Vec3d* q[4] = {&coords[v[0]], &coords[v[1]], &coords[v[2]], &coords[v[3]]};
-    const double s = in_sphere(*q[0], *q[1], *q[2], *q[3], p);
-    if (s != 0) return s > 0;
-    return perturbed_inside(q, p);
-  }
+bool Tet3Mesh::ghost_conflict(const Vec3d* C, const std::uint32_t* T, std::uint32_t t, const Vec3d& p) {
+  const std::uint32_t* v = &T[8 * std::size_t(t)];
   const Vec3d* q[4];
-  for (int k = 0; k < 4; ++k) q[k] = k == g ? &p : &coords[v[k]];
+  int g = 0;
+  for (int k = 0; k < 4; ++k) {
+    if (v[k] == kGhost) g = k;
+    q[k] = v[k] == kGhost ? &p : &C[v[k]];
+  }
   const double o = orient(*q[0], *q[1], *q[2], *q[3]);
   if (o != 0) return o > 0;
-  return in_conflict(adjacency[4 * std::size_t(t) + g] >> 2, p);  // on the hull face's plane: as the tetrahedron behind it
+  return conflict(C, T, T[8 * std::size_t(t) + 4 + g] >> 2, p);  // on the hull face's plane: as the tetrahedron behind it
 }
 
 std::uint32_t Tet3Mesh::walk(const Vec3d& p, std::uint32_t t, std::size_t& steps, std::uint32_t& random) const {
-  if (const int g = ghost_index(t); g >= 0) t = adjacency[4 * std::size_t(t) + g] >> 2;
+  if (const int g = ghost_index(t); g >= 0) t = tets[8 * std::size_t(t) + 4 + g] >> 2;
   std::uint32_t from = 4;  // the face we entered through: p lies strictly beyond it
   for (;;) {
     ++steps;
-    const std::uint32_t* v = &vertices[4 * std::size_t(t)];
+    const std::uint32_t* v = &tets[8 * std::size_t(t)];
     const Vec3d* q[4] = {&coords[v[0]], &coords[v[1]], &coords[v[2]], &coords[v[3]]};
     random ^= random << 13, random ^= random >> 17, random ^= random << 5;
     const std::uint32_t first = random & 3;
@@ -90,7 +95,7 @@ std::uint32_t Tet3Mesh::walk(const Vec3d& p, std::uint32_t t, std::size_t& steps
       const double o = orient(*q[0], *q[1], *q[2], *q[3]);
       q[f] = saved;
       if (o < 0) {
-        next = adjacency[4 * std::size_t(t) + f];
+        next = tets[8 * std::size_t(t) + 4 + f];
         break;
       }
     }
@@ -107,32 +112,29 @@ std::uint32_t Tet3Mesh::new_slot() {
     free_slots.pop_back();
     return s;
   }
-  const std::uint32_t s = std::uint32_t(vertices.size() / 4);
-  vertices.resize(vertices.size() + 4);
-  adjacency.resize(adjacency.size() + 4);
+  const std::uint32_t s = std::uint32_t(tets.size() / 8);
+  tets.resize(tets.size() + 8);
   mark.push_back(0);
   return s;
 }
 
 void Tet3Mesh::free_slot(std::uint32_t s) {
-  vertices[4 * std::size_t(s)] = vertices[4 * std::size_t(s) + 1] = vertices[4 * std::size_t(s) + 2] =
-      vertices[4 * std::size_t(s) + 3] = kNone;
+  std::fill_n(&tets[8 * std::size_t(s)], 4, kNone);
   free_slots.push_back(s);
 }
 
 void Tet3Mesh::make_first(std::uint32_t a, std::uint32_t b, std::uint32_t c, std::uint32_t d) {
-  vertices.clear();
-  adjacency.clear();
+  tets.clear();
   free_slots.clear();
   mark.clear();
   if (orient(coords[a], coords[b], coords[c], coords[d]) < 0) std::swap(a, b);
   const std::uint32_t v[4] = {a, b, c, d};
   for (std::uint32_t s = 0; s < 5; ++s) new_slot();
-  std::copy(v, v + 4, vertices.begin());
+  std::copy(v, v + 4, tets.begin());
   // Ghost tetrahedron 1 + i behind face i: v with v[i] replaced by the ghost,
   // then two other entries swapped (an odd permutation: the ghost's side).
   for (int i = 0; i < 4; ++i) {
-    std::uint32_t* g = &vertices[4 * std::size_t(1 + i)];
+    std::uint32_t* g = &tets[8 * std::size_t(1 + i)];
     std::copy(v, v + 4, g);
     g[i] = kGhost;
     std::swap(g[(i + 1) % 4], g[(i + 2) % 4]);
@@ -140,10 +142,10 @@ void Tet3Mesh::make_first(std::uint32_t a, std::uint32_t b, std::uint32_t c, std
   // Link every pair of the five tetrahedra that share a face.
   for (std::uint32_t s = 0; s < 5; ++s)
     for (std::uint32_t f = 0; f < 4; ++f) {
-      const std::uint32_t* vs = &vertices[4 * s];
+      const std::uint32_t* vs = &tets[8 * s];
       for (std::uint32_t t = 0; t < 5; ++t) {
         if (t == s) continue;
-        const std::uint32_t* vt = &vertices[4 * t];
+        const std::uint32_t* vt = &tets[8 * t];
         // t shares s's face f if it holds the three other vertices of s
         int shared = 0;
         std::uint32_t missing = 4;
@@ -153,7 +155,7 @@ void Tet3Mesh::make_first(std::uint32_t a, std::uint32_t b, std::uint32_t c, std
           else
             missing = k;
         }
-        if (shared == 3) adjacency[4 * s + f] = 4 * t + missing;
+        if (shared == 3) tets[8 * s + 4 + f] = 4 * t + missing;
       }
     }
   last = 0;
@@ -164,64 +166,71 @@ std::uint32_t Tet3Mesh::insert(std::uint32_t pv) {
   const std::uint32_t t = walk(p, last, walk_steps, random);
   if (!is_ghost(t))
     for (int k = 0; k < 4; ++k) {
-      const std::uint32_t u = vertices[4 * std::size_t(t) + k];
+      const std::uint32_t u = tets[8 * std::size_t(t) + k];
       if (same(coords[u], p)) {
         last = t;
         return u;
       }
     }
-  // The cavity: the tetrahedra in conflict with p, breadth first from t.
+  // The cavity: the tetrahedra in conflict with p, depth first from t. Raw
+  // pointers: nothing below grows the arrays until the new tetrahedra.
+  const Vec3d* C = coords.data();
+  std::uint32_t* T = tets.data();
+  std::uint32_t* M = mark.data();
   ++epoch;
   const std::uint32_t in = 2 * epoch + 1, out = 2 * epoch;
   stack.clear();
   cavity.clear();
   boundary.clear();
   stack.push_back(t);
-  mark[t] = in;
+  M[t] = in;
   while (!stack.empty()) {
     const std::uint32_t c = stack.back();
     stack.pop_back();
     cavity.push_back(c);
     for (std::uint32_t f = 0; f < 4; ++f) {
-      const std::uint32_t a = adjacency[4 * std::size_t(c) + f], n = a >> 2;
-      if (mark[n] == in) continue;
-      if (mark[n] != out) {
-        if (in_conflict(n, p)) {
-          mark[n] = in;
+      const std::uint32_t a = T[8 * std::size_t(c) + 4 + f], n = a >> 2;
+      const std::uint32_t m = M[n];
+      if (m == in) continue;
+      if (m != out) {
+        if (conflict(C, T, n, p)) {
+          M[n] = in;
           stack.push_back(n);
           continue;
         }
-        mark[n] = out;
+        M[n] = out;
       }
-      Boundary b;
-      std::copy_n(&vertices[4 * std::size_t(c)], 4, b.v);
+      Boundary& b = boundary.emplace_back();
+      std::copy_n(&T[8 * std::size_t(c)], 4, b.v);
       b.v[f] = pv;
       b.face = f;
       b.outer = a;
-      boundary.push_back(b);
     }
   }
   conflicts += cavity.size();
   // The new tetrahedra: each boundary face joined to p, in the cavity's slots first.
+  if (boundary.size() > cavity.size()) {
+    const std::size_t more = boundary.size() - cavity.size();
+    for (std::size_t k = 0; k < more; ++k) cavity.push_back(new_slot());
+    T = tets.data();
+  }
   edges.begin(boundary.size());
   std::uint32_t newest = kNone;
   for (std::size_t i = 0; i < boundary.size(); ++i) {
     const Boundary& b = boundary[i];
-    const std::uint32_t s = i < cavity.size() ? cavity[i] : new_slot();
-    std::copy_n(b.v, 4, &vertices[4 * std::size_t(s)]);
-    adjacency[4 * std::size_t(s) + b.face] = b.outer;
-    adjacency[b.outer] = 4 * s + b.face;
+    const std::uint32_t s = cavity[i];
+    std::copy_n(b.v, 4, &T[8 * std::size_t(s)]);
+    T[8 * std::size_t(s) + 4 + b.face] = b.outer;
+    T[entry(b.outer)] = 4 * s + b.face;
     for (std::uint32_t j = 0; j < 4; ++j) {
       if (j == b.face) continue;
       // face j holds p and the edge of the two vertices other than b.face and j
-      std::uint32_t u = kNone, w = kNone;
-      for (std::uint32_t k = 0; k < 4; ++k)
-        if (k != j && k != b.face) (u == kNone ? u : w) = b.v[k];
+      const std::uint32_t u = b.v[kEdgeOf[b.face][j][0]], w = b.v[kEdgeOf[b.face][j][1]];
       const std::uint32_t other = edges.match(u < w ? (std::uint64_t(u) << 32 | w) : (std::uint64_t(w) << 32 | u),
                                               4 * s + j);
       if (other != kNone) {
-        adjacency[4 * std::size_t(s) + j] = other;
-        adjacency[other] = 4 * s + j;
+        T[8 * std::size_t(s) + 4 + j] = other;
+        T[entry(other)] = 4 * s + j;
       }
     }
     if (newest == kNone || ((b.v[0] | b.v[1] | b.v[2] | b.v[3]) & kGhostBit) == 0) newest = s;
@@ -234,25 +243,11 @@ std::uint32_t Tet3Mesh::insert(std::uint32_t pv) {
 void Tet3Mesh::EdgeTable::begin(std::size_t faces) {
   std::size_t want = 64;
   while (want < 4 * faces) want *= 2;
-  if (want > keys.size()) {
-    keys.assign(want, 0);
-    values.assign(want, 0);
-    stamps.assign(want, 0);
-  }
-  mask = std::min(want, keys.size()) - 1;
-  ++stamp;
-}
-
-std::uint32_t Tet3Mesh::EdgeTable::match(std::uint64_t key, std::uint32_t value) {
-  std::size_t h = std::size_t((key * 0x9E3779B97F4A7C15ull) >> 40) & mask;
-  for (;; h = (h + 1) & mask) {
-    if (stamps[h] != stamp) {
-      stamps[h] = stamp;
-      keys[h] = key;
-      values[h] = value;
-      return kNone;
-    }
-    if (keys[h] == key) return values[h];  // each edge is shared by exactly two new tetrahedra
+  if (want > entries.size()) entries.assign(want, Entry{});
+  mask = want - 1;
+  if (++stamp == 0) {  // wrapped: forget every old stamp
+    for (Entry& e : entries) e.stamp = 0;
+    stamp = 1;
   }
 }
 
@@ -276,8 +271,7 @@ void Delaunay3::build(Options options) {
   internal_of_.assign(n, kNone);
   coords_.clear();
   original_of_.clear();
-  tet_vertices_.clear();
-  tet_adjacency_.clear();
+  tets_.clear();
   free_slots_.clear();
   if (n == 0) {
     dimension_ = -1;
@@ -317,11 +311,10 @@ void Delaunay3::build(Options options) {
     return;
   }
 
-  Tet3Mesh mesh(coords_, tet_vertices_, tet_adjacency_, free_slots_);
+  Tet3Mesh mesh(coords_, tets_, free_slots_);
   coords_.reserve(n);
   original_of_.reserve(n);
-  tet_vertices_.reserve(4 * 7 * n + 64);
-  tet_adjacency_.reserve(4 * 7 * n + 64);
+  tets_.reserve(8 * 7 * n + 64);
   mesh.mark.reserve(7 * n + 16);
   const std::size_t first[4] = {0, kb, kc, kd};
   for (std::size_t k : first) {
@@ -351,11 +344,11 @@ void Delaunay3::build(Options options) {
 }
 
 void Delaunay3::publish() {
-  const std::size_t slots = tet_vertices_.size() / 4;
+  const std::size_t slots = tets_.size() / 8;
   public_of_.assign(slots, kNone);
   std::size_t count = 0;
   for (std::size_t s = 0; s < slots; ++s) {
-    const std::uint32_t* v = &tet_vertices_[4 * s];
+    const std::uint32_t* v = &tets_[8 * s];
     if (((v[0] | v[1] | v[2] | v[3]) & Tet3Mesh::kGhostBit) == 0) public_of_[s] = std::uint32_t(count++);
   }
   tetrahedra_.resize(4 * count);
@@ -365,8 +358,8 @@ void Delaunay3::publish() {
       const std::uint32_t t = public_of_[s];
       if (t == kNone) continue;
       for (int k = 0; k < 4; ++k) {
-        tetrahedra_[4 * std::size_t(t) + k] = original_of_[tet_vertices_[4 * s + k]];
-        neighbors_[4 * std::size_t(t) + k] = public_of_[tet_adjacency_[4 * s + k] >> 2];
+        tetrahedra_[4 * std::size_t(t) + k] = original_of_[tets_[8 * s + k]];
+        neighbors_[4 * std::size_t(t) + k] = public_of_[tets_[8 * s + 4 + k] >> 2];
       }
     }
   });
@@ -374,9 +367,9 @@ void Delaunay3::publish() {
 
 std::vector<Delaunay3::Triangle> Delaunay3::hull() const {
   std::vector<Triangle> out;
-  const std::size_t slots = tet_vertices_.size() / 4;
+  const std::size_t slots = tets_.size() / 8;
   for (std::size_t s = 0; s < slots; ++s) {
-    const std::uint32_t* v = &tet_vertices_[4 * s];
+    const std::uint32_t* v = &tets_[8 * s];
     if (v[0] == kNone) continue;
     for (int g = 0; g < 4; ++g)
       if (v[g] == Tet3Mesh::kGhost) {
@@ -400,13 +393,14 @@ Delaunay3Stats Delaunay3::stats() const {
   s.duplicates = duplicate_count();
   s.vertices = s.points - s.duplicates;
   s.tetrahedra = tetrahedron_count();
-  for (const std::uint32_t v : tet_vertices_) s.hull_triangles += v == Tet3Mesh::kGhost;
+  for (std::size_t k = 0; k < tets_.size(); k += 8)
+    s.hull_triangles += std::count(&tets_[k], &tets_[k] + 4, Tet3Mesh::kGhost);
   s.dimension = dimension_ < 0 ? 0 : std::size_t(dimension_);
   s.walk_steps = walk_steps_;
   s.conflicts = conflicts_;
   const auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
   s.bytes = bytes(points_) + bytes(rep_) + bytes(coords_) + bytes(original_of_) + bytes(internal_of_) +
-            bytes(tet_vertices_) + bytes(tet_adjacency_) + bytes(free_slots_) + bytes(tetrahedra_) +
+            bytes(tets_) + bytes(free_slots_) + bytes(tetrahedra_) +
             bytes(neighbors_) + bytes(public_of_);
   return s;
 }
@@ -424,10 +418,9 @@ void Delaunay3::validate() const {
     if (!tetrahedra_.empty()) throw Error("Delaunay3: a lower-dimensional set has tetrahedra");
     return;
   }
-  const std::size_t slots = tet_vertices_.size() / 4;
-  if (tet_adjacency_.size() != tet_vertices_.size()) throw Error("Delaunay3: adjacency of the wrong size");
-  Tet3Mesh mesh(const_cast<std::vector<Vec3d>&>(coords_), const_cast<std::vector<std::uint32_t>&>(tet_vertices_),
-                const_cast<std::vector<std::uint32_t>&>(tet_adjacency_),
+  const std::size_t slots = tets_.size() / 8;
+  if (tets_.size() % 8) throw Error("Delaunay3: tetrahedron array of the wrong size");
+  Tet3Mesh mesh(const_cast<std::vector<Vec3d>&>(coords_), const_cast<std::vector<std::uint32_t>&>(tets_),
                 const_cast<std::vector<std::uint32_t>&>(free_slots_));
   const std::size_t vertex_count = coords_.size();
   std::vector<std::uint8_t> used(vertex_count, 0);
@@ -440,7 +433,7 @@ void Delaunay3::validate() const {
       [&](std::size_t block) {
         try {
           for (std::size_t s = block * kBlock; s < std::min(slots, (block + 1) * kBlock); ++s) {
-            const std::uint32_t* v = &tet_vertices_[4 * s];
+            const std::uint32_t* v = &tets_[8 * s];
             if (v[0] == kNone) continue;
             int ghosts = 0;
             for (int k = 0; k < 4; ++k) {
@@ -453,18 +446,18 @@ void Delaunay3::validate() const {
             }
             if (ghosts > 1) throw Error("Delaunay3: " + tet_name(std::uint32_t(s)) + " has two ghost vertices");
             for (std::uint32_t f = 0; f < 4; ++f) {
-              const std::uint32_t a = tet_adjacency_[4 * s + f];
-              if ((a >> 2) >= slots || tet_vertices_[(a & ~3u)] == kNone || tet_adjacency_[a] != 4 * s + f)
+              const std::uint32_t a = tets_[8 * s + 4 + f];
+              if ((a >> 2) >= slots || tets_[8 * std::size_t(a >> 2)] == kNone || tets_[Tet3Mesh::entry(a)] != 4 * s + f)
                 throw Error("Delaunay3: " + tet_name(std::uint32_t(s)) + " face " + std::to_string(f) +
                             ": neighbour not mutual");
               for (std::uint32_t k = 0; k < 4; ++k) {
                 if (k == f) continue;
-                const std::uint32_t* w = &tet_vertices_[a & ~3u];
+                const std::uint32_t* w = &tets_[8 * std::size_t(a >> 2)];
                 if (std::find(w, w + 4, v[k]) == w + 4 || w[a & 3] == v[k])
                   throw Error("Delaunay3: " + tet_name(std::uint32_t(s)) + " face " + std::to_string(f) +
                               ": neighbour does not share the face");
               }
-              const std::uint32_t opposite = tet_vertices_[a];
+              const std::uint32_t opposite = tets_[Tet3Mesh::opposite(a)];
               if (opposite == Tet3Mesh::kGhost) continue;
               const Vec3d& p = coords_[opposite];
               if (ghosts == 0) {
@@ -500,8 +493,8 @@ void Delaunay3::validate() const {
     const std::uint32_t t = public_of_[s];
     if (t == kNone) continue;
     for (int k = 0; k < 4; ++k)
-      if (tetrahedra_[4 * std::size_t(t) + k] != original_of_[tet_vertices_[4 * s + k]] ||
-          neighbors_[4 * std::size_t(t) + k] != public_of_[tet_adjacency_[4 * s + k] >> 2])
+      if (tetrahedra_[4 * std::size_t(t) + k] != original_of_[tets_[8 * s + k]] ||
+          neighbors_[4 * std::size_t(t) + k] != public_of_[tets_[8 * s + 4 + k] >> 2])
         throw Error("Delaunay3: public tetrahedron " + std::to_string(t) + " differs from its slot");
   }
 }

@@ -100,9 +100,9 @@ class Delaunay3 {
 
  private:
   // The closed tetrahedralization, over internal vertex numbers (insertion
-  // order, their coordinates copied in that order): per slot four vertices
-  // (kGhost for the infinite one, no_index in a free slot) and four
-  // adjacencies, 4 * neighbour + the face's index in the neighbour.
+  // order, their coordinates copied in that order): per slot eight words,
+  // four vertices (the ghost for the infinite one, no_index in a free slot)
+  // and four adjacencies, 4 * neighbour + the face's index in the neighbour.
   void build(Options options);
   void publish();
 
@@ -114,7 +114,7 @@ class Delaunay3 {
   std::vector<Vec3d> coords_;               // per internal vertex
   std::vector<std::uint32_t> original_of_;  // internal vertex -> the point it stands for
   std::vector<std::uint32_t> internal_of_;  // representative point -> internal vertex (no_index for others)
-  std::vector<std::uint32_t> tet_vertices_, tet_adjacency_, free_slots_;
+  std::vector<std::uint32_t> tets_, free_slots_;
   std::size_t walk_steps_ = 0, conflicts_ = 0;
 
   std::vector<std::uint32_t> tetrahedra_, neighbors_;  // public, finite only
