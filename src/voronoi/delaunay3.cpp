@@ -265,21 +265,25 @@ Delaunay3::Delaunay3(std::span<const Vec3d> points, Options options) : options_(
 }
 
 void Delaunay3::build(Options options) {
-  const std::size_t n = points_.size();
-  rep_.resize(n);
-  std::iota(rep_.begin(), rep_.end(), 0u);
-  internal_of_.assign(n, kNone);
+  const std::size_t total = points_.size();
+  removed_.resize(total, 0);
+  rep_.assign(total, kNone);
+  internal_of_.assign(total, kNone);
   coords_.clear();
   original_of_.clear();
   tets_.clear();
   free_slots_.clear();
+  walk_steps_ = conflicts_ = 0;
+  std::vector<std::uint32_t> active;
+  active.reserve(total);
+  for (std::size_t i = 0; i < total; ++i)
+    if (!removed_[i]) active.push_back(std::uint32_t(i));
+  const std::size_t n = active.size();
   if (n == 0) {
     dimension_ = -1;
     return;
   }
-  std::vector<std::uint32_t> all(n);
-  std::iota(all.begin(), all.end(), 0u);
-  const std::vector<std::uint32_t> order = brio_order(std::span<const Vec3d>(points_), all, options.seed);
+  const std::vector<std::uint32_t> order = brio_order(std::span<const Vec3d>(points_), active, options.seed);
 
   // The first tetrahedron: the earliest four affinely independent points in the order.
   const auto at = [&](std::size_t k) -> const Vec3d& { return points_[order[k]]; };
@@ -292,7 +296,7 @@ void Delaunay3::build(Options options) {
   dimension_ = kb >= n ? 0 : kc >= n ? 1 : kd >= n ? 2 : 3;
   if (dimension_ < 3) {
     // No tetrahedra: merge duplicates by sorting.
-    std::vector<std::uint32_t> sorted = all;
+    std::vector<std::uint32_t> sorted = active;
     std::sort(sorted.begin(), sorted.end(), [&](std::uint32_t a, std::uint32_t b) {
       return Tet3Mesh::lex_less(points_[a], points_[b]) || (same(points_[a], points_[b]) && a < b);
     });
@@ -307,7 +311,7 @@ void Delaunay3::build(Options options) {
         original_of_.push_back(i);
       }
     }
-    for (std::size_t i = 0; i < n; ++i) internal_of_[i] = internal_of_[rep_[i]];
+    for (std::uint32_t i : active) internal_of_[i] = internal_of_[rep_[i]];
     return;
   }
 
@@ -325,22 +329,60 @@ void Delaunay3::build(Options options) {
   mesh.make_first(0, 1, 2, 3);
   for (std::size_t k = 1; k < n; ++k) {
     if (k == kb || k == kc || k == kd) continue;
-    const std::uint32_t i = order[k];
-    const std::uint32_t v = std::uint32_t(coords_.size());
-    coords_.push_back(points_[i]);
-    const std::uint32_t existing = mesh.insert(v);
-    if (existing == kNone) {
-      original_of_.push_back(i);
-      internal_of_[i] = v;
-    } else {
-      coords_.pop_back();
-      internal_of_[i] = existing;
-      original_of_[existing] = std::min(original_of_[existing], i);  // the first occurrence stands for all
-    }
+    insert_point(mesh, order[k]);
   }
-  for (std::size_t i = 0; i < n; ++i) rep_[i] = original_of_[internal_of_[i]];
+  for (std::uint32_t i : active) rep_[i] = original_of_[internal_of_[i]];
   walk_steps_ = mesh.walk_steps;
   conflicts_ = mesh.conflicts;
+  last_ = mesh.last;
+}
+
+void Delaunay3::insert_point(Tet3Mesh& mesh, std::uint32_t i) {
+  const std::uint32_t v = std::uint32_t(coords_.size());
+  coords_.push_back(points_[i]);
+  const std::uint32_t existing = mesh.insert(v);
+  if (existing == kNone) {
+    original_of_.push_back(i);
+    internal_of_[i] = v;
+  } else {
+    coords_.pop_back();
+    internal_of_[i] = existing;
+    original_of_[existing] = std::min(original_of_[existing], i);  // the first occurrence stands for all
+  }
+}
+
+std::uint32_t Delaunay3::insert(const Vec3d& p) {
+  if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
+    throw Error("Delaunay3.insert: the point has a NaN or infinite coordinate");
+  if (points_.size() + 1 >= (std::size_t(1) << 31)) throw Error("Delaunay3.insert: 2^31 - 1 points are the most");
+  const std::uint32_t i = std::uint32_t(points_.size());
+  points_.push_back(p);
+  removed_.push_back(0);
+  rep_.push_back(kNone);
+  internal_of_.push_back(kNone);
+  if (dimension_ < 3) {  // the new point may lift the set to a solid: start again
+    build(options_);
+    publish();
+    return i;
+  }
+  Tet3Mesh mesh(coords_, tets_, free_slots_);
+  mesh.mark.assign(tets_.size() / 8, 0);
+  mesh.last = last_;
+  insert_point(mesh, i);
+  rep_[i] = original_of_[internal_of_[i]];
+  walk_steps_ += mesh.walk_steps;
+  conflicts_ += mesh.conflicts;
+  last_ = mesh.last;
+  publish();
+  return i;
+}
+
+void Delaunay3::remove(std::uint32_t i) {
+  if (i >= points_.size() || removed_[i])
+    throw Error("Delaunay3.remove: point " + std::to_string(i) + (i >= points_.size() ? " does not exist" : " was removed"));
+  removed_[i] = 1;
+  build(options_);
+  publish();
 }
 
 void Delaunay3::publish() {
@@ -353,6 +395,12 @@ void Delaunay3::publish() {
   }
   tetrahedra_.resize(4 * count);
   neighbors_.resize(4 * count);
+  vertex_slot_.assign(coords_.size(), kNone);
+  for (std::size_t s = 0; s < slots; ++s)
+    for (int k = 0; k < 4; ++k) {
+      const std::uint32_t v = tets_[8 * s + k];
+      if ((v & Tet3Mesh::kGhostBit) == 0) vertex_slot_[v] = std::uint32_t(s);
+    }
   parallel_for(0, slots, 1 << 14, [&](std::size_t begin, std::size_t end) {
     for (std::size_t s = begin; s < end; ++s) {
       const std::uint32_t t = public_of_[s];
@@ -383,15 +431,98 @@ std::vector<Delaunay3::Triangle> Delaunay3::hull() const {
 
 std::size_t Delaunay3::duplicate_count() const {
   std::size_t count = 0;
-  for (std::size_t i = 0; i < rep_.size(); ++i) count += rep_[i] != i;
+  for (std::size_t i = 0; i < rep_.size(); ++i) count += rep_[i] != i && rep_[i] != kNone;
   return count;
+}
+
+std::uint32_t Delaunay3::start_slot(std::uint32_t hint) const {
+  if (hint != kNone && hint < tetrahedron_count()) {
+    // the public index's slot: the k-th live finite slot; find it through its vertices
+    const std::uint32_t v = internal_of_[tetrahedra_[4 * std::size_t(hint)]];
+    if (v != kNone && v < vertex_slot_.size()) return vertex_slot_[v];
+  }
+  return last_ < tets_.size() / 8 && tets_[8 * std::size_t(last_)] != kNone ? last_ : vertex_slot_[0];
+}
+
+std::uint32_t Delaunay3::locate(const Vec3d& q, std::uint32_t hint) const {
+  if (dimension_ < 3) return kNone;
+  if (!std::isfinite(q[0]) || !std::isfinite(q[1]) || !std::isfinite(q[2]))
+    throw Error("Delaunay3.locate: the query has a NaN or infinite coordinate");
+  Tet3Mesh mesh(const_cast<std::vector<Vec3d>&>(coords_), const_cast<std::vector<std::uint32_t>&>(tets_),
+                const_cast<std::vector<std::uint32_t>&>(free_slots_));
+  std::size_t steps = 0;
+  std::uint32_t random = 2463534242u;
+  const std::uint32_t t = mesh.walk(q, start_slot(hint), steps, random);
+  return mesh.is_ghost(t) ? kNone : public_of_[t];
+}
+
+std::vector<std::uint32_t> Delaunay3::vertex_neighbors(std::uint32_t point) const {
+  std::vector<std::uint32_t> out;
+  if (point >= rep_.size() || rep_[point] != point) return out;
+  const std::uint32_t v = internal_of_[point];
+  if (dimension_ < 3) return out;
+  // The star of v: the slots around it, breadth first across the faces that hold v.
+  std::vector<std::uint32_t> stack = {vertex_slot_[v]}, seen = stack;
+  while (!stack.empty()) {
+    const std::uint32_t t = stack.back();
+    stack.pop_back();
+    for (int k = 0; k < 4; ++k) {
+      const std::uint32_t u = tets_[8 * std::size_t(t) + k];
+      if (u == v) continue;
+      if ((u & Tet3Mesh::kGhostBit) == 0) out.push_back(original_of_[u]);
+      const std::uint32_t n = tets_[8 * std::size_t(t) + 4 + k] >> 2;  // across the face opposite u: holds v
+      if (std::find(seen.begin(), seen.end(), n) == seen.end()) {
+        seen.push_back(n);
+        stack.push_back(n);
+      }
+    }
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+std::uint32_t Delaunay3::nearest_vertex(const Vec3d& q) const {
+  if (!std::isfinite(q[0]) || !std::isfinite(q[1]) || !std::isfinite(q[2]))
+    throw Error("Delaunay3.nearest_vertex: the query has a NaN or infinite coordinate");
+  if (coords_.empty()) return kNone;
+  const auto distance = [&](std::uint32_t v) { return (coords_[v] - q).squaredNorm(); };
+  std::uint32_t best = 0;
+  if (dimension_ < 3) {
+    for (std::uint32_t v = 1; v < coords_.size(); ++v)
+      if (distance(v) < distance(best)) best = v;
+    return original_of_[best];
+  }
+  Tet3Mesh mesh(const_cast<std::vector<Vec3d>&>(coords_), const_cast<std::vector<std::uint32_t>&>(tets_),
+                const_cast<std::vector<std::uint32_t>&>(free_slots_));
+  std::size_t steps = 0;
+  std::uint32_t random = 2463534242u;
+  const std::uint32_t t = mesh.walk(q, start_slot(kNone), steps, random);
+  best = kNone;
+  for (int k = 0; k < 4; ++k) {
+    const std::uint32_t u = tets_[8 * std::size_t(t) + k];
+    if ((u & Tet3Mesh::kGhostBit) == 0 && (best == kNone || distance(u) < distance(best))) best = u;
+  }
+  // Greedy descent: a vertex none of whose Delaunay neighbours is closer is the nearest.
+  for (bool moved = true; moved;) {
+    moved = false;
+    for (const std::uint32_t w : vertex_neighbors(original_of_[best])) {
+      const std::uint32_t u = internal_of_[w];
+      if (distance(u) < distance(best)) {
+        best = u;
+        moved = true;
+      }
+    }
+  }
+  return original_of_[best];
 }
 
 Delaunay3Stats Delaunay3::stats() const {
   Delaunay3Stats s;
   s.points = points_.size();
   s.duplicates = duplicate_count();
-  s.vertices = s.points - s.duplicates;
+  s.removed = std::size_t(std::count(removed_.begin(), removed_.end(), 1));
+  s.vertices = s.points - s.duplicates - s.removed;
   s.tetrahedra = tetrahedron_count();
   for (std::size_t k = 0; k < tets_.size(); k += 8)
     s.hull_triangles += std::count(&tets_[k], &tets_[k] + 4, Tet3Mesh::kGhost);
@@ -400,16 +531,20 @@ Delaunay3Stats Delaunay3::stats() const {
   s.conflicts = conflicts_;
   const auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
   s.bytes = bytes(points_) + bytes(rep_) + bytes(coords_) + bytes(original_of_) + bytes(internal_of_) +
-            bytes(tets_) + bytes(free_slots_) + bytes(tetrahedra_) +
+            bytes(tets_) + bytes(removed_) + bytes(vertex_slot_) + bytes(free_slots_) + bytes(tetrahedra_) +
             bytes(neighbors_) + bytes(public_of_);
   return s;
 }
 
 void Delaunay3::validate() const {
   const std::size_t n = points_.size();
-  if (rep_.size() != n || internal_of_.size() != n) throw Error("Delaunay3: per-point arrays of the wrong size");
+  if (rep_.size() != n || internal_of_.size() != n || removed_.size() != n) throw Error("Delaunay3: per-point arrays of the wrong size");
   for (std::size_t i = 0; i < n; ++i) {
     const std::uint32_t r = rep_[i], v = internal_of_[i];
+    if (removed_[i]) {
+      if (r != kNone || v != kNone) throw Error("Delaunay3: removed point " + std::to_string(i) + " has a vertex");
+      continue;
+    }
     if (r > i || rep_[r] != r) throw Error("Delaunay3: point " + std::to_string(i) + " has a bad representative");
     if (v >= coords_.size() || original_of_[v] != r || !same(coords_[v], points_[i]))
       throw Error("Delaunay3: point " + std::to_string(i) + " is not at its vertex");

@@ -282,5 +282,91 @@ TEST(Delaunay3, StatsCountWhatIsThere) {
   EXPECT_GT(s.bytes, s.tetrahedra * 32);
 }
 
+TEST(Delaunay3, LocateAndNearestVertexAgreeWithBruteForce) {
+  for (Shape shape : {Shape::uniform, Shape::lattice, Shape::duplicates}) {
+    const auto p = make_points(shape, 500, 9);
+    const Delaunay3 dt(p);
+    Rng rng(4);
+    const auto& tets = dt.tetrahedra();
+    for (int k = 0; k < 200; ++k) {
+      const Vec3d q(rng.uniform(-0.2, 1.2) * 7, rng.uniform(-0.2, 1.2) * 7, rng.uniform(-0.2, 1.2) * 7);
+      const Vec3d scaled = shape == Shape::lattice ? q : q / 7.0;
+      // locate: the tetrahedron holds q (exact orientations), or q is outside the hull
+      const std::uint32_t t = dt.locate(scaled);
+      bool inside_hull = true;
+      for (const auto& f : dt.hull())
+        if (orient3d(p[f[0]], p[f[1]], p[f[2]], scaled) < 0) inside_hull = false;  // beyond an outward face
+      ASSERT_EQ(t != Delaunay3::no_index, inside_hull) << "query " << k;
+      if (t != Delaunay3::no_index) {
+        const Vec3d* v[4] = {&p[tets[4 * t]], &p[tets[4 * t + 1]], &p[tets[4 * t + 2]], &p[tets[4 * t + 3]]};
+        for (int f = 0; f < 4; ++f) {
+          const Vec3d* w[4] = {v[0], v[1], v[2], v[3]};
+          w[f] = &scaled;
+          EXPECT_LE(orient3d(*w[0], *w[1], *w[2], *w[3]), 0) << "query " << k << " face " << f;
+        }
+      }
+      // nearest_vertex: as close as the closest point
+      double best = INFINITY;
+      for (const Vec3d& x : p) best = std::min(best, (x - scaled).squaredNorm());
+      const std::uint32_t n = dt.nearest_vertex(scaled);
+      ASSERT_NE(n, Delaunay3::no_index);
+      EXPECT_EQ(dt.representative(n), n);
+      EXPECT_EQ((p[n] - scaled).squaredNorm(), best) << "query " << k;
+    }
+  }
+}
+
+TEST(Delaunay3, InsertAndRemoveGiveTheTetrahedralizationOfTheSet) {
+  auto p = make_points(Shape::lattice, 0, 21);
+  std::vector<Vec3d> first(p.begin(), p.begin() + 150), rest(p.begin() + 150, p.end());
+  Delaunay3 dt(first);
+  for (const Vec3d& x : rest) dt.insert(x);
+  dt.insert(p[3]);  // a duplicate
+  std::vector<Vec3d> all = first;
+  all.insert(all.end(), rest.begin(), rest.end());
+  all.push_back(p[3]);
+  ASSERT_NO_THROW(dt.validate());
+  EXPECT_EQ(sorted_tets(dt), sorted_tets(Delaunay3(all)));
+  EXPECT_EQ(dt.representative(std::uint32_t(all.size() - 1)), 3u);
+  // Remove the first copy of p[3]: its duplicate stands for it; remove some others.
+  dt.remove(3);
+  EXPECT_EQ(dt.representative(3), Delaunay3::no_index);
+  EXPECT_EQ(dt.representative(std::uint32_t(all.size() - 1)), std::uint32_t(all.size() - 1));
+  for (std::uint32_t i : {0u, 10u, 200u}) dt.remove(i);
+  ASSERT_NO_THROW(dt.validate());
+  EXPECT_EQ(dt.stats().removed, 4u);
+  EXPECT_THROW(dt.remove(10), Error);
+  EXPECT_THROW(dt.remove(100000), Error);
+  // The same tetrahedra as a fresh build of what is left (compared by coordinates).
+  std::vector<Vec3d> left;
+  for (std::size_t i = 0; i < all.size(); ++i)
+    if (i != 3 && i != 0 && i != 10 && i != 200) left.push_back(all[i]);
+  const Delaunay3 fresh(left);
+  EXPECT_EQ(fresh.tetrahedron_count(), dt.tetrahedron_count());
+  // Inserting into a lower-dimensional set lifts it.
+  Delaunay3 flat(std::vector<Vec3d>{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}});
+  EXPECT_EQ(flat.dimension(), 2);
+  flat.insert(Vec3d(0, 0, 1));
+  EXPECT_EQ(flat.dimension(), 3);
+  EXPECT_EQ(flat.tetrahedron_count(), 1u);
+  EXPECT_THROW(flat.insert(Vec3d(0, NAN, 1)), Error);
+}
+
+TEST(Delaunay3, VertexNeighborsAreTheEdges) {
+  const auto p = make_points(Shape::uniform, 300, 2);
+  const Delaunay3 dt(p);
+  std::set<std::pair<std::uint32_t, std::uint32_t>> edges;
+  const auto& tets = dt.tetrahedra();
+  for (std::size_t t = 0; t < dt.tetrahedron_count(); ++t)
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j)
+        if (i != j) edges.insert({tets[4 * t + i], tets[4 * t + j]});
+  for (std::uint32_t v = 0; v < p.size(); ++v)
+    for (std::uint32_t w : dt.vertex_neighbors(v)) EXPECT_TRUE(edges.count({v, w}));
+  std::size_t total = 0;
+  for (std::uint32_t v = 0; v < p.size(); ++v) total += dt.vertex_neighbors(v).size();
+  EXPECT_EQ(total, edges.size());
+}
+
 }  // namespace
 }  // namespace geods::voronoi

@@ -41,10 +41,13 @@
 
 namespace geods::voronoi {
 
+struct Tet3Mesh;
+
 struct Delaunay3Stats {
   std::size_t points = 0;          // input points
   std::size_t vertices = 0;        // distinct points, vertices of the tetrahedralization
   std::size_t duplicates = 0;      // points merged into an earlier equal point
+  std::size_t removed = 0;         // points removed by remove()
   std::size_t tetrahedra = 0;      // finite tetrahedra
   std::size_t hull_triangles = 0;  // triangles of the convex hull
   std::size_t dimension = 0;       // affine dimension of the points (0 for none)
@@ -84,9 +87,33 @@ class Delaunay3 {
   /// from outside, over point indices.
   std::vector<Triangle> hull() const;
 
-  /// The vertex that stands for point i: i itself or the first occurrence of an equal point.
+  /// The vertex that stands for point i: i itself, the first occurrence of an
+  /// equal point, or no_index for a removed point.
   std::uint32_t representative(std::uint32_t i) const { return rep_[i]; }
   std::size_t duplicate_count() const;
+
+  /// A finite tetrahedron (index into tetrahedra() / 4) whose closed volume
+  /// holds q, or no_index outside the hull (or for dimension() < 3). A
+  /// visibility walk from `hint` (a tetrahedron, or no_index for the last one
+  /// built): O(n^(1/3)) expected steps from afar, O(1) from close by. Thread-safe.
+  std::uint32_t locate(const Vec3d& q, std::uint32_t hint = no_index) const;
+  /// The point nearest to q (a representative; ties broken arbitrarily), by
+  /// locating q and descending greedily along Delaunay edges (for
+  /// dimension() < 3, by scanning the distinct points); no_index if empty. Thread-safe.
+  std::uint32_t nearest_vertex(const Vec3d& q) const;
+  /// The Delaunay neighbours of the vertex of point v (a representative), ascending.
+  std::vector<std::uint32_t> vertex_neighbors(std::uint32_t v) const;
+
+  /// Inserts a point, returns its index (points().size() - 1 after the call).
+  /// A duplicate is merged into the existing point. Bowyer-Watson in place:
+  /// O(cavity) plus O(n) to renumber the public arrays.
+  std::uint32_t insert(const Vec3d& p);
+  /// Removes point i (its index stays, representative(i) becomes no_index; an
+  /// equal point, if any, stands for the place from then on). The
+  /// tetrahedralization is rebuilt from the remaining points: O(n log n). The
+  /// perturbed Delaunay tetrahedralization is unique, so this is the result
+  /// any local deletion would give.
+  void remove(std::uint32_t i);
 
   Delaunay3Stats stats() const;
   /// Checks every invariant; throws geods::Error naming the first violation:
@@ -104,11 +131,14 @@ class Delaunay3 {
   // four vertices (the ghost for the infinite one, no_index in a free slot)
   // and four adjacencies, 4 * neighbour + the face's index in the neighbour.
   void build(Options options);
+  void insert_point(Tet3Mesh& mesh, std::uint32_t i);  // internal vertex for point i, or merged into an equal one
   void publish();
+  std::uint32_t start_slot(std::uint32_t hint) const;  // a live slot to walk from
 
   Options options_;
   std::vector<Vec3d> points_;
-  std::vector<std::uint32_t> rep_;  // representative per point
+  std::vector<std::uint32_t> rep_;     // representative per point, no_index when removed
+  std::vector<std::uint8_t> removed_;  // per point: removed by remove()
   int dimension_ = -1;
 
   std::vector<Vec3d> coords_;               // per internal vertex
@@ -116,6 +146,8 @@ class Delaunay3 {
   std::vector<std::uint32_t> internal_of_;  // representative point -> internal vertex (no_index for others)
   std::vector<std::uint32_t> tets_, free_slots_;
   std::size_t walk_steps_ = 0, conflicts_ = 0;
+  std::uint32_t last_ = 0;                // the slot of the last insertion
+  std::vector<std::uint32_t> vertex_slot_;  // per internal vertex: a slot holding it
 
   std::vector<std::uint32_t> tetrahedra_, neighbors_;  // public, finite only
   std::vector<std::uint32_t> public_of_;               // internal slot -> public tetrahedron (no_index: ghost or free)

@@ -2,6 +2,7 @@
 // The fields of the voronoi module's stats structs, named once (see
 // spatial/stats_fields.hpp).
 #include "geods/voronoi/delaunay2.hpp"
+#include "geods/voronoi/delaunay3.hpp"
 #include "geods/voronoi/metric_voronoi.hpp"
 #include "geods/voronoi/post_office.hpp"
 #include "geods/voronoi/voronoi2.hpp"
@@ -14,6 +15,14 @@ void for_each_field(const Delaunay2Stats& s, F&& f) {
   f("points", s.points), f("vertices", s.vertices), f("duplicates", s.duplicates), f("removed", s.removed);
   f("triangles", s.triangles), f("hull", s.hull), f("flips", s.flips), f("walk_steps", s.walk_steps);
   f("dag_nodes", s.dag_nodes), f("bytes", s.bytes);
+}
+
+template <typename F>
+void for_each_field(const Delaunay3Stats& s, F&& f) {
+  f("points", s.points), f("vertices", s.vertices), f("duplicates", s.duplicates), f("removed", s.removed);
+  f("tetrahedra", s.tetrahedra);
+  f("hull_triangles", s.hull_triangles), f("dimension", s.dimension), f("walk_steps", s.walk_steps);
+  f("conflicts", s.conflicts), f("bytes", s.bytes);
 }
 
 template <typename F>
