@@ -176,9 +176,8 @@ std::uint32_t Tet3Mesh::insert(std::uint32_t pv) {
   // pointers: nothing below grows the arrays until the new tetrahedra.
   const Vec3d* C = coords.data();
   std::uint32_t* T = tets.data();
-  std::uint32_t* M = mark.data();
-  ++epoch;
-  const std::uint32_t in = 2 * epoch + 1, out = 2 * epoch;
+  std::uint8_t* M = mark.data();
+  constexpr std::uint8_t in = 1, out = 2;
   stack.clear();
   cavity.clear();
   boundary.clear();
@@ -188,9 +187,14 @@ std::uint32_t Tet3Mesh::insert(std::uint32_t pv) {
     const std::uint32_t c = stack.back();
     stack.pop_back();
     cavity.push_back(c);
+    const std::uint32_t* adjacent = &T[8 * std::size_t(c) + 4];
+    for (std::uint32_t f = 0; f < 4; ++f) {  // the neighbours' records and marks are the cache misses: ask early
+      __builtin_prefetch(&T[8 * std::size_t(adjacent[f] >> 2)]);
+      __builtin_prefetch(&M[adjacent[f] >> 2]);
+    }
     for (std::uint32_t f = 0; f < 4; ++f) {
-      const std::uint32_t a = T[8 * std::size_t(c) + 4 + f], n = a >> 2;
-      const std::uint32_t m = M[n];
+      const std::uint32_t a = adjacent[f], n = a >> 2;
+      const std::uint8_t m = M[n];
       if (m == in) continue;
       if (m != out) {
         if (conflict(C, T, n, p)) {
@@ -207,6 +211,9 @@ std::uint32_t Tet3Mesh::insert(std::uint32_t pv) {
       b.outer = a;
     }
   }
+  // Marks back to untested: the cavity's slots and the tetrahedra tested around it.
+  for (const std::uint32_t c : cavity) M[c] = 0;
+  for (const Boundary& b : boundary) M[b.outer >> 2] = 0;
   conflicts += cavity.size();
   // The new tetrahedra: each boundary face joined to p, in the cavity's slots first.
   if (boundary.size() > cavity.size()) {
@@ -315,23 +322,56 @@ void Delaunay3::build(Options options) {
     return;
   }
 
+  // The points' coordinates in insertion order (vertex k is order[k]), with
+  // the first tetrahedron's corners first, so that insertion reads them sequentially.
+  std::vector<std::uint32_t> sequence(order);
+  std::swap(sequence[1], sequence[kb]);
+  std::swap(sequence[2], sequence[kc]);
+  std::swap(sequence[3], sequence[kd]);
+  coords_.resize(n);
+  parallel_for(0, n, 1 << 14, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k) coords_[k] = points_[sequence[k]];
+  });
   Tet3Mesh mesh(coords_, tets_, free_slots_);
-  coords_.reserve(n);
-  original_of_.reserve(n);
   tets_.reserve(8 * 7 * n + 64);
   mesh.mark.reserve(7 * n + 16);
-  const std::size_t first[4] = {0, kb, kc, kd};
-  for (std::size_t k : first) {
-    internal_of_[order[k]] = std::uint32_t(coords_.size());
-    coords_.push_back(at(k));
-    original_of_.push_back(order[k]);
-  }
   mesh.make_first(0, 1, 2, 3);
-  for (std::size_t k = 1; k < n; ++k) {
-    if (k == kb || k == kc || k == kd) continue;
-    insert_point(mesh, order[k]);
+  std::vector<std::uint32_t> merged(n, kNone);  // per vertex k: the earlier vertex at the same place
+  std::size_t duplicates = 0;
+  for (std::size_t k = 4; k < n; ++k) {
+    merged[k] = mesh.insert(std::uint32_t(k));
+    duplicates += merged[k] != kNone;
   }
-  for (std::uint32_t i : active) rep_[i] = original_of_[internal_of_[i]];
+  // Number the vertices densely (without the merged ones) and map the points to them.
+  std::vector<std::uint32_t> number(n);
+  std::uint32_t next = 0;
+  for (std::size_t k = 0; k < n; ++k) number[k] = merged[k] == kNone ? next++ : kNone;
+  for (std::size_t k = 0; k < n; ++k)
+    if (merged[k] != kNone) number[k] = number[merged[k]];
+  original_of_.assign(next, kNone);
+  for (std::size_t k = 0; k < n; ++k) {  // the first occurrence stands for all
+    std::uint32_t& o = original_of_[number[k]];
+    o = std::min(o, sequence[k]);
+  }
+  if (duplicates > 0) {
+    std::vector<Vec3d> dense(next);
+    for (std::size_t k = 0; k < n; ++k)
+      if (merged[k] == kNone) dense[number[k]] = coords_[k];
+    coords_.swap(dense);
+    parallel_for(0, tets_.size() / 8, 1 << 14, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t t = begin; t < end; ++t)
+        for (int j = 0; j < 4; ++j) {
+          std::uint32_t& v = tets_[8 * t + j];
+          if ((v & Tet3Mesh::kGhostBit) == 0) v = number[v];
+        }
+    });
+  }
+  parallel_for(0, n, 1 << 14, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k) internal_of_[sequence[k]] = number[k];
+  });
+  parallel_for(0, n, 1 << 14, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k) rep_[active[k]] = original_of_[internal_of_[active[k]]];
+  });
   walk_steps_ = mesh.walk_steps;
   conflicts_ = mesh.conflicts;
   last_ = mesh.last;

@@ -28,8 +28,7 @@ struct Tet3Mesh {
   std::vector<Vec3d>& coords;
   std::vector<std::uint32_t>& tets;
   std::vector<std::uint32_t>& free_slots;
-  std::vector<std::uint32_t> mark;  // per slot: 2 epoch + 1 in this insertion's cavity, 2 epoch tested and not
-  std::uint32_t epoch = 0;
+  std::vector<std::uint8_t> mark;  // per slot, during an insertion: 1 in the cavity, 2 tested and not; else 0
   std::uint32_t last = 0;  // where the next walk starts
   std::uint32_t random = 2463534242u;
   std::size_t walk_steps = 0, conflicts = 0;
