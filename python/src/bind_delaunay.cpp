@@ -13,6 +13,7 @@
 #include "geods/core/error.hpp"
 #include "geods/voronoi/delaunay2.hpp"
 #include "geods/voronoi/delaunay3.hpp"
+#include "geods/voronoi/voronoi3.hpp"
 #include "geods/voronoi/stats_fields.hpp"
 #include "stats_dict.hpp"
 
@@ -152,6 +153,46 @@ occurrence; fewer than four distinct points or all coplanar give no tetrahedra
           py::arg("i"), "removes point i (rebuilds: O(n log n))")
       .def("validate", &Delaunay3::validate, "checks every invariant (exact); raises geods.Error on a violation")
       .def("stats", [](const Delaunay3& dt) { return stats_dict(dt.stats()); });
+
+  m.def(
+      "voronoi3",
+      [](const py::handle& points_in, const py::handle& box_in) {
+        const std::vector<Vec3d> points = points_of<double, 3>(points_in, "voronoi3");
+        const py::array_t<double, py::array::c_style | py::array::forcecast> box =
+            py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(box_in);
+        if (!box || box.size() != 6) throw Error("voronoi3: box must be 6 numbers x0, y0, z0, x1, y1, z1");
+        const double* b = box.data();
+        std::vector<voronoi::Voronoi3Cell> cells;
+        {
+          py::gil_scoped_release release;
+          cells = voronoi::Voronoi3(points, AABB3d(Vec3d(b[0], b[1], b[2]), Vec3d(b[3], b[4], b[5]))).cells();
+        }
+        py::list out;
+        for (const auto& cell : cells) {
+          py::dict d;
+          d["site"] = std::int64_t(cell.site);
+          d["volume"] = cell.volume;
+          d["centroid"] = copy_array(cell.centroid.data(), {3});
+          d["vertices"] = points_array(cell.vertices);
+          py::list faces;
+          for (std::size_t f = 0; f < cell.face_count(); ++f)
+            faces.append(index_array(std::span<const std::uint32_t>(
+                cell.face_vertices.data() + cell.face_offsets[f], cell.face_offsets[f + 1] - cell.face_offsets[f])));
+          d["faces"] = faces;
+          std::vector<std::int64_t> labels;
+          for (const std::uint32_t l : cell.face_neighbors) labels.push_back(std::int32_t(l));  // box side k: -2 - k
+          d["neighbors"] = copy_array(labels.data(), {py::ssize_t(labels.size())});
+          out.append(d);
+        }
+        return out;
+      },
+      py::arg("points"), py::arg("box"), R"doc(
+The Voronoi cells of 3D points clipped to a box (x0, y0, z0, x1, y1, z1): one dict per
+distinct point with "site" (its index), "volume", "centroid", "vertices" (k, 3), "faces"
+(index loops into vertices, counter-clockwise seen from outside) and "neighbors" (per
+face the site across, or -2 - k for box side k: -x, +x, -y, +y, -z, +z). The cells
+partition the box.
+)doc");
 }
 
 }  // namespace

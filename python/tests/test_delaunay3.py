@@ -136,3 +136,45 @@ def test_cli_delaunay3(cli, tmp_path):
     r = subprocess.run([str(cli), "delaunay3", str(tmp_path / "bad.npy"), "-o", str(out)], capture_output=True,
                        text=True)
     assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1
+
+
+def test_voronoi3_cells_partition_the_box():
+    rng = np.random.default_rng(10)
+    pts = rng.random((200, 3))
+    box = [0, 0, 0, 1, 1, 1]
+    cells = geods.voronoi3(pts, box)
+    assert len(cells) == 200 and sorted(c["site"] for c in cells) == list(range(200))
+    assert sum(c["volume"] for c in cells) == pytest.approx(1.0, rel=1e-9)
+    by_site = {c["site"]: c for c in cells}
+    # each sampled point is inside the cell of its nearest site (scipy-free brute force)
+    for q in rng.random((200, 3)):
+        cell = by_site[int(np.argmin(np.linalg.norm(pts - q, axis=1)))]
+        v = cell["vertices"]
+        for loop in cell["faces"]:
+            n = sum(np.cross(v[loop[k]], v[loop[(k + 1) % len(loop)]]) for k in range(len(loop)))
+            assert np.dot(n / np.linalg.norm(n), q - v[loop[0]]) <= 1e-9
+    # the faces across sites are the Delaunay edges; box sides are -2..-7
+    dt = geods.Delaunay3(pts)
+    for c in cells[:20]:
+        across = {int(x) for x in c["neighbors"] if x >= 0}
+        assert across <= set(dt.vertex_neighbors(c["site"]).tolist())
+        assert all(-7 <= x <= -2 for x in c["neighbors"] if x < 0)
+    with pytest.raises(ValueError):
+        geods.voronoi3(pts, [0, 0, 0, 1, 1])
+
+
+def test_cli_voronoi3(cli, tmp_path):
+    pts = np.random.default_rng(11).random((150, 3))
+    np.save(tmp_path / "p.npy", pts)
+    r = subprocess.run([str(cli), "voronoi3", str(tmp_path / "p.npy"), "--box", "0,0,0,1,1,1", "-o",
+                        str(tmp_path / "cells.ply"), "--volumes", str(tmp_path / "v.npy"), "--json"],
+                       capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    info = json.loads(r.stdout)
+    assert info["cells"] == 150 and info["volume_total"] == pytest.approx(1.0, rel=1e-9)
+    v = np.load(tmp_path / "v.npy")
+    assert v.shape == (150, 5) and v[:, 1].sum() == pytest.approx(1.0, rel=1e-9)
+    assert (tmp_path / "cells.ply").stat().st_size > 0
+    r = subprocess.run([str(cli), "voronoi3", str(tmp_path / "p.npy"), "--box", "0,0,0,1,1"], capture_output=True,
+                       text=True)
+    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1

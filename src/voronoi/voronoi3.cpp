@@ -183,4 +183,23 @@ Voronoi3Stats Voronoi3::stats() const {
   return s;
 }
 
+TriMesh Voronoi3::mesh(double explode, std::vector<std::uint32_t>* cell_of_triangle) const {
+  TriMesh out;
+  const Vec3d centre = (box_.lo + box_.hi) * 0.5;
+  if (cell_of_triangle) cell_of_triangle->clear();
+  for (std::uint32_t c = 0; c < cells_.size(); ++c) {
+    const Voronoi3Cell& cell = cells_[c];
+    const Vec3d shift = (cell.centroid - centre) * explode;
+    const std::uint32_t base = std::uint32_t(out.vertices.size());
+    for (const Vec3d& x : cell.vertices) out.vertices.push_back((x + shift).cast<float>());
+    for (std::size_t f = 0; f < cell.face_count(); ++f)
+      for (std::uint32_t k = cell.face_offsets[f] + 1; k + 1 < cell.face_offsets[f + 1]; ++k) {
+        out.triangles.push_back({base + cell.face_vertices[cell.face_offsets[f]], base + cell.face_vertices[k],
+                                 base + cell.face_vertices[k + 1]});
+        if (cell_of_triangle) cell_of_triangle->push_back(c);
+      }
+  }
+  return out;
+}
+
 }  // namespace geods::voronoi

@@ -6,6 +6,7 @@
 #include "geods/voronoi/metric_voronoi.hpp"
 #include "geods/voronoi/post_office.hpp"
 #include "geods/voronoi/voronoi2.hpp"
+#include "geods/voronoi/voronoi3.hpp"
 
 namespace geods::voronoi {
 
@@ -29,6 +30,11 @@ template <typename F>
 void for_each_field(const Voronoi2Stats& s, F&& f) {
   f("sites", s.sites), f("distinct", s.distinct), f("vertices", s.vertices), f("edges", s.edges);
   f("unbounded_cells", s.unbounded_cells), f("bytes", s.bytes);
+}
+
+template <typename F>
+void for_each_field(const Voronoi3Stats& s, F&& f) {
+  f("sites", s.sites), f("faces", s.faces), f("vertices", s.vertices), f("empty", s.empty), f("bytes", s.bytes);
 }
 
 template <typename F>

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "geods/core/aabb.hpp"
+#include "geods/core/tri_mesh.hpp"
 #include "geods/core/vec.hpp"
 #include "geods/voronoi/delaunay3.hpp"
 
@@ -56,6 +57,12 @@ class Voronoi3 {
   /// The sum of the cell volumes: the box's volume up to rounding (for any non-empty set of sites).
   double volume_total() const;
   Voronoi3Stats stats() const;
+  /// The cells as one triangle mesh (each face a fan), every cell a closed
+  /// surface; with `explode` > 0 each cell is moved away from the box's centre
+  /// by that fraction of its centroid's offset (an exploded view). The
+  /// triangles of cell c are those whose index in `cell_of_triangle` (when
+  /// given) holds c.
+  TriMesh mesh(double explode = 0, std::vector<std::uint32_t>* cell_of_triangle = nullptr) const;
 
  private:
   AABB3d box_;
