@@ -275,9 +275,6 @@ void Delaunay3::build(Options options) {
   const std::size_t total = points_.size();
   removed_.resize(total, 0);
   rep_.assign(total, kNone);
-  internal_of_.assign(total, kNone);
-  coords_.clear();
-  original_of_.clear();
   tets_.clear();
   free_slots_.clear();
   walk_steps_ = conflicts_ = 0;
@@ -313,12 +310,8 @@ void Delaunay3::build(Options options) {
         rep_[i] = rep_[sorted[k - 1]];
       } else {
         rep_[i] = i;
-        internal_of_[i] = std::uint32_t(coords_.size());
-        coords_.push_back(points_[i]);
-        original_of_.push_back(i);
       }
     }
-    for (std::uint32_t i : active) internal_of_[i] = internal_of_[rep_[i]];
     return;
   }
 
@@ -328,11 +321,11 @@ void Delaunay3::build(Options options) {
   std::swap(sequence[1], sequence[kb]);
   std::swap(sequence[2], sequence[kc]);
   std::swap(sequence[3], sequence[kd]);
-  coords_.resize(n);
+  std::vector<Vec3d> coords(n);
   parallel_for(0, n, 1 << 14, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t k = begin; k < end; ++k) coords_[k] = points_[sequence[k]];
+    for (std::size_t k = begin; k < end; ++k) coords[k] = points_[sequence[k]];
   });
-  Tet3Mesh mesh(coords_, tets_, free_slots_);
+  Tet3Mesh mesh(coords, tets_, free_slots_);
   tets_.reserve(8 * 7 * n + 64);
   mesh.mark.reserve(7 * n + 16);
   mesh.make_first(0, 1, 2, 3);
@@ -342,53 +335,27 @@ void Delaunay3::build(Options options) {
     merged[k] = mesh.insert(std::uint32_t(k));
     duplicates += merged[k] != kNone;
   }
-  // Number the vertices densely (without the merged ones) and map the points to them.
-  std::vector<std::uint32_t> number(n);
-  std::uint32_t next = 0;
-  for (std::size_t k = 0; k < n; ++k) number[k] = merged[k] == kNone ? next++ : kNone;
+  // From here on a vertex is the index of the point it stands for: the first
+  // occurrence among equal points.
+  std::vector<std::uint32_t> point_of(n);
+  for (std::size_t k = 0; k < n; ++k) point_of[k] = merged[k] == kNone ? sequence[k] : kNone;
   for (std::size_t k = 0; k < n; ++k)
-    if (merged[k] != kNone) number[k] = number[merged[k]];
-  original_of_.assign(next, kNone);
-  for (std::size_t k = 0; k < n; ++k) {  // the first occurrence stands for all
-    std::uint32_t& o = original_of_[number[k]];
-    o = std::min(o, sequence[k]);
-  }
-  if (duplicates > 0) {
-    std::vector<Vec3d> dense(next);
-    for (std::size_t k = 0; k < n; ++k)
-      if (merged[k] == kNone) dense[number[k]] = coords_[k];
-    coords_.swap(dense);
-    parallel_for(0, tets_.size() / 8, 1 << 14, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t t = begin; t < end; ++t)
-        for (int j = 0; j < 4; ++j) {
-          std::uint32_t& v = tets_[8 * t + j];
-          if ((v & Tet3Mesh::kGhostBit) == 0) v = number[v];
-        }
-    });
-  }
-  parallel_for(0, n, 1 << 14, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t k = begin; k < end; ++k) internal_of_[sequence[k]] = number[k];
-  });
-  parallel_for(0, n, 1 << 14, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t k = begin; k < end; ++k) rep_[active[k]] = original_of_[internal_of_[active[k]]];
+    if (merged[k] != kNone) {
+      std::uint32_t& first = point_of[merged[k]];
+      first = std::min(first, sequence[k]);
+    }
+  for (std::size_t k = 0; k < n; ++k) rep_[sequence[k]] = point_of[merged[k] == kNone ? k : merged[k]];
+  (void)duplicates;
+  parallel_for(0, tets_.size() / 8, 1 << 14, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t t = begin; t < end; ++t)
+      for (int j = 0; j < 4; ++j) {
+        std::uint32_t& v = tets_[8 * t + j];
+        if ((v & Tet3Mesh::kGhostBit) == 0) v = point_of[v];
+      }
   });
   walk_steps_ = mesh.walk_steps;
   conflicts_ = mesh.conflicts;
   last_ = mesh.last;
-}
-
-void Delaunay3::insert_point(Tet3Mesh& mesh, std::uint32_t i) {
-  const std::uint32_t v = std::uint32_t(coords_.size());
-  coords_.push_back(points_[i]);
-  const std::uint32_t existing = mesh.insert(v);
-  if (existing == kNone) {
-    original_of_.push_back(i);
-    internal_of_[i] = v;
-  } else {
-    coords_.pop_back();
-    internal_of_[i] = existing;
-    original_of_[existing] = std::min(original_of_[existing], i);  // the first occurrence stands for all
-  }
 }
 
 std::uint32_t Delaunay3::insert(const Vec3d& p) {
@@ -399,17 +366,16 @@ std::uint32_t Delaunay3::insert(const Vec3d& p) {
   points_.push_back(p);
   removed_.push_back(0);
   rep_.push_back(kNone);
-  internal_of_.push_back(kNone);
   if (dimension_ < 3) {  // the new point may lift the set to a solid: start again
     build(options_);
     publish();
     return i;
   }
-  Tet3Mesh mesh(coords_, tets_, free_slots_);
+  Tet3Mesh mesh(points_, tets_, free_slots_);
   mesh.mark.assign(tets_.size() / 8, 0);
   mesh.last = last_;
-  insert_point(mesh, i);
-  rep_[i] = original_of_[internal_of_[i]];
+  const std::uint32_t existing = mesh.insert(i);
+  rep_[i] = existing == kNone ? i : existing;
   walk_steps_ += mesh.walk_steps;
   conflicts_ += mesh.conflicts;
   last_ = mesh.last;
@@ -434,8 +400,7 @@ void Delaunay3::publish() {
     if (((v[0] | v[1] | v[2] | v[3]) & Tet3Mesh::kGhostBit) == 0) public_of_[s] = std::uint32_t(count++);
   }
   tetrahedra_.resize(4 * count);
-  neighbors_.resize(4 * count);
-  vertex_slot_.assign(coords_.size(), kNone);
+  vertex_slot_.assign(points_.size(), kNone);
   for (std::size_t s = 0; s < slots; ++s)
     for (int k = 0; k < 4; ++k) {
       const std::uint32_t v = tets_[8 * s + k];
@@ -446,11 +411,22 @@ void Delaunay3::publish() {
       const std::uint32_t t = public_of_[s];
       if (t == kNone) continue;
       for (int k = 0; k < 4; ++k) {
-        tetrahedra_[4 * std::size_t(t) + k] = original_of_[tets_[8 * s + k]];
-        neighbors_[4 * std::size_t(t) + k] = public_of_[tets_[8 * s + 4 + k] >> 2];
+        tetrahedra_[4 * std::size_t(t) + k] = tets_[8 * s + k];
       }
     }
   });
+}
+
+std::vector<std::uint32_t> Delaunay3::neighbors() const {
+  std::vector<std::uint32_t> out(tetrahedra_.size());
+  parallel_for(0, public_of_.size(), 1 << 14, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t s = begin; s < end; ++s) {
+      const std::uint32_t t = public_of_[s];
+      if (t == kNone) continue;
+      for (int k = 0; k < 4; ++k) out[4 * std::size_t(t) + k] = public_of_[tets_[8 * s + 4 + k] >> 2];
+    }
+  });
+  return out;
 }
 
 std::vector<Delaunay3::Triangle> Delaunay3::hull() const {
@@ -463,7 +439,7 @@ std::vector<Delaunay3::Triangle> Delaunay3::hull() const {
       if (v[g] == Tet3Mesh::kGhost) {
         // The face opposite the ghost, oriented towards it (outwards of the hull).
         const std::array<int, 3> f = Tet3Mesh::face_towards(g);
-        out.push_back({original_of_[v[f[0]]], original_of_[v[f[1]]], original_of_[v[f[2]]]});
+        out.push_back({v[f[0]], v[f[1]], v[f[2]]});
       }
   }
   return out;
@@ -478,8 +454,7 @@ std::size_t Delaunay3::duplicate_count() const {
 std::uint32_t Delaunay3::start_slot(std::uint32_t hint) const {
   if (hint != kNone && hint < tetrahedron_count()) {
     // the public index's slot: the k-th live finite slot; find it through its vertices
-    const std::uint32_t v = internal_of_[tetrahedra_[4 * std::size_t(hint)]];
-    if (v != kNone && v < vertex_slot_.size()) return vertex_slot_[v];
+    return vertex_slot_[tetrahedra_[4 * std::size_t(hint)]];
   }
   return last_ < tets_.size() / 8 && tets_[8 * std::size_t(last_)] != kNone ? last_ : vertex_slot_[0];
 }
@@ -488,7 +463,7 @@ std::uint32_t Delaunay3::locate(const Vec3d& q, std::uint32_t hint) const {
   if (dimension_ < 3) return kNone;
   if (!std::isfinite(q[0]) || !std::isfinite(q[1]) || !std::isfinite(q[2]))
     throw Error("Delaunay3.locate: the query has a NaN or infinite coordinate");
-  Tet3Mesh mesh(const_cast<std::vector<Vec3d>&>(coords_), const_cast<std::vector<std::uint32_t>&>(tets_),
+  Tet3Mesh mesh(const_cast<std::vector<Vec3d>&>(points_), const_cast<std::vector<std::uint32_t>&>(tets_),
                 const_cast<std::vector<std::uint32_t>&>(free_slots_));
   std::size_t steps = 0;
   std::uint32_t random = 2463534242u;
@@ -499,7 +474,7 @@ std::uint32_t Delaunay3::locate(const Vec3d& q, std::uint32_t hint) const {
 std::vector<std::uint32_t> Delaunay3::vertex_neighbors(std::uint32_t point) const {
   std::vector<std::uint32_t> out;
   if (point >= rep_.size() || rep_[point] != point) return out;
-  const std::uint32_t v = internal_of_[point];
+  const std::uint32_t v = point;
   if (dimension_ < 3) return out;
   // The star of v: the slots around it, breadth first across the faces that hold v.
   std::vector<std::uint32_t> stack = {vertex_slot_[v]}, seen = stack;
@@ -509,7 +484,7 @@ std::vector<std::uint32_t> Delaunay3::vertex_neighbors(std::uint32_t point) cons
     for (int k = 0; k < 4; ++k) {
       const std::uint32_t u = tets_[8 * std::size_t(t) + k];
       if (u == v) continue;
-      if ((u & Tet3Mesh::kGhostBit) == 0) out.push_back(original_of_[u]);
+      if ((u & Tet3Mesh::kGhostBit) == 0) out.push_back(u);
       const std::uint32_t n = tets_[8 * std::size_t(t) + 4 + k] >> 2;  // across the face opposite u: holds v
       if (std::find(seen.begin(), seen.end(), n) == seen.end()) {
         seen.push_back(n);
@@ -525,15 +500,15 @@ std::vector<std::uint32_t> Delaunay3::vertex_neighbors(std::uint32_t point) cons
 std::uint32_t Delaunay3::nearest_vertex(const Vec3d& q) const {
   if (!std::isfinite(q[0]) || !std::isfinite(q[1]) || !std::isfinite(q[2]))
     throw Error("Delaunay3.nearest_vertex: the query has a NaN or infinite coordinate");
-  if (coords_.empty()) return kNone;
-  const auto distance = [&](std::uint32_t v) { return (coords_[v] - q).squaredNorm(); };
-  std::uint32_t best = 0;
+  if (dimension_ < 0) return kNone;
+  const auto distance = [&](std::uint32_t v) { return (points_[v] - q).squaredNorm(); };
+  std::uint32_t best = kNone;
   if (dimension_ < 3) {
-    for (std::uint32_t v = 1; v < coords_.size(); ++v)
-      if (distance(v) < distance(best)) best = v;
-    return original_of_[best];
+    for (std::uint32_t v = 0; v < points_.size(); ++v)
+      if (rep_[v] == v && (best == kNone || distance(v) < distance(best))) best = v;
+    return best;
   }
-  Tet3Mesh mesh(const_cast<std::vector<Vec3d>&>(coords_), const_cast<std::vector<std::uint32_t>&>(tets_),
+  Tet3Mesh mesh(const_cast<std::vector<Vec3d>&>(points_), const_cast<std::vector<std::uint32_t>&>(tets_),
                 const_cast<std::vector<std::uint32_t>&>(free_slots_));
   std::size_t steps = 0;
   std::uint32_t random = 2463534242u;
@@ -546,15 +521,14 @@ std::uint32_t Delaunay3::nearest_vertex(const Vec3d& q) const {
   // Greedy descent: a vertex none of whose Delaunay neighbours is closer is the nearest.
   for (bool moved = true; moved;) {
     moved = false;
-    for (const std::uint32_t w : vertex_neighbors(original_of_[best])) {
-      const std::uint32_t u = internal_of_[w];
+    for (const std::uint32_t u : vertex_neighbors(best)) {
       if (distance(u) < distance(best)) {
         best = u;
         moved = true;
       }
     }
   }
-  return original_of_[best];
+  return best;
 }
 
 Delaunay3Stats Delaunay3::stats() const {
@@ -570,24 +544,22 @@ Delaunay3Stats Delaunay3::stats() const {
   s.walk_steps = walk_steps_;
   s.conflicts = conflicts_;
   const auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
-  s.bytes = bytes(points_) + bytes(rep_) + bytes(coords_) + bytes(original_of_) + bytes(internal_of_) +
-            bytes(tets_) + bytes(removed_) + bytes(vertex_slot_) + bytes(free_slots_) + bytes(tetrahedra_) +
-            bytes(neighbors_) + bytes(public_of_);
+  s.bytes = bytes(points_) + bytes(rep_) +
+            bytes(tets_) + bytes(removed_) + bytes(vertex_slot_) + bytes(free_slots_) + bytes(tetrahedra_) + bytes(public_of_);
   return s;
 }
 
 void Delaunay3::validate() const {
   const std::size_t n = points_.size();
-  if (rep_.size() != n || internal_of_.size() != n || removed_.size() != n) throw Error("Delaunay3: per-point arrays of the wrong size");
+  if (rep_.size() != n || removed_.size() != n) throw Error("Delaunay3: per-point arrays of the wrong size");
   for (std::size_t i = 0; i < n; ++i) {
-    const std::uint32_t r = rep_[i], v = internal_of_[i];
+    const std::uint32_t r = rep_[i];
     if (removed_[i]) {
-      if (r != kNone || v != kNone) throw Error("Delaunay3: removed point " + std::to_string(i) + " has a vertex");
+      if (r != kNone) throw Error("Delaunay3: removed point " + std::to_string(i) + " has a vertex");
       continue;
     }
-    if (r > i || rep_[r] != r) throw Error("Delaunay3: point " + std::to_string(i) + " has a bad representative");
-    if (v >= coords_.size() || original_of_[v] != r || !same(coords_[v], points_[i]))
-      throw Error("Delaunay3: point " + std::to_string(i) + " is not at its vertex");
+    if (r > i || rep_[r] != r || removed_[r] || !same(points_[r], points_[i]))
+      throw Error("Delaunay3: point " + std::to_string(i) + " has a bad representative");
   }
   if (dimension_ < 3) {
     if (!tetrahedra_.empty()) throw Error("Delaunay3: a lower-dimensional set has tetrahedra");
@@ -595,9 +567,9 @@ void Delaunay3::validate() const {
   }
   const std::size_t slots = tets_.size() / 8;
   if (tets_.size() % 8) throw Error("Delaunay3: tetrahedron array of the wrong size");
-  Tet3Mesh mesh(const_cast<std::vector<Vec3d>&>(coords_), const_cast<std::vector<std::uint32_t>&>(tets_),
+  Tet3Mesh mesh(const_cast<std::vector<Vec3d>&>(points_), const_cast<std::vector<std::uint32_t>&>(tets_),
                 const_cast<std::vector<std::uint32_t>&>(free_slots_));
-  const std::size_t vertex_count = coords_.size();
+  const std::size_t vertex_count = n;
   std::vector<std::uint8_t> used(vertex_count, 0);
   constexpr std::size_t kBlock = 1 << 14;
   const std::size_t blocks = (slots + kBlock - 1) / kBlock;
@@ -614,8 +586,8 @@ void Delaunay3::validate() const {
             for (int k = 0; k < 4; ++k) {
               if (v[k] == Tet3Mesh::kGhost)
                 ++ghosts;
-              else if (v[k] >= vertex_count)
-                throw Error("Delaunay3: " + tet_name(std::uint32_t(s)) + " has a vertex out of range");
+              else if (v[k] >= vertex_count || rep_[v[k]] != v[k])
+                throw Error("Delaunay3: " + tet_name(std::uint32_t(s)) + " has a vertex that is not a representative");
               else
                 used[v[k]] = 1;  // benign race: every writer stores 1
             }
@@ -634,9 +606,9 @@ void Delaunay3::validate() const {
               }
               const std::uint32_t opposite = tets_[Tet3Mesh::opposite(a)];
               if (opposite == Tet3Mesh::kGhost) continue;
-              const Vec3d& p = coords_[opposite];
+              const Vec3d& p = points_[opposite];
               if (ghosts == 0) {
-                const double s_exact = mesh.in_sphere(coords_[v[0]], coords_[v[1]], coords_[v[2]], coords_[v[3]], p);
+                const double s_exact = mesh.in_sphere(points_[v[0]], points_[v[1]], points_[v[2]], points_[v[3]], p);
                 if (s_exact > 0)
                   throw Error("Delaunay3: " + tet_name(std::uint32_t(s)) +
                               ": the opposite vertex of a neighbour is inside its circumsphere");
@@ -646,7 +618,7 @@ void Delaunay3::validate() const {
                             (ghosts ? ": the hull is not convex there" : ": not Delaunay after the perturbation"));
             }
             if (ghosts == 0) {
-              if (Tet3Mesh::orient(coords_[v[0]], coords_[v[1]], coords_[v[2]], coords_[v[3]]) <= 0)
+              if (Tet3Mesh::orient(points_[v[0]], points_[v[1]], points_[v[2]], points_[v[3]]) <= 0)
                 throw Error("Delaunay3: " + tet_name(std::uint32_t(s)) + " is not positively oriented");
               ++finite[block];
             }
@@ -662,14 +634,13 @@ void Delaunay3::validate() const {
     total += finite[b];
   }
   for (std::size_t u = 0; u < vertex_count; ++u)
-    if (!used[u]) throw Error("Delaunay3: vertex of point " + std::to_string(original_of_[u]) + " is in no tetrahedron");
+    if (!used[u] && rep_[u] == u) throw Error("Delaunay3: point " + std::to_string(u) + " is in no tetrahedron");
   if (total != tetrahedron_count()) throw Error("Delaunay3: the public tetrahedra are not the finite ones");
   for (std::size_t s = 0; s < slots; ++s) {
     const std::uint32_t t = public_of_[s];
     if (t == kNone) continue;
     for (int k = 0; k < 4; ++k)
-      if (tetrahedra_[4 * std::size_t(t) + k] != original_of_[tets_[8 * s + k]] ||
-          neighbors_[4 * std::size_t(t) + k] != public_of_[tets_[8 * s + 4 + k] >> 2])
+      if (tetrahedra_[4 * std::size_t(t) + k] != tets_[8 * s + k])
         throw Error("Delaunay3: public tetrahedron " + std::to_string(t) + " differs from its slot");
   }
 }

@@ -144,9 +144,11 @@ void check_solid(const std::vector<Vec3d>& p, const Delaunay3& dt) {
   for (std::uint32_t v : hull.vertices) EXPECT_TRUE(on_hull.count(dt.representative(v))) << "hull corner " << v;
   // Neighbours share faces; no_index exactly on the hull triangles.
   std::size_t open = 0;
+  const std::vector<std::uint32_t> neighbors = dt.neighbors();
+  ASSERT_EQ(neighbors.size(), tets.size());
   for (std::size_t t = 0; t < m; ++t)
     for (int f = 0; f < 4; ++f) {
-      const std::uint32_t u = dt.neighbors()[4 * t + f];
+      const std::uint32_t u = neighbors[4 * t + f];
       if (u == Delaunay3::no_index) {
         ++open;
         continue;

@@ -77,8 +77,9 @@ class Delaunay3 {
   /// Finite tetrahedra, four positively oriented vertex indices each.
   const std::vector<std::uint32_t>& tetrahedra() const { return tetrahedra_; }
   /// Per tetrahedron, the four neighbouring tetrahedra: neighbour i shares
-  /// the face opposite vertex i; no_index on the convex hull.
-  const std::vector<std::uint32_t>& neighbors() const { return neighbors_; }
+  /// the face opposite vertex i; no_index on the convex hull. Made from the
+  /// internal adjacency on each call (O(m), in parallel): keep the result.
+  std::vector<std::uint32_t> neighbors() const;
   std::size_t tetrahedron_count() const { return tetrahedra_.size() / 4; }
   /// Affine dimension of the points: -1 none, 0 all equal, 1 collinear,
   /// 2 coplanar (no tetrahedra in these cases), 3 a solid.
@@ -126,12 +127,11 @@ class Delaunay3 {
   void validate() const;
 
  private:
-  // The closed tetrahedralization, over internal vertex numbers (insertion
-  // order, their coordinates copied in that order): per slot eight words,
+  // The closed tetrahedralization, over point indices (while building, over
+  // vertices in insertion order, renumbered at the end): per slot eight words,
   // four vertices (the ghost for the infinite one, no_index in a free slot)
   // and four adjacencies, 4 * neighbour + the face's index in the neighbour.
   void build(Options options);
-  void insert_point(Tet3Mesh& mesh, std::uint32_t i);  // internal vertex for point i, or merged into an equal one
   void publish();
   std::uint32_t start_slot(std::uint32_t hint) const;  // a live slot to walk from
 
@@ -141,15 +141,12 @@ class Delaunay3 {
   std::vector<std::uint8_t> removed_;  // per point: removed by remove()
   int dimension_ = -1;
 
-  std::vector<Vec3d> coords_;               // per internal vertex
-  std::vector<std::uint32_t> original_of_;  // internal vertex -> the point it stands for
-  std::vector<std::uint32_t> internal_of_;  // representative point -> internal vertex (no_index for others)
   std::vector<std::uint32_t> tets_, free_slots_;
   std::size_t walk_steps_ = 0, conflicts_ = 0;
   std::uint32_t last_ = 0;                // the slot of the last insertion
-  std::vector<std::uint32_t> vertex_slot_;  // per internal vertex: a slot holding it
+  std::vector<std::uint32_t> vertex_slot_;  // per point: a slot holding its vertex
 
-  std::vector<std::uint32_t> tetrahedra_, neighbors_;  // public, finite only
+  std::vector<std::uint32_t> tetrahedra_;  // public, finite only
   std::vector<std::uint32_t> public_of_;               // internal slot -> public tetrahedron (no_index: ghost or free)
 };
 
