@@ -178,3 +178,19 @@ def test_cli_voronoi3(cli, tmp_path):
     r = subprocess.run([str(cli), "voronoi3", str(tmp_path / "p.npy"), "--box", "0,0,0,1,1"], capture_output=True,
                        text=True)
     assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1
+
+
+def test_proximity_in_3d_against_brute_force():
+    pts = np.random.default_rng(12).random((250, 3))
+    pts[40] = pts[3]
+    d = np.linalg.norm(pts[:, None] - pts[None], axis=2)
+    np.fill_diagonal(d, np.inf)
+    i, j, dist = geods.closest_pair(pts)
+    assert dist == d.min() and d[i, j] == d.min() and i < j
+    nn = geods.all_nearest_neighbors(pts)
+    assert np.array_equal(d[np.arange(len(pts)), nn], d.min(1))
+    edges, length = geods.emst(pts)
+    from scipy.sparse.csgraph import minimum_spanning_tree
+    distinct = np.delete(pts, 40, axis=0)  # the duplicate joins by a zero-length edge, which scipy cannot hold
+    dd = np.linalg.norm(distinct[:, None] - distinct[None], axis=2)
+    assert edges.shape == (249, 2) and length == pytest.approx(minimum_spanning_tree(dd).sum(), rel=1e-12)
