@@ -17,9 +17,9 @@ using Parallel = CGAL::Delaunay_triangulation_3<Kernel, ParallelTds>;
 #endif
 
 template <class Triangulation>
-del3::Result counts(const Triangulation& dt, double before) {
+del3::Result counts(const Triangulation& dt, const del3::MemoryMark& before) {
   return {dt.number_of_vertices(), dt.number_of_finite_cells(), dt.number_of_cells() - dt.number_of_finite_cells(),
-          del3::resident_bytes() - before};
+          del3::memory_since(before)};
 }
 
 struct Cgal {
@@ -27,7 +27,7 @@ struct Cgal {
   static constexpr int max_reps = 100;
   static constexpr const char* anchor = "cgal";
   static del3::Result tetrahedralize(const std::vector<double>& xyz, std::size_t n, int threads) {
-    const double before = del3::resident_bytes();
+    const del3::MemoryMark before = del3::memory_mark();
     std::vector<Kernel::Point_3> points;
     points.reserve(n);
     for (std::size_t i = 0; i < n; ++i) points.emplace_back(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);

@@ -9,12 +9,12 @@ struct Geods {
   static constexpr int max_reps = 100;
   static constexpr const char* anchor = "geods";
   static del3::Result tetrahedralize(const std::vector<double>& xyz, std::size_t n, int /*threads*/) {
-    const double before = del3::resident_bytes();
+    const del3::MemoryMark before = del3::memory_mark();
     std::vector<geods::Vec3d> points(n);
     for (std::size_t i = 0; i < n; ++i) points[i] = geods::Vec3d(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
     const geods::voronoi::Delaunay3 dt(points);
     const geods::voronoi::Delaunay3Stats s = dt.stats();
-    return {s.vertices, s.tetrahedra, s.hull_triangles, del3::resident_bytes() - before};
+    return {s.vertices, s.tetrahedra, s.hull_triangles, del3::memory_since(before)};
   }
 };
 

@@ -7,6 +7,7 @@
 // tetrahedralization each time) and checks the one fact of WORKLOADS.md, every input point a
 // vertex (the workload has no duplicates); the counts of tetrahedra must agree between libraries.
 #pragma once
+#include <malloc.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -23,8 +24,25 @@ struct Result {
   std::size_t vertices = 0;    // distinct points that are vertices
   std::size_t tetrahedra = 0;  // finite tetrahedra
   std::size_t hull = 0;        // hull triangles
-  double bytes = 0;            // resident memory added by the structure (its peak, as far as RSS tells)
+  double bytes = 0;            // memory held by the structure and the input copy (memory_since)
 };
+
+/// The memory a structure holds: the larger of the growth of the bytes malloc has handed out
+/// (mallinfo2, exact whatever pages earlier builds freed) and of the resident set (which also sees
+/// allocators beside malloc, such as the TBB scalable allocator of CGAL's Parallel_tag, but not
+/// pages reused from an earlier build). Take `memory_mark()` before, `memory_since(mark)` while alive.
+struct MemoryMark {
+  double heap = 0, resident = 0;
+};
+inline double resident_bytes();
+inline MemoryMark memory_mark() {
+  const struct mallinfo2 m = mallinfo2();
+  return {double(m.uordblks + m.hblkhd), resident_bytes()};
+}
+inline double memory_since(const MemoryMark& before) {
+  const MemoryMark now = memory_mark();
+  return std::max(now.heap - before.heap, now.resident - before.resident);
+}
 
 /// Resident set size of this process in bytes (from /proc/self/statm).
 inline double resident_bytes() {
@@ -42,9 +60,12 @@ void run_variant(const compare::Args& args, const std::string& variant) {
   const std::size_t full = variant == "uniform_200k" ? 200000 : 1000000;
   const std::size_t n = std::min(xyz.size() / 3, args.scaled(full));
   xyz.resize(3 * n);
-  Result result;
+  // Memory: a first, untimed build.
+  Result result = Library::tetrahedralize(xyz, n, args.threads);
+  const double bytes = result.bytes;
   const int reps = std::min(args.reps, Library::max_reps);
   const double build_s = compare::median_time_s(reps, [&] { result = Library::tetrahedralize(xyz, n, args.threads); });
+  result.bytes = bytes;
   const bool all_vertices = result.vertices == n;
   compare::Record(Library::workload, Library::anchor, variant, args.threads)
       .timing(build_s, 0.0, n, reps)
