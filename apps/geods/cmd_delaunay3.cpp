@@ -31,6 +31,7 @@ class Delaunay3Command : public Command {
     app.add_option("--neighbors", neighbors_,
                    "Output: int64 m x 4, the tetrahedron across the face opposite each vertex (-1 on the hull)");
     app.add_option("--hull", hull_, "Output: int64 h x 3 hull triangles, counter-clockwise seen from outside");
+    add_save(app, save_, "the tetrahedralization", "Delaunay3.load");
   }
 
   void run(const RunContext&, Report& report) override {
@@ -55,6 +56,8 @@ class Delaunay3Command : public Command {
       io::write_npy<std::int64_t>(hull_, as_int64(flat), {flat.size() / 3, 3});
     }
 
+    if (!save_.empty()) dt.save(save_);
+
     Json& j = report.json;
     put_stats(j, stats);
     j["build_s"] = build_s;
@@ -68,12 +71,12 @@ class Delaunay3Command : public Command {
                                                           : ""));
     report.lines.push_back(fmt::format("  built in {:.3f} s ({:.1f} bytes per point)", build_s,
                                        points.empty() ? 0.0 : double(stats.bytes) / double(points.size())));
-    for (const std::string* path : {&output_, &neighbors_, &hull_})
+    for (const std::string* path : {&output_, &neighbors_, &hull_, &save_})
       if (!path->empty()) report.lines.push_back("  wrote " + *path);
   }
 
  private:
-  std::string points_, output_, neighbors_, hull_;
+  std::string points_, output_, neighbors_, hull_, save_;
 };
 
 const bool registered = register_command<Delaunay3Command>();

@@ -1,8 +1,6 @@
 // geods voronoi3: the Voronoi cells of 3D points clipped to a box, as closed polyhedra.
 #include <fmt/format.h>
 
-#include <cmath>
-#include <sstream>
 #include <vector>
 
 #include "command.hpp"
@@ -20,22 +18,11 @@ namespace {
 
 using voronoi::Voronoi3;
 
-// "x0,y0,z0,x1,y1,z1" with x0 < x1, y0 < y1, z0 < z1.
+// "x0,y0,z0,x1,y1,z1"; Voronoi3 checks lo < hi and finiteness.
 AABB3d parse_box3(const std::string& text) {
-  std::vector<double> v;
-  std::stringstream in(text);
-  std::string field;
-  while (std::getline(in, field, ',')) {
-    try {
-      std::size_t used = 0;
-      v.push_back(std::stod(field, &used));
-      if (used != field.size()) v.push_back(std::nan(""));
-    } catch (const std::exception&) {
-      v.push_back(std::nan(""));
-    }
-  }
+  const std::vector<double> v = parse_numbers(text);
   if (v.size() != 6) throw Error("--box: expected X0,Y0,Z0,X1,Y1,Z1, got '" + text + "'");
-  return AABB3d(Vec3d(v[0], v[1], v[2]), Vec3d(v[3], v[4], v[5]));  // Voronoi3 checks lo < hi and finiteness
+  return AABB3d(Vec3d(v[0], v[1], v[2]), Vec3d(v[3], v[4], v[5]));
 }
 
 class Voronoi3Command : public Command {

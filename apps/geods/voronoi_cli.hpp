@@ -32,7 +32,8 @@ inline std::vector<Vec3d> read_points_3d(const std::filesystem::path& path) {
 }
 
 /// "x0,y0,x1,y1" with x0 < x1 and y0 < y1.
-inline AABB2d parse_box(const std::string& text) {
+/// The comma-separated numbers of `text` (a field that is not a number gives NaN).
+inline std::vector<double> parse_numbers(const std::string& text) {
   std::vector<double> v;
   std::stringstream in(text);
   std::string field;
@@ -45,6 +46,11 @@ inline AABB2d parse_box(const std::string& text) {
       v.push_back(std::nan(""));
     }
   }
+  return v;
+}
+
+inline AABB2d parse_box(const std::string& text) {
+  const std::vector<double> v = parse_numbers(text);
   if (v.size() != 4 || !(v[0] < v[2]) || !(v[1] < v[3]) || !std::isfinite(v[2] - v[0]) || !std::isfinite(v[3] - v[1]))
     throw Error("--box: expected x0,y0,x1,y1 with x0 < x1 and y0 < y1, got '" + text + "'");
   return AABB2d({v[0], v[1]}, {v[2], v[3]});

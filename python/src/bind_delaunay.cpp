@@ -151,6 +151,12 @@ occurrence; fewer than four distinct points or all coplanar give no tetrahedra
       .def(
           "remove", [](Delaunay3& dt, std::int64_t i) { dt.remove(point_index3(i, dt, "Delaunay3.remove")); },
           py::arg("i"), "removes point i (rebuilds: O(n log n))")
+      .def(
+          "save", [](const Delaunay3& dt, const std::filesystem::path& path) { dt.save(path); }, py::arg("path"),
+          "writes the tetrahedralization to a geods archive")
+      .def_static(
+          "load", [](const std::filesystem::path& path) { return Delaunay3::load(path); }, py::arg("path"),
+          "reads a tetrahedralization written by save() (checked exactly); insert and remove go on as before")
       .def("validate", &Delaunay3::validate, "checks every invariant (exact); raises geods.Error on a violation")
       .def("stats", [](const Delaunay3& dt) { return stats_dict(dt.stats()); });
 

@@ -132,6 +132,15 @@ def test_cli_delaunay3(cli, tmp_path):
     assert np.array_equal(tets, geods.Delaunay3(pts).tetrahedra)
     assert info["duplicates"] == 1 and info["vertices"] == 799 and "compute_s" in info and "build_s" in info
     assert np.load(tmp_path / "h.npy").shape == (info["hull_triangles"], 3)
+    r = subprocess.run([str(cli), "delaunay3", str(tmp_path / "p.npy"), "--save", str(tmp_path / "dt.geods")],
+                       capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    loaded = geods.Delaunay3.load(tmp_path / "dt.geods")
+    loaded.validate()
+    assert np.array_equal(loaded.tetrahedra, tets)
+    (tmp_path / "bad.geods").write_bytes((tmp_path / "dt.geods").read_bytes()[:100])
+    with pytest.raises(ValueError):
+        geods.Delaunay3.load(tmp_path / "bad.geods")
     np.save(tmp_path / "bad.npy", np.array([[0.0, np.inf, 0], [1, 1, 1], [2, 0, 0], [0, 0, 1]]))
     r = subprocess.run([str(cli), "delaunay3", str(tmp_path / "bad.npy"), "-o", str(out)], capture_output=True,
                        text=True)

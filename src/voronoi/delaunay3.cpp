@@ -74,7 +74,12 @@ bool Tet3Mesh::ghost_conflict(const Vec3d* C, const std::uint32_t* T, std::uint3
   }
   const double o = orient(*q[0], *q[1], *q[2], *q[3]);
   if (o != 0) return o > 0;
-  return conflict(C, T, T[8 * std::size_t(t) + 4 + g] >> 2, p);  // on the hull face's plane: as the tetrahedron behind it
+  // On the hull face's plane: as the finite tetrahedron behind it (a ghost there is a corrupt
+  // mesh, such as a crafted file that load() is checking: no endless recursion).
+  const std::uint32_t behind = T[8 * std::size_t(t) + 4 + g] >> 2;
+  const std::uint32_t* w = &T[8 * std::size_t(behind)];
+  if (((w[0] | w[1] | w[2] | w[3]) & kGhostBit) != 0) return false;
+  return conflict(C, T, behind, p);
 }
 
 std::uint32_t Tet3Mesh::walk(const Vec3d& p, std::uint32_t t, std::size_t& steps, std::uint32_t& random) const {

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <filesystem>
 #include <limits>
 #include <set>
 #include <vector>
@@ -352,6 +353,34 @@ TEST(Delaunay3, InsertAndRemoveGiveTheTetrahedralizationOfTheSet) {
   EXPECT_EQ(flat.dimension(), 3);
   EXPECT_EQ(flat.tetrahedron_count(), 1u);
   EXPECT_THROW(flat.insert(Vec3d(0, NAN, 1)), Error);
+}
+
+TEST(Delaunay3, SaveLoadRoundTripAndBadFiles) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "geods_delaunay3_test";
+  std::filesystem::create_directories(dir);
+  auto p = make_points(Shape::duplicates, 300, 4);
+  Delaunay3 dt(p);
+  dt.remove(5);
+  dt.save(dir / "dt.geods");
+  Delaunay3 loaded = Delaunay3::load(dir / "dt.geods");
+  EXPECT_EQ(loaded.tetrahedra(), dt.tetrahedra());
+  EXPECT_EQ(loaded.neighbors(), dt.neighbors());
+  EXPECT_EQ(loaded.representative(5), Delaunay3::no_index);
+  EXPECT_EQ(loaded.nearest_vertex(Vec3d(0.5, 0.5, 0.5)), dt.nearest_vertex(Vec3d(0.5, 0.5, 0.5)));
+  // Updates go on as on the saved structure.
+  loaded.insert(Vec3d(0.25, 0.5, 0.75));
+  dt.insert(Vec3d(0.25, 0.5, 0.75));
+  EXPECT_EQ(sorted_tets(loaded), sorted_tets(dt));
+  // A lower-dimensional set round-trips too.
+  Delaunay3(std::vector<Vec3d>{{0, 0, 0}, {1, 1, 1}}).save(dir / "line.geods");
+  EXPECT_EQ(Delaunay3::load(dir / "line.geods").dimension(), 1);
+  // Truncated and missing files, another kind.
+  const auto size = std::filesystem::file_size(dir / "dt.geods");
+  std::filesystem::copy_file(dir / "dt.geods", dir / "cut.geods", std::filesystem::copy_options::overwrite_existing);
+  std::filesystem::resize_file(dir / "cut.geods", size / 2);
+  EXPECT_THROW(Delaunay3::load(dir / "cut.geods"), Error);
+  EXPECT_THROW(Delaunay3::load(dir / "missing.geods"), Error);
+  std::filesystem::remove_all(dir);
 }
 
 TEST(Delaunay3, VertexNeighborsAreTheEdges) {

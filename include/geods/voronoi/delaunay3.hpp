@@ -34,9 +34,11 @@
 // coordinates raise geods::Error.
 #include <array>
 #include <cstdint>
+#include <filesystem>
 #include <span>
 #include <vector>
 
+#include "geods/core/archive.hpp"
 #include "geods/core/vec.hpp"
 
 namespace geods::voronoi {
@@ -115,6 +117,20 @@ class Delaunay3 {
   /// perturbed Delaunay tetrahedralization is unique, so this is the result
   /// any local deletion would give.
   void remove(std::uint32_t i);
+
+  /// Writes the tetrahedralization to `path` as a geods archive
+  /// (core/archive.hpp, kind "voronoi.Delaunay3", version 1): the points, the
+  /// removal flags, the representatives and the closed tetrahedralization's
+  /// slots. Throws geods::Error naming the file if it cannot be written.
+  void save(const std::filesystem::path& path) const;
+  /// A tetrahedralization equal to the one save()d to `path` (same arrays,
+  /// same answers; insert() and remove() go on as they would have). Unlike the
+  /// 2D structures it copies the sections into arrays of its own (insertion
+  /// changes them in place). Every index is checked before use, then
+  /// validate() runs (exact, O(n)). Throws geods::Error naming the file if it
+  /// is missing, truncated, corrupt, of another kind or version, or not a
+  /// Delaunay tetrahedralization of its points.
+  static Delaunay3 load(const std::filesystem::path& path, Archive::Verify verify = Archive::Verify::checksums);
 
   Delaunay3Stats stats() const;
   /// Checks every invariant; throws geods::Error naming the first violation:
