@@ -23,8 +23,17 @@ inline std::vector<Vec2d> read_points_2d(const std::filesystem::path& path) {
   return points;
 }
 
+/// An n x 3 table of points (io::read_table: .npy, .csv, .txt, .xyz, .ply). Throws geods::Error naming the file.
+inline std::vector<Vec3d> read_points_3d(const std::filesystem::path& path) {
+  const io::Table t = io::read_table(path, "point", 3);
+  std::vector<Vec3d> points(t.rows);
+  for (std::size_t i = 0; i < t.rows; ++i) points[i] = {t.values[3 * i], t.values[3 * i + 1], t.values[3 * i + 2]};
+  return points;
+}
+
 /// "x0,y0,x1,y1" with x0 < x1 and y0 < y1.
-inline AABB2d parse_box(const std::string& text) {
+/// The comma-separated numbers of `text` (a field that is not a number gives NaN).
+inline std::vector<double> parse_numbers(const std::string& text) {
   std::vector<double> v;
   std::stringstream in(text);
   std::string field;
@@ -37,6 +46,11 @@ inline AABB2d parse_box(const std::string& text) {
       v.push_back(std::nan(""));
     }
   }
+  return v;
+}
+
+inline AABB2d parse_box(const std::string& text) {
+  const std::vector<double> v = parse_numbers(text);
   if (v.size() != 4 || !(v[0] < v[2]) || !(v[1] < v[3]) || !std::isfinite(v[2] - v[0]) || !std::isfinite(v[3] - v[1]))
     throw Error("--box: expected x0,y0,x1,y1 with x0 < x1 and y0 < y1, got '" + text + "'");
   return AABB2d({v[0], v[1]}, {v[2], v[3]});

@@ -12,6 +12,8 @@
 #include "arrays.hpp"
 #include "geods/core/error.hpp"
 #include "geods/voronoi/delaunay2.hpp"
+#include "geods/voronoi/delaunay3.hpp"
+#include "geods/voronoi/voronoi3.hpp"
 #include "geods/voronoi/stats_fields.hpp"
 #include "stats_dict.hpp"
 
@@ -70,9 +72,139 @@ Delaunay2 make(const py::handle& points_in, const py::object& segments_in, std::
   return Delaunay2(points, segments, options);
 }
 
+using voronoi::Delaunay3;
+
+std::uint32_t point_index3(std::int64_t i, const Delaunay3& dt, const char* what) {
+  if (i < 0 || std::size_t(i) >= dt.points().size())
+    throw Error(std::string(what) + ": point " + std::to_string(i) + " does not exist");
+  return std::uint32_t(i);
+}
+
+void bind_delaunay3(py::module_& m) {
+  py::class_<Delaunay3>(m, "Delaunay3", R"doc(
+Delaunay tetrahedralization of 3D points (Bowyer-Watson insertion in BRIO order,
+exact predicates with symbolic perturbation: any input, cospherical or coplanar
+sets included, gives a valid and unique result).
+
+Delaunay3(points, seed=...) -- points (n, 3). Duplicates merge into their first
+occurrence; fewer than four distinct points or all coplanar give no tetrahedra
+(dimension < 3). NaN/inf raise geods.Error (ValueError).
+)doc")
+      .def(py::init([](const py::handle& points_in, std::uint64_t seed) {
+             const std::vector<Vec3d> points = points_of<double, 3>(points_in, "Delaunay3");
+             py::gil_scoped_release release;
+             return Delaunay3(points, {.seed = seed});
+           }),
+           py::arg("points"), py::arg("seed") = Delaunay3::Options{}.seed)
+      .def_property_readonly(
+          "points", [](const Delaunay3& dt) { return points_array(dt.points()); }, "(n, 3) float64: the points")
+      .def_property_readonly(
+          "tetrahedra",
+          [](const Delaunay3& dt) {
+            return index_array(dt.tetrahedra(), {py::ssize_t(dt.tetrahedron_count()), 4});
+          },
+          "(m, 4) int64: positively oriented vertex indices (first occurrences of duplicates)")
+      .def_property_readonly(
+          "neighbors",
+          [](const Delaunay3& dt) { return index_array(dt.neighbors(), {py::ssize_t(dt.tetrahedron_count()), 4}); },
+          "(m, 4) int64: the tetrahedron across the face opposite each vertex, -1 on the hull")
+      .def_property_readonly("dimension", &Delaunay3::dimension,
+                             "affine dimension: -1 no points, 0 all equal, 1 collinear, 2 coplanar, 3 a solid")
+      .def(
+          "hull",
+          [](const Delaunay3& dt) {
+            std::vector<std::uint32_t> flat;
+            for (const auto& t : dt.hull()) flat.insert(flat.end(), t.begin(), t.end());
+            return index_array(flat, {py::ssize_t(flat.size() / 3), 3});
+          },
+          "(h, 3) int64: the convex hull's triangles, counter-clockwise seen from outside")
+      .def(
+          "representative",
+          [](const Delaunay3& dt, std::int64_t i) {
+            return index_value(dt.representative(point_index3(i, dt, "Delaunay3.representative")));
+          },
+          py::arg("i"), "the first occurrence of point i, -1 if it was removed")
+      .def(
+          "locate",
+          [](const Delaunay3& dt, const py::handle& q) {
+            return index_value(dt.locate(point_of<double, 3>(q, "Delaunay3.locate")));
+          },
+          py::arg("q"), "index of a tetrahedron containing q (closed), -1 outside the hull")
+      .def(
+          "nearest_vertex",
+          [](const Delaunay3& dt, const py::handle& q) {
+            return index_value(dt.nearest_vertex(point_of<double, 3>(q, "Delaunay3.nearest_vertex")));
+          },
+          py::arg("q"), "index of the nearest point (a first occurrence), -1 if empty")
+      .def(
+          "vertex_neighbors",
+          [](const Delaunay3& dt, std::int64_t v) {
+            return index_array(dt.vertex_neighbors(point_index3(v, dt, "Delaunay3.vertex_neighbors")));
+          },
+          py::arg("v"), "the Delaunay neighbours of point v, ascending")
+      .def(
+          "insert",
+          [](Delaunay3& dt, const py::handle& p) {
+            return std::int64_t(dt.insert(point_of<double, 3>(p, "Delaunay3.insert")));
+          },
+          py::arg("p"), "inserts a point, returns its index")
+      .def(
+          "remove", [](Delaunay3& dt, std::int64_t i) { dt.remove(point_index3(i, dt, "Delaunay3.remove")); },
+          py::arg("i"), "removes point i (rebuilds: O(n log n))")
+      .def(
+          "save", [](const Delaunay3& dt, const std::filesystem::path& path) { dt.save(path); }, py::arg("path"),
+          "writes the tetrahedralization to a geods archive")
+      .def_static(
+          "load", [](const std::filesystem::path& path) { return Delaunay3::load(path); }, py::arg("path"),
+          "reads a tetrahedralization written by save() (checked exactly); insert and remove go on as before")
+      .def("validate", &Delaunay3::validate, "checks every invariant (exact); raises geods.Error on a violation")
+      .def("stats", [](const Delaunay3& dt) { return stats_dict(dt.stats()); });
+
+  m.def(
+      "voronoi3",
+      [](const py::handle& points_in, const py::handle& box_in) {
+        const std::vector<Vec3d> points = points_of<double, 3>(points_in, "voronoi3");
+        const py::array_t<double, py::array::c_style | py::array::forcecast> box =
+            py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(box_in);
+        if (!box || box.size() != 6) throw Error("voronoi3: box must be 6 numbers x0, y0, z0, x1, y1, z1");
+        const double* b = box.data();
+        std::vector<voronoi::Voronoi3Cell> cells;
+        {
+          py::gil_scoped_release release;
+          cells = voronoi::Voronoi3(points, AABB3d(Vec3d(b[0], b[1], b[2]), Vec3d(b[3], b[4], b[5]))).cells();
+        }
+        py::list out;
+        for (const auto& cell : cells) {
+          py::dict d;
+          d["site"] = std::int64_t(cell.site);
+          d["volume"] = cell.volume;
+          d["centroid"] = copy_array(cell.centroid.data(), {3});
+          d["vertices"] = points_array(cell.vertices);
+          py::list faces;
+          for (std::size_t f = 0; f < cell.face_count(); ++f)
+            faces.append(index_array(std::span<const std::uint32_t>(
+                cell.face_vertices.data() + cell.face_offsets[f], cell.face_offsets[f + 1] - cell.face_offsets[f])));
+          d["faces"] = faces;
+          std::vector<std::int64_t> labels;
+          for (const std::uint32_t l : cell.face_neighbors) labels.push_back(std::int32_t(l));  // box side k: -2 - k
+          d["neighbors"] = copy_array(labels.data(), {py::ssize_t(labels.size())});
+          out.append(d);
+        }
+        return out;
+      },
+      py::arg("points"), py::arg("box"), R"doc(
+The Voronoi cells of 3D points clipped to a box (x0, y0, z0, x1, y1, z1): one dict per
+distinct point with "site" (its index), "volume", "centroid", "vertices" (k, 3), "faces"
+(index loops into vertices, counter-clockwise seen from outside) and "neighbors" (per
+face the site across, or -2 - k for box side k: -x, +x, -y, +y, -z, +z). The cells
+partition the box.
+)doc");
+}
+
 }  // namespace
 
 void bind_delaunay(py::module_& m) {
+  bind_delaunay3(m);
   py::class_<Delaunay2>(m, "Delaunay2", R"doc(
 Delaunay triangulation of 2D points (incremental, Lawson flips, exact predicates),
 optionally constrained by segments.

@@ -270,27 +270,46 @@ void bind_voronoi(py::module_& m) {
       .def("stats", &PyMetricVoronoi::stats, "dict: sites, distinct, edges, cell_vertices, max_candidates")
       .def("validate", &PyMetricVoronoi::validate);
 
+  // (n, 3) points take the 3D versions (from Delaunay3), anything else the 2D ones.
+  const auto three_columns = [](const py::handle& points) {
+    const py::array a = py::array::ensure(points);
+    return a && a.ndim() == 2 && a.shape(1) == 3;
+  };
   m.def(
       "emst",
-      [](const py::handle& points) {
-        const std::vector<Vec2d> p = to_points(points, "emst");
-        const voronoi::SpanningTree tree = without_gil([&] { return voronoi::emst(p); });
+      [three_columns](const py::handle& points) {
+        voronoi::SpanningTree tree;
+        if (three_columns(points)) {
+          const std::vector<Vec3d> p = points_of<double, 3>(points, "emst");
+          tree = without_gil([&] { return voronoi::emst(p); });
+        } else {
+          const std::vector<Vec2d> p = to_points(points, "emst");
+          tree = without_gil([&] { return voronoi::emst(p); });
+        }
         std::vector<std::uint32_t> ends;
         for (const auto& [a, b] : tree.edges) ends.insert(ends.end(), {a, b});
         return py::make_tuple(index_array(ends, {py::ssize_t(tree.edges.size()), 2}), tree.length);
       },
-      py::arg("points"), "Euclidean minimum spanning tree: ((n - 1, 2) int64 edges by increasing length, total length).");
+      py::arg("points"),
+      "Euclidean minimum spanning tree of (n, 2) or (n, 3) points: ((n - 1, 2) int64 edges by increasing length, "
+      "total length).");
   m.def(
       "closest_pair",
-      [](const py::handle& points) {
-        const voronoi::ClosestPair c = voronoi::closest_pair(to_points(points, "closest_pair"));
+      [three_columns](const py::handle& points) {
+        const voronoi::ClosestPair c = three_columns(points)
+                                           ? voronoi::closest_pair(points_of<double, 3>(points, "closest_pair"))
+                                           : voronoi::closest_pair(to_points(points, "closest_pair"));
         return py::make_tuple(c.i, c.j, c.distance);
       },
-      py::arg("points"), "The two nearest points: (i, j, distance) with i < j.");
+      py::arg("points"), "The two nearest of (n, 2) or (n, 3) points: (i, j, distance) with i < j.");
   m.def(
       "all_nearest_neighbors",
-      [](const py::handle& points) { return index_array(voronoi::all_nearest_neighbors(to_points(points, "all_nearest_neighbors"))); },
-      py::arg("points"), "For each point the index of its nearest other point.");
+      [three_columns](const py::handle& points) {
+        return index_array(three_columns(points)
+                               ? voronoi::all_nearest_neighbors(points_of<double, 3>(points, "all_nearest_neighbors"))
+                               : voronoi::all_nearest_neighbors(to_points(points, "all_nearest_neighbors")));
+      },
+      py::arg("points"), "For each of (n, 2) or (n, 3) points the index of its nearest other point.");
   m.def(
       "largest_empty_circle",
       [](const py::handle& points) {

@@ -136,7 +136,7 @@ def test_application_errors():
     with pytest.raises(ValueError):
         geods.smallest_enclosing_circle(np.zeros((0, 2)))
     with pytest.raises(ValueError):
-        geods.emst(np.zeros((3, 3)))
+        geods.emst(np.zeros((3, 4)))  # (n, 3) is the 3D version
 
 
 def test_cli_voronoi_and_nearest(cli, workdir):

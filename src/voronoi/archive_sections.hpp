@@ -21,11 +21,17 @@ inline std::span<const double> coordinates_of(std::span<const Vec2d> points) {
   return {points.empty() ? nullptr : points.data()->data(), 2 * points.size()};
 }
 
-/// The points of section `name` (pairs of doubles) viewed in place, checked finite.
-inline FlatArray<Vec2d> read_points(const Archive& archive, std::string_view name) {
-  FlatArray<Vec2d> points = archive.grouped<Vec2d, double>(name);
+/// The same for points in space: x0, y0, z0, x1, ...
+inline std::span<const double> coordinates_of(std::span<const Vec3d> points) {
+  return {points.empty() ? nullptr : points.data()->data(), 3 * points.size()};
+}
+
+/// The points of section `name` (pairs, or triples for Vec3d, of doubles) viewed in place, checked finite.
+template <class Point = Vec2d>
+inline FlatArray<Point> read_points(const Archive& archive, std::string_view name) {
+  FlatArray<Point> points = archive.grouped<Point, double>(name);
   for (std::size_t i = 0; i < points.size(); ++i)
-    if (!std::isfinite(points[i][0]) || !std::isfinite(points[i][1]))
+    if (!points[i].allFinite())
       throw archive.error(std::string(name) + ": point " + std::to_string(i) + " is not finite");
   return points;
 }

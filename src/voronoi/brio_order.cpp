@@ -5,6 +5,7 @@
 #include <bit>
 #include <cmath>
 
+#include "geods/core/morton.hpp"
 #include "geods/core/parallel.hpp"
 #include "geods/core/rng.hpp"
 
@@ -47,6 +48,31 @@ std::uint32_t hilbert_index(std::uint32_t x, std::uint32_t y) {
   const std::uint32_t a = C ^ (C >> 1), b = D ^ (D >> 1);
   const std::uint32_t i0 = x ^ y, i1 = b | (0xFFFF ^ (i0 | a));
   return (interleave_bits(i1) << 1) | interleave_bits(i0);
+}
+
+// Index of (x, y, z) along the Hilbert curve of a 2^kBits3 grid per axis
+// (Skilling, "Programming the Hilbert curve", 2004: axes to transpose, then
+// the transpose's bits interleaved).
+constexpr int kBits3 = 9;
+std::uint32_t hilbert_index3(std::uint32_t x, std::uint32_t y, std::uint32_t z) {
+  std::uint32_t X[3] = {x, y, z};
+  constexpr std::uint32_t M = 1u << (kBits3 - 1);
+  for (std::uint32_t Q = M; Q > 1; Q >>= 1) {
+    const std::uint32_t P = Q - 1;
+    for (int i = 0; i < 3; ++i)
+      if (X[i] & Q) {
+        X[0] ^= P;
+      } else {
+        const std::uint32_t t = (X[0] ^ X[i]) & P;
+        X[0] ^= t, X[i] ^= t;
+      }
+  }
+  X[1] ^= X[0], X[2] ^= X[1];
+  std::uint32_t t = 0;
+  for (std::uint32_t Q = M; Q > 1; Q >>= 1)
+    if (X[2] & Q) t ^= Q - 1;
+  for (auto& v : X) v ^= t;
+  return morton3d_encode32(X[2], X[1], X[0]);
 }
 
 // Sorts `items` by their bits [first_bit, first_bit + bits), stably (LSD radix sort, 11 bits a pass).
@@ -103,6 +129,44 @@ std::vector<std::uint32_t> brio_order(std::span<const Vec2d> points, std::span<c
   radix_sort(keys, 30, 34);
   std::vector<std::uint32_t> order(n);
   for (std::size_t k = 0; k < n; ++k) order[k] = std::uint32_t(keys[k] & 0x3FFFFFFF);
+  return order;
+}
+
+std::vector<std::uint32_t> brio_order(std::span<const Vec3d> points, std::span<const std::uint32_t> active,
+                                      std::uint64_t seed) {
+  const std::size_t n = active.size();
+  double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (std::uint32_t i : active)
+    for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], points[i][a]), hi[a] = std::max(hi[a], points[i][a]);
+  constexpr double kTop = double((1u << kBits3) - 1);
+  double scale[3];
+  for (int a = 0; a < 3; ++a) {
+    const double extent = hi[a] * 0.5 - lo[a] * 0.5;
+    scale[a] = extent > 0 ? kTop / extent : 0.0;
+  }
+  // As in 2D: the key packs round (6 bits), Hilbert index (27 bits) and point index (31 bits).
+  const int last_round = int(std::bit_width(n));
+  std::vector<std::uint64_t> keys(n);
+  Rng rng(seed);
+  std::vector<std::uint64_t> random(n);
+  for (auto& r : random) r = rng();
+  constexpr std::uint32_t kHilbertMask = (1u << (3 * kBits3)) - 1;
+  parallel_for(0, n, 4096, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k) {
+      const Vec3d& p = points[active[k]];
+      const auto cell = [&](int a) {
+        const double t = (p[a] * 0.5 - lo[a] * 0.5) * scale[a];
+        return std::uint32_t(std::clamp(t, 0.0, kTop));
+      };
+      const int round = std::max(0, last_round - std::countr_zero(random[k] | (std::uint64_t(1) << 63)));
+      std::uint32_t h = hilbert_index3(cell(0), cell(1), cell(2));
+      if (round % 2) h = ~h & kHilbertMask;
+      keys[k] = (std::uint64_t(round) << 58) | (std::uint64_t(h) << 31) | active[k];
+    }
+  });
+  radix_sort(keys, 31, 33);
+  std::vector<std::uint32_t> order(n);
+  for (std::size_t k = 0; k < n; ++k) order[k] = std::uint32_t(keys[k] & 0x7FFFFFFF);
   return order;
 }
 

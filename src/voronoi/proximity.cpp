@@ -14,20 +14,53 @@
 namespace geods::voronoi {
 namespace {
 
-void require_two(const Voronoi2& diagram, const char* what) {
-  if (diagram.size() < 2) throw Error(std::string(what) + ": needs at least 2 points, got " + std::to_string(diagram.size()));
+constexpr std::uint32_t kNone = std::uint32_t(-1);
+
+// The Delaunay graph of 3D points as the 2D functions read it: size(),
+// representative(i) (kNone for a removed point), neighbors(i), points().
+// Without tetrahedra (fewer than four non-coplanar points) every other site is
+// a neighbour: O(n^2), which the graph of the lower-dimensional set would
+// avoid, but such sets are small in practice.
+struct Delaunay3Graph {
+  const Delaunay3& dt;
+  std::vector<std::uint32_t> sites;  // only for dimension() < 3
+  explicit Delaunay3Graph(const Delaunay3& d) : dt(d) {
+    if (dt.dimension() < 3)
+      for (std::uint32_t i = 0; i < dt.points().size(); ++i)
+        if (dt.representative(i) == i) sites.push_back(i);
+  }
+  std::size_t size() const { return dt.points().size(); }
+  std::uint32_t representative(std::uint32_t i) const { return dt.representative(i); }
+  std::span<const Vec3d> points() const { return dt.points(); }
+  std::vector<std::uint32_t> neighbors(std::uint32_t i) const {
+    if (dt.dimension() == 3) return dt.vertex_neighbors(i);
+    std::vector<std::uint32_t> out;
+    for (std::uint32_t s : sites)
+      if (s != i) out.push_back(s);
+    return out;
+  }
+};
+
+template <class Graph>
+void require_two(const Graph& graph, const char* what) {
+  std::size_t present = 0;
+  for (std::uint32_t i = 0; i < graph.size() && present < 2; ++i) present += graph.representative(i) != kNone;
+  if (present < 2) throw Error(std::string(what) + ": needs at least 2 points, got " + std::to_string(present));
 }
 
-double squared(const Voronoi2& d, std::uint32_t a, std::uint32_t b) {
+template <class Graph>
+double squared(const Graph& d, std::uint32_t a, std::uint32_t b) {
   return (d.points()[a] - d.points()[b]).squaredNorm();
 }
 
 // Every candidate edge of the spanning tree and of the closest pair: the Delaunay
 // edges between representatives (i < j) and each duplicate with its first occurrence.
-std::vector<std::pair<std::uint32_t, std::uint32_t>> candidate_edges(const Voronoi2& diagram) {
+template <class Graph>
+std::vector<std::pair<std::uint32_t, std::uint32_t>> candidate_edges(const Graph& diagram) {
   std::vector<std::pair<std::uint32_t, std::uint32_t>> out;
   for (std::uint32_t i = 0; i < diagram.size(); ++i) {
     const std::uint32_t r = diagram.representative(i);
+    if (r == kNone) continue;  // removed
     if (r != i) {
       out.push_back({r, i});
       continue;
@@ -38,9 +71,8 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> candidate_edges(const Voron
   return out;
 }
 
-}  // namespace
-
-ClosestPair closest_pair(const Voronoi2& diagram) {
+template <class Graph>
+ClosestPair closest_pair_of(const Graph& diagram) {
   require_two(diagram, "closest_pair");
   ClosestPair best;
   double best_d = std::numeric_limits<double>::infinity();
@@ -54,21 +86,23 @@ ClosestPair closest_pair(const Voronoi2& diagram) {
   return best;
 }
 
-std::vector<std::uint32_t> all_nearest_neighbors(const Voronoi2& diagram) {
+template <class Graph>
+std::vector<std::uint32_t> all_nearest_neighbors_of(const Graph& diagram) {
   require_two(diagram, "all_nearest_neighbors");
   const std::size_t n = diagram.size();
-  // The two smallest indices of each group of copies (kInfinity when a site has no copy).
-  std::vector<std::uint32_t> second(n, Voronoi2::kInfinity);
+  // The two smallest indices of each group of copies (kNone when a site has no copy).
+  std::vector<std::uint32_t> second(n, kNone);
   for (std::uint32_t i = 0; i < n; ++i) {
     const std::uint32_t r = diagram.representative(i);
-    if (r != i && second[r] == Voronoi2::kInfinity) second[r] = i;
+    if (r != kNone && r != i && second[r] == kNone) second[r] = i;
   }
-  std::vector<std::uint32_t> nearest(n);
+  std::vector<std::uint32_t> nearest(n, kNone);
   for (std::uint32_t i = 0; i < n; ++i) {
     const std::uint32_t r = diagram.representative(i);
+    if (r == kNone) continue;
     if (r != i) {
       nearest[i] = r;
-    } else if (second[i] != Voronoi2::kInfinity) {
+    } else if (second[i] != kNone) {
       nearest[i] = second[i];
     } else {
       double best = std::numeric_limits<double>::infinity();
@@ -79,7 +113,8 @@ std::vector<std::uint32_t> all_nearest_neighbors(const Voronoi2& diagram) {
   return nearest;
 }
 
-SpanningTree emst(const Voronoi2& diagram) {
+template <class Graph>
+SpanningTree emst_of(const Graph& diagram) {
   std::vector<std::pair<std::uint32_t, std::uint32_t>> candidates = candidate_edges(diagram);
   std::vector<double> length(candidates.size());
   for (std::size_t k = 0; k < candidates.size(); ++k) length[k] = squared(diagram, candidates[k].first, candidates[k].second);
@@ -94,18 +129,37 @@ SpanningTree emst(const Voronoi2& diagram) {
     while (parent[x] != x) x = parent[x] = parent[parent[x]];
     return x;
   };
+  std::size_t present = 0;
+  for (std::uint32_t i = 0; i < diagram.size(); ++i) present += diagram.representative(i) != kNone;
   SpanningTree tree;
-  tree.edges.reserve(diagram.size() - 1);
+  if (present == 0) return tree;
+  tree.edges.reserve(present - 1);
   for (std::uint32_t k : order) {
     const std::uint32_t a = root(candidates[k].first), b = root(candidates[k].second);
     if (a == b) continue;
     parent[std::max(a, b)] = std::min(a, b);
     tree.edges.push_back(candidates[k]);
     tree.length += std::sqrt(length[k]);
-    if (tree.edges.size() + 1 == diagram.size()) break;
+    if (tree.edges.size() + 1 == present) break;
   }
   return tree;
 }
+
+}  // namespace
+
+ClosestPair closest_pair(const Voronoi2& diagram) { return closest_pair_of(diagram); }
+std::vector<std::uint32_t> all_nearest_neighbors(const Voronoi2& diagram) { return all_nearest_neighbors_of(diagram); }
+SpanningTree emst(const Voronoi2& diagram) { return emst_of(diagram); }
+ClosestPair closest_pair(const Delaunay3& dt) { return closest_pair_of(Delaunay3Graph(dt)); }
+std::vector<std::uint32_t> all_nearest_neighbors(const Delaunay3& dt) {
+  return all_nearest_neighbors_of(Delaunay3Graph(dt));
+}
+SpanningTree emst(const Delaunay3& dt) { return emst_of(Delaunay3Graph(dt)); }
+ClosestPair closest_pair(std::span<const Vec3d> points) { return closest_pair(Delaunay3(points)); }
+std::vector<std::uint32_t> all_nearest_neighbors(std::span<const Vec3d> points) {
+  return all_nearest_neighbors(Delaunay3(points));
+}
+SpanningTree emst(std::span<const Vec3d> points) { return emst(Delaunay3(points)); }
 
 ClosestPair closest_pair(std::span<const Vec2d> points) { return closest_pair(Voronoi2(points)); }
 std::vector<std::uint32_t> all_nearest_neighbors(std::span<const Vec2d> points) {

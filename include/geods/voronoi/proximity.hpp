@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "geods/core/vec.hpp"
+#include "geods/voronoi/delaunay3.hpp"
 #include "geods/voronoi/post_office.hpp"
 #include "geods/voronoi/voronoi2.hpp"
 
@@ -44,6 +45,17 @@ struct SpanningTree {
 /// zero-length edges. Ties are broken by (length, i, j), so it is deterministic.
 SpanningTree emst(const Voronoi2& diagram);
 SpanningTree emst(std::span<const Vec2d> points);
+
+/// The same in 3D (seed §5.4.3 carries over): from the Delaunay
+/// tetrahedralization's edges. A removed point takes no part (its nearest is
+/// no_index). Without tetrahedra (fewer than four non-coplanar points) every
+/// pair of sites is a candidate: O(n^2).
+ClosestPair closest_pair(const Delaunay3& dt);
+ClosestPair closest_pair(std::span<const Vec3d> points);
+std::vector<std::uint32_t> all_nearest_neighbors(const Delaunay3& dt);
+std::vector<std::uint32_t> all_nearest_neighbors(std::span<const Vec3d> points);
+SpanningTree emst(const Delaunay3& dt);
+SpanningTree emst(std::span<const Vec3d> points);
 
 /// The k nearest distinct sites of q (representative indices), nearest first,
 /// ties by index; fewer if there are fewer sites. Best-first search in the

@@ -2,9 +2,11 @@
 // The fields of the voronoi module's stats structs, named once (see
 // spatial/stats_fields.hpp).
 #include "geods/voronoi/delaunay2.hpp"
+#include "geods/voronoi/delaunay3.hpp"
 #include "geods/voronoi/metric_voronoi.hpp"
 #include "geods/voronoi/post_office.hpp"
 #include "geods/voronoi/voronoi2.hpp"
+#include "geods/voronoi/voronoi3.hpp"
 
 namespace geods::voronoi {
 
@@ -17,9 +19,22 @@ void for_each_field(const Delaunay2Stats& s, F&& f) {
 }
 
 template <typename F>
+void for_each_field(const Delaunay3Stats& s, F&& f) {
+  f("points", s.points), f("vertices", s.vertices), f("duplicates", s.duplicates), f("removed", s.removed);
+  f("tetrahedra", s.tetrahedra);
+  f("hull_triangles", s.hull_triangles), f("dimension", s.dimension), f("walk_steps", s.walk_steps);
+  f("conflicts", s.conflicts), f("bytes", s.bytes);
+}
+
+template <typename F>
 void for_each_field(const Voronoi2Stats& s, F&& f) {
   f("sites", s.sites), f("distinct", s.distinct), f("vertices", s.vertices), f("edges", s.edges);
   f("unbounded_cells", s.unbounded_cells), f("bytes", s.bytes);
+}
+
+template <typename F>
+void for_each_field(const Voronoi3Stats& s, F&& f) {
+  f("sites", s.sites), f("faces", s.faces), f("vertices", s.vertices), f("empty", s.empty), f("bytes", s.bytes);
 }
 
 template <typename F>

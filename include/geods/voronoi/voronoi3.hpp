@@ -1,0 +1,72 @@
+#pragma once
+// The Voronoi diagram of points in space (seed §5.3.1, the dual of Delaunay3):
+// every site's cell clipped to a box, as a closed convex polyhedron with its
+// volume and centroid. The cells of the sites inside the box partition it.
+//
+// A cell is the box cut by the bisector planes between its site and the site's
+// Delaunay neighbours (only they bound a Voronoi cell), clipped in doubles.
+// Layout, flat per cell: its vertices, its faces as index loops into them
+// (counter-clockwise seen from outside), and per face the site across it, or
+// a box side (Voronoi3::box_side(k), k = 0..5 for -x, +x, -y, +y, -z, +z).
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "geods/core/aabb.hpp"
+#include "geods/core/tri_mesh.hpp"
+#include "geods/core/vec.hpp"
+#include "geods/voronoi/delaunay3.hpp"
+
+namespace geods::voronoi {
+
+struct Voronoi3Cell {
+  std::uint32_t site = 0;                   // the point it belongs to
+  std::vector<Vec3d> vertices;              // the cell's corners
+  std::vector<std::uint32_t> face_offsets;  // face f is face_vertices[face_offsets[f] .. face_offsets[f + 1])
+  std::vector<std::uint32_t> face_vertices;
+  std::vector<std::uint32_t> face_neighbors;  // per face: the site across, or box_side(k)
+  double volume = 0;                        // 0 for a cell that misses the box (no faces)
+  Vec3d centroid = Vec3d::Zero();
+  std::size_t face_count() const { return face_neighbors.size(); }
+};
+
+struct Voronoi3Stats {
+  std::size_t sites = 0;     // cells (distinct points)
+  std::size_t faces = 0;     // cell faces, each shared face counted per cell
+  std::size_t vertices = 0;  // cell corners, counted per cell
+  std::size_t empty = 0;     // cells that miss the box
+  std::size_t bytes = 0;
+};
+
+class Voronoi3 {
+ public:
+  /// The face label of box side k (0: x = lo.x, 1: x = hi.x, 2, 3: y, 4, 5: z).
+  static constexpr std::uint32_t box_side(int k) { return std::uint32_t(-2 - k); }
+  static bool is_box_side(std::uint32_t label) { return label >= box_side(5) && label <= box_side(0); }
+
+  /// The cells of the points' distinct sites (representatives of Delaunay3),
+  /// clipped to `box`, computed in parallel (the result does not depend on
+  /// the thread count). Throws geods::Error for an empty, NaN or infinite box.
+  /// O(sum of cell sizes) after the tetrahedralization; for fewer than four
+  /// non-coplanar sites every other site bounds each cell: O(n^2).
+  Voronoi3(const Delaunay3& dt, const AABB3d& box);
+  Voronoi3(std::span<const Vec3d> points, const AABB3d& box) : Voronoi3(Delaunay3(points), box) {}
+
+  const std::vector<Voronoi3Cell>& cells() const { return cells_; }
+  const AABB3d& box() const { return box_; }
+  /// The sum of the cell volumes: the box's volume up to rounding (for any non-empty set of sites).
+  double volume_total() const;
+  Voronoi3Stats stats() const;
+  /// The cells as one triangle mesh (each face a fan), every cell a closed
+  /// surface; with `explode` > 0 each cell is moved away from the box's centre
+  /// by that fraction of its centroid's offset (an exploded view). The
+  /// triangles of cell c are those whose index in `cell_of_triangle` (when
+  /// given) holds c.
+  TriMesh mesh(double explode = 0, std::vector<std::uint32_t>* cell_of_triangle = nullptr) const;
+
+ private:
+  AABB3d box_;
+  std::vector<Voronoi3Cell> cells_;
+};
+
+}  // namespace geods::voronoi

@@ -1,0 +1,653 @@
+// Delaunay3: Bowyer-Watson insertion over flat tetrahedron arrays closed by a
+// ghost vertex, exact predicates with the lexicographic symbolic perturbation
+// (see delaunay3.hpp).
+#include "geods/voronoi/delaunay3.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <optional>
+#include <string>
+
+#include "brio_order.hpp"
+#include "delaunay3_mesh.hpp"
+#include "geods/core/error.hpp"
+#include "geods/core/parallel.hpp"
+
+namespace geods::voronoi {
+namespace {
+
+constexpr std::uint32_t kNone = Delaunay3::no_index;
+
+bool same(const Vec3d& a, const Vec3d& b) { return a[0] == b[0] && a[1] == b[1] && a[2] == b[2]; }
+
+// Exact collinearity: the cross product's components are the three projected orientations.
+bool collinear(const Vec3d& a, const Vec3d& b, const Vec3d& c) {
+  for (int axis = 0; axis < 3; ++axis) {
+    const int i = (axis + 1) % 3, j = (axis + 2) % 3;
+    const double pa[2] = {a[i], a[j]}, pb[2] = {b[i], b[j]}, pc[2] = {c[i], c[j]};
+    if (orient2d(pa, pb, pc) != 0) return false;
+  }
+  return true;
+}
+
+// kEdgeOf[f][j]: the two indices of a tetrahedron other than f and j.
+constexpr std::uint8_t kEdgeOf[4][4][2] = {
+    {{0, 0}, {2, 3}, {1, 3}, {1, 2}},
+    {{2, 3}, {0, 0}, {0, 3}, {0, 2}},
+    {{1, 3}, {0, 3}, {0, 0}, {0, 1}},
+    {{1, 2}, {0, 2}, {0, 1}, {0, 0}},
+};
+
+std::string tet_name(std::uint32_t t) { return "tetrahedron slot " + std::to_string(t); }
+
+}  // namespace
+
+// ------------------------------------------------------------------ Mesh steps
+
+bool Tet3Mesh::perturbed_inside(const Vec3d* const q[4], const Vec3d& p) {
+  // Devillers-Teillaud / CGAL: rank the five points lexicographically; the
+  // sign of the perturbed determinant is that of the first non-zero term, the
+  // orientation of the tetrahedron with the highest-ranked point replaced by p.
+  const Vec3d* ranked[5] = {q[0], q[1], q[2], q[3], &p};
+  std::sort(ranked, ranked + 5, [](const Vec3d* a, const Vec3d* b) { return lex_less(*a, *b); });
+  for (int r = 4; r >= 0; --r) {
+    if (ranked[r] == &p) return false;
+    for (int j = 0; j < 4; ++j)
+      if (ranked[r] == q[j]) {
+        const Vec3d* s[4] = {q[0], q[1], q[2], q[3]};
+        s[j] = &p;
+        const double o = orient(*s[0], *s[1], *s[2], *s[3]);
+        if (o != 0) return o > 0;
+      }
+  }
+  return false;
+}
+
+bool Tet3Mesh::ghost_conflict(const Vec3d* C, const std::uint32_t* T, std::uint32_t t, const Vec3d& p) {
+  const std::uint32_t* v = &T[8 * std::size_t(t)];
+  const Vec3d* q[4];
+  int g = 0;
+  for (int k = 0; k < 4; ++k) {
+    if (v[k] == kGhost) g = k;
+    q[k] = v[k] == kGhost ? &p : &C[v[k]];
+  }
+  const double o = orient(*q[0], *q[1], *q[2], *q[3]);
+  if (o != 0) return o > 0;
+  // On the hull face's plane: as the finite tetrahedron behind it (a ghost there is a corrupt
+  // mesh, such as a crafted file that load() is checking: no endless recursion).
+  const std::uint32_t behind = T[8 * std::size_t(t) + 4 + g] >> 2;
+  const std::uint32_t* w = &T[8 * std::size_t(behind)];
+  if (((w[0] | w[1] | w[2] | w[3]) & kGhostBit) != 0) return false;
+  return conflict(C, T, behind, p);
+}
+
+std::uint32_t Tet3Mesh::walk(const Vec3d& p, std::uint32_t t, std::size_t& steps, std::uint32_t& random) const {
+  if (const int g = ghost_index(t); g >= 0) t = tets[8 * std::size_t(t) + 4 + g] >> 2;
+  std::uint32_t from = 4;  // the face we entered through: p lies strictly beyond it
+  for (;;) {
+    ++steps;
+    const std::uint32_t* v = &tets[8 * std::size_t(t)];
+    const Vec3d* q[4] = {&coords[v[0]], &coords[v[1]], &coords[v[2]], &coords[v[3]]};
+    random ^= random << 13, random ^= random >> 17, random ^= random << 5;
+    const std::uint32_t first = random & 3;
+    std::uint32_t next = kNone;
+    for (std::uint32_t k = 0; k < 4; ++k) {
+      const std::uint32_t f = (first + k) & 3;
+      if (f == from) continue;
+      const Vec3d* saved = q[f];
+      q[f] = &p;
+      const double o = orient(*q[0], *q[1], *q[2], *q[3]);
+      q[f] = saved;
+      if (o < 0) {
+        next = tets[8 * std::size_t(t) + 4 + f];
+        break;
+      }
+    }
+    if (next == kNone) return t;
+    t = next >> 2;
+    from = next & 3;
+    if (is_ghost(t)) return t;
+  }
+}
+
+std::uint32_t Tet3Mesh::new_slot() {
+  if (!free_slots.empty()) {
+    const std::uint32_t s = free_slots.back();
+    free_slots.pop_back();
+    return s;
+  }
+  const std::uint32_t s = std::uint32_t(tets.size() / 8);
+  tets.resize(tets.size() + 8);
+  mark.push_back(0);
+  return s;
+}
+
+void Tet3Mesh::free_slot(std::uint32_t s) {
+  std::fill_n(&tets[8 * std::size_t(s)], 4, kNone);
+  free_slots.push_back(s);
+}
+
+void Tet3Mesh::make_first(std::uint32_t a, std::uint32_t b, std::uint32_t c, std::uint32_t d) {
+  tets.clear();
+  free_slots.clear();
+  mark.clear();
+  if (orient(coords[a], coords[b], coords[c], coords[d]) < 0) std::swap(a, b);
+  const std::uint32_t v[4] = {a, b, c, d};
+  for (std::uint32_t s = 0; s < 5; ++s) new_slot();
+  std::copy(v, v + 4, tets.begin());
+  // Ghost tetrahedron 1 + i behind face i: v with v[i] replaced by the ghost,
+  // then two other entries swapped (an odd permutation: the ghost's side).
+  for (int i = 0; i < 4; ++i) {
+    std::uint32_t* g = &tets[8 * std::size_t(1 + i)];
+    std::copy(v, v + 4, g);
+    g[i] = kGhost;
+    std::swap(g[(i + 1) % 4], g[(i + 2) % 4]);
+  }
+  // Link every pair of the five tetrahedra that share a face.
+  for (std::uint32_t s = 0; s < 5; ++s)
+    for (std::uint32_t f = 0; f < 4; ++f) {
+      const std::uint32_t* vs = &tets[8 * s];
+      for (std::uint32_t t = 0; t < 5; ++t) {
+        if (t == s) continue;
+        const std::uint32_t* vt = &tets[8 * t];
+        // t shares s's face f if it holds the three other vertices of s
+        int shared = 0;
+        std::uint32_t missing = 4;
+        for (std::uint32_t k = 0; k < 4; ++k) {
+          if (std::find(vs, vs + 4, vt[k]) != vs + 4 && vt[k] != vs[f])
+            ++shared;
+          else
+            missing = k;
+        }
+        if (shared == 3) tets[8 * s + 4 + f] = 4 * t + missing;
+      }
+    }
+  last = 0;
+}
+
+std::uint32_t Tet3Mesh::insert(std::uint32_t pv) {
+  const Vec3d& p = coords[pv];
+  const std::uint32_t t = walk(p, last, walk_steps, random);
+  if (!is_ghost(t))
+    for (int k = 0; k < 4; ++k) {
+      const std::uint32_t u = tets[8 * std::size_t(t) + k];
+      if (same(coords[u], p)) {
+        last = t;
+        return u;
+      }
+    }
+  // The cavity: the tetrahedra in conflict with p, depth first from t. Raw
+  // pointers: nothing below grows the arrays until the new tetrahedra.
+  const Vec3d* C = coords.data();
+  std::uint32_t* T = tets.data();
+  std::uint8_t* M = mark.data();
+  constexpr std::uint8_t in = 1, out = 2;
+  stack.clear();
+  cavity.clear();
+  boundary.clear();
+  stack.push_back(t);
+  M[t] = in;
+  while (!stack.empty()) {
+    const std::uint32_t c = stack.back();
+    stack.pop_back();
+    cavity.push_back(c);
+    const std::uint32_t* adjacent = &T[8 * std::size_t(c) + 4];
+    for (std::uint32_t f = 0; f < 4; ++f) {  // the neighbours' records and marks are the cache misses: ask early
+      __builtin_prefetch(&T[8 * std::size_t(adjacent[f] >> 2)]);
+      __builtin_prefetch(&M[adjacent[f] >> 2]);
+    }
+    for (std::uint32_t f = 0; f < 4; ++f) {
+      const std::uint32_t a = adjacent[f], n = a >> 2;
+      const std::uint8_t m = M[n];
+      if (m == in) continue;
+      if (m != out) {
+        if (conflict(C, T, n, p)) {
+          M[n] = in;
+          stack.push_back(n);
+          continue;
+        }
+        M[n] = out;
+      }
+      Boundary& b = boundary.emplace_back();
+      std::copy_n(&T[8 * std::size_t(c)], 4, b.v);
+      b.v[f] = pv;
+      b.face = f;
+      b.outer = a;
+    }
+  }
+  // Marks back to untested: the cavity's slots and the tetrahedra tested around it.
+  for (const std::uint32_t c : cavity) M[c] = 0;
+  for (const Boundary& b : boundary) M[b.outer >> 2] = 0;
+  conflicts += cavity.size();
+  // The new tetrahedra: each boundary face joined to p, in the cavity's slots first.
+  if (boundary.size() > cavity.size()) {
+    const std::size_t more = boundary.size() - cavity.size();
+    for (std::size_t k = 0; k < more; ++k) cavity.push_back(new_slot());
+    T = tets.data();
+  }
+  edges.begin(boundary.size());
+  std::uint32_t newest = kNone;
+  for (std::size_t i = 0; i < boundary.size(); ++i) {
+    const Boundary& b = boundary[i];
+    const std::uint32_t s = cavity[i];
+    std::copy_n(b.v, 4, &T[8 * std::size_t(s)]);
+    T[8 * std::size_t(s) + 4 + b.face] = b.outer;
+    T[entry(b.outer)] = 4 * s + b.face;
+    for (std::uint32_t j = 0; j < 4; ++j) {
+      if (j == b.face) continue;
+      // face j holds p and the edge of the two vertices other than b.face and j
+      const std::uint32_t u = b.v[kEdgeOf[b.face][j][0]], w = b.v[kEdgeOf[b.face][j][1]];
+      const std::uint32_t other = edges.match(u < w ? (std::uint64_t(u) << 32 | w) : (std::uint64_t(w) << 32 | u),
+                                              4 * s + j);
+      if (other != kNone) {
+        T[8 * std::size_t(s) + 4 + j] = other;
+        T[entry(other)] = 4 * s + j;
+      }
+    }
+    if (newest == kNone || ((b.v[0] | b.v[1] | b.v[2] | b.v[3]) & kGhostBit) == 0) newest = s;
+  }
+  for (std::size_t i = boundary.size(); i < cavity.size(); ++i) free_slot(cavity[i]);
+  last = newest;
+  return kNone;
+}
+
+void Tet3Mesh::EdgeTable::begin(std::size_t faces) {
+  std::size_t want = 64;
+  while (want < 4 * faces) want *= 2;
+  if (want > entries.size()) entries.assign(want, Entry{});
+  mask = want - 1;
+  if (++stamp == 0) {  // wrapped: forget every old stamp
+    for (Entry& e : entries) e.stamp = 0;
+    stamp = 1;
+  }
+}
+
+// ------------------------------------------------------------------ Delaunay3
+
+Delaunay3::Delaunay3(std::span<const Vec3d> points, Options options) : options_(options) {
+  if (points.size() >= (std::size_t(1) << 31))
+    throw Error("Delaunay3: " + std::to_string(points.size()) + " points, at most 2^31 - 1 are supported");
+  for (std::size_t i = 0; i < points.size(); ++i)
+    if (!std::isfinite(points[i][0]) || !std::isfinite(points[i][1]) || !std::isfinite(points[i][2]))
+      throw Error("Delaunay3: point " + std::to_string(i) + " has a NaN or infinite coordinate");
+  points_.assign(points.begin(), points.end());
+  build(options);
+  publish();
+}
+
+void Delaunay3::build(Options options) {
+  const std::size_t total = points_.size();
+  removed_.resize(total, 0);
+  rep_.assign(total, kNone);
+  tets_.clear();
+  free_slots_.clear();
+  walk_steps_ = conflicts_ = 0;
+  std::vector<std::uint32_t> active;
+  active.reserve(total);
+  for (std::size_t i = 0; i < total; ++i)
+    if (!removed_[i]) active.push_back(std::uint32_t(i));
+  const std::size_t n = active.size();
+  if (n == 0) {
+    dimension_ = -1;
+    return;
+  }
+  const std::vector<std::uint32_t> order = brio_order(std::span<const Vec3d>(points_), active, options.seed);
+
+  // The first tetrahedron: the earliest four affinely independent points in the order.
+  const auto at = [&](std::size_t k) -> const Vec3d& { return points_[order[k]]; };
+  std::size_t kb = 1, kc, kd;
+  while (kb < n && same(at(kb), at(0))) ++kb;
+  for (kc = kb + 1; kc < n && collinear(at(0), at(kb), at(kc)); ++kc) {
+  }
+  for (kd = kc + 1; kd < n && Tet3Mesh::orient(at(0), at(kb), at(kc), at(kd)) == 0; ++kd) {
+  }
+  dimension_ = kb >= n ? 0 : kc >= n ? 1 : kd >= n ? 2 : 3;
+  if (dimension_ < 3) {
+    // No tetrahedra: merge duplicates by sorting.
+    std::vector<std::uint32_t> sorted = active;
+    std::sort(sorted.begin(), sorted.end(), [&](std::uint32_t a, std::uint32_t b) {
+      return Tet3Mesh::lex_less(points_[a], points_[b]) || (same(points_[a], points_[b]) && a < b);
+    });
+    for (std::size_t k = 0; k < n; ++k) {
+      const std::uint32_t i = sorted[k];
+      if (k > 0 && same(points_[i], points_[sorted[k - 1]])) {
+        rep_[i] = rep_[sorted[k - 1]];
+      } else {
+        rep_[i] = i;
+      }
+    }
+    return;
+  }
+
+  // The points' coordinates in insertion order (vertex k is order[k]), with
+  // the first tetrahedron's corners first, so that insertion reads them sequentially.
+  std::vector<std::uint32_t> sequence(order);
+  std::swap(sequence[1], sequence[kb]);
+  std::swap(sequence[2], sequence[kc]);
+  std::swap(sequence[3], sequence[kd]);
+  std::vector<Vec3d> coords(n);
+  parallel_for(0, n, 1 << 14, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k) coords[k] = points_[sequence[k]];
+  });
+  Tet3Mesh mesh(coords, tets_, free_slots_);
+  tets_.reserve(8 * 7 * n + 64);
+  mesh.mark.reserve(7 * n + 16);
+  mesh.make_first(0, 1, 2, 3);
+  std::vector<std::uint32_t> merged(n, kNone);  // per vertex k: the earlier vertex at the same place
+  std::size_t duplicates = 0;
+  for (std::size_t k = 4; k < n; ++k) {
+    merged[k] = mesh.insert(std::uint32_t(k));
+    duplicates += merged[k] != kNone;
+  }
+  // From here on a vertex is the index of the point it stands for: the first
+  // occurrence among equal points.
+  std::vector<std::uint32_t> point_of(n);
+  for (std::size_t k = 0; k < n; ++k) point_of[k] = merged[k] == kNone ? sequence[k] : kNone;
+  for (std::size_t k = 0; k < n; ++k)
+    if (merged[k] != kNone) {
+      std::uint32_t& first = point_of[merged[k]];
+      first = std::min(first, sequence[k]);
+    }
+  for (std::size_t k = 0; k < n; ++k) rep_[sequence[k]] = point_of[merged[k] == kNone ? k : merged[k]];
+  (void)duplicates;
+  parallel_for(0, tets_.size() / 8, 1 << 14, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t t = begin; t < end; ++t)
+      for (int j = 0; j < 4; ++j) {
+        std::uint32_t& v = tets_[8 * t + j];
+        if ((v & Tet3Mesh::kGhostBit) == 0) v = point_of[v];
+      }
+  });
+  walk_steps_ = mesh.walk_steps;
+  conflicts_ = mesh.conflicts;
+  last_ = mesh.last;
+}
+
+std::uint32_t Delaunay3::insert(const Vec3d& p) {
+  if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
+    throw Error("Delaunay3.insert: the point has a NaN or infinite coordinate");
+  if (points_.size() + 1 >= (std::size_t(1) << 31)) throw Error("Delaunay3.insert: 2^31 - 1 points are the most");
+  const std::uint32_t i = std::uint32_t(points_.size());
+  points_.push_back(p);
+  removed_.push_back(0);
+  rep_.push_back(kNone);
+  if (dimension_ < 3) {  // the new point may lift the set to a solid: start again
+    build(options_);
+    publish();
+    return i;
+  }
+  Tet3Mesh mesh(points_, tets_, free_slots_);
+  mesh.mark.assign(tets_.size() / 8, 0);
+  mesh.last = last_;
+  const std::uint32_t existing = mesh.insert(i);
+  rep_[i] = existing == kNone ? i : existing;
+  walk_steps_ += mesh.walk_steps;
+  conflicts_ += mesh.conflicts;
+  last_ = mesh.last;
+  publish();
+  return i;
+}
+
+void Delaunay3::remove(std::uint32_t i) {
+  if (i >= points_.size() || removed_[i])
+    throw Error("Delaunay3.remove: point " + std::to_string(i) + (i >= points_.size() ? " does not exist" : " was removed"));
+  removed_[i] = 1;
+  build(options_);
+  publish();
+}
+
+void Delaunay3::publish() {
+  const std::size_t slots = tets_.size() / 8;
+  public_of_.assign(slots, kNone);
+  std::size_t count = 0;
+  for (std::size_t s = 0; s < slots; ++s) {
+    const std::uint32_t* v = &tets_[8 * s];
+    if (((v[0] | v[1] | v[2] | v[3]) & Tet3Mesh::kGhostBit) == 0) public_of_[s] = std::uint32_t(count++);
+  }
+  tetrahedra_.resize(4 * count);
+  vertex_slot_.assign(points_.size(), kNone);
+  for (std::size_t s = 0; s < slots; ++s)
+    for (int k = 0; k < 4; ++k) {
+      const std::uint32_t v = tets_[8 * s + k];
+      if ((v & Tet3Mesh::kGhostBit) == 0) vertex_slot_[v] = std::uint32_t(s);
+    }
+  parallel_for(0, slots, 1 << 14, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t s = begin; s < end; ++s) {
+      const std::uint32_t t = public_of_[s];
+      if (t == kNone) continue;
+      for (int k = 0; k < 4; ++k) {
+        tetrahedra_[4 * std::size_t(t) + k] = tets_[8 * s + k];
+      }
+    }
+  });
+}
+
+std::vector<std::uint32_t> Delaunay3::neighbors() const {
+  std::vector<std::uint32_t> out(tetrahedra_.size());
+  parallel_for(0, public_of_.size(), 1 << 14, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t s = begin; s < end; ++s) {
+      const std::uint32_t t = public_of_[s];
+      if (t == kNone) continue;
+      for (int k = 0; k < 4; ++k) out[4 * std::size_t(t) + k] = public_of_[tets_[8 * s + 4 + k] >> 2];
+    }
+  });
+  return out;
+}
+
+std::vector<Delaunay3::Triangle> Delaunay3::hull() const {
+  std::vector<Triangle> out;
+  const std::size_t slots = tets_.size() / 8;
+  for (std::size_t s = 0; s < slots; ++s) {
+    const std::uint32_t* v = &tets_[8 * s];
+    if (v[0] == kNone) continue;
+    for (int g = 0; g < 4; ++g)
+      if (v[g] == Tet3Mesh::kGhost) {
+        // The face opposite the ghost, oriented towards it (outwards of the hull).
+        const std::array<int, 3> f = Tet3Mesh::face_towards(g);
+        out.push_back({v[f[0]], v[f[1]], v[f[2]]});
+      }
+  }
+  return out;
+}
+
+std::size_t Delaunay3::duplicate_count() const {
+  std::size_t count = 0;
+  for (std::size_t i = 0; i < rep_.size(); ++i) count += rep_[i] != i && rep_[i] != kNone;
+  return count;
+}
+
+std::uint32_t Delaunay3::start_slot(std::uint32_t hint) const {
+  if (hint != kNone && hint < tetrahedron_count()) {
+    // the public index's slot: the k-th live finite slot; find it through its vertices
+    return vertex_slot_[tetrahedra_[4 * std::size_t(hint)]];
+  }
+  return last_ < tets_.size() / 8 && tets_[8 * std::size_t(last_)] != kNone ? last_ : vertex_slot_[0];
+}
+
+std::uint32_t Delaunay3::locate(const Vec3d& q, std::uint32_t hint) const {
+  if (dimension_ < 3) return kNone;
+  if (!std::isfinite(q[0]) || !std::isfinite(q[1]) || !std::isfinite(q[2]))
+    throw Error("Delaunay3.locate: the query has a NaN or infinite coordinate");
+  Tet3Mesh mesh(const_cast<std::vector<Vec3d>&>(points_), const_cast<std::vector<std::uint32_t>&>(tets_),
+                const_cast<std::vector<std::uint32_t>&>(free_slots_));
+  std::size_t steps = 0;
+  std::uint32_t random = 2463534242u;
+  const std::uint32_t t = mesh.walk(q, start_slot(hint), steps, random);
+  return mesh.is_ghost(t) ? kNone : public_of_[t];
+}
+
+std::vector<std::uint32_t> Delaunay3::vertex_neighbors(std::uint32_t point) const {
+  std::vector<std::uint32_t> out;
+  if (point >= rep_.size() || rep_[point] != point) return out;
+  const std::uint32_t v = point;
+  if (dimension_ < 3) return out;
+  // The star of v: the slots around it, breadth first across the faces that hold v.
+  std::vector<std::uint32_t> stack = {vertex_slot_[v]}, seen = stack;
+  while (!stack.empty()) {
+    const std::uint32_t t = stack.back();
+    stack.pop_back();
+    for (int k = 0; k < 4; ++k) {
+      const std::uint32_t u = tets_[8 * std::size_t(t) + k];
+      if (u == v) continue;
+      if ((u & Tet3Mesh::kGhostBit) == 0) out.push_back(u);
+      const std::uint32_t n = tets_[8 * std::size_t(t) + 4 + k] >> 2;  // across the face opposite u: holds v
+      if (std::find(seen.begin(), seen.end(), n) == seen.end()) {
+        seen.push_back(n);
+        stack.push_back(n);
+      }
+    }
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+std::uint32_t Delaunay3::nearest_vertex(const Vec3d& q) const {
+  if (!std::isfinite(q[0]) || !std::isfinite(q[1]) || !std::isfinite(q[2]))
+    throw Error("Delaunay3.nearest_vertex: the query has a NaN or infinite coordinate");
+  if (dimension_ < 0) return kNone;
+  const auto distance = [&](std::uint32_t v) { return (points_[v] - q).squaredNorm(); };
+  std::uint32_t best = kNone;
+  if (dimension_ < 3) {
+    for (std::uint32_t v = 0; v < points_.size(); ++v)
+      if (rep_[v] == v && (best == kNone || distance(v) < distance(best))) best = v;
+    return best;
+  }
+  Tet3Mesh mesh(const_cast<std::vector<Vec3d>&>(points_), const_cast<std::vector<std::uint32_t>&>(tets_),
+                const_cast<std::vector<std::uint32_t>&>(free_slots_));
+  std::size_t steps = 0;
+  std::uint32_t random = 2463534242u;
+  const std::uint32_t t = mesh.walk(q, start_slot(kNone), steps, random);
+  best = kNone;
+  for (int k = 0; k < 4; ++k) {
+    const std::uint32_t u = tets_[8 * std::size_t(t) + k];
+    if ((u & Tet3Mesh::kGhostBit) == 0 && (best == kNone || distance(u) < distance(best))) best = u;
+  }
+  // Greedy descent: a vertex none of whose Delaunay neighbours is closer is the nearest.
+  for (bool moved = true; moved;) {
+    moved = false;
+    for (const std::uint32_t u : vertex_neighbors(best)) {
+      if (distance(u) < distance(best)) {
+        best = u;
+        moved = true;
+      }
+    }
+  }
+  return best;
+}
+
+Delaunay3Stats Delaunay3::stats() const {
+  Delaunay3Stats s;
+  s.points = points_.size();
+  s.duplicates = duplicate_count();
+  s.removed = std::size_t(std::count(removed_.begin(), removed_.end(), 1));
+  s.vertices = s.points - s.duplicates - s.removed;
+  s.tetrahedra = tetrahedron_count();
+  for (std::size_t k = 0; k < tets_.size(); k += 8)
+    s.hull_triangles += std::count(&tets_[k], &tets_[k] + 4, Tet3Mesh::kGhost);
+  s.dimension = dimension_ < 0 ? 0 : std::size_t(dimension_);
+  s.walk_steps = walk_steps_;
+  s.conflicts = conflicts_;
+  const auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
+  s.bytes = bytes(points_) + bytes(rep_) +
+            bytes(tets_) + bytes(removed_) + bytes(vertex_slot_) + bytes(free_slots_) + bytes(tetrahedra_) + bytes(public_of_);
+  return s;
+}
+
+void Delaunay3::validate() const {
+  const std::size_t n = points_.size();
+  if (rep_.size() != n || removed_.size() != n) throw Error("Delaunay3: per-point arrays of the wrong size");
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint32_t r = rep_[i];
+    if (removed_[i]) {
+      if (r != kNone) throw Error("Delaunay3: removed point " + std::to_string(i) + " has a vertex");
+      continue;
+    }
+    if (r > i || rep_[r] != r || removed_[r] || !same(points_[r], points_[i]))
+      throw Error("Delaunay3: point " + std::to_string(i) + " has a bad representative");
+  }
+  if (dimension_ < 3) {
+    if (!tetrahedra_.empty()) throw Error("Delaunay3: a lower-dimensional set has tetrahedra");
+    return;
+  }
+  const std::size_t slots = tets_.size() / 8;
+  if (tets_.size() % 8) throw Error("Delaunay3: tetrahedron array of the wrong size");
+  Tet3Mesh mesh(const_cast<std::vector<Vec3d>&>(points_), const_cast<std::vector<std::uint32_t>&>(tets_),
+                const_cast<std::vector<std::uint32_t>&>(free_slots_));
+  const std::size_t vertex_count = n;
+  std::vector<std::uint8_t> used(vertex_count, 0);
+  constexpr std::size_t kBlock = 1 << 14;
+  const std::size_t blocks = (slots + kBlock - 1) / kBlock;
+  std::vector<std::optional<Error>> errors(blocks);
+  std::vector<std::size_t> finite(blocks, 0);
+  parallel_for_each_index(
+      0, blocks,
+      [&](std::size_t block) {
+        try {
+          for (std::size_t s = block * kBlock; s < std::min(slots, (block + 1) * kBlock); ++s) {
+            const std::uint32_t* v = &tets_[8 * s];
+            if (v[0] == kNone) continue;
+            int ghosts = 0;
+            for (int k = 0; k < 4; ++k) {
+              if (v[k] == Tet3Mesh::kGhost)
+                ++ghosts;
+              else if (v[k] >= vertex_count || rep_[v[k]] != v[k])
+                throw Error("Delaunay3: " + tet_name(std::uint32_t(s)) + " has a vertex that is not a representative");
+              else
+                used[v[k]] = 1;  // benign race: every writer stores 1
+            }
+            if (ghosts > 1) throw Error("Delaunay3: " + tet_name(std::uint32_t(s)) + " has two ghost vertices");
+            for (std::uint32_t f = 0; f < 4; ++f) {
+              const std::uint32_t a = tets_[8 * s + 4 + f];
+              if ((a >> 2) >= slots || tets_[8 * std::size_t(a >> 2)] == kNone || tets_[Tet3Mesh::entry(a)] != 4 * s + f)
+                throw Error("Delaunay3: " + tet_name(std::uint32_t(s)) + " face " + std::to_string(f) +
+                            ": neighbour not mutual");
+              for (std::uint32_t k = 0; k < 4; ++k) {
+                if (k == f) continue;
+                const std::uint32_t* w = &tets_[8 * std::size_t(a >> 2)];
+                if (std::find(w, w + 4, v[k]) == w + 4 || w[a & 3] == v[k])
+                  throw Error("Delaunay3: " + tet_name(std::uint32_t(s)) + " face " + std::to_string(f) +
+                              ": neighbour does not share the face");
+              }
+              const std::uint32_t opposite = tets_[Tet3Mesh::opposite(a)];
+              if (opposite == Tet3Mesh::kGhost) continue;
+              const Vec3d& p = points_[opposite];
+              if (ghosts == 0) {
+                const double s_exact = mesh.in_sphere(points_[v[0]], points_[v[1]], points_[v[2]], points_[v[3]], p);
+                if (s_exact > 0)
+                  throw Error("Delaunay3: " + tet_name(std::uint32_t(s)) +
+                              ": the opposite vertex of a neighbour is inside its circumsphere");
+              }
+              if (mesh.in_conflict(std::uint32_t(s), p))
+                throw Error("Delaunay3: " + tet_name(std::uint32_t(s)) + " face " + std::to_string(f) +
+                            (ghosts ? ": the hull is not convex there" : ": not Delaunay after the perturbation"));
+            }
+            if (ghosts == 0) {
+              if (Tet3Mesh::orient(points_[v[0]], points_[v[1]], points_[v[2]], points_[v[3]]) <= 0)
+                throw Error("Delaunay3: " + tet_name(std::uint32_t(s)) + " is not positively oriented");
+              ++finite[block];
+            }
+          }
+        } catch (const Error& e) {
+          errors[block] = e;
+        }
+      },
+      1);
+  std::size_t total = 0;
+  for (std::size_t b = 0; b < blocks; ++b) {
+    if (errors[b]) throw *errors[b];
+    total += finite[b];
+  }
+  for (std::size_t u = 0; u < vertex_count; ++u)
+    if (!used[u] && rep_[u] == u) throw Error("Delaunay3: point " + std::to_string(u) + " is in no tetrahedron");
+  if (total != tetrahedron_count()) throw Error("Delaunay3: the public tetrahedra are not the finite ones");
+  for (std::size_t s = 0; s < slots; ++s) {
+    const std::uint32_t t = public_of_[s];
+    if (t == kNone) continue;
+    for (int k = 0; k < 4; ++k)
+      if (tetrahedra_[4 * std::size_t(t) + k] != tets_[8 * s + k])
+        throw Error("Delaunay3: public tetrahedron " + std::to_string(t) + " differs from its slot");
+  }
+}
+
+}  // namespace geods::voronoi

@@ -1,0 +1,133 @@
+#pragma once
+// The closed tetrahedralization that Delaunay3 builds and queries: flat arrays
+// over internal vertices, a ghost vertex on the far side of every hull face,
+// and the steps of Bowyer-Watson insertion (walk, cavity, star). The arrays
+// belong to the Delaunay3; a Tet3Mesh works on them by reference.
+//
+// Slot t holds tets[8t .. 8t+3], its vertices, and tets[8t+4 .. 8t+7], its
+// adjacencies, side by side in one cache line: adjacency 4u + g means
+// neighbour u, where this face is u's face g (opposite u's vertex g). Tetrahedra are positively oriented (orient() > 0); a ghost tetrahedron
+// is oriented as if its ghost were a point beyond its hull face.
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "geods/core/predicates.hpp"
+#include "geods/core/vec.hpp"
+
+namespace geods::voronoi {
+
+struct Tet3Mesh {
+  static constexpr std::uint32_t kNone = std::uint32_t(-1);    // a free slot's vertices
+  static constexpr std::uint32_t kGhost = std::uint32_t(-2);   // the vertex at infinity
+  static constexpr std::uint32_t kGhostBit = 1u << 31;         // set in kGhost and kNone, never in a vertex
+
+  Tet3Mesh(std::vector<Vec3d>& c, std::vector<std::uint32_t>& t, std::vector<std::uint32_t>& f)
+      : coords(c), tets(t), free_slots(f) {}
+
+  std::vector<Vec3d>& coords;
+  std::vector<std::uint32_t>& tets;
+  std::vector<std::uint32_t>& free_slots;
+  std::vector<std::uint8_t> mark;  // per slot, during an insertion: 1 in the cavity, 2 tested and not; else 0
+  std::uint32_t last = 0;  // where the next walk starts
+  std::uint32_t random = 2463534242u;
+  std::size_t walk_steps = 0, conflicts = 0;
+
+  /// det(b - a, c - a, d - a): > 0 for a positively oriented tetrahedron (exact sign).
+  static double orient(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& d) {
+    return -orient3d(a.data(), b.data(), c.data(), d.data());
+  }
+  /// For a positive (a, b, c, d): > 0 if e is inside their sphere, < 0 outside, 0 on it (exact sign).
+  static double in_sphere(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& d, const Vec3d& e) {
+    return -insphere(a.data(), b.data(), c.data(), d.data(), e.data());
+  }
+  static bool lex_less(const Vec3d& a, const Vec3d& b) {
+    if (a[0] != b[0]) return a[0] < b[0];
+    if (a[1] != b[1]) return a[1] < b[1];
+    return a[2] < b[2];
+  }
+  /// The perturbed in-sphere test for in_sphere(q...) == 0, p distinct from the q's.
+  static bool perturbed_inside(const Vec3d* const q[4], const Vec3d& p);
+  /// The face opposite vertex i, as indices into the tetrahedron, counter-clockwise
+  /// seen from vertex i's side.
+  static std::array<int, 3> face_towards(int i) {
+    return i % 2 == 0 ? std::array<int, 3>{(i + 1) % 4, (i + 3) % 4, (i + 2) % 4}
+                      : std::array<int, 3>{(i + 1) % 4, (i + 2) % 4, (i + 3) % 4};
+  }
+
+  bool is_ghost(std::uint32_t t) const {
+    const std::uint32_t* v = &tets[8 * std::size_t(t)];
+    return ((v[0] | v[1] | v[2] | v[3]) & kGhostBit) != 0;
+  }
+  int ghost_index(std::uint32_t t) const {
+    const std::uint32_t* v = &tets[8 * std::size_t(t)];
+    for (int k = 0; k < 4; ++k)
+      if (v[k] == kGhost) return k;
+    return -1;
+  }
+  /// p inside the (perturbed) circumsphere of t; for a ghost t: p beyond its
+  /// hull face, or on its plane and in conflict with the tetrahedron behind it.
+  bool in_conflict(std::uint32_t t, const Vec3d& p) const {
+    return conflict(coords.data(), tets.data(), t, p);
+  }
+  /// The same over raw arrays (the insertion's hot loop).
+  static bool conflict(const Vec3d* C, const std::uint32_t* T, std::uint32_t t, const Vec3d& p) {
+    const std::uint32_t* v = &T[8 * std::size_t(t)];
+    if (((v[0] | v[1] | v[2] | v[3]) & kGhostBit) == 0) [[likely]] {
+      const double s = in_sphere(C[v[0]], C[v[1]], C[v[2]], C[v[3]], p);
+      if (s != 0) [[likely]]
+        return s > 0;
+      const Vec3d* q[4] = {&C[v[0]], &C[v[1]], &C[v[2]], &C[v[3]]};
+      return perturbed_inside(q, p);
+    }
+    return ghost_conflict(C, T, t, p);
+  }
+  /// conflict() for a ghost tetrahedron.
+  static bool ghost_conflict(const Vec3d* C, const std::uint32_t* T, std::uint32_t t, const Vec3d& p);
+  /// Where adjacency a = 4u + g is stored (u's face g), and u's vertex g opposite it.
+  static std::size_t entry(std::uint32_t a) { return 8 * std::size_t(a >> 2) + 4 + (a & 3); }
+  static std::size_t opposite(std::uint32_t a) { return 8 * std::size_t(a >> 2) + (a & 3); }
+  /// The tetrahedron whose closed volume holds p, or a ghost one whose hull
+  /// face p lies strictly beyond: a stochastic visibility walk from t.
+  std::uint32_t walk(const Vec3d& p, std::uint32_t t, std::size_t& steps, std::uint32_t& random) const;
+
+  /// The first tetrahedron of four vertices (not coplanar) and its four ghosts.
+  void make_first(std::uint32_t a, std::uint32_t b, std::uint32_t c, std::uint32_t d);
+  /// Inserts vertex pv (coords[pv] set): kNone, or the vertex at the same place (nothing changes).
+  std::uint32_t insert(std::uint32_t pv);
+  std::uint32_t new_slot();
+  void free_slot(std::uint32_t s);
+
+  struct Boundary {
+    std::uint32_t v[4];  // the new tetrahedron: the cavity one with p in place of the vertex facing out
+    std::uint32_t face;  // its face on the cavity's boundary
+    std::uint32_t outer;  // the adjacency across it
+  };
+  /// The faces of the new tetrahedra around p, matched by their edge opposite p.
+  struct EdgeTable {
+    struct Entry {
+      std::uint64_t key = 0;
+      std::uint32_t value = 0, stamp = 0;  // stamp == the table's: occupied
+    };
+    std::vector<Entry> entries;
+    std::size_t mask = 0;
+    std::uint32_t stamp = 0;
+    void begin(std::size_t faces);
+    /// The value stored with key, or kNone after storing `value` with it.
+    std::uint32_t match(std::uint64_t key, std::uint32_t value) {
+      for (std::size_t h = std::size_t((key * 0x9E3779B97F4A7C15ull) >> 40) & mask;; h = (h + 1) & mask) {
+        Entry& e = entries[h];
+        if (e.stamp != stamp) {
+          e = {key, value, stamp};
+          return kNone;
+        }
+        if (e.key == key) return e.value;  // each edge is shared by exactly two new tetrahedra
+      }
+    }
+  };
+  std::vector<std::uint32_t> stack, cavity;
+  std::vector<Boundary> boundary;
+  EdgeTable edges;
+};
+
+}  // namespace geods::voronoi

@@ -1,0 +1,205 @@
+// Voronoi3: each cell is the box clipped by the bisectors of its site and the
+// site's Delaunay neighbours (Sutherland-Hodgman on every face, the cut closed
+// by a cap polygon ordered around its centre).
+#include "geods/voronoi/voronoi3.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "geods/core/error.hpp"
+#include "geods/core/parallel.hpp"
+
+namespace geods::voronoi {
+namespace {
+
+struct Face {
+  std::vector<Vec3d> loop;  // counter-clockwise seen from outside
+  std::uint32_t label;
+};
+
+// Keeps the part of the convex polyhedron where normal . x <= offset; the cut
+// becomes a face labelled `label`. `tolerance` merges cut points closer than it.
+void clip(std::vector<Face>& faces, const Vec3d& normal, double offset, std::uint32_t label, double tolerance) {
+  std::vector<Vec3d> cut;
+  std::vector<Face> kept;
+  kept.reserve(faces.size() + 1);
+  bool any_outside = false;
+  for (Face& face : faces) {
+    const std::size_t m = face.loop.size();
+    std::vector<double> side(m);
+    bool inside = false, outside = false;
+    for (std::size_t k = 0; k < m; ++k) {
+      side[k] = normal.dot(face.loop[k]) - offset;
+      inside |= side[k] <= 0;
+      outside |= side[k] > 0;
+    }
+    any_outside |= outside;
+    if (!outside) {
+      for (std::size_t k = 0; k < m; ++k)
+        if (side[k] == 0) cut.push_back(face.loop[k]);
+      kept.push_back(std::move(face));
+      continue;
+    }
+    if (!inside) continue;
+    Face out{{}, face.label};
+    for (std::size_t k = 0; k < m; ++k) {
+      const Vec3d& a = face.loop[k];
+      const Vec3d& b = face.loop[(k + 1) % m];
+      const double sa = side[k], sb = side[(k + 1) % m];
+      if (sa <= 0) out.loop.push_back(a);
+      if (sa == 0) cut.push_back(a);
+      if ((sa < 0 && sb > 0) || (sa > 0 && sb < 0)) {
+        // computed from the lexicographically smaller end, so that the two faces of the edge agree bit for bit
+        const bool forward = std::lexicographical_compare(a.data(), a.data() + 3, b.data(), b.data() + 3);
+        const Vec3d x = forward ? Vec3d(a + (b - a) * (sa / (sa - sb))) : Vec3d(b + (a - b) * (sb / (sb - sa)));
+        out.loop.push_back(x);
+        cut.push_back(x);
+      }
+    }
+    if (out.loop.size() >= 3) kept.push_back(std::move(out));
+  }
+  faces.swap(kept);
+  if (!any_outside || faces.empty()) return;
+  // The cap: the cut points, merged and ordered counter-clockwise around the outward normal.
+  Vec3d centre = Vec3d::Zero();
+  for (const Vec3d& x : cut) centre += x;
+  centre /= double(cut.size());
+  const Vec3d n = normal.normalized();
+  const Vec3d u = (std::abs(n[0]) < 0.9 ? Vec3d(1, 0, 0) : Vec3d(0, 1, 0)).cross(n).normalized();
+  const Vec3d v = n.cross(u);
+  std::vector<std::pair<double, Vec3d>> around;
+  for (const Vec3d& x : cut) around.push_back({std::atan2((x - centre).dot(v), (x - centre).dot(u)), x});
+  std::sort(around.begin(), around.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  Face cap{{}, label};
+  for (const auto& [angle, x] : around)
+    if (cap.loop.empty() || (x - cap.loop.back()).norm() > tolerance) cap.loop.push_back(x);
+  while (cap.loop.size() > 1 && (cap.loop.front() - cap.loop.back()).norm() <= tolerance) cap.loop.pop_back();
+  if (cap.loop.size() >= 3) faces.push_back(std::move(cap));
+}
+
+Voronoi3Cell make_cell(std::uint32_t site, const std::vector<Face>& faces, double tolerance) {
+  Voronoi3Cell cell;
+  cell.site = site;
+  cell.face_offsets.push_back(0);
+  for (const Face& face : faces) {
+    for (const Vec3d& x : face.loop) {
+      // the corners shared by faces: equal, or within rounding of each other
+      auto it = std::find_if(cell.vertices.begin(), cell.vertices.end(),
+                             [&](const Vec3d& y) { return (x - y).norm() <= tolerance; });
+      if (it == cell.vertices.end()) {
+        cell.vertices.push_back(x);
+        it = cell.vertices.end() - 1;
+      }
+      cell.face_vertices.push_back(std::uint32_t(it - cell.vertices.begin()));
+    }
+    cell.face_offsets.push_back(std::uint32_t(cell.face_vertices.size()));
+    cell.face_neighbors.push_back(face.label);
+  }
+  if (faces.empty()) return cell;
+  // Volume and centroid: tetrahedra from a point inside to the fan of each face.
+  Vec3d reference = Vec3d::Zero();
+  for (const Vec3d& x : cell.vertices) reference += x;
+  reference /= double(cell.vertices.size());
+  Vec3d moment = Vec3d::Zero();
+  for (const Face& face : faces)
+    for (std::size_t k = 1; k + 1 < face.loop.size(); ++k) {
+      const Vec3d a = face.loop[0] - reference, b = face.loop[k] - reference, c = face.loop[k + 1] - reference;
+      const double v = a.dot(b.cross(c)) / 6;
+      cell.volume += v;
+      moment += v * (a + b + c) / 4;
+    }
+  cell.centroid = cell.volume > 0 ? Vec3d(reference + moment / cell.volume) : reference;
+  return cell;
+}
+
+}  // namespace
+
+Voronoi3::Voronoi3(const Delaunay3& dt, const AABB3d& box) : box_(box) {
+  for (int a = 0; a < 3; ++a)
+    if (!std::isfinite(box.lo[a]) || !std::isfinite(box.hi[a]) || !(box.lo[a] < box.hi[a]) ||
+        !std::isfinite(box.hi[a] - box.lo[a]))
+      throw Error("Voronoi3: the box must have finite corners with lo < hi on every axis");
+  const auto points = dt.points();
+  std::vector<std::uint32_t> sites;
+  for (std::uint32_t i = 0; i < points.size(); ++i)
+    if (dt.representative(i) == i) sites.push_back(i);
+  const double size = (box.hi - box.lo).norm();
+  const double tolerance = 1e-12 * size;
+  std::vector<Face> initial;
+  const Vec3d& lo = box.lo;
+  const Vec3d& hi = box.hi;
+  const Vec3d c[8] = {{lo[0], lo[1], lo[2]}, {hi[0], lo[1], lo[2]}, {lo[0], hi[1], lo[2]}, {hi[0], hi[1], lo[2]},
+                      {lo[0], lo[1], hi[2]}, {hi[0], lo[1], hi[2]}, {lo[0], hi[1], hi[2]}, {hi[0], hi[1], hi[2]}};
+  initial.push_back({{c[0], c[4], c[6], c[2]}, box_side(0)});
+  initial.push_back({{c[1], c[3], c[7], c[5]}, box_side(1)});
+  initial.push_back({{c[0], c[1], c[5], c[4]}, box_side(2)});
+  initial.push_back({{c[2], c[6], c[7], c[3]}, box_side(3)});
+  initial.push_back({{c[0], c[2], c[3], c[1]}, box_side(4)});
+  initial.push_back({{c[4], c[5], c[7], c[6]}, box_side(5)});
+  cells_.resize(sites.size());
+  parallel_for_each_index(
+      0, sites.size(),
+      [&](std::size_t k) {
+        const std::uint32_t s = sites[k];
+        std::vector<std::uint32_t> neighbors = dt.vertex_neighbors(s);
+        if (dt.dimension() < 3) neighbors.assign(sites.begin(), sites.end());
+        // Nearest neighbours first: their bisectors cut the most, the later ones less.
+        const Vec3d& p = points[s];
+        std::sort(neighbors.begin(), neighbors.end(), [&](std::uint32_t a, std::uint32_t b) {
+          return (points[a] - p).squaredNorm() < (points[b] - p).squaredNorm() ||
+                 ((points[a] - p).squaredNorm() == (points[b] - p).squaredNorm() && a < b);
+        });
+        std::vector<Face> faces = initial;
+        for (const std::uint32_t w : neighbors) {
+          if (w == s) continue;
+          const Vec3d normal = points[w] - p;
+          clip(faces, normal, normal.dot((points[w] + p) * 0.5), w, tolerance);
+          if (faces.empty()) break;
+        }
+        cells_[k] = make_cell(s, faces, tolerance);
+      },
+      16);
+}
+
+double Voronoi3::volume_total() const {
+  double total = 0;
+  for (const Voronoi3Cell& cell : cells_) total += cell.volume;
+  return total;
+}
+
+Voronoi3Stats Voronoi3::stats() const {
+  Voronoi3Stats s;
+  s.sites = cells_.size();
+  s.bytes = cells_.capacity() * sizeof(Voronoi3Cell);
+  for (const Voronoi3Cell& cell : cells_) {
+    s.faces += cell.face_count();
+    s.vertices += cell.vertices.size();
+    s.empty += cell.face_count() == 0;
+    s.bytes += cell.vertices.capacity() * sizeof(Vec3d) +
+               (cell.face_offsets.capacity() + cell.face_vertices.capacity() + cell.face_neighbors.capacity()) *
+                   sizeof(std::uint32_t);
+  }
+  return s;
+}
+
+TriMesh Voronoi3::mesh(double explode, std::vector<std::uint32_t>* cell_of_triangle) const {
+  TriMesh out;
+  const Vec3d centre = (box_.lo + box_.hi) * 0.5;
+  if (cell_of_triangle) cell_of_triangle->clear();
+  for (std::uint32_t c = 0; c < cells_.size(); ++c) {
+    const Voronoi3Cell& cell = cells_[c];
+    const Vec3d shift = (cell.centroid - centre) * explode;
+    const std::uint32_t base = std::uint32_t(out.vertices.size());
+    for (const Vec3d& x : cell.vertices) out.vertices.push_back((x + shift).cast<float>());
+    for (std::size_t f = 0; f < cell.face_count(); ++f)
+      for (std::uint32_t k = cell.face_offsets[f] + 1; k + 1 < cell.face_offsets[f + 1]; ++k) {
+        out.triangles.push_back({base + cell.face_vertices[cell.face_offsets[f]], base + cell.face_vertices[k],
+                                 base + cell.face_vertices[k + 1]});
+        if (cell_of_triangle) cell_of_triangle->push_back(c);
+      }
+  }
+  return out;
+}
+
+}  // namespace geods::voronoi

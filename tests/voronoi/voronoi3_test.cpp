@@ -1,0 +1,106 @@
+// Voronoi3 against brute force: the cells' volumes add up to the box, every
+// sampled point of the box lies in the cell of its nearest site (found by a
+// scan of all sites), centroids lie in their cells.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "geods/core/error.hpp"
+#include "geods/core/rng.hpp"
+#include "geods/voronoi/voronoi3.hpp"
+
+namespace geods::voronoi {
+namespace {
+
+// q inside the closed cell: on the inner side of every face's plane (its outward
+// normal from the loop), within `slack`.
+bool in_cell(const Voronoi3Cell& cell, const Vec3d& q, double slack) {
+  for (std::size_t f = 0; f < cell.face_count(); ++f) {
+    const std::uint32_t* loop = &cell.face_vertices[cell.face_offsets[f]];
+    const std::size_t m = cell.face_offsets[f + 1] - cell.face_offsets[f];
+    Vec3d normal = Vec3d::Zero();
+    for (std::size_t k = 0; k < m; ++k) normal += cell.vertices[loop[k]].cross(cell.vertices[loop[(k + 1) % m]]);
+    if (normal.normalized().dot(q - cell.vertices[loop[0]]) > slack) return false;
+  }
+  return cell.face_count() > 0;
+}
+
+void check_partition(const std::vector<Vec3d>& sites, const AABB3d& box, std::uint64_t seed) {
+  const Voronoi3 vd(sites, box);
+  const double box_volume = (box.hi - box.lo).prod();
+  EXPECT_NEAR(vd.volume_total(), box_volume, 1e-9 * box_volume);
+  Rng rng(seed);
+  const double slack = 1e-9 * (box.hi - box.lo).norm();
+  for (int k = 0; k < 300; ++k) {
+    const Vec3d q(rng.uniform(box.lo[0], box.hi[0]), rng.uniform(box.lo[1], box.hi[1]),
+                  rng.uniform(box.lo[2], box.hi[2]));
+    std::size_t best = 0;
+    for (std::size_t c = 1; c < vd.cells().size(); ++c)
+      if ((sites[vd.cells()[c].site] - q).squaredNorm() < (sites[vd.cells()[best].site] - q).squaredNorm()) best = c;
+    EXPECT_TRUE(in_cell(vd.cells()[best], q, slack)) << "sample " << k << " nearest site " << vd.cells()[best].site;
+  }
+  for (const Voronoi3Cell& cell : vd.cells()) {
+    if (cell.face_count() == 0) {
+      EXPECT_EQ(cell.volume, 0);
+      continue;
+    }
+    EXPECT_GT(cell.volume, 0);
+    EXPECT_TRUE(in_cell(cell, cell.centroid, slack));
+    // Closed: every edge is used by exactly two faces, once in each direction.
+    std::size_t directed = 0, matched = 0;
+    for (std::size_t f = 0; f < cell.face_count(); ++f) {
+      const std::size_t m = cell.face_offsets[f + 1] - cell.face_offsets[f];
+      for (std::size_t e = 0; e < m; ++e) {
+        const std::uint32_t a = cell.face_vertices[cell.face_offsets[f] + e];
+        const std::uint32_t b = cell.face_vertices[cell.face_offsets[f] + (e + 1) % m];
+        ++directed;
+        for (std::size_t g = 0; g < cell.face_count(); ++g) {
+          const std::size_t n = cell.face_offsets[g + 1] - cell.face_offsets[g];
+          for (std::size_t h = 0; h < n; ++h)
+            matched += cell.face_vertices[cell.face_offsets[g] + h] == b &&
+                       cell.face_vertices[cell.face_offsets[g] + (h + 1) % n] == a;
+        }
+      }
+    }
+    EXPECT_EQ(directed, matched) << "cell of site " << cell.site;
+  }
+}
+
+TEST(Voronoi3, CellsPartitionTheBoxAndHoldTheirNearestPoints) {
+  Rng rng(3);
+  std::vector<Vec3d> uniform;
+  for (int i = 0; i < 300; ++i) uniform.emplace_back(rng.uniform(), rng.uniform(), rng.uniform());
+  check_partition(uniform, AABB3d(Vec3d(0, 0, 0), Vec3d(1, 1, 1)), 1);
+  // Sites outside the box still own parts of it.
+  check_partition(uniform, AABB3d(Vec3d(0.2, -0.5, 0.3), Vec3d(0.7, 0.5, 1.5)), 2);
+  // A lattice with duplicates: cubes of equal volume.
+  std::vector<Vec3d> lattice;
+  for (int x = 0; x < 4; ++x)
+    for (int y = 0; y < 4; ++y)
+      for (int z = 0; z < 4; ++z) lattice.emplace_back(x + 0.5, y + 0.5, z + 0.5);
+  lattice.push_back(lattice[5]);
+  const AABB3d cube(Vec3d(0, 0, 0), Vec3d(4, 4, 4));
+  check_partition(lattice, cube, 3);
+  const Voronoi3 vd(lattice, cube);
+  EXPECT_EQ(vd.cells().size(), 64u);
+  for (const Voronoi3Cell& cell : vd.cells()) {
+    EXPECT_NEAR(cell.volume, 1.0, 1e-12);
+    EXPECT_NEAR((cell.centroid - lattice[cell.site]).norm(), 0.0, 1e-12);
+    EXPECT_EQ(cell.face_count(), 6u);
+  }
+}
+
+TEST(Voronoi3, LowerDimensionalSitesAndBadBoxes) {
+  // Coplanar sites (no tetrahedra): slabs and prisms still partition the box.
+  const std::vector<Vec3d> plane = {{0.1, 0.2, 0.5}, {0.8, 0.3, 0.5}, {0.4, 0.9, 0.5}, {0.5, 0.5, 0.5}};
+  check_partition(plane, AABB3d(Vec3d(0, 0, 0), Vec3d(1, 1, 1)), 4);
+  const std::vector<Vec3d> one = {{0.3, 0.3, 0.3}};
+  const Voronoi3 single(one, AABB3d(Vec3d(0, 0, 0), Vec3d(1, 2, 3)));
+  EXPECT_NEAR(single.volume_total(), 6.0, 1e-12);
+  EXPECT_THROW(Voronoi3(one, AABB3d(Vec3d(0, 0, 0), Vec3d(1, 0, 1))), Error);
+  EXPECT_THROW(Voronoi3(one, AABB3d(Vec3d(0, 0, 0), Vec3d(1, NAN, 1))), Error);
+}
+
+}  // namespace
+}  // namespace geods::voronoi
