@@ -324,6 +324,10 @@ def test_library_messages_print_short_numbers():
     mask = np.ones((3, 3), dtype=bool)
     with pytest.raises(ValueError, match=r"spacing 1e-300 along x"):   # was "0.000000"
         geods.edt(mask, spacing=(1e-300, 1))
+    tree = geods.DynamicKdTree(dim=2)
+    tree.insert([0.0, 0.0])
+    with pytest.raises(ValueError, match=r"got -1e\+300$"):            # was 301 digits
+        tree.query_radius([0.0, 0.0], -1e300)
 
 
 def test_knn_and_nearest_never_write_npy_bytes_under_another_name(cli, points_and_boxes):

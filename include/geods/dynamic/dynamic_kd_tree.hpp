@@ -361,7 +361,7 @@ class DynamicKdTree {
   /// Every stored point within distance r of q (inclusive), sorted like query.
   std::vector<Neighbor> query_radius(std::span<const T> q, double r) const {
     check_point(q, "query point");
-    if (!(r >= 0)) throw Error("DynamicKdTree::query_radius: radius must be >= 0, got " + std::to_string(r));
+    if (!(r >= 0)) throw Error("DynamicKdTree::query_radius: radius must be >= 0, got " + format_number(r));
     const T r2 = spatial::squared_limit<T>(r);
     std::vector<Neighbor> out;
     tree_.for_each([&](const Block& block, std::span<const Id> ids) {
