@@ -7,7 +7,6 @@
 #include <optional>
 
 #include "command.hpp"
-#include "geods/io/npy.hpp"
 #include "geods/io/table_io.hpp"
 #include "geods/spatial/stats_fields.hpp"
 #include "kd_tree_cli.hpp"
@@ -26,11 +25,12 @@ class KnnCommand : public Command {
   void add_options(CLI::App& app) override {
     input_.add_options(app);
     app.add_option("--queries", queries_, "Query points, m x d")->required();
-    app.add_option("--k", k_, "Neighbours per query")->required()->check(CLI::PositiveNumber);
+    app.add_option("--k", k_, "Neighbours per query")->required()->check(at_least(1));
     app.add_option("--radius", radius_, "Only neighbours within this distance (fewer than k: index -1, distance inf)");
     app.add_option("--eps", eps_, "Approximation: distances within (1 + eps) of the true ones (default 0: exact)");
-    app.add_option("--indices", indices_, "Output: int64 m x k neighbour indices, -1 where missing");
-    app.add_option("--distances", distances_, "Output: float64 m x k Euclidean distances, ascending, inf where missing");
+    add_output(app, "--indices", indices_, "Output: int64 m x k neighbour indices, -1 where missing", io::OutputKind::table);
+    add_output(app, "--distances", distances_, "Output: float64 m x k Euclidean distances, ascending, inf where missing",
+               io::OutputKind::table);
   }
 
   void run(const RunContext&, Report& report) override {
@@ -72,8 +72,8 @@ class KnnCommand : public Command {
       found += !missing;
     }
     const std::vector<std::size_t> shape = {queries.rows, k_};
-    if (!indices_.empty()) io::write_npy<std::int64_t>(indices_, indices, shape);
-    if (!distances_.empty()) io::write_npy<double>(distances_, distances, shape);
+    if (!indices_.empty()) io::write_table(indices_, std::span<const std::int64_t>(indices), shape);
+    if (!distances_.empty()) io::write_table(distances_, std::span<const double>(distances), shape);
 
     Json& j = report.json;
     j["points"] = n;

@@ -5,7 +5,7 @@
 #include <cstdint>
 
 #include "command.hpp"
-#include "geods/io/npy.hpp"
+#include "geods/io/table_io.hpp"
 #include "geods/spatial/kd_tree.hpp"
 #include "geods/voronoi/post_office.hpp"
 #include "geods/voronoi/stats_fields.hpp"
@@ -26,7 +26,8 @@ class NearestCommand : public Command {
   void add_options(CLI::App& app) override {
     add_input(app, "sites", sites_, "Sites, n x 2 (.npy, .csv, .txt, .xyz, .ply)", "--sites");
     app.add_option("--queries", queries_, "Query points, m x 2")->required();
-    app.add_option("-o,--output", output_, "Output: int64 (m,) index of the nearest site (first occurrence of duplicates)");
+    add_output(app, "-o,--output", output_, "Output: int64 (m,) index of the nearest site (first occurrence of duplicates)",
+               io::OutputKind::table);
     app.add_option("--method", method_, "walk (WalkLocator, the default: O(n) memory), slab (SlabLocator: "
                                         "O(n^1.5) memory in the worst case) or kd_tree (KdTree); kdtree is the "
                                         "deprecated spelling of kd_tree")
@@ -69,7 +70,7 @@ class NearestCommand : public Command {
     }
     if (!output_.empty()) {
       std::vector<std::int64_t> indices(nearest.begin(), nearest.end());
-      io::write_npy<std::int64_t>(output_, indices, {indices.size()});
+      io::write_table(output_, std::span<const std::int64_t>(indices), {indices.size()});
     }
     j["sites"] = sites.size();
     j["queries"] = queries.size();

@@ -9,6 +9,7 @@
 #include <string>
 #include <tuple>
 
+#include "geods/core/coordinate_range.hpp"
 #include "geods/core/error.hpp"
 
 namespace geods::voronoi {
@@ -24,7 +25,11 @@ constexpr std::uint32_t kNone = std::uint32_t(-1);
 struct Delaunay3Graph {
   const Delaunay3& dt;
   std::vector<std::uint32_t> sites;  // only for dimension() < 3
-  explicit Delaunay3Graph(const Delaunay3& d) : dt(d) {
+  // The Delaunay graph takes any finite coordinates; the distances along it
+  // are squared in double, so `what` refuses what they cannot hold.
+  Delaunay3Graph(const Delaunay3& d, const char* what) : dt(d) {
+    if (!dt.points().empty())
+      check_coordinate_range(dt.points().front().data(), dt.points().size(), 3, 3, 2, what);
     if (dt.dimension() < 3)
       for (std::uint32_t i = 0; i < dt.points().size(); ++i)
         if (dt.representative(i) == i) sites.push_back(i);
@@ -150,11 +155,11 @@ SpanningTree emst_of(const Graph& diagram) {
 ClosestPair closest_pair(const Voronoi2& diagram) { return closest_pair_of(diagram); }
 std::vector<std::uint32_t> all_nearest_neighbors(const Voronoi2& diagram) { return all_nearest_neighbors_of(diagram); }
 SpanningTree emst(const Voronoi2& diagram) { return emst_of(diagram); }
-ClosestPair closest_pair(const Delaunay3& dt) { return closest_pair_of(Delaunay3Graph(dt)); }
+ClosestPair closest_pair(const Delaunay3& dt) { return closest_pair_of(Delaunay3Graph(dt, "closest_pair")); }
 std::vector<std::uint32_t> all_nearest_neighbors(const Delaunay3& dt) {
-  return all_nearest_neighbors_of(Delaunay3Graph(dt));
+  return all_nearest_neighbors_of(Delaunay3Graph(dt, "all_nearest_neighbors"));
 }
-SpanningTree emst(const Delaunay3& dt) { return emst_of(Delaunay3Graph(dt)); }
+SpanningTree emst(const Delaunay3& dt) { return emst_of(Delaunay3Graph(dt, "emst")); }
 ClosestPair closest_pair(std::span<const Vec3d> points) { return closest_pair(Delaunay3(points)); }
 std::vector<std::uint32_t> all_nearest_neighbors(std::span<const Vec3d> points) {
   return all_nearest_neighbors(Delaunay3(points));

@@ -4,9 +4,11 @@
 #include "geods/voronoi/voronoi3.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <string>
 
+#include "geods/core/coordinate_range.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"
 
@@ -121,6 +123,10 @@ Voronoi3::Voronoi3(const Delaunay3& dt, const AABB3d& box) : box_(box) {
         !std::isfinite(box.hi[a] - box.lo[a]))
       throw Error("Voronoi3: the box must have finite corners with lo < hi on every axis");
   const auto points = dt.points();
+  // Cell volumes are cubic in the coordinates: refuse what they cannot hold.
+  if (!points.empty()) check_coordinate_range(points.front().data(), points.size(), 3, 3, 3, "Voronoi3");
+  const std::array<Vec3d, 2> corners{box.lo, box.hi};
+  check_coordinate_range(corners.front().data(), 2, 3, 3, 3, "Voronoi3 box");
   std::vector<std::uint32_t> sites;
   for (std::uint32_t i = 0; i < points.size(); ++i)
     if (dt.representative(i) == i) sites.push_back(i);

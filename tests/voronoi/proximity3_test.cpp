@@ -75,5 +75,32 @@ TEST(Proximity3, AgreesWithBruteForce) {
   EXPECT_THROW(closest_pair(std::vector<Vec3d>{{1, 2, 3}}), Error);
 }
 
+
+// The distances along the exact Delaunay graph are squared in double: scaled
+// copies inside that range give the same answers scaled exactly, and 1e300 or
+// 1e-300 are refused (they used to give the pair (0, 0) at distance 0).
+TEST(Proximity3, ExtremeScalesAreExactOrRefused) {
+  const std::vector<Vec3d> unit = sample(0, 41);
+  const ClosestPair pair = closest_pair(unit);
+  const auto nn = all_nearest_neighbors(unit);
+  const SpanningTree tree = emst(unit);
+  for (int e : {-440, 480}) {
+    std::vector<Vec3d> p = unit;
+    for (Vec3d& x : p) x = Vec3d(std::ldexp(x[0], e), std::ldexp(x[1], e), std::ldexp(x[2], e));
+    const ClosestPair got = closest_pair(p);
+    EXPECT_EQ(std::pair(got.i, got.j), std::pair(pair.i, pair.j)) << e;
+    EXPECT_EQ(got.distance, std::ldexp(pair.distance, e)) << e;
+    EXPECT_EQ(all_nearest_neighbors(p), nn) << e;
+    EXPECT_EQ(emst(p).edges, tree.edges) << e;
+  }
+  for (double s : {1e300, 1e-300}) {
+    std::vector<Vec3d> p = unit;
+    for (Vec3d& x : p) x *= s;
+    EXPECT_THROW(closest_pair(p), Error) << s;
+    EXPECT_THROW(all_nearest_neighbors(p), Error) << s;
+    EXPECT_THROW(emst(p), Error) << s;
+  }
+}
+
 }  // namespace
 }  // namespace geods::voronoi

@@ -102,5 +102,27 @@ TEST(Voronoi3, LowerDimensionalSitesAndBadBoxes) {
   EXPECT_THROW(Voronoi3(one, AABB3d(Vec3d(0, 0, 0), Vec3d(1, NAN, 1))), Error);
 }
 
+
+// Cell volumes are cubic in the coordinates: a power-of-two copy inside that
+// range has the volumes scaled exactly (to rounding), 1e300 sites or boxes are refused.
+TEST(Voronoi3, ExtremeScalesAreScaledOrRefused) {
+  Rng rng(43);
+  std::vector<Vec3d> unit;
+  for (int i = 0; i < 40; ++i) unit.emplace_back(rng.uniform(), rng.uniform(), rng.uniform());
+  const Voronoi3 reference(unit, AABB3d(Vec3d(0, 0, 0), Vec3d(1, 1, 1)));
+  for (int e : {-280, 330}) {
+    std::vector<Vec3d> p = unit;
+    for (Vec3d& x : p) x = Vec3d(std::ldexp(x[0], e), std::ldexp(x[1], e), std::ldexp(x[2], e));
+    const double s = std::ldexp(1.0, e);
+    const Voronoi3 v(p, AABB3d(Vec3d(0, 0, 0), Vec3d(s, s, s)));
+    for (std::size_t i = 0; i < unit.size(); ++i)
+      EXPECT_NEAR(v.cells()[i].volume / (s * s * s), reference.cells()[i].volume, 1e-12) << e;
+  }
+  std::vector<Vec3d> far = unit;
+  for (Vec3d& x : far) x *= 1e300;
+  EXPECT_THROW(Voronoi3(far, AABB3d(Vec3d(0, 0, 0), Vec3d(1e300, 1e300, 1e300))), Error);
+  EXPECT_THROW(Voronoi3(unit, AABB3d(Vec3d(-1e200, 0, 0), Vec3d(1, 1, 1))), Error);
+}
+
 }  // namespace
 }  // namespace geods::voronoi

@@ -189,7 +189,7 @@ class KdTree {
   std::vector<Neighbor<T>> query_radius(std::span<const T> query, double radius, const Skip& skip = {}) const {
     check_point(query, "query point");
     check_query_range(query, 2, "KdTree");
-    if (!(radius >= 0)) throw Error("KdTree::query_radius: radius must be >= 0, got " + std::to_string(radius));
+    if (!(radius >= 0)) throw Error("KdTree::query_radius: radius must be >= 0, got " + format_number(radius));
     std::vector<Neighbor<T>> out;
     search_radius(query.data(), squared_limit<T>(radius), [&](std::uint32_t i, T d) { out.push_back({i, d}); }, skip);
     std::sort(out.begin(), out.end());

@@ -45,9 +45,9 @@ inline std::size_t check_request(const KnnRequest& request, const char* who) {
   if (request.k == 0) throw Error(std::string(who) + ": k must be >= 1");
   if (request.k > (std::size_t(1) << 32)) throw Error(std::string(who) + ": k is too large");
   if (!(request.eps >= 0) || std::isinf(request.eps))
-    throw Error(std::string(who) + ": eps must be finite and >= 0, got " + std::to_string(request.eps));
+    throw Error(std::string(who) + ": eps must be finite and >= 0, got " + format_number(request.eps));
   if (!(request.max_distance >= 0))
-    throw Error(std::string(who) + ": max_distance must be >= 0, got " + std::to_string(request.max_distance));
+    throw Error(std::string(who) + ": max_distance must be >= 0, got " + format_number(request.max_distance));
   return request.k;
 }
 

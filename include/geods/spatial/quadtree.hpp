@@ -238,7 +238,7 @@ class Orthtree {
   std::vector<Neighbor<T>> query_radius(const VecT& q, double radius) const {
     check_point(q, "query point");
     check_query_range(std::span<const T>(q.data(), Dim), 2, "Orthtree");
-    if (!(radius >= 0)) throw Error("Orthtree::query_radius: radius must be >= 0, got " + std::to_string(radius));
+    if (!(radius >= 0)) throw Error("Orthtree::query_radius: radius must be >= 0, got " + format_number(radius));
     std::vector<Neighbor<T>> out;
     if (nodes_.empty()) return out;
     const double r2 = radius * radius;
