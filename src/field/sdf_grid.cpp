@@ -102,10 +102,13 @@ __attribute__((always_inline)) inline V8 load8(const float* p) {
 }
 
 // Entries [i, i + 8) of t.
-__attribute__((always_inline)) inline V8 distance8(const Packed::Arrays& f, std::size_t i, V8 px, V8 py, V8 pz) {
+// Vectors by reference in and out: passed or returned by value in the default
+// (no AVX) clone they change the ABI, which clang refuses.
+__attribute__((always_inline)) inline void distance8(const Packed::Arrays& f, std::size_t i, const V8& px, const V8& py,
+                                                    const V8& pz, V8& out) {
   const V8 zero = V8{}, one = V8{} + 1.0f;
-  const auto clamp01 = [&](V8 s) {
-    s = s < zero ? zero : s;
+  const auto clamp01 = [&](const V8& t) {
+    const V8 s = t < zero ? zero : t;
     return s > one ? one : s;
   };
   const auto at = [&](int k) { return load8(f[k].data() + i); };
@@ -134,14 +137,15 @@ __attribute__((always_inline)) inline V8 distance8(const Packed::Arrays& f, std:
   const V8 dbc = rx * rx + ry * ry + rz * rz;
   V8 edge = dab < dac ? dab : dac;
   edge = dbc < edge ? dbc : edge;
-  return inside ? face : edge;
+  out = inside ? face : edge;
 }
 
 __attribute__((target_clones("avx2", "default"))) void squared_distances(const Packed& t, const Vec3f& p, float* d2) {
   const std::size_t n = (t.size + 15) & ~std::size_t(15);
   const V8 px = V8{} + p.x(), py = V8{} + p.y(), pz = V8{} + p.z();
   for (std::size_t i = 0; i < n; i += 8) {
-    const V8 r = distance8(t.f, i, px, py, pz);
+    V8 r;
+    distance8(t.f, i, px, py, pz, r);
     std::memcpy(d2 + i, &r, sizeof r);
   }
 }
@@ -149,11 +153,15 @@ __attribute__((target_clones("avx2", "default"))) void squared_distances(const P
 using I8 = std::int32_t __attribute__((vector_size(32)));
 
 // The smallest of 8 lanes, in three halving steps.
-__attribute__((always_inline)) inline float min8(V8 v) {
-  using M = std::int32_t __attribute__((vector_size(32)));
-  v = v < __builtin_shuffle(v, M{4, 5, 6, 7, 0, 1, 2, 3}) ? v : __builtin_shuffle(v, M{4, 5, 6, 7, 0, 1, 2, 3});
-  v = v < __builtin_shuffle(v, M{2, 3, 0, 1, 6, 7, 4, 5}) ? v : __builtin_shuffle(v, M{2, 3, 0, 1, 6, 7, 4, 5});
-  v = v < __builtin_shuffle(v, M{1, 0, 3, 2, 5, 4, 7, 6}) ? v : __builtin_shuffle(v, M{1, 0, 3, 2, 5, 4, 7, 6});
+// (__builtin_shufflevector: GCC 12 and clang both have it; the fuzz build is clang.)
+__attribute__((always_inline)) inline float min8(const V8& in) {
+  V8 v = in;
+  V8 w = __builtin_shufflevector(v, v, 4, 5, 6, 7, 0, 1, 2, 3);
+  v = v < w ? v : w;
+  w = __builtin_shufflevector(v, v, 2, 3, 0, 1, 6, 7, 4, 5);
+  v = v < w ? v : w;
+  w = __builtin_shufflevector(v, v, 1, 0, 3, 2, 5, 4, 7, 6);
+  v = v < w ? v : w;
   return v[0];
 }
 
@@ -187,7 +195,8 @@ __attribute__((target_clones("avx2", "default"))) std::size_t nearest(const Pack
   const auto group = [&](std::size_t c) __attribute__((always_inline)) {  // inlined: compiled for the clone's target
     const std::size_t i = 8 * c;
     const I8 lane = lanes + std::int32_t(i);
-    V8 r = distance8(t.f, i, px, py, pz);
+    V8 r;
+    distance8(t.f, i, px, py, pz, r);
     r = lane < size ? r : V8{} + kInf;  // the padding
     I8 face;
     std::memcpy(&face, t.face.data() + i, sizeof face);
@@ -511,7 +520,8 @@ void propagate(const MeshDistance& mesh, const Grid3Geometry& grid, const SdfGri
     for (int dy = -1; dy <= 1; ++dy)
       for (int dx = -1; dx <= 1; ++dx)
         if (dz < 0 || (dz == 0 && (dy < 0 || (dy == 0 && dx < 0)))) steps.push_back({dx, dy, dz});
-  const auto [nx, ny, nz] = grid.dims;
+  // Named copies, not a structured binding: the lambda below captures them (clang 14 cannot).
+  const std::size_t nx = grid.dims[0], ny = grid.dims[1], nz = grid.dims[2];
   const auto scan = [&](int sign) {
     for (std::size_t kk = 0; kk < nz; ++kk)
       for (std::size_t jj = 0; jj < ny; ++jj)
