@@ -32,7 +32,7 @@ export ASAN_OPTIONS=${ASAN_OPTIONS:-quarantine_size_mb=64:detect_leaks=1}
 export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$root/fuzz/lsan.supp:print_suppressions=0}
 
 failed=()
-for target in ply obj stl off gltf image npy nrrd nifti points segments archive; do
+for target in ply obj stl off gltf image npy nrrd nifti points segments archive shape; do
   exe=$bin/fuzz_$target
   if [ ! -x "$exe" ]; then
     echo "missing $exe (build the fuzz preset first)" >&2
