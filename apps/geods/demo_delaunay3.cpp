@@ -20,18 +20,11 @@
 namespace geods::cli {
 namespace {
 
-// Renders `mesh` from a viewpoint above and to the side of its bounds, into out_dir/name.
+// Renders `mesh` seen from direction `view` (above and to the side), into out_dir/name.
 void picture(const DemoContext& context, const TriMesh& mesh, const std::string& name, const Vec3f& view) {
   ray::RenderOptions options;
   options.width = options.height = 448;
-  const AABB3f box = mesh.bounds();
-  const Vec3f centre = box.center(), size = box.hi - box.lo;
-  ray::Camera camera;
-  camera.target = centre;
-  camera.up = Vec3f::UnitY();
-  camera.eye = centre + view * size.norm();
-  camera.vertical_fov_deg = 38;
-  options.camera = camera;
+  options.camera = ray::Camera::framing(mesh.bounds(), view);
   options.shadows = true;
   io::write_png(context.out_dir / name, ray::render(mesh, options).image);
 }

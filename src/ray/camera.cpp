@@ -7,7 +7,7 @@
 
 namespace geods::ray {
 
-Camera Camera::framing(const AABB3f& bounds) {
+Camera Camera::framing(const AABB3f& bounds, const Vec3f& direction) {
   Camera camera;
   const AABB3f box = bounds.empty() ? AABB3f(Vec3f::Constant(-1), Vec3f::Constant(1)) : bounds;
   const float radius = std::max(0.5f * box.extent().norm(), 1e-6f * std::max(1.0f, box.hi.cwiseAbs().maxCoeff()));
@@ -15,7 +15,7 @@ Camera Camera::framing(const AABB3f& bounds) {
   const float half_fov = 0.5f * camera.vertical_fov_deg * std::numbers::pi_v<float> / 180.0f;
   // The bounding sphere fits the vertical field of view with 5% to spare.
   const float distance = 1.05f * radius / std::sin(half_fov);
-  camera.eye = camera.target + distance * Vec3f(0.55f, 0.45f, 0.70f).normalized();
+  camera.eye = camera.target + distance * direction.normalized();
   return camera;
 }
 

@@ -20,7 +20,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 void check_query(const Vec2d& q) {
   if (!std::isfinite(q[0]) || !std::isfinite(q[1]))
     throw Error("nearest site: non-finite query point (" + format_number(q[0]) + ", " + format_number(q[1]) + ")");
-  check_query_range(std::span<const double>(q.data(), 2), 2, "nearest site");
+  check_query_range<2>(std::span<const double>(q.data(), 2), "nearest site");
 }
 
 }  // namespace

@@ -64,8 +64,8 @@ TEST(CoordinateRange, RefusesPointsBeyondTheRangeAndNothingElse) {
     EXPECT_LT(m.size(), 160u) << m;
   }
   const std::vector<double> q{3e200, 0};
-  EXPECT_THROW(check_query_range(std::span<const double>(q), 2, "test"), Error);
-  EXPECT_NO_THROW(check_query_range(std::span<const double>(q).subspan(1), 2, "test"));
+  EXPECT_THROW(check_query_range<2>(std::span<const double>(q), "test"), Error);
+  EXPECT_NO_THROW(check_query_range<2>(std::span<const double>(q).subspan(1), "test"));
 }
 
 }  // namespace

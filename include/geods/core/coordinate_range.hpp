@@ -17,22 +17,31 @@
 
 namespace geods {
 
+/// 2^e, exactly, in a constant expression (std::ldexp is not constexpr).
+template <typename T>
+constexpr T power_of_two(int e) {
+  T r = 1;
+  for (; e > 0; --e) r *= 2;
+  for (; e < 0; ++e) r /= 2;
+  return r;
+}
+
 /// The largest |coordinate| for which polynomials of the given degree in
 /// coordinate differences (summed over up to 2^16 terms) stay finite in T:
 /// 2^502 (1.3e151) for distances in double, 2^54 (1.8e16) in float, 2^334
 /// (3.5e100) for circumcentres in double.
 template <typename T>
-T coordinate_limit(int degree) {
-  return std::ldexp(T(1), (std::numeric_limits<T>::max_exponent - 18) / degree - 1);
+constexpr T coordinate_limit(int degree) {
+  return power_of_two<T>((std::numeric_limits<T>::max_exponent - 18) / degree - 1);
 }
 
 /// The smallest extent of a point set whose resolvable differences
 /// (extent * 2^-digits) still have a normal k-th power in T: 2^-458 for
 /// distances in double, 2^-39 in float.
 template <typename T>
-T extent_floor(int degree) {
+constexpr T extent_floor(int degree) {
   const int min_exponent = std::numeric_limits<T>::min_exponent - 1;
-  return std::ldexp(T(1), -(-min_exponent / degree) + std::numeric_limits<T>::digits);
+  return power_of_two<T>(-(-min_exponent / degree) + std::numeric_limits<T>::digits);
 }
 
 /// Checks that n points of `dim` coordinates (row i at coords[i * stride])
@@ -65,10 +74,10 @@ void check_coordinate_range(const T* coords, std::size_t n, std::size_t dim, std
 }
 
 /// Checks one query point against coordinate_limit (a far query's distances
-/// overflow like a far point's).
-template <typename T>
-void check_query_range(std::span<const T> q, int degree, const char* what) {
-  const T limit = coordinate_limit<T>(degree);
+/// overflow like a far point's). On the query path: the limit is a constant.
+template <int Degree, typename T>
+void check_query_range(std::span<const T> q, const char* what) {
+  constexpr T limit = coordinate_limit<T>(Degree);
   for (T x : q)
     if (std::abs(x) > limit)
       throw Error(std::string(what) + ": query coordinate " + format_number(double(x)) + " is beyond +-" +

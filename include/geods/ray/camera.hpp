@@ -12,8 +12,9 @@ struct Camera {
   float vertical_fov_deg = 40;
 
   /// A pleasant three-quarter view of the box from above and to the front
-  /// right (+x, +y, +z side), far enough that the whole box fits the field of view.
-  static Camera framing(const AABB3f& bounds);
+  /// right (+x, +y, +z side), or from `direction` (from the box's centre
+  /// towards the eye), far enough that the whole box fits the field of view.
+  static Camera framing(const AABB3f& bounds, const Vec3f& direction = Vec3f(0.55f, 0.45f, 0.70f));
 
   /// Throws geods::Error for an eye at the target, a non-finite value, an up
   /// vector parallel to the view direction or a field of view outside (0, 180).

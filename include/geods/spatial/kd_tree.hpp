@@ -176,7 +176,7 @@ class KdTree {
                          const Skip& skip = {}) const {
     const std::size_t k = check_request(request, "KdTree::query");
     check_point(query, "query point");
-    check_query_range(query, 2, "KdTree");
+    check_query_range<2>(query, "KdTree");
     KnnResultSet<T> result(out, k, squared_limit<T>(request.max_distance));
     search_nearest(query.data(), result, request.eps, skip);
     result.finish();
@@ -188,7 +188,7 @@ class KdTree {
   template <typename Skip = KeepAll>
   std::vector<Neighbor<T>> query_radius(std::span<const T> query, double radius, const Skip& skip = {}) const {
     check_point(query, "query point");
-    check_query_range(query, 2, "KdTree");
+    check_query_range<2>(query, "KdTree");
     if (!(radius >= 0)) throw Error("KdTree::query_radius: radius must be >= 0, got " + format_number(radius));
     std::vector<Neighbor<T>> out;
     search_radius(query.data(), squared_limit<T>(radius), [&](std::uint32_t i, T d) { out.push_back({i, d}); }, skip);

@@ -225,7 +225,7 @@ class Orthtree {
   std::vector<Neighbor<T>> query(const VecT& q, std::size_t k) const {
     if (k == 0) throw Error("Orthtree::query: k must be >= 1");
     check_point(q, "query point");
-    check_query_range(std::span<const T>(q.data(), Dim), 2, "Orthtree");
+    check_query_range<2>(std::span<const T>(q.data(), Dim), "Orthtree");
     std::vector<Neighbor<T>> out(std::min(k, size()));
     if (out.empty()) return out;
     KnnResultSet<T> result(out.data(), out.size(), std::numeric_limits<T>::infinity());
@@ -237,7 +237,7 @@ class Orthtree {
   /// Every point within distance `radius` of q (inclusive), sorted like query().
   std::vector<Neighbor<T>> query_radius(const VecT& q, double radius) const {
     check_point(q, "query point");
-    check_query_range(std::span<const T>(q.data(), Dim), 2, "Orthtree");
+    check_query_range<2>(std::span<const T>(q.data(), Dim), "Orthtree");
     if (!(radius >= 0)) throw Error("Orthtree::query_radius: radius must be >= 0, got " + format_number(radius));
     std::vector<Neighbor<T>> out;
     if (nodes_.empty()) return out;
