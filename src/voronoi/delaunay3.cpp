@@ -392,8 +392,127 @@ void Delaunay3::remove(std::uint32_t i) {
   if (i >= points_.size() || removed_[i])
     throw Error("Delaunay3.remove: point " + std::to_string(i) + (i >= points_.size() ? " does not exist" : " was removed"));
   removed_[i] = 1;
-  build(options_);
+  const std::uint32_t v = rep_[i];
+  rep_[i] = kNone;
+  if (dimension_ < 3) {
+    build(options_);
+    publish();
+    return;
+  }
+  if (v != i) return;  // a duplicate: its first occurrence stays the vertex
+  // Another copy of the point takes the vertex over: the first remaining one.
+  std::uint32_t heir = kNone;
+  for (std::size_t j = i + 1; j < points_.size() && heir == kNone; ++j)
+    if (rep_[j] == i) heir = std::uint32_t(j);
+  if (heir != kNone) {
+    for (std::size_t j = heir; j < points_.size(); ++j)
+      if (rep_[j] == i) rep_[j] = heir;
+    for (std::size_t k = 0; k < tets_.size(); k += 8)
+      for (int j = 0; j < 4; ++j)
+        if (tets_[k + j] == i) tets_[k + j] = heir;
+    publish();
+    return;
+  }
+  if (!remove_locally(v)) {
+    ++rebuilds_;
+    build(options_);
+  }
   publish();
+}
+
+bool Delaunay3::remove_locally(std::uint32_t v) {
+  // The star of v (every slot holding it, ghosts included) and its boundary:
+  // per star slot, the face opposite v, seen counter-clockwise from v's side.
+  std::vector<std::uint32_t> star = {vertex_slot_[v]}, link;
+  for (std::size_t k = 0; k < star.size(); ++k) {
+    const std::uint32_t t = star[k];
+    for (int j = 0; j < 4; ++j) {
+      const std::uint32_t u = tets_[8 * std::size_t(t) + j];
+      if (u == v) continue;
+      if ((u & Tet3Mesh::kGhostBit) == 0) link.push_back(u);
+      const std::uint32_t n = tets_[8 * std::size_t(t) + 4 + j] >> 2;  // across the face opposite u: holds v
+      if (std::find(star.begin(), star.end(), n) == star.end()) star.push_back(n);
+    }
+  }
+  std::sort(link.begin(), link.end());
+  link.erase(std::unique(link.begin(), link.end()), link.end());
+  std::vector<Vec3d> link_points(link.size());
+  for (std::size_t k = 0; k < link.size(); ++k) link_points[k] = points_[link[k]];
+  const Delaunay3 small(link_points);
+  if (small.dimension() < 3) return false;
+
+  // A face as its three vertices in counter-clockwise order, rotated to start at the smallest.
+  using Face = std::array<std::uint32_t, 3>;
+  const auto face_of = [](const std::uint32_t* vertices, int opposite) {
+    const std::array<int, 3> f = Tet3Mesh::face_towards(opposite);
+    Face face = {vertices[f[0]], vertices[f[1]], vertices[f[2]]};
+    std::rotate(face.begin(), std::min_element(face.begin(), face.end()), face.end());
+    return face;
+  };
+  std::vector<std::pair<Face, std::uint32_t>> boundary;  // the face and the adjacency across it
+  for (const std::uint32_t t : star) {
+    const std::uint32_t* w = &tets_[8 * std::size_t(t)];
+    const int j = int(std::find(w, w + 4, v) - w);
+    boundary.push_back({face_of(w, j), w[4 + j]});
+  }
+  std::sort(boundary.begin(), boundary.end());
+
+  // The small tetrahedralization's slots over big vertex ids; the seeds are
+  // those with a boundary face, their fill spreads across the other faces.
+  const std::size_t small_slots = small.tets_.size() / 8;
+  std::vector<std::uint32_t> mapped(small.tets_.size());
+  for (std::size_t k = 0; k < small.tets_.size(); k += 8)
+    for (int j = 0; j < 4; ++j) {
+      const std::uint32_t u = small.tets_[k + j];
+      mapped[k + j] = (u & Tet3Mesh::kGhostBit) ? u : link[u];
+      mapped[k + 4 + j] = small.tets_[k + 4 + j];
+    }
+  std::vector<std::uint32_t> new_slot(small_slots, kNone), outer(4 * small_slots, kNone), fill;
+  std::size_t matched = 0;
+  for (std::size_t s = 0; s < small_slots; ++s) {
+    if (mapped[8 * s] == kNone) continue;
+    for (int j = 0; j < 4; ++j) {
+      const Face face = face_of(&mapped[8 * s], j);
+      const auto it = std::lower_bound(boundary.begin(), boundary.end(), std::pair(face, std::uint32_t(0)));
+      if (it == boundary.end() || it->first != face) continue;
+      outer[4 * s + j] = it->second;
+      ++matched;
+      if (new_slot[s] == kNone) {
+        new_slot[s] = 0;
+        fill.push_back(std::uint32_t(s));
+      }
+    }
+  }
+  if (matched != boundary.size()) return false;  // not expected: rebuild rather than guess
+  for (std::size_t k = 0; k < fill.size(); ++k)
+    for (int j = 0; j < 4; ++j) {
+      const std::uint32_t s = fill[k], n = mapped[8 * std::size_t(s) + 4 + j] >> 2;
+      if (outer[4 * s + j] == kNone && new_slot[n] == kNone) {
+        new_slot[n] = 0;
+        fill.push_back(n);
+      }
+    }
+
+  // Replace the star by the fill: slots first, then adjacencies.
+  Tet3Mesh mesh(points_, tets_, free_slots_);
+  for (const std::uint32_t t : star) mesh.free_slot(t);
+  for (const std::uint32_t s : fill) new_slot[s] = mesh.new_slot();
+  for (const std::uint32_t s : fill) {
+    const std::uint32_t t = new_slot[s];
+    std::copy_n(&mapped[8 * std::size_t(s)], 4, &tets_[8 * std::size_t(t)]);
+    for (std::uint32_t j = 0; j < 4; ++j) {
+      const std::uint32_t a = outer[4 * s + j];
+      if (a != kNone) {
+        tets_[8 * std::size_t(t) + 4 + j] = a;
+        tets_[Tet3Mesh::entry(a)] = 4 * t + j;
+      } else {
+        const std::uint32_t inner = mapped[8 * std::size_t(s) + 4 + j];
+        tets_[8 * std::size_t(t) + 4 + j] = 4 * new_slot[inner >> 2] + (inner & 3);
+      }
+    }
+  }
+  last_ = new_slot[fill.front()];
+  return true;
 }
 
 void Delaunay3::publish() {
@@ -541,6 +660,7 @@ Delaunay3Stats Delaunay3::stats() const {
   s.points = points_.size();
   s.duplicates = duplicate_count();
   s.removed = std::size_t(std::count(removed_.begin(), removed_.end(), 1));
+  s.rebuilds = rebuilds_;
   s.vertices = s.points - s.duplicates - s.removed;
   s.tetrahedra = tetrahedron_count();
   for (std::size_t k = 0; k < tets_.size(); k += 8)

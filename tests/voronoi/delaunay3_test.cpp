@@ -355,6 +355,46 @@ TEST(Delaunay3, InsertAndRemoveGiveTheTetrahedralizationOfTheSet) {
   EXPECT_THROW(flat.insert(Vec3d(0, NAN, 1)), Error);
 }
 
+// Removal is local (the star refilled from its link's tetrahedralization):
+// after every step the result is the fresh tetrahedralization of the points
+// left, compared by original point indices, on every shape.
+TEST(Delaunay3, LocalRemovalEqualsAFreshBuildOnEveryShape) {
+  for (Shape shape : kShapes) {
+    SCOPED_TRACE("shape " + std::to_string(int(shape)));
+    const auto p = make_points(shape, 240, 7);
+    Delaunay3 dt(p);
+    if (dt.dimension() < 3) continue;
+    Rng rng(99);
+    std::vector<std::uint8_t> gone(p.size(), 0);
+    for (int step = 0; step < 60; ++step) {
+      std::uint32_t i;
+      do {
+        i = std::uint32_t(rng.below(p.size()));
+      } while (gone[i]);
+      gone[i] = 1;
+      dt.remove(i);
+      if (step % 15 != 14) continue;
+      ASSERT_NO_THROW(dt.validate());
+      std::vector<Vec3d> left;
+      std::vector<std::uint32_t> original;
+      for (std::uint32_t k = 0; k < p.size(); ++k)
+        if (!gone[k]) left.push_back(p[k]), original.push_back(k);
+      const Delaunay3 fresh(left);
+      auto expected = sorted_tets(fresh);
+      for (auto& t : expected) {
+        for (auto& v : t) v = original[v];
+        std::sort(t.begin(), t.end());
+      }
+      std::sort(expected.begin(), expected.end());
+      EXPECT_EQ(sorted_tets(dt), expected);
+      for (std::uint32_t k = 0; k < left.size(); ++k)
+        EXPECT_EQ(dt.representative(original[k]), original[fresh.representative(k)]);
+    }
+    // Only a hull vertex with coplanar neighbours (the integer sphere has some) needs a rebuild.
+    if (shape != Shape::sphere) EXPECT_EQ(dt.stats().rebuilds, 0u);
+  }
+}
+
 TEST(Delaunay3, SaveLoadRoundTripAndBadFiles) {
   const std::filesystem::path dir = std::filesystem::temp_directory_path() / "geods_delaunay3_test";
   std::filesystem::create_directories(dir);

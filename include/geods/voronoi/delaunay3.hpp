@@ -50,6 +50,7 @@ struct Delaunay3Stats {
   std::size_t vertices = 0;        // distinct points, vertices of the tetrahedralization
   std::size_t duplicates = 0;      // points merged into an earlier equal point
   std::size_t removed = 0;         // points removed by remove()
+  std::size_t rebuilds = 0;        // removals that rebuilt everything (a flat link) instead of the star
   std::size_t tetrahedra = 0;      // finite tetrahedra
   std::size_t hull_triangles = 0;  // triangles of the convex hull
   std::size_t dimension = 0;       // affine dimension of the points (0 for none)
@@ -112,10 +113,15 @@ class Delaunay3 {
   /// O(cavity) plus O(n) to renumber the public arrays.
   std::uint32_t insert(const Vec3d& p);
   /// Removes point i (its index stays, representative(i) becomes no_index; an
-  /// equal point, if any, stands for the place from then on). The
-  /// tetrahedralization is rebuilt from the remaining points: O(n log n). The
-  /// perturbed Delaunay tetrahedralization is unique, so this is the result
-  /// any local deletion would give.
+  /// equal point, if any, stands for the place from then on). Local, after
+  /// Devillers: the tetrahedra around the vertex (its star) are replaced by
+  /// those of the Delaunay tetrahedralization of its neighbours (its link)
+  /// that lie in the star. The perturbation depends on coordinates only, so
+  /// that small tetrahedralization agrees with the big one, and the result is
+  /// the tetrahedralization of the remaining points, equal to a rebuild.
+  /// O(d log d) for d neighbours plus O(n) to renumber the public arrays. A
+  /// vertex whose neighbours are coplanar (a cap on a flat part of the hull)
+  /// or a set that becomes flat is rebuilt from scratch (stats().rebuilds).
   void remove(std::uint32_t i);
 
   /// Writes the tetrahedralization to `path` as a geods archive
@@ -148,6 +154,7 @@ class Delaunay3 {
   // four vertices (the ghost for the infinite one, no_index in a free slot)
   // and four adjacencies, 4 * neighbour + the face's index in the neighbour.
   void build(Options options);
+  bool remove_locally(std::uint32_t v);  // false: the link is flat, rebuild instead
   void publish();
   std::uint32_t start_slot(std::uint32_t hint) const;  // a live slot to walk from
 
@@ -158,7 +165,7 @@ class Delaunay3 {
   int dimension_ = -1;
 
   std::vector<std::uint32_t> tets_, free_slots_;
-  std::size_t walk_steps_ = 0, conflicts_ = 0;
+  std::size_t walk_steps_ = 0, conflicts_ = 0, rebuilds_ = 0;
   std::uint32_t last_ = 0;                // the slot of the last insertion
   std::vector<std::uint32_t> vertex_slot_;  // per point: a slot holding its vertex
 
