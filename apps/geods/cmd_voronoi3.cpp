@@ -29,11 +29,12 @@ class Voronoi3Command : public Command {
  public:
   std::string name() const override { return "voronoi3"; }
   std::string summary() const override {
-    return "Voronoi cells of 3D points clipped to a box: closed polyhedra (PLY), volumes and centroids";
+    return "Voronoi cells of 3D points clipped to a box or the convex hull: closed polyhedra (PLY), volumes and centroids";
   }
   void add_options(CLI::App& app) override {
     add_input(app, "points", points_, "Sites, n x 3 (.npy, .csv, .txt, .xyz, .ply)");
     app.add_option("--box", box_, "The box X0,Y0,Z0,X1,Y1,Z1 (default: the sites' bounding box)");
+    app.add_flag("--hull", hull_, "Clip the cells to the sites' convex hull instead of a box")->excludes("--box");
     app.add_option("-o,--output", output_, "Output: the cells as one triangle mesh (.ply, .obj, .stl), each closed");
     app.add_option("--explode", explode_,
                    "Move each cell away from the box centre by this fraction of its centroid's offset (0: none)")
@@ -45,7 +46,9 @@ class Voronoi3Command : public Command {
   void run(const RunContext&, Report& report) override {
     const std::vector<Vec3d> points = read_points_3d(points_);
     AABB3d box;
-    if (box_.empty()) {
+    if (hull_) {
+      if (points.empty()) throw Error(points_ + ": no points");
+    } else if (box_.empty()) {
       for (const Vec3d& p : points) box.extend(p);
       if (points.empty()) throw Error(points_ + ": no points");
       for (int a = 0; a < 3; ++a)
@@ -57,8 +60,9 @@ class Voronoi3Command : public Command {
     const voronoi::Delaunay3 dt(points);
     const double build_s = watch.seconds();
     watch = Stopwatch();
-    const Voronoi3 vd(dt, box);
+    const Voronoi3 vd = hull_ ? Voronoi3(dt) : Voronoi3(dt, box);
     const double cells_s = watch.seconds();
+    if (hull_) box = vd.box();
     const voronoi::Voronoi3Stats stats = vd.stats();
     if (!output_.empty()) io::write_mesh(output_, vd.mesh(explode_));
     if (!volumes_.empty()) {
@@ -72,13 +76,17 @@ class Voronoi3Command : public Command {
     j["cells"] = vd.cells().size();
     put_stats(j, stats);
     j["volume_total"] = vd.volume_total();
-    j["box_volume"] = (box.hi - box.lo).prod();
+    j["box_volume"] = (box.hi - box.lo).prod();  // with --hull: the hull's bounding box
     j["build_s"] = build_s;
     j["cells_s"] = cells_s;
     j["compute_s"] = build_s + cells_s;
-    report.lines.push_back(fmt::format("voronoi3: {} points -> {} cells ({} miss the box), {} faces; volume {:.6g} of a {:.6g} box",
-                                       points.size(), vd.cells().size(), stats.empty, stats.faces, vd.volume_total(),
-                                       (box.hi - box.lo).prod()));
+    if (hull_)
+      report.lines.push_back(fmt::format("voronoi3: {} points -> {} cells, {} faces; volume {:.6g} (the convex hull's)",
+                                         points.size(), vd.cells().size(), stats.faces, vd.volume_total()));
+    else
+      report.lines.push_back(fmt::format("voronoi3: {} points -> {} cells ({} miss the box), {} faces; volume {:.6g} of a {:.6g} box",
+                                         points.size(), vd.cells().size(), stats.empty, stats.faces, vd.volume_total(),
+                                         (box.hi - box.lo).prod()));
     report.lines.push_back(fmt::format("  tetrahedralized in {:.3f} s, cells in {:.3f} s", build_s, cells_s));
     for (const std::string* path : {&output_, &volumes_})
       if (!path->empty()) report.lines.push_back("  wrote " + *path);
@@ -87,6 +95,7 @@ class Voronoi3Command : public Command {
  private:
   std::string points_, box_, output_, volumes_;
   double explode_ = 0;
+  bool hull_ = false;
 };
 
 const bool registered = register_command<Voronoi3Command>();

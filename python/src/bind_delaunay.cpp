@@ -13,9 +13,11 @@
 #include "geods/core/error.hpp"
 #include "geods/voronoi/delaunay2.hpp"
 #include "geods/voronoi/delaunay3.hpp"
+#include "geods/voronoi/spheres.hpp"
 #include "geods/voronoi/voronoi3.hpp"
 #include "geods/voronoi/stats_fields.hpp"
 #include "stats_dict.hpp"
+#include "without_gil.hpp"
 
 namespace py = pybind11;
 
@@ -164,12 +166,15 @@ occurrence; fewer than four distinct points or all coplanar give no tetrahedra
       "voronoi3",
       [](const py::handle& points_in, const py::handle& box_in) {
         const std::vector<Vec3d> points = points_of<double, 3>(points_in, "voronoi3");
-        const py::array_t<double, py::array::c_style | py::array::forcecast> box =
-            py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(box_in);
-        if (!box || box.size() != 6) throw Error("voronoi3: box must be 6 numbers x0, y0, z0, x1, y1, z1");
-        const double* b = box.data();
         std::vector<voronoi::Voronoi3Cell> cells;
-        {
+        if (box_in.is_none()) {
+          py::gil_scoped_release release;
+          cells = voronoi::Voronoi3(voronoi::Delaunay3(points)).cells();
+        } else {
+          const py::array_t<double, py::array::c_style | py::array::forcecast> box =
+              py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(box_in);
+          if (!box || box.size() != 6) throw Error("voronoi3: box must be 6 numbers x0, y0, z0, x1, y1, z1, or None");
+          const double* b = box.data();
           py::gil_scoped_release release;
           cells = voronoi::Voronoi3(points, AABB3d(Vec3d(b[0], b[1], b[2]), Vec3d(b[3], b[4], b[5]))).cells();
         }
@@ -186,18 +191,31 @@ occurrence; fewer than four distinct points or all coplanar give no tetrahedra
                 cell.face_vertices.data() + cell.face_offsets[f], cell.face_offsets[f + 1] - cell.face_offsets[f])));
           d["faces"] = faces;
           std::vector<std::int64_t> labels;
-          for (const std::uint32_t l : cell.face_neighbors) labels.push_back(std::int32_t(l));  // box side k: -2 - k
+          for (const std::uint32_t l : cell.face_neighbors)  // box side k: -2 - k; hull triangle k: -1000 - k
+            labels.push_back(voronoi::Voronoi3::is_hull_face(l) ? -1000 - std::int64_t(l & 0x7fffffffu) : std::int32_t(l));
           d["neighbors"] = copy_array(labels.data(), {py::ssize_t(labels.size())});
           out.append(d);
         }
         return out;
       },
-      py::arg("points"), py::arg("box"), R"doc(
-The Voronoi cells of 3D points clipped to a box (x0, y0, z0, x1, y1, z1): one dict per
-distinct point with "site" (its index), "volume", "centroid", "vertices" (k, 3), "faces"
-(index loops into vertices, counter-clockwise seen from outside) and "neighbors" (per
-face the site across, or -2 - k for box side k: -x, +x, -y, +y, -z, +z). The cells
-partition the box.
+      py::arg("points"), py::arg("box") = py::none(), R"doc(
+The Voronoi cells of 3D points clipped to a box (x0, y0, z0, x1, y1, z1), or with
+box=None to the points' convex hull: one dict per distinct point with "site" (its
+index), "volume", "centroid", "vertices" (k, 3), "faces" (index loops into vertices,
+counter-clockwise seen from outside) and "neighbors" (per face the site across, -2 - k
+for box side k: -x, +x, -y, +y, -z, +z, or -1000 - k for Delaunay3.hull triangle k).
+The cells partition the box (or the hull).
+)doc");
+  m.def(
+      "largest_empty_sphere",
+      [](const py::handle& points_in) {
+        const std::vector<Vec3d> points = points_of<double, 3>(points_in, "largest_empty_sphere");
+        const voronoi::Sphere s = without_gil([&] { return voronoi::largest_empty_sphere(points); });
+        return py::make_tuple(copy_array(s.center.data(), {3}), s.radius);
+      },
+      py::arg("points"), R"doc(
+The largest sphere centred in the convex hull of (n, 3) points with no point inside:
+(center (3,), radius). Coplanar points give the largest empty circle in their plane.
 )doc");
 }
 

@@ -203,3 +203,39 @@ def test_proximity_in_3d_against_brute_force():
     distinct = np.delete(pts, 40, axis=0)  # the duplicate joins by a zero-length edge, which scipy cannot hold
     dd = np.linalg.norm(distinct[:, None] - distinct[None], axis=2)
     assert edges.shape == (249, 2) and length == pytest.approx(minimum_spanning_tree(dd).sum(), rel=1e-12)
+
+
+def test_voronoi3_cells_clipped_to_the_hull_and_the_largest_empty_sphere():
+    rng = np.random.default_rng(13)
+    pts = rng.normal(size=(150, 3))
+    cells = geods.voronoi3(pts)  # box=None: the convex hull
+    hull = ConvexHull(pts)
+    assert sum(c["volume"] for c in cells) == pytest.approx(hull.volume, rel=1e-9)
+    inside = Delaunay(pts)
+    for c in cells:
+        assert np.all(inside.find_simplex(c["vertices"], tol=1e-9) >= 0)
+    labels = np.concatenate([c["neighbors"] for c in cells])
+    assert labels.min() <= -1000 and not np.any((labels < 0) & (labels > -1000))  # hull labels, no box sides
+    centre, radius = geods.largest_empty_sphere(pts)
+    assert np.linalg.norm(pts - centre, axis=1).min() == pytest.approx(radius, rel=1e-12)
+    assert inside.find_simplex(centre, tol=1e-9) >= 0
+    # no sample of the hull is farther from every point than the radius
+    samples = rng.uniform(pts.min(0), pts.max(0), size=(20000, 3))
+    samples = samples[inside.find_simplex(samples) >= 0]
+    nearest = np.min(np.linalg.norm(samples[:, None] - pts[None], axis=2), axis=1)
+    assert nearest.max() <= radius * (1 + 1e-12) and nearest.max() > 0.5 * radius
+    flat_centre, flat_radius = geods.largest_empty_sphere([[0, 0, 1], [2, 0, 1], [2, 2, 1], [0, 2, 1]])
+    assert flat_radius == pytest.approx(np.sqrt(2)) and np.allclose(flat_centre, [1, 1, 1])
+    with pytest.raises(ValueError):
+        geods.voronoi3([[0, 0, 0], [1, 0, 0], [0, 1, 0]])  # flat: no hull to clip to
+
+
+def test_cli_voronoi3_hull(cli, tmp_path):
+    pts = np.random.default_rng(14).random((120, 3))
+    np.save(tmp_path / "p.npy", pts)
+    r = subprocess.run([str(cli), "voronoi3", str(tmp_path / "p.npy"), "--hull", "--json"], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    assert json.loads(r.stdout)["volume_total"] == pytest.approx(ConvexHull(pts).volume, rel=1e-9)
+    r = subprocess.run([str(cli), "voronoi3", str(tmp_path / "p.npy"), "--hull", "--box", "0,0,0,1,1,1"],
+                       capture_output=True, text=True)
+    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1

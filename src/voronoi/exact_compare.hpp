@@ -23,6 +23,13 @@ inline Vec2d circumcentre(const Vec2d& a, const Vec2d& b, const Vec2d& c) {
   return a + Vec2d(ac[1] * ab2 - ab[1] * ac2, ab[0] * ac2 - ac[0] * ab2) / d;
 }
 
+/// The centre of the sphere through a, b, c, d (not coplanar), the same way.
+inline Vec3d circumcentre(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& d) {
+  const Vec3d ab = b - a, ac = c - a, ad = d - a;
+  const double det = -2 * orient3d(a.data(), b.data(), c.data(), d.data());  // 2 det(ab, ac, ad)
+  return a + (ab.squaredNorm() * ac.cross(ad) + ac.squaredNorm() * ad.cross(ab) + ad.squaredNorm() * ab.cross(ac)) / det;
+}
+
 inline exact::Expansion<2> exact_diff(double a, double b) { return exact::from_two_term(exact::two_diff(a, b)); }
 
 /// Sign of (a0 - b0)(c0 - d0) + (a1 - b1)(c1 - d1) - (e0 - f0)(g0 - h0) - (e1 - f1)(g1 - h1),

@@ -11,6 +11,7 @@
 #include "geods/core/coordinate_range.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"
+#include "exact_compare.hpp"
 
 namespace geods::voronoi {
 namespace {
@@ -122,6 +123,30 @@ Voronoi3::Voronoi3(const Delaunay3& dt, const AABB3d& box) : box_(box) {
     if (!std::isfinite(box.lo[a]) || !std::isfinite(box.hi[a]) || !(box.lo[a] < box.hi[a]) ||
         !std::isfinite(box.hi[a] - box.lo[a]))
       throw Error("Voronoi3: the box must have finite corners with lo < hi on every axis");
+  build(dt, {});
+}
+
+Voronoi3::Voronoi3(const Delaunay3& dt) {
+  if (dt.dimension() != 3)
+    throw Error("Voronoi3: clipping to the convex hull needs points that span space (dimension " +
+                std::to_string(dt.dimension()) + "); give a box instead");
+  for (const std::uint32_t v : dt.tetrahedra()) box_.extend(dt.points()[v]);
+  std::vector<Plane> hull;
+  // The cells start from a box a little larger than the hull's, so that the hull planes cut every box face away.
+  const AABB3d bounds = box_;
+  const Vec3d margin = (bounds.hi - bounds.lo) * (1.0 / 16);
+  box_ = AABB3d(bounds.lo - margin, bounds.hi + margin);
+  for (const auto& t : dt.hull()) {
+    const Vec3d &a = dt.points()[t[0]], &b = dt.points()[t[1]], &c = dt.points()[t[2]];
+    const Vec3d normal = (b - a).cross(c - a);  // outwards: the triangle is counter-clockwise seen from outside
+    hull.push_back({normal, normal.dot(a)});
+  }
+  build(dt, hull);
+  box_ = bounds;
+}
+
+void Voronoi3::build(const Delaunay3& dt, std::span<const Plane> hull) {
+  const AABB3d& box = box_;
   const auto points = dt.points();
   // Cell volumes are cubic in the coordinates: refuse what they cannot hold.
   if (!points.empty()) check_coordinate_range(points.front().data(), points.size(), 3, 3, 3, "Voronoi3");
@@ -130,6 +155,26 @@ Voronoi3::Voronoi3(const Delaunay3& dt, const AABB3d& box) : box_(box) {
   std::vector<std::uint32_t> sites;
   for (std::uint32_t i = 0; i < points.size(); ++i)
     if (dt.representative(i) == i) sites.push_back(i);
+  // With a hull: the sites whose cells may cross it, those on it and those
+  // with a Voronoi vertex (a circumcentre) outside it.
+  std::vector<std::uint8_t> crosses_hull;
+  if (!hull.empty()) {
+    crosses_hull.assign(points.size(), 0);
+    for (const auto& t : dt.hull())
+      for (const std::uint32_t v : t) crosses_hull[v] = 1;
+    const auto& tets = dt.tetrahedra();
+    std::vector<std::uint8_t> outside(dt.tetrahedron_count());
+    parallel_for(0, outside.size(), 1 << 12, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t t = begin; t < end; ++t) {
+        const Vec3d c = detail::circumcentre(points[tets[4 * t]], points[tets[4 * t + 1]], points[tets[4 * t + 2]],
+                                             points[tets[4 * t + 3]]);
+        outside[t] = !std::isfinite(c[0] + c[1] + c[2]) || dt.locate(c, std::uint32_t(t)) == Delaunay3::no_index;
+      }
+    });
+    for (std::size_t t = 0; t < outside.size(); ++t)
+      if (outside[t])
+        for (int k = 0; k < 4; ++k) crosses_hull[tets[4 * t + k]] = 1;
+  }
   const double size = (box.hi - box.lo).norm();
   const double tolerance = 1e-12 * size;
   std::vector<Face> initial;
@@ -162,6 +207,18 @@ Voronoi3::Voronoi3(const Delaunay3& dt, const AABB3d& box) : box_(box) {
           const Vec3d normal = points[w] - p;
           clip(faces, normal, normal.dot((points[w] + p) * 0.5), w, tolerance);
           if (faces.empty()) break;
+        }
+        if (!hull.empty() && crosses_hull[s]) {
+          for (std::uint32_t h = 0; h < hull.size() && !faces.empty(); ++h) {
+            // skip the planes the cell's bounding box lies within
+            AABB3d bounds;
+            for (const Face& f : faces)
+              for (const Vec3d& x : f.loop) bounds.extend(x);
+            const Vec3d& n = hull[h].normal;
+            double reach = 0;
+            for (int a = 0; a < 3; ++a) reach += n[a] * (n[a] > 0 ? bounds.hi[a] : bounds.lo[a]);
+            if (reach > hull[h].offset) clip(faces, n, hull[h].offset, hull_face(h), tolerance);
+          }
         }
         cells_[k] = make_cell(s, faces, tolerance);
       },

@@ -102,6 +102,62 @@ TEST(Voronoi3, LowerDimensionalSitesAndBadBoxes) {
   EXPECT_THROW(Voronoi3(one, AABB3d(Vec3d(0, 0, 0), Vec3d(1, NAN, 1))), Error);
 }
 
+// Clipped to the convex hull: the cells' volumes add up to the tetrahedra's,
+// every corner lies in the hull, samples of the hull lie in their nearest
+// site's cell, and cut faces carry hull labels.
+TEST(Voronoi3, CellsClippedToTheHullPartitionIt) {
+  Rng rng(8);
+  std::vector<Vec3d> sets[2];
+  for (int i = 0; i < 250; ++i) sets[0].emplace_back(rng.uniform(), rng.uniform(), rng.uniform());
+  for (int x = 0; x < 4; ++x)  // a lattice: hull faces through many sites, cospherical everywhere
+    for (int y = 0; y < 3; ++y)
+      for (int z = 0; z < 5; ++z) sets[1].emplace_back(x, y, z);
+  for (const auto& sites : sets) {
+    const Delaunay3 dt(sites);
+    const Voronoi3 vd(dt);
+    double hull_volume = 0;
+    for (std::size_t t = 0; t < dt.tetrahedron_count(); ++t) {
+      const std::uint32_t* v = &dt.tetrahedra()[4 * t];
+      hull_volume += (sites[v[1]] - sites[v[0]]).dot((sites[v[2]] - sites[v[0]]).cross(sites[v[3]] - sites[v[0]])) / 6;
+    }
+    EXPECT_NEAR(vd.volume_total(), hull_volume, 1e-9 * hull_volume);
+    const auto hull = dt.hull();
+    const double slack = 1e-9 * (vd.box().hi - vd.box().lo).norm();
+    const auto in_hull = [&](const Vec3d& q) {
+      for (const auto& h : hull) {
+        const Vec3d n = (sites[h[1]] - sites[h[0]]).cross(sites[h[2]] - sites[h[0]]).normalized();
+        if (n.dot(q - sites[h[0]]) > slack) return false;
+      }
+      return true;
+    };
+    std::size_t hull_labels = 0;
+    for (const Voronoi3Cell& cell : vd.cells()) {
+      for (const Vec3d& x : cell.vertices) EXPECT_TRUE(in_hull(x));
+      for (const std::uint32_t l : cell.face_neighbors) {
+        EXPECT_FALSE(Voronoi3::is_box_side(l));
+        if (Voronoi3::is_hull_face(l)) {
+          ++hull_labels;
+          EXPECT_LT(l & 0x7fffffffu, hull.size());
+        }
+      }
+    }
+    EXPECT_GT(hull_labels, 0u);
+    for (int k = 0; k < 300; ++k) {
+      // a random point of a random tetrahedron
+      const std::uint32_t* v = &dt.tetrahedra()[4 * rng.below(dt.tetrahedron_count())];
+      double w[4], sum = 0;
+      for (double& x : w) sum += (x = rng.uniform());
+      Vec3d q = Vec3d::Zero();
+      for (int j = 0; j < 4; ++j) q += sites[v[j]] * (w[j] / sum);
+      std::size_t best = 0;
+      for (std::size_t c = 1; c < vd.cells().size(); ++c)
+        if ((sites[vd.cells()[c].site] - q).squaredNorm() < (sites[vd.cells()[best].site] - q).squaredNorm()) best = c;
+      EXPECT_TRUE(in_cell(vd.cells()[best], q, slack));
+    }
+  }
+  EXPECT_THROW(Voronoi3(Delaunay3(std::vector<Vec3d>{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}})), Error);
+}
+
 
 // Cell volumes are cubic in the coordinates: a power-of-two copy inside that
 // range has the volumes scaled exactly (to rounding), 1e300 sites or boxes are refused.

@@ -1,13 +1,15 @@
 #pragma once
 // The Voronoi diagram of points in space (seed §5.3.1, the dual of Delaunay3):
-// every site's cell clipped to a box, as a closed convex polyhedron with its
-// volume and centroid. The cells of the sites inside the box partition it.
+// every site's cell clipped to a box or to the sites' convex hull, as a closed
+// convex polyhedron with its volume and centroid. The cells partition the box
+// (of the sites inside it) or the hull.
 //
 // A cell is the box cut by the bisector planes between its site and the site's
 // Delaunay neighbours (only they bound a Voronoi cell), clipped in doubles.
 // Layout, flat per cell: its vertices, its faces as index loops into them
-// (counter-clockwise seen from outside), and per face the site across it, or
-// a box side (Voronoi3::box_side(k), k = 0..5 for -x, +x, -y, +y, -z, +z).
+// (counter-clockwise seen from outside), and per face the site across it, a
+// box side (Voronoi3::box_side(k), k = 0..5 for -x, +x, -y, +y, -z, +z) or a
+// hull triangle (Voronoi3::hull_face(k), k indexing Delaunay3::hull()).
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -24,7 +26,7 @@ struct Voronoi3Cell {
   std::vector<Vec3d> vertices;              // the cell's corners
   std::vector<std::uint32_t> face_offsets;  // face f is face_vertices[face_offsets[f] .. face_offsets[f + 1])
   std::vector<std::uint32_t> face_vertices;
-  std::vector<std::uint32_t> face_neighbors;  // per face: the site across, or box_side(k)
+  std::vector<std::uint32_t> face_neighbors;  // per face: the site across, box_side(k) or hull_face(k)
   double volume = 0;                        // 0 for a cell that misses the box (no faces)
   Vec3d centroid = Vec3d::Zero();
   std::size_t face_count() const { return face_neighbors.size(); }
@@ -43,6 +45,9 @@ class Voronoi3 {
   /// The face label of box side k (0: x = lo.x, 1: x = hi.x, 2, 3: y, 4, 5: z).
   static constexpr std::uint32_t box_side(int k) { return std::uint32_t(-2 - k); }
   static bool is_box_side(std::uint32_t label) { return label >= box_side(5) && label <= box_side(0); }
+  /// The face label of hull triangle k (Delaunay3::hull()[k]); sites are below 2^31.
+  static constexpr std::uint32_t hull_face(std::uint32_t k) { return k | 0x80000000u; }
+  static bool is_hull_face(std::uint32_t label) { return (label & 0x80000000u) && !is_box_side(label); }
 
   /// The cells of the points' distinct sites (representatives of Delaunay3),
   /// clipped to `box`, computed in parallel (the result does not depend on
@@ -51,10 +56,16 @@ class Voronoi3 {
   /// non-coplanar sites every other site bounds each cell: O(n^2).
   Voronoi3(const Delaunay3& dt, const AABB3d& box);
   Voronoi3(std::span<const Vec3d> points, const AABB3d& box) : Voronoi3(Delaunay3(points), box) {}
+  /// The cells clipped to the convex hull of the sites (box() is the sites'
+  /// bounding box). A cell is cut by the hull's planes only if its site is on
+  /// the hull or a Voronoi vertex of it (a tetrahedron's circumcentre) lies
+  /// outside: O(h) more per such cell for h hull triangles. Throws
+  /// geods::Error unless dt.dimension() == 3.
+  explicit Voronoi3(const Delaunay3& dt);
 
   const std::vector<Voronoi3Cell>& cells() const { return cells_; }
   const AABB3d& box() const { return box_; }
-  /// The sum of the cell volumes: the box's volume up to rounding (for any non-empty set of sites).
+  /// The sum of the cell volumes: the box's (or the hull's) volume up to rounding.
   double volume_total() const;
   Voronoi3Stats stats() const;
   /// The cells as one triangle mesh (each face a fan), every cell a closed
@@ -65,6 +76,11 @@ class Voronoi3 {
   TriMesh mesh(double explode = 0, std::vector<std::uint32_t>* cell_of_triangle = nullptr) const;
 
  private:
+  struct Plane {
+    Vec3d normal;
+    double offset;  // the half-space normal . x <= offset
+  };
+  void build(const Delaunay3& dt, std::span<const Plane> hull);
   AABB3d box_;
   std::vector<Voronoi3Cell> cells_;
 };
