@@ -62,6 +62,7 @@ struct Packed {
   Arrays f;
   std::vector<std::uint32_t> leaf;  // leaf-order triangle of each entry
   std::vector<std::int32_t> face;   // its face index (padded as the arrays)
+  std::vector<float> floor;         // a block's list: per group of 8, a bound below every distance in the block
   std::size_t size = 0;
 
   void clear() { size = 0, leaf.clear(); }
@@ -72,18 +73,6 @@ struct Packed {
       for (auto& a : f) a.resize(padded, 0.0f);
       face.resize(padded, 0);
     }
-  }
-  // Entries idx of `from`, in that order, replacing this list's.
-  void assign(const Packed& from, const std::vector<std::uint32_t>& idx) {
-    clear();
-    reserve(idx.size());
-    for (int k = 0; k < kFields; ++k) {
-      const float* in = from.f[k].data();
-      float* o = f[k].data();
-      for (std::size_t j = 0; j < idx.size(); ++j) o[j] = in[idx[j]];
-    }
-    for (std::size_t j = 0; j < idx.size(); ++j) face[j] = from.face[idx[j]], leaf.push_back(from.leaf[idx[j]]);
-    size = idx.size();
   }
 };
 
@@ -140,17 +129,38 @@ __attribute__((always_inline)) inline void distance8(const Packed::Arrays& f, st
   out = inside ? face : edge;
 }
 
-__attribute__((target_clones("avx2", "default"))) void squared_distances(const Packed& t, const Vec3f& p, float* d2) {
-  const std::size_t n = (t.size + 15) & ~std::size_t(15);
-  const V8 px = V8{} + p.x(), py = V8{} + p.y(), pz = V8{} + p.z();
-  for (std::size_t i = 0; i < n; i += 8) {
-    V8 r;
-    distance8(t.f, i, px, py, pz, r);
-    std::memcpy(d2 + i, &r, sizeof r);
+using I8 = std::int32_t __attribute__((vector_size(32)));
+
+// An entry that passes a box's corner test, with its squared distances from the 8 corners.
+struct Kept {
+  float key;  // the smallest of k
+  std::uint32_t index;
+  std::array<float, 8> k;
+};
+
+// The entries of t within bound2[k] of some corner k, appended to `kept`,
+// eight entries at a time.
+__attribute__((target_clones("avx2", "default"))) void corner_test(const Packed& t, const std::array<Vec3f, 8>& corners,
+                                                                  const std::array<float, 8>& bound2,
+                                                                  std::vector<Kept>& kept) {
+  const I8 size = I8{} + std::int32_t(t.size), lanes = I8{0, 1, 2, 3, 4, 5, 6, 7};
+  for (std::size_t i = 0; i < t.size; i += 8) {
+    V8 d[8];
+    I8 pass = I8{};
+    for (int k = 0; k < 8; ++k) {
+      distance8(t.f, i, V8{} + corners[k].x(), V8{} + corners[k].y(), V8{} + corners[k].z(), d[k]);
+      pass |= d[k] <= bound2[k];
+    }
+    pass &= (lanes + std::int32_t(i)) < size;
+    for (int l = 0; l < 8; ++l) {
+      if (!pass[l]) continue;
+      Kept& e = kept.emplace_back();
+      e.index = std::uint32_t(i + std::size_t(l));
+      e.key = d[0][l];
+      for (int k = 0; k < 8; ++k) e.k[k] = d[k][l], e.key = std::min(e.key, d[k][l]);
+    }
   }
 }
-
-using I8 = std::int32_t __attribute__((vector_size(32)));
 
 // The smallest of 8 lanes, in three halving steps.
 // (__builtin_shufflevector: GCC 12 and clang both have it; the fuzz build is clang.)
@@ -185,6 +195,7 @@ struct InBlock {
 __attribute__((target_clones("avx2", "default"))) std::size_t nearest(const Packed& t, const Vec3f& p,
                                                                        const InBlock* in_block, float slack,
                                                                        std::size_t seed, float& d2) {
+  const float* floor = in_block && !t.floor.empty() ? t.floor.data() : nullptr;
   const InBlock at_p = in_block ? *in_block : InBlock{};
   const V8 px = V8{} + p.x(), py = V8{} + p.y(), pz = V8{} + p.z();
   const V8 wx = V8{} + at_p.wx, wy = V8{} + at_p.wy, wz = V8{} + at_p.wz;
@@ -219,6 +230,7 @@ __attribute__((target_clones("avx2", "default"))) std::size_t nearest(const Pack
   if (seed >= groups) seed = 0;
   group(seed);
   for (std::size_t c = 0; c < groups; ++c) {
+    if (floor && floor[c] > reach2 * (1 + 1e-4f)) break;  // the groups are sorted by their floors
     if (c == seed || (in_block && lower(c) > reach2 * (1 + 1e-4f))) continue;
     group(c);
   }
@@ -229,6 +241,12 @@ __attribute__((target_clones("avx2", "default"))) std::size_t nearest(const Pack
     if (best[l] < d2 || (best[l] == d2 && best_face[l] < face)) d2 = best[l], face = best_face[l], index = std::size_t(at[l]);
   return index;
 }
+
+struct Scratch {
+  Packed tile_list, block_list, near;
+  std::vector<Kept> kept;
+  std::vector<std::uint32_t> found;
+};
 
 class GridSolver {
  public:
@@ -275,37 +293,26 @@ class GridSolver {
       return (i - box.lo[0]) + nx * ((j - box.lo[1]) + ny * (k - box.lo[2]));
     };
     if (!(centre.distance - box.radius > band_ + margin_)) {
-      Packed tile_list, block_list, near;
-      std::vector<float> d2, pass;
-      std::vector<std::uint32_t> keep;
-      gather(box, centre.closest, tile_list, near, keep, d2, pass);
+      // Scratch lists of this thread, kept from tile to tile: no allocation or zeroing per tile.
+      thread_local Scratch scratch;
+      auto& [tile_list, block_list, near, kept, found] = scratch;
+      gather(box, centre.closest, tile_list, near, found, kept);
       for (std::size_t bz = box.lo[2]; bz < box.hi[2]; bz += kBlock)
         for (std::size_t by = box.lo[1]; by < box.hi[1]; by += kBlock)
           for (std::size_t bx = box.lo[0]; bx < box.hi[0]; bx += kBlock) {
             const SampleBox block(grid_, {bx, by, bz},
                                   {std::min(bx + kBlock, box.hi[0]), std::min(by + kBlock, box.hi[1]),
                                    std::min(bz + kBlock, box.hi[2])});
-            const Closest c = closest_in(tile_list, block.centre);
+            const InBlock centre_in_tile = in_box(box, block.centre);
+            const Closest c = closest_in(tile_list, block.centre, &centre_in_tile);
             if (std::sqrt(c.d2) - block.radius > band_ + margin_) continue;
-            filter(tile_list, block, c.point, block_list, d2, pass, keep);
+            filter(tile_list, block, c.point, block_list, kept, true);
             std::size_t seed = 0;  // the group of the previous sample's nearest face
-            const Vec3f extent = block.corners[7] - block.corners[0];
             for (std::size_t k = block.lo[2]; k < block.hi[2]; ++k)
               for (std::size_t j = block.lo[1]; j < block.hi[1]; ++j)
                 for (std::size_t i = block.lo[0]; i < block.hi[0]; ++i) {
                   const Vec3f p = grid_.position(i, j, k);
-                  InBlock at_p;
-                  const auto weight = [&](int a) {
-                    return extent[a] > 0 ? std::clamp((p[a] - block.corners[0][a]) / extent[a], 0.0f, 1.0f) : 0.0f;
-                  };
-                  at_p.wx = weight(0), at_p.wy = weight(1), at_p.wz = weight(2);
-                  // sum_k w_k |v_k - p|^2 of the box's corners, one axis at a time (rounded up).
-                  at_p.spread = 0;
-                  for (int a = 0; a < 3; ++a) {
-                    const float w = a == 0 ? at_p.wx : a == 1 ? at_p.wy : at_p.wz;
-                    at_p.spread += extent[a] * extent[a] * w * (1 - w);
-                  }
-                  at_p.spread = at_p.spread * (1 + 1e-4f) + margin_ * margin_;
+                  const InBlock at_p = in_box(block, p);
                   const Closest s = closest_in(block_list, p, &at_p, seed);
                   seed = s.slot / 8;
                   const float d = std::sqrt(s.d2);
@@ -357,6 +364,18 @@ class GridSolver {
   }
 
  private:
+  // Where p (inside the box) sits: its trilinear weights and the spread
+  // sum_k w_k |v_k - p|^2 of the box's corners, one axis at a time (rounded up).
+  InBlock in_box(const SampleBox& box, const Vec3f& p) const {
+    const Vec3f extent = box.corners[7] - box.corners[0];
+    float w[3], spread = 0;
+    for (int a = 0; a < 3; ++a) {
+      w[a] = extent[a] > 0 ? std::clamp((p[a] - box.corners[0][a]) / extent[a], 0.0f, 1.0f) : 0.0f;
+      spread += extent[a] * extent[a] * w[a] * (1 - w[a]);
+    }
+    return {w[0], w[1], w[2], spread * (1 + 1e-4f) + margin_ * margin_};
+  }
+
   // Squared distance bounds at a box's corners from a surface point q.
   std::array<float, 8> bounds_from(const SampleBox& box, const Vec3f& q) const {
     std::array<float, 8> bound2;
@@ -372,7 +391,7 @@ class GridSolver {
   // of the box's corners, then their triangles the same test (filter), in
   // leaf order.
   void gather(const SampleBox& box, const Vec3f& q, Packed& out, Packed& near, std::vector<std::uint32_t>& found,
-              std::vector<float>& d2, std::vector<float>& pass) const {
+              std::vector<Kept>& kept) const {
     const std::array<float, 8> bound2 = bounds_from(box, q);
     const bvh::Topology& topo = mesh_.bvh().topology();
     found.clear();
@@ -392,31 +411,50 @@ class GridSolver {
               [](float) { return true; });
         },
         mesh_.bvh().volumes());
-    near.assign(all_, found);
-    filter(near, box, q, out, d2, pass, found);
+    near.clear();
+    near.reserve(found.size());
+    for (int k = 0; k < Packed::kFields; ++k) {
+      const float* in = all_.f[k].data();
+      float* o = near.f[k].data();
+      for (std::size_t j = 0; j < found.size(); ++j) o[j] = in[found[j]];
+    }
+    for (std::size_t j = 0; j < found.size(); ++j) near.face[j] = all_.face[found[j]], near.leaf.push_back(found[j]);
+    near.size = found.size();
+    filter(near, box, q, out, kept, false);
   }
 
-  // The list keeps each entry's squared distances from the 8 corners (k0..k7).
-  void filter(const Packed& in, const SampleBox& box, const Vec3f& q, Packed& out, std::vector<float>& d2,
-              std::vector<float>& pass, std::vector<std::uint32_t>& keep) const {
-    const std::array<float, 8> bound2 = bounds_from(box, q);
-    const std::size_t stride = in.f[0].size();
-    d2.resize(8 * stride);
-    pass.assign(in.size, 0.0f);
-    for (int k = 0; k < 8; ++k) {
-      float* dk = d2.data() + std::size_t(k) * stride;
-      squared_distances(in, box.corners[k], dk);
-      for (std::size_t i = 0; i < in.size; ++i) pass[i] = dk[i] <= bound2[k] ? 1.0f : pass[i];
+  // The entries of `in` that pass the corner test of `box` with the surface
+  // point q, with their squared distances from the 8 corners (k0..k7);
+  // `sorted`: ordered by the smallest of them, with each group's floor, a
+  // bound below the squared distance from any point of the box to any of
+  // the group's faces (by the concavity above: at least the smallest corner
+  // distance less the largest spread).
+  void filter(const Packed& in, const SampleBox& box, const Vec3f& q, Packed& out, std::vector<Kept>& kept,
+              bool sorted) const {
+    kept.clear();
+    corner_test(in, box.corners, bounds_from(box, q), kept);
+    if (sorted)
+      std::sort(kept.begin(), kept.end(),
+                [](const Kept& a, const Kept& b) { return a.key < b.key || (a.key == b.key && a.index < b.index); });
+    const std::size_t n = kept.size();
+    out.clear();
+    out.reserve(n);
+    for (int k = 0; k < Packed::k0; ++k) {
+      const float* src = in.f[k].data();
+      float* o = out.f[k].data();
+      for (std::size_t j = 0; j < n; ++j) o[j] = src[kept[j].index];
     }
-    keep.clear();
-    for (std::size_t i = 0; i < in.size; ++i)
-      if (pass[i] != 0) keep.push_back(std::uint32_t(i));
-    out.assign(in, keep);
     for (int k = 0; k < 8; ++k) {
-      const float* dk = d2.data() + std::size_t(k) * stride;
       float* o = out.f[Packed::k0 + k].data();
-      for (std::size_t j = 0; j < keep.size(); ++j) o[j] = dk[keep[j]];
+      for (std::size_t j = 0; j < n; ++j) o[j] = kept[j].k[k];
     }
+    for (std::size_t j = 0; j < n; ++j) out.face[j] = in.face[kept[j].index], out.leaf.push_back(in.leaf[kept[j].index]);
+    out.size = n;
+    out.floor.clear();
+    if (!sorted) return;
+    const Vec3f extent = box.corners[7] - box.corners[0];
+    const float spread = 0.25f * extent.squaredNorm() * (1 + 1e-4f) + margin_ * margin_;
+    for (std::size_t j = 0; j < n; j += 8) out.floor.push_back(kept[j].key * (1 - 1e-4f) - spread - slack_);
   }
 
   // The closest entry of `list` to p (ties: the smallest face index), with

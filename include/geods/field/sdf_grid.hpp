@@ -22,7 +22,10 @@
 //   neighbour's distance + the spacing); by the same concavity, dist^2(p, f)
 //   is at least the trilinear interpolation of f's distances from the
 //   block's corners less the spread of the corners about p, so a group
-//   whose bounds all exceed the best distance so far is skipped.
+//   whose bounds all exceed the best distance so far is skipped; a block's
+//   list is sorted by each face's smallest corner distance, and the search
+//   stops at the first group whose floor (that less the largest spread)
+//   exceeds the best distance.
 // - Sign: the mesh's SignMethod. With winding numbers on a closed mesh, a
 //   sample whose distance and that of a neighbour earlier in the tile add up
 //   to more than their separation takes the neighbour's sign (the segment
