@@ -6,6 +6,7 @@
 
 #include "command.hpp"
 #include "geods/io/npy.hpp"
+#include "geods/core/parallel.hpp"
 #include "geods/voronoi/delaunay3.hpp"
 #include "geods/voronoi/stats_fields.hpp"
 #include "stats_json.hpp"
@@ -60,6 +61,8 @@ class Delaunay3Command : public Command {
 
     Json& j = report.json;
     put_stats(j, stats);
+    j["bytes_per_point"] = points.empty() ? 0.0 : double(stats.bytes) / double(points.size());
+    j["threads"] = num_threads();
     j["build_s"] = build_s;
     j["compute_s"] = build_s;
     const char* lower[] = {"no points", "all points equal", "all points collinear", "all points coplanar"};
@@ -69,7 +72,11 @@ class Delaunay3Command : public Command {
                                        dt.dimension() < 3 ? fmt::format(" (dimension {}: {})", dt.dimension(),
                                                                         lower[dt.dimension() + 1])
                                                           : ""));
-    report.lines.push_back(fmt::format("  built in {:.3f} s ({:.1f} bytes per point)", build_s,
+    report.lines.push_back(fmt::format("  built in {:.3f} s on {} threads{} ({:.1f} bytes per point)", build_s,
+                                       num_threads(),
+                                       stats.seam_points ? fmt::format(", halves stitched at a seam of {} points",
+                                                                       stats.seam_points)
+                                                         : "",
                                        points.empty() ? 0.0 : double(stats.bytes) / double(points.size())));
     for (const std::string* path : {&output_, &neighbors_, &hull_, &save_})
       if (!path->empty()) report.lines.push_back("  wrote " + *path);

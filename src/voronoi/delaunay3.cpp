@@ -276,13 +276,13 @@ Delaunay3::Delaunay3(std::span<const Vec3d> points, Options options) : options_(
   publish();
 }
 
-void Delaunay3::build(Options options) {
+void Delaunay3::build(Options options, bool may_split) {
   const std::size_t total = points_.size();
   removed_.resize(total, 0);
   rep_.assign(total, kNone);
   tets_.clear();
   free_slots_.clear();
-  walk_steps_ = conflicts_ = 0;
+  walk_steps_ = conflicts_ = seam_points_ = 0;
   std::vector<std::uint32_t> active;
   active.reserve(total);
   for (std::size_t i = 0; i < total; ++i)
@@ -292,6 +292,8 @@ void Delaunay3::build(Options options) {
     dimension_ = -1;
     return;
   }
+  if (may_split && num_threads() > 1 && n >= std::max<std::size_t>(options.parallel_from, 16) && build_split(active))
+    return;
   const std::vector<std::uint32_t> order = brio_order(std::span<const Vec3d>(points_), active, options.seed);
 
   // The first tetrahedron: the earliest four affinely independent points in the order.
@@ -515,30 +517,66 @@ bool Delaunay3::remove_locally(std::uint32_t v) {
   return true;
 }
 
+// The public arrays in a canonical order, the same however the slots were
+// filled (sequentially, in parallel, after updates): each tetrahedron starts at
+// its smallest vertex, then the smaller of the two next in its orientation (an
+// even permutation, so it stays positive), and the tetrahedra are sorted by
+// their four vertices: a counting sort on the first, then each bucket.
 void Delaunay3::publish() {
   const std::size_t slots = tets_.size() / 8;
-  public_of_.assign(slots, kNone);
-  std::size_t count = 0;
-  for (std::size_t s = 0; s < slots; ++s) {
-    const std::uint32_t* v = &tets_[8 * s];
-    if (((v[0] | v[1] | v[2] | v[3]) & Tet3Mesh::kGhostBit) == 0) public_of_[s] = std::uint32_t(count++);
-  }
-  tetrahedra_.resize(4 * count);
-  vertex_slot_.assign(points_.size(), kNone);
+  const std::size_t n = points_.size();
+  std::vector<std::array<std::uint32_t, 4>> canonical(slots);
+  std::vector<std::uint32_t> count(n + 1, 0);
+  parallel_for(0, slots, 1 << 14, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t s = begin; s < end; ++s) {
+      const std::uint32_t* v = &tets_[8 * s];
+      std::array<std::uint32_t, 4>& c = canonical[s];
+      if (((v[0] | v[1] | v[2] | v[3]) & Tet3Mesh::kGhostBit) != 0) {
+        c[0] = kNone;
+        continue;
+      }
+      // The even permutations that bring the smallest vertex first: (0123), (1032), (2301), (3210)
+      // rotated in their last three; pick the smallest first, then rotate the rest.
+      const int m = int(std::min_element(v, v + 4) - v);
+      static constexpr int kEven[4][4] = {{0, 1, 2, 3}, {1, 0, 3, 2}, {2, 3, 0, 1}, {3, 2, 1, 0}};
+      std::uint32_t r[3] = {v[kEven[m][1]], v[kEven[m][2]], v[kEven[m][3]]};
+      const int k = int(std::min_element(r, r + 3) - r);
+      c = {v[m], r[k], r[(k + 1) % 3], r[(k + 2) % 3]};
+    }
+  });
   for (std::size_t s = 0; s < slots; ++s)
+    if (canonical[s][0] != kNone) ++count[canonical[s][0] + 1];
+  for (std::size_t i = 0; i < n; ++i) count[i + 1] += count[i];
+  const std::size_t total = count[n];
+  std::vector<std::uint32_t> order(total);  // slots by first vertex
+  {
+    std::vector<std::uint32_t> next(count.begin(), count.end() - 1);
+    for (std::size_t s = 0; s < slots; ++s)
+      if (canonical[s][0] != kNone) order[next[canonical[s][0]]++] = std::uint32_t(s);
+  }
+  parallel_for(0, n, 1 << 12, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t v = begin; v < end; ++v)
+      std::sort(order.begin() + count[v], order.begin() + count[v + 1],
+                [&](std::uint32_t a, std::uint32_t b) { return canonical[a] < canonical[b]; });
+  });
+  public_of_.assign(slots, kNone);
+  tetrahedra_.resize(4 * total);
+  parallel_for(0, total, 1 << 14, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t t = begin; t < end; ++t) {
+      public_of_[order[t]] = std::uint32_t(t);
+      std::copy_n(canonical[order[t]].begin(), 4, &tetrahedra_[4 * t]);
+    }
+  });
+  index_vertices();
+}
+
+void Delaunay3::index_vertices() {
+  vertex_slot_.assign(points_.size(), kNone);
+  for (std::size_t s = 0; s < tets_.size() / 8; ++s)
     for (int k = 0; k < 4; ++k) {
       const std::uint32_t v = tets_[8 * s + k];
       if ((v & Tet3Mesh::kGhostBit) == 0) vertex_slot_[v] = std::uint32_t(s);
     }
-  parallel_for(0, slots, 1 << 14, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t s = begin; s < end; ++s) {
-      const std::uint32_t t = public_of_[s];
-      if (t == kNone) continue;
-      for (int k = 0; k < 4; ++k) {
-        tetrahedra_[4 * std::size_t(t) + k] = tets_[8 * s + k];
-      }
-    }
-  });
 }
 
 std::vector<std::uint32_t> Delaunay3::neighbors() const {
@@ -547,7 +585,11 @@ std::vector<std::uint32_t> Delaunay3::neighbors() const {
     for (std::size_t s = begin; s < end; ++s) {
       const std::uint32_t t = public_of_[s];
       if (t == kNone) continue;
-      for (int k = 0; k < 4; ++k) out[4 * std::size_t(t) + k] = public_of_[tets_[8 * s + 4 + k] >> 2];
+      // public vertex i is the slot's vertex j: its neighbour is across the face opposite it
+      for (int i = 0; i < 4; ++i)
+        for (int j = 0; j < 4; ++j)
+          if (tets_[8 * s + j] == tetrahedra_[4 * std::size_t(t) + i])
+            out[4 * std::size_t(t) + i] = public_of_[tets_[8 * s + 4 + j] >> 2];
     }
   });
   return out;
@@ -632,12 +674,18 @@ std::uint32_t Delaunay3::nearest_vertex(const Vec3d& q) const {
       if (rep_[v] == v && (best == kNone || distance(v) < distance(best))) best = v;
     return best;
   }
+  std::uint32_t slot = start_slot(kNone);
+  return nearest_vertex_from(q, slot);
+}
+
+std::uint32_t Delaunay3::nearest_vertex_from(const Vec3d& q, std::uint32_t& slot) const {
+  const auto distance = [&](std::uint32_t v) { return (points_[v] - q).squaredNorm(); };
   Tet3Mesh mesh(const_cast<std::vector<Vec3d>&>(points_), const_cast<std::vector<std::uint32_t>&>(tets_),
                 const_cast<std::vector<std::uint32_t>&>(free_slots_));
   std::size_t steps = 0;
   std::uint32_t random = 2463534242u;
-  const std::uint32_t t = mesh.walk(q, start_slot(kNone), steps, random);
-  best = kNone;
+  const std::uint32_t t = slot = mesh.walk(q, slot, steps, random);
+  std::uint32_t best = kNone;
   for (int k = 0; k < 4; ++k) {
     const std::uint32_t u = tets_[8 * std::size_t(t) + k];
     if ((u & Tet3Mesh::kGhostBit) == 0 && (best == kNone || distance(u) < distance(best))) best = u;
@@ -668,6 +716,7 @@ Delaunay3Stats Delaunay3::stats() const {
   s.dimension = dimension_ < 0 ? 0 : std::size_t(dimension_);
   s.walk_steps = walk_steps_;
   s.conflicts = conflicts_;
+  s.seam_points = seam_points_;
   const auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
   s.bytes = bytes(points_) + bytes(rep_) +
             bytes(tets_) + bytes(removed_) + bytes(vertex_slot_) + bytes(free_slots_) + bytes(tetrahedra_) + bytes(public_of_);
@@ -764,9 +813,11 @@ void Delaunay3::validate() const {
   for (std::size_t s = 0; s < slots; ++s) {
     const std::uint32_t t = public_of_[s];
     if (t == kNone) continue;
-    for (int k = 0; k < 4; ++k)
-      if (tetrahedra_[4 * std::size_t(t) + k] != tets_[8 * s + k])
-        throw Error("Delaunay3: public tetrahedron " + std::to_string(t) + " differs from its slot");
+    const std::uint32_t* p = &tetrahedra_[4 * std::size_t(t)];
+    const bool same_vertices = std::is_permutation(p, p + 4, &tets_[8 * s]);
+    if (!same_vertices || Tet3Mesh::orient(points_[p[0]], points_[p[1]], points_[p[2]], points_[p[3]]) <= 0 ||
+        (t > 0 && !std::lexicographical_compare(p - 4, p, p, p + 4)))
+      throw Error("Delaunay3: public tetrahedron " + std::to_string(t) + " differs from its slot or is out of order");
   }
 }
 

@@ -15,6 +15,7 @@
 #include "geods/core/convex_hull3.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/predicates.hpp"
+#include "geods/core/parallel.hpp"
 #include "geods/core/rng.hpp"
 #include "geods/voronoi/delaunay3.hpp"
 
@@ -391,7 +392,36 @@ TEST(Delaunay3, LocalRemovalEqualsAFreshBuildOnEveryShape) {
         EXPECT_EQ(dt.representative(original[k]), original[fresh.representative(k)]);
     }
     // Only a hull vertex with coplanar neighbours (the integer sphere has some) needs a rebuild.
-    if (shape != Shape::sphere) EXPECT_EQ(dt.stats().rebuilds, 0u);
+    if (shape != Shape::sphere) {
+      EXPECT_EQ(dt.stats().rebuilds, 0u);
+    }
+  }
+}
+
+// The parallel build (two halves and a seam) gives the sequential build's
+// arrays exactly, on every shape, with the split forced on small inputs.
+// Coordinates whose squares leave double range (1e300, 1e-300) build sequentially.
+TEST(Delaunay3, ParallelBuildEqualsTheSequentialOne) {
+  const int threads = num_threads();
+  for (Shape shape : kShapes) {
+    SCOPED_TRACE("shape " + std::to_string(int(shape)));
+    const bool extreme = shape == Shape::tiny || shape == Shape::huge;
+    const auto p = make_points(shape, extreme ? 300 : 2000, 9);
+    set_num_threads(1);
+    const Delaunay3 sequential(p);
+    set_num_threads(2);
+    const Delaunay3 parallel(p, {.parallel_from = 16});
+    set_num_threads(threads);
+    if (extreme) {
+      EXPECT_EQ(parallel.stats().seam_points, 0u);
+    } else {
+      EXPECT_GT(parallel.stats().seam_points, 0u);
+    }
+    EXPECT_EQ(sequential.stats().seam_points, 0u);
+    ASSERT_NO_THROW(parallel.validate());
+    EXPECT_EQ(parallel.tetrahedra(), sequential.tetrahedra());
+    EXPECT_EQ(parallel.neighbors(), sequential.neighbors());
+    for (std::uint32_t i = 0; i < p.size(); ++i) EXPECT_EQ(parallel.representative(i), sequential.representative(i));
   }
 }
 

@@ -27,6 +27,17 @@
 // holds a point strictly beyond its hull face, and a point on the face's plane
 // when the finite tetrahedron behind the face holds it.
 //
+// Parallel construction: with several threads and many points, the points
+// left and right of the median x are tetrahedralized at the same time. The
+// tetrahedra of each half whose circumsphere (or hull face) certainly holds
+// no point of the other half are tetrahedra of the whole set (the
+// perturbation depends on coordinates only); the others, near the seam, are
+// replaced by the tetrahedra of the seam's vertices' own tetrahedralization
+// that fill the region they leave (matched by its boundary faces, as in
+// remove()). The certificates are conservative (a doubtful tetrahedron goes to
+// the seam), so the result is the unique tetrahedralization, in the same
+// canonical order as a sequential build.
+//
 // Lower-dimensional input: duplicates are merged (representative(i) is the
 // first occurrence; duplicate_count()). If the distinct points are fewer than
 // four or all coplanar there are no tetrahedra: dimension() says 0 (all equal),
@@ -56,11 +67,17 @@ struct Delaunay3Stats {
   std::size_t dimension = 0;       // affine dimension of the points (0 for none)
   std::size_t walk_steps = 0;      // tetrahedra visited by point location while inserting
   std::size_t conflicts = 0;       // tetrahedra replaced by insertions (cavity sizes summed)
+  std::size_t seam_points = 0;     // parallel build: points of the seam retetrahedralized between the halves (0: sequential)
   std::size_t bytes = 0;           // memory of all arrays
 };
 
 struct Delaunay3Options {
   std::uint64_t seed = 0x5eed;  // of the randomized insertion order (the result does not depend on it)
+  /// With more than one thread (geods::num_threads()) and at least this many
+  /// points, the two halves of the set (split at the median x) are
+  /// tetrahedralized at the same time and stitched (see Delaunay3); the
+  /// result is the same as on one thread.
+  std::size_t parallel_from = 100000;
 };
 
 class Delaunay3 {
@@ -77,7 +94,11 @@ class Delaunay3 {
 
   /// The input points, indexed as given.
   std::span<const Vec3d> points() const { return points_; }
-  /// Finite tetrahedra, four positively oriented vertex indices each.
+  /// Finite tetrahedra, four positively oriented vertex indices each, in a
+  /// canonical order that depends only on the points (not on the insertion
+  /// order, the thread count or the updates that led here): each starts at its
+  /// smallest vertex, then the smallest of the other three, and the
+  /// tetrahedra are sorted by their vertices.
   const std::vector<std::uint32_t>& tetrahedra() const { return tetrahedra_; }
   /// Per tetrahedron, the four neighbouring tetrahedra: neighbour i shares
   /// the face opposite vertex i; no_index on the convex hull. Made from the
@@ -153,10 +174,14 @@ class Delaunay3 {
   // vertices in insertion order, renumbered at the end): per slot eight words,
   // four vertices (the ghost for the infinite one, no_index in a free slot)
   // and four adjacencies, 4 * neighbour + the face's index in the neighbour.
-  void build(Options options);
+  void build(Options options, bool may_split = true);
+  bool build_split(const std::vector<std::uint32_t>& active);  // false: the halves cannot be stitched, build sequentially
   bool remove_locally(std::uint32_t v);  // false: the link is flat, rebuild instead
   void publish();
+  void index_vertices();  // vertex_slot_ from the slots
   std::uint32_t start_slot(std::uint32_t hint) const;  // a live slot to walk from
+  // nearest_vertex(q) walking from `slot` (dimension 3), which becomes the slot q lies in (or a ghost beyond it).
+  std::uint32_t nearest_vertex_from(const Vec3d& q, std::uint32_t& slot) const;
 
   Options options_;
   std::vector<Vec3d> points_;
@@ -165,7 +190,7 @@ class Delaunay3 {
   int dimension_ = -1;
 
   std::vector<std::uint32_t> tets_, free_slots_;
-  std::size_t walk_steps_ = 0, conflicts_ = 0, rebuilds_ = 0;
+  std::size_t walk_steps_ = 0, conflicts_ = 0, rebuilds_ = 0, seam_points_ = 0;
   std::uint32_t last_ = 0;                // the slot of the last insertion
   std::vector<std::uint32_t> vertex_slot_;  // per point: a slot holding its vertex
 

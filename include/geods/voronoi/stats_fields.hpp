@@ -23,7 +23,7 @@ void for_each_field(const Delaunay3Stats& s, F&& f) {
   f("points", s.points), f("vertices", s.vertices), f("duplicates", s.duplicates), f("removed", s.removed);
   f("rebuilds", s.rebuilds), f("tetrahedra", s.tetrahedra);
   f("hull_triangles", s.hull_triangles), f("dimension", s.dimension), f("walk_steps", s.walk_steps);
-  f("conflicts", s.conflicts), f("bytes", s.bytes);
+  f("conflicts", s.conflicts), f("seam_points", s.seam_points), f("bytes", s.bytes);
 }
 
 template <typename F>

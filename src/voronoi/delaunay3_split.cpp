@@ -1,0 +1,295 @@
+// Delaunay3's parallel build: the two halves of the set (split at the median
+// x) tetrahedralized at the same time, their certainly-Delaunay tetrahedra
+// kept, the seam between them refilled from the seam vertices' own
+// tetrahedralization (see delaunay3.hpp).
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cmath>
+#include <optional>
+#include <utility>
+
+#include "delaunay3_mesh.hpp"
+#include "geods/core/aabb.hpp"
+#include "geods/core/parallel.hpp"
+#include "geods/spatial/kd_tree.hpp"
+#include "geods/voronoi/delaunay3.hpp"
+
+namespace geods::voronoi {
+namespace {
+
+constexpr std::uint32_t kNone = Delaunay3::no_index;
+constexpr std::uint32_t kGhost = Tet3Mesh::kGhost;
+
+using Face = std::array<std::uint32_t, 3>;
+
+// A face as its three vertices counter-clockwise seen from the side of the
+// tetrahedron's vertex `opposite`, rotated to start at the smallest.
+Face face_of(const std::uint32_t* vertices, int opposite) {
+  const std::array<int, 3> f = Tet3Mesh::face_towards(opposite);
+  Face face = {vertices[f[0]], vertices[f[1]], vertices[f[2]]};
+  std::rotate(face.begin(), std::min_element(face.begin(), face.end()), face.end());
+  return face;
+}
+
+// The point of a convex polytope's vertices (given by their adjacency) that is
+// farthest along `direction`: a strict hill climb from `start` (on a convex
+// polytope a vertex that no neighbour beats is a maximum).
+std::uint32_t extreme_vertex(const std::vector<std::vector<std::uint32_t>>& adjacent, std::span<const Vec3d> points,
+                             const Vec3d& direction, std::uint32_t start) {
+  std::uint32_t best = start;
+  double value = direction.dot(points[best]);
+  for (bool moved = true; moved;) {
+    moved = false;
+    for (const std::uint32_t u : adjacent[best])
+      if (const double x = direction.dot(points[u]); x > value) {
+        best = u, value = x, moved = true;
+        break;
+      }
+  }
+  return best;
+}
+
+}  // namespace
+
+bool Delaunay3::build_split(const std::vector<std::uint32_t>& active) {
+  double scale = 0;
+  AABB3d bounds;
+  for (const std::uint32_t i : active) {
+    bounds.extend(points_[i]);
+    scale = std::max({scale, std::abs(points_[i][0]), std::abs(points_[i][1]), std::abs(points_[i][2])});
+  }
+  const double extent = (bounds.hi - bounds.lo).maxCoeff();
+  // Squared distances of the certificates below must stay in double range: else build sequentially.
+  if (!(scale < 1e100 && extent > 1e-100)) return false;
+  // The halves: x below the median, and the rest (equal points stay together).
+  std::vector<double> xs(active.size());
+  for (std::size_t k = 0; k < active.size(); ++k) xs[k] = points_[active[k]][0];
+  std::nth_element(xs.begin(), xs.begin() + std::ptrdiff_t(xs.size() / 2), xs.end());
+  const double split = xs[xs.size() / 2];
+  std::array<std::vector<std::uint32_t>, 2> global;  // per half, its points' indices here
+  for (const std::uint32_t i : active) global[points_[i][0] < split ? 0 : 1].push_back(i);
+  if (global[0].size() < 8 || global[1].size() < 8) return false;
+  std::array<Delaunay3, 2> half;
+  parallel_for_each_index(
+      0, 2,
+      [&](std::size_t h) {
+        half[h].options_ = options_;
+        half[h].points_.resize(global[h].size());
+        for (std::size_t k = 0; k < global[h].size(); ++k) half[h].points_[k] = points_[global[h][k]];
+        half[h].build(options_, false);
+        half[h].index_vertices();  // for nearest_vertex
+      },
+      1);
+  if (half[0].dimension_ < 3 || half[1].dimension_ < 3) return false;
+
+  const double tolerance = 1e-9 * scale;
+  // A finite slot's circumsphere: its centre and a radius that covers the
+  // rounding; none for slivers, whose centres' rounding the margins do not
+  // bound (they go to the seam). Plain doubles: the orientation here only
+  // measures flatness.
+  struct Sphere {
+    Vec3d centre;
+    double reach;
+  };
+  const auto sphere = [&](const Delaunay3& d, const std::uint32_t* v) -> std::optional<Sphere> {
+    const Vec3d* C = d.points_.data();
+    const Vec3d ab = C[v[1]] - C[v[0]], ac = C[v[2]] - C[v[0]], ad = C[v[3]] - C[v[0]];
+    const double det = 2 * ab.dot(ac.cross(ad));
+    const double edge = std::max({ab.norm(), ac.norm(), ad.norm()});
+    if (!(std::abs(det) >= 2e-6 * edge * edge * edge)) return {};
+    const Vec3d offset =
+        (ab.squaredNorm() * ac.cross(ad) + ac.squaredNorm() * ad.cross(ab) + ad.squaredNorm() * ab.cross(ac)) / det;
+    const double radius = offset.norm();
+    if (!std::isfinite(radius)) return {};
+    return Sphere{C[v[0]] + offset, radius * (1 + 1e-6) + tolerance};
+  };
+  // Per half, its hull's vertex adjacency (for the extreme points the other half's hull faces ask for).
+  std::array<std::vector<std::vector<std::uint32_t>>, 2> hull_adjacent;
+  std::array<std::uint32_t, 2> hull_start{};
+  for (int h = 0; h < 2; ++h) {
+    hull_adjacent[h].resize(half[h].points_.size());
+    for (const auto& t : half[h].hull())
+      for (int k = 0; k < 3; ++k) {
+        hull_adjacent[h][t[k]].push_back(t[(k + 1) % 3]);
+        hull_start[h] = t[0];
+      }
+  }
+  // state[h][s] of slot s of half h: kept (certainly a (ghost) tetrahedron of
+  // the whole set), to the seam, or pending (its sphere crosses the split).
+  constexpr std::uint8_t seam_slot = 0, kept = 1, pending = 2;
+  const double far = 16 * extent / std::cbrt(double(active.size()));  // 16 mean spacings
+  std::array<std::vector<std::uint8_t>, 2> valid;
+  std::array<std::atomic<double>, 2> beyond{};  // per half: how far its pending spheres reach past the split
+  for (int h = 0; h < 2; ++h) {
+    const Delaunay3& self = half[h];
+    const Delaunay3& other = half[1 - h];
+    const std::size_t slots = self.tets_.size() / 8;
+    valid[h].assign(slots, seam_slot);
+    const Vec3d* C = self.points_.data();
+    parallel_for(0, slots, 1 << 12, [&](std::size_t begin, std::size_t end) {
+      std::uint32_t climb = hull_start[1 - h];
+      double deepest = 0;
+      for (std::size_t s = begin; s < end; ++s) {
+        const std::uint32_t* v = &self.tets_[8 * s];
+        if (v[0] == kNone) continue;
+        const int g = int(std::find(v, v + 4, kGhost) - v);
+        if (g < 4) {
+          // A hull face: kept if the other half lies strictly inside its plane, by a margin.
+          const std::array<int, 3> f = Tet3Mesh::face_towards(g);
+          const Vec3d &a = C[v[f[0]]], &b = C[v[f[1]]], &c = C[v[f[2]]];
+          const Vec3d normal = (b - a).cross(c - a);  // outwards: the face is counter-clockwise seen from the ghost's side
+          const double length = normal.norm();
+          if (!(length > 0)) continue;
+          climb = extreme_vertex(hull_adjacent[1 - h], other.points_, normal, climb);
+          valid[h][s] = normal.dot(other.points_[climb] - a) / length < -tolerance ? kept : seam_slot;
+          continue;
+        }
+        const auto b = sphere(self, v);
+        if (!b) continue;
+        const double past = h == 0 ? b->centre[0] + b->reach - split : split - (b->centre[0] - b->reach);
+        if (past < 0) {
+          valid[h][s] = kept;  // the sphere does not reach the other half's side
+        } else if (past <= far) {  // (larger spheres, flat ones by the hull, go to the seam: the slab stays thin)
+          valid[h][s] = pending;
+          deepest = std::max(deepest, past);
+        }
+      }
+      for (double seen = beyond[h].load(); deepest > seen && !beyond[h].compare_exchange_weak(seen, deepest);) {
+      }
+    });
+  }
+  // The pending spheres against the other half's points they can reach: the
+  // nearest one (in a k-d tree of those within reach of the split) outside
+  // the sphere by a margin, so is every other.
+  for (int h = 0; h < 2; ++h) {
+    const Delaunay3& other = half[1 - h];
+    const double depth = beyond[h] * (1 + 1e-6) + tolerance;
+    std::vector<Vec3d> slab;
+    for (const Vec3d& p : other.points_)
+      if (std::abs(p[0] - split) <= depth) slab.push_back(p);
+    if (slab.empty()) slab.push_back(other.points_[0]);
+    const spatial::KdTree<double, 3> tree(spatial::PointView<double>(slab[0].data(), slab.size(), 3));
+    parallel_for(0, valid[h].size(), 1 << 12, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t s = begin; s < end; ++s) {
+        if (valid[h][s] != pending) continue;
+        const Sphere b = *sphere(half[h], &half[h].tets_[8 * s]);
+        const spatial::Neighbor<double> q = tree.query(b.centre, 1).front();
+        valid[h][s] = std::sqrt(q.squared_distance) > b.reach * (1 + 1e-6) ? kept : seam_slot;
+      }
+    });
+  }
+  // The seam: every vertex of a doubtful slot; its own tetrahedralization.
+  std::vector<std::uint32_t> seam;
+  for (int h = 0; h < 2; ++h)
+    for (std::size_t s = 0; s < valid[h].size(); ++s) {
+      const std::uint32_t* v = &half[h].tets_[8 * s];
+      if (v[0] == kNone || valid[h][s]) continue;
+      for (int k = 0; k < 4; ++k)
+        if (v[k] != kGhost) seam.push_back(global[h][v[k]]);
+    }
+  std::sort(seam.begin(), seam.end());
+  seam.erase(std::unique(seam.begin(), seam.end()), seam.end());
+  if (seam.empty()) return false;
+  Delaunay3 filler;
+  filler.options_ = options_;
+  filler.points_.resize(seam.size());
+  for (std::size_t k = 0; k < seam.size(); ++k) filler.points_[k] = points_[seam[k]];
+  filler.build(options_, false);
+  if (filler.dimension_ < 3) return false;
+
+  // New slot numbers: the kept slots of half 0, then of half 1, then the fill.
+  std::array<std::vector<std::uint32_t>, 2> renumber;
+  std::uint32_t next = 0;
+  for (int h = 0; h < 2; ++h) {
+    renumber[h].assign(valid[h].size(), kNone);
+    for (std::size_t s = 0; s < valid[h].size(); ++s)
+      if (valid[h][s] && half[h].tets_[8 * s] != kNone) renumber[h][s] = next++;
+  }
+  const auto to_global = [&](int h, std::uint32_t v) { return v == kGhost ? kGhost : global[h][v]; };
+  // The seam region's boundary: kept slots' faces towards doubtful ones, seen from the seam's side.
+  std::vector<std::pair<Face, std::uint32_t>> boundary;  // the face and the adjacency across it (new numbers)
+  for (int h = 0; h < 2; ++h)
+    for (std::size_t s = 0; s < valid[h].size(); ++s) {
+      if (renumber[h][s] == kNone) continue;
+      for (std::uint32_t f = 0; f < 4; ++f) {
+        const std::uint32_t a = half[h].tets_[8 * s + 4 + f], u = a >> 2;
+        if (valid[h][u]) continue;
+        std::uint32_t w[4];
+        for (int k = 0; k < 4; ++k) w[k] = to_global(h, half[h].tets_[8 * std::size_t(u) + k]);
+        boundary.push_back({face_of(w, int(a & 3)), 4 * renumber[h][s] + f});
+      }
+    }
+  std::sort(boundary.begin(), boundary.end());
+
+  // The fill: the filler's slots with a boundary face, and those reached from them across other faces.
+  const std::size_t filler_slots = filler.tets_.size() / 8;
+  std::vector<std::uint32_t> mapped(filler.tets_.size());
+  for (std::size_t k = 0; k < filler.tets_.size(); k += 8)
+    for (int j = 0; j < 4; ++j) {
+      const std::uint32_t u = filler.tets_[k + j];
+      mapped[k + j] = (u & Tet3Mesh::kGhostBit) ? u : seam[u];
+      mapped[k + 4 + j] = filler.tets_[k + 4 + j];
+    }
+  std::vector<std::uint32_t> fill_slot(filler_slots, kNone), outer(4 * filler_slots, kNone), fill;
+  std::size_t matched = 0;
+  for (std::size_t s = 0; s < filler_slots; ++s) {
+    if (mapped[8 * s] == kNone) continue;
+    for (int j = 0; j < 4; ++j) {
+      const Face face = face_of(&mapped[8 * s], j);
+      const auto it = std::lower_bound(boundary.begin(), boundary.end(), std::pair(face, std::uint32_t(0)));
+      if (it == boundary.end() || it->first != face) continue;
+      outer[4 * s + j] = it->second;
+      ++matched;
+      if (fill_slot[s] == kNone) fill_slot[s] = 0, fill.push_back(std::uint32_t(s));
+    }
+  }
+  // Nothing kept next to the seam (a small or flat half), or a face unmatched (not expected): build sequentially.
+  if (boundary.empty() || matched != boundary.size()) return false;
+  for (std::size_t k = 0; k < fill.size(); ++k)
+    for (int j = 0; j < 4; ++j) {
+      const std::uint32_t s = fill[k], n = mapped[8 * std::size_t(s) + 4 + j] >> 2;
+      if (outer[4 * s + j] == kNone && fill_slot[n] == kNone) fill_slot[n] = 0, fill.push_back(n);
+    }
+  for (const std::uint32_t s : fill) fill_slot[s] = next++;
+
+  // Assemble: kept slots with their adjacencies renumbered (towards the seam: the fill's), then the fill.
+  tets_.assign(8 * std::size_t(next), 0);
+  for (int h = 0; h < 2; ++h)
+    parallel_for(0, valid[h].size(), 1 << 14, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t s = begin; s < end; ++s) {
+        const std::uint32_t t = renumber[h][s];
+        if (t == kNone) continue;
+        for (int k = 0; k < 4; ++k) {
+          tets_[8 * std::size_t(t) + k] = to_global(h, half[h].tets_[8 * s + k]);
+          const std::uint32_t a = half[h].tets_[8 * s + 4 + k];
+          if (valid[h][a >> 2]) tets_[8 * std::size_t(t) + 4 + k] = 4 * renumber[h][a >> 2] + (a & 3);
+        }
+      }
+    });
+  for (const std::uint32_t s : fill) {
+    const std::uint32_t t = fill_slot[s];
+    std::copy_n(&mapped[8 * std::size_t(s)], 4, &tets_[8 * std::size_t(t)]);
+    for (std::uint32_t j = 0; j < 4; ++j) {
+      const std::uint32_t a = outer[4 * s + j];
+      if (a != kNone) {
+        tets_[8 * std::size_t(t) + 4 + j] = a;
+        tets_[Tet3Mesh::entry(a)] = 4 * t + j;
+      } else {
+        const std::uint32_t inner = mapped[8 * std::size_t(s) + 4 + j];
+        tets_[8 * std::size_t(t) + 4 + j] = 4 * fill_slot[inner >> 2] + (inner & 3);
+      }
+    }
+  }
+  // Representatives: equal points fall in the same half, whose first occurrence is the first here too.
+  for (int h = 0; h < 2; ++h)
+    for (std::size_t k = 0; k < global[h].size(); ++k) rep_[global[h][k]] = global[h][half[h].rep_[k]];
+  dimension_ = 3;
+  walk_steps_ = half[0].walk_steps_ + half[1].walk_steps_ + filler.walk_steps_;
+  conflicts_ = half[0].conflicts_ + half[1].conflicts_ + filler.conflicts_;
+  seam_points_ = seam.size();
+  last_ = fill_slot[fill.front()];
+  return true;
+}
+
+}  // namespace geods::voronoi
