@@ -14,9 +14,13 @@
 
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"
+#include "triangle_raster.hpp"
 
 namespace geods::terrain {
 namespace {
+
+using detail::P2;
+using detail::triangle_error;
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
@@ -34,45 +38,6 @@ std::uint64_t spread_bits(std::uint64_t v) {  // 32 bits -> even bits of 64
   v = (v | (v << 2)) & 0x3333333333333333ULL;
   v = (v | (v << 1)) & 0x5555555555555555ULL;
   return v;
-}
-
-struct P2 {
-  std::int64_t x, y;
-};
-
-// The largest |z(sample) - plane(sample)| over the grid samples in the closed
-// triangle (a, b, c) (integer grid coordinates) of an n-wide matrix of heights.
-double triangle_error(const float* z, std::uint64_t n, P2 a, P2 b, P2 c) {
-  const double za = z[a.y * n + a.x], zb = z[b.y * n + b.x], zc = z[c.y * n + c.x];
-  // Plane z = za + gx (x - ax) + gy (y - ay).
-  const double ux = double(b.x - a.x), uy = double(b.y - a.y), vx = double(c.x - a.x), vy = double(c.y - a.y);
-  const double det = ux * vy - uy * vx;
-  const double gx = ((zb - za) * vy - (zc - za) * uy) / det;
-  const double gy = ((zc - za) * ux - (zb - za) * vx) / det;
-  // Edge functions, made >= 0 inside.
-  P2 v[3] = {a, b, c};
-  if (det < 0) std::swap(v[1], v[2]);
-  const std::int64_t y0 = std::min({a.y, b.y, c.y}), y1 = std::max({a.y, b.y, c.y});
-  const std::int64_t xmin = std::min({a.x, b.x, c.x}), xmax = std::max({a.x, b.x, c.x});
-  double worst = 0;
-  for (std::int64_t y = y0; y <= y1; ++y) {
-    std::int64_t lo = xmin, hi = xmax;
-    for (int e = 0; e < 3; ++e) {
-      const P2 p = v[e], q = v[(e + 1) % 3];
-      // E(x, y) = (q.x - p.x) (y - p.y) - (q.y - p.y) (x - p.x) >= 0, i.e. A x <= B.
-      const std::int64_t A = q.y - p.y, B = (q.x - p.x) * (y - p.y) + (q.y - p.y) * p.x;
-      if (A > 0)
-        hi = std::min(hi, B >= 0 ? B / A : -((-B + A - 1) / A));
-      else if (A < 0)
-        lo = std::max(lo, (-B) >= 0 ? ((-B) + (-A) - 1) / (-A) : -((B) / (-A)));
-      else if (B < 0)
-        lo = hi + 1;
-    }
-    const float* row = z + y * n;
-    const double base = za + gy * double(y - a.y) - gx * double(a.x);
-    for (std::int64_t x = lo; x <= hi; ++x) worst = std::max(worst, std::abs(double(row[x]) - (base + gx * double(x))));
-  }
-  return worst;
 }
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
@@ -510,18 +475,21 @@ TerrainMesh Terrain::refine_tiles(const Refinement& refinement, std::uint32_t ti
   return assemble(*this, refiner);
 }
 
+std::vector<float> Terrain::heights_matrix() const {
+  std::vector<float> z(width_ * height_);
+  parallel_for(0, height_, 16, [&](std::size_t b, std::size_t e) {
+    for (std::size_t y = b; y < e; ++y)
+      for (std::size_t x = 0; x < width_; ++x) z[y * width_ + x] = sample(std::uint32_t(x), std::uint32_t(y));
+  });
+  return z;
+}
+
 double Terrain::measure_error(const TerrainMesh& mesh) const {
-  const std::uint64_t n = index_.n();
-  // Heights of the field (times z_scale) as a matrix, for triangle_error.
-  std::vector<float> z(n * n, 0.0f);
   for (const auto& tri : mesh.triangles)
     for (const std::uint32_t v : tri)
       if (mesh.samples.size() <= v || mesh.samples[v][0] >= width_ || mesh.samples[v][1] >= height_)
         throw Error("terrain measure_error: a vertex without a sample of the field");
-  parallel_for(0, height_, 16, [&](std::size_t b, std::size_t e) {
-    for (std::size_t y = b; y < e; ++y)
-      for (std::size_t x = 0; x < width_; ++x) z[y * n + x] = sample(std::uint32_t(x), std::uint32_t(y));
-  });
+  const std::vector<float> z = heights_matrix();
   return tbb::parallel_reduce(
       tbb::blocked_range<std::size_t>(0, mesh.triangles.size(), 256), 0.0,
       [&](const tbb::blocked_range<std::size_t>& r, double worst) {
@@ -530,7 +498,7 @@ double Terrain::measure_error(const TerrainMesh& mesh) const {
           const auto p = [&](std::uint32_t v) { return P2{mesh.samples[v][0], mesh.samples[v][1]}; };
           const P2 a = p(t[0]), b = p(t[1]), c = p(t[2]);
           if ((b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x) == 0) continue;  // degenerate: no area
-          worst = std::max(worst, triangle_error(z.data(), n, a, b, c));
+          worst = std::max(worst, triangle_error(z.data(), width_, a, b, c));
         }
         return worst;
       },

@@ -125,6 +125,15 @@ class Terrain {
   /// cracks because border vertices carry errors nested over both sides.
   TerrainMesh refine_tiles(const Refinement& refinement, std::uint32_t tiles) const;
 
+  /// A triangulated irregular network within `max_error` of every sample, by
+  /// greedy insertion (Garland & Heckbert): starting from the field's corners,
+  /// the sample farthest (vertically) from the current triangulation is inserted
+  /// into a voronoi::Delaunay2 until none is farther than max_error. With
+  /// tiles > 1 the field is cut into tiles x tiles tiles whose shared borders are
+  /// first simplified once (greedy insertion along the border polyline), so
+  /// that the tiles' triangulations meet without cracks. No strip (empty).
+  TerrainMesh tin(double max_error, std::uint32_t tiles = 1) const;
+
   /// The largest vertical distance between `mesh` and the field's samples
   /// (each sample against the triangle over it; `mesh.samples` places vertices).
   double measure_error(const TerrainMesh& mesh) const;
@@ -149,6 +158,7 @@ class Terrain {
   static Terrain load(const std::filesystem::path& path, Archive::Verify verify = Archive::Verify::checksums);
 
  private:
+  std::vector<float> heights_matrix() const;  // the field's samples (times z_scale), rows first
   std::uint64_t width_ = 0, height_ = 0;
   std::array<double, 2> spacing_{1, 1}, origin_{0, 0};
   double z_scale_ = 1;
