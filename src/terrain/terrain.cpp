@@ -228,11 +228,6 @@ TerrainStats Terrain::stats() const {
   s.unused_slots = s.slots - s.grid * s.grid;
   s.unused_slots_pct = s.slots ? 100.0 * double(s.unused_slots) / double(s.slots) : 0;
   s.filled_samples = filled_;
-  const std::uint32_t c = std::uint32_t(index_.n() / 2);
-  if (!records_.empty()) {
-    const float e = record(c, c).error;
-    s.max_error = std::isfinite(e) ? e : 0;
-  }
   s.bytes = records_.size() * sizeof(VertexRecord);
   s.mapped = records_.mapped();
   s.build_s = build_s_;

@@ -101,7 +101,6 @@ struct TerrainStats {
   std::uint64_t slots = 0, unused_slots = 0;
   double unused_slots_pct = 0;
   std::uint64_t filled_samples = 0;  // missing samples filled by the no-data rule
-  double max_error = 0;              // the largest finite nested error (what a 2-triangle... coarsest mesh misses)
   std::uint64_t bytes = 0;           // of the vertex records
   bool mapped = false;
   double build_s = 0;
@@ -128,7 +127,8 @@ class Terrain {
   /// A triangulated irregular network within `max_error` of every sample, by
   /// greedy insertion (Garland & Heckbert): starting from the field's corners,
   /// the sample farthest (vertically) from the current triangulation is inserted
-  /// into a voronoi::Delaunay2 until none is farther than max_error. With
+  /// into the Delaunay triangulation (split, then Lawson flips with the exact
+  /// incircle test) until none is farther than max_error. With
   /// tiles > 1 the field is cut into tiles x tiles tiles whose shared borders are
   /// first simplified once (greedy insertion along the border polyline), so
   /// that the tiles' triangulations meet without cracks. No strip (empty).
