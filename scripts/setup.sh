@@ -21,6 +21,7 @@ for arg in "$@"; do
   case "$arg" in
     --fuzz) packages+=(clang libclang-rt-14-dev) ;;
     --bench)
+      bench_npm=1
       # The workload generator runs `npm pack`; any npm will do (a NodeSource
       # nodejs ships its own and conflicts with Debian's npm package).
       command -v npm >/dev/null || packages+=(npm)
@@ -33,6 +34,15 @@ for arg in "$@"; do
   esac
 done
 
+# npm programs of bench/compare (run with node, never linked into geods), from their lock files.
+bench_npm_install() {
+  [[ "${bench_npm:-0}" == 1 ]] || return 0
+  for lock in bench/compare/*/package-lock.json; do
+    dir=$(dirname "$lock")
+    [[ -d "$dir/node_modules" ]] || npm ci --prefix "$dir" --no-audit --no-fund --loglevel=error
+  done
+}
+
 missing=()
 for p in "${packages[@]}"; do
   if [[ "$(dpkg-query -W -f='${Status}' "$p" 2>/dev/null)" != "install ok installed" ]]; then
@@ -41,6 +51,7 @@ for p in "${packages[@]}"; do
 done
 if ((${#missing[@]} == 0)); then
   echo "setup: all ${#packages[@]} packages present"
+  bench_npm_install
   exit 0
 fi
 
@@ -58,4 +69,5 @@ fi
 export DEBIAN_FRONTEND=noninteractive
 "${as_root[@]}" apt-get update -qq
 "${as_root[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
+bench_npm_install
 echo "setup: done"

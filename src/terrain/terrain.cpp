@@ -416,12 +416,28 @@ TerrainMesh assemble(const Terrain& t, const Refiner& refiner) {
   }
   for (const auto& tri : refiner.tris_)
     if (inside(tri[0]) && inside(tri[1]) && inside(tri[2])) ids.insert(ids.end(), tri.begin(), tri.end());
-  std::vector<std::uint64_t> unique = ids;
-  unique.insert(unique.end(), strip.begin(), strip.end());
-  std::sort(unique.begin(), unique.end());
-  unique.erase(std::unique(unique.begin(), unique.end()), unique.end());
+  // Vertices numbered in grid order: by a dense table up to 2^24 samples, else by sorting.
+  std::vector<std::uint64_t> unique;
+  std::vector<std::uint32_t> dense;
+  constexpr std::uint32_t kUnused = std::numeric_limits<std::uint32_t>::max();
+  if (n * n <= (std::uint64_t(1) << 24)) {
+    dense.assign(n * n, kUnused);
+    for (const std::uint64_t g : ids) dense[g] = 0;
+    for (const std::uint64_t g : strip) dense[g] = 0;
+    for (std::uint64_t g = 0; g < n * n; ++g)
+      if (dense[g] == 0) {
+        dense[g] = std::uint32_t(unique.size());
+        unique.push_back(g);
+      }
+  } else {
+    unique = ids;
+    unique.insert(unique.end(), strip.begin(), strip.end());
+    std::sort(unique.begin(), unique.end());
+    unique.erase(std::unique(unique.begin(), unique.end()), unique.end());
+  }
   auto number = [&](std::uint64_t g) {
-    return std::uint32_t(std::lower_bound(unique.begin(), unique.end(), g) - unique.begin());
+    return dense.empty() ? std::uint32_t(std::lower_bound(unique.begin(), unique.end(), g) - unique.begin())
+                         : dense[g];
   };
   mesh.vertices.resize(unique.size());
   mesh.samples.resize(unique.size());
