@@ -59,6 +59,13 @@ terrain::Refinement refinement_of(std::optional<double> max_error, const std::op
   return r;
 }
 
+terrain::TerrainMesh refined(const terrain::Terrain& t, std::optional<double> max_error,
+                             const std::optional<py::dict>& camera, std::optional<double> pixel_error,
+                             std::uint32_t tiles) {
+  const terrain::Refinement r = refinement_of(max_error, camera, pixel_error);
+  return without_gil([&] { return t.refine_tiles(r, tiles); });
+}
+
 py::tuple mesh_tuple(const terrain::TerrainMesh& m) {
   TriMesh t;
   t.vertices = m.vertices;
@@ -89,8 +96,7 @@ void bind_terrain(py::module_& m) {
           "refine",
           [](const terrain::Terrain& t, std::optional<double> max_error, std::optional<py::dict> camera,
              std::optional<double> pixel_error, std::uint32_t tiles) {
-            const terrain::Refinement r = refinement_of(max_error, camera, pixel_error);
-            return mesh_tuple(without_gil([&] { return t.refine_tiles(r, tiles); }));
+            return mesh_tuple(refined(t, max_error, camera, pixel_error, tiles));
           },
           py::arg("max_error") = py::none(), py::arg("camera") = py::none(), py::arg("pixel_error") = py::none(),
           py::arg("tiles") = 1,
@@ -100,9 +106,7 @@ void bind_terrain(py::module_& m) {
           "strip",
           [](const terrain::Terrain& t, std::optional<double> max_error, std::optional<py::dict> camera,
              std::optional<double> pixel_error, std::uint32_t tiles) {
-            const terrain::Refinement r = refinement_of(max_error, camera, pixel_error);
-            const terrain::TerrainMesh mesh = without_gil([&] { return t.refine_tiles(r, tiles); });
-            return index_array(mesh.strip);
+            return index_array(refined(t, max_error, camera, pixel_error, tiles).strip);
           },
           py::arg("max_error") = py::none(), py::arg("camera") = py::none(), py::arg("pixel_error") = py::none(),
           py::arg("tiles") = 1,

@@ -13,6 +13,7 @@
 #include <string>
 
 #include "geods/core/error.hpp"
+#include "geods/core/morton.hpp"
 #include "geods/core/parallel.hpp"
 #include "triangle_raster.hpp"
 
@@ -28,16 +29,6 @@ float round_up(double v) {
   float f = float(v);
   if (double(f) < v) f = std::nextafter(f, kInf);
   return f;
-}
-
-std::uint64_t spread_bits(std::uint64_t v) {  // 32 bits -> even bits of 64
-  v &= 0xffffffffULL;
-  v = (v | (v << 16)) & 0x0000ffff0000ffffULL;
-  v = (v | (v << 8)) & 0x00ff00ff00ff00ffULL;
-  v = (v | (v << 4)) & 0x0f0f0f0f0f0f0f0fULL;
-  v = (v | (v << 2)) & 0x3333333333333333ULL;
-  v = (v | (v << 1)) & 0x5555555555555555ULL;
-  return v;
 }
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
@@ -92,7 +83,7 @@ std::uint64_t LayoutIndex::interleaved_slot(std::uint32_t x, std::uint32_t y) co
   const std::int64_t m = N >> t;
   const std::int64_t u = (X + Y) >> t, v = (X - Y) / s;  // odd, u in (0, 2m), v in (-m, m)
   const std::uint64_t i = std::uint64_t((u - 1) / 2), j = std::uint64_t((v + m - 1) / 2);
-  return base_[std::size_t(t)] + (spread_bits(i) | (spread_bits(j) << 1));
+  return base_[std::size_t(t)] + morton2d_encode64(std::uint32_t(i), std::uint32_t(j));
 }
 
 // ---------------------------------------------------------------- build
