@@ -369,7 +369,8 @@ class Refiner {
 // vertices numbered in order of first use.
 TerrainMesh assemble(const Terrain& t, const Refiner& refiner) {
   const std::uint64_t n = t.layout().n(), W = t.width(), H = t.height();
-  auto inside = [&](std::uint64_t g) { return g % n < W && g / n < H; };
+  const bool full = W == n && H == n;  // no padding: every triangle is inside
+  auto inside = [&](std::uint64_t g) { return full || (g % n < W && g / n < H); };
   TerrainMesh mesh;
   std::vector<std::uint64_t> ids;
   ids.reserve(refiner.tris_.size() * 2);
