@@ -11,6 +11,7 @@ packages=(
   cmake ninja-build g++ ccache pkg-config git
   libeigen3-dev libtbb-dev libassimp-dev libstb-dev libnifti2-dev zlib1g-dev
   libzip-dev  # zip archives and .sh3f furniture libraries of shape collections (BSD)
+  libgdal-dev  # GeoTIFF and other rasters as terrain height fields (MIT)
   libcli11-dev nlohmann-json3-dev libfmt-dev
   libgtest-dev libbenchmark-dev libgmp-dev
   python3 python3-dev python3-numpy python3-pytest pybind11-dev
@@ -20,6 +21,7 @@ for arg in "$@"; do
   case "$arg" in
     --fuzz) packages+=(clang libclang-rt-14-dev) ;;
     --bench)
+      bench_npm=1
       # The workload generator runs `npm pack`; any npm will do (a NodeSource
       # nodejs ships its own and conflicts with Debian's npm package).
       command -v npm >/dev/null || packages+=(npm)
@@ -32,6 +34,15 @@ for arg in "$@"; do
   esac
 done
 
+# npm programs of bench/compare (run with node, never linked into geods), from their lock files.
+bench_npm_install() {
+  [[ "${bench_npm:-0}" == 1 ]] || return 0
+  for lock in bench/compare/*/package-lock.json; do
+    dir=$(dirname "$lock")
+    [[ -d "$dir/node_modules" ]] || npm ci --prefix "$dir" --no-audit --no-fund --loglevel=error
+  done
+}
+
 missing=()
 for p in "${packages[@]}"; do
   if [[ "$(dpkg-query -W -f='${Status}' "$p" 2>/dev/null)" != "install ok installed" ]]; then
@@ -40,6 +51,7 @@ for p in "${packages[@]}"; do
 done
 if ((${#missing[@]} == 0)); then
   echo "setup: all ${#packages[@]} packages present"
+  bench_npm_install
   exit 0
 fi
 
@@ -57,4 +69,5 @@ fi
 export DEBIAN_FRONTEND=noninteractive
 "${as_root[@]}" apt-get update -qq
 "${as_root[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
+bench_npm_install
 echo "setup: done"

@@ -1,0 +1,91 @@
+// geods::terrain on the terrain comparison: data/trigger_tropic_h.png (1024^2, 8-bit) padded
+// to 1025^2 by repeating its last row and column (as field.mjs does for martini and delatin).
+// Variants: e<T>: the 4-8 mesh within T of every sample (build_s = the hierarchy, query_s =
+// the refinement); tin_e<T>: the greedy TIN within T; view: view-dependent refinement
+// (tau = 1 pixel, 1024 x 768, 60 degrees) from 16 low viewpoints, query_s = per view;
+// view_matrix: the same with the matrix layout. Every mesh's error is measured against
+// every sample (max_error) and must be <= T.
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "common.hpp"
+#include "geods/terrain/terrain.hpp"
+
+using namespace geods;
+
+static terrain::HeightField field_1025() {
+  const terrain::HeightField in = terrain::read_height_field(GEODS_DATA_DIR "/trigger_tropic_h.png");
+  terrain::HeightField f;
+  f.width = f.height = 1025;
+  f.heights.resize(1025 * 1025);
+  for (std::size_t y = 0; y < 1025; ++y)
+    for (std::size_t x = 0; x < 1025; ++x)
+      f.heights[y * 1025 + x] = in(std::min<std::size_t>(x, in.width - 1), std::min<std::size_t>(y, in.height - 1));
+  return f;
+}
+
+int main(int argc, char** argv) {
+  const compare::Args args = compare::parse_args(argc, argv);
+  const compare::ThreadLimit limit(args.threads);
+  const terrain::HeightField field = field_1025();
+  terrain::Terrain t;
+  const double build_s = compare::median_time_s(args.reps, [&] { t = terrain::Terrain(field); });
+  for (const double target : {1.0, 2.0, 4.0, 8.0, 16.0}) {
+    const std::string e = std::to_string(int(target));
+    if (args.wants("e" + e)) {
+      terrain::Refinement r;
+      r.max_error = target;
+      terrain::TerrainMesh m;
+      const double s = compare::median_time_s(args.reps, [&] { m = t.refine(r); });
+      const double err = t.measure_error(m);
+      compare::Record("terrain", "geods", "e" + e, args.threads)
+          .timing(build_s, s, m.triangles.size(), args.reps)
+          .set("triangles", m.triangles.size())
+          .set("max_error", err)
+          .set("strip_length", m.strip.size())
+          .print(err <= target);
+    }
+    if (args.wants("tin_e" + e)) {
+      terrain::TerrainMesh m;
+      const double s = compare::median_time_s(args.reps, [&] { m = t.tin(target); });
+      const double err = t.measure_error(m);
+      compare::Record("terrain", "geods", "tin_e" + e, args.threads)
+          .timing(0, s, m.triangles.size(), args.reps)
+          .set("triangles", m.triangles.size())
+          .set("max_error", err)
+          .print(err <= target);
+    }
+  }
+  // Views: a low flight across the field, looking ahead and a little down.
+  for (const auto layout : {terrain::Layout::interleaved, terrain::Layout::matrix}) {
+    const std::string name = layout == terrain::Layout::matrix ? "view_matrix" : "view";
+    if (!args.wants(name)) continue;
+    terrain::TerrainOptions o;
+    o.layout = layout;
+    const terrain::Terrain tv = layout == terrain::Layout::interleaved ? t : terrain::Terrain(field, o);
+    std::size_t triangles = 0;
+    const int views = 16;
+    const double s = compare::median_time_s(args.reps, [&] {
+      triangles = 0;
+      for (int k = 0; k < views; ++k) {
+        const double a = 2 * M_PI * k / views;
+        terrain::Refinement r;
+        terrain::TerrainView v;
+        v.camera.eye = Vec3f(float(512 + 400 * std::cos(a)), float(512 + 400 * std::sin(a)), 300.0f);
+        v.camera.target = Vec3f(float(512 + 400 * std::cos(a + 0.8)), float(512 + 400 * std::sin(a + 0.8)), 120.0f);
+        v.camera.up = Vec3f(0, 0, 1);
+        v.camera.vertical_fov_deg = 60;
+        r.view = v;
+        r.pixel_error = 1;
+        triangles += tv.refine(r).triangles.size();
+      }
+    });
+    compare::Record("terrain", "geods", name, args.threads)
+        .timing(build_s, s / views, triangles / views, args.reps)
+        .set("triangles", triangles / views)
+        .set("ms_per_view", 1e3 * s / views)
+        .print(triangles > 0);
+  }
+  return 0;
+}
