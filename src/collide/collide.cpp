@@ -76,6 +76,8 @@ CollisionMesh::CollisionMesh(const TriMesh& mesh, const CollisionMeshOptions& op
   if (mesh.triangles.empty()) return;
   bvh_ = bvh::TriangleBvh::build(mesh, bo);
   depth_ = bvh_.topology().depth();
+  leaf_position_.resize(mesh.triangles.size());
+  for (std::uint32_t k = 0; k < bvh_.triangle_ids().size(); ++k) leaf_position_[bvh_.triangle_ids()[k]] = k;
   for (const auto& t : mesh.triangles)
     for (const auto v : t) extent_ = std::max(extent_, double(mesh.vertices[v].cwiseAbs().maxCoeff()));
   std::visit(
@@ -97,7 +99,7 @@ CollisionMesh::CollisionMesh(const TriMesh& mesh, const CollisionMeshOptions& op
           }
           if constexpr (std::is_same_v<BV, bvh::Obb3f>) {
             oriented_[i] = {volumes[i].axes.template cast<double>(), volumes[i].center.template cast<double>(),
-                            volumes[i].half.template cast<double>()};
+                            volumes[i].half.template cast<double>(), volumes[i].half.template cast<double>().norm()};
             sizes_[i] = 2 * oriented_[i].half.norm();
           }
         }
@@ -167,7 +169,7 @@ struct BoxTester {
     return (c - a[i].center).cwiseAbs() - a[i].half - h;
   }
   bool overlap(std::uint32_t i, std::uint32_t j) const { return (gap(i, j).array() <= f.eps).all(); }
-  double lower(std::uint32_t i, std::uint32_t j) const {
+  double lower(std::uint32_t i, std::uint32_t j, double) const {
     return gap(i, j).cwiseMax(Vec3d::Zero()).norm() - f.eps;
   }
 };
@@ -182,7 +184,7 @@ struct BallTester {
     return (c - a[i].center).norm() - a[i].radius - b[j].radius;
   }
   bool overlap(std::uint32_t i, std::uint32_t j) const { return gap(i, j) <= f.eps; }
-  double lower(std::uint32_t i, std::uint32_t j) const { return gap(i, j) - f.eps; }
+  double lower(std::uint32_t i, std::uint32_t j, double) const { return gap(i, j) - f.eps; }
 };
 
 // k-DOPs do not rotate: each side's k-DOP is tested against the rotated
@@ -238,7 +240,7 @@ struct KdopTester {
     return g;
   }
   bool overlap(std::uint32_t i, std::uint32_t j) const { return gap(i, j, true) <= f.eps; }
-  double lower(std::uint32_t i, std::uint32_t j) const { return gap(i, j, false) - f.eps; }
+  double lower(std::uint32_t i, std::uint32_t j, double) const { return gap(i, j, false) - f.eps; }
 };
 
 // Gottschalk's 15-axis separating test, B's box carried into A's box frame.
@@ -251,16 +253,32 @@ struct ObbTester {
   const CollisionMesh::Oriented* b;
   explicit ObbTester(const Frames& fr) : f(fr), a(fr.a.oriented().data()), b(fr.b.oriented().data()) {}
 
+  // Lower: a lower bound of the distance, returned as soon as it reaches
+  // `cutoff` (the pair is then pruned whatever its exact bound).
   template <bool Lower>
-  double gap(std::uint32_t i, std::uint32_t j) const {
+  double gap(std::uint32_t i, std::uint32_t j, double cutoff = 0) const {
     const CollisionMesh::Oriented& A = a[i];
     const CollisionMesh::Oriented& B = b[j];
     const Eigen::Matrix3d& R = f.ab.r;
     const double eps = f.eps;
     // B's centre in A's model frame, then relative to A's centre.
     const Vec3d d = R * B.center + f.ab.t - A.center;
+    // The bounding spheres first: apart, they bound the gap from below.
+    const double reach = A.radius + B.radius + eps;
+    const double d2 = d.squaredNorm();
+    if (d2 > reach * reach) {
+      if constexpr (!Lower) return std::sqrt(d2) - A.radius - B.radius;
+    }
     double g = -std::numeric_limits<double>::infinity();
+    if constexpr (Lower) {
+      g = std::sqrt(d2) - A.radius - B.radius;
+      if (g >= cutoff) return g;
+    }
     double t[3], r[3][3], ar[3][3];
+    // Lower bound: the gaps along A's axes are those between A's box and B's
+    // box bounded in A's frame, whose distance is their Euclidean norm (and
+    // the same in B's frame).
+    double sum_a = 0, sum_b = 0;
     for (int k = 0; k < 3; ++k) {
       // Row k: A's axis k in B's model frame (m = R^T a_k), against B's axes.
       const Vec3d ak = A.axes.col(k);
@@ -273,6 +291,7 @@ struct ObbTester {
       const double s = std::abs(t[k]) - A.half[k] - (B.half[0] * ar[k][0] + B.half[1] * ar[k][1] + B.half[2] * ar[k][2]);
       g = std::max(g, s);
       if (!Lower && g > eps) return g;
+      if (s > 0) sum_a += s * s;
     }
     const Vec3d& ha = A.half;
     const Vec3d& hb = B.half;
@@ -281,6 +300,11 @@ struct ObbTester {
                        (ha[0] * ar[0][l] + ha[1] * ar[1][l] + ha[2] * ar[2][l]) - hb[l];
       g = std::max(g, s);
       if (!Lower && g > eps) return g;
+      if (s > 0) sum_b += s * s;
+    }
+    if constexpr (Lower) {
+      g = std::max(g, std::sqrt(std::max(sum_a, sum_b)));
+      if (g >= cutoff) return g;
     }
     for (int k = 0; k < 3; ++k) {
       const int k1 = (k + 1) % 3, k2 = (k + 2) % 3;
@@ -290,6 +314,8 @@ struct ObbTester {
         const double rb = hb[l1] * ar[k][l2] + hb[l2] * ar[k][l1];
         double s = std::abs(t[k2] * r[k1][l] - t[k1] * r[k2][l]) - ra - rb;
         if constexpr (Lower) {
+          // Normalized by the axis' length, only if it can raise the bound.
+          if (s <= std::min(g, 0.0)) continue;
           const double len = std::sqrt(std::max(0.0, 1 - r[k][l] * r[k][l]));
           if (len < 1e-6) continue;
           s /= len;
@@ -301,7 +327,9 @@ struct ObbTester {
     return g;
   }
   bool overlap(std::uint32_t i, std::uint32_t j) const { return gap<false>(i, j) <= f.eps; }
-  double lower(std::uint32_t i, std::uint32_t j) const { return gap<true>(i, j) - f.eps; }
+  double lower(std::uint32_t i, std::uint32_t j, double cutoff) const {
+    return gap<true>(i, j, cutoff + f.eps) - f.eps;
+  }
 };
 
 // ---- The traversal.
@@ -441,6 +469,18 @@ CollideResult collide_frames(const Frames& f, const CollideRequest& request) {
   return result;
 }
 
+// A lower bound of the distance between triangles s and t: how far t lies on
+// one side of s's plane (0 if it reaches the plane or s is degenerate).
+double plane_gap(const TriangleD& s, const TriangleD& t) {
+  const Vec3d n = (s[1] - s[0]).cross(s[2] - s[0]);
+  const double len = n.norm();
+  if (!(len > 0)) return 0;
+  const double d0 = n.dot(t[0] - s[0]), d1 = n.dot(t[1] - s[0]), d2 = n.dot(t[2] - s[0]);
+  const double lo = std::min({d0, d1, d2}), hi = std::max({d0, d1, d2});
+  const double g = lo > 0 ? lo : (hi < 0 ? -hi : 0.0);
+  return g / len * (1 - 1e-12);  // rounded down a little: a bound, never above the distance
+}
+
 float key_below(double x) {
   float k = float(x);
   if (double(k) > x) k = std::nextafter(k, -std::numeric_limits<float>::infinity());
@@ -449,6 +489,25 @@ float key_below(double x) {
 
 DistanceResult distance_frames(const Frames& f, const DistanceRequest& request) {
   DistanceResult result;
+  // In contact: the first contact answers (distance 0, a common point), far
+  // faster than the search for a pair at distance 0 among all pairs that may be.
+  const CollideResult contact = collide_frames(f, {CollideMode::first, request.descend});
+  result.stats = contact.stats;
+  if (contact.colliding) {
+    const Contact c = contact.pairs[0];
+    auto world_triangle = [](const CollisionMesh& m, const Rigid& pose, std::uint32_t id) {
+      const auto& t = m.bvh().triangles()[m.leaf_position(id)];
+      return TriangleD{to_world(pose, t.a), to_world(pose, t.b), to_world(pose, t.c)};
+    };
+    const TrianglePairDistance d = triangle_distance(world_triangle(f.a, f.wa, c.a), world_triangle(f.b, f.wb, c.b));
+    result.distance = 0;
+    result.point_a = d.on_s;
+    result.point_b = d.on_t;
+    result.triangle_a = c.a;
+    result.triangle_b = c.b;
+    result.within = request.within >= 0;
+    return result;
+  }
   double best = std::numeric_limits<double>::infinity();
   const double within = request.within;
   LeafTriangles la, lb;
@@ -459,7 +518,7 @@ DistanceResult distance_frames(const Frames& f, const DistanceRequest& request) 
         f, request.descend,
         [&](std::uint32_t i, std::uint32_t j, float& key) {
           ++result.stats.volume_tests;
-          const double lower = tester.lower(i, j);
+          const double lower = tester.lower(i, j, within >= 0 ? std::min(best, within) : best);
           key = key_below(lower);
           return lower < best && !(within >= 0 && lower > within);
         },
@@ -472,6 +531,7 @@ DistanceResult distance_frames(const Frames& f, const DistanceRequest& request) 
               // The boxes' distance bounds the triangles' from below.
               const Vec3d gap = (la.box[s].lo - lb.box[t].hi).cwiseMax(lb.box[t].lo - la.box[s].hi).cwiseMax(0.0);
               if (gap.squaredNorm() >= best * best) continue;
+              if (plane_gap(la.tri[s], lb.tri[t]) >= best || plane_gap(lb.tri[t], la.tri[s]) >= best) continue;
               ++result.stats.triangle_tests;
               const TrianglePairDistance d = triangle_distance(la.tri[s], lb.tri[t]);
               if (d.distance < best) {

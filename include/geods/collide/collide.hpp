@@ -98,10 +98,13 @@ class CollisionMesh {
   struct Oriented {
     Eigen::Matrix3d axes;  // columns
     Vec3d center, half;
+    double radius;  // |half|: the bounding sphere about the centre, a cheap first test
   };
   const std::vector<Box>& boxes() const { return boxes_; }
   const std::vector<Ball>& balls() const { return balls_; }
   const std::vector<Oriented>& oriented() const { return oriented_; }
+  /// Where triangle `id` of the mesh sits in bvh().triangles() (leaf order).
+  std::uint32_t leaf_position(std::uint32_t id) const { return leaf_position_[id]; }
   /// Per node, the size the "larger" descend rule compares (the volume's diameter).
   const std::vector<double>& sizes() const { return sizes_; }
 
@@ -114,6 +117,7 @@ class CollisionMesh {
   std::vector<Ball> balls_;        // sphere
   std::vector<Oriented> oriented_;  // obb, obb_hull
   std::vector<double> sizes_;
+  std::vector<std::uint32_t> leaf_position_;
 };
 
 /// Which node of a pair the simultaneous traversal opens.
