@@ -2,6 +2,7 @@
 // simultaneous traversal of their hierarchies on bvh::traverse, one volume
 // tester per bounding volume, exact triangle tests at the leaves.
 #include "geods/collide/collide.hpp"
+#include "geods/collide/incremental.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -433,13 +434,29 @@ auto with_tester(const Frames& f, Fn&& fn) {
   return fn(BoxTester(f));  // aabb, boxtree, and meshes of different volumes
 }
 
+// The exact tests of the triangles of leaves i (of A) and j (of B): calls
+// contact(Contact) for each intersecting pair; false from it stops.
+template <typename OnContact>
+bool leaf_contacts(const Frames& f, LeafTriangles& la, LeafTriangles& lb, std::uint32_t i, std::uint32_t j,
+                   CollideStats& stats, OnContact&& contact) {
+  ++stats.leaf_pairs;
+  la.load(f.a, f.wa, f.a.bvh().topology().nodes[i]);
+  lb.load(f.b, f.wb, f.b.bvh().topology().nodes[j]);
+  for (std::size_t s = 0; s < la.tri.size(); ++s)
+    for (std::size_t t = 0; t < lb.tri.size(); ++t) {
+      if (!la.box[s].overlaps(lb.box[t])) continue;
+      ++stats.triangle_tests;
+      if (!triangles_intersect(la.tri[s], lb.tri[t])) continue;
+      if (!contact(Contact{la.id[s], lb.id[t]})) return false;
+    }
+  return true;
+}
+
 CollideResult collide_frames(const Frames& f, const CollideRequest& request) {
   CollideResult result;
   const bool all = request.mode == CollideMode::all;
   if (request.max_pairs == 0) return result;
   LeafTriangles la, lb;
-  const bvh::TopoNode* na = f.a.bvh().topology().nodes.data();
-  const bvh::TopoNode* nb = f.b.bvh().topology().nodes.data();
   with_tester(f, [&](const auto& tester) {
     traverse_pairs<false>(
         f, request.descend,
@@ -448,19 +465,11 @@ CollideResult collide_frames(const Frames& f, const CollideRequest& request) {
           return tester.overlap(i, j);
         },
         [&](std::uint32_t i, std::uint32_t j) {
-          ++result.stats.leaf_pairs;
-          la.load(f.a, f.wa, na[i]);
-          lb.load(f.b, f.wb, nb[j]);
-          for (std::size_t s = 0; s < la.tri.size(); ++s)
-            for (std::size_t t = 0; t < lb.tri.size(); ++t) {
-              if (!la.box[s].overlaps(lb.box[t])) continue;
-              ++result.stats.triangle_tests;
-              if (!triangles_intersect(la.tri[s], lb.tri[t])) continue;
-              result.colliding = true;
-              result.pairs.push_back({la.id[s], lb.id[t]});
-              if (!all || result.pairs.size() >= request.max_pairs) return false;
-            }
-          return true;
+          return leaf_contacts(f, la, lb, i, j, result.stats, [&](const Contact& c) {
+            result.colliding = true;
+            result.pairs.push_back(c);
+            return all && result.pairs.size() < request.max_pairs;
+          });
         },
         [](float) { return true; });
     return 0;
@@ -571,6 +580,156 @@ DistanceResult distance(const CollisionMesh& a, const Posed& pose_a, const Colli
 DistanceResult distance(const CollisionMesh& a, const Posef& pose_a, const CollisionMesh& b, const Posef& pose_b,
                         const DistanceRequest& request) {
   return distance(a, to_double(pose_a), b, to_double(pose_b), request);
+}
+
+// ---- Incremental collision detection.
+
+IncrementalCollide::IncrementalCollide(const CollisionMesh& a, const CollisionMesh& b, DescendRule descend)
+    : a_(&a), b_(&b), descend_(descend) {}
+
+void IncrementalCollide::reset() {
+  slice_.clear();
+  parent_.clear();
+}
+
+namespace {
+constexpr std::uint64_t kNoPair = ~std::uint64_t(0);
+std::uint64_t pair_key(std::uint32_t a, std::uint32_t b) { return std::uint64_t(a) << 32 | b; }
+}  // namespace
+
+CollideResult IncrementalCollide::update(const Posed& pose_a, const Posed& pose_b) {
+  const Frames f = frames(*a_, pose_a, *b_, pose_b);
+  CollideResult result;
+  const auto& na = a_->bvh().topology().nodes;
+  const auto& nb = b_->bvh().topology().nodes;
+  if (na.empty() || nb.empty()) return result;
+  if (slice_.empty()) slice_.push_back({0, 0, kNoPair, false});
+  auto opens_a = [&](std::uint32_t i, std::uint32_t j) {
+    return open_a(na[i], nb[j], a_->sizes()[i], b_->sizes()[j], descend_);
+  };
+  LeafTriangles la, lb;
+  std::vector<Entry> next;
+  next.reserve(slice_.size());
+  with_tester(f, [&](const auto& tester) {
+    // Down: each slice pair that overlaps now is replaced by the bottom slice of its subtree.
+    std::vector<Entry> stack;
+    for (const Entry& e : slice_) {
+      stack.push_back(e);
+      while (!stack.empty()) {
+        const Entry p = stack.back();
+        stack.pop_back();
+        ++result.stats.volume_tests;
+        if (!tester.overlap(p.a, p.b)) {
+          next.push_back({p.a, p.b, p.parent, true});
+          continue;
+        }
+        if (na[p.a].leaf() && nb[p.b].leaf()) {
+          leaf_contacts(f, la, lb, p.a, p.b, result.stats, [&](const Contact& c) {
+            result.pairs.push_back(c);
+            return true;
+          });
+          next.push_back({p.a, p.b, p.parent, false});
+          continue;
+        }
+        const std::uint64_t here = pair_key(p.a, p.b);
+        parent_[here] = p.parent;
+        if (opens_a(p.a, p.b)) {
+          for (std::uint32_t c = 0; c < na[p.a].num_children; ++c) stack.push_back({na[p.a].first_child + c, p.b, here, false});
+        } else {
+          for (std::uint32_t c = 0; c < nb[p.b].num_children; ++c) stack.push_back({p.a, nb[p.b].first_child + c, here, false});
+        }
+      }
+    }
+    // Up: siblings all apart, under a parent apart too, become the parent (one
+    // level per frame: a pair keeps rising while it stays apart).
+    std::vector<std::uint32_t> idx;
+    for (bool changed = true; changed;) {
+      if (!changed) break;
+      changed = false;
+      idx.clear();
+      for (std::uint32_t k = 0; k < next.size(); ++k)
+        if (next[k].apart && next[k].parent != kNoPair) idx.push_back(k);
+      std::sort(idx.begin(), idx.end(), [&](std::uint32_t x, std::uint32_t y) { return next[x].parent < next[y].parent; });
+      std::vector<bool> drop(next.size(), false);
+      std::vector<Entry> raised;
+      for (std::size_t g = 0; g < idx.size();) {
+        std::size_t h = g;
+        const std::uint64_t p = next[idx[g]].parent;
+        while (h < idx.size() && next[idx[h]].parent == p) ++h;
+        const auto i = std::uint32_t(p >> 32), j = std::uint32_t(p);
+        const std::uint32_t children = opens_a(i, j) ? na[i].num_children : nb[j].num_children;
+        if (h - g == children) {
+          ++result.stats.volume_tests;
+          if (!tester.overlap(i, j)) {
+            for (std::size_t k = g; k < h; ++k) drop[idx[k]] = true;
+            const auto it = parent_.find(p);
+            raised.push_back({i, j, it->second, true});
+            parent_.erase(it);
+            changed = true;
+          }
+        }
+        g = h;
+      }
+      std::size_t w = 0;
+      for (std::size_t k = 0; k < next.size(); ++k)
+        if (!drop[k]) next[w++] = next[k];
+      next.resize(w);
+      next.insert(next.end(), raised.begin(), raised.end());
+      changed = false;  // one level
+    }
+    return 0;
+  });
+  slice_.swap(next);
+  std::sort(result.pairs.begin(), result.pairs.end());
+  result.colliding = !result.pairs.empty();
+  return result;
+}
+
+// ---- Broad phase.
+
+BroadPhase::BroadPhase(std::vector<const CollisionMesh*> meshes) : meshes_(std::move(meshes)) {
+  order_.resize(meshes_.size());
+  for (std::uint32_t i = 0; i < order_.size(); ++i) order_[i] = i;
+}
+
+std::vector<std::pair<std::uint32_t, std::uint32_t>> BroadPhase::update(const std::vector<Posed>& poses) {
+  if (poses.size() != meshes_.size())
+    throw Error("collide: BroadPhase::update needs one pose per mesh (" + std::to_string(meshes_.size()) + "), got " +
+                std::to_string(poses.size()));
+  // World boxes: the root's bounding box carried by the pose, padded like the volume tests.
+  std::vector<AABB3d> boxes(meshes_.size());
+  for (std::size_t i = 0; i < meshes_.size(); ++i) {
+    const Rigid r = rigid(poses[i], "a mesh");
+    if (meshes_[i]->boxes().empty()) continue;  // empty mesh: empty box
+    const CollisionMesh::Box& b = meshes_[i]->boxes()[0];
+    const Vec3d c = r.r * b.center + r.t;
+    const double pad = 1e-9 * (meshes_[i]->extent() + r.t.cwiseAbs().maxCoeff());
+    const Vec3d h = r.r.cwiseAbs() * b.half + Vec3d::Constant(pad);
+    boxes[i] = AABB3d(c - h, c + h);
+  }
+  // Insertion sort by the low x: nearly sorted after a small motion, O(n) then.
+  auto low = [&](std::uint32_t i) { return boxes[i].empty() ? std::numeric_limits<double>::infinity() : boxes[i].lo[0]; };
+  for (std::size_t k = 1; k < order_.size(); ++k) {
+    const std::uint32_t v = order_[k];
+    std::size_t m = k;
+    while (m > 0 && low(order_[m - 1]) > low(v)) order_[m] = order_[m - 1], --m;
+    order_[m] = v;
+  }
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> out;
+  candidates_ = 0;
+  for (std::size_t k = 0; k < order_.size(); ++k) {
+    const std::uint32_t i = order_[k];
+    if (boxes[i].empty()) break;
+    for (std::size_t m = k + 1; m < order_.size() && low(order_[m]) <= boxes[i].hi[0]; ++m) {
+      const std::uint32_t j = order_[m];
+      if (!boxes[i].overlaps(boxes[j])) continue;
+      ++candidates_;
+      const std::uint32_t x = std::min(i, j), y = std::max(i, j);
+      if (collide(*meshes_[x], poses[x], *meshes_[y], poses[y]).colliding) out.push_back({x, y});
+    }
+  }
+  std::sort(out.begin(), out.end());
+  return out;
 }
 
 }  // namespace geods::collide
