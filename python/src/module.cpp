@@ -20,4 +20,5 @@ PYBIND11_MODULE(_geods, m) {
   geods::python::bind_field(m);
   geods::python::bind_terrain(m);
   geods::python::bind_shape(m);
+  geods::python::bind_collide(m);
 }
