@@ -13,6 +13,7 @@
 #include "geods/core/parallel.hpp"
 #include "geods/core/predicates.hpp"
 #include "geods/voronoi/delaunay_core.hpp"
+#include "generalized_common.hpp"
 #include "halfplane_clip.hpp"
 
 namespace geods::voronoi {
@@ -457,7 +458,7 @@ PowerDiagram::PowerDiagram(std::span<const Vec2d> points, std::span<const double
 
 PowerDiagram::PowerDiagram(RegularTriangulation triangulation, const AABB2d& box)
     : triangulation_(std::move(triangulation)), box_(box) {
-  if (box.empty() || !(box.hi - box.lo).allFinite()) throw Error("PowerDiagram: empty or non-finite box");
+  detail::check_sites_and_box(triangulation_.points(), box, "PowerDiagram");
   const RegularTriangulation& rt = triangulation_;
   const std::size_t n = rt.points().size();
   cells_.resize(n);
@@ -500,19 +501,7 @@ void PowerDiagram::validate() const {
   triangulation_.validate();
   const auto fail = [](const std::string& what) { throw Error("PowerDiagram::validate: " + what); };
   const double side = std::max(box_.hi[0] - box_.lo[0], box_.hi[1] - box_.lo[1]);
-  for (std::size_t i = 0; i < cells_.size(); ++i) {
-    const auto& cell = cells_[i];
-    if (cell.empty()) continue;
-    double twice = 0;
-    for (std::size_t k = 0; k < cell.size(); ++k) {
-      const Vec2d& a = cell[k];
-      const Vec2d& b = cell[(k + 1) % cell.size()];
-      twice += a[0] * b[1] - b[0] * a[1];
-      if (((a - box_.lo).array() < -1e-9 * side).any() || ((a - box_.hi).array() > 1e-9 * side).any())
-        fail("cell " + std::to_string(i) + " leaves the box");
-    }
-    if (twice < 0) fail("cell " + std::to_string(i) + " is clockwise");
-  }
+  for (std::size_t i = 0; i < cells_.size(); ++i) detail::check_cell(cells_[i], box_, "PowerDiagram::validate: cell " + std::to_string(i));
   for (const Edge& e : edges_) {
     const Vec2d &pa = points()[e.a], &pb = points()[e.b];
     const double wa = weights()[e.a], wb = weights()[e.b];
