@@ -43,8 +43,15 @@ inline std::vector<Vec2d> convex_polygon_of(std::vector<Vec2d> pts) {
     hull[k++] = pts[i];
   }
   hull.resize(k - 1);
-  if (hull.size() < 3) hull.clear();
-  return hull;
+  // Corners found twice (rounded apart by the clipping of neighbouring pieces) count once.
+  double extent = 0;
+  for (const Vec2d& p : pts) extent = std::max(extent, (p - pts.front()).cwiseAbs().maxCoeff());
+  std::vector<Vec2d> out;
+  for (const Vec2d& p : hull)
+    if (out.empty() || (p - out.back()).cwiseAbs().maxCoeff() > 1e-12 * extent) out.push_back(p);
+  while (out.size() > 1 && (out.front() - out.back()).cwiseAbs().maxCoeff() <= 1e-12 * extent) out.pop_back();
+  if (out.size() < 3) out.clear();
+  return out;
 }
 
 /// Checks a counter-clockwise polygon inside the box (to 1e-9 of its side).
