@@ -29,16 +29,16 @@ struct GeneralizedDiagram {
   std::string title;
 };
 
-/// One weight per point: a 1-D .npy of n values, or an n x 1 table (.npy, .csv, .txt).
-inline std::vector<double> read_weights(const std::string& path, std::size_t points) {
+/// One value per point (`option` names it in messages): a 1-D .npy of n values, or an n x 1 table (.npy, .csv, .txt).
+inline std::vector<double> read_per_point(const std::string& path, std::size_t points, const std::string& option) {
   std::vector<double> w;
   if (std::filesystem::path(path).extension() == ".npy" && path != "-") {
     const io::NpyArray a = io::read_npy(path);
     if (a.shape.size() == 1) w = a.to_vector<double>();
   }
-  if (w.empty()) w = io::read_table(path, "weight", 1).values;
+  if (w.empty()) w = io::read_table(path, "value", 1).values;
   if (w.size() != points)
-    throw Error("--weights: " + path + " has " + std::to_string(w.size()) + " weights for " + std::to_string(points) + " points");
+    throw Error(option + ": " + path + " has " + std::to_string(w.size()) + " values for " + std::to_string(points) + " points");
   return w;
 }
 
@@ -52,7 +52,7 @@ inline GeneralizedDiagram build_generalized(const std::vector<Vec2d>& points, co
     }
   };
   if (!weights.empty()) {
-    const voronoi::PowerDiagram d(points, read_weights(weights, points.size()), box);
+    const voronoi::PowerDiagram d(points, read_per_point(weights, points.size(), "--weights"), box);
     g.kind = "power";
     g.cells = d.cells();
     take_edges(d.edges());

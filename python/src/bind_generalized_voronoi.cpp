@@ -1,5 +1,6 @@
 // Python bindings of the generalized Voronoi diagrams (seed §5.3.3):
-// geods.power_diagram, geods.farthest_voronoi, geods.kth_order_voronoi.
+// geods.power_diagram, geods.farthest_voronoi, geods.kth_order_voronoi, and of
+// §5.4.3 geods.smallest_color_spanning_circle.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -11,6 +12,7 @@
 #include "arrays.hpp"
 #include "bindings.hpp"
 #include "geods/core/error.hpp"
+#include "geods/voronoi/color_spanning.hpp"
 #include "geods/voronoi/farthest_voronoi.hpp"
 #include "geods/voronoi/generalized_stats_fields.hpp"
 #include "geods/voronoi/kth_order_voronoi.hpp"
@@ -182,6 +184,31 @@ void bind_generalized_voronoi(py::module_& m) {
   m.def("kth_order_voronoi", [](const py::handle& p, long k, const py::object& box) { return PyKthOrderVoronoi(p, k, box); },
         py::arg("points"), py::arg("k"), py::arg("box") = py::none(),
         "The k-th order Voronoi diagram of points (n, 2): regions of equal k nearest sites, clipped to box.");
+
+  m.def(
+      "smallest_color_spanning_circle",
+      [](const py::handle& points, const py::handle& colors) {
+        const std::vector<Vec2d> p = to_points(points, "smallest_color_spanning_circle");
+        const py::array_t<std::int64_t> c = py::array_t<std::int64_t, py::array::forcecast>::ensure(colors);
+        if (!c) throw Error("smallest_color_spanning_circle: colors must be integers");
+        std::vector<std::uint32_t> labels;
+        const auto flat = c.attr("ravel")().cast<py::array_t<std::int64_t>>();
+        for (py::ssize_t i = 0; i < flat.size(); ++i) {
+          const std::int64_t v = flat.at(i);
+          if (v < 0 || v > std::int64_t(0xffffffff))
+            throw Error("smallest_color_spanning_circle: color " + std::to_string(v) + " is not a non-negative 32-bit integer");
+          labels.push_back(std::uint32_t(v));
+        }
+        const voronoi::ColorSpanningCircle r = [&] {
+          py::gil_scoped_release release;
+          return voronoi::smallest_color_spanning_circle(p, labels);
+        }();
+        return py::make_tuple(points_array(std::vector<Vec2d>{r.circle.center}).reshape({2}), r.circle.radius,
+                              index_array(r.support));
+      },
+      py::arg("points"), py::arg("colors"),
+      "Smallest circle holding a point of every color (colors: (n,) non-negative integers): "
+      "(center, radius, support), support the 1 to 3 points on its boundary that define it.");
 }
 
 }  // namespace geods::python

@@ -131,3 +131,55 @@ def test_cli_flags(cli, tmp_path):
     assert bad.returncode == 2 and len(bad.stderr.strip().splitlines()) == 1
     bad = subprocess.run([cli, "voronoi", str(tmp_path / "p.npy"), "--order", "41"], capture_output=True, text=True)
     assert bad.returncode == 2 and "k = 41" in bad.stderr
+
+
+def brute_color_spanning(p, colors):
+    m = len(set(colors.tolist()))
+    best = np.inf
+    n = len(p)
+
+    def spans(c, r):
+        return len(set(colors[np.linalg.norm(p - c, axis=1) <= r * (1 + 1e-12) + 1e-15].tolist())) == m
+
+    for i in range(n):
+        for j in range(i + 1, n):
+            c, r = (p[i] + p[j]) / 2, np.linalg.norm(p[i] - p[j]) / 2
+            if r < best and spans(c, r):
+                best = r
+            for k in range(j + 1, n):
+                a, b = p[j] - p[i], p[k] - p[i]
+                d = 2 * (a[0] * b[1] - a[1] * b[0])
+                if d == 0:
+                    continue
+                c = p[i] + np.array([b[1] * (a @ a) - a[1] * (b @ b), a[0] * (b @ b) - b[0] * (a @ a)]) / d
+                r = np.linalg.norm(c - p[i])
+                if r < best and spans(c, r):
+                    best = r
+    return best
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3, 4])
+def test_smallest_color_spanning_circle_matches_brute_force(seed):
+    rng = np.random.default_rng(seed)
+    p = rng.random((18, 2))
+    colors = rng.integers(0, 2 + seed % 3, 18)
+    center, radius, support = geods.smallest_color_spanning_circle(p, colors)
+    assert radius == pytest.approx(brute_color_spanning(p, colors), rel=1e-12)
+    assert np.allclose(np.linalg.norm(p[support] - center, axis=1), radius)
+    with pytest.raises(geods.Error):
+        geods.smallest_color_spanning_circle(p, colors[:-1])
+    with pytest.raises(geods.Error, match="non-negative"):
+        geods.smallest_color_spanning_circle(p, -colors - 1)
+
+
+def test_cli_circles(cli, tmp_path):
+    rng = np.random.default_rng(8)
+    np.save(tmp_path / "p.npy", rng.random((30, 2)))
+    np.save(tmp_path / "c.npy", rng.integers(0, 3, 30))
+    out = subprocess.run([cli, "circles", str(tmp_path / "p.npy"), "--colors", str(tmp_path / "c.npy"), "--json",
+                          "--svg", str(tmp_path / "c.svg")], capture_output=True, text=True, check=True)
+    report = json.loads(out.stdout)
+    center, radius, _ = geods.smallest_color_spanning_circle(np.load(tmp_path / "p.npy"), np.load(tmp_path / "c.npy"))
+    assert report["color_spanning"]["radius"] == pytest.approx(radius)
+    assert report["enclosing"]["radius"] >= report["color_spanning"]["radius"]
+    assert (tmp_path / "c.svg").stat().st_size > 0
