@@ -26,7 +26,9 @@ inline void clip_halfplane(LabeledPolygon& poly, const Vec2d& origin, const Vec2
                            std::uint32_t label) {
   const std::size_t n = poly.points.size();
   if (n == 0) return;
-  std::vector<double> side(n);
+  thread_local std::vector<double> side;  // scratch buffers: clipping runs per cell, in parallel
+  thread_local LabeledPolygon out;
+  side.resize(n);
   bool any_out = false, any_in = false;
   for (std::size_t k = 0; k < n; ++k) {
     side[k] = normal.dot(poly.points[k] - origin) - offset;
@@ -39,7 +41,8 @@ inline void clip_halfplane(LabeledPolygon& poly, const Vec2d& origin, const Vec2
     poly.labels.clear();
     return;
   }
-  LabeledPolygon out;
+  out.points.clear();
+  out.labels.clear();
   const auto push = [&](const Vec2d& p, std::uint32_t l) {
     if (!out.points.empty() && out.points.back() == p) {
       out.labels.back() = l;
@@ -62,8 +65,8 @@ inline void clip_halfplane(LabeledPolygon& poly, const Vec2d& origin, const Vec2
     out.points.pop_back();
     out.labels.pop_back();
   }
-  if (out.points.size() < 3) out = {};
-  poly = std::move(out);
+  if (out.points.size() < 3) out.points.clear(), out.labels.clear();
+  std::swap(poly, out);
 }
 
 }  // namespace geods::voronoi::detail

@@ -375,27 +375,28 @@ void RegularTriangulation::build_collinear() {
 }
 
 void RegularTriangulation::build_neighbors() {
+  // Each undirected edge once per end: a half-edge a -> c gives c to a, and to c
+  // also a when it has no twin (a hull edge); interior edges come back through their twin.
   const std::size_t n = points_.size();
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
-  if (triangles_.empty()) {
-    for (std::size_t k = 0; k + 1 < chain_.size(); ++k) {
-      pairs.push_back({chain_[k], chain_[k + 1]});
-      pairs.push_back({chain_[k + 1], chain_[k]});
+  const auto each_pair = [&](const auto& f) {
+    if (triangles_.empty()) {
+      for (std::size_t k = 0; k + 1 < chain_.size(); ++k) f(chain_[k], chain_[k + 1]), f(chain_[k + 1], chain_[k]);
+      return;
     }
-  } else {
     for (std::uint32_t e = 0; e < triangles_.size(); ++e) {
       const std::uint32_t a = triangles_[e], c = triangles_[e % 3 == 2 ? e - 2 : e + 1];
-      pairs.push_back({a, c});
-      pairs.push_back({c, a});
+      f(a, c);
+      if (halfedges_[e] == no_edge) f(c, a);
     }
-  }
-  std::sort(pairs.begin(), pairs.end());
-  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  };
   neighbor_offsets_.assign(n + 1, 0);
-  for (const auto& [a, c] : pairs) ++neighbor_offsets_[a + 1];
+  each_pair([&](std::uint32_t a, std::uint32_t) { ++neighbor_offsets_[a + 1]; });
   std::partial_sum(neighbor_offsets_.begin(), neighbor_offsets_.end(), neighbor_offsets_.begin());
-  neighbors_.resize(pairs.size());
-  for (std::size_t i = 0; i < pairs.size(); ++i) neighbors_[i] = pairs[i].second;
+  neighbors_.resize(neighbor_offsets_[n]);
+  std::vector<std::uint32_t> fill(neighbor_offsets_.begin(), neighbor_offsets_.end() - 1);
+  each_pair([&](std::uint32_t a, std::uint32_t c) { neighbors_[fill[a]++] = c; });
+  for (std::size_t i = 0; i < n; ++i)
+    std::sort(neighbors_.begin() + neighbor_offsets_[i], neighbors_.begin() + neighbor_offsets_[i + 1]);
 }
 
 std::vector<std::uint32_t> RegularTriangulation::redundant() const {
