@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "../core/big_int.hpp"
+#include "../core/expansion.hpp"
 #include "geods/voronoi/power_diagram.hpp"
 
 namespace geods::voronoi {
@@ -13,23 +14,8 @@ namespace {
 
 using exact::BigInt;
 
-struct SplitDouble {
-  std::uint64_t odd;  // odd significand
-  int exponent;       // of its lowest bit
-};
-
-SplitDouble split(double x) {
-  const std::uint64_t bits = std::bit_cast<std::uint64_t>(x);
-  const int biased = int((bits >> 52) & 0x7ff);
-  std::uint64_t significand = bits & ((std::uint64_t(1) << 52) - 1);
-  int exponent = -1074;
-  if (biased != 0) {
-    significand |= std::uint64_t(1) << 52;
-    exponent = biased - 1075;
-  }
-  const int zeros = std::countr_zero(significand);
-  return {significand >> zeros, exponent + zeros};
-}
+using exact::SplitDouble;
+constexpr auto split = exact::split_double;
 
 int floor_half(int e) { return e >= 0 ? e / 2 : -((-e + 1) / 2); }
 
@@ -50,7 +36,7 @@ struct Integers {
     const auto make = [](double v, int shift) {
       if (v == 0) return BigInt();
       const SplitDouble s = split(v);
-      return BigInt::from_shifted(s.odd, s.exponent - shift, v < 0);
+      return BigInt::from_shifted(s.odd_significand, s.exponent - shift, v < 0);
     };
     for (std::size_t i = 0; i < N; ++i) {
       x[i] = make((*p[i])[0], q);
@@ -70,6 +56,32 @@ int exact_power_test(const Vec2d& a, double wa, const Vec2d& b, double wb, const
   const BigInt blift = bdx * bdx + bdy * bdy - (v.w[1] - v.w[3]);
   const BigInt clift = cdx * cdx + cdy * cdy - (v.w[2] - v.w[3]);
   return (alift * (bdx * cdy - cdx * bdy) + blift * (cdx * ady - adx * cdy) + clift * (adx * bdy - bdx * ady)).sign();
+}
+
+// The exponent window where expansion arithmetic on the degree-4 determinant is
+// exact (as predicates.cpp's in_window: every term a multiple of 2^-1074, no
+// overflow); weights are of degree 2 and get twice the window.
+bool in_window(double x, int degree) {
+  if (x == 0) return true;
+  const int e = std::ilogb(x);
+  return e >= degree * (52 - 1074 / 4) && e <= degree * (1000 / 4 - 3);
+}
+
+// Shewchuk's expansions: exact, and fast on the ties of integer grids.
+int expansion_power_test(const Vec2d& a, double wa, const Vec2d& b, double wb, const Vec2d& c, double wc,
+                         const Vec2d& d, double wd) {
+  using exact::Expansion;
+  const auto diff = [](double x, double y) { return exact::from_two_term(exact::two_diff(x, y)); };
+  const Expansion<2> adx = diff(a[0], d[0]), ady = diff(a[1], d[1]);
+  const Expansion<2> bdx = diff(b[0], d[0]), bdy = diff(b[1], d[1]);
+  const Expansion<2> cdx = diff(c[0], d[0]), cdy = diff(c[1], d[1]);
+  const auto lift = [&](const Expansion<2>& x, const Expansion<2>& y, double w) {
+    return (x * x + y * y) - (exact::exact(w) - exact::exact(wd));
+  };
+  const auto det = lift(adx, ady, wa) * (bdx * cdy - cdx * bdy) + lift(bdx, bdy, wb) * (cdx * ady - adx * cdy) +
+                   lift(cdx, cdy, wc) * (adx * bdy - bdx * ady);
+  const double top = det.top();
+  return (top > 0) - (top < 0);
 }
 
 }  // namespace
@@ -95,6 +107,10 @@ int power_test(const Vec2d& a, double wa, const Vec2d& b, double wb, const Vec2d
   const double bound = 32 * std::numeric_limits<double>::epsilon() * permanent + 1e-300;
   if (det > bound) return 1;   // false for NaN or inf: those go the exact way
   if (det < -bound) return -1;
+  bool window = true;
+  for (const Vec2d* p : {&a, &b, &c, &d}) window &= in_window((*p)[0], 1) && in_window((*p)[1], 1);
+  for (double w : {wa, wb, wc, wd}) window &= in_window(w, 2);
+  if (window) return expansion_power_test(a, wa, b, wb, c, wc, d, wd);
   return exact_power_test(a, wa, b, wb, c, wc, d, wd);
 }
 

@@ -207,6 +207,32 @@ TEST(PowerDiagram, PowerTestIsExactNearDegeneracy) {
   EXPECT_EQ(collinear_power_test(Vec2d(0, 0), 0, Vec2d(1, 0), -1.5, Vec2d(2, 0), 0), -1);
 }
 
+// Against 128-bit integer arithmetic on small integers, scaled by powers of two
+// (which keep the sign) into the filter's, the expansions' and the big integers' ranges.
+TEST(PowerDiagram, PowerTestMatchesIntegerArithmetic) {
+  Rng rng(99);
+  int zeros = 0;
+  for (int trial = 0; trial < 4000; ++trial) {
+    std::int64_t x[4], y[4], w[4];
+    for (int k = 0; k < 4; ++k) x[k] = std::int64_t(rng.below(9)) - 4, y[k] = std::int64_t(rng.below(9)) - 4, w[k] = std::int64_t(rng.below(21)) - 10;
+    __int128 lift[3], m[3];
+    const auto dx = [&](int k) { return __int128(x[k] - x[3]); };
+    const auto dy = [&](int k) { return __int128(y[k] - y[3]); };
+    for (int k = 0; k < 3; ++k) lift[k] = dx(k) * dx(k) + dy(k) * dy(k) - (w[k] - w[3]);
+    m[0] = dx(1) * dy(2) - dx(2) * dy(1), m[1] = dx(2) * dy(0) - dx(0) * dy(2), m[2] = dx(0) * dy(1) - dx(1) * dy(0);
+    const __int128 det = lift[0] * m[0] + lift[1] * m[1] + lift[2] * m[2];
+    const int expected = (det > 0) - (det < 0);
+    zeros += expected == 0;
+    for (const int e : {0, -40, 300}) {
+      Vec2d p[4];
+      double wt[4];
+      for (int k = 0; k < 4; ++k) p[k] = {std::ldexp(double(x[k]), e), std::ldexp(double(y[k]), e)}, wt[k] = std::ldexp(double(w[k]), 2 * e);
+      ASSERT_EQ(power_test(p[0], wt[0], p[1], wt[1], p[2], wt[2], p[3], wt[3]), expected) << trial << " scaled by 2^" << e;
+    }
+  }
+  EXPECT_GT(zeros, 20);  // ties are exercised
+}
+
 TEST(PowerDiagram, BadInput) {
   const std::vector<Vec2d> p{{0, 0}, {1, 0}, {0, 1}};
   EXPECT_THROW(RegularTriangulation(p, std::vector<double>{1, 2}), Error);
