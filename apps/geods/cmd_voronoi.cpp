@@ -34,8 +34,11 @@ class VoronoiCommand : public Command {
     auto* farthest = app.add_flag("--farthest", farthest_, "Farthest-point Voronoi diagram");
     auto* order = app.add_option("--order", order_, "K-th order Voronoi diagram (regions of equal k nearest sites)")
                       ->check(CLI::PositiveNumber);
-    weights->excludes(farthest)->excludes(order);
-    farthest->excludes(order);
+    auto* constraints = app.add_option("--constraints", constraints_,
+                                       "Constrained Voronoi diagram VD(S, L): segments as int m x 2 point indices (non-crossing)");
+    weights->excludes(farthest)->excludes(order)->excludes(constraints);
+    farthest->excludes(order)->excludes(constraints);
+    order->excludes(constraints);
   }
 
   void run(const RunContext&, Report& report) override {
@@ -50,14 +53,14 @@ class VoronoiCommand : public Command {
     std::vector<std::pair<Vec2d, Vec2d>> edges;
     Json stats = Json::object();  // the diagram's stats: distinct sites, vertices (L2), ...
     double build_s = 0, cells_s = 0;
-    const bool generalized = !weights_.empty() || farthest_ || order_ > 0;
+    const bool generalized = !weights_.empty() || farthest_ || order_ > 0 || !constraints_.empty();
     std::string kind = voronoi::metric_name(metric), title;
     Json extra;
     if (generalized && (metric != voronoi::Metric::l2 || !save_.empty()))
-      throw Error("--weights, --farthest and --order take neither --metric nor --save");
+      throw Error("--weights, --farthest, --order and --constraints take neither --metric nor --save");
     if (generalized) {
       Stopwatch build_watch;
-      GeneralizedDiagram g = build_generalized(points, box, weights_, farthest_, order_);
+      GeneralizedDiagram g = build_generalized(points, box, weights_, farthest_, order_, constraints_);
       build_s = build_watch.seconds();
       cells = std::move(g.cells), edges = std::move(g.edges), edge_sites = std::move(g.edge_sites);
       stats = std::move(g.stats), extra = std::move(g.extra), kind = g.kind, title = g.title;
@@ -92,9 +95,18 @@ class VoronoiCommand : public Command {
     if (!svg_.empty()) {
       io::SvgWriter svg(box, 900);
       svg.title(generalized ? title : fmt::format("{} Voronoi diagram of {} points", voronoi::metric_name(metric), points.size()));
-      draw_diagram(svg, cells, edges, points, "#1f4e79", points.size() > 2000 ? 0.8 : 2.0);
+      if (kind == "constrained") {  // pieces coloured by their site (a region is several pieces)
+        const Json& sites = extra["piece_sites"];
+        for (std::size_t k = 0; k < cells.size(); ++k)
+          svg.polygon(cells[k], {.stroke = "none", .fill = cell_colour(sites[k].get<std::size_t>())});
+        draw_diagram(svg, {}, edges, points, "#1f4e79", points.size() > 2000 ? 0.8 : 2.0);
+      } else {
+        draw_diagram(svg, cells, edges, points, "#1f4e79", points.size() > 2000 ? 0.8 : 2.0);
+      }
       if (kind == "order")  // regions have no edge list: outline them
         for (const auto& cell : cells) svg.polygon(cell, {.stroke = "#1f4e79", .fill = "none", .stroke_width = 1.2});
+      if (kind == "constrained")  // the constraints
+        for (const auto& s : extra["constraints"]) svg.segment(points[s[0].get<std::size_t>()], points[s[1].get<std::size_t>()], {.stroke = "#c0392b", .stroke_width = 2.5});
       svg.save(svg_);
     }
     if (!output_.empty()) {
@@ -138,7 +150,7 @@ class VoronoiCommand : public Command {
   }
 
  private:
-  std::string points_, metric_ = "l2", box_, svg_, output_, save_, weights_;
+  std::string points_, metric_ = "l2", box_, svg_, output_, save_, weights_, constraints_;
   bool farthest_ = false;
   std::size_t order_ = 0;
 };

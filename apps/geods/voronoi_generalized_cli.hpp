@@ -11,6 +11,7 @@
 
 #include "geods/io/npy.hpp"
 #include "geods/io/table_io.hpp"
+#include "geods/voronoi/constrained_voronoi.hpp"
 #include "geods/voronoi/farthest_voronoi.hpp"
 #include "geods/voronoi/generalized_stats_fields.hpp"
 #include "geods/voronoi/kth_order_voronoi.hpp"
@@ -42,8 +43,22 @@ inline std::vector<double> read_per_point(const std::string& path, std::size_t p
   return w;
 }
 
+/// Segments as an m x 2 table of point indices.
+inline std::vector<voronoi::ConstrainedVoronoi::Segment> read_index_pairs(const std::string& path, std::size_t points) {
+  const io::Table t = io::read_table(path, "segment", 2);
+  std::vector<voronoi::ConstrainedVoronoi::Segment> out(t.rows);
+  for (std::size_t i = 0; i < 2 * t.rows; ++i) {
+    const double v = t.values[i];
+    if (!(v >= 0 && v == std::floor(v) && v < double(points)))
+      throw Error("--constraints: " + path + " holds " + format_number(v) + ", not a point index below " + std::to_string(points));
+    out[i / 2][i % 2] = std::uint32_t(v);
+  }
+  return out;
+}
+
 inline GeneralizedDiagram build_generalized(const std::vector<Vec2d>& points, const AABB2d& box,
-                                            const std::string& weights, bool farthest, std::size_t order) {
+                                            const std::string& weights, bool farthest, std::size_t order,
+                                            const std::string& constraints = "") {
   GeneralizedDiagram g;
   const auto take_edges = [&](const auto& list) {
     for (const auto& e : list) {
@@ -61,6 +76,20 @@ inline GeneralizedDiagram build_generalized(const std::vector<Vec2d>& points, co
     g.stats["distinct"] = t.points - t.duplicates;
     g.extra["redundant"] = d.triangulation().redundant();
     g.title = fmt::format("Power diagram of {} weighted points ({} redundant)", points.size(), t.redundant);
+  } else if (!constraints.empty()) {
+    const voronoi::ConstrainedVoronoi d(points, read_index_pairs(constraints, points.size()), box);
+    g.kind = "constrained";
+    Json sites = Json::array();
+    for (const auto& piece : d.pieces()) {
+      g.cells.push_back(piece.polygon);
+      sites.push_back(piece.site);
+    }
+    put_stats(g.stats, d.stats());
+    g.extra["piece_sites"] = std::move(sites);
+    Json segs = Json::array();
+    for (const auto& s : d.constraints()) segs.push_back({s[0], s[1]});
+    g.extra["constraints"] = std::move(segs);
+    g.title = fmt::format("Constrained Voronoi diagram of {} points and {} segments", points.size(), d.constraints().size());
   } else if (farthest) {
     const voronoi::FarthestVoronoi d(points, box);
     g.kind = "farthest";

@@ -1,6 +1,6 @@
 // Python bindings of the generalized Voronoi diagrams (seed §5.3.3):
-// geods.power_diagram, geods.farthest_voronoi, geods.kth_order_voronoi, and of
-// §5.4.3 geods.smallest_color_spanning_circle.
+// geods.power_diagram, geods.farthest_voronoi, geods.kth_order_voronoi, of §5.3.2
+// geods.constrained_voronoi, and of §5.4.3 geods.smallest_color_spanning_circle.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -13,6 +13,7 @@
 #include "bindings.hpp"
 #include "geods/core/error.hpp"
 #include "geods/voronoi/color_spanning.hpp"
+#include "geods/voronoi/constrained_voronoi.hpp"
 #include "geods/voronoi/farthest_voronoi.hpp"
 #include "geods/voronoi/generalized_stats_fields.hpp"
 #include "geods/voronoi/kth_order_voronoi.hpp"
@@ -136,6 +137,53 @@ class PyKthOrderVoronoi {
   std::unique_ptr<voronoi::KthOrderVoronoi> d_;
 };
 
+class PyConstrainedVoronoi {
+ public:
+  PyConstrainedVoronoi(const py::handle& points, const py::handle& segments, const py::object& box) {
+    const std::vector<Vec2d> p = to_points(points, "constrained_voronoi");
+    const auto s = py::array_t<std::int64_t, py::array::forcecast>::ensure(segments);
+    if (!s || (s.size() > 0 && (s.ndim() != 2 || s.shape(1) != 2)))
+      throw Error("constrained_voronoi: segments must be an (m, 2) array of point indices");
+    std::vector<voronoi::ConstrainedVoronoi::Segment> pairs(std::size_t(s.size() / 2));
+    const auto flat = s.attr("ravel")().cast<py::array_t<std::int64_t>>();
+    for (py::ssize_t i = 0; i < flat.size(); ++i) {
+      const std::int64_t v = flat.at(i);
+      if (v < 0 || v >= std::int64_t(p.size()))
+        throw Error("constrained_voronoi: segment index " + std::to_string(v) + " is not a point index");
+      pairs[std::size_t(i / 2)][std::size_t(i % 2)] = std::uint32_t(v);
+    }
+    const AABB2d b = box_or_frame(box, p, "constrained_voronoi");
+    py::gil_scoped_release release;
+    d_ = std::make_unique<voronoi::ConstrainedVoronoi>(p, pairs, b);
+  }
+  py::list cells() const {
+    py::list out;
+    for (const auto& piece : d_->pieces()) out.append(points_array(piece.polygon));
+    return out;
+  }
+  py::array sites() const {
+    std::vector<std::uint32_t> s;
+    for (const auto& piece : d_->pieces()) s.push_back(piece.site);
+    return index_array(s);
+  }
+  py::array constraints() const {
+    std::vector<std::uint32_t> s;
+    for (const auto& c : d_->constraints()) s.insert(s.end(), {c[0], c[1]});
+    return index_array(s, {py::ssize_t(s.size() / 2), 2});
+  }
+  bool visible(const py::handle& x, std::uint32_t site) const {
+    const std::vector<double> v = x.cast<std::vector<double>>();
+    if (v.size() != 2 || site >= d_->points().size()) throw Error("ConstrainedVoronoi.visible: a point (x, y) and a site index");
+    return d_->visible(Vec2d(v[0], v[1]), site);
+  }
+  py::tuple box() const { return box_tuple(d_->box()); }
+  py::dict stats() const { return stats_dict(d_->stats()); }
+  void validate() const { d_->validate(); }
+
+ private:
+  std::unique_ptr<voronoi::ConstrainedVoronoi> d_;
+};
+
 }  // namespace
 
 void bind_generalized_voronoi(py::module_& m) {
@@ -184,6 +232,25 @@ void bind_generalized_voronoi(py::module_& m) {
   m.def("kth_order_voronoi", [](const py::handle& p, long k, const py::object& box) { return PyKthOrderVoronoi(p, k, box); },
         py::arg("points"), py::arg("k"), py::arg("box") = py::none(),
         "The k-th order Voronoi diagram of points (n, 2): regions of equal k nearest sites, clipped to box.");
+
+  py::class_<PyConstrainedVoronoi>(m, "ConstrainedVoronoi",
+                                   "Constrained Voronoi diagram VD(S, L) (seed §5.3.2) as convex pieces tiling the box.")
+      .def(py::init<const py::handle&, const py::handle&, const py::object&>(), py::arg("points"), py::arg("segments"),
+           py::arg("box") = py::none())
+      .def_property_readonly("cells", &PyConstrainedVoronoi::cells, "One counter-clockwise convex (k, 2) polygon per piece.")
+      .def_property_readonly("sites", &PyConstrainedVoronoi::sites, "int64 per piece: the site whose region it is in.")
+      .def_property_readonly("constraints", &PyConstrainedVoronoi::constraints,
+                             "(m, 2) int64: the segments, split at sites on them.")
+      .def_property_readonly("box", &PyConstrainedVoronoi::box)
+      .def("visible", &PyConstrainedVoronoi::visible, py::arg("point"), py::arg("site"),
+           "Whether the segment from point to the site crosses no constraint.")
+      .def("stats", &PyConstrainedVoronoi::stats, "dict: sites, distinct, segments, pieces, cells, max_candidates")
+      .def("validate", &PyConstrainedVoronoi::validate);
+  m.def("constrained_voronoi",
+        [](const py::handle& p, const py::handle& s, const py::object& box) { return PyConstrainedVoronoi(p, s, box); },
+        py::arg("points"), py::arg("segments"), py::arg("box") = py::none(),
+        "The constrained Voronoi diagram of points (n, 2) and non-crossing segments (m, 2) of point indices that block "
+        "sight: each piece of the box belongs to its nearest visible site.");
 
   m.def(
       "smallest_color_spanning_circle",

@@ -183,3 +183,42 @@ def test_cli_circles(cli, tmp_path):
     assert report["color_spanning"]["radius"] == pytest.approx(radius)
     assert report["enclosing"]["radius"] >= report["color_spanning"]["radius"]
     assert (tmp_path / "c.svg").stat().st_size > 0
+
+
+def crosses(x, q, a, b):
+    def orient(p, r, s):
+        return (r[0] - p[0]) * (s[1] - p[1]) - (r[1] - p[1]) * (s[0] - p[0])
+    return orient(a, b, x) * orient(a, b, q) < 0 and orient(x, q, a) * orient(x, q, b) < 0
+
+
+def test_constrained_voronoi_pieces_hold_the_nearest_visible_site(cli, tmp_path):
+    # A room (square walls) with a wall inside it, sites inside and outside.
+    p = np.array([[0, 0], [4, 0], [4, 4], [0, 4], [2, 1], [2, 3], [1, 2], [3, 2], [2, 5], [5, 2], [-1, 2], [2, -1],
+                  [0.5, 0.7], [3.4, 3.1]], dtype=float)
+    seg = np.array([[0, 1], [1, 2], [2, 3], [3, 0], [4, 5]])
+    d = geods.constrained_voronoi(p, seg)
+    d.validate()
+    assert len(d.cells) == len(d.sites)
+    assert sum(polygon_area(c) for c in d.cells) == pytest.approx(box_area(d.box), rel=1e-9)
+    q = samples(d.box, 300, 9)
+    best = []
+    for x in q:
+        visible = [i for i in range(len(p)) if not any(crosses(x, p[i], p[a], p[b]) for a, b in seg)]
+        best.append(min(np.linalg.norm(p[visible] - x, axis=1)))
+    best = np.array(best)
+    found = np.zeros(len(q), dtype=bool)
+    for s, c in zip(d.sites, d.cells):
+        hit = inside(c, q)
+        found |= hit
+        assert np.allclose(np.linalg.norm(q[hit] - p[s], axis=1), best[hit], atol=1e-9)
+        for x in q[hit][:3]:
+            assert d.visible(x, int(s))
+    assert found.mean() > 0.97
+    with pytest.raises(geods.Error, match="cross"):
+        geods.constrained_voronoi(p, np.array([[0, 2], [1, 3]]))
+    np.savetxt(tmp_path / "p.csv", p, delimiter=",")
+    np.savetxt(tmp_path / "s.csv", seg, delimiter=",", fmt="%d")
+    out = subprocess.run([cli, "voronoi", str(tmp_path / "p.csv"), "--constraints", str(tmp_path / "s.csv"), "--json"],
+                         capture_output=True, text=True, check=True)
+    report = json.loads(out.stdout)
+    assert report["diagram"] == "constrained" and report["pieces"] == len(d.cells)

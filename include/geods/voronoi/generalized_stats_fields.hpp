@@ -1,6 +1,7 @@
 #pragma once
 // The fields of the generalized diagrams' stats structs (power, farthest-point,
-// k-th order), named once (see voronoi/stats_fields.hpp).
+// k-th order, constrained), named once (see voronoi/stats_fields.hpp).
+#include "geods/voronoi/constrained_voronoi.hpp"
 #include "geods/voronoi/farthest_voronoi.hpp"
 #include "geods/voronoi/kth_order_voronoi.hpp"
 #include "geods/voronoi/power_diagram.hpp"
@@ -29,6 +30,12 @@ template <typename F>
 void for_each_field(const KthOrderVoronoiStats& s, F&& f) {
   f("sites", s.sites), f("distinct", s.distinct), f("k", s.k), f("regions", s.regions), f("pieces", s.pieces);
   f("region_vertices", s.region_vertices);
+}
+
+template <typename F>
+void for_each_field(const ConstrainedVoronoiStats& s, F&& f) {
+  f("sites", s.sites), f("distinct", s.distinct), f("segments", s.segments), f("pieces", s.pieces);
+  f("cells", s.cells), f("max_candidates", s.max_candidates);
 }
 
 }  // namespace geods::voronoi
