@@ -1,6 +1,6 @@
-// Demo step of the voronoi module's generalized diagrams (seed §5.3.3, §5.4.3):
+// Demo step of the voronoi module's generalized diagrams (seed §5.3.2, §5.3.3, §5.4.3):
 // a power diagram with its weight circles, the farthest-point diagram, the
-// 2nd and 3rd order diagrams, and the smallest color-spanning circle.
+// 2nd and 3rd order diagrams, a constrained diagram, and the smallest color-spanning circle.
 #include <fmt/format.h>
 
 #include <cmath>
@@ -10,6 +10,7 @@
 #include "geods/core/rng.hpp"
 #include "geods/io/svg.hpp"
 #include "geods/voronoi/color_spanning.hpp"
+#include "geods/voronoi/constrained_voronoi.hpp"
 #include "geods/voronoi/farthest_voronoi.hpp"
 #include "geods/voronoi/kth_order_voronoi.hpp"
 #include "geods/voronoi/power_diagram.hpp"
@@ -96,6 +97,29 @@ void run_generalized(const DemoContext& context, DemoResult& result) {
                                                 few.size())});
   }
 
+  {
+    // A floor plan: walls between sites (a room with a door, a corridor wall), and the sites around.
+    std::vector<Vec2d> sites(points.begin(), points.begin() + 60);
+    const auto n = std::uint32_t(sites.size());
+    for (const Vec2d& v : {Vec2d(0.3, 0.3), Vec2d(0.7, 0.3), Vec2d(0.7, 0.7), Vec2d(0.3, 0.7), Vec2d(0.45, 0.7), Vec2d(0.1, 0.15),
+                           Vec2d(0.9, 0.15)})
+      sites.push_back(v);
+    const std::vector<voronoi::ConstrainedVoronoi::Segment> walls{{n, n + 1}, {n + 1, n + 2}, {n + 3, n}, {n + 2, n + 4}, {n + 5, n + 6}};
+    watch = Stopwatch();
+    const voronoi::ConstrainedVoronoi constrained(sites, walls, kUnit);
+    result.timing("constrained Voronoi diagram", watch.seconds());
+    io::SvgWriter svg(kUnit, 700);
+    svg.title("Constrained Voronoi diagram");
+    for (const auto& piece : constrained.pieces())
+      svg.polygon(piece.polygon, {.stroke = "none", .fill = region_colour(piece.site)});
+    for (const auto& w : constrained.constraints()) svg.segment(sites[w[0]], sites[w[1]], {.stroke = "#c0392b", .stroke_width = 3});
+    svg.points(sites, {.stroke = "none", .fill = "black", .radius = 2.5});
+    svg.save(context.out_dir / "voronoi_constrained.svg");
+    result.figures.push_back({"voronoi_constrained.svg", fmt::format("{} sites and {} walls (red): each region holds the points to "
+                                                                     "which its site is the nearest visible one",
+                                                                     sites.size(), walls.size())});
+  }
+
   std::vector<std::uint32_t> colors(points.size());
   for (auto& c : colors) c = std::uint32_t(rng.below(4));
   watch = Stopwatch();
@@ -113,13 +137,13 @@ void run_generalized(const DemoContext& context, DemoResult& result) {
   result.figures.push_back({"voronoi_color_spanning.svg",
                             fmt::format("the smallest circle holding one point of each of 4 colors: radius {:.4f}", spanning.circle.radius)});
   result.text = "Seed §5.3.3's generalizations: the power diagram (its dual, the regular triangulation, built with exact "
-                "power tests), the farthest-point diagram and k-th order diagrams; and of §5.4.3 the smallest "
-                "color-spanning circle.";
+                "power tests), the farthest-point diagram and k-th order diagrams; of §5.3.2 the constrained diagram "
+                "(walls block sight); and of §5.4.3 the smallest color-spanning circle.";
   result.stat("power diagram", fmt::format("{} cells, {} redundant", power.stats().cells, power.stats().redundant));
 }
 
 const bool registered = register_demo_step(
-    {"voronoi", "voronoi_generalized", "Power, farthest-point and k-th order diagrams; color-spanning circle", &run_generalized});
+    {"voronoi", "voronoi_generalized", "Power, farthest-point, k-th order and constrained diagrams; color-spanning circle", &run_generalized});
 
 }  // namespace
 }  // namespace geods::cli
