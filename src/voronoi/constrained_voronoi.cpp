@@ -50,13 +50,7 @@ ConstrainedVoronoi::ConstrainedVoronoi(std::span<const Vec2d> points, std::span<
   if (!dt.intersection_points().empty())
     throw Error("ConstrainedVoronoi: the segments cross (" + std::to_string(dt.intersection_points().size()) +
                 " crossings); L must not cross (split them first)");
-  const std::size_t n = points.size();
-  representative_.resize(n);
-  std::vector<std::uint32_t> sites;
-  for (std::uint32_t i = 0; i < n; ++i) {
-    representative_[i] = dt.representative(i);
-    if (representative_[i] == i) sites.push_back(i);
-  }
+  const std::vector<std::uint32_t> sites = detail::distinct_sites(dt, representative_);
   constraints_ = dt.constrained_edges();
 
   // The convex pieces of the box, each with a site every point of it sees.

@@ -17,8 +17,7 @@ FarthestVoronoi::FarthestVoronoi(std::span<const Vec2d> points, const AABB2d& bo
   detail::check_sites_and_box(points, box, "FarthestVoronoi");
   const Delaunay2 dt(points);
   const std::size_t n = points.size();
-  representative_.resize(n);
-  for (std::uint32_t i = 0; i < n; ++i) representative_[i] = dt.representative(i);
+  detail::distinct_sites(dt, representative_);
   const auto& hull = dt.hull();
   if (dt.degenerate()) {
     // Sorted along the line: the extremes are the corners.

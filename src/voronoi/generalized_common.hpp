@@ -10,6 +10,7 @@
 #include "geods/core/coordinate_range.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/vec.hpp"
+#include "geods/voronoi/delaunay2.hpp"
 
 namespace geods::voronoi::detail {
 
@@ -22,6 +23,19 @@ inline void check_sites_and_box(std::span<const Vec2d> points, const AABB2d& box
   check_coordinate_range(points.front().data(), points.size(), 2, 2, 3, what);
   if (box.empty() || !box.lo.allFinite() || !box.hi.allFinite() || !(box.lo[0] < box.hi[0] && box.lo[1] < box.hi[1]))
     throw Error(what + ": empty or non-finite box");
+}
+
+/// Fills `representative` (per point, its first equal point) from the
+/// triangulation and returns the representatives (the distinct sites), ascending.
+inline std::vector<std::uint32_t> distinct_sites(const Delaunay2& dt, std::vector<std::uint32_t>& representative) {
+  const std::size_t n = dt.points().size();
+  representative.resize(n);
+  std::vector<std::uint32_t> sites;
+  for (std::uint32_t i = 0; i < n; ++i) {
+    representative[i] = dt.representative(i);
+    if (representative[i] == i) sites.push_back(i);
+  }
+  return sites;
 }
 
 /// Counter-clockwise convex hull of floating-point points (monotone chain), without collinear points.

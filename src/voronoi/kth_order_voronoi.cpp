@@ -20,19 +20,13 @@ KthOrderVoronoi::KthOrderVoronoi(std::span<const Vec2d> points, std::size_t k, c
     : points_(points.begin(), points.end()), k_(k), box_(box) {
   detail::check_sites_and_box(points, box, "KthOrderVoronoi");
   const Delaunay2 dt(points);
-  const std::size_t n = points.size();
-  representative_.resize(n);
-  std::vector<std::uint32_t> sites;
-  for (std::uint32_t i = 0; i < n; ++i) {
-    representative_[i] = dt.representative(i);
-    if (representative_[i] == i) sites.push_back(i);
-  }
+  const std::vector<std::uint32_t> sites = detail::distinct_sites(dt, representative_);
   distinct_ = sites.size();
   if (k == 0 || k > distinct_)
     throw Error("KthOrderVoronoi: k = " + std::to_string(k) + " must be between 1 and the " +
                 std::to_string(distinct_) + " distinct points");
   const double min_area = 1e-14 * (box.hi[0] - box.lo[0]) * (box.hi[1] - box.lo[1]);
-  std::vector<std::vector<std::uint32_t>> neighbors(n);
+  std::vector<std::vector<std::uint32_t>> neighbors(points.size());
   for (std::uint32_t s : sites) neighbors[s] = dt.neighbors(s);
 
   // Order 1: the Voronoi cells.
