@@ -1,4 +1,5 @@
-// geods voronoi: the Voronoi diagram of 2D points under L2, L1 or L-infinity, as an SVG and/or cells in JSON.
+// geods voronoi: the Voronoi diagram of 2D points under L2, L1 or L-infinity, or a generalized one (power diagram
+// with --weights, farthest-point with --farthest, k-th order with --order), as an SVG and/or cells in JSON.
 #include <fmt/format.h>
 
 #include <optional>
@@ -10,6 +11,7 @@
 #include "stats_json.hpp"
 #include "stopwatch.hpp"
 #include "voronoi_cli.hpp"
+#include "voronoi_generalized_cli.hpp"
 
 namespace geods::cli {
 namespace {
@@ -28,6 +30,15 @@ class VoronoiCommand : public Command {
     add_output(app, "-o,--output", output_, "Output: JSON with the box, each point's cell polygon and the edges",
                io::OutputKind::json);
     add_save(app, save_, "the l2 diagram", "Voronoi2.load");
+    auto* weights = app.add_option("--weights", weights_, "Power diagram of the points weighted by W (n x 1 .npy, .csv, .txt)");
+    auto* farthest = app.add_flag("--farthest", farthest_, "Farthest-point Voronoi diagram");
+    auto* order = app.add_option("--order", order_, "K-th order Voronoi diagram (regions of equal k nearest sites)")
+                      ->check(CLI::PositiveNumber);
+    auto* constraints = app.add_option("--constraints", constraints_,
+                                       "Constrained Voronoi diagram VD(S, L): segments as int m x 2 point indices (non-crossing)");
+    weights->excludes(farthest)->excludes(order)->excludes(constraints);
+    farthest->excludes(order)->excludes(constraints);
+    order->excludes(constraints);
   }
 
   void run(const RunContext&, Report& report) override {
@@ -42,7 +53,18 @@ class VoronoiCommand : public Command {
     std::vector<std::pair<Vec2d, Vec2d>> edges;
     Json stats = Json::object();  // the diagram's stats: distinct sites, vertices (L2), ...
     double build_s = 0, cells_s = 0;
-    if (metric == voronoi::Metric::l2) {
+    const bool generalized = !weights_.empty() || farthest_ || order_ > 0 || !constraints_.empty();
+    std::string kind = voronoi::metric_name(metric), title;
+    Json extra;
+    if (generalized && (metric != voronoi::Metric::l2 || !save_.empty()))
+      throw Error("--weights, --farthest, --order and --constraints take neither --metric nor --save");
+    if (generalized) {
+      Stopwatch build_watch;
+      GeneralizedDiagram g = build_generalized(points, box, weights_, farthest_, order_, constraints_);
+      build_s = build_watch.seconds();
+      cells = std::move(g.cells), edges = std::move(g.edges), edge_sites = std::move(g.edge_sites);
+      stats = std::move(g.stats), extra = std::move(g.extra), kind = g.kind, title = g.title;
+    } else if (metric == voronoi::Metric::l2) {
       Stopwatch build_watch;
       const voronoi::Voronoi2 diagram(points);
       build_s = build_watch.seconds();
@@ -72,13 +94,25 @@ class VoronoiCommand : public Command {
 
     if (!svg_.empty()) {
       io::SvgWriter svg(box, 900);
-      svg.title(fmt::format("{} Voronoi diagram of {} points", voronoi::metric_name(metric), points.size()));
-      draw_diagram(svg, cells, edges, points, "#1f4e79", points.size() > 2000 ? 0.8 : 2.0);
+      svg.title(generalized ? title : fmt::format("{} Voronoi diagram of {} points", voronoi::metric_name(metric), points.size()));
+      if (kind == "constrained") {  // pieces coloured by their site (a region is several pieces)
+        const Json& sites = extra["piece_sites"];
+        for (std::size_t k = 0; k < cells.size(); ++k)
+          svg.polygon(cells[k], {.stroke = "none", .fill = cell_colour(sites[k].get<std::size_t>())});
+        draw_diagram(svg, {}, edges, points, "#1f4e79", points.size() > 2000 ? 0.8 : 2.0);
+      } else {
+        draw_diagram(svg, cells, edges, points, "#1f4e79", points.size() > 2000 ? 0.8 : 2.0);
+      }
+      if (kind == "order")  // regions have no edge list: outline them
+        for (const auto& cell : cells) svg.polygon(cell, {.stroke = "#1f4e79", .fill = "none", .stroke_width = 1.2});
+      if (kind == "constrained")  // the constraints
+        for (const auto& s : extra["constraints"]) svg.segment(points[s[0].get<std::size_t>()], points[s[1].get<std::size_t>()], {.stroke = "#c0392b", .stroke_width = 2.5});
       svg.save(svg_);
     }
     if (!output_.empty()) {
       Json out;
       out["metric"] = voronoi::metric_name(metric);
+      if (generalized) out["diagram"] = kind, out.update(extra);
       out["box"] = {box.lo[0], box.lo[1], box.hi[0], box.hi[1]};
       Json cell_list = Json::array();
       for (const auto& cell : cells) {
@@ -100,13 +134,14 @@ class VoronoiCommand : public Command {
     j["points"] = points.size();
     j.update(stats);
     j["metric"] = voronoi::metric_name(metric);
+    if (generalized) j["diagram"] = kind;
     j["box"] = {box.lo[0], box.lo[1], box.hi[0], box.hi[1]};
     j["edges_in_box"] = edges.size();
     j["build_s"] = build_s;
     j["cells_s"] = cells_s;
     j["compute_s"] = build_s + cells_s;
     report.lines.push_back(fmt::format("voronoi ({}): {} points ({} distinct), {} edges in the box{}",
-                                       voronoi::metric_name(metric), points.size(), stats["distinct"].get<std::size_t>(), edges.size(),
+                                       kind, points.size(), stats["distinct"].get<std::size_t>(), edges.size(),
                                        stats.contains("vertices") ? fmt::format(", {} vertices", stats["vertices"].get<std::size_t>()) : ""));
     report.lines.push_back(fmt::format("  built in {:.3f} s, cells clipped in {:.3f} s", build_s, cells_s));
     if (!svg_.empty()) report.lines.push_back("  wrote " + svg_);
@@ -115,7 +150,9 @@ class VoronoiCommand : public Command {
   }
 
  private:
-  std::string points_, metric_ = "l2", box_, svg_, output_, save_;
+  std::string points_, metric_ = "l2", box_, svg_, output_, save_, weights_, constraints_;
+  bool farthest_ = false;
+  std::size_t order_ = 0;
 };
 
 const bool registered = register_command<VoronoiCommand>();

@@ -14,6 +14,7 @@ void bind_delaunay(pybind11::module_& m);  // bind_delaunay.cpp: Delaunay triang
 void bind_ray(pybind11::module_& m);  // bind_ray.cpp: ray accelerators, render
 void bind_iso(pybind11::module_& m);       // bind_iso.cpp: isosurfaces, min/max octree
 void bind_voronoi(pybind11::module_& m);  // bind_voronoi.cpp: Voronoi2, MetricVoronoi, emst, circles
+void bind_generalized_voronoi(pybind11::module_& m);  // bind_generalized_voronoi.cpp: power, farthest, k-th order
 void bind_texture(pybind11::module_& m);  // bind_texture.cpp: texture synthesis, hole filling
 void bind_field(pybind11::module_& m);    // bind_field.cpp: distance transform
 void bind_terrain(pybind11::module_& m);  // bind_terrain.cpp: terrain level of detail

@@ -13,6 +13,7 @@ PYBIND11_MODULE(_geods, m) {
   geods::python::bind_dynamic(m);
   geods::python::bind_quadtree(m);
   geods::python::bind_voronoi(m);
+  geods::python::bind_generalized_voronoi(m);
   geods::python::bind_delaunay(m);
   geods::python::bind_ray(m);
   geods::python::bind_iso(m);

@@ -13,6 +13,26 @@
 
 namespace geods::exact {
 
+/// A finite nonzero double as odd_significand * 2^exponent: the integer it
+/// scales to when every value of a formula is shifted by the smallest exponent.
+struct SplitDouble {
+  std::uint64_t odd_significand;
+  int exponent;  // of its lowest bit
+};
+
+inline SplitDouble split_double(double x) {
+  const std::uint64_t bits = std::bit_cast<std::uint64_t>(x);
+  const int biased = int((bits >> 52) & 0x7ff);
+  std::uint64_t significand = bits & ((std::uint64_t(1) << 52) - 1);
+  int exponent = -1074;
+  if (biased != 0) {
+    significand |= std::uint64_t(1) << 52;
+    exponent = biased - 1075;
+  }
+  const int zeros = std::countr_zero(significand);
+  return {significand >> zeros, exponent + zeros};
+}
+
 class BigInt {
  public:
   BigInt() = default;

@@ -135,23 +135,8 @@ bool fits_expansions(const std::array<const double*, N>& points) {
 // m; with q the smallest k, a coordinate is the integer (sign * m * 2^(k-q))
 // times 2^q, and a homogeneous formula of degree d scales by 2^(d q).
 
-struct SplitDouble {
-  std::uint64_t odd_significand;
-  int exponent;  // of its lowest bit
-};
-
-SplitDouble split(double x) {
-  const std::uint64_t bits = std::bit_cast<std::uint64_t>(x);
-  const int biased = int((bits >> 52) & 0x7ff);
-  std::uint64_t significand = bits & ((std::uint64_t(1) << 52) - 1);
-  int exponent = -1074;
-  if (biased != 0) {
-    significand |= std::uint64_t(1) << 52;
-    exponent = biased - 1075;
-  }
-  const int zeros = std::countr_zero(significand);
-  return {significand >> zeros, exponent + zeros};
-}
+using exact::SplitDouble;
+SplitDouble split(double x) { return exact::split_double(x); }
 
 // Formula takes an array of N pointers to Dim BigInt coordinates.
 template <int Degree, int Dim, std::size_t N, typename Formula>
