@@ -362,9 +362,15 @@ SegmentVoronoi::EdgeCurve SegmentVoronoi::edge_curve(std::uint32_t e) const {
 
 double SegmentVoronoi::edge_clearance(std::uint32_t e) const {
   const EdgeCurve c = edge_curve(e);
+  return edge_clearance(e, c.t0, c.t1);
+}
+
+double SegmentVoronoi::edge_clearance(std::uint32_t e, double a, double b) const {
+  const EdgeCurve c = edge_curve(e);
   const Edge& ed = edges_[e];
   const auto np = static_cast<std::uint32_t>(points_.size());
-  double tstar = 0;
+  // The distance to the sites along the curve is convex in the parameter, smallest at tstar.
+  double tstar = 0;  // point-point and a segment with its endpoint: the origin
   if (c.parabolic) {
     tstar = (c.focus - c.origin).dot(c.direction);
   } else if (ed.site[0] >= np && ed.site[1] >= np) {
@@ -372,12 +378,33 @@ double SegmentVoronoi::edge_clearance(std::uint32_t e) const {
     const Vec2d a0 = points_[sg[0]], a1 = points_[sg[1]];
     const Vec2d n1 = perp_cw(a1 - a0).normalized();
     const double den = n1.dot(c.direction);
-    tstar = den != 0 ? -n1.dot(c.origin - a0) / den : c.t0;
+    tstar = den != 0 ? -n1.dot(c.origin - a0) / den : a;
   }
-  // point-point and a segment with its endpoint: the closest point is the origin (t = 0).
-  const double t = std::clamp(tstar, c.t0, c.t1);
+  const double t = std::clamp(tstar, a, b);
   if (!std::isfinite(t)) return std::numeric_limits<double>::infinity();
   return site_distance(ed.site[0], c.point(t));
+}
+
+double SegmentVoronoi::edge_length(std::uint32_t e, double a, double b) const {
+  const EdgeCurve c = edge_curve(e);
+  if (!c.parabolic) return std::abs(b - a);
+  const Vec2d rel = c.focus - c.origin;
+  const double tp = rel.dot(c.direction);
+  // The curve is y(t) = ((t - tp)^2 + H^2) / (2 H), H the focus' distance to the directrix: dy/dt = (t - tp) / H.
+  const double H = std::abs(cross(c.direction, rel));
+  auto F = [&](double u) { return 0.5 * u * std::sqrt(1 + (u / H) * (u / H)) + 0.5 * H * std::asinh(u / H); };
+  return std::abs(F(b - tp) - F(a - tp));
+}
+
+std::vector<Vec2d> SegmentVoronoi::sample_edge(std::uint32_t e, double a, double b, double step) const {
+  if (!(step > 0)) throw Error("segment voronoi: sample step must be positive");
+  const EdgeCurve c = edge_curve(e);
+  const double length = edge_length(e, std::min(a, b), std::max(a, b));
+  const auto n = static_cast<std::size_t>(std::clamp(std::ceil(length / step), 1.0, 1e6));
+  std::vector<Vec2d> out;
+  out.reserve(n + 1);
+  for (std::size_t k = 0; k <= n; ++k) out.push_back(c.point(a + (b - a) * static_cast<double>(k) / static_cast<double>(n)));
+  return out;
 }
 
 std::vector<Vec2d> SegmentVoronoi::sample_edge(std::uint32_t e, double step, const AABB2d& box) const {

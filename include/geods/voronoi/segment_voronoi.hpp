@@ -121,6 +121,12 @@ class SegmentVoronoi {
   /// Smallest distance to the sites along edge e (at an end or at the
   /// bisector's closest point to the sites when that lies inside the edge).
   double edge_clearance(std::uint32_t e) const;
+  /// The same for the part of edge e between curve parameters a <= b.
+  double edge_clearance(std::uint32_t e, double a, double b) const;
+  /// Arc length of edge e between curve parameters a <= b (exact for lines and parabolas).
+  double edge_length(std::uint32_t e, double a, double b) const;
+  /// Points of edge e from parameter a to parameter b (either order), at most about `step` apart.
+  std::vector<Vec2d> sample_edge(std::uint32_t e, double a, double b, double step) const;
 
   /// The medial axis: the primary edges inside the region bounded by the
   /// segments (even-odd rule; the segments should form closed polygons).
