@@ -5,6 +5,7 @@
 #include <limits>
 #include <queue>
 
+#include "even_odd.hpp"
 #include "geods/core/error.hpp"
 
 namespace geods::voronoi {
@@ -79,7 +80,11 @@ MotionPlanner::MotionPlanner(const std::vector<std::vector<Vec2d>>& polygons, co
   build(polygons);
 }
 
+MotionPlanner::~MotionPlanner() = default;
+MotionPlanner::MotionPlanner(MotionPlanner&&) noexcept = default;
+
 void MotionPlanner::build(const std::vector<std::vector<Vec2d>>&) {
+  inside_ = std::make_unique<detail::EvenOddIndex>(obstacle_segments_);
   if (diagram_.split_count() > 0)
     throw Error("plan: obstacle edges cross (a self-intersecting polygon, overlapping polygons, or an obstacle "
                 "crossing the frame)");
@@ -107,17 +112,7 @@ void MotionPlanner::build(const std::vector<std::vector<Vec2d>>&) {
   }
 }
 
-bool MotionPlanner::inside_obstacle(const Vec2d& x) const {
-  bool in = false;
-  for (const auto& s : obstacle_segments_) {
-    const Vec2d a = s[0], b = s[1];
-    if ((a[1] > x[1]) != (b[1] > x[1])) {
-      const double xi = a[0] + (x[1] - a[1]) * (b[0] - a[0]) / (b[1] - a[1]);
-      if (xi > x[0]) in = !in;
-    }
-  }
-  return in;
-}
+bool MotionPlanner::inside_obstacle(const Vec2d& x) const { return inside_->inside(x); }
 
 double MotionPlanner::clearance(const Vec2d& x) const {
   double d = kInf;

@@ -6,6 +6,7 @@
 #include <unordered_map>
 
 #include "geods/core/error.hpp"
+#include "even_odd.hpp"
 #include "segment_voronoi_sweep.hpp"
 
 namespace geods::voronoi {
@@ -451,25 +452,23 @@ std::vector<Vec2d> SegmentVoronoi::sample_edge(std::uint32_t e, double step, con
   return out;
 }
 
-bool SegmentVoronoi::inside(const Vec2d& x) const {
-  bool in = false;
-  for (const auto& s : segments_) {
-    const Vec2d a = points_[s[0]], b = points_[s[1]];
-    if ((a[1] > x[1]) != (b[1] > x[1])) {
-      const double xi = a[0] + (x[1] - a[1]) * (b[0] - a[0]) / (b[1] - a[1]);
-      if (xi > x[0]) in = !in;
-    }
-  }
-  return in;
+std::vector<std::array<Vec2d, 2>> SegmentVoronoi::segment_geometry() const {
+  std::vector<std::array<Vec2d, 2>> out;
+  out.reserve(segments_.size());
+  for (const auto& s : segments_) out.push_back({points_[s[0]], points_[s[1]]});
+  return out;
 }
 
+bool SegmentVoronoi::inside(const Vec2d& x) const { return detail::EvenOddIndex(segment_geometry()).inside(x); }
+
 std::vector<std::uint32_t> SegmentVoronoi::medial_axis() const {
+  const detail::EvenOddIndex index(segment_geometry());
   std::vector<std::uint32_t> out;
   for (std::uint32_t e = 0; e < edges_.size(); ++e) {
     const Edge& ed = edges_[e];
     if (!ed.primary || ed.vertex[0] == kNone || ed.vertex[1] == kNone) continue;
     const EdgeCurve c = edge_curve(e);
-    if (inside(c.point(0.5 * (c.t0 + c.t1)))) out.push_back(e);
+    if (index.inside(c.point(0.5 * (c.t0 + c.t1)))) out.push_back(e);
   }
   return out;
 }

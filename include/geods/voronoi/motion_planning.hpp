@@ -17,6 +17,7 @@
 // goal inside an obstacle or outside the frame, NaN, or a negative radius
 // raise geods::Error. Polygons may touch at shared vertices.
 #include <array>
+#include <memory>
 #include <cstdint>
 #include <span>
 #include <string>
@@ -28,6 +29,9 @@
 #include "geods/voronoi/segment_voronoi.hpp"
 
 namespace geods::voronoi {
+namespace detail {
+class EvenOddIndex;
+}
 
 struct PlanOptions {
   double margin = 0.25;  // frame: bounding box grown by margin * its larger side
@@ -55,6 +59,8 @@ class MotionPlanner {
                 const Vec2d& goal);
   /// Build for a given frame (options.use_bounds must be set), to plan many queries in it.
   MotionPlanner(const std::vector<std::vector<Vec2d>>& polygons, const PlanOptions& options);
+  ~MotionPlanner();
+  MotionPlanner(MotionPlanner&&) noexcept;
 
   /// The shortest path on the diagram for a disc of radius r.
   PathPlan plan(const Vec2d& start, const Vec2d& goal, double radius) const;
@@ -96,6 +102,7 @@ class MotionPlanner {
   std::vector<double> edge_length_, edge_clearance_;  // per diagram edge (graph edges only)
   std::vector<std::vector<std::uint32_t>> vertex_edges_;
   std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> pair_edges_;
+  std::unique_ptr<detail::EvenOddIndex> inside_;
 };
 
 /// One-shot planning: builds the planner for these obstacles, start and goal.

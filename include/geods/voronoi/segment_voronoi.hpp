@@ -131,8 +131,11 @@ class SegmentVoronoi {
   /// The medial axis: the primary edges inside the region bounded by the
   /// segments (even-odd rule; the segments should form closed polygons).
   std::vector<std::uint32_t> medial_axis() const;
-  /// Even-odd inside test against the segments.
+  /// Even-odd inside test against the segments (builds an index: for many
+  /// points, medial_axis() shares one).
   bool inside(const Vec2d& x) const;
+  /// The segments as endpoint pairs.
+  std::vector<std::array<Vec2d, 2>> segment_geometry() const;
 
   /// A box around the sites and the vertices.
   AABB2d bounds() const;
