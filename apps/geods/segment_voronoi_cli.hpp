@@ -1,6 +1,7 @@
 #pragma once
 // Shared by `geods segvoronoi`, `geods plan` and the demo: reading segment
 // sites and obstacle maps, and drawing a segment Voronoi diagram.
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -38,9 +39,17 @@ inline void draw_segment_voronoi(io::SvgWriter& svg, const voronoi::SegmentVoron
   const double step = (view.hi - view.lo).maxCoeff() / 300;
   std::vector<char> hot(v.edges().size(), 0);
   for (std::uint32_t e : highlight) hot[e] = 1;
+  // Finite edges whose coarse outline misses the view are not drawn.
+  auto visible = [&](std::uint32_t e) {
+    const auto c = v.edge_curve(e);
+    if (!std::isfinite(c.t0) || !std::isfinite(c.t1)) return true;
+    AABB2d b;
+    for (int k = 0; k <= 8; ++k) b.extend(c.point(c.t0 + (c.t1 - c.t0) * k / 8));
+    return !(b.lo[0] > view.hi[0] || b.hi[0] < view.lo[0] || b.lo[1] > view.hi[1] || b.hi[1] < view.lo[1]);
+  };
   for (std::uint32_t e = 0; e < v.edges().size(); ++e) {
     const auto& ed = v.edges()[e];
-    if (hot[e] || (!ed.primary && !secondary)) continue;
+    if (hot[e] || (!ed.primary && !secondary) || !visible(e)) continue;
     const auto pts = v.sample_edge(e, step, view);
     if (pts.size() < 2) continue;
     io::SvgStyle style;
@@ -49,6 +58,7 @@ inline void draw_segment_voronoi(io::SvgWriter& svg, const voronoi::SegmentVoron
     svg.polyline(pts, style);
   }
   for (std::uint32_t e : highlight) {
+    if (!visible(e)) continue;
     const auto pts = v.sample_edge(e, step, view);
     if (pts.size() < 2) continue;
     io::SvgStyle style;
