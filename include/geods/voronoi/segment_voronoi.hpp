@@ -26,13 +26,16 @@
 //   splits the segment there;
 // - collinear overlapping segments raise geods::Error.
 //
-// Construction: Fortune's sweep generalized to segments (as in Boost.Polygon's
-// voronoi_builder, written anew): site events for points and segments, circle
-// events for every triple of point/segment sites. Orientation tests on the
-// snapped integers are exact (every product fits a double's 53 bits); the
-// tangent-circle computations (the predicates with square roots) are
-// evaluated in long double on the exact snapped integers, without any
-// tolerance; see docs/voronoi.md for what that means at the last bits.
+// Construction: Fortune's sweep generalized to segments (the structure of
+// Boost.Polygon's voronoi_builder, written anew): site events for points and
+// segments, circle events for every triple of point/segment sites.
+// Orientation tests and the beach-line filter of the point-segment case are
+// exact on the snapped integers (doubles, 128-bit integers); the tangent
+// circles are computed in long double from closed forms whose root is chosen
+// by the cyclic order of the tangency points, every "point on a line" case
+// decided exactly. Two comparisons keep Boost.Polygon's tolerance of 64 units
+// in the last place of a double: a site event against a circle event at the
+// same x, and a circle's centre against the end of a vertical segment.
 #include <array>
 #include <cstdint>
 #include <limits>
