@@ -189,8 +189,8 @@ void SegmentVoronoi::build(std::span<const double> points, std::span<const doubl
       for (std::size_t i = 0; i < cell.size(); ++i) {
         for (std::size_t j = i + 1; j < cell.size(); ++j) {
           const std::uint32_t s = std::min(cell[i], cell[j]), t = std::max(cell[i], cell[j]);
-          const IntPoint &a0 = ipts[segs[s][0]], &a1 = ipts[segs[s][1]];
-          const IntPoint &b0 = ipts[segs[t][0]], &b1 = ipts[segs[t][1]];
+          const IntPoint a0 = ipts[segs[s][0]], a1 = ipts[segs[s][1]];  // copies: get_id below may grow ipts
+          const IntPoint b0 = ipts[segs[t][0]], b1 = ipts[segs[t][1]];
           const int o1 = orient(a0, a1, b0), o2 = orient(a0, a1, b1);
           const int o3 = orient(b0, b1, a0), o4 = orient(b0, b1, a1);
           if (o1 == 0 && o2 == 0) {
