@@ -150,6 +150,9 @@ Projection project_distance(const ProjectionSites& sites, const Grid3Geometry& g
         frags += i1 - i0;
         if (changed) farthest = *std::max_element(depth, depth + nx);
       }
+      if (std::isfinite(options.max_distance))  // the cleared depth beyond every bounded cone
+        for (std::size_t i = 0; i < nx; ++i)
+          if (id[i] == kNoIndex) depth[i] = std::numeric_limits<double>::infinity();
     }
     fragments += frags;
     culled += skipped;

@@ -71,7 +71,7 @@ void check_all(const ProjectionSites& sites, const Grid3Geometry& grid, const Pr
         const double scale = 1 + best;
         if (best > max_distance) {
           ASSERT_EQ(r.ids[n], kNoIndex) << i << " " << j << " " << k;
-          ASSERT_EQ(r.distance.data[n], max_distance);
+          ASSERT_EQ(r.distance.data[n], INFINITY);
           continue;
         }
         ASSERT_NEAR(r.distance.data[n], best, 1e-12 * scale) << i << " " << j << " " << k;
