@@ -129,10 +129,10 @@ void run_csg(const DemoContext& context, DemoResult& result) {
   };
   const Vec3f size = box.hi - box.lo;
   Stopwatch csg_watch;
-  Grid3<float> carved = field::csg(d, ball(box.lo + Vec3f(0.75f, 0.55f, 0.3f).cwiseProduct(size), 0.22f * size.y()),
+  Grid3<float> carved = field::csg(d, ball(box.lo + Vec3f(0.7f, 0.4f, 0.95f).cwiseProduct(size), 0.2f * size.y()),
                                    field::CsgOp::difference);
   carved = field::csg(carved, drill(box.lo.y() + 0.3f * size.y(), 0.07f * size.y()), field::CsgOp::difference);
-  carved = field::blend(carved, ball(box.lo + Vec3f(0.3f, 0.95f, 0.55f).cwiseProduct(size), 0.12f * size.y()),
+  carved = field::blend(carved, ball(box.lo + Vec3f(0.3f, 0.82f, 0.55f).cwiseProduct(size), 0.1f * size.y()),
                         0.06 * size.y());
   const Grid3<float> shell = field::csg(carved, field::offset(carved, -0.04 * size.y()), field::CsgOp::difference);
   const double csg_s = csg_watch.seconds();
@@ -176,7 +176,7 @@ void run_morph(const DemoContext& context, DemoResult& result) {
   const field::Morph plain = field::Morph::build(bunny, teapot, options);
   result.timing("morph: the two signed distance fields (96 samples)", build_watch.seconds());
   // Correspondences: the bunny's ears go to the spout and the handle, its tail to the lid's top.
-  const auto corner = [](const AABB3f& box, float x, float y, float z) {
+  const auto corner = [](const AABB3f& box, float x, float y, float z) -> Vec3d {
     return (box.lo + Vec3f(x, y, z).cwiseProduct(box.hi - box.lo)).cast<double>();
   };
   const AABB3f tb = teapot.bounds();

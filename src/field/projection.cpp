@@ -17,6 +17,8 @@
 namespace geods::field {
 namespace {
 
+constexpr std::size_t kBlock = 16;  // pixels per block of a row's depth bounds
+
 double segment_distance2(const Vec2d& p, const Vec2d& a, const Vec2d& b) {
   const Vec2d ab = b - a;
   const double len2 = ab.squaredNorm();
@@ -116,6 +118,7 @@ Projection project_distance(const ProjectionSites& sites, const Grid3Geometry& g
 
   parallel_for(0, rows, 4, [&](std::size_t first, std::size_t last) {
     std::vector<std::pair<double, std::uint32_t>> order(boxes.size());
+    std::vector<double> block_max((nx + kBlock - 1) / kBlock);
     std::uint64_t frags = 0, skipped = 0;
     for (std::size_t row = first; row < last; ++row) {
       const std::size_t j = row % grid.dims[1], k = row / grid.dims[1];
@@ -130,6 +133,7 @@ Projection project_distance(const ProjectionSites& sites, const Grid3Geometry& g
       std::sort(order.begin(), order.end());
       double* depth = result.distance.data.data() + row * nx;
       std::uint32_t* id = result.ids.data() + row * nx;
+      std::fill(block_max.begin(), block_max.end(), options.max_distance);
       double farthest = options.max_distance;
       for (std::size_t o = 0; o < order.size(); ++o) {
         const auto [bound, s] = order[o];
@@ -143,12 +147,25 @@ Projection project_distance(const ProjectionSites& sites, const Grid3Geometry& g
         const std::size_t i0 = lo <= 0 ? 0 : std::size_t(std::min(std::floor(lo), double(nx)));
         const std::size_t i1 = hi < 0 ? 0 : std::size_t(std::min(std::floor(hi) + 2, double(nx)));
         bool changed = false;
-        for (std::size_t i = i0; i < i1; ++i) {
-          const double d = site_distance(sites, s, Vec3d(ox + double(i) * sx, y, z));
-          if (d < depth[i] || (d == depth[i] && s < id[i])) depth[i] = d, id[i] = s, changed = true;
+        // Blocks of pixels whose farthest depth the site cannot beat are skipped whole.
+        for (std::size_t b = i0 / kBlock; b * kBlock < i1; ++b) {
+          const std::size_t b0 = std::max(b * kBlock, i0), b1 = std::min((b + 1) * kBlock, i1);
+          const double x0 = ox + double(b0) * sx, x1 = ox + double(b1 - 1) * sx;
+          const double gap = std::max({boxes[s].lo.x() - x1, 0.0, x0 - boxes[s].hi.x()});
+          if (gap * gap + bound * bound > block_max[b] * block_max[b]) continue;
+          bool block_changed = false;
+          for (std::size_t i = b0; i < b1; ++i) {
+            const double d = site_distance(sites, s, Vec3d(ox + double(i) * sx, y, z));
+            if (d < depth[i] || (d == depth[i] && s < id[i])) depth[i] = d, id[i] = s, block_changed = true;
+          }
+          frags += b1 - b0;
+          if (block_changed) {
+            const std::size_t c0 = b * kBlock, c1 = std::min(c0 + kBlock, nx);
+            block_max[b] = *std::max_element(depth + c0, depth + c1);
+            changed = true;
+          }
         }
-        frags += i1 - i0;
-        if (changed) farthest = *std::max_element(depth, depth + nx);
+        if (changed) farthest = *std::max_element(block_max.begin(), block_max.end());
       }
       if (std::isfinite(options.max_distance))  // the cleared depth beyond every bounded cone
         for (std::size_t i = 0; i < nx; ++i)
