@@ -171,10 +171,10 @@ void run_morph(const DemoContext& context, DemoResult& result) {
   for (Vec3f& v : teapot.vertices) v = (v - t.center()) * scale + b.center();
   teapot.normals.clear();
   field::MorphOptions options;
-  options.res = 96;
+  options.res = 80;
   Stopwatch build_watch;
   const field::Morph plain = field::Morph::build(bunny, teapot, options);
-  result.timing("morph: the two signed distance fields (96 samples)", build_watch.seconds());
+  result.timing("morph: the two signed distance fields (80 samples)", build_watch.seconds());
   // Correspondences: the bunny's ears go to the spout and the handle, its tail to the lid's top.
   const auto corner = [](const AABB3f& box, float x, float y, float z) -> Vec3d {
     return (box.lo + Vec3f(x, y, z).cwiseProduct(box.hi - box.lo)).cast<double>();
