@@ -165,6 +165,10 @@ void bind_field_modeling(py::module_& m) {
         "sites (n, 3), segments (m, 6), polygons in the plane z = 0, results (D, H, W). Sample (i, j[, k])\n"
         "sits at origin + (i, j[, k]) * spacing. -> (distance float64, ids int64): ids number the points,\n"
         "then the segments, then the polygons; -1 (and inf) beyond max_distance. Exact at the samples.");
+  m.def("cone_tessellation_error", &field::cone_tessellation_error, py::arg("max_distance"), py::arg("sides"),
+        "Largest overestimate of a point's distance (up to max_distance) by a cone tessellated as a fan of\n"
+        "`sides` triangles (the graphics-hardware method): max_distance (1 / cos(pi / sides) - 1).\n"
+        "project_distance has none: it evaluates the distance functions exactly at the samples.");
   m.def("csg_field", &csg_field_py, py::arg("a"), py::arg("b"), py::arg("op") = "union", py::arg("blend") = 0.0,
         "Boolean operation on two signed distance fields of the same grid (negative inside), seed 6.2.2:\n"
         "'union' min(a, b), 'intersection' max(a, b), 'difference' max(a, -b); blend > 0 rounds the\n"

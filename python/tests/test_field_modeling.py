@@ -139,3 +139,17 @@ def test_cli_project_and_morph(tmp_path, cli):
     r = subprocess.run([str(cli), "morph", "a.ply", "b.ply", "--steps", "3", "-o", "out.ply"], cwd=tmp_path,
                        capture_output=True, text=True)
     assert r.returncode == 2 and "%d" in r.stderr
+    # Bad input: one line on stderr, exit code 2.
+    for args in (["project", "sites.npy", "-o", "d.npy", "--size", "32"],             # W,H needed
+                 ["project", "sites.npy", "-o", "d.npy", "--size", "32,24,8"],        # 2-column sites for a volume
+                 ["project", "sites.npy", "-o", "d.npy", "--size", "32,24", "--spacing", "0"],
+                 ["project", "missing.npy", "-o", "d.npy", "--size", "32,24"],
+                 ["morph", "a.ply", "missing.ply", "--steps", "3", "-o", "o_%d.ply"],
+                 ["morph", "a.ply", "b.ply", "--steps", "1", "-o", "o_%d.ply"],
+                 ["morph", "a.ply", "b.ply", "--steps", "3", "--correspondences", "sites.npy", "-o", "o_%d.ply"]):
+        r = subprocess.run([str(cli), *args], cwd=tmp_path, capture_output=True, text=True)
+        assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1, (args, r.stderr)
+
+
+def test_cone_tessellation_error():
+    assert abs(geods.cone_tessellation_error(10, 32) - 10 * (1 / np.cos(np.pi / 32) - 1)) < 1e-12
