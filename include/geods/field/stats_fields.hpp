@@ -1,5 +1,6 @@
 #pragma once
 // The fields of SdfGridStats, named once (see spatial/stats_fields.hpp).
+#include "geods/field/adf.hpp"
 #include "geods/field/sdf_grid.hpp"
 
 namespace geods::field {
@@ -9,6 +10,12 @@ template <typename F>
 void for_each_field(const SdfGridStats& s, F&& f) {
   f("samples", s.samples), f("in_band", s.in_band), f("tiles", s.tiles), f("tiles_outside", s.tiles_outside),
       f("candidates_per_sample", s.candidates_per_sample), f("winding_numbers", s.winding_numbers);
+}
+
+template <typename F>
+void for_each_field(const AdfStats& s, F&& f) {
+  f("cells", s.cells), f("leaves", s.leaves), f("depth", s.depth), f("unresolved", s.unresolved),
+      f("exact_queries", s.exact_queries), f("signs", s.signs), f("bytes", s.bytes), f("dense_bytes", s.dense_bytes);
 }
 
 }  // namespace geods::field
