@@ -16,6 +16,7 @@ void bind_iso(pybind11::module_& m);       // bind_iso.cpp: isosurfaces, min/max
 void bind_voronoi(pybind11::module_& m);  // bind_voronoi.cpp: Voronoi2, MetricVoronoi, emst, circles
 void bind_texture(pybind11::module_& m);  // bind_texture.cpp: texture synthesis, hole filling
 void bind_field(pybind11::module_& m);    // bind_field.cpp: distance transform
+void bind_adf(pybind11::module_& m);      // bind_adf.cpp: adaptively sampled distance fields
 void bind_shape(pybind11::module_& m);    // bind_shape.cpp: shape distributions, ShapeDatabase
 
 }  // namespace geods::python

@@ -18,5 +18,6 @@ PYBIND11_MODULE(_geods, m) {
   geods::python::bind_iso(m);
   geods::python::bind_texture(m);
   geods::python::bind_field(m);
+  geods::python::bind_adf(m);
   geods::python::bind_shape(m);
 }
