@@ -46,8 +46,9 @@ Image<std::uint8_t> slice_with_cells(const field::Adf& adf, double z, std::size_
   // The leaves whose cube meets the plane: their square's outline.
   adf.for_each_leaf([&](int, const Vec3d& lo, double side, const float*) {
     if (z < lo.z() || z >= lo.z() + side) return;
-    const auto col = [&](double wx) { return std::min<long>(long(px) - 1, long((wx - o.x()) / pixel)); };
-    const auto row = [&](double wy) { return std::min<long>(long(px) - 1, long(px) - 1 - long((wy - o.y()) / pixel)); };
+    const auto clamp = [&](long v) { return std::clamp<long>(v, 0, long(px) - 1); };
+    const auto col = [&](double wx) { return clamp(long((wx - o.x()) / pixel)); };
+    const auto row = [&](double wy) { return clamp(long(px) - 1 - long((wy - o.y()) / pixel)); };
     const long x0 = col(lo.x()), x1 = col(lo.x() + side), y0 = row(lo.y() + side), y1 = row(lo.y());
     for (long x = x0; x <= x1; ++x)
       for (const long y : {y0, y1})
