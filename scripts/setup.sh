@@ -10,9 +10,8 @@ cd "$(dirname "$0")/.."
 packages=(
   cmake ninja-build g++ ccache pkg-config git
   libeigen3-dev libtbb-dev libassimp-dev libstb-dev libnifti2-dev zlib1g-dev
-  libgdal-dev  # 2D maps: WKT, GeoJSON, shapefiles (MIT)
+  libgdal-dev  # terrain rasters (GeoTIFF...) and 2D maps (WKT, GeoJSON, shapefiles) (MIT)
   libzip-dev  # zip archives and .sh3f furniture libraries of shape collections (BSD)
-  libgdal-dev  # GeoTIFF and other rasters as terrain height fields (MIT)
   libcli11-dev nlohmann-json3-dev libfmt-dev
   libgtest-dev libbenchmark-dev libgmp-dev
   python3 python3-dev python3-numpy python3-pytest pybind11-dev

@@ -19,6 +19,7 @@ void bind_texture(pybind11::module_& m);  // bind_texture.cpp: texture synthesis
 void bind_field(pybind11::module_& m);    // bind_field.cpp: distance transform
 void bind_terrain(pybind11::module_& m);  // bind_terrain.cpp: terrain level of detail
 void bind_field_modeling(pybind11::module_& m);  // bind_field_modeling.cpp: projection, CSG, morph
+void bind_adf(pybind11::module_& m);      // bind_adf.cpp: adaptively sampled distance fields
 void bind_shape(pybind11::module_& m);    // bind_shape.cpp: shape distributions, ShapeDatabase
 void bind_collide(pybind11::module_& m);  // bind_collide.cpp: collision detection, mesh distance
 void bind_segment_voronoi(pybind11::module_& m);  // bind_segment_voronoi.cpp: SegmentVoronoi, MotionPlanner, plan_path

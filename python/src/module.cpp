@@ -21,6 +21,7 @@ PYBIND11_MODULE(_geods, m) {
   geods::python::bind_field(m);
   geods::python::bind_terrain(m);
   geods::python::bind_field_modeling(m);
+  geods::python::bind_adf(m);
   geods::python::bind_shape(m);
   geods::python::bind_collide(m);
   geods::python::bind_segment_voronoi(m);

@@ -2,6 +2,7 @@
 // The fields of SdfGridStats, named once (see spatial/stats_fields.hpp).
 #include "geods/field/morph.hpp"
 #include "geods/field/projection.hpp"
+#include "geods/field/adf.hpp"
 #include "geods/field/sdf_grid.hpp"
 
 namespace geods::field {
@@ -23,6 +24,12 @@ template <typename F>
 void for_each_field(const MorphStats& s, F&& f) {
   f("samples", s.samples), f("correspondences", s.correspondences), f("rotation_angle", s.rotation_angle),
       f("fit_residual", s.fit_residual);
+}
+
+template <typename F>
+void for_each_field(const AdfStats& s, F&& f) {
+  f("cells", s.cells), f("leaves", s.leaves), f("depth", s.depth), f("unresolved", s.unresolved),
+      f("exact_queries", s.exact_queries), f("signs", s.signs), f("bytes", s.bytes), f("dense_bytes", s.dense_bytes);
 }
 
 }  // namespace geods::field

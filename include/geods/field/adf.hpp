@@ -1,0 +1,178 @@
+#pragma once
+// Adaptively sampled distance fields (seed §6.1, Figure 60; Frisken et al.
+// 2000): the signed distance of a triangle mesh stored in an octree whose
+// leaves hold the exact distances at their 8 corners; inside a leaf the field
+// is their trilinear interpolation.
+//
+// Build (top-down, level by level): a cell is split into 8 while the
+// trilinear interpolation of its corner distances differs by more than the
+// error E from the exact field (MeshDistance, the same sign method) at any of
+// its test points: the points of an n x n x n lattice over the cell other than
+// its 8 corners (n = AdfOptions::checks, odd; n = 3 gives the 19 points of
+// Frisken et al.: the 12 edge midpoints, the 6 face centres and the centre).
+// The lattice of a split cell holds its children's corners, so each exact
+// distance is computed once. The cells of a level are evaluated in parallel
+// and stored in level order, so the tree does not depend on the thread count.
+//
+// The bound holds at the test points. Between them it is not a proof: a
+// kink of the field (the medial axis, a sharp edge) can fall between test
+// points and its error is then only seen partly (at least half of it along a
+// lattice line). measure_adf_error reports what the bound is worth at random
+// points (docs/field.md gives measured values for n = 3 and 5).
+//
+// Finite by two options: max_depth (cells at that depth are leaves whatever
+// their error; they are counted as `unresolved`), and band: with a finite
+// band B the ADF is the field clamped to [-B, B]: the error bound applies to
+// the clamped values, |clamp(interpolation) - clamp(exact)| <= E at the test
+// points, and distance() returns clamped values. The corners store the exact
+// distance clamped to [-2B, 2B] (so the clamp's kink at B needs no
+// refinement); a cell whose centre is farther than B + its half diagonal
+// from the surface is one leaf without test points. Refinement thus happens
+// only within about B of the surface.
+//
+// Queries: distance (the trilinear interpolation in the leaf holding the
+// point), gradient (that of the interpolation: piecewise, not continuous
+// across cells), closest point (p - d g / |g|: on the ADF's zero set to first
+// order, at distance |d| from p). Outside the root cube the distance is the
+// one at the nearest point c of the cube plus |p - c|.
+#include <cstdint>
+#include <filesystem>
+#include <limits>
+
+#include "geods/core/archive.hpp"
+#include "geods/core/flat_array.hpp"
+#include "geods/core/tri_mesh.hpp"
+#include "geods/field/mesh_distance.hpp"
+
+namespace geods::field {
+
+struct AdfOptions {
+  /// Largest difference allowed between the interpolation and the exact
+  /// field at a cell's test points (world units, > 0).
+  double error = 0;
+  /// Deepest level (root 0), at most kAdfMaxDepth.
+  int max_depth = 10;
+  /// Half-width of the band (world units): the ADF is the distance clamped
+  /// to [-band, band] (see above). Infinity: the whole field.
+  double band = std::numeric_limits<double>::infinity();
+  /// Test points per cell: the checks^3 lattice less the corners (odd, 3 to 9).
+  int checks = 3;
+  /// The root cube: the mesh's bounding cube grown by padding x its largest extent on each side.
+  double padding = 0.1;
+  SignMethod sign = SignMethod::winding;
+};
+
+inline constexpr int kAdfMaxDepth = 20;
+
+struct AdfStats {
+  std::size_t cells = 0;          // octree cells (inner and leaves)
+  std::size_t leaves = 0;         // cells holding 8 corner distances
+  std::size_t depth = 0;          // deepest leaf's level
+  std::size_t unresolved = 0;     // leaves at max_depth whose test points exceed the error
+  std::size_t exact_queries = 0;  // exact distances computed by the build
+  std::size_t signs = 0;          // of them, signs computed (the others: a neighbour's, see adf.cpp)
+  std::size_t bytes = 0;          // the ADF's arrays: 4 bytes a cell + 32 a leaf
+  std::size_t dense_bytes = 0;    // a float grid of the finest leaves' spacing over the root cube: 4 (2^depth + 1)^3
+};
+
+/// The ADF's interpolation at a point, with its gradient.
+struct AdfSample {
+  float distance = 0;
+  Vec3f gradient = Vec3f::Zero();
+};
+
+class Adf {
+ public:
+  /// A node is a leaf if this bit is set (the rest: the leaf's index), else
+  /// the index of its first child (the 8 children are consecutive, in the
+  /// order x + 2y + 4z of their octants).
+  static constexpr std::uint32_t kLeaf = 0x80000000u;
+
+  Adf() = default;
+
+  /// Builds the ADF of the mesh behind `mesh`. Throws geods::Error for a
+  /// non-positive or non-finite error, a bad max_depth, checks, padding or
+  /// band, and (before allocating it) a tree larger than the machine's memory.
+  static Adf build(const TriMesh& source, const MeshDistance& mesh, const AdfOptions& options);
+  /// The same, building the MeshDistance first (geods::Error for an empty or invalid mesh).
+  static Adf build(const TriMesh& mesh, const AdfOptions& options);
+
+  /// Distance at p (finite, else geods::Error), clamped to the band: see the header's comment.
+  float distance(const Vec3f& p) const { return sample(p).distance; }
+  Vec3f gradient(const Vec3f& p) const { return sample(p).gradient; }
+  AdfSample sample(const Vec3f& p) const;
+  /// p - d g / |g| (p itself where the gradient vanishes).
+  Vec3f closest_point(const Vec3f& p) const;
+
+  /// The surface {distance = offset} (|offset| < band) by marching cubes on
+  /// the ADF sampled at res samples along each side of the root cube (0:
+  /// 2^min(depth, 8) + 1), oriented outward. geods::Error for a non-finite
+  /// offset, one outside the band, res < 2 or a grid the memory cannot hold.
+  TriMesh isosurface(double offset, std::size_t res = 0) const;
+
+  /// Calls f(level, lo, size, corners) for each leaf in node order: its
+  /// cube's low corner, side and 8 corner distances (order x + 2y + 4z).
+  template <typename F>
+  void for_each_leaf(F&& f) const;
+
+  void save(const std::filesystem::path& path) const;
+  static Adf load(const std::filesystem::path& path, Archive::Verify verify = Archive::Verify::checksums);
+  /// Throws geods::Error unless the nodes form a tree in level order, leaf
+  /// indices are consecutive, values are finite (within twice the band) and the cube is finite.
+  void validate() const;
+
+  AdfStats stats() const { return stats_; }
+  const AdfOptions& options() const { return options_; }
+  /// The root cube: low corner and side.
+  const Vec3d& origin() const { return origin_; }
+  double size() const { return size_; }
+  const FlatArray<std::uint32_t>& nodes() const { return nodes_; }
+  const FlatArray<float>& values() const { return values_; }
+
+ private:
+  void finish_stats();
+
+  AdfOptions options_;
+  Vec3d origin_ = Vec3d::Zero();
+  double size_ = 1;
+  FlatArray<std::uint32_t> nodes_;
+  FlatArray<float> values_;
+  AdfStats stats_;
+};
+
+/// The ADF's error against the exact (clamped) field at `samples` random
+/// points (seeded): half uniform in the root cube, half near the surface (a
+/// uniform point of a random face moved by up to 8 x the finest leaf side).
+struct AdfError {
+  double max_error = 0;
+  double mean_error = 0;
+  std::size_t samples = 0;
+};
+AdfError measure_adf_error(const Adf& adf, const TriMesh& source, const MeshDistance& mesh, std::size_t samples,
+                           std::uint64_t seed = 1);
+
+template <typename F>
+void Adf::for_each_leaf(F&& f) const {
+  // Level order: walk the levels with the cubes of the current one.
+  struct Cell {
+    std::uint32_t node;
+    Vec3d lo;
+  };
+  std::vector<Cell> level{{0, origin_}}, next;
+  double side = size_;
+  for (int l = 0; !level.empty(); ++l, side /= 2) {
+    next.clear();
+    for (const Cell& c : level) {
+      const std::uint32_t n = nodes_[c.node];
+      if (n & kLeaf) {
+        f(l, c.lo, side, &values_[std::size_t(n & ~kLeaf) * 8]);
+      } else {
+        for (std::uint32_t o = 0; o < 8; ++o)
+          next.push_back({n + o, c.lo + Vec3d(o & 1, (o >> 1) & 1, (o >> 2) & 1) * (side / 2)});
+      }
+    }
+    std::swap(level, next);
+  }
+}
+
+}  // namespace geods::field
