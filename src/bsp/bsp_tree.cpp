@@ -87,6 +87,22 @@ void check_mesh(const std::vector<Vec3d>& vertices, const std::vector<std::array
   if (triangles.empty()) throw Error(std::string(what) + ": empty mesh");
 }
 
+Triangles from_tri_mesh(const TriMesh& m) {
+  Triangles t;
+  t.vertices.reserve(m.vertices.size());
+  for (const auto& v : m.vertices) t.vertices.push_back(v.cast<double>());
+  t.triangles = m.triangles;
+  return t;
+}
+
+TriMesh to_tri_mesh(const Triangles& m) {
+  TriMesh t;
+  t.vertices.reserve(m.vertices.size());
+  for (const auto& v : m.vertices) t.vertices.push_back(v.cast<float>());
+  t.triangles = m.triangles;
+  return t;
+}
+
 // ---------------------------------------------------------------- construction
 
 namespace {

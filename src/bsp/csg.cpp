@@ -232,21 +232,20 @@ class Merger {
       if (planes_.normal_dot_sign(h, n.plane) > 0) return {n.neg, n.pos};
       return {n.pos, n.neg};
     }
-    const Polygon& face = faces_[n.face];
+    const Polygon face = faces_[n.face];  // a copy: the recursion below appends to faces_
     std::vector<int> fsigns;
     const Side fs = classify(planes_, face, h, &fsigns);
     if (s == Side::straddling) {
       // "Mixed": both children are cut.
-      Polygon pn, pp;
-      split(planes_, p, n.plane, signs, pn, pp);
-      auto [nn, np] = split_tree(n.neg, h, pn);
-      auto [pn2, pp2] = split_tree(n.pos, h, pp);
       if (fs != Side::straddling) throw Error("bsp split-tree: inconsistent faces (internal error)");
-      Polygon fn, fp;
+      Polygon pn, pp, fn, fp;
+      split(planes_, p, n.plane, signs, pn, pp);
       split(planes_, face, h, fsigns, fn, fp);
       const auto fni = static_cast<std::uint32_t>(faces_.size());
       faces_.push_back(std::move(fn));
       faces_.push_back(std::move(fp));
+      auto [nn, np] = split_tree(n.neg, h, pn);
+      auto [pn2, pp2] = split_tree(n.pos, h, pp);
       return {make(n.plane, fni, nn, pn2), make(n.plane, fni + 1, np, pp2)};
     }
     // P lies on one side of T's plane: only that child is cut; the other child's cell lies on

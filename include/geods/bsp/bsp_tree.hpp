@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "geods/bsp/plane_based.hpp"
+#include "geods/core/tri_mesh.hpp"
 #include "geods/core/vec.hpp"
 
 namespace geods::bsp {
@@ -76,6 +77,10 @@ struct Triangles {
   std::vector<Vec3d> vertices;
   std::vector<std::array<std::uint32_t, 3>> triangles;
 };
+
+/// Conversions from and to the library's float meshes.
+Triangles from_tri_mesh(const TriMesh& m);
+TriMesh to_tri_mesh(const Triangles& m);
 
 class BspTree {
  public:
