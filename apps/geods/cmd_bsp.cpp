@@ -65,12 +65,17 @@ class CsgCommand : public Command {
     app.add_option("op", op_, "union, intersection, difference (a minus b) or xor")->required();
     app.add_option("b", b_, "Second closed mesh")->required();
     add_output(app, "-o,--output", output_, "Output: the closed result mesh", io::OutputKind::mesh)->required();
+    app.add_option("--heuristic", heuristic_, "BSP construction of the operands: cost, random or balanced");
+    app.add_option("--k", k_, "Candidate polygons per node")->check(at_least(1));
   }
   void run(const RunContext&, Report& report) override {
     const bsp::CsgOp op = bsp::parse_csg_op(op_);
     const bsp::Triangles a = bsp::from_tri_mesh(io::read_mesh(a_));
     const bsp::Triangles b = bsp::from_tri_mesh(io::read_mesh(b_));
-    const bsp::CsgResult r = bsp::csg(a, b, op);
+    bsp::BuildOptions options;
+    options.heuristic = bsp::parse_heuristic(heuristic_);
+    options.k = static_cast<std::uint32_t>(k_);
+    const bsp::CsgResult r = bsp::csg(a, b, op, options);
     io::write_mesh(output_, bsp::to_tri_mesh(r.mesh));
     const bsp::CsgStats& s = r.stats;
     Json& j = report.json;
@@ -87,7 +92,8 @@ class CsgCommand : public Command {
   }
 
  private:
-  std::string a_, op_, b_, output_;
+  std::string a_, op_, b_, output_, heuristic_ = "cost";
+  long long k_ = 8;
 };
 
 const bool registered_bsp = register_command<BspCommand>();

@@ -17,5 +17,6 @@ void bind_voronoi(pybind11::module_& m);  // bind_voronoi.cpp: Voronoi2, MetricV
 void bind_texture(pybind11::module_& m);  // bind_texture.cpp: texture synthesis, hole filling
 void bind_field(pybind11::module_& m);    // bind_field.cpp: distance transform
 void bind_shape(pybind11::module_& m);    // bind_shape.cpp: shape distributions, ShapeDatabase
+void bind_bsp(pybind11::module_& m);      // bind_bsp.cpp: BSP trees, boolean operations
 
 }  // namespace geods::python

@@ -19,4 +19,5 @@ PYBIND11_MODULE(_geods, m) {
   geods::python::bind_texture(m);
   geods::python::bind_field(m);
   geods::python::bind_shape(m);
+  geods::python::bind_bsp(m);
 }

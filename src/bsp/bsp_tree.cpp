@@ -166,11 +166,10 @@ void BspTree::build(const std::vector<Vec3d>& vertices, const std::vector<std::a
   if (options.k == 0) throw Error("bsp: k must be at least 1");
   PlaneSet& planes = *planes_;
   std::vector<std::array<std::int64_t, 3>> snapped(vertices.size());
-  std::vector<char> used(vertices.size(), 0);
+  std::vector<std::uint32_t> point_id(vertices.size(), kNoPoint);
   for (const auto& t : triangles)
-    for (auto v : t) used[v] = 1;
-  for (std::size_t i = 0; i < vertices.size(); ++i)
-    if (used[i]) snapped[i] = grid_.snap(vertices[i]);
+    for (auto v : t)
+      if (point_id[v] == kNoPoint) snapped[v] = grid_.snap(vertices[v]), point_id[v] = planes.add_point(snapped[v]);
 
   std::vector<Frag> pool;
   pool.reserve(triangles.size() * 2);
@@ -187,6 +186,7 @@ void BspTree::build(const std::vector<Vec3d>& vertices, const std::vector<std::a
     poly.support = planes.add(s);
     poly.edges = {planes.add(edge_plane(p0, p1, p2, axis)), planes.add(edge_plane(p1, p2, p0, axis)),
                   planes.add(edge_plane(p2, p0, p1, axis))};
+    poly.points = {point_id[triangles[t][0]], point_id[triangles[t][1]], point_id[triangles[t][2]]};
     pool.push_back(make_frag(planes, std::move(poly)));
   }
   if (pool.empty()) throw Error("bsp: every triangle is degenerate (at the grid's resolution)");
@@ -367,7 +367,7 @@ void BspTree::compute_stats() {
   double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
   for (const auto& f : fragments_)
     for (std::size_t k = 0; k < f.size(); ++k) {
-      const auto p = planes_->point(f.support, f.prev_edge(k), f.edges[k]);
+      const auto p = planes_->point(f.vertex(k));
       for (int i = 0; i < 3; ++i) lo[i] = std::min(lo[i], p[i]), hi[i] = std::max(hi[i], p[i]);
     }
   std::mt19937_64 rng(12345);
@@ -564,7 +564,7 @@ Triangles BspTree::fragment_mesh() const {
   Triangles m;
   for (const auto& f : fragments_) {
     const auto base = static_cast<std::uint32_t>(m.vertices.size());
-    for (std::size_t k = 0; k < f.size(); ++k) m.vertices.push_back(grid_.to_world(planes_->point(f.support, f.prev_edge(k), f.edges[k])));
+    for (std::size_t k = 0; k < f.size(); ++k) m.vertices.push_back(grid_.to_world(planes_->point(f.vertex(k))));
     for (std::uint32_t k = 1; k + 1 < f.size(); ++k) m.triangles.push_back({base, base + k, base + k + 1});
   }
   return m;

@@ -273,7 +273,7 @@ namespace {
 // Welds exact vertices, inserts T-junction vertices, fans the pieces.
 Triangles to_mesh(const PlaneSet& planes, const Grid& grid, const std::vector<Polygon>& pieces, CsgStats& st) {
   struct V {
-    std::uint32_t p, q, r;
+    Vertex v;
     std::array<double, 3> x;
     double rad;
   };
@@ -283,15 +283,18 @@ Triangles to_mesh(const PlaneSet& planes, const Grid& grid, const std::vector<Po
     first[i] = static_cast<std::uint32_t>(verts.size());
     const Polygon& f = pieces[i];
     for (std::size_t k = 0; k < f.size(); ++k) {
-      V v{f.support, f.prev_edge(k), f.edges[k], {}, 0};
-      v.x = planes.point(v.p, v.q, v.r, &v.rad);
+      V v{f.vertex(k), {}, 0};
+      v.x = planes.point(v.v, &v.rad);
       verts.push_back(v);
     }
   }
   first[pieces.size()] = static_cast<std::uint32_t>(verts.size());
   auto same = [&](const V& a, const V& b) {
-    return planes.side(a.p & ~kFlip, b.p, b.q, b.r) == 0 && planes.side(a.q & ~kFlip, b.p, b.q, b.r) == 0 &&
-           planes.side(a.r & ~kFlip, b.p, b.q, b.r) == 0;
+    if (a.v.point != kNoPoint && b.v.point != kNoPoint)
+      return planes.integer_point(a.v.point) == planes.integer_point(b.v.point);
+    const Vertex& t = a.v.point == kNoPoint ? a.v : b.v;  // a vertex given by its planes
+    const Vertex& o = a.v.point == kNoPoint ? b.v : a.v;
+    return planes.side(t.p, o) == 0 && planes.side(t.q, o) == 0 && planes.side(t.r, o) == 0;
   };
   // Weld: sweep in x with the error radii; union-find.
   std::vector<std::uint32_t> parent(verts.size());
@@ -363,9 +366,8 @@ Triangles to_mesh(const PlaneSet& planes, const Grid& grid, const std::vector<Po
         for (int ax = 1; ax < 3; ++ax)
           in_box &= c.x[ax] >= std::min(pa[ax], pb[ax]) - r && c.x[ax] <= std::max(pa[ax], pb[ax]) + r;
         if (!in_box) continue;
-        if (planes.side(f.support, c.p, c.q, c.r) != 0 || planes.side(f.edges[k], c.p, c.q, c.r) != 0) continue;
-        if (planes.side(f.prev_edge(k), c.p, c.q, c.r) >= 0 || planes.side(f.edges[(k + 1) % n], c.p, c.q, c.r) >= 0)
-          continue;
+        if (planes.side(f.support, c.v) != 0 || planes.side(f.edges[k], c.v) != 0) continue;
+        if (planes.side(f.prev_edge(k), c.v) >= 0 || planes.side(f.edges[(k + 1) % n], c.v) >= 0) continue;
         const double t = (c.x[0] - pa[0]) * d[0] + (c.x[1] - pa[1]) * d[1] + (c.x[2] - pa[2]) * d[2];
         inserted.push_back({t, w});
       }
@@ -421,11 +423,7 @@ CsgResult csg(const Triangles& a, const Triangles& b, CsgOp op, const BuildOptio
     if (front == Label::outside && back == Label::inside) {
       pieces.push_back(p);
     } else if (front == Label::inside && back == Label::outside) {
-      Polygon r;
-      r.support = p.support ^ kFlip;
-      r.source = p.source;
-      r.edges.assign(p.edges.rbegin(), p.edges.rend());
-      pieces.push_back(std::move(r));
+      pieces.push_back(p.reversed());
     }
   };
   for (const auto& f : ta.fragments()) m.push(root, f, emit);

@@ -229,14 +229,48 @@ int PlaneSet::side(std::uint32_t h, const double* x) const {
   return flip * expansion_sign(t, 8);
 }
 
+std::uint32_t PlaneSet::add_point(const std::array<std::int64_t, 3>& q) {
+  points_.push_back(q);
+  return static_cast<std::uint32_t>(points_.size() - 1);
+}
+
+int PlaneSet::side(std::uint32_t h, const Vertex& v) const {
+  if (v.point == kNoPoint) return side(h, v.p, v.q, v.r);
+  const Plane& P = planes_[plane_index(h)];
+  const auto& x = points_[v.point];
+  const __int128 val = static_cast<__int128>(P.a) * x[0] + static_cast<__int128>(P.b) * x[1] +
+                       static_cast<__int128>(P.c) * x[2] + P.d;
+  const int s = (val > 0) - (val < 0);
+  return (h & kFlip) ? -s : s;
+}
+
+std::array<double, 3> PlaneSet::point(const Vertex& v, double* radius) const {
+  if (v.point == kNoPoint) return point(v.p, v.q, v.r, radius);
+  if (radius) *radius = 0;
+  const auto& x = points_[v.point];
+  return {static_cast<double>(x[0]), static_cast<double>(x[1]), static_cast<double>(x[2])};
+}
+
 // ---------------------------------------------------------------- polygons
+
+Polygon Polygon::reversed() const {
+  // Vertex k of the reversed edge list is vertex n - k of this one.
+  Polygon r;
+  const std::size_t n = edges.size();
+  r.support = support ^ kFlip;
+  r.source = source;
+  r.edges.assign(edges.rbegin(), edges.rend());
+  r.points.resize(n);
+  for (std::size_t k = 0; k < n; ++k) r.points[k] = points[(n - k) % n];
+  return r;
+}
 
 Side classify(const PlaneSet& planes, const Polygon& poly, std::uint32_t h, std::vector<int>* signs) {
   const std::size_t n = poly.edges.size();
   bool neg = false, pos = false;
   if (signs) signs->resize(n);
   for (std::size_t k = 0; k < n; ++k) {
-    const int s = planes.side(h, poly.support, poly.prev_edge(k), poly.edges[k]);
+    const int s = planes.side(h, poly.vertex(k));
     if (signs) (*signs)[k] = s;
     neg |= s < 0;
     pos |= s > 0;
@@ -256,19 +290,27 @@ void split(const PlaneSet& planes, const Polygon& poly, std::uint32_t h, const s
     out.support = poly.support;
     out.source = poly.source;
     out.edges.clear();
+    out.points.clear();
     // Edge k runs from vertex k to vertex k+1; it is kept if part of it is strictly on `side`.
     // The vertices strictly on `side` are one cyclic run (convexity): start at the edge that
-    // enters it, close the piece with h after the edge that leaves it.
+    // enters it, close the piece with h after the edge that leaves it. A new vertex on h that
+    // is an old vertex (sign 0) keeps its snapped point.
     auto on_side = [&](std::size_t k) { return signs[k % n] * side > 0; };
     std::size_t start = 0;
-    while (!( !on_side(start) && on_side(start + 1))) ++start;
+    while (!(!on_side(start) && on_side(start + 1))) ++start;
     for (std::size_t i = 0; i < n; ++i) {
       const std::size_t k = (start + i) % n;
       if (!on_side(k) && !on_side(k + 1)) continue;
+      // The vertex where this edge starts: the old vertex k, or h ∩ edge k (entering edge).
+      out.points.push_back(on_side(k) || signs[k] == 0 ? poly.points[k] : kNoPoint);
       out.edges.push_back(poly.edges[k]);
       // Edge planes keep the interior on their negative side, so the positive piece
       // closes with the opposite of h.
-      if (!on_side(k + 1)) out.edges.push_back(side < 0 ? h : (h ^ kFlip));
+      if (!on_side(k + 1)) {
+        const std::size_t k1 = (k + 1) % n;
+        out.points.push_back(signs[k1] == 0 ? poly.points[k1] : kNoPoint);  // edge k ∩ h
+        out.edges.push_back(side < 0 ? h : (h ^ kFlip));
+      }
     }
   }
 }
@@ -299,6 +341,7 @@ Polygon universe_polygon(const PlaneSet& planes, std::uint32_t h) {
   p.edges = {static_cast<std::uint32_t>(2 * j + 1), static_cast<std::uint32_t>(2 * i),
              static_cast<std::uint32_t>(2 * j), static_cast<std::uint32_t>(2 * i + 1)};
   if (n[k] < 0) std::swap(p.edges[1], p.edges[3]);
+  p.points.assign(4, kNoPoint);
   if (!clip(planes, p, static_cast<std::uint32_t>(2 * k), -1) ||
       !clip(planes, p, static_cast<std::uint32_t>(2 * k + 1), -1))
     throw Error("bsp: a plane misses the universe box (internal error)");
@@ -309,7 +352,7 @@ double approx_area(const PlaneSet& planes, const Polygon& poly) {
   const std::size_t n = poly.edges.size();
   std::array<double, 3> c{0, 0, 0};
   std::vector<std::array<double, 3>> v(n);
-  for (std::size_t k = 0; k < n; ++k) v[k] = planes.point(poly.support, poly.prev_edge(k), poly.edges[k]);
+  for (std::size_t k = 0; k < n; ++k) v[k] = planes.point(poly.vertex(k));
   double s[3] = {0, 0, 0};
   for (std::size_t k = 1; k + 1 < n; ++k) {
     const double a[3] = {v[k][0] - v[0][0], v[k][1] - v[0][1], v[k][2] - v[0][2]};
@@ -326,7 +369,7 @@ std::array<double, 3> approx_centroid(const PlaneSet& planes, const Polygon& pol
   std::array<double, 3> c{0, 0, 0};
   const std::size_t n = poly.edges.size();
   for (std::size_t k = 0; k < n; ++k) {
-    const auto v = planes.point(poly.support, poly.prev_edge(k), poly.edges[k]);
+    const auto v = planes.point(poly.vertex(k));
     for (int i = 0; i < 3; ++i) c[i] += v[i] / static_cast<double>(n);
   }
   return c;

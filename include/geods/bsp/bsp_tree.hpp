@@ -38,7 +38,7 @@ struct BuildOptions {
   double beta = 0.5;        // equation (5): penalty per split polygon
   std::uint32_t k = 8;      // candidates: the k largest (cost) or k random (random) polygons
   std::uint64_t seed = 1;   // random choices
-  std::size_t sample = 512; // polygons a candidate is scored on (all if fewer)
+  std::size_t sample = 128; // polygons a candidate is scored on (a random sample if more)
 };
 
 struct BspStats {

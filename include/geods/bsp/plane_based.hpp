@@ -38,6 +38,15 @@ struct Plane {
   std::int64_t a = 0, b = 0, c = 0, d = 0;
 };
 
+inline constexpr std::uint32_t kNoPoint = 0xffffffffu;
+
+/// A polygon vertex: the point where planes p, q, r meet; if `point` is not kNoPoint it is
+/// also that snapped input vertex (integer coordinates), which makes its sign tests cheap.
+struct Vertex {
+  std::uint32_t p = 0, q = 0, r = 0;
+  std::uint32_t point = kNoPoint;
+};
+
 /// 256-bit two's complement integer (only what the predicate needs).
 struct Int256 {
   std::array<std::uint64_t, 4> limb{};  // little endian
@@ -61,6 +70,11 @@ class PlaneSet {
   /// Sign of plane reference h at the point where planes p, q, r meet (they must meet in
   /// one point; their kFlip bits do not matter).
   int side(std::uint32_t h, std::uint32_t p, std::uint32_t q, std::uint32_t r) const;
+  /// Sign of plane h at a vertex (integer evaluation for snapped input vertices).
+  int side(std::uint32_t h, const Vertex& v) const;
+  std::array<double, 3> point(const Vertex& v, double* radius = nullptr) const;
+  std::uint32_t add_point(const std::array<std::int64_t, 3>& q);
+  const std::array<std::int64_t, 3>& integer_point(std::uint32_t i) const { return points_[i]; }
   /// Sign of the dot product of the normals of planes p and q (exact).
   int normal_dot_sign(std::uint32_t p, std::uint32_t q) const;
   /// Double approximation of the point where p, q, r meet (grid coordinates).
@@ -75,6 +89,7 @@ class PlaneSet {
  private:
   std::vector<Plane> planes_;
   std::vector<std::array<double, 4>> approx_;
+  std::vector<std::array<std::int64_t, 3>> points_;
 };
 
 /// A convex polygon: vertex k is support ∩ edges[k-1] ∩ edges[k]; the interior is on
@@ -83,10 +98,14 @@ class PlaneSet {
 struct Polygon {
   std::uint32_t support = 0;
   std::vector<std::uint32_t> edges;
-  std::uint32_t source = 0;  // input triangle (or tag) this fragment came from
+  std::vector<std::uint32_t> points;  // per vertex: its snapped input point, or kNoPoint
+  std::uint32_t source = 0;           // input triangle (or tag) this fragment came from
 
   std::size_t size() const { return edges.size(); }
   std::uint32_t prev_edge(std::size_t k) const { return edges[(k + edges.size() - 1) % edges.size()]; }
+  Vertex vertex(std::size_t k) const { return {support, prev_edge(k), edges[k], points[k]}; }
+  /// The same polygon with the opposite orientation.
+  Polygon reversed() const;
 };
 
 enum class Side { negative, positive, coplanar, straddling };
