@@ -179,7 +179,7 @@ TEST(BspTree, VisibilityOrderMatchesRayOcclusion) {
   std::vector<std::vector<Vec3d>> polys;
   for (const auto& f : t.fragments()) {
     std::vector<Vec3d> p;
-    for (std::size_t k = 0; k < f.size(); ++k) p.push_back(t.grid().to_world(t.planes().point(f.support, f.prev_edge(k), f.edges[k])));
+    for (std::size_t k = 0; k < f.size(); ++k) p.push_back(t.grid().to_world(t.planes().point(f.vertex(k))));
     polys.push_back(p);
   }
   for (int view = 0; view < 3; ++view) {
