@@ -23,5 +23,6 @@ void bind_adf(pybind11::module_& m);      // bind_adf.cpp: adaptively sampled di
 void bind_shape(pybind11::module_& m);    // bind_shape.cpp: shape distributions, ShapeDatabase
 void bind_collide(pybind11::module_& m);  // bind_collide.cpp: collision detection, mesh distance
 void bind_segment_voronoi(pybind11::module_& m);  // bind_segment_voronoi.cpp: SegmentVoronoi, MotionPlanner, plan_path
+void bind_bsp(pybind11::module_& m);      // bind_bsp.cpp: BSP trees, boolean operations
 
 }  // namespace geods::python

@@ -25,4 +25,5 @@ PYBIND11_MODULE(_geods, m) {
   geods::python::bind_shape(m);
   geods::python::bind_collide(m);
   geods::python::bind_segment_voronoi(m);
+  geods::python::bind_bsp(m);
 }
