@@ -20,7 +20,10 @@ namespace fs = std::filesystem;
 void run_info(const DemoContext& context, DemoResult& result) {
   std::vector<fs::path> files;
   for (const auto& entry : fs::directory_iterator(context.data_dir)) {
-    if (entry.is_regular_file() && entry.path().extension() != ".md") files.push_back(entry.path());
+    // (a shapefile's .dbf, .shx and .prj go with its .shp)
+    const std::string ext = entry.path().extension().string();
+    if (entry.is_regular_file() && ext != ".md" && ext != ".dbf" && ext != ".shx" && ext != ".prj")
+      files.push_back(entry.path());
   }
   std::sort(files.begin(), files.end());
   result.text = "geods info on every file in data/: what it holds, its bounds and the problems validate() finds.";

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <map>
 #include <string>
@@ -11,10 +12,12 @@
 #include "geods/io/image_io.hpp"
 #include "geods/io/mesh_io.hpp"
 #include "geods/io/npy.hpp"
+#include "geods/io/polygon_io.hpp"
 #include "geods/io/point_io.hpp"
 #include "geods/io/table_io.hpp"
 #include "geods/io/volume_io.hpp"
 #include "geods/shape/collection.hpp"
+#include "geods/terrain/height_field.hpp"
 #include "stopwatch.hpp"
 
 namespace geods::cli {
@@ -196,6 +199,46 @@ void describe_standard_input_ply(Report& report) {
 }
 
 // A shape collection (.sh3f furniture library, zip of meshes): members and labels, without reading the meshes.
+// A 2D map (polygons, polylines, points) read through GDAL/OGR or the SVG/.cin readers.
+void describe_map(const fs::path& path, Report& report) {
+  const io::PolygonSet map = io::read_polygons(path);
+  AABB2d box;
+  std::size_t ring_points = 0;
+  for (const auto& ring : map.rings) {
+    ring_points += ring.size();
+    for (const Vec2d& p : ring) box.extend(p);
+  }
+  for (const auto& s : map.segments) box.extend(Vec2d(s[0], s[1])).extend(Vec2d(s[2], s[3]));
+  for (const Vec2d& p : map.points) box.extend(p);
+  report.json["kind"] = "map";
+  report.json["rings"] = map.rings.size();
+  report.json["ring_points"] = ring_points;
+  report.json["segments"] = map.segments.size();
+  report.json["points"] = map.points.size();
+  report.lines.push_back(fmt::format("{}: 2D map, {} rings ({} corners), {} polyline segments, {} points",
+                                     path.filename().string(), map.rings.size(), ring_points, map.segments.size(),
+                                     map.points.size()));
+  add_bounds(report, box);
+}
+
+// A raster read as a height field (GeoTIFF and other GDAL rasters, Terragen .ter).
+void describe_raster(const fs::path& path, Report& report) {
+  const terrain::HeightField field = terrain::read_height_field(path);
+  float lo = INFINITY, hi = -INFINITY;
+  for (const float h : field.heights)
+    if (!std::isnan(h)) lo = std::min(lo, h), hi = std::max(hi, h);
+  report.json["kind"] = "height_field";
+  report.json["width"] = field.width;
+  report.json["height"] = field.height;
+  report.json["spacing"] = field.spacing;
+  report.json["missing"] = field.missing();
+  report.lines.push_back(fmt::format("{}: height field {} x {}, spacing {} x {}, heights {} .. {}",
+                                     path.filename().string(), field.width, field.height,
+                                     format_number(field.spacing[0]), format_number(field.spacing[1]),
+                                     format_number(lo), format_number(hi)));
+  if (field.missing()) report.lines.push_back(fmt::format("  {} missing (no-data) samples", field.missing()));
+}
+
 void describe_collection(const fs::path& path, Report& report) {
   const shape::ShapeCollection c = shape::ShapeCollection::open(path);
   std::map<std::string, std::size_t> labels;
@@ -246,12 +289,17 @@ Report describe_file(const fs::path& path, const std::optional<RawVolumeSpec>& r
     describe_npy(path, report);
   } else if (ext == ".sh3f" || ext == ".zip") {
     describe_collection(path, report);
+  } else if (ext == ".shp" || ext == ".wkt" || ext == ".geojson" || ext == ".gpkg" || ext == ".kml" || ext == ".svg") {
+    describe_map(path, report);
+  } else if (ext == ".tif" || ext == ".tiff" || ext == ".ter" || ext == ".asc" || ext == ".hgt") {
+    describe_raster(path, report);
   } else if (ext == ".raw") {
     throw Error(path.string() + ": a raw volume needs --dims X,Y,Z and --dtype");
   } else {
     throw Error(path.string() + ": unknown file type '" + ext +
                 "' (meshes .ply .obj .stl .off .gltf .glb, also .gz; volumes .nii .nii.gz .nrrd .npy .raw; images .png "
-                ".jpg .bmp; points .xyz .csv .txt .ply .npy; segments .edg .cin .npy; shape collections .sh3f .zip; "
+                ".jpg .bmp; points .xyz .csv .txt .ply .npy; segments .edg .cin .npy; shape collections .sh3f .zip; maps .shp "
+                ".wkt .geojson .gpkg .kml .svg; height fields .tif .ter .asc .hgt; "
                 "- for standard input)");
   }
   report.json["compute_s"] = watch.seconds();

@@ -72,7 +72,9 @@ void check_pair(const Triangles& a, const Triangles& b, double tol, int points =
       EXPECT_EQ(std::round(w) > 0.5, member(op, std::round(wa) > 0.5, std::round(wb) > 0.5)) << csg_op_name(op);
     }
   }
-  if (points > 0) EXPECT_GT(checked, points);
+  if (points > 0) {
+    EXPECT_GT(checked, points);
+  }
 }
 
 }  // namespace

@@ -48,7 +48,9 @@ TEST(DeferredBsp, ExactAndAdaptive) {
     const Vec3d c = skewed ? hot + Vec3d(0.6 * g(rng), 0.6 * g(rng), 0.6 * g(rng)) : Vec3d(5 * g(rng), 5 + 4 * g(rng), 4 * g(rng));
     const Vec3d d = Vec3d(g(rng), g(rng), g(rng)).normalized() * (skewed ? 0.8 : 2.0);
     const bool got = lazy.intersects(c - d, c + d);
-    if (i < 400) EXPECT_EQ(got, brute(bunny, c - d, c + d));
+    if (i < 400) {
+      EXPECT_EQ(got, brute(bunny, c - d, c + d));
+    }
     EXPECT_EQ(oblivious.intersects(c - d, c + d), got);
     hits += got;
   }

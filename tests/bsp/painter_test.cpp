@@ -53,7 +53,9 @@ TEST(Painter, MatchesRayTracedImage) {
     EXPECT_GT(covered, 3000u);
     EXPECT_EQ(interior_mismatches, 0u) << (b2f ? "back to front" : "front to back");
     EXPECT_LT(mismatches, covered / 20);
-    if (!b2f) EXPECT_LE(r.pixel_writes, std::size_t(view.width * view.height));  // each pixel at most once
+    if (!b2f) {
+      EXPECT_LE(r.pixel_writes, std::size_t(view.width * view.height));  // each pixel at most once
+    }
   }
   PainterView bad = view;
   bad.target = bad.eye;
