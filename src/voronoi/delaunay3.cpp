@@ -292,8 +292,10 @@ void Delaunay3::build(Options options, bool may_split) {
     dimension_ = -1;
     return;
   }
-  if (may_split && num_threads() > 1 && n >= std::max<std::size_t>(options.parallel_from, 16) && build_split(active))
+  if (may_split && num_threads() > 1 && n >= std::max<std::size_t>(options.parallel_from, 16) && build_split(active)) {
+    canonicalize();
     return;
+  }
   const std::vector<std::uint32_t> order = brio_order(std::span<const Vec3d>(points_), active, options.seed);
 
   // The first tetrahedron: the earliest four affinely independent points in the order.
@@ -363,6 +365,7 @@ void Delaunay3::build(Options options, bool may_split) {
   walk_steps_ = mesh.walk_steps;
   conflicts_ = mesh.conflicts;
   last_ = mesh.last;
+  if (may_split) canonicalize();  // (the halves and seams of a parallel build need not be)
 }
 
 std::uint32_t Delaunay3::insert(const Vec3d& p) {
@@ -443,35 +446,45 @@ bool Delaunay3::remove_locally(std::uint32_t v) {
   const Delaunay3 small(link_points);
   if (small.dimension() < 3) return false;
 
-  // A face as its three vertices in counter-clockwise order, rotated to start at the smallest.
-  using Face = std::array<std::uint32_t, 3>;
-  const auto face_of = [](const std::uint32_t* vertices, int opposite) {
-    const std::array<int, 3> f = Tet3Mesh::face_towards(opposite);
-    Face face = {vertices[f[0]], vertices[f[1]], vertices[f[2]]};
-    std::rotate(face.begin(), std::min_element(face.begin(), face.end()), face.end());
-    return face;
-  };
-  std::vector<std::pair<Face, std::uint32_t>> boundary;  // the face and the adjacency across it
+  RegionFill region;
   for (const std::uint32_t t : star) {
     const std::uint32_t* w = &tets_[8 * std::size_t(t)];
     const int j = int(std::find(w, w + 4, v) - w);
-    boundary.push_back({face_of(w, j), w[4 + j]});
+    region.boundary.push_back({RegionFill::face_of(w, j), w[4 + j]});
   }
-  std::sort(boundary.begin(), boundary.end());
+  if (!region.match(small.tets_, link)) return false;  // not expected: rebuild rather than guess
+  // Replace the star by the fill.
+  Tet3Mesh mesh(points_, tets_, free_slots_);
+  for (const std::uint32_t t : star) mesh.free_slot(t);
+  for (const std::uint32_t s : region.fill) region.slot[s] = mesh.new_slot();
+  region.write(tets_);
+  last_ = region.slot[region.fill.front()];
+  return true;
+}
 
-  // The small tetrahedralization's slots over big vertex ids; the seeds are
-  // those with a boundary face, their fill spreads across the other faces.
-  const std::size_t small_slots = small.tets_.size() / 8;
-  std::vector<std::uint32_t> mapped(small.tets_.size());
-  for (std::size_t k = 0; k < small.tets_.size(); k += 8)
+RegionFill::Face RegionFill::face_of(const std::uint32_t* vertices, int opposite) {
+  const std::array<int, 3> f = Tet3Mesh::face_towards(opposite);
+  Face face = {vertices[f[0]], vertices[f[1]], vertices[f[2]]};
+  std::rotate(face.begin(), std::min_element(face.begin(), face.end()), face.end());
+  return face;
+}
+
+bool RegionFill::match(const std::vector<std::uint32_t>& filler, std::span<const std::uint32_t> ids) {
+  if (boundary.empty()) return false;
+  std::sort(boundary.begin(), boundary.end());
+  const std::size_t slots = filler.size() / 8;
+  mapped.resize(filler.size());
+  for (std::size_t k = 0; k < filler.size(); k += 8)
     for (int j = 0; j < 4; ++j) {
-      const std::uint32_t u = small.tets_[k + j];
-      mapped[k + j] = (u & Tet3Mesh::kGhostBit) ? u : link[u];
-      mapped[k + 4 + j] = small.tets_[k + 4 + j];
+      const std::uint32_t u = filler[k + j];
+      mapped[k + j] = (u & Tet3Mesh::kGhostBit) ? u : ids[u];
+      mapped[k + 4 + j] = filler[k + 4 + j];
     }
-  std::vector<std::uint32_t> new_slot(small_slots, kNone), outer(4 * small_slots, kNone), fill;
+  slot.assign(slots, kNone);
+  outer.assign(4 * slots, kNone);
+  fill.clear();
   std::size_t matched = 0;
-  for (std::size_t s = 0; s < small_slots; ++s) {
+  for (std::size_t s = 0; s < slots; ++s) {
     if (mapped[8 * s] == kNone) continue;
     for (int j = 0; j < 4; ++j) {
       const Face face = face_of(&mapped[8 * s], j);
@@ -479,95 +492,124 @@ bool Delaunay3::remove_locally(std::uint32_t v) {
       if (it == boundary.end() || it->first != face) continue;
       outer[4 * s + j] = it->second;
       ++matched;
-      if (new_slot[s] == kNone) {
-        new_slot[s] = 0;
-        fill.push_back(std::uint32_t(s));
-      }
+      if (slot[s] == kNone) slot[s] = 0, fill.push_back(std::uint32_t(s));
     }
   }
-  if (matched != boundary.size()) return false;  // not expected: rebuild rather than guess
+  if (matched != boundary.size()) return false;
   for (std::size_t k = 0; k < fill.size(); ++k)
     for (int j = 0; j < 4; ++j) {
       const std::uint32_t s = fill[k], n = mapped[8 * std::size_t(s) + 4 + j] >> 2;
-      if (outer[4 * s + j] == kNone && new_slot[n] == kNone) {
-        new_slot[n] = 0;
-        fill.push_back(n);
-      }
+      if (outer[4 * s + j] == kNone && slot[n] == kNone) slot[n] = 0, fill.push_back(n);
     }
-
-  // Replace the star by the fill: slots first, then adjacencies.
-  Tet3Mesh mesh(points_, tets_, free_slots_);
-  for (const std::uint32_t t : star) mesh.free_slot(t);
-  for (const std::uint32_t s : fill) new_slot[s] = mesh.new_slot();
-  for (const std::uint32_t s : fill) {
-    const std::uint32_t t = new_slot[s];
-    std::copy_n(&mapped[8 * std::size_t(s)], 4, &tets_[8 * std::size_t(t)]);
-    for (std::uint32_t j = 0; j < 4; ++j) {
-      const std::uint32_t a = outer[4 * s + j];
-      if (a != kNone) {
-        tets_[8 * std::size_t(t) + 4 + j] = a;
-        tets_[Tet3Mesh::entry(a)] = 4 * t + j;
-      } else {
-        const std::uint32_t inner = mapped[8 * std::size_t(s) + 4 + j];
-        tets_[8 * std::size_t(t) + 4 + j] = 4 * new_slot[inner >> 2] + (inner & 3);
-      }
-    }
-  }
-  last_ = new_slot[fill.front()];
   return true;
 }
 
-// The public arrays in a canonical order, the same however the slots were
-// filled (sequentially, in parallel, after updates): each tetrahedron starts at
-// its smallest vertex, then the smaller of the two next in its orientation (an
-// even permutation, so it stays positive), and the tetrahedra are sorted by
-// their four vertices: a counting sort on the first, then each bucket.
-void Delaunay3::publish() {
+void RegionFill::write(std::vector<std::uint32_t>& tets) const {
+  for (const std::uint32_t s : fill) {
+    const std::uint32_t t = slot[s];
+    std::copy_n(&mapped[8 * std::size_t(s)], 4, &tets[8 * std::size_t(t)]);
+    for (std::uint32_t j = 0; j < 4; ++j) {
+      const std::uint32_t a = outer[4 * s + j];
+      if (a != kNone) {
+        tets[8 * std::size_t(t) + 4 + j] = a;
+        tets[Tet3Mesh::entry(a)] = 4 * t + j;
+      } else {
+        const std::uint32_t inner = mapped[8 * std::size_t(s) + 4 + j];
+        tets[8 * std::size_t(t) + 4 + j] = 4 * slot[inner >> 2] + (inner & 3);
+      }
+    }
+  }
+}
+
+// The slots in a canonical order that depends only on the points (not on
+// the insertion order or the thread count), so that every build gives the same
+// arrays: each tetrahedron starts at its smallest vertex, then the smallest of
+// the other three in its orientation (an even permutation, so it stays
+// positive), and the slots are sorted by their vertices (a counting sort on
+// the first, then each bucket); ghosts sort among them (the ghost is the
+// largest vertex), free slots go.
+void Delaunay3::canonicalize() {
   const std::size_t slots = tets_.size() / 8;
   const std::size_t n = points_.size();
   std::vector<std::array<std::uint32_t, 4>> canonical(slots);
-  std::vector<std::uint32_t> count(n + 1, 0);
+  std::vector<std::array<std::uint8_t, 4>> position(slots);  // canonical[s][i] = tets_[8s + position[s][i]]
+  std::vector<std::array<std::uint8_t, 4>> place(slots);     // its inverse: where entry j of slot s goes
   parallel_for(0, slots, 1 << 14, [&](std::size_t begin, std::size_t end) {
     for (std::size_t s = begin; s < end; ++s) {
       const std::uint32_t* v = &tets_[8 * s];
-      std::array<std::uint32_t, 4>& c = canonical[s];
-      if (((v[0] | v[1] | v[2] | v[3]) & Tet3Mesh::kGhostBit) != 0) {
-        c[0] = kNone;
-        continue;
-      }
-      // The even permutations that bring the smallest vertex first: (0123), (1032), (2301), (3210)
-      // rotated in their last three; pick the smallest first, then rotate the rest.
+      if (v[0] == kNone) continue;
+      // The even permutations that bring each index first: (0123), (1032), (2301), (3210); then a rotation of the rest.
+      static constexpr std::uint8_t kEven[4][4] = {{0, 1, 2, 3}, {1, 0, 3, 2}, {2, 3, 0, 1}, {3, 2, 1, 0}};
       const int m = int(std::min_element(v, v + 4) - v);
-      static constexpr int kEven[4][4] = {{0, 1, 2, 3}, {1, 0, 3, 2}, {2, 3, 0, 1}, {3, 2, 1, 0}};
-      std::uint32_t r[3] = {v[kEven[m][1]], v[kEven[m][2]], v[kEven[m][3]]};
-      const int k = int(std::min_element(r, r + 3) - r);
-      c = {v[m], r[k], r[(k + 1) % 3], r[(k + 2) % 3]};
+      const std::uint8_t* r = &kEven[m][1];
+      int k = 0;
+      for (int i = 1; i < 3; ++i)
+        if (v[r[i]] < v[r[k]]) k = i;
+      position[s] = {kEven[m][0], r[k], r[(k + 1) % 3], r[(k + 2) % 3]};
+      for (int i = 0; i < 4; ++i) canonical[s][i] = v[position[s][i]], place[s][position[s][i]] = std::uint8_t(i);
     }
   });
+  std::vector<std::uint32_t> count(n + 1, 0);
   for (std::size_t s = 0; s < slots; ++s)
-    if (canonical[s][0] != kNone) ++count[canonical[s][0] + 1];
+    if (tets_[8 * s] != kNone) ++count[canonical[s][0] + 1];
   for (std::size_t i = 0; i < n; ++i) count[i + 1] += count[i];
-  const std::size_t total = count[n];
-  std::vector<std::uint32_t> order(total);  // slots by first vertex
+  std::vector<std::uint32_t> order(count[n]);
   {
     std::vector<std::uint32_t> next(count.begin(), count.end() - 1);
     for (std::size_t s = 0; s < slots; ++s)
-      if (canonical[s][0] != kNone) order[next[canonical[s][0]]++] = std::uint32_t(s);
+      if (tets_[8 * s] != kNone) order[next[canonical[s][0]]++] = std::uint32_t(s);
   }
   parallel_for(0, n, 1 << 12, [&](std::size_t begin, std::size_t end) {
     for (std::size_t v = begin; v < end; ++v)
       std::sort(order.begin() + count[v], order.begin() + count[v + 1],
                 [&](std::uint32_t a, std::uint32_t b) { return canonical[a] < canonical[b]; });
   });
-  public_of_.assign(slots, kNone);
-  tetrahedra_.resize(4 * total);
-  parallel_for(0, total, 1 << 14, [&](std::size_t begin, std::size_t end) {
+  std::vector<std::uint32_t> new_of(slots, kNone);
+  for (std::size_t t = 0; t < order.size(); ++t) new_of[order[t]] = std::uint32_t(t);
+  std::vector<std::uint32_t> out(8 * order.size());
+  parallel_for(0, order.size(), 1 << 14, [&](std::size_t begin, std::size_t end) {
     for (std::size_t t = begin; t < end; ++t) {
-      public_of_[order[t]] = std::uint32_t(t);
-      std::copy_n(canonical[order[t]].begin(), 4, &tetrahedra_[4 * t]);
+      const std::uint32_t s = order[t];
+      for (int i = 0; i < 4; ++i) {
+        out[8 * t + i] = canonical[s][i];
+        const std::uint32_t a = tets_[8 * std::size_t(s) + 4 + position[s][i]], u = a >> 2;
+        out[8 * t + 4 + i] = 4 * new_of[u] + place[u][a & 3];
+      }
     }
   });
+  tets_.swap(out);
+  free_slots_.clear();
+  last_ = last_ < slots && new_of[last_] != kNone ? new_of[last_] : 0;
+}
+
+// The public arrays: the finite slots in slot order (canonical after a build;
+// insert and remove reuse and append slots).
+void Delaunay3::publish() {
+  const std::size_t slots = tets_.size() / 8;
+  public_of_.assign(slots, kNone);
+  std::size_t count = 0;
+  for (std::size_t s = 0; s < slots; ++s) {
+    const std::uint32_t* v = &tets_[8 * s];
+    if (((v[0] | v[1] | v[2] | v[3]) & Tet3Mesh::kGhostBit) == 0) public_of_[s] = std::uint32_t(count++);
+  }
+  tetrahedra_.resize(4 * count);
+  parallel_for(0, slots, 1 << 14, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t s = begin; s < end; ++s)
+      if (public_of_[s] != kNone) std::copy_n(&tets_[8 * s], 4, &tetrahedra_[4 * std::size_t(public_of_[s])]);
+  });
   index_vertices();
+}
+
+std::vector<std::uint32_t> Delaunay3::neighbors() const {
+  std::vector<std::uint32_t> out(tetrahedra_.size());
+  parallel_for(0, public_of_.size(), 1 << 14, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t s = begin; s < end; ++s) {
+      const std::uint32_t t = public_of_[s];
+      if (t == kNone) continue;
+      for (int k = 0; k < 4; ++k) out[4 * std::size_t(t) + k] = public_of_[tets_[8 * s + 4 + k] >> 2];
+    }
+  });
+  return out;
 }
 
 void Delaunay3::index_vertices() {
@@ -577,22 +619,6 @@ void Delaunay3::index_vertices() {
       const std::uint32_t v = tets_[8 * s + k];
       if ((v & Tet3Mesh::kGhostBit) == 0) vertex_slot_[v] = std::uint32_t(s);
     }
-}
-
-std::vector<std::uint32_t> Delaunay3::neighbors() const {
-  std::vector<std::uint32_t> out(tetrahedra_.size());
-  parallel_for(0, public_of_.size(), 1 << 14, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t s = begin; s < end; ++s) {
-      const std::uint32_t t = public_of_[s];
-      if (t == kNone) continue;
-      // public vertex i is the slot's vertex j: its neighbour is across the face opposite it
-      for (int i = 0; i < 4; ++i)
-        for (int j = 0; j < 4; ++j)
-          if (tets_[8 * s + j] == tetrahedra_[4 * std::size_t(t) + i])
-            out[4 * std::size_t(t) + i] = public_of_[tets_[8 * s + 4 + j] >> 2];
-    }
-  });
-  return out;
 }
 
 std::vector<Delaunay3::Triangle> Delaunay3::hull() const {
@@ -813,11 +839,9 @@ void Delaunay3::validate() const {
   for (std::size_t s = 0; s < slots; ++s) {
     const std::uint32_t t = public_of_[s];
     if (t == kNone) continue;
-    const std::uint32_t* p = &tetrahedra_[4 * std::size_t(t)];
-    const bool same_vertices = std::is_permutation(p, p + 4, &tets_[8 * s]);
-    if (!same_vertices || Tet3Mesh::orient(points_[p[0]], points_[p[1]], points_[p[2]], points_[p[3]]) <= 0 ||
-        (t > 0 && !std::lexicographical_compare(p - 4, p, p, p + 4)))
-      throw Error("Delaunay3: public tetrahedron " + std::to_string(t) + " differs from its slot or is out of order");
+    for (int k = 0; k < 4; ++k)
+      if (tetrahedra_[4 * std::size_t(t) + k] != tets_[8 * s + k])
+        throw Error("Delaunay3: public tetrahedron " + std::to_string(t) + " differs from its slot");
   }
 }
 

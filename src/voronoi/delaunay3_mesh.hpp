@@ -10,6 +10,8 @@
 // is oriented as if its ghost were a point beyond its hull face.
 #include <array>
 #include <cstdint>
+#include <span>
+#include <utility>
 #include <vector>
 
 #include "geods/core/predicates.hpp"
@@ -128,6 +130,30 @@ struct Tet3Mesh {
   std::vector<std::uint32_t> stack, cavity;
   std::vector<Boundary> boundary;
   EdgeTable edges;
+};
+
+/// Refilling a region of a closed tetrahedralization (a removed vertex's star,
+/// the seam of a parallel build) from another tetrahedralization, the filler,
+/// over the region's vertices: the filler's slots inside the region are those
+/// with one of the region's boundary faces (oriented: the side towards the
+/// region), and those reached from them across other faces.
+struct RegionFill {
+  using Face = std::array<std::uint32_t, 3>;
+  /// A face as its three vertices counter-clockwise seen from the side of
+  /// vertex `opposite`, rotated to start at the smallest.
+  static Face face_of(const std::uint32_t* vertices, int opposite);
+
+  std::vector<std::pair<Face, std::uint32_t>> boundary;  // seen from inside the region; the adjacency across it
+  std::vector<std::uint32_t> mapped;  // the filler's slots over the region's vertex ids
+  std::vector<std::uint32_t> outer;   // per filler slot face: the adjacency across it on the boundary, or kNone
+  std::vector<std::uint32_t> fill;    // the filler's slots inside the region
+  std::vector<std::uint32_t> slot;    // per filler slot: where it goes (the caller sets it for fill's)
+
+  /// Matches the boundary against the filler's slots (vertex k of the filler
+  /// is ids[k]); false if there is no boundary or a face of it has no match.
+  bool match(const std::vector<std::uint32_t>& filler, std::span<const std::uint32_t> ids);
+  /// Writes the fill into `tets` at its slots, linked to each other and across the boundary.
+  void write(std::vector<std::uint32_t>& tets) const;
 };
 
 }  // namespace geods::voronoi

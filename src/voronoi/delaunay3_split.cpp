@@ -21,17 +21,6 @@ namespace {
 constexpr std::uint32_t kNone = Delaunay3::no_index;
 constexpr std::uint32_t kGhost = Tet3Mesh::kGhost;
 
-using Face = std::array<std::uint32_t, 3>;
-
-// A face as its three vertices counter-clockwise seen from the side of the
-// tetrahedron's vertex `opposite`, rotated to start at the smallest.
-Face face_of(const std::uint32_t* vertices, int opposite) {
-  const std::array<int, 3> f = Tet3Mesh::face_towards(opposite);
-  Face face = {vertices[f[0]], vertices[f[1]], vertices[f[2]]};
-  std::rotate(face.begin(), std::min_element(face.begin(), face.end()), face.end());
-  return face;
-}
-
 // The point of a convex polytope's vertices (given by their adjacency) that is
 // farthest along `direction`: a strict hill climb from `start` (on a convex
 // polytope a vertex that no neighbour beats is a maximum).
@@ -208,7 +197,7 @@ bool Delaunay3::build_split(const std::vector<std::uint32_t>& active) {
   }
   const auto to_global = [&](int h, std::uint32_t v) { return v == kGhost ? kGhost : global[h][v]; };
   // The seam region's boundary: kept slots' faces towards doubtful ones, seen from the seam's side.
-  std::vector<std::pair<Face, std::uint32_t>> boundary;  // the face and the adjacency across it (new numbers)
+  RegionFill seam_fill;  // its boundary: the face and the adjacency across it (new numbers)
   for (int h = 0; h < 2; ++h)
     for (std::size_t s = 0; s < valid[h].size(); ++s) {
       if (renumber[h][s] == kNone) continue;
@@ -217,41 +206,13 @@ bool Delaunay3::build_split(const std::vector<std::uint32_t>& active) {
         if (valid[h][u]) continue;
         std::uint32_t w[4];
         for (int k = 0; k < 4; ++k) w[k] = to_global(h, half[h].tets_[8 * std::size_t(u) + k]);
-        boundary.push_back({face_of(w, int(a & 3)), 4 * renumber[h][s] + f});
+        seam_fill.boundary.push_back({RegionFill::face_of(w, int(a & 3)), 4 * renumber[h][s] + f});
       }
     }
-  std::sort(boundary.begin(), boundary.end());
 
-  // The fill: the filler's slots with a boundary face, and those reached from them across other faces.
-  const std::size_t filler_slots = filler.tets_.size() / 8;
-  std::vector<std::uint32_t> mapped(filler.tets_.size());
-  for (std::size_t k = 0; k < filler.tets_.size(); k += 8)
-    for (int j = 0; j < 4; ++j) {
-      const std::uint32_t u = filler.tets_[k + j];
-      mapped[k + j] = (u & Tet3Mesh::kGhostBit) ? u : seam[u];
-      mapped[k + 4 + j] = filler.tets_[k + 4 + j];
-    }
-  std::vector<std::uint32_t> fill_slot(filler_slots, kNone), outer(4 * filler_slots, kNone), fill;
-  std::size_t matched = 0;
-  for (std::size_t s = 0; s < filler_slots; ++s) {
-    if (mapped[8 * s] == kNone) continue;
-    for (int j = 0; j < 4; ++j) {
-      const Face face = face_of(&mapped[8 * s], j);
-      const auto it = std::lower_bound(boundary.begin(), boundary.end(), std::pair(face, std::uint32_t(0)));
-      if (it == boundary.end() || it->first != face) continue;
-      outer[4 * s + j] = it->second;
-      ++matched;
-      if (fill_slot[s] == kNone) fill_slot[s] = 0, fill.push_back(std::uint32_t(s));
-    }
-  }
   // Nothing kept next to the seam (a small or flat half), or a face unmatched (not expected): build sequentially.
-  if (boundary.empty() || matched != boundary.size()) return false;
-  for (std::size_t k = 0; k < fill.size(); ++k)
-    for (int j = 0; j < 4; ++j) {
-      const std::uint32_t s = fill[k], n = mapped[8 * std::size_t(s) + 4 + j] >> 2;
-      if (outer[4 * s + j] == kNone && fill_slot[n] == kNone) fill_slot[n] = 0, fill.push_back(n);
-    }
-  for (const std::uint32_t s : fill) fill_slot[s] = next++;
+  if (!seam_fill.match(filler.tets_, seam)) return false;
+  for (const std::uint32_t s : seam_fill.fill) seam_fill.slot[s] = next++;
 
   // Assemble: kept slots with their adjacencies renumbered (towards the seam: the fill's), then the fill.
   tets_.assign(8 * std::size_t(next), 0);
@@ -267,20 +228,7 @@ bool Delaunay3::build_split(const std::vector<std::uint32_t>& active) {
         }
       }
     });
-  for (const std::uint32_t s : fill) {
-    const std::uint32_t t = fill_slot[s];
-    std::copy_n(&mapped[8 * std::size_t(s)], 4, &tets_[8 * std::size_t(t)]);
-    for (std::uint32_t j = 0; j < 4; ++j) {
-      const std::uint32_t a = outer[4 * s + j];
-      if (a != kNone) {
-        tets_[8 * std::size_t(t) + 4 + j] = a;
-        tets_[Tet3Mesh::entry(a)] = 4 * t + j;
-      } else {
-        const std::uint32_t inner = mapped[8 * std::size_t(s) + 4 + j];
-        tets_[8 * std::size_t(t) + 4 + j] = 4 * fill_slot[inner >> 2] + (inner & 3);
-      }
-    }
-  }
+  seam_fill.write(tets_);
   // Representatives: equal points fall in the same half, whose first occurrence is the first here too.
   for (int h = 0; h < 2; ++h)
     for (std::size_t k = 0; k < global[h].size(); ++k) rep_[global[h][k]] = global[h][half[h].rep_[k]];
@@ -288,7 +236,7 @@ bool Delaunay3::build_split(const std::vector<std::uint32_t>& active) {
   walk_steps_ = half[0].walk_steps_ + half[1].walk_steps_ + filler.walk_steps_;
   conflicts_ = half[0].conflicts_ + half[1].conflicts_ + filler.conflicts_;
   seam_points_ = seam.size();
-  last_ = fill_slot[fill.front()];
+  last_ = seam_fill.slot[seam_fill.fill.front()];
   return true;
 }
 

@@ -94,11 +94,11 @@ class Delaunay3 {
 
   /// The input points, indexed as given.
   std::span<const Vec3d> points() const { return points_; }
-  /// Finite tetrahedra, four positively oriented vertex indices each, in a
-  /// canonical order that depends only on the points (not on the insertion
-  /// order, the thread count or the updates that led here): each starts at its
-  /// smallest vertex, then the smallest of the other three, and the
-  /// tetrahedra are sorted by their vertices.
+  /// Finite tetrahedra, four positively oriented vertex indices each. After a
+  /// build in a canonical order that depends only on the points (not on the
+  /// insertion order or the thread count): each starts at its smallest vertex,
+  /// then the smallest of the other three, and the tetrahedra are sorted by
+  /// their vertices; insert() and remove() change it in place.
   const std::vector<std::uint32_t>& tetrahedra() const { return tetrahedra_; }
   /// Per tetrahedron, the four neighbouring tetrahedra: neighbour i shares
   /// the face opposite vertex i; no_index on the convex hull. Made from the
@@ -177,6 +177,7 @@ class Delaunay3 {
   void build(Options options, bool may_split = true);
   bool build_split(const std::vector<std::uint32_t>& active);  // false: the halves cannot be stitched, build sequentially
   bool remove_locally(std::uint32_t v);  // false: the link is flat, rebuild instead
+  void canonicalize();  // slots in an order that depends only on the points
   void publish();
   void index_vertices();  // vertex_slot_ from the slots
   std::uint32_t start_slot(std::uint32_t hint) const;  // a live slot to walk from
