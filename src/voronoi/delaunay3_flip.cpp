@@ -150,8 +150,20 @@ std::uint32_t Tet3Mesh::insert_by_flips(std::uint32_t pv) {
     int zeros = 0;
     for (int k = 0; k < 4; ++k) zeros += (o[k] = orient_of(with(q, k, pv))) == 0;
     if (zeros == 0) {
-      const Quad four[4] = {with(q, 0, pv), with(q, 1, pv), with(q, 2, pv), with(q, 3, pv)};
-      replace(&t, 1, four, 4);
+      // 1-4: new k is q with p for vertex k; its face k is q's, its face j
+      // new j's face k.
+      const std::uint32_t s[4] = {t, new_slot(), new_slot(), new_slot()};
+      std::uint32_t outer[4];
+      for (int k = 0; k < 4; ++k) outer[k] = tets[8 * std::size_t(t) + 4 + k];
+      for (int k = 0; k < 4; ++k) {
+        std::uint32_t* w = &tets[8 * std::size_t(s[k])];
+        std::copy_n(q.data(), 4, w);
+        w[k] = pv;
+        for (int j = 0; j < 4; ++j) w[4 + j] = j == k ? outer[k] : 4 * s[j] + std::uint32_t(k);
+        tets[entry(outer[k])] = 4 * s[k] + std::uint32_t(k);
+        flip_stack.push_back(4 * s[k] + std::uint32_t(k));
+      }
+      last = t;
       ++flip_counts[flip_14];
     } else {
       // On a face or an edge: every tetrahedron whose closed volume holds p,
@@ -231,7 +243,33 @@ std::uint32_t Tet3Mesh::insert_by_flips(std::uint32_t pv) {
       }
     }
     bool done = false;
-    if (negatives == 0 && zeros == 0) {
+    if (negatives == 0 && zeros == 0 && g < 0) {
+      // 2-3: new m is tq with x for vertex k = ks[m]; its face k is tq's, its
+      // face i (opposite p) n's face without tq[k], its face ks[m2] new m2's face k.
+      const Quad nq = quad_of(tets.data(), n);
+      int ks[3], m = 0;
+      for (int k = 0; k < 4; ++k)
+        if (k != i) ks[m++] = k;
+      std::uint32_t at_t[3], at_n[3];
+      for (m = 0; m < 3; ++m) {
+        at_t[m] = tets[8 * std::size_t(t0) + 4 + ks[m]];
+        at_n[m] = tets[8 * std::size_t(n) + 4 + index_of(nq, tq[ks[m]])];
+      }
+      const std::uint32_t s[3] = {t0, n, new_slot()};
+      for (m = 0; m < 3; ++m) {
+        std::uint32_t* w = &tets[8 * std::size_t(s[m])];
+        std::copy_n(tq.data(), 4, w);
+        w[ks[m]] = x;
+        for (int m2 = 0; m2 < 3; ++m2)
+          if (m2 != m) w[4 + ks[m2]] = 4 * s[m2] + std::uint32_t(ks[m]);
+        w[4 + ks[m]] = at_t[m], tets[entry(at_t[m])] = 4 * s[m] + std::uint32_t(ks[m]);
+        w[4 + i] = at_n[m], tets[entry(at_n[m])] = 4 * s[m] + std::uint32_t(i);
+        flip_stack.push_back(4 * s[m] + std::uint32_t(i));
+      }
+      last = t0;
+      ++flip_counts[flip_23];
+      done = true;
+    } else if (negatives == 0 && zeros == 0) {  // (a ghost 2-3: not expected once p sees no hull triangle)
       gone[0] = t0, gone[1] = n;
       int m = 0;
       for (int k = 0; k < 4; ++k)
@@ -244,11 +282,33 @@ std::uint32_t Tet3Mesh::insert_by_flips(std::uint32_t pv) {
       // tetrahedron around it (across tq's face `negative`) has x.
       const std::uint32_t a3 = tets[8 * std::size_t(t0) + 4 + negative];
       if (tets[opposite(a3)] == x) {
-        gone[0] = t0, gone[1] = n, gone[2] = a3 >> 2;
-        int m = 0;
+        // New m is tq with x for the edge's vertex k = ks[m]: its face k is tq's,
+        // its face i n's face without tq[k], its face `negative` the third's face
+        // without tq[k], its face ks[1 - m] the other new one's face k.
+        const std::uint32_t t3 = a3 >> 2;
+        const Quad nq = quad_of(tets.data(), n), t3q = quad_of(tets.data(), t3);
+        int ks[2], m = 0;
         for (int k = 0; k < 4; ++k)
-          if (k != i && k != negative) made[m++] = with(tq, k, x);
-        replace(gone, 3, made, 2);
+          if (k != i && k != negative) ks[m++] = k;
+        std::uint32_t at_t[2], at_n[2], at_3[2];
+        for (m = 0; m < 2; ++m) {
+          at_t[m] = tets[8 * std::size_t(t0) + 4 + ks[m]];
+          at_n[m] = tets[8 * std::size_t(n) + 4 + index_of(nq, tq[ks[m]])];
+          at_3[m] = tets[8 * std::size_t(t3) + 4 + index_of(t3q, tq[ks[m]])];
+        }
+        free_slot(t3);
+        const std::uint32_t s[2] = {t0, n};
+        for (m = 0; m < 2; ++m) {
+          std::uint32_t* w = &tets[8 * std::size_t(s[m])];
+          std::copy_n(tq.data(), 4, w);
+          w[ks[m]] = x;
+          w[4 + ks[1 - m]] = 4 * s[1 - m] + std::uint32_t(ks[m]);
+          w[4 + ks[m]] = at_t[m], tets[entry(at_t[m])] = 4 * s[m] + std::uint32_t(ks[m]);
+          w[4 + i] = at_n[m], tets[entry(at_n[m])] = 4 * s[m] + std::uint32_t(i);
+          w[4 + negative] = at_3[m], tets[entry(at_3[m])] = 4 * s[m] + std::uint32_t(negative);
+          flip_stack.push_back(4 * s[m] + std::uint32_t(i));
+        }
+        last = t0;
         ++flip_counts[flip_32];
         done = true;
       }
