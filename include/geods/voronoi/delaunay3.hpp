@@ -18,6 +18,11 @@
 // cavity, found by a breadth-first search from the one it lies in) are
 // replaced by the tetrahedra joining it to the cavity's boundary. Expected
 // O(n log n), near linear for uniform points.
+// Options::insertion = flips inserts by flips instead (delaunay3_flip.cpp):
+// the tetrahedron holding the point is split 1-4 (a point outside the hull is
+// joined to the hull triangles it sees), then the non-Delaunay faces of its
+// link are flipped 2-3, 3-2 or 4-4 in the stack order of Edelsbrunner-Shah;
+// same predicates and perturbation, so the same tetrahedralization.
 //
 // Degeneracies: in_sphere == 0 is decided by the symbolic perturbation of
 // CGAL's Delaunay_triangulation_3 (Devillers-Teillaud, "Perturbations and
