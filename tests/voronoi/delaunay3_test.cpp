@@ -518,6 +518,18 @@ TEST(Delaunay3, FlipInsertOneByOneAndInParallel) {
     EXPECT_GT(dt.stats().flips_14 + dt.stats().splits + dt.stats().hull_inserts, 0u);
     const Delaunay3 whole(p);
     EXPECT_EQ(sorted_tets(dt), sorted_tets(whole));
+    // A saved flip build goes on inserting by flips after load.
+    const std::filesystem::path file = std::filesystem::temp_directory_path() / "geods_delaunay3_flips_test.geods";
+    Delaunay3(std::vector<Vec3d>(p.begin(), p.end() - 1), {.insertion = Delaunay3Insertion::flips}).save(file);
+    Delaunay3 loaded = Delaunay3::load(file);
+    std::filesystem::remove(file);
+    const Delaunay3Stats before = loaded.stats();
+    loaded.insert(p.back());
+    const Delaunay3Stats after = loaded.stats();
+    if (whole.representative(std::uint32_t(p.size() - 1)) == p.size() - 1) {
+      EXPECT_EQ(after.flips_14 + after.splits + after.hull_inserts, before.flips_14 + before.splits + before.hull_inserts + 1);
+    }
+    EXPECT_EQ(loaded.tetrahedra().size(), whole.tetrahedra().size());
     for (std::uint32_t i = 0; i < p.size(); ++i) EXPECT_EQ(dt.representative(i), whole.representative(i));
     const int threads = num_threads();
     set_num_threads(2);
