@@ -167,6 +167,7 @@ void Tet3Mesh::make_first(std::uint32_t a, std::uint32_t b, std::uint32_t c, std
 }
 
 std::uint32_t Tet3Mesh::insert(std::uint32_t pv) {
+  if (flips) return insert_by_flips(pv);
   const Vec3d& p = coords[pv];
   const std::uint32_t t = walk(p, last, walk_steps, random);
   if (!is_ghost(t))
@@ -283,6 +284,7 @@ void Delaunay3::build(Options options, bool may_split) {
   tets_.clear();
   free_slots_.clear();
   walk_steps_ = conflicts_ = seam_points_ = 0;
+  flip_counts_ = {};
   std::vector<std::uint32_t> active;
   active.reserve(total);
   for (std::size_t i = 0; i < total; ++i)
@@ -335,6 +337,7 @@ void Delaunay3::build(Options options, bool may_split) {
     for (std::size_t k = begin; k < end; ++k) coords[k] = points_[sequence[k]];
   });
   Tet3Mesh mesh(coords, tets_, free_slots_);
+  mesh.flips = options.insertion == Delaunay3Insertion::flips;
   tets_.reserve(8 * 7 * n + 64);
   mesh.mark.reserve(7 * n + 16);
   mesh.make_first(0, 1, 2, 3);
@@ -364,6 +367,7 @@ void Delaunay3::build(Options options, bool may_split) {
   });
   walk_steps_ = mesh.walk_steps;
   conflicts_ = mesh.conflicts;
+  flip_counts_ = mesh.flip_counts;
   last_ = mesh.last;
   if (may_split) canonicalize();  // (the halves and seams of a parallel build need not be)
 }
@@ -384,10 +388,12 @@ std::uint32_t Delaunay3::insert(const Vec3d& p) {
   Tet3Mesh mesh(points_, tets_, free_slots_);
   mesh.mark.assign(tets_.size() / 8, 0);
   mesh.last = last_;
+  mesh.flips = options_.insertion == Delaunay3Insertion::flips;
   const std::uint32_t existing = mesh.insert(i);
   rep_[i] = existing == kNone ? i : existing;
   walk_steps_ += mesh.walk_steps;
   conflicts_ += mesh.conflicts;
+  for (std::size_t k = 0; k < flip_counts_.size(); ++k) flip_counts_[k] += mesh.flip_counts[k];
   last_ = mesh.last;
   publish();
   return i;
@@ -755,6 +761,10 @@ Delaunay3Stats Delaunay3::stats() const {
   s.walk_steps = walk_steps_;
   s.conflicts = conflicts_;
   s.seam_points = seam_points_;
+  s.flips_14 = flip_counts_[Tet3Mesh::flip_14], s.flips_23 = flip_counts_[Tet3Mesh::flip_23];
+  s.flips_32 = flip_counts_[Tet3Mesh::flip_32], s.flips_44 = flip_counts_[Tet3Mesh::flip_44];
+  s.splits = flip_counts_[Tet3Mesh::flip_split], s.hull_inserts = flip_counts_[Tet3Mesh::flip_hull];
+  s.unflippable = flip_counts_[Tet3Mesh::flip_unflippable], s.flip_repairs = flip_counts_[Tet3Mesh::flip_repair];
   const auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
   s.bytes = bytes(points_) + bytes(rep_) +
             bytes(tets_) + bytes(removed_) + bytes(vertex_slot_) + bytes(free_slots_) + bytes(tetrahedra_) + bytes(public_of_);
