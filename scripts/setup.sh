@@ -16,6 +16,7 @@ packages=(
   libgtest-dev libbenchmark-dev libgmp-dev
   python3 python3-dev python3-numpy python3-pytest pybind11-dev
   python3-scipy  # the oracle of python/tests/test_convex_hull.py (Qhull)
+  python3-dask python3-distributed  # geods.dask: volumes in chunks, collections, terrain tiles (BSD)
 )
 for arg in "$@"; do
   case "$arg" in

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <random>
 #include <set>
@@ -480,6 +481,49 @@ TEST(Terrain, GreedyTinsWithinTheBoundAndTiled) {
   EXPECT_EQ(t.tin(1e9).triangles.size(), 2u);
   EXPECT_THROW(t.tin(-1), Error);
   EXPECT_THROW(t.tin(1, 0), Error);
+}
+
+// Every tile of tin(e, tiles) is tin_tile() of its block of samples on its own
+// (with the whole field's border limit), shifted: tiles can be computed apart.
+TEST(Terrain, TinTilesComputedApartEqualTheTiledTin) {
+  const HeightField f = real_field();
+  const Terrain t(f);
+  const float lo = *std::min_element(f.heights.begin(), f.heights.end());
+  const float hi = *std::max_element(f.heights.begin(), f.heights.end());
+  for (const std::uint32_t tiles : {1u, 3u}) {
+    const double e = 2.0;
+    const TerrainMesh whole = t.tin(e, tiles);
+    std::multiset<std::array<std::array<std::uint32_t, 2>, 3>> expected, got;
+    for (const Tri& tri : whole.triangles) {
+      std::array<std::array<std::uint32_t, 2>, 3> c{whole.samples[tri[0]], whole.samples[tri[1]], whole.samples[tri[2]]};
+      std::rotate(c.begin(), std::min_element(c.begin(), c.end()), c.end());
+      expected.insert(c);
+    }
+    const std::size_t W = f.width, H = f.height;
+    for (std::uint32_t ty = 0; ty < tiles; ++ty)
+      for (std::uint32_t tx = 0; tx < tiles; ++tx) {
+        const std::size_t x0 = tx * (W - 1) / tiles, x1 = (tx + 1) * (W - 1) / tiles;
+        const std::size_t y0 = ty * (H - 1) / tiles, y1 = (ty + 1) * (H - 1) / tiles;
+        std::vector<float> block;
+        for (std::size_t y = y0; y <= y1; ++y)
+          for (std::size_t x = x0; x <= x1; ++x) block.push_back(f.heights[y * W + x]);
+        const TerrainMesh m = tin_tile(block, x1 - x0 + 1, y1 - y0 + 1, e, tin_border_limit(e, lo, hi));
+        for (const Tri& tri : m.triangles) {
+          std::array<std::array<std::uint32_t, 2>, 3> c;
+          for (int k = 0; k < 3; ++k)
+            c[k] = {m.samples[tri[k]][0] + std::uint32_t(x0), m.samples[tri[k]][1] + std::uint32_t(y0)};
+          std::rotate(c.begin(), std::min_element(c.begin(), c.end()), c.end());
+          got.insert(c);
+        }
+      }
+    EXPECT_EQ(got, expected) << tiles;
+  }
+  const std::vector<float> z(4, 1.0f);
+  EXPECT_THROW(tin_tile(z, 2, 2, -1, 0), Error);
+  EXPECT_THROW(tin_tile(z, 4, 1, 1, 0), Error);
+  EXPECT_THROW(tin_tile(z, 2, 2, 1, 2), Error);
+  const std::vector<float> bad{1, 2, std::numeric_limits<float>::quiet_NaN(), 4};
+  EXPECT_THROW(tin_tile(bad, 2, 2, 1, 0), Error);
 }
 
 }  // namespace
