@@ -30,7 +30,10 @@
 // norm <= 1, plus the residual sqrt(|v - m|^2 - |B (v - m) / s|^2). Both
 // bounds above hold for any such map, so the rounded basis costs nothing in
 // correctness, and a query's projection is a few 16-bit multiply-adds per
-// value (it was most of a search's time in doubles).
+// value. The tree holds the coordinates rounded to float (half the memory of
+// doubles, faster leaves); the search widens its bound by the rounding, which
+// is at most |v - m| 2^-24 per point. With the default 8 components the tree
+// has a compile-time dimension of 9.
 #include <cstddef>
 #include <cstdint>
 #include <limits>
@@ -84,7 +87,7 @@ class NeighborhoodIndex {
 
   /// Per-thread buffers of nearest(), reused across queries.
   struct Scratch {
-    std::vector<double> projected;
+    std::vector<float> projected;
     std::vector<std::int16_t> centred;
     std::size_t full_distances = 0;  // full distances computed, summed over queries
   };
@@ -102,7 +105,7 @@ class NeighborhoodIndex {
   Match brute_force(const std::uint8_t* query, Scratch& scratch) const;
   // The coordinates of v (dimension() values) on the principal directions: reduced_dimension() values.
   // Candidates and queries go through this one computation, so equal vectors project bit-identically.
-  void project(const std::uint8_t* v, double* out, std::vector<std::int16_t>& centred) const;
+  void project(const std::uint8_t* v, float* out, std::vector<std::int16_t>& centred) const;
 
   std::vector<std::uint8_t> vectors_;
   std::size_t count_ = 0, dim_ = 0, reduced_ = 0;
@@ -111,10 +114,13 @@ class NeighborhoodIndex {
   std::vector<std::int16_t> mean_;  // padded_: the candidates' mean, rounded (0 in the padding)
   std::vector<std::int16_t> basis_; // reduced_ rows of padded_: the principal directions, rounded to integers
   double scale_ = 0;                // tree coordinate = (basis row . (v - mean)) * scale_
-  std::vector<double> projected_;  // count_ rows of reduced_ + 1 (the components, the residual norm)
+  // count_ rows of reduced_ + 1 (the components, the residual norm), rounded to float: the searches
+  // widen their bound by the rounding (margin_), see nearest().
+  std::vector<float> projected_;
+  double margin_ = 0;
   static constexpr std::size_t kFixedTreeDim = 9;  // 8 components (the synthesis' default) and the residual
-  std::unique_ptr<spatial::KdTree<double>> tree_;
-  std::unique_ptr<spatial::KdTree<double, int(kFixedTreeDim)>> fixed_tree_;
+  std::unique_ptr<spatial::KdTree<float>> tree_;
+  std::unique_ptr<spatial::KdTree<float, int(kFixedTreeDim)>> fixed_tree_;
 };
 
 }  // namespace geods::texture
