@@ -1,13 +1,14 @@
 // The exact sign evaluation of the segment Voronoi predicates
 // (src/voronoi/segment_voronoi_exact.hpp: a double interval filter, then MPFR
 // balls past the BFMSS separation bound) against an independent oracle:
-// rational arithmetic (boost::multiprecision::cpp_rational) on squared forms,
+// rational arithmetic (GMP mpq_class) on squared forms,
 // sign(a + sqrt(b) - sqrt(c)) decided by isolating and squaring with sign
 // tracking. Inputs are small integers, so that exact ties (cocircular points,
 // equal circle events, a site on a circle's rightmost point) are frequent.
 #include <gtest/gtest.h>
 
-#include <boost/multiprecision/cpp_int.hpp>
+#include <gmpxx.h>
+
 #include <cmath>
 
 #include "../../src/voronoi/segment_voronoi_exact.hpp"
@@ -16,9 +17,9 @@
 namespace geods::voronoi::detail::exact {
 namespace {
 
-using Q = boost::multiprecision::cpp_rational;
+using Q = mpq_class;
 
-int sign(const Q& q) { return q > 0 ? 1 : q < 0 ? -1 : 0; }
+int sign(const Q& q) { return sgn(q); }
 // sign(p + q sqrt(b)), b >= 0.
 int sign_pq(const Q& p, const Q& q, const Q& b) {
   if (q == 0 || b == 0) return sign(p);
