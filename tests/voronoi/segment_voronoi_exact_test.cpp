@@ -13,6 +13,7 @@
 
 #include "../../src/voronoi/segment_voronoi_exact.hpp"
 #include "geods/core/rng.hpp"
+#include "geods/voronoi/segment_voronoi.hpp"
 
 namespace geods::voronoi::detail::exact {
 namespace {
@@ -216,6 +217,29 @@ TEST(SegmentVoronoiExactSign, CircleEventOrderAgainstRationals) {
   }
   EXPECT_GE(ties, 50);
   EXPECT_GE(site_ties, 50);
+}
+
+TEST(SegmentVoronoiExactSign, FilterDecidesRandomInputExactStageDecidesTies) {
+  // Random disjoint segments with large coordinates: the filter decides (almost) everything.
+  Rng rng(43);
+  std::vector<double> segs;
+  for (int i = 0; i < 60; ++i)
+    for (int j = 0; j < 60; ++j) {
+      const double x = i * 65536.0 + std::floor(rng.uniform(1, 30000)), y = j * 65536.0 + std::floor(rng.uniform(1, 30000));
+      segs.insert(segs.end(), {x, y, x + std::floor(rng.uniform(1, 30000)), y + std::floor(rng.uniform(1, 30000))});
+    }
+  const ExactStats before = exact_stats;
+  const SegmentVoronoi random_diagram({}, segs);
+  const std::uint64_t random_exact = exact_stats.evaluations - before.evaluations;
+  EXPECT_LE(random_exact, random_diagram.vertices().size() / 1000) << random_exact << " exact evaluations";
+  // A lattice of points: every circle event ties with others, the exact stage decides them.
+  std::vector<double> pts;
+  for (int i = 0; i < 6; ++i)
+    for (int j = 0; j < 6; ++j) pts.insert(pts.end(), {double(i), double(j)});
+  const ExactStats mid = exact_stats;
+  const SegmentVoronoi grid(pts, {});
+  EXPECT_GT(exact_stats.evaluations - mid.evaluations, 10u);
+  EXPECT_EQ(grid.vertices().size(), 2u * 25u);  // two (coincident) vertices per lattice cell
 }
 
 }  // namespace
