@@ -46,8 +46,9 @@ struct Uncertain {};
 struct NeedPrecision {};
 
 // ---------------------------------------------------------------- double intervals
-inline double round_down(double r) { return r - (std::fabs(r) * 0x1p-52 + 0x1p-1074); }
-inline double round_up(double r) { return r + (std::fabs(r) * 0x1p-52 + 0x1p-1074); }
+#define GEODS_EXACT_INLINE [[gnu::always_inline]] inline
+GEODS_EXACT_INLINE double round_down(double r) { return r - (std::fabs(r) * 0x1p-52 + 0x1p-1074); }
+GEODS_EXACT_INLINE double round_up(double r) { return r + (std::fabs(r) * 0x1p-52 + 0x1p-1074); }
 
 struct Iv {
   double lo = 0, hi = 0;
@@ -57,29 +58,34 @@ struct Iv {
   double mid() const { return 0.5 * lo + 0.5 * hi; }
   bool point() const { return lo == hi; }
 };
-inline Iv operator+(Iv a, Iv b) {
+GEODS_EXACT_INLINE Iv operator+(Iv a, Iv b) {
   if (a.point() && b.point()) {  // exact when the two-sum error is 0
     const double s = a.lo + b.lo, bb = s - a.lo, err = (a.lo - (s - bb)) + (b.lo - bb);
     if (err == 0) return Iv(s);
   }
   return {round_down(a.lo + b.lo), round_up(a.hi + b.hi)};
 }
-inline Iv operator-(Iv a) { return {-a.hi, -a.lo}; }
-inline Iv operator-(Iv a, Iv b) { return a + (-b); }
-inline Iv operator*(Iv a, Iv b) {
+GEODS_EXACT_INLINE Iv operator-(Iv a) { return {-a.hi, -a.lo}; }
+GEODS_EXACT_INLINE Iv operator-(Iv a, Iv b) { return a + (-b); }
+GEODS_EXACT_INLINE Iv operator*(Iv a, Iv b) {
   const double p1 = a.lo * b.lo, p2 = a.lo * b.hi, p3 = a.hi * b.lo, p4 = a.hi * b.hi;
   return {round_down(std::min(std::min(p1, p2), std::min(p3, p4))), round_up(std::max(std::max(p1, p2), std::max(p3, p4)))};
 }
-inline Iv operator/(Iv a, Iv b) {
-  if (!(b.lo > 0 || b.hi < 0)) throw Uncertain{};
-  const double q1 = a.lo / b.lo, q2 = a.lo / b.hi, q3 = a.hi / b.lo, q4 = a.hi / b.hi;
-  return {round_down(std::min(std::min(q1, q2), std::min(q3, q4))), round_up(std::max(std::max(q1, q2), std::max(q3, q4)))};
+GEODS_EXACT_INLINE Iv operator/(Iv a, Iv b) {
+  if (b.hi < 0) {  // a / b = (-a) / (-b)
+    a = -a;
+    b = -b;
+  } else if (!(b.lo > 0)) {
+    throw Uncertain{};
+  }
+  // b > 0: x / b increases with x; for a fixed x it decreases with b when x >= 0.
+  return {round_down(a.lo / (a.lo >= 0 ? b.hi : b.lo)), round_up(a.hi / (a.hi >= 0 ? b.lo : b.hi))};
 }
-inline Iv sqrt(Iv a) {
+GEODS_EXACT_INLINE Iv sqrt(Iv a) {
   if (a.hi < 0) throw Uncertain{};
   return {std::max(0.0, round_down(std::sqrt(std::max(a.lo, 0.0)))), round_up(std::sqrt(a.hi))};
 }
-inline int sgn(Iv a) {
+GEODS_EXACT_INLINE int sgn(Iv a) {
   if (a.lo > 0) return 1;
   if (a.hi < 0) return -1;
   if (a.lo == 0 && a.hi == 0) return 0;

@@ -109,8 +109,9 @@ bool point_arc_less(const Site& left, const Site& right, const Pt& p) {
   const double dx1 = left.p0.x - p.x, dy1 = left.p0.y - p.y, dx2 = right.p0.x - p.x, dy2 = right.p0.y - p.y;
   if (dx1 == 0) return false;
   if (dx2 == 0) return true;
-  const i128 n1 = static_cast<i128>(dx1 * dx1 + dy1 * dy1), n2 = static_cast<i128>(dx2 * dx2 + dy2 * dy2);
-  const i128 l = n1 * static_cast<i128>(dx2), r = n2 * static_cast<i128>(dx1);
+  using i64 = std::int64_t;  // through 64-bit integers: a direct double -> __int128 conversion is a library call
+  const i128 n1 = static_cast<i64>(dx1 * dx1 + dy1 * dy1), n2 = static_cast<i64>(dx2 * dx2 + dy2 * dy2);
+  const i128 l = n1 * static_cast<i64>(dx2), r = n2 * static_cast<i64>(dx1);
   return (dx1 > 0) == (dx2 > 0) ? l < r : l > r;
 }
 
@@ -146,8 +147,9 @@ Fast fast_ps(const Site& left, const Site& right, const Pt& p, bool reverse_orde
   }
   // a (dy^2 - dx^2) against 2 b dx dy, exactly (|terms| < 2^80).
   using i128 = __int128;
-  const auto a = static_cast<i128>(s1.x - s0.x), b = static_cast<i128>(s1.y - s0.y);
-  const auto dx = static_cast<i128>(p.x - site_point.x), dy = static_cast<i128>(p.y - site_point.y);
+  using i64 = std::int64_t;
+  const i128 a = static_cast<i64>(s1.x - s0.x), b = static_cast<i64>(s1.y - s0.y);
+  const i128 dx = static_cast<i64>(p.x - site_point.x), dy = static_cast<i64>(p.y - site_point.y);
   const i128 lhs = a * (dy + dx) * (dy - dx), rhs = 2 * b * dx * dy;
   if (lhs != rhs) {
     if ((lhs > rhs) ^ reverse_order) return reverse_order ? Fast::less : Fast::more;
@@ -660,6 +662,11 @@ class Builder {
   int compare_events(std::uint32_t ia, std::uint32_t ib) const {
     const Event& a = events_[ia];
     const Event& b = events_[ib];
+    if (a.c.lower_x.hi < b.c.lower_x.lo) return -1;  // the usual case, inline
+    if (a.c.lower_x.lo > b.c.lower_x.hi) return 1;
+    return compare_events_slow(a, b);
+  }
+  [[gnu::noinline]] int compare_events_slow(const Event& a, const Event& b) const {
     for (const bool by_y : {false, true}) {
       int s = by_y ? interval_compare(a.c.y, b.c.y) : interval_compare(a.c.lower_x, b.c.lower_x);
       if (s == 2) {
