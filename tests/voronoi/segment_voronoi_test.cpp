@@ -391,6 +391,30 @@ TEST(SegmentVoronoiExact, CocircularLatticePoints) {
   EXPECT_EQ(unbounded, 36u);
 }
 
+TEST(SegmentVoronoiExact, CocircularAtLargeCoordinates) {
+  // The 68 lattice points of x^2 + y^2 = 5^16 (radius 390625) around (16000000, -16000000):
+  // every circle event ties at coordinates near 2^24, decided exactly.
+  const std::int64_t R = 390625;
+  std::vector<double> pts;
+  for (std::int64_t x = -R; x <= R; ++x) {
+    const std::int64_t y2 = R * R - x * x;
+    const auto y = static_cast<std::int64_t>(std::llround(std::sqrt(static_cast<double>(y2))));
+    if (y * y != y2) continue;
+    pts.insert(pts.end(), {16000000.0 + x, -16000000.0 + y});
+    if (y != 0) pts.insert(pts.end(), {16000000.0 + x, -16000000.0 - y});
+  }
+  ASSERT_EQ(pts.size(), 2u * 68u);
+  SegmentVoronoi v(pts, {});
+  expect_edges_sound(v);
+  expect_vertices_and_euler(v);
+  EXPECT_EQ(v.vertices().size(), 66u);
+  for (const auto& vx : v.vertices()) {
+    EXPECT_NEAR(vx.position[0], 16000000.0, 1e-9 * R);
+    EXPECT_NEAR(vx.position[1], -16000000.0, 1e-9 * R);
+    EXPECT_NEAR(vx.clearance, double(R), 1e-9 * R);
+  }
+}
+
 TEST(SegmentVoronoiExact, PointGrid) {
   // A 9 x 7 lattice: square cells, the 8 x 6 cell corners each shared by 4 cocircular points,
   // many circle events with identical x.
