@@ -13,7 +13,7 @@ packages=(
   libgdal-dev  # terrain rasters (GeoTIFF...) and 2D maps (WKT, GeoJSON, shapefiles) (MIT)
   libzip-dev  # zip archives and .sh3f furniture libraries of shape collections (BSD)
   libcli11-dev nlohmann-json3-dev libfmt-dev
-  libgtest-dev libbenchmark-dev libgmp-dev
+  libgtest-dev libbenchmark-dev libgmp-dev libmpfr-dev
   python3 python3-dev python3-numpy python3-pytest pybind11-dev
   python3-scipy  # the oracle of python/tests/test_convex_hull.py (Qhull)
   python3-dask python3-distributed  # geods.dask: volumes in chunks, collections, terrain tiles (BSD)

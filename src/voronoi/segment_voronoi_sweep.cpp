@@ -6,23 +6,28 @@
 // temporary node per segment between its two sides until its second
 // endpoint is reached); the predicates and the tangent-circle constructions
 // are our own: orientation tests on the snapped integers are exact in double,
-// and the circles tangent to points and lines are computed in long double
-// from closed forms whose root is chosen by exact signs (the cyclic order of
-// the three tangency points on the circle is clockwise for a circle event).
+// and the circles tangent to points and lines come from closed forms whose
+// root is chosen by the cyclic order of the three tangency points on the
+// circle (clockwise for a circle event). Every decision is exact: the circle
+// forms are evaluated in filtered interval arithmetic and, when the filter
+// cannot decide, in MPFR balls beyond the expression's BFMSS separation bound
+// (segment_voronoi_exact.hpp); no epsilon.
 #include "segment_voronoi_sweep.hpp"
+
+#include "segment_voronoi_exact.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
 #include <queue>
+#include <type_traits>
 #include <utility>
 
 namespace geods::voronoi::detail {
 namespace {
 
 constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
-using real = long double;
 
 struct Pt {
   double x = 0, y = 0;
@@ -76,24 +81,38 @@ bool site_less(const Site& lhs, const Site& rhs) {
   return orient(lhs.p1, lhs.p0, rhs.p1) == kLeft;
 }
 
-struct Circle {
-  real x = 0, y = 0, lower_x = 0;
-};
-
 // ---------------------------------------------------------------- distance predicate
 // Does the horizontal line through the new point hit the right arc of the
-// node (left, right) first (the point is above the breakpoint)?
-real distance_to_point_arc(const Site& site, const Pt& p) {
-  const real dx = real(site.p0.x) - p.x, dy = real(site.p0.y) - p.y;
-  return (dx * dx + dy * dy) / (2 * dx);
+// node (left, right) first (the point is above the breakpoint)? Each side is
+// the x distance, from the new point, of the centre of the circle through (or
+// tangent to) the arc's site and tangent to the horizontal line at the point
+// (up to a common factor); the comparisons are exact (integers, or
+// exact::filtered_sign for the segment arcs, whose values hold a square root).
+template <class T>
+T distance_to_point_arc(const Site& site, const Pt& p) {  // site.p0.x != p.x
+  const double dx = site.p0.x - p.x, dy = site.p0.y - p.y;
+  return T(dx * dx + dy * dy) / T(2 * dx);  // integers below 2^53: exact
 }
-real distance_to_segment_arc(const Site& site, const Pt& p) {
-  if (is_vertical(site)) return (real(site.p0.x) - p.x) * 0.5L;
-  const real a1 = real(site.p1.x) - site.p0.x, b1 = real(site.p1.y) - site.p0.y;
-  real k = std::sqrt(a1 * a1 + b1 * b1);
-  k = b1 >= 0 ? 1 / (b1 + k) : (k - b1) / (a1 * a1);
-  const real cross = real((site.p1.x - site.p0.x) * (p.y - site.p0.y) - (site.p1.y - site.p0.y) * (p.x - site.p0.x));
-  return k * cross;
+template <class T>
+T distance_to_segment_arc(const Site& site, const Pt& p) {
+  if (is_vertical(site)) return T(site.p0.x - p.x) * T(0.5);
+  const double a1 = site.p1.x - site.p0.x, b1 = site.p1.y - site.p0.y;
+  const T len = sqrt(T(a1 * a1 + b1 * b1));
+  const T k = b1 >= 0 ? T(1) / (T(b1) + len) : (len - T(b1)) / T(a1 * a1);
+  const double cross = a1 * (p.y - site.p0.y) - b1 * (p.x - site.p0.x);  // exact
+  return k * T(cross);
+}
+
+// n1 / dx1 < n2 / dx2 for integers (|n| < 2^54, |dx| < 2^27), dx = 0 meaning +infinity.
+bool point_arc_less(const Site& left, const Site& right, const Pt& p) {
+  using i128 = __int128;
+  const double dx1 = left.p0.x - p.x, dy1 = left.p0.y - p.y, dx2 = right.p0.x - p.x, dy2 = right.p0.y - p.y;
+  if (dx1 == 0) return false;
+  if (dx2 == 0) return true;
+  using i64 = std::int64_t;  // through 64-bit integers: a direct double -> __int128 conversion is a library call
+  const i128 n1 = static_cast<i64>(dx1 * dx1 + dy1 * dy1), n2 = static_cast<i64>(dx2 * dx2 + dy2 * dy2);
+  const i128 l = n1 * static_cast<i64>(dx2), r = n2 * static_cast<i64>(dx1);
+  return (dx1 > 0) == (dx2 > 0) ? l < r : l > r;
 }
 
 bool pp_predicate(const Site& left, const Site& right, const Pt& p) {
@@ -106,7 +125,7 @@ bool pp_predicate(const Site& left, const Site& right, const Pt& p) {
   } else {
     return l.y + r.y < 2 * p.y;
   }
-  return distance_to_point_arc(left, p) < distance_to_point_arc(right, p);
+  return point_arc_less(left, right, p);
 }
 
 enum class Fast { less, undefined, more };
@@ -128,8 +147,9 @@ Fast fast_ps(const Site& left, const Site& right, const Pt& p, bool reverse_orde
   }
   // a (dy^2 - dx^2) against 2 b dx dy, exactly (|terms| < 2^80).
   using i128 = __int128;
-  const auto a = static_cast<i128>(s1.x - s0.x), b = static_cast<i128>(s1.y - s0.y);
-  const auto dx = static_cast<i128>(p.x - site_point.x), dy = static_cast<i128>(p.y - site_point.y);
+  using i64 = std::int64_t;
+  const i128 a = static_cast<i64>(s1.x - s0.x), b = static_cast<i64>(s1.y - s0.y);
+  const i128 dx = static_cast<i64>(p.x - site_point.x), dy = static_cast<i64>(p.y - site_point.y);
   const i128 lhs = a * (dy + dx) * (dy - dx), rhs = 2 * b * dx * dy;
   if (lhs != rhs) {
     if ((lhs > rhs) ^ reverse_order) return reverse_order ? Fast::less : Fast::more;
@@ -141,14 +161,20 @@ Fast fast_ps(const Site& left, const Site& right, const Pt& p, bool reverse_orde
 bool ps_predicate(const Site& left, const Site& right, const Pt& p, bool reverse_order) {
   const Fast f = fast_ps(left, right, p, reverse_order);
   if (f != Fast::undefined) return f == Fast::less;
-  const real d1 = distance_to_point_arc(left, p);
-  const real d2 = distance_to_segment_arc(right, p);
-  return reverse_order ^ (d1 < d2);
+  if (left.p0.x == p.x) return reverse_order;  // the point arc's distance is +infinity
+  const int s = exact::filtered_sign([&](auto type) {
+    using T = typename decltype(type)::type;
+    return distance_to_point_arc<T>(left, p) - distance_to_segment_arc<T>(right, p);
+  });
+  return reverse_order ^ (s < 0);
 }
 
 bool ss_predicate(const Site& left, const Site& right, const Pt& p) {
   if (left.sorted_index == right.sorted_index) return orient(left.p0, left.p1, p) == kLeft;
-  return distance_to_segment_arc(left, p) < distance_to_segment_arc(right, p);
+  return exact::filtered_sign([&](auto type) {
+           using T = typename decltype(type)::type;
+           return distance_to_segment_arc<T>(left, p) - distance_to_segment_arc<T>(right, p);
+         }) < 0;
 }
 
 bool distance_predicate(const Site& left, const Site& right, const Pt& p) {
@@ -206,200 +232,241 @@ using BeachLine = std::map<Key, NodeData, KeyLess>;
 using BeachIt = BeachLine::iterator;
 
 // ---------------------------------------------------------------- circles
-struct Line {
-  real ax, ay;  // a point
-  real ux, uy;  // unit direction
-  real nx, ny;  // unit right normal (the site's side)
+// The circle tangent to three sites, computed in a number type T (exact::Iv,
+// the filter, or exact::Bx, the exact evaluation): every branch is taken on
+// an exact sign (sgn of T throws when the filter cannot tell), so both types
+// follow the same path and the event exists exactly when the exact circle
+// does. The forms keep the expressions shallow (integer coefficients and the
+// segment lengths L = sqrt(dx^2 + dy^2); one more square root for the
+// quadratics), which keeps the separation bounds of the exact stage small.
+template <class T>
+struct CircleT {
+  T x, y, lower_x;
 };
-Line site_line(const Site& s) {
-  Line l;
-  l.ax = s.p0.x;
-  l.ay = s.p0.y;
-  const real dx = real(s.p1.x) - s.p0.x, dy = real(s.p1.y) - s.p0.y;
-  const real len = std::sqrt(dx * dx + dy * dy);
-  l.ux = dx / len;
-  l.uy = dy / len;
-  l.nx = l.uy;
-  l.ny = -l.ux;
-  return l;
-}
-inline real side_dist(const Line& l, real x, real y) { return l.nx * (x - l.ax) + l.ny * (y - l.ay); }
 
-bool circle_ppp(const Site& a, const Site& b, const Site& c, Circle& out) {
+// A segment site's supporting line: c = (dy, -dx) is the integer right normal
+// (the site's side), L^2 = dx^2 + dy^2, and the signed distance of X is
+// (c . (X - a)) / L.
+struct LineI {
+  double cx, cy, ax, ay, len2;
+};
+inline LineI site_line(const Site& s) {
+  const double dx = s.p1.x - s.p0.x, dy = s.p1.y - s.p0.y;
+  return LineI{dy, -dx, s.p0.x, s.p0.y, dx * dx + dy * dy};  // exact (|len2| <= 2^53)
+}
+// c . (p - a) for an integer point: exact (|terms| <= 2^52).
+inline double line_offset(const LineI& l, const Pt& p) { return l.cx * (p.x - l.ax) + l.cy * (p.y - l.ay); }
+
+template <class T>
+bool circle_ppp(const Site& a, const Site& b, const Site& c, CircleT<T>& out) {
   if (orient(a.p0, b.p0, c.p0) != kRight) return false;
-  const real ax = a.p0.x, ay = a.p0.y;
-  const real bx = real(b.p0.x) - ax, by = real(b.p0.y) - ay, cx = real(c.p0.x) - ax, cy = real(c.p0.y) - ay;
-  const real d = 2 * real(bx * cy - by * cx);  // exact in double already
-  const real b2 = bx * bx + by * by, c2 = cx * cx + cy * cy;
-  const real ux = (cy * b2 - by * c2) / d, uy = (bx * c2 - cx * b2) / d;
-  out.x = ax + ux;
-  out.y = ay + uy;
-  out.lower_x = out.x + std::sqrt(ux * ux + uy * uy);
+  const double ax = a.p0.x, ay = a.p0.y;
+  const double bx = b.p0.x - ax, by = b.p0.y - ay, cx = c.p0.x - ax, cy = c.p0.y - ay;  // exact
+  const T d(2 * (bx * cy - by * cx));                                                    // exact
+  const double b2 = bx * bx + by * by, c2 = cx * cx + cy * cy;                            // exact
+  const T ux = (T(cy) * T(b2) - T(by) * T(c2)) / d, uy = (T(bx) * T(c2) - T(cx) * T(b2)) / d;
+  out.x = T(ax) + ux;
+  out.y = T(ay) + uy;
+  out.lower_x = out.x + sqrt(ux * ux + uy * uy);
   return true;
 }
 
-// Roots of (1 - E^2) t^2 - 2 D E t + (g2 - D^2) = 0, the parameters t where
-// a point X = B + t v of a line (unit v, B the foot of the point p) is as far
-// from p (|B - p|^2 = g2) as from a line (distance D + t E). Stable for
-// E^2 near 1 (one root far away) and E = +-1 (linear: `linear` set by the caller
-// from an exact test).
-int tangent_roots(real D, real E, real g2, bool linear, real t[2]) {
+// Roots of A s^2 + 2 B s + C = 0 (A = 0 when `linear`, decided exactly by the
+// caller), in the stable form s0 = q / A, s1 = C / q with q = -(B + sign(B) sqrt(B^2 - AC)).
+template <class T>
+int quadratic_roots(const T& A, const T& B, const T& C, bool linear, T s[2]) {
+  const int sb = sgn(B);
   if (linear) {
-    if (D * E == 0) return 0;
-    t[0] = (g2 - D * D) / (2 * D * E);
+    if (sb == 0) return 0;
+    s[0] = -C / (T(2) * B);
     return 1;
   }
-  const real a = 1 - E * E;
-  real disc = D * D - g2 * a;
-  if (disc < 0) return 0;
-  const real sq = std::sqrt(disc);
-  const real q = D * E + (D * E >= 0 ? sq : -sq);
-  if (q == 0) {
-    t[0] = 0;
+  const T disc = B * B - A * C;
+  if (sgn(disc) < 0) return 0;
+  const T sq = sqrt(disc);
+  const T q = sb >= 0 ? -(B + sq) : sq - B;
+  if (sgn(q) == 0) {  // B = 0 and C = 0: the double root 0
+    s[0] = T(0);
     return 1;
   }
-  t[0] = q / a;
-  t[1] = (g2 - D * D) / q;
+  s[0] = q / A;
+  s[1] = C / q;
   return 2;
 }
 
-// Of the candidate centres X (radius R, tangency points T_i = X - R n_i on the
-// lines), the one whose tangency order has the required orientation: the
-// candidate with the largest required * orient, in floating point (the
-// candidates are far apart whenever there are two).
+// Of the candidate centres (radius r >= 0), the one whose tangency order has
+// the required orientation: the largest required * orient, compared exactly.
+template <class T>
 struct Candidate {
-  real x, y, r, score;
+  bool found = false;
+  T x, y, r, score;
+  void offer(const T& cx, const T& cy, const T& cr, const T& s) {
+    if (!found || sgn(s - score) > 0) {
+      found = true;
+      x = cx;
+      y = cy;
+      r = cr;
+      score = s;
+    }
+  }
 };
 
 // Circle through points p, q, tangent to the segment site s; `index` is the
 // position of the segment in the triple (1, 2 or 3): the tangency point T must
 // satisfy orient(p, q, T) < 0 for 1 and 3, > 0 for 2.
-bool circle_pps(const Site& sp, const Site& sq, const Site& s, int index, Circle& out) {
+template <class T>
+bool circle_pps(const Site& sp, const Site& sq, const Site& s, int index, CircleT<T>& out) {
   const Pt& p = sp.p0;
   const Pt& q = sq.p0;
   const int op = orient(s.p0, s.p1, p), oq = orient(s.p0, s.p1, q);
   if (op == kLeft || oq == kLeft) return false;
-  const Line l = site_line(s);
-  const int required = index == 2 ? 1 : -1;
+  const LineI l = site_line(s);
+  const T L = sqrt(T(l.len2));
   if (op == 0 || oq == 0) {
-    // Tangent at the point on the line: the centre is on the normal there.
+    // Tangent at the point on the line: the centre is on the normal there, at
+    // rho = |off - on|^2 / (2 n.(off - on)) = |off - on|^2 L / (2 c.(off - on)).
     const Pt& on = op == 0 ? p : q;
     const Pt& off = op == 0 ? q : p;
-    const real dn = l.nx * (real(off.x) - on.x) + l.ny * (real(off.y) - on.y);
-    if (!(dn > 0)) return false;
-    const real dx = real(off.x) - on.x, dy = real(off.y) - on.y;
-    const real rho = (dx * dx + dy * dy) / (2 * dn);
-    out.x = on.x + rho * l.nx;
-    out.y = on.y + rho * l.ny;
-    out.lower_x = out.x + rho;
+    const double ox = off.x - on.x, oy = off.y - on.y;
+    const double cross = l.cx * ox + l.cy * oy;  // exact
+    if (!(cross > 0)) return false;
+    const T f = T(ox * ox + oy * oy) / T(2 * cross);
+    out.x = T(on.x) + f * T(l.cx);
+    out.y = T(on.y) + f * T(l.cy);
+    out.lower_x = out.x + f * L;
     return true;
   }
-  // Centre X = M + t w on the perpendicular bisector of pq.
-  const real hx = (real(q.x) - p.x) / 2, hy = (real(q.y) - p.y) / 2;
-  const real h = std::sqrt(hx * hx + hy * hy);
-  const real wx = -hy / h, wy = hx / h;
-  const real mx = p.x + hx, my = p.y + hy;
-  const real D = side_dist(l, mx, my), E = l.nx * wx + l.ny * wy;
-  const bool linear = cross_sign(q.x - p.x, q.y - p.y, s.p1.x - s.p0.x, s.p1.y - s.p0.y) == 0;
-  real t[2];
-  const int n = tangent_roots(D, E, h * h, linear, t);
-  Candidate best{0, 0, 0, -std::numeric_limits<real>::infinity()};
+  const int required = index == 2 ? 1 : -1;
+  // Centre X = M + t w on the perpendicular bisector of pq (M = (p + q) / 2,
+  // w = perp(q - p)); its distance to the line is (g + t k) / L with
+  // g = c.(M - a), k = c.w, and to p sqrt(hh + t^2 ww), so
+  // (k^2 - L^2 ww) t^2 + 2 g k t + (g^2 - L^2 hh) = 0.
+  const double ux = q.x - p.x, uy = q.y - p.y;
+  const double wx = -uy, wy = ux;
+  const double ww = ux * ux + uy * uy, hh = ww / 4;  // exact
+  const double mx = p.x + ux / 2, my = p.y + uy / 2;  // exact halves
+  const T g = (T(l.cx) * T(2 * mx - 2 * l.ax) + T(l.cy) * T(2 * my - 2 * l.ay)) / T(2);
+  const T k = T(l.cx) * T(wx) + T(l.cy) * T(wy);
+  const T len2(l.len2);
+  const bool linear = cross_sign(ux, uy, -l.cy, l.cx) == 0;  // pq parallel to the line: k^2 = L^2 ww
+  T t[2];
+  const int n = quadratic_roots(k * k - len2 * T(ww), g * k, g * g - len2 * T(hh), linear, t);
+  Candidate<T> best;
   for (int i = 0; i < n; ++i) {
-    const real x = mx + t[i] * wx, y = my + t[i] * wy, r = D + t[i] * E;
-    if (!(r >= 0)) continue;
-    const real tx = x - r * l.nx, ty = y - r * l.ny;
-    const real o = (real(q.x) - p.x) * (ty - p.y) - (real(q.y) - p.y) * (tx - p.x);
-    const real score = required * o;
-    if (score > best.score) best = Candidate{x, y, r, score};
+    const T rl = g + t[i] * k;  // r L
+    if (sgn(rl) < 0) continue;
+    const T x = T(mx) + t[i] * T(wx), y = T(my) + t[i] * T(wy);
+    const T f = rl / len2;  // T = X - r n = X - f c
+    const T tx = x - f * T(l.cx), ty = y - f * T(l.cy);
+    const T o = T(ux) * (ty - T(p.y)) - T(uy) * (tx - T(p.x));
+    best.offer(x, y, rl / L, required > 0 ? o : -o);
   }
-  if (!(best.score > -std::numeric_limits<real>::infinity())) return false;
+  if (!best.found) return false;
   out.x = best.x;
   out.y = best.y;
   out.lower_x = best.x + best.r;
   return true;
+}
+
+// Do two segment sites lie on parallel lines with the same orientation (same right normal)?
+inline bool same_normal(const Site& a, const Site& b) {
+  const double ax = a.p1.x - a.p0.x, ay = a.p1.y - a.p0.y, bx = b.p1.x - b.p0.x, by = b.p1.y - b.p0.y;
+  return cross_sign(ax, ay, bx, by) == 0 && ax * bx + ay * by > 0;  // exact (|terms| <= 2^52)
 }
 
 // Circle through point p tangent to segment sites s1, s2; the cyclic order of
 // tangency is (p, s1, s2) for index 1 and 3, (s1, p, s2) for index 2.
-bool circle_pss(const Site& sp, const Site& s1, const Site& s2, int index, Circle& out) {
+template <class T>
+bool circle_pss(const Site& sp, const Site& s1, const Site& s2, int index, CircleT<T>& out) {
   const Pt& p = sp.p0;
-  const Line l1 = site_line(s1), l2 = site_line(s2);
   const int required = index == 2 ? 1 : -1;  // sign of orient(p, T1, T2)
-  const real px = p.x, py = p.y;
   const int o1 = orient(s1.p0, s1.p1, p), o2 = orient(s2.p0, s2.p1, p);
   if (o1 == kLeft || o2 == kLeft) return false;
   if (o1 == 0 && o2 == 0) {  // p is the lines' intersection: a circle of radius 0
-    out.x = px;
-    out.y = py;
-    out.lower_x = px;
+    out.x = T(p.x);
+    out.y = T(p.y);
+    out.lower_x = T(p.x);
     return true;
   }
-  const real k = 1 + l1.nx * l2.nx + l1.ny * l2.ny;
+  if (same_normal(s1, s2)) return false;  // parallel lines facing the same way: no circle
+  const LineI l1 = site_line(s1), l2 = site_line(s2);
+  const T L1 = sqrt(T(l1.len2)), L2 = sqrt(T(l2.len2));
+  const T px(p.x), py(p.y);
+  const T c12 = T(l1.cx) * T(l2.cx) + T(l1.cy) * T(l2.cy);
+  // e_i = c_i . (p - a_i) = L_i d_i(p) >= 0, exact.
+  const double e1 = line_offset(l1, p), e2 = line_offset(l2, p);
   if (o1 == 0 || o2 == 0) {
-    // Tangent at p to the line through it: the centre is on that line's normal at p,
-    // at the distance t where it is as far from the other line: t = d_other(p) / (1 - n1.n2).
-    const Line& at = o1 == 0 ? l1 : l2;
-    const Line& other = o1 == 0 ? l2 : l1;
-    const real t = side_dist(other, px, py) / (2 - k);
-    if (!(t > 0)) return false;
-    out.x = px + t * at.nx;
-    out.y = py + t * at.ny;
-    out.lower_x = out.x + t;
+    // Tangent at p to the line through it: the centre is on that line's normal
+    // at p, at t = d_other(p) / (1 - n1.n2) = e_other L_at / (L1 L2 - c1.c2).
+    const LineI& at = o1 == 0 ? l1 : l2;
+    const T& L_at = o1 == 0 ? L1 : L2;
+    const T den = L1 * L2 - c12;
+    if (sgn(den) <= 0) return false;
+    const T f = T(o1 == 0 ? e2 : e1) / den;  // X = p + f c_at, r = f L_at
+    if (sgn(f) <= 0) return false;
+    out.x = px + f * T(at.cx);
+    out.y = py + f * T(at.cy);
+    out.lower_x = out.x + f * L_at;
     return true;
   }
-  // The bisector d1 = d2: m.X = c with m = n1 - n2; B the foot of p on it, v its direction.
-  const real mxv = l1.nx - l2.nx, myv = l1.ny - l2.ny;
-  const real m2 = mxv * mxv + myv * myv;
-  if (!(m2 > 0)) return false;  // same lines facing the same way
-  const real c = l1.nx * l1.ax + l1.ny * l1.ay - (l2.nx * l2.ax + l2.ny * l2.ay);
-  const real f = (mxv * px + myv * py - c) / m2;
-  const real bx = px - f * mxv, by = py - f * myv;
-  const real ml = std::sqrt(m2);
-  const real vx = -myv / ml, vy = mxv / ml;
-  const real D = side_dist(l1, bx, by), E = l1.nx * vx + l1.ny * vy;
-  const real g2 = f * f * m2;
-  real t[2];
-  const int n = tangent_roots(D, E, g2, false, t);
-  Candidate best{0, 0, 0, -std::numeric_limits<real>::infinity()};
+  // With Y = X - p: d_i = (c_i . Y + e_i) / L_i. The bisector d1 = d2 is
+  // m . Y = h0 with m = L2 c1 - L1 c2, h0 = L1 e2 - L2 e1; Y = (h0 m + s v) / mm
+  // with v = perp(m), mm = |m|^2; then d1 = (beta + s alpha) / (mm L1) with
+  // alpha = c1 . v, beta = h0 (c1 . m) + e1 mm, and d1^2 = |Y|^2 = (h0^2 + s^2) / mm:
+  // (alpha^2 - L1^2 mm) s^2 + 2 alpha beta s + (beta^2 - L1^2 mm h0^2) = 0.
+  const T mx = L2 * T(l1.cx) - L1 * T(l2.cx), my = L2 * T(l1.cy) - L1 * T(l2.cy);
+  const T h0 = L1 * T(e2) - L2 * T(e1);
+  const T mm = mx * mx + my * my;
+  const T vx = -my, vy = mx;
+  const T alpha = T(l1.cx) * vx + T(l1.cy) * vy;
+  const T beta = h0 * (T(l1.cx) * mx + T(l1.cy) * my) + T(e1) * mm;
+  const T l1mm = T(l1.len2) * mm;
+  T s[2];
+  const int n = quadratic_roots(alpha * alpha - l1mm, alpha * beta, beta * beta - l1mm * h0 * h0, false, s);
+  Candidate<T> best;
   for (int i = 0; i < n; ++i) {
-    const real x = bx + t[i] * vx, y = by + t[i] * vy, r = D + t[i] * E;
-    if (!(r >= 0)) continue;
-    const real t1x = x - r * l1.nx, t1y = y - r * l1.ny, t2x = x - r * l2.nx, t2y = y - r * l2.ny;
-    const real o = (t1x - px) * (t2y - py) - (t1y - py) * (t2x - px);
-    const real score = required * o;
-    if (score > best.score) best = Candidate{x, y, r, score};
+    const T rn = beta + s[i] * alpha;  // r mm L1
+    if (sgn(rn) < 0) continue;
+    const T x = px + (h0 * mx + s[i] * vx) / mm, y = py + (h0 * my + s[i] * vy) / mm;
+    const T r = rn / (mm * L1);
+    // Tangency points T_i = X - r c_i / L_i.
+    const T f1 = r / L1, f2 = r / L2;
+    const T t1x = x - f1 * T(l1.cx), t1y = y - f1 * T(l1.cy), t2x = x - f2 * T(l2.cx), t2y = y - f2 * T(l2.cy);
+    const T o = (t1x - px) * (t2y - py) - (t1y - py) * (t2x - px);
+    best.offer(x, y, r, required > 0 ? o : -o);
   }
-  if (!(best.score > -std::numeric_limits<real>::infinity())) return false;
+  if (!best.found) return false;
   out.x = best.x;
   out.y = best.y;
   out.lower_x = best.x + best.r;
   return true;
 }
 
-bool circle_sss(const Site& s1, const Site& s2, const Site& s3, Circle& out) {
-  const Line l[3] = {site_line(s1), site_line(s2), site_line(s3)};
-  // n_i . X - r = n_i . a_i
-  real m[3][3], rhs[3];
+// Circle tangent to three segment sites: c_i . X - L_i r = c_i . a_i, by Cramer's rule.
+template <class T>
+bool circle_sss(const Site& s1, const Site& s2, const Site& s3, CircleT<T>& out) {
+  const LineI l[3] = {site_line(s1), site_line(s2), site_line(s3)};
+  T m[3][3], rhs[3];
   for (int i = 0; i < 3; ++i) {
-    m[i][0] = l[i].nx;
-    m[i][1] = l[i].ny;
-    m[i][2] = -1;
-    rhs[i] = l[i].nx * l[i].ax + l[i].ny * l[i].ay;
+    m[i][0] = T(l[i].cx);
+    m[i][1] = T(l[i].cy);
+    m[i][2] = -sqrt(T(l[i].len2));
+    rhs[i] = T(l[i].cx * l[i].ax + l[i].cy * l[i].ay);  // exact (|terms| <= 2^51)
   }
-  auto det3 = [](real a[3][3]) {
+  auto det3 = [](const T a[3][3]) {
     return a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
            a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
   };
-  const real d = det3(m);
-  if (d == 0) return false;
-  real sol[3];
+  const T d = det3(m);
+  if (sgn(d) == 0) return false;
+  T sol[3];
   for (int j = 0; j < 3; ++j) {
-    real mj[3][3];
+    T mj[3][3];
     for (int i = 0; i < 3; ++i)
       for (int k = 0; k < 3; ++k) mj[i][k] = k == j ? rhs[i] : m[i][k];
     sol[j] = det3(mj) / d;
   }
-  if (!(sol[2] >= 0)) return false;
+  if (sgn(sol[2]) < 0) return false;
   out.x = sol[0];
   out.y = sol[1];
   out.lower_x = sol[0] + sol[2];
@@ -431,18 +498,18 @@ bool exists_pss(const Site& s1, const Site& s2, const Site& s3, int index) {
   return true;
 }
 
-bool outside_vertical(const Circle& c, const Site& s) {
+// Is the centre outside the y range of a vertical segment site? Exact: the
+// centre's y equals an endpoint's y when the circle passes through it.
+template <class T>
+bool outside_vertical(const CircleT<T>& c, const Site& s) {
   if (!s.segment || !is_vertical(s)) return false;
-  const real y0 = s.inverse ? s.y1() : s.y0();
-  const real y1 = s.inverse ? s.y0() : s.y1();
-  // The centre's y is rounded (it is an endpoint's y exactly when the circle
-  // passes through that endpoint): compared within 64 units in the last place
-  // of a double, as Boost.Polygon does.
-  const real tol = 64 * std::numeric_limits<double>::epsilon() * std::max<real>({std::fabs(c.y), std::fabs(y0), std::fabs(y1), 1});
-  return c.y < y0 - tol || c.y > y1 + tol;
+  const double y0 = s.inverse ? s.y1() : s.y0();
+  const double y1 = s.inverse ? s.y0() : s.y1();
+  return sgn(c.y - T(y0)) < 0 || sgn(c.y - T(y1)) > 0;
 }
 
-bool circle_formation(const Site& s1, const Site& s2, const Site& s3, Circle& c) {
+template <class T>
+bool circle_formation(const Site& s1, const Site& s2, const Site& s3, CircleT<T>& c) {
   bool ok;
   if (!s1.segment) {
     if (!s2.segment) {
@@ -472,19 +539,53 @@ bool circle_formation(const Site& s1, const Site& s2, const Site& s3, Circle& c)
   if (!ok) return false;
   if (outside_vertical(c, s1) || outside_vertical(c, s2) || outside_vertical(c, s3)) return false;
   // A circle tangent to a vertical segment from its left touches the sweep line
-  // exactly when it reaches the segment's x: exact, so that the events at one
-  // vertical segment are ordered by y and not by rounding.
+  // exactly when it reaches the segment's x, so that the events at one
+  // vertical segment are ordered by y.
   for (const Site* s : {&s1, &s2, &s3})
-    if (s->segment && is_vertical(*s) && s->p0.y > s->p1.y) c.lower_x = s->p0.x;
+    if (s->segment && is_vertical(*s) && s->p0.y > s->p1.y) c.lower_x = T(s->p0.x);
   return true;
 }
 
-// Site x against a circle's lower x: the site first when it is below by more
-// than the rounding of the circle's computation (64 units in the last place of a double).
-bool site_before_circle(const Site& s, const Circle& c) {
-  const real x = s.x0();
-  const real tol = 64 * std::numeric_limits<double>::epsilon() * std::max<real>(std::fabs(x), std::fabs(c.lower_x));
-  return x < c.lower_x - tol;
+// A circle event: enclosures of the centre and of its lower x (points when
+// exact), refined by the exact evaluation when the filter was not sure or not
+// tight enough for the output vertex.
+struct Circle {
+  exact::Iv x, y, lower_x;
+};
+
+template <class T>
+Circle to_circle(const CircleT<T>& c) {
+  if constexpr (std::is_same_v<T, exact::Iv>) {
+    return Circle{c.x, c.y, c.lower_x};
+  } else {
+    auto iv = [](const exact::Bx& b) { return exact::Iv(b.lower(), b.upper()); };
+    return Circle{iv(c.x), iv(c.y), iv(c.lower_x)};
+  }
+}
+
+inline bool tight(const exact::Iv& v) { return v.hi - v.lo <= 0x1p-40 * (std::fabs(v.lo) + std::fabs(v.hi) + 1); }
+
+bool circle_event(const Site& s1, const Site& s2, const Site& s3, Circle& out) {
+  try {
+    CircleT<exact::Iv> c;
+    if (!circle_formation(s1, s2, s3, c)) return false;
+    out = to_circle(c);
+    if (tight(out.x) && tight(out.y) && tight(out.lower_x)) return true;
+  } catch (const exact::Uncertain&) {
+  }
+  bool found = false;
+  exact::exact_sign([&](auto type) {
+    using T = typename decltype(type)::type;
+    CircleT<T> c;
+    found = circle_formation(s1, s2, s3, c);
+    if (found) {
+      out = to_circle(c);
+      // The output needs a tight enclosure, not only the branch signs.
+      if (!(tight(out.x) && tight(out.y) && tight(out.lower_x))) throw exact::NeedPrecision{};
+    }
+    return T(0);
+  });
+  return found;
 }
 
 // ---------------------------------------------------------------- the builder
@@ -522,7 +623,7 @@ class Builder {
         process_site();
       } else if (next_ == sites_.size()) {
         process_circle();
-      } else if (site_before_circle(sites_[next_], events_[queue_.top()].c)) {
+      } else if (site_before_circle(sites_[next_], events_[queue_.top()])) {
         process_site();
       } else {
         process_circle();
@@ -536,17 +637,66 @@ class Builder {
   struct Event {
     Circle c;
     BeachIt node;
+    std::array<std::uint32_t, 3> site{};  // sorted indices of the three sites
+    std::uint8_t inverse = 0;             // bit i: site i inverted
     bool active = true;
   };
   struct EventLess {
-    const std::vector<Event>* events;
-    bool operator()(std::uint32_t a, std::uint32_t b) const {
-      const Circle& ca = (*events)[a].c;
-      const Circle& cb = (*events)[b].c;
-      if (ca.lower_x != cb.lower_x) return ca.lower_x > cb.lower_x;
-      return ca.y > cb.y;
-    }
+    const Builder* builder;
+    bool operator()(std::uint32_t a, std::uint32_t b) const { return builder->compare_events(a, b) > 0; }
   };
+
+  Site event_site(const Event& e, int i) const {
+    Site s = sites_[e.site[i]];
+    if ((e.inverse >> i) & 1) s.invert();
+    return s;
+  }
+  // Exact sign of a - b, for intervals known to enclose a and b, or 2 when they cannot tell.
+  static int interval_compare(const exact::Iv& a, const exact::Iv& b) {
+    if (a.hi < b.lo) return -1;
+    if (a.lo > b.hi) return 1;
+    if (a.point() && b.point() && a.lo == b.lo) return 0;
+    return 2;
+  }
+  // Events ordered by the lower x of their circles, then by the centre's y, exactly.
+  int compare_events(std::uint32_t ia, std::uint32_t ib) const {
+    const Event& a = events_[ia];
+    const Event& b = events_[ib];
+    if (a.c.lower_x.hi < b.c.lower_x.lo) return -1;  // the usual case, inline
+    if (a.c.lower_x.lo > b.c.lower_x.hi) return 1;
+    return compare_events_slow(a, b);
+  }
+  [[gnu::noinline]] int compare_events_slow(const Event& a, const Event& b) const {
+    for (const bool by_y : {false, true}) {
+      int s = by_y ? interval_compare(a.c.y, b.c.y) : interval_compare(a.c.lower_x, b.c.lower_x);
+      if (s == 2) {
+        const Site a0 = event_site(a, 0), a1 = event_site(a, 1), a2 = event_site(a, 2);
+        const Site b0 = event_site(b, 0), b1 = event_site(b, 1), b2 = event_site(b, 2);
+        s = exact::exact_sign([&](auto type) {
+          using T = typename decltype(type)::type;
+          CircleT<T> ca, cb;
+          circle_formation(a0, a1, a2, ca);
+          circle_formation(b0, b1, b2, cb);
+          return by_y ? ca.y - cb.y : ca.lower_x - cb.lower_x;
+        });
+      }
+      if (s != 0) return s;
+    }
+    return 0;
+  }
+  // The site comes first when its x is below the circle's lower x (equal: the circle first).
+  bool site_before_circle(const Site& s, const Event& e) const {
+    const double x = s.x0();
+    if (x < e.c.lower_x.lo) return true;
+    if (x >= e.c.lower_x.hi) return false;
+    const Site e0 = event_site(e, 0), e1 = event_site(e, 1), e2 = event_site(e, 2);
+    return exact::exact_sign([&](auto type) {
+             using T = typename decltype(type)::type;
+             CircleT<T> c;
+             circle_formation(e0, e1, e2, c);
+             return T(x) - c.lower_x;
+           }) < 0;
+  }
   struct EndPoint {
     Pt p;
     BeachIt node;
@@ -624,8 +774,9 @@ class Builder {
 
   void activate(const Site& s1, const Site& s2, const Site& s3, BeachIt node) {
     Circle c;
-    if (circle_formation(s1, s2, s3, c)) {
-      events_.push_back(Event{c, node, true});
+    if (circle_event(s1, s2, s3, c)) {
+      const auto inverse = static_cast<std::uint8_t>(int(s1.inverse) | int(s2.inverse) << 1 | int(s3.inverse) << 2);
+      events_.push_back(Event{c, node, {s1.sorted_index, s2.sorted_index, s3.sorted_index}, inverse, true});
       const auto id = static_cast<std::uint32_t>(events_.size() - 1);
       node->second.circle = id;
       queue_.push(id);
@@ -687,7 +838,8 @@ class Builder {
     const Site site1 = it_first->first.left;
     if (!site1.segment && site3.segment && site3.p1 == site1.p0) site3.invert();
     // The vertex.
-    out_.vertices.push_back(SweepVertex{c.x, c.y, c.lower_x - c.x});
+    const long double cx = c.x.mid(), cy = c.y.mid();
+    out_.vertices.push_back(SweepVertex{cx, cy, static_cast<long double>(c.lower_x.mid()) - cx});
     const auto v = static_cast<std::uint32_t>(out_.vertices.size() - 1);
     if (d1.edge != kNone) out_.edges[d1.edge].vertex[d1.end] = v;
     if (d2.edge != kNone) out_.edges[d2.edge].vertex[d2.end] = v;
@@ -720,13 +872,15 @@ class Builder {
   std::size_t next_ = 0;
   BeachLine beach_;
   std::vector<Event> events_;
-  std::priority_queue<std::uint32_t, std::vector<std::uint32_t>, EventLess> queue_{EventLess{&events_}};
+  std::priority_queue<std::uint32_t, std::vector<std::uint32_t>, EventLess> queue_{EventLess{this}};
   std::priority_queue<EndPoint, std::vector<EndPoint>, EndPointLess> ends_;
   SweepOutput out_;
 };
 
 }  // namespace
 
-SweepOutput sweep_segment_voronoi(const SweepInput& input) { return Builder(input).run(); }
+SweepOutput sweep_segment_voronoi(const SweepInput& input) {
+  return Builder(input).run();
+}
 
 }  // namespace geods::voronoi::detail

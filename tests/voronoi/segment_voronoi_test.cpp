@@ -338,3 +338,179 @@ TEST(SegmentVoronoi, BadInput) {
 
 }  // namespace
 }  // namespace geods::voronoi
+
+// ---------------------------------------------------------------- degenerate inputs (exact predicates)
+namespace geods::voronoi {
+namespace {
+
+// Every vertex is equidistant (its clearance) to the sites of its edges, no
+// site is nearer (empty circle), and Euler's relation holds for the diagram
+// closed by one vertex at infinity: V + 1 - E + (number of sites) = 2.
+void expect_vertices_and_euler(const SegmentVoronoi& v) {
+  const double tol = 1e-9 * extent(v);
+  for (std::size_t i = 0; i < v.vertices().size(); ++i) {
+    const auto& vx = v.vertices()[i];
+    for (std::uint32_t s = 0; s < v.num_sites(); ++s)
+      ASSERT_GE(v.site_distance(s, vx.position), vx.clearance - tol) << "vertex " << i << ": site " << s << " is inside its circle";
+  }
+  for (const auto& e : v.edges())
+    for (int k = 0; k < 2; ++k) {
+      if (e.vertex[k] == SegmentVoronoi::kInfinity) continue;
+      const auto& vx = v.vertices()[e.vertex[k]];
+      for (int j = 0; j < 2; ++j) ASSERT_NEAR(v.site_distance(e.site[j], vx.position), vx.clearance, tol);
+    }
+  EXPECT_EQ(static_cast<long>(v.vertices().size()) + 1 - static_cast<long>(v.edges().size()) + static_cast<long>(v.num_sites()), 2);
+}
+
+// Distinct vertex positions (coincident vertices of cocircular sites merged).
+std::size_t distinct_vertices(const SegmentVoronoi& v, double tol) {
+  std::vector<Vec2d> out;
+  for (const auto& vx : v.vertices()) {
+    bool seen = false;
+    for (const Vec2d& p : out) seen = seen || (p - vx.position).norm() <= tol;
+    if (!seen) out.push_back(vx.position);
+  }
+  return out.size();
+}
+
+TEST(SegmentVoronoiExact, CocircularLatticePoints) {
+  // The 36 integer points on x^2 + y^2 = 65^2 (65 = 5 * 13): every triple has the same circle.
+  std::vector<double> pts;
+  for (int x = -65; x <= 65; ++x)
+    for (int y = -65; y <= 65; ++y)
+      if (x * x + y * y == 65 * 65) pts.insert(pts.end(), {double(x), double(y)});
+  ASSERT_EQ(pts.size(), 72u);
+  SegmentVoronoi v(pts, {});
+  expect_edges_sound(v);
+  expect_vertices_and_euler(v);
+  // All vertices at the centre; n points on a circle give n - 2 (coincident) vertices, n rays.
+  for (const auto& vx : v.vertices()) EXPECT_LE(vx.position.norm(), 1e-9 * 65);
+  EXPECT_EQ(v.vertices().size(), 34u);
+  std::size_t unbounded = 0;
+  for (const auto& e : v.edges()) unbounded += e.vertex[0] == SegmentVoronoi::kInfinity || e.vertex[1] == SegmentVoronoi::kInfinity;
+  EXPECT_EQ(unbounded, 36u);
+}
+
+TEST(SegmentVoronoiExact, CocircularAtLargeCoordinates) {
+  // The 68 lattice points of x^2 + y^2 = 5^16 (radius 390625) around (16000000, -16000000):
+  // every circle event ties at coordinates near 2^24, decided exactly.
+  const std::int64_t R = 390625;
+  std::vector<double> pts;
+  for (std::int64_t x = -R; x <= R; ++x) {
+    const std::int64_t y2 = R * R - x * x;
+    const auto y = static_cast<std::int64_t>(std::llround(std::sqrt(static_cast<double>(y2))));
+    if (y * y != y2) continue;
+    pts.insert(pts.end(), {16000000.0 + x, -16000000.0 + y});
+    if (y != 0) pts.insert(pts.end(), {16000000.0 + x, -16000000.0 - y});
+  }
+  ASSERT_EQ(pts.size(), 2u * 68u);
+  SegmentVoronoi v(pts, {});
+  expect_edges_sound(v);
+  expect_vertices_and_euler(v);
+  EXPECT_EQ(v.vertices().size(), 66u);
+  for (const auto& vx : v.vertices()) {
+    EXPECT_NEAR(vx.position[0], 16000000.0, 1e-9 * R);
+    EXPECT_NEAR(vx.position[1], -16000000.0, 1e-9 * R);
+    EXPECT_NEAR(vx.clearance, double(R), 1e-9 * R);
+  }
+}
+
+TEST(SegmentVoronoiExact, PointGrid) {
+  // A 9 x 7 lattice: square cells, the 8 x 6 cell corners each shared by 4 cocircular points,
+  // many circle events with identical x.
+  std::vector<double> pts;
+  for (int i = 0; i < 9; ++i)
+    for (int j = 0; j < 7; ++j) pts.insert(pts.end(), {double(3 * i), double(3 * j)});
+  SegmentVoronoi v(pts, {});
+  expect_edges_sound(v);
+  expect_vertices_and_euler(v);
+  expect_cells_complete(v, 21);
+  EXPECT_EQ(distinct_vertices(v, 1e-9), 48u);
+  for (const auto& vx : v.vertices()) {
+    EXPECT_DOUBLE_EQ(std::fmod(vx.position[0], 3.0), 1.5);
+    EXPECT_DOUBLE_EQ(std::fmod(vx.position[1], 3.0), 1.5);
+  }
+}
+
+TEST(SegmentVoronoiExact, SegmentsTangentToOneCircle) {
+  // 12 segments tangent to the circle of radius 100 at its Pythagorean points
+  // (20 (3, 4) and the like): the centre is equidistant to all of them.
+  std::vector<double> segs;
+  const int pyth[12][2] = {{5, 0}, {4, 3}, {3, 4}, {0, 5}, {-3, 4}, {-4, 3}, {-5, 0}, {-4, -3}, {-3, -4}, {0, -5}, {3, -4}, {4, -3}};
+  for (const auto& p : pyth) {
+    const double a = p[0], b = p[1];
+    segs.insert(segs.end(), {20 * a - b, 20 * b + a, 20 * a + b, 20 * b - a});
+  }
+  SegmentVoronoi v({}, segs);
+  expect_edges_sound(v);
+  expect_vertices_and_euler(v);
+  expect_cells_complete(v, 22);
+  std::size_t at_centre = 0;
+  for (const auto& vx : v.vertices())
+    if (vx.position.norm() <= 1e-9 * 100) {
+      ++at_centre;
+      EXPECT_NEAR(vx.clearance, 100, 1e-9 * 100);
+    }
+  EXPECT_GE(at_centre, 1u);
+}
+
+TEST(SegmentVoronoiExact, SquareWithSplitDiagonals) {
+  // A square, its two diagonals split at the centre (8 segments meeting at
+  // endpoints): the medial axis is the diagonals themselves, every vertex is
+  // an endpoint or lies on a symmetry axis.
+  const std::vector<double> segs{0, 0, 40, 0, 40, 0, 40, 40, 40, 40, 0, 40, 0, 40, 0, 0,
+                                 0, 0, 20, 20, 40, 0, 20, 20, 40, 40, 20, 20, 0, 40, 20, 20};
+  SegmentVoronoi v({}, segs);
+  expect_edges_sound(v);
+  expect_vertices_and_euler(v);
+  expect_cells_complete(v, 23);
+  // Inside each of the four triangles, the incentre is a vertex equidistant to
+  // its three sides: r = 20 / (1 + sqrt(2)).
+  const double r = 20 / (1 + std::sqrt(2.0));
+  for (const Vec2d c : {Vec2d(20, r), Vec2d(20, 40 - r), Vec2d(r, 20), Vec2d(40 - r, 20)}) {
+    bool found = false;
+    for (const auto& vx : v.vertices()) found = found || ((vx.position - c).norm() <= 1e-9 * 40 && std::abs(vx.clearance - r) <= 1e-9 * 40);
+    EXPECT_TRUE(found) << "incentre " << c.transpose();
+  }
+}
+
+TEST(SegmentVoronoiExact, ParallelSegmentsAtEqualDistances) {
+  // Horizontal segments of equal length 10 apart, and a second column shifted:
+  // the bisectors are the lines y = 5 + 10 k, with ties between every pair of neighbours.
+  std::vector<double> segs;
+  for (int k = 0; k < 6; ++k) {
+    segs.insert(segs.end(), {0, double(10 * k), 30, double(10 * k)});
+    segs.insert(segs.end(), {40, double(10 * k), 70, double(10 * k)});
+  }
+  SegmentVoronoi v({}, segs);
+  expect_edges_sound(v);
+  expect_vertices_and_euler(v);
+  expect_cells_complete(v, 24);
+  for (const auto& vx : v.vertices()) {
+    // Between the columns, the vertices are where the bisectors meet: x = 35 by symmetry, or on y = 5 + 10 k.
+    const bool on_axis = std::abs(vx.position[0] - 35) <= 1e-9 * 70;
+    const bool on_bisector = std::abs(std::fmod(vx.position[1] + 1000, 10.0) - 5) <= 1e-9 * 70;
+    EXPECT_TRUE(on_axis || on_bisector) << vx.position.transpose();
+  }
+}
+
+TEST(SegmentVoronoiExact, SegmentLatticeAndDiagonalGrid) {
+  // A 6 x 6 lattice of unit squares and a lattice of disjoint diagonal
+  // segments (all the same length, many cocircular and cotangent triples).
+  std::vector<double> segs;
+  const int n = 6;
+  for (int i = 0; i <= n; ++i)
+    for (int j = 0; j < n; ++j) {
+      segs.insert(segs.end(), {double(2 * j), double(2 * i), double(2 * j + 2), double(2 * i)});
+      segs.insert(segs.end(), {double(2 * i), double(2 * j), double(2 * i), double(2 * j + 2)});
+    }
+  for (int i = 0; i < 5; ++i)
+    for (int j = 0; j < 5; ++j) segs.insert(segs.end(), {double(20 + 4 * i), double(4 * j), double(21 + 4 * i), double(4 * j + 1)});
+  SegmentVoronoi v({}, segs);
+  expect_edges_sound(v);
+  expect_vertices_and_euler(v);
+  expect_cells_complete(v, 25);
+}
+
+}  // namespace
+}  // namespace geods::voronoi

@@ -29,13 +29,13 @@
 // Construction: Fortune's sweep generalized to segments (the structure of
 // Boost.Polygon's voronoi_builder, written anew): site events for points and
 // segments, circle events for every triple of point/segment sites.
-// Orientation tests and the beach-line filter of the point-segment case are
-// exact on the snapped integers (doubles, 128-bit integers); the tangent
-// circles are computed in long double from closed forms whose root is chosen
-// by the cyclic order of the tangency points, every "point on a line" case
-// decided exactly. Two comparisons keep Boost.Polygon's tolerance of 64 units
-// in the last place of a double: a site event against a circle event at the
-// same x, and a circle's centre against the end of a vertical segment.
+// Every predicate is exact on the snapped integers, no epsilon: orientation
+// tests in doubles and 128-bit integers; the tangent circles (closed forms
+// with integer coefficients and the segment lengths, the root chosen by the
+// cyclic order of the tangency points), their order, and site-against-circle
+// and centre-against-vertical-segment tests by a double interval filter and,
+// when it cannot decide, MPFR balls evaluated past the expression's BFMSS
+// separation bound (docs/voronoi.md, "Predicates (exact)").
 #include <array>
 #include <cstdint>
 #include <limits>
