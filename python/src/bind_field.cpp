@@ -167,7 +167,8 @@ void bind_field(py::module_& m) {
 
   m.def("chamfer", &chamfer_py, py::arg("mask"), py::arg("size") = field::ChamferRequest{}.size,
         py::arg("spacing") = py::none(),
-        "Chamfer distance transform of a 1-, 2- or 3-D mask (nonzero = foreground; edt's convention): the\n"
+        "Chamfer distance transform of a 1-, 2- or 3-D mask, (n,), (ny, nx) or (nz, ny, nx) (nonzero =\n"
+        "foreground; edt's convention): the\n"
         "distance to the nearest zero sample approximated by a forward and a backward scan with the\n"
         "3x3x3 (size=3) or 5x5x5 (size=5) matrix of Euclidean step lengths (seed Figure 61), float64 of\n"
         "the mask's shape. Never below the exact distance, at most chamfer_max_error(size) above it\n"

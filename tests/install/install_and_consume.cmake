@@ -16,6 +16,10 @@ file(GLOB docs ${SOURCE_DIR}/docs/*.md)
 run(/usr/bin/python3 ${CMAKE_CURRENT_LIST_DIR}/extract_examples.py cpp cpp ${WORK_DIR}/examples ${docs})
 
 run(${CMAKE_COMMAND} --install ${GEODS_BINARY_DIR} --prefix ${WORK_DIR}/prefix)
+# The CLI, man page, bash completion and Python package it installed.
+if(CHECK_CLI AND CHECK_PYTHON)
+  run(/usr/bin/python3 ${CMAKE_CURRENT_LIST_DIR}/check_installed.py ${WORK_DIR}/prefix)
+endif()
 find_program(CCACHE ccache)
 if(CCACHE)
   set(launcher -DCMAKE_CXX_COMPILER_LAUNCHER=${CCACHE})
