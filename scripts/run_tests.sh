@@ -16,6 +16,8 @@ echo "=== python tests (pytest)"
 PYTHONPATH=build/release/python GEODS_CLI=build/release/bin/geods \
   /usr/bin/python3 -m pytest python/tests -q -p no:cacheprovider || failed+=("pytest")
 
+# The asan preset compiles at -O1 -g1 (line tables are enough for the reports):
+# half the compile time of -O2 -g, and compiling is most of this stage.
 echo "=== asan+ubsan build and unit tests (ctest)"
 if { [[ -f build/asan/build.ninja ]] || cmake --preset asan >/dev/null; } &&
    cmake --build build/asan -j"$jobs"; then

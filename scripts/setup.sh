@@ -18,6 +18,7 @@ packages=(
   python3-scipy  # the oracle of python/tests/test_convex_hull.py (Qhull)
   python3-mesonpy python3-venv  # pip install . (meson-python drives the CMake build; docs/install.md)
   python3-mypy  # python/tests/test_stubs.py checks calls against the type stubs
+  python3-dask python3-distributed  # geods.dask: volumes in chunks, collections, terrain tiles (BSD)
 )
 for arg in "$@"; do
   case "$arg" in

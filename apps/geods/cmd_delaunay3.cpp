@@ -32,13 +32,20 @@ class Delaunay3Command : public Command {
     app.add_option("--neighbors", neighbors_,
                    "Output: int64 m x 4, the tetrahedron across the face opposite each vertex (-1 on the hull)");
     app.add_option("--hull", hull_, "Output: int64 h x 3 hull triangles, counter-clockwise seen from outside");
+    app.add_option("--insertion", insertion_,
+                   "How each point is inserted (seed 5.3.1): cavity (Bowyer-Watson) or flips (1-4, 2-3, 3-2); the "
+                   "same tetrahedra")
+        ->check(CLI::IsMember({"cavity", "flips"}))
+        ->capture_default_str();
     add_save(app, save_, "the tetrahedralization", "Delaunay3.load");
   }
 
   void run(const RunContext&, Report& report) override {
     const std::vector<Vec3d> points = read_points_3d(points_);
     Stopwatch watch;
-    const Delaunay3 dt(points);
+    voronoi::Delaunay3Options options;
+    options.insertion = insertion_ == "flips" ? voronoi::Delaunay3Insertion::flips : voronoi::Delaunay3Insertion::cavity;
+    const Delaunay3 dt(points, options);
     const double build_s = watch.seconds();
     const voronoi::Delaunay3Stats stats = dt.stats();
 
@@ -63,6 +70,7 @@ class Delaunay3Command : public Command {
     put_stats(j, stats);
     j["bytes_per_point"] = points.empty() ? 0.0 : double(stats.bytes) / double(points.size());
     j["threads"] = num_threads();
+    j["insertion"] = insertion_;
     j["build_s"] = build_s;
     j["compute_s"] = build_s;
     const char* lower[] = {"no points", "all points equal", "all points collinear", "all points coplanar"};
@@ -78,12 +86,16 @@ class Delaunay3Command : public Command {
                                                                        stats.seam_points)
                                                          : "",
                                        points.empty() ? 0.0 : double(stats.bytes) / double(points.size())));
+    if (insertion_ == "flips")
+      report.lines.push_back(fmt::format("  flips: {} 1-4, {} 2-3, {} 3-2, {} 4-4, {} face/edge splits, {} outside the hull",
+                                         stats.flips_14, stats.flips_23, stats.flips_32, stats.flips_44, stats.splits,
+                                         stats.hull_inserts));
     for (const std::string* path : {&output_, &neighbors_, &hull_, &save_})
       if (!path->empty()) report.lines.push_back("  wrote " + *path);
   }
 
  private:
-  std::string points_, output_, neighbors_, hull_, save_;
+  std::string points_, output_, neighbors_, hull_, save_, insertion_ = "cavity";
 };
 
 const bool registered = register_command<Delaunay3Command>();

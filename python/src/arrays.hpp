@@ -135,11 +135,11 @@ inline io::AnyGrid3 volume_from_array(const py::array& array, const std::array<d
     return g;
   };
   const py::dtype dt = array.dtype();
-  if (dt.is(py::dtype::of<std::uint8_t>()) || dt.kind() == 'b') return grid(std::uint8_t{});
-  if (dt.is(py::dtype::of<std::uint16_t>())) return grid(std::uint16_t{});
-  if (dt.is(py::dtype::of<std::int16_t>()) || dt.is(py::dtype::of<std::int8_t>())) return grid(std::int16_t{});
-  if (dt.is(py::dtype::of<float>())) return grid(float{});
-  if (dt.is(py::dtype::of<double>()) || dt.kind() == 'i' || dt.kind() == 'u') return grid(double{});
+  if (dt.equal(py::dtype::of<std::uint8_t>()) || dt.kind() == 'b') return grid(std::uint8_t{});
+  if (dt.equal(py::dtype::of<std::uint16_t>())) return grid(std::uint16_t{});
+  if (dt.equal(py::dtype::of<std::int16_t>()) || dt.equal(py::dtype::of<std::int8_t>())) return grid(std::int16_t{});
+  if (dt.equal(py::dtype::of<float>())) return grid(float{});
+  if (dt.equal(py::dtype::of<double>()) || dt.kind() == 'i' || dt.kind() == 'u') return grid(double{});
   throw Error(what + ": unsupported dtype " + py::cast<std::string>(py::repr(dt)));
 }
 

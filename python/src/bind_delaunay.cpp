@@ -88,16 +88,22 @@ Delaunay tetrahedralization of 3D points (Bowyer-Watson insertion in BRIO order,
 exact predicates with symbolic perturbation: any input, cospherical or coplanar
 sets included, gives a valid and unique result).
 
-Delaunay3(points, seed=...) -- points (n, 3). Duplicates merge into their first
-occurrence; fewer than four distinct points or all coplanar give no tetrahedra
-(dimension < 3). NaN/inf raise geods.Error (ValueError).
+Delaunay3(points, seed=..., insertion="cavity") -- points (n, 3). Duplicates merge
+into their first occurrence; fewer than four distinct points or all coplanar give
+no tetrahedra (dimension < 3). NaN/inf raise geods.Error (ValueError).
+insertion="flips" inserts each point (here and in insert()) by 1-4, 2-3, 3-2
+(and 4-4) flips instead of the Bowyer-Watson cavity: the same tetrahedra.
 )doc")
-      .def(py::init([](const py::handle& points_in, std::uint64_t seed) {
+      .def(py::init([](const py::handle& points_in, std::uint64_t seed, const std::string& insertion) {
+             if (insertion != "cavity" && insertion != "flips")
+               throw Error("Delaunay3: insertion must be \"cavity\" or \"flips\", got \"" + insertion + "\"");
              const std::vector<Vec3d> points = points_of<double, 3>(points_in, "Delaunay3");
              py::gil_scoped_release release;
-             return Delaunay3(points, {.seed = seed});
+             return Delaunay3(points, {.insertion = insertion == "flips" ? voronoi::Delaunay3Insertion::flips
+                                                                         : voronoi::Delaunay3Insertion::cavity,
+                                       .seed = seed});
            }),
-           py::arg("points"), py::arg("seed") = Delaunay3::Options{}.seed)
+           py::arg("points"), py::arg("seed") = Delaunay3::Options{}.seed, py::arg("insertion") = "cavity")
       .def_property_readonly(
           "points", [](const Delaunay3& dt) { return points_array(dt.points()); }, "(n, 3) float64: the points")
       .def_property_readonly(

@@ -152,6 +152,22 @@ py::array_t<double> chamfer_py(const py::object& mask, int size, const py::objec
   return copy_array(d.data.data(), shape);
 }
 
+// One pass of the separable EDT over a copy of g (1-, 2- or 3-D float64); axis in geods order (0 = x = last).
+py::array_t<double> edt_pass_py(const py::array_t<double, py::array::c_style | py::array::forcecast>& g, int axis,
+                                double spacing) {
+  if (g.ndim() < 1 || g.ndim() > 3) throw Error("edt_pass: g must be a 1-, 2- or 3-D array");
+  if (axis < 0 || axis >= g.ndim())
+    throw Error("edt_pass: axis must be in 0.." + std::to_string(g.ndim() - 1) + " (0 = x, the last array axis), got " +
+                std::to_string(axis));
+  std::array<std::size_t, 3> dims{1, 1, 1};
+  std::vector<py::ssize_t> shape(g.shape(), g.shape() + g.ndim());
+  for (py::ssize_t d = 0; d < g.ndim(); ++d) dims[std::size_t(d)] = std::size_t(g.shape(g.ndim() - 1 - d));
+  py::array_t<double> out = copy_array(g.data(), shape);
+  const std::span<double> values(out.mutable_data(), std::size_t(out.size()));
+  without_gil([&] { field::edt_pass(values, dims, axis, spacing); });
+  return out;
+}
+
 }  // namespace
 
 void bind_field(py::module_& m) {
@@ -165,6 +181,11 @@ void bind_field(py::module_& m) {
         "squared: squared distances. Felzenszwalb-Huttenlocher, parallel; equal to brute force bit for bit\n"
         "with integer spacings.");
 
+  m.def("edt_pass", &edt_pass_py, py::arg("g"), py::arg("axis"), py::arg("spacing") = 1.0,
+        "One separable pass of edt on float64 squared distances g (1-, 2- or 3-D): every line along `axis`\n"
+        "(geods order: 0 = x = the last array axis) becomes g'(q) = min_p g(p) + (spacing (q - p))^2\n"
+        "(inf: no sample). From 0 on the background and inf elsewhere, one pass per axis gives the squared\n"
+        "EDT; a chunk needs only be whole along the pass's axis (geods.dask.edt). Returns a new array.");
   m.def("chamfer", &chamfer_py, py::arg("mask"), py::arg("size") = field::ChamferRequest{}.size,
         py::arg("spacing") = py::none(),
         "Chamfer distance transform of a 1-, 2- or 3-D mask, (n,), (ny, nx) or (nz, ny, nx) (nonzero =\n"

@@ -99,12 +99,12 @@ py::array_t<std::uint8_t> read_image_py(const path& p) {
 // round(255 v), other integers if every value is in 0..255; anything else is refused.
 void write_png_py(const path& p, const py::array& a) {
   const py::dtype dt = a.dtype();
-  if (dt.is(py::dtype::of<std::uint8_t>()) || dt.kind() == 'b') {
+  if (dt.equal(py::dtype::of<std::uint8_t>()) || dt.kind() == 'b') {
     const Image<std::uint8_t> im = image_from_array(Rows<std::uint8_t>::ensure(a), "write_png");
     py::gil_scoped_release release;
     return io::write_png(p, im);
   }
-  if (dt.is(py::dtype::of<std::uint16_t>())) {
+  if (dt.equal(py::dtype::of<std::uint16_t>())) {
     const Image<std::uint16_t> im = image_from_array(Rows<std::uint16_t>::ensure(a), "write_png");
     py::gil_scoped_release release;
     return io::write_png(p, im);

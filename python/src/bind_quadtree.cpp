@@ -66,7 +66,7 @@ class PyOrthtree {
     } else if (build != "top_down" && build != "topdown") {  // topdown: the deprecated spelling
       throw Error(std::string(kName) + ": build is 'top_down' or 'morton', got '" + build + "'");
     }
-    if (points.dtype().is(py::dtype::of<float>())) {
+    if (points.dtype().equal(py::dtype::of<float>())) {
       make<float>(points, options);
     } else {
       make<double>(points, options);

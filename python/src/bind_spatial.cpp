@@ -32,7 +32,7 @@ class PyKdTree {
   PyKdTree(const py::array& points, std::size_t leaf_size) {
     if (points.ndim() != 2) throw Error("KdTree: points must be an (n, d) array, got " + std::to_string(points.ndim()) +
                                         " dimensions");
-    if (points.dtype().is(py::dtype::of<float>())) {
+    if (points.dtype().equal(py::dtype::of<float>())) {
       build<float>(points, leaf_size);
     } else {
       build<double>(points, leaf_size);
@@ -148,7 +148,7 @@ class PyKdTree {
     // Zero-copy when every row is contiguous; otherwise one converted C-order copy.
     py::array_t<T> rows;
     const auto item = py::ssize_t(sizeof(T));
-    if (points.dtype().is(py::dtype::of<T>()) && (points.shape(1) <= 1 || points.strides(1) == item) &&
+    if (points.dtype().equal(py::dtype::of<T>()) && (points.shape(1) <= 1 || points.strides(1) == item) &&
         points.strides(0) % item == 0 && points.strides(0) >= points.shape(1) * item) {
       rows = py::reinterpret_borrow<py::array_t<T>>(points);
     } else {

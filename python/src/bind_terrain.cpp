@@ -4,7 +4,10 @@
 #include <pybind11/stl/filesystem.h>
 
 #include <array>
+#include <algorithm>
 #include <cstdint>
+#include <span>
+#include <utility>
 #include <optional>
 #include <string>
 
@@ -126,6 +129,29 @@ void bind_terrain(py::module_& m) {
       .def_static(
           "load", [](const std::filesystem::path& path) { return terrain::Terrain::load(path); }, py::arg("path"),
           "Maps a terrain written by save(): its vertex records are read in place.");
+  m.def(
+      "tin_tile",
+      [](const py::object& heights, double max_error, std::optional<double> border_limit) {
+        const auto a = Rows<float>::ensure(heights);
+        if (!a || a.ndim() != 2) throw Error("tin_tile: heights must be a 2-D array (rows = y)");
+        const std::span<const float> z(a.data(), std::size_t(a.size()));
+        if (!border_limit) {
+          const auto [lo, hi] = z.empty() ? std::pair{0.0f, 0.0f} : std::pair{*std::min_element(z.begin(), z.end()),
+                                                                               *std::max_element(z.begin(), z.end())};
+          border_limit = terrain::tin_border_limit(max_error, lo, hi);
+        }
+        return mesh_tuple(without_gil([&] {
+          return terrain::tin_tile(z, std::size_t(a.shape(1)), std::size_t(a.shape(0)), max_error, *border_limit);
+        }));
+      },
+      py::arg("heights"), py::arg("max_error"), py::arg("border_limit") = py::none(),
+      "(V, F): one tile of Terrain.tin computed on its own from the tile's block of heights (2-D, rows = y,\n"
+      "finite): vertices at the block's sample coordinates (x, y, z). border_limit: the sides' tolerance,\n"
+      "tin_border_limit(max_error, lo, hi) of the WHOLE field (default: of this block); with it, the tile\n"
+      "[x0, x1] x [y0, y1] of Terrain(h).tin(max_error, tiles) is this mesh of h[y0:y1+1, x0:x1+1] shifted\n"
+      "by (x0, y0) (geods.dask.terrain_tiles).");
+  m.def("tin_border_limit", &terrain::tin_border_limit, py::arg("max_error"), py::arg("lo"), py::arg("hi"),
+        "The side tolerance of Terrain.tin for a field whose samples span [lo, hi] (a little below max_error).");
 }
 
 }  // namespace geods::python

@@ -239,3 +239,42 @@ def test_cli_voronoi3_hull(cli, tmp_path):
     r = subprocess.run([str(cli), "voronoi3", str(tmp_path / "p.npy"), "--hull", "--box", "0,0,0,1,1,1"],
                        capture_output=True, text=True)
     assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1
+
+
+def test_flip_insertion_gives_the_cavity_tetrahedralization(cli, tmp_path):
+    """insertion="flips" (1-4, 2-3, 3-2 flips) and the Bowyer-Watson cavity give the same arrays,
+    on random points (also against scipy's Qhull), points on a sphere, and a lattice with duplicates."""
+    rng = np.random.default_rng(11)
+    random = rng.random((1500, 3))
+    sphere = rng.normal(size=(600, 3))
+    sphere = np.round(sphere / np.linalg.norm(sphere, axis=1)[:, None] * 8) / 2  # cospherical-ish, many duplicates
+    g = np.stack(np.meshgrid(*[np.arange(4.0)] * 3, indexing="ij"), -1).reshape(-1, 3)
+    lattice = np.vstack([g, g[:9]])[rng.permutation(len(g) + 9)]
+    for pts in (random, sphere, lattice):
+        flips = geods.Delaunay3(pts, insertion="flips")
+        cavity = geods.Delaunay3(pts)
+        flips.validate()
+        assert np.array_equal(flips.tetrahedra, cavity.tetrahedra)
+        assert np.array_equal(flips.neighbors, cavity.neighbors)
+        s = flips.stats()
+        assert s["flips_14"] + s["splits"] + s["hull_inserts"] == s["vertices"] - 4
+        assert s["duplicates"] == cavity.stats()["duplicates"] and s["flip_repairs"] == 0
+    assert set(map(tuple, np.sort(geods.Delaunay3(random, insertion="flips").tetrahedra, 1))) == set(
+        map(tuple, np.sort(Delaunay(random).simplices, 1)))
+    dt = geods.Delaunay3(random[:1000], insertion="flips")
+    for p in random[1000:1100]:
+        dt.insert(p)
+    dt.validate()
+    assert set(map(tuple, np.sort(dt.tetrahedra, 1))) == set(map(tuple, np.sort(Delaunay(random[:1100]).simplices, 1)))
+    with pytest.raises(ValueError):
+        geods.Delaunay3(random, insertion="lawson")
+    np.save(tmp_path / "p.npy", random)
+    r = subprocess.run([str(cli), "delaunay3", str(tmp_path / "p.npy"), "--insertion", "flips", "-o",
+                        str(tmp_path / "t.npy"), "--json"], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    info = json.loads(r.stdout)
+    assert info["insertion"] == "flips" and info["flips_23"] > 0 and info["flips_32"] > 0
+    assert np.array_equal(np.load(tmp_path / "t.npy"), geods.Delaunay3(random).tetrahedra)
+    r = subprocess.run([str(cli), "delaunay3", str(tmp_path / "p.npy"), "--insertion", "lawson"],
+                       capture_output=True, text=True)
+    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1

@@ -215,3 +215,15 @@ def test_iso_command(cli, tmp_path):
     assert curv["triangles"] == len(F) and curv["curvilinear"]
     bad = run(cli, "iso", tmp_path / "ball.npy", "--iso", 0, "--coords", tmp_path / "ball.npy")
     assert bad.returncode == 2 and len(bad.stderr.strip().splitlines()) == 1
+
+
+def test_isosurface_of_an_unpickled_volume():
+    # An array that crossed a process boundary (pickle protocol 5, as Dask workers receive
+    # chunks) has a dtype equal to, but not the same object as, numpy's builtin one.
+    import pickle
+
+    vol = np.random.default_rng(3).random((6, 7, 8))
+    copy = pickle.loads(pickle.dumps(vol, protocol=5))
+    V0, F0, _ = geods.isosurface(vol, 0.5)
+    V1, F1, _ = geods.isosurface(copy, 0.5)
+    assert np.array_equal(V0, V1) and np.array_equal(F0, F1)

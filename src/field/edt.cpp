@@ -70,7 +70,7 @@ class LineEnvelope {
 // The pass along y (axis 1) or z (axis 2): every line of the grid through the
 // envelope, in place. Lines are copied out and back in bundles of kBundle
 // neighbours in x, so each strided step reads and writes whole cache lines.
-void pass(const Grid3Geometry& grid, int axis, double s, std::vector<double>& g, std::vector<std::uint64_t>* feature) {
+void pass(const Grid3Geometry& grid, int axis, double s, std::span<double> g, std::vector<std::uint64_t>* feature) {
   constexpr std::size_t kBundle = 8;
   const auto& d = grid.dims;
   const std::size_t n = d[axis];
@@ -138,19 +138,45 @@ void first_pass(const Grid3View<std::uint8_t>& mask, double s, std::vector<doubl
   });
 }
 
+void check_spacing(double s, int axis, double side) {
+  const std::string where = format_number(s) + " along " + std::string(1, char('x' + axis));
+  if (!std::isfinite(s) || !(s > 0)) throw Error("edt: spacing must be finite and > 0, got " + where);
+  // Squared distances of up to (spacing * side)^2 must neither underflow nor overflow.
+  if (s < 1e-150 || s * side > 1e150)
+    throw Error("edt: spacing " + where + " is out of range (squared distances would underflow or overflow; "
+                "rescale the spacing)");
+}
+
 }  // namespace
+
+void edt_pass(std::span<double> g, const std::array<std::size_t, 3>& dims, int axis, double spacing) {
+  if (axis < 0 || axis > 2) throw Error("edt_pass: axis must be 0 (x), 1 (y) or 2 (z), got " + std::to_string(axis));
+  check_spacing(spacing, axis, double(dims[std::size_t(axis)]));
+  const std::size_t size = Grid3<double>::checked_size(dims[0], dims[1], dims[2]);
+  if (g.size() != size)
+    throw Error("edt_pass: the array holds " + std::to_string(g.size()) + " values, its dims say " + std::to_string(size));
+  if (size == 0) return;
+  if (axis > 0) {
+    Grid3Geometry grid;
+    grid.dims = dims;
+    pass(grid, axis, spacing, g, nullptr);
+    return;
+  }
+  const std::size_t n = dims[0];
+  parallel_for(0, dims[1] * dims[2], std::max<std::size_t>(1, 4096 / n), [&](std::size_t begin, std::size_t end) {
+    LineEnvelope envelope;
+    std::vector<double> out(n);
+    for (std::size_t l = begin; l < end; ++l) {
+      envelope.run(n, spacing, g.data() + l * n, nullptr, out.data(), nullptr);
+      std::copy_n(out.data(), n, g.data() + l * n);
+    }
+  });
+}
 
 EdtResult edt(const Grid3View<std::uint8_t>& mask, const EdtRequest& request) {
   std::array<double, 3> spacing{double(mask.spacing[0]), double(mask.spacing[1]), double(mask.spacing[2])};
   if (request.spacing) spacing = *request.spacing;
-  for (int a = 0; a < 3; ++a) {
-    const std::string where = format_number(spacing[a]) + " along " + std::string(1, char('x' + a));
-    if (!std::isfinite(spacing[a]) || !(spacing[a] > 0)) throw Error("edt: spacing must be finite and > 0, got " + where);
-    // Squared distances of up to (spacing * side)^2 must neither underflow nor overflow.
-    if (spacing[a] < 1e-150 || spacing[a] * double(mask.dims[a]) > 1e150)
-      throw Error("edt: spacing " + where + " is out of range (squared distances would underflow or overflow; "
-                  "rescale the spacing)");
-  }
+  for (int a = 0; a < 3; ++a) check_spacing(spacing[a], a, double(mask.dims[a]));
   const std::size_t size = Grid3<double>::checked_size(mask.dims[0], mask.dims[1], mask.dims[2]);
   if (mask.data.size() != size) throw Error("edt: the mask holds " + std::to_string(mask.data.size()) +
                                             " samples, its dims say " + std::to_string(size));

@@ -281,8 +281,8 @@ class Refiner {
     return lambda_ * double(v.error) > r_.pixel_error * dd;
   }
 
-  // The mesh of the square [x0, x0 + L] x [y0, y0 + L] (L a power of two >= 2):
-  // its strip (grid ids, appended to strip_) and its triangles (to tris_).
+  // The mesh of the square [x0, x0 + L] x [y0, y0 + L] (L a power of two >= 2)
+  // as a strip of grid ids, appended to strip_; its non-degenerate triangles are the mesh.
   void square(std::int64_t x0, std::int64_t y0, std::int64_t L, std::uint32_t depth) {
     const std::int64_t X0 = 2 * x0, Y0 = 2 * y0, X1 = 2 * (x0 + L), Y1 = 2 * (y0 + L), C = X0 + L, CY = Y0 + L;
     const P2 corners[4] = {{X1, Y0}, {X1, Y1}, {X0, Y1}, {X0, Y0}};
@@ -296,12 +296,10 @@ class Refiner {
       append(corners[q], 1);
     }
     strip_begin_.push_back(first);
-    for (int q = 0; q < 4; ++q) triangles({C, CY}, mids[q], 2 * depth, kAllPlanes);
   }
 
   std::vector<std::uint64_t> strip_;
   std::vector<std::size_t> strip_begin_;  // where each square's strip starts
-  std::vector<std::array<std::uint64_t, 3>> tris_;
 
  private:
   std::uint64_t id(std::int64_t x2, std::int64_t y2) const { return std::uint64_t(y2 / 2) * n_ + std::uint64_t(x2 / 2); }
@@ -342,19 +340,6 @@ class Refiner {
     strip_.push_back(w);
   }
 
-  // The same mesh as a triangle list, by a recursion of its own: the triangle
-  // of apex a and split vertex m is split when m is active.
-  void triangles(P2 a, P2 m, std::uint32_t l, unsigned planes) {
-    const std::int64_t dx = a.x - m.x, dy = a.y - m.y;
-    const P2 left{m.x - dy, m.y + dx}, right{m.x + dy, m.y - dx};
-    if (l >= 2 && active(m.x, m.y, planes)) {
-      triangles(m, child_left(a, m), l - 1, planes);
-      triangles(m, child_right(a, m), l - 1, planes);
-      return;
-    }
-    tris_.push_back({id(left.x, left.y), id(a.x, a.y), id(right.x, right.y)});
-  }
-
   const Terrain& t_;
   const Refinement& r_;
   std::uint64_t n_ = 0;
@@ -372,8 +357,7 @@ TerrainMesh assemble(const Terrain& t, const Refiner& refiner) {
   const bool full = W == n && H == n;  // no padding: every triangle is inside
   auto inside = [&](std::uint64_t g) { return full || (g % n < W && g / n < H); };
   TerrainMesh mesh;
-  std::vector<std::uint64_t> ids;
-  ids.reserve(refiner.tris_.size() * 2);
+  std::vector<std::uint64_t> ids;  // the triangles: the strip's non-degenerate ones inside the field
   // Strip: keep the triangles inside (degenerate ones too, they turn the
   // strip); runs of kept triangles are joined by degenerate triangles that keep
   // each triangle's parity, so the winding is what the submesh recursion made.
@@ -406,8 +390,11 @@ TerrainMesh assemble(const Terrain& t, const Refiner& refiner) {
       k = end + 1;
     }
   }
-  for (const auto& tri : refiner.tris_)
-    if (inside(tri[0]) && inside(tri[1]) && inside(tri[2])) ids.insert(ids.end(), tri.begin(), tri.end());
+  for (std::size_t part = 0; part + 1 < begins.size(); ++part)
+    for (std::size_t k = begins[part]; k + 2 < begins[part + 1]; ++k) {
+      const std::uint64_t a = s[k], b = s[k + 1], c = s[k + 2];
+      if (a != b && b != c && a != c && inside(a) && inside(b) && inside(c)) ids.insert(ids.end(), {a, b, c});
+    }
   // Vertices numbered in grid order: by a dense table up to 2^24 samples, else by sorting.
   std::vector<std::uint64_t> unique;
   std::vector<std::uint32_t> dense;

@@ -9,6 +9,8 @@
 #include <cmath>
 #include <limits>
 #include <queue>
+#include <span>
+#include <string>
 #include <unordered_map>
 
 #include "geods/core/error.hpp"
@@ -207,8 +209,62 @@ class GreedyTin {
 
 }  // namespace
 
+namespace {
+
+// The greedy TIN of the tile [c00, c11] of the row-major samples z (row length w):
+// its four sides simplified on their own to border_limit (the neighbour does the
+// same), then the inside to limit. Only differences of coordinates enter the
+// arithmetic, so a block holding the tile gives the same triangles, shifted.
+GreedyTin tile_tin(const float* z, std::uint64_t w, P2 c00, P2 c11, double limit, double border_limit) {
+  const P2 c10{c11.x, c00.y}, c01{c00.x, c11.y};
+  std::vector<P2> start{c00, c10, c11, c01};
+  simplify_segment(z, w, c00, c10, border_limit, start);
+  simplify_segment(z, w, c10, c11, border_limit, start);
+  simplify_segment(z, w, c01, c11, border_limit, start);
+  simplify_segment(z, w, c00, c01, border_limit, start);
+  GreedyTin g(z, w, limit);
+  g.start(c00, c10, c11, c01, std::vector<P2>(start.begin() + 4, start.end()));
+  g.refine();
+  return g;
+}
+
+void check_max_error(double max_error, const char* what) {
+  if (!(max_error >= 0) || !std::isfinite(max_error))
+    throw Error(std::string(what) + ": max_error must be finite and >= 0");
+}
+
+}  // namespace
+
+double tin_border_limit(double max_error, double lo, double hi) {
+  // The borders are simplified to a little less than the bound, so that a
+  // border sample (measured in 1D) is never picked in 2D, where rounding
+  // differs: neighbouring tiles keep the same border vertices.
+  return max_error - 1e-9 * (1 + std::abs(max_error) + (hi - lo));
+}
+
+TerrainMesh tin_tile(std::span<const float> z, std::size_t width, std::size_t height, double max_error,
+                     double border_limit) {
+  check_max_error(max_error, "terrain tin_tile");
+  if (width < 2 || height < 2 || z.size() != width * height)
+    throw Error("terrain tin_tile: a tile needs at least 2 x 2 samples, with width x height of them (got " +
+                std::to_string(z.size()) + " for " + std::to_string(width) + " x " + std::to_string(height) + ")");
+  if (!std::isfinite(border_limit) || border_limit > max_error)
+    throw Error("terrain tin_tile: border_limit must be finite and <= max_error");
+  for (const float v : z)
+    if (!std::isfinite(v)) throw Error("terrain tin_tile: the heights hold a NaN or infinite sample");
+  const GreedyTin g = tile_tin(z.data(), width, P2{0, 0}, P2{std::int64_t(width) - 1, std::int64_t(height) - 1},
+                               max_error, border_limit);
+  TerrainMesh mesh;
+  for (const P2& p : g.pts_) {
+    mesh.samples.push_back({std::uint32_t(p.x), std::uint32_t(p.y)});
+    mesh.vertices.push_back(Vec3f(float(p.x), float(p.y), z[std::size_t(p.y) * width + std::size_t(p.x)]));
+  }
+  for (std::size_t k = 0; k + 2 < g.tri_.size(); k += 3) mesh.triangles.push_back({g.tri_[k], g.tri_[k + 1], g.tri_[k + 2]});
+  return mesh;
+}
+
 TerrainMesh Terrain::tin(double max_error, std::uint32_t tiles) const {
-  if (!(max_error >= 0) || !std::isfinite(max_error)) throw Error("terrain tin: max_error must be finite and >= 0");
+  check_max_error(max_error, "terrain tin");
   if (tiles < 1 || tiles > std::min(width_, height_) - 1)
     throw Error("terrain tin: tiles must be in 1.." + std::to_string(std::min(width_, height_) - 1) + ", got " +
                 std::to_string(tiles));
@@ -216,10 +272,7 @@ TerrainMesh Terrain::tin(double max_error, std::uint32_t tiles) const {
   const std::int64_t W = std::int64_t(width_), H = std::int64_t(height_);
   float lo = z[0], hi = z[0];
   for (const float v : z) lo = std::min(lo, v), hi = std::max(hi, v);
-  // The borders are simplified to a little less than the bound, so that a
-  // border sample (measured in 1D) is never picked in 2D, where rounding
-  // differs: neighbouring tiles keep the same border vertices.
-  const double limit = max_error, border_limit = max_error - 1e-9 * (1 + std::abs(max_error) + double(hi - lo));
+  const double limit = max_error, border_limit = tin_border_limit(max_error, lo, hi);
   std::vector<std::int64_t> xs(tiles + 1), ys(tiles + 1);
   for (std::uint32_t k = 0; k <= tiles; ++k) xs[k] = std::int64_t(k) * (W - 1) / tiles, ys[k] = std::int64_t(k) * (H - 1) / tiles;
 
@@ -238,16 +291,7 @@ TerrainMesh Terrain::tin(double max_error, std::uint32_t tiles) const {
 
   for (std::uint32_t ty = 0; ty < tiles; ++ty)
     for (std::uint32_t tx = 0; tx < tiles; ++tx) {
-      const P2 c00{xs[tx], ys[ty]}, c10{xs[tx + 1], ys[ty]}, c11{xs[tx + 1], ys[ty + 1]}, c01{xs[tx], ys[ty + 1]};
-      std::vector<P2> start{c00, c10, c11, c01};
-      // The border: each side simplified on its own (the neighbour does the same).
-      simplify_segment(z.data(), width_, c00, c10, border_limit, start);
-      simplify_segment(z.data(), width_, c10, c11, border_limit, start);
-      simplify_segment(z.data(), width_, c01, c11, border_limit, start);
-      simplify_segment(z.data(), width_, c00, c01, border_limit, start);
-      GreedyTin g(z.data(), width_, limit);
-      g.start(c00, c10, c11, c01, std::vector<P2>(start.begin() + 4, start.end()));
-      g.refine();
+      const GreedyTin g = tile_tin(z.data(), width_, P2{xs[tx], ys[ty]}, P2{xs[tx + 1], ys[ty + 1]}, limit, border_limit);
       for (std::size_t k = 0; k + 2 < g.tri_.size(); k += 3)
         mesh.triangles.push_back({vertex(g.pts_[g.tri_[k]]), vertex(g.pts_[g.tri_[k + 1]]), vertex(g.pts_[g.tri_[k + 2]])});
     }

@@ -47,9 +47,10 @@ inline Worst triangle_worst(const float* z, std::uint64_t n, P2 a, P2 b, P2 c) {
         lo = hi + 1;
     }
     const float* row = z + y * n;
-    const double base = za + gy * double(y - a.y) - gx * double(a.x);
+    // Relative to a: the same rounding wherever the triangle lies (tin_tile() of a block equals the tile of tin()).
+    const double base = za + gy * double(y - a.y);
     for (std::int64_t x = lo; x <= hi; ++x) {
-      const double d = std::abs(double(row[x]) - (base + gx * double(x)));
+      const double d = std::abs(double(row[x]) - (base + gx * double(x - a.x)));
       if (d > worst.error) worst = {d, {x, y}};
     }
   }

@@ -3,6 +3,7 @@
 #include <tbb/enumerable_thread_specific.h>
 
 #include <algorithm>
+#include <iterator>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -20,6 +21,7 @@ namespace {
 constexpr std::size_t kMaxLevels = 4;
 constexpr std::uint32_t kNoSource = std::numeric_limits<std::uint32_t>::max();
 // The causal neighbours whose patches the coherent start continues.
+// (All 12 of the 5 x 5 causal window were tried: no better matches on brick or gravel, 5 % slower.)
 constexpr Offset kCoherenceOffsets[] = {{-1, 0}, {-1, -1}, {0, -1}, {1, -1}};
 constexpr std::size_t kMaxOutputPixels = std::size_t(1) << 30;
 // Principal components in the k-d tree when the caller leaves it to us: fewer
@@ -187,6 +189,8 @@ struct LevelSynthesis {
     const NeighborhoodIndex& index = *candidates.index;
     const std::size_t h1 = std::size_t(shape.fine_half) + 1;
     NeighborhoodIndex::Match best;
+    std::uint32_t seen[std::size(kCoherenceOffsets)];  // neighbours in one patch give one candidate: its distance once
+    std::size_t seen_count = 0;
     for (const Offset o : kCoherenceOffsets) {
       std::ptrdiff_t qx = std::ptrdiff_t(x) + o.dx, qy = std::ptrdiff_t(y) + o.dy;
       const auto w = std::ptrdiff_t(canvas.width), h = std::ptrdiff_t(canvas.height);
@@ -204,16 +208,17 @@ struct LevelSynthesis {
       if (sx < 0 || sy < 0 || sx >= std::ptrdiff_t(candidates.width) || sy >= std::ptrdiff_t(candidates.height))
         continue;
       const std::uint32_t i = candidates.at[std::size_t(sy) * candidates.width + std::size_t(sx)];
-      if (i == kNoSource) continue;
+      if (i == kNoSource || std::find(seen, seen + seen_count, i) != seen + seen_count) continue;
+      seen[seen_count++] = i;
       const NeighborhoodIndex::Match m{i, index.squared_distance(query, i)};
       if (m.before(best)) best = m;
     }
     return best;
   }
 
-  void synthesize(std::size_t x, std::size_t y, const std::vector<std::uint8_t>& source,
+  // w: the calling thread's buffers (workers.local(), looked up once per chunk of pixels).
+  void synthesize(Worker& w, std::size_t x, std::size_t y, const std::vector<std::uint8_t>& source,
                   std::optional<std::size_t> t) {
-    Worker& w = workers.local();
     gather(x, y, source, t, w.query);
     const NeighborhoodIndex& index = *candidates.index;
     const NeighborhoodIndex::Match start = t && options.search != NeighborSearch::brute
@@ -244,9 +249,10 @@ void causal_pass(LevelSynthesis& s, Progress& progress, std::size_t& done) {
     const std::size_t y_lo = t >= w ? (t - (w - 1) + h1 - 1) / h1 : 0, y_hi = std::min(h - 1, t / h1);
     if (y_lo > y_hi) continue;
     parallel_for(y_lo, y_hi + 1, 4, [&](std::size_t b, std::size_t e) {
+      LevelSynthesis::Worker& worker = s.workers.local();
       for (std::size_t y = b; y < e; ++y) {
         const std::size_t x = t - h1 * y;
-        if (canvas.unknown[canvas.interior(x, y)]) s.synthesize(x, y, canvas.values, t);
+        if (canvas.unknown[canvas.interior(x, y)]) s.synthesize(worker, x, y, canvas.values, t);
       }
     });
     done += y_hi + 1 - y_lo;
@@ -262,9 +268,10 @@ void refinement_pass(LevelSynthesis& s, Progress& progress, std::size_t& done) {
   for (std::size_t y0 = 0; y0 < canvas.height; y0 += kRowsPerUpdate) {
     const std::size_t y1 = std::min(canvas.height, y0 + kRowsPerUpdate);
     parallel_for(y0 * canvas.width, y1 * canvas.width, 16, [&](std::size_t b, std::size_t e) {
+      LevelSynthesis::Worker& worker = s.workers.local();
       for (std::size_t i = b; i < e; ++i) {
         const std::size_t x = i % canvas.width, y = i / canvas.width;
-        if (canvas.unknown[i]) s.synthesize(x, y, previous, std::nullopt);
+        if (canvas.unknown[i]) s.synthesize(worker, x, y, previous, std::nullopt);
       }
     });
     done += (y1 - y0) * canvas.width;

@@ -167,6 +167,7 @@ void Tet3Mesh::make_first(std::uint32_t a, std::uint32_t b, std::uint32_t c, std
 }
 
 std::uint32_t Tet3Mesh::insert(std::uint32_t pv) {
+  if (flips) return insert_by_flips(pv);
   const Vec3d& p = coords[pv];
   const std::uint32_t t = walk(p, last, walk_steps, random);
   if (!is_ghost(t))
@@ -283,6 +284,7 @@ void Delaunay3::build(Options options, bool may_split) {
   tets_.clear();
   free_slots_.clear();
   walk_steps_ = conflicts_ = seam_points_ = 0;
+  flip_counts_ = {};
   std::vector<std::uint32_t> active;
   active.reserve(total);
   for (std::size_t i = 0; i < total; ++i)
@@ -335,6 +337,7 @@ void Delaunay3::build(Options options, bool may_split) {
     for (std::size_t k = begin; k < end; ++k) coords[k] = points_[sequence[k]];
   });
   Tet3Mesh mesh(coords, tets_, free_slots_);
+  mesh.flips = options.insertion == Delaunay3Insertion::flips;
   tets_.reserve(8 * 7 * n + 64);
   mesh.mark.reserve(7 * n + 16);
   mesh.make_first(0, 1, 2, 3);
@@ -364,6 +367,7 @@ void Delaunay3::build(Options options, bool may_split) {
   });
   walk_steps_ = mesh.walk_steps;
   conflicts_ = mesh.conflicts;
+  flip_counts_ = mesh.flip_counts;
   last_ = mesh.last;
   if (may_split) canonicalize();  // (the halves and seams of a parallel build need not be)
 }
@@ -384,10 +388,12 @@ std::uint32_t Delaunay3::insert(const Vec3d& p) {
   Tet3Mesh mesh(points_, tets_, free_slots_);
   mesh.mark.assign(tets_.size() / 8, 0);
   mesh.last = last_;
+  mesh.flips = options_.insertion == Delaunay3Insertion::flips;
   const std::uint32_t existing = mesh.insert(i);
   rep_[i] = existing == kNone ? i : existing;
   walk_steps_ += mesh.walk_steps;
   conflicts_ += mesh.conflicts;
+  for (std::size_t k = 0; k < flip_counts_.size(); ++k) flip_counts_[k] += mesh.flip_counts[k];
   last_ = mesh.last;
   publish();
   return i;
@@ -527,12 +533,13 @@ void RegionFill::write(std::vector<std::uint32_t>& tets) const {
 // the other three in its orientation (an even permutation, so it stays
 // positive), and the slots are sorted by their vertices (a counting sort on
 // the first, then each bucket); ghosts sort among them (the ghost is the
-// largest vertex), free slots go.
+// largest vertex), free slots go. Memory bound: the keys are sorted where they
+// lie, and the slots are then scattered in their own (spatially coherent)
+// order, so that a slot's neighbours are mostly in cache.
 void Delaunay3::canonicalize() {
   const std::size_t slots = tets_.size() / 8;
   const std::size_t n = points_.size();
-  std::vector<std::array<std::uint32_t, 4>> canonical(slots);
-  std::vector<std::array<std::uint8_t, 4>> position(slots);  // canonical[s][i] = tets_[8s + position[s][i]]
+  std::vector<std::array<std::uint8_t, 4>> position(slots);  // canonical entry i of slot s = tets_[8s + position[s][i]]
   std::vector<std::array<std::uint8_t, 4>> place(slots);     // its inverse: where entry j of slot s goes
   parallel_for(0, slots, 1 << 14, [&](std::size_t begin, std::size_t end) {
     for (std::size_t s = begin; s < end; ++s) {
@@ -546,34 +553,45 @@ void Delaunay3::canonicalize() {
       for (int i = 1; i < 3; ++i)
         if (v[r[i]] < v[r[k]]) k = i;
       position[s] = {kEven[m][0], r[k], r[(k + 1) % 3], r[(k + 2) % 3]};
-      for (int i = 0; i < 4; ++i) canonical[s][i] = v[position[s][i]], place[s][position[s][i]] = std::uint8_t(i);
+      for (int i = 0; i < 4; ++i) place[s][position[s][i]] = std::uint8_t(i);
     }
   });
   std::vector<std::uint32_t> count(n + 1, 0);
   for (std::size_t s = 0; s < slots; ++s)
-    if (tets_[8 * s] != kNone) ++count[canonical[s][0] + 1];
+    if (tets_[8 * s] != kNone) ++count[tets_[8 * s + position[s][0]] + 1];
   for (std::size_t i = 0; i < n; ++i) count[i + 1] += count[i];
-  std::vector<std::uint32_t> order(count[n]);
+  struct Key {  // a slot's other three canonical vertices (the bucket is the first)
+    std::uint32_t v[3];
+    std::uint32_t slot;
+  };
+  std::vector<Key> keys(count[n]);
   {
     std::vector<std::uint32_t> next(count.begin(), count.end() - 1);
-    for (std::size_t s = 0; s < slots; ++s)
-      if (tets_[8 * s] != kNone) order[next[canonical[s][0]]++] = std::uint32_t(s);
+    for (std::size_t s = 0; s < slots; ++s) {
+      const std::uint32_t* v = &tets_[8 * s];
+      if (v[0] == kNone) continue;
+      const std::array<std::uint8_t, 4>& at = position[s];
+      keys[next[v[at[0]]]++] = {{v[at[1]], v[at[2]], v[at[3]]}, std::uint32_t(s)};
+    }
   }
-  parallel_for(0, n, 1 << 12, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t v = begin; v < end; ++v)
-      std::sort(order.begin() + count[v], order.begin() + count[v + 1],
-                [&](std::uint32_t a, std::uint32_t b) { return canonical[a] < canonical[b]; });
-  });
   std::vector<std::uint32_t> new_of(slots, kNone);
-  for (std::size_t t = 0; t < order.size(); ++t) new_of[order[t]] = std::uint32_t(t);
-  std::vector<std::uint32_t> out(8 * order.size());
-  parallel_for(0, order.size(), 1 << 14, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t t = begin; t < end; ++t) {
-      const std::uint32_t s = order[t];
-      for (int i = 0; i < 4; ++i) {
-        out[8 * t + i] = canonical[s][i];
-        const std::uint32_t a = tets_[8 * std::size_t(s) + 4 + position[s][i]], u = a >> 2;
-        out[8 * t + 4 + i] = 4 * new_of[u] + place[u][a & 3];
+  parallel_for(0, n, 1 << 12, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t v = begin; v < end; ++v) {
+      std::sort(keys.begin() + count[v], keys.begin() + count[v + 1], [](const Key& a, const Key& b) {
+        return std::lexicographical_compare(a.v, a.v + 3, b.v, b.v + 3);
+      });
+      for (std::size_t t = count[v]; t < count[v + 1]; ++t) new_of[keys[t].slot] = std::uint32_t(t);
+    }
+  });
+  std::vector<std::uint32_t> out(8 * keys.size());
+  parallel_for(0, slots, 1 << 14, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t s = begin; s < end; ++s) {
+      const std::size_t t = new_of[s];
+      if (t == kNone) continue;
+      for (int j = 0; j < 4; ++j) {
+        const std::uint32_t a = tets_[8 * s + 4 + j], u = a >> 2;
+        out[8 * t + place[s][j]] = tets_[8 * s + j];
+        out[8 * t + 4 + place[s][j]] = 4 * new_of[u] + place[u][a & 3];
       }
     }
   });
@@ -743,6 +761,10 @@ Delaunay3Stats Delaunay3::stats() const {
   s.walk_steps = walk_steps_;
   s.conflicts = conflicts_;
   s.seam_points = seam_points_;
+  s.flips_14 = flip_counts_[Tet3Mesh::flip_14], s.flips_23 = flip_counts_[Tet3Mesh::flip_23];
+  s.flips_32 = flip_counts_[Tet3Mesh::flip_32], s.flips_44 = flip_counts_[Tet3Mesh::flip_44];
+  s.splits = flip_counts_[Tet3Mesh::flip_split], s.hull_inserts = flip_counts_[Tet3Mesh::flip_hull];
+  s.unflippable = flip_counts_[Tet3Mesh::flip_unflippable], s.flip_repairs = flip_counts_[Tet3Mesh::flip_repair];
   const auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
   s.bytes = bytes(points_) + bytes(rep_) +
             bytes(tets_) + bytes(removed_) + bytes(vertex_slot_) + bytes(free_slots_) + bytes(tetrahedra_) + bytes(public_of_);

@@ -25,6 +25,7 @@ void Delaunay3::save(const std::filesystem::path& path) const {
   w.add("free_slots", free_slots_);
   w.add_value("dimension", std::int32_t(dimension_));
   w.add_value("seed", options_.seed);
+  w.add_value("insertion", std::int32_t(options_.insertion));  // (absent from older files: cavity)
   w.add_value("last", last_);
   w.write(path);
 }
@@ -46,6 +47,12 @@ Delaunay3 Delaunay3::load(const std::filesystem::path& path, Archive::Verify ver
   dt.dimension_ = a.value<std::int32_t>("dimension");
   if (dt.dimension_ < -1 || dt.dimension_ > 3) throw a.error("dimension: " + std::to_string(dt.dimension_));
   dt.options_.seed = a.value<std::uint64_t>("seed");
+  if (a.has("insertion")) {
+    const std::int32_t insertion = a.value<std::int32_t>("insertion");
+    if (insertion != std::int32_t(Delaunay3Insertion::cavity) && insertion != std::int32_t(Delaunay3Insertion::flips))
+      throw a.error("insertion: " + std::to_string(insertion) + " is neither cavity (0) nor flips (1)");
+    dt.options_.insertion = Delaunay3Insertion(insertion);
+  }
   dt.last_ = a.value<std::uint32_t>("last");
   if (dt.dimension_ < 3 ? slots != 0 : (slots == 0 || dt.last_ >= slots))
     throw a.error("tetrahedra_slots: do not fit dimension " + std::to_string(dt.dimension_));

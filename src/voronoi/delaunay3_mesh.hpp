@@ -130,6 +130,20 @@ struct Tet3Mesh {
   std::vector<std::uint32_t> stack, cavity;
   std::vector<Boundary> boundary;
   EdgeTable edges;
+
+  // Flip-based insertion (delaunay3_flip.cpp): insert() defers to
+  // insert_by_flips() when `flips` is set; same answer, same tetrahedralization.
+  enum FlipCount { flip_14, flip_23, flip_32, flip_44, flip_split, flip_hull, flip_unflippable, flip_repair };
+  bool flips = false;
+  std::array<std::size_t, 8> flip_counts{};
+  std::uint32_t insert_by_flips(std::uint32_t pv);
+  std::vector<std::uint32_t> flip_stack, flip_skipped;
+  struct FaceKey {
+    std::array<std::uint32_t, 3> key;  // the face's vertices, ascending
+    std::uint32_t adjacency;           // 4 * slot + face index
+    bool outer;                        // a face outside the replaced set
+  };
+  std::vector<FaceKey> faces;
 };
 
 /// Refilling a region of a closed tetrahedralization (a removed vertex's star,

@@ -236,6 +236,8 @@ bool Delaunay3::build_split(const std::vector<std::uint32_t>& active) {
   walk_steps_ = half[0].walk_steps_ + half[1].walk_steps_ + filler.walk_steps_;
   conflicts_ = half[0].conflicts_ + half[1].conflicts_ + filler.conflicts_;
   seam_points_ = seam.size();
+  for (std::size_t k = 0; k < flip_counts_.size(); ++k)
+    flip_counts_[k] = half[0].flip_counts_[k] + half[1].flip_counts_[k] + filler.flip_counts_[k];
   last_ = seam_fill.slot[seam_fill.fill.front()];
   return true;
 }

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <random>
 #include <set>
@@ -145,6 +146,55 @@ std::vector<Tri> strip_triangles(const TerrainMesh& m, bool* consistent) {
   return out;
 }
 
+// The max-error mesh by explicit longest-edge bisection, independent of the
+// library's strip recursion: the 4 triangles around the centre of the padded
+// grid, a triangle split while its hypotenuse's midpoint is a sample whose
+// nested error exceeds e (the padding's is infinite); the triangles inside
+// the field, as sorted sample-coordinate triples.
+std::multiset<std::array<std::array<std::uint32_t, 2>, 3>> bisection_mesh(const Terrain& t, double e) {
+  const std::int64_t N = std::int64_t(t.layout().n()) - 1, c = N / 2;
+  using P = std::array<std::int64_t, 2>;
+  struct T {
+    P apex, l, r;
+  };
+  std::vector<T> stack = {{{c, c}, {0, 0}, {N, 0}}, {{c, c}, {N, 0}, {N, N}}, {{c, c}, {N, N}, {0, N}}, {{c, c}, {0, N}, {0, 0}}};
+  std::multiset<std::array<std::array<std::uint32_t, 2>, 3>> out;
+  while (!stack.empty()) {
+    const T tri = stack.back();
+    stack.pop_back();
+    const std::int64_t mx = tri.l[0] + tri.r[0], my = tri.l[1] + tri.r[1];
+    if (mx % 2 == 0 && my % 2 == 0) {
+      const float err = t.record(std::uint32_t(mx / 2), std::uint32_t(my / 2)).error;
+      if (std::isinf(err) || double(err) > e) {
+        const P m{mx / 2, my / 2};
+        stack.push_back({m, tri.apex, tri.l});
+        stack.push_back({m, tri.r, tri.apex});
+        continue;
+      }
+    }
+    std::array<std::array<std::uint32_t, 2>, 3> v;
+    bool inside = true;
+    for (int k = 0; k < 3; ++k) {
+      const P& p = k == 0 ? tri.apex : k == 1 ? tri.l : tri.r;
+      inside = inside && p[0] < std::int64_t(t.width()) && p[1] < std::int64_t(t.height());
+      v[k] = {std::uint32_t(p[0]), std::uint32_t(p[1])};
+    }
+    std::sort(v.begin(), v.end());
+    if (inside) out.insert(v);
+  }
+  return out;
+}
+
+std::multiset<std::array<std::array<std::uint32_t, 2>, 3>> mesh_by_samples(const TerrainMesh& m) {
+  std::multiset<std::array<std::array<std::uint32_t, 2>, 3>> out;
+  for (const Tri& tri : m.triangles) {
+    std::array<std::array<std::uint32_t, 2>, 3> v{m.samples[tri[0]], m.samples[tri[1]], m.samples[tri[2]]};
+    std::sort(v.begin(), v.end());
+    out.insert(v);
+  }
+  return out;
+}
+
 void expect_valid(const Terrain& t, const TerrainMesh& m, std::optional<double> bound) {
   expect_tiling(m, t.width(), t.height());
   bool consistent = false;
@@ -174,6 +224,7 @@ TEST(Terrain, MaxErrorMeshesTileTheDomainWithinTheBound) {
       SCOPED_TRACE(e);
       const TerrainMesh m = t.refine(by_error(e));
       expect_valid(t, m, e);
+      EXPECT_EQ(mesh_by_samples(m), bisection_mesh(t, e)) << "not the mesh of longest-edge bisection";
     }
     // Error 0 keeps every sample that is off the interpolating planes; a huge
     // error gives the coarsest mesh (4 triangles around the centre on a 2^k+1 field).
@@ -430,6 +481,49 @@ TEST(Terrain, GreedyTinsWithinTheBoundAndTiled) {
   EXPECT_EQ(t.tin(1e9).triangles.size(), 2u);
   EXPECT_THROW(t.tin(-1), Error);
   EXPECT_THROW(t.tin(1, 0), Error);
+}
+
+// Every tile of tin(e, tiles) is tin_tile() of its block of samples on its own
+// (with the whole field's border limit), shifted: tiles can be computed apart.
+TEST(Terrain, TinTilesComputedApartEqualTheTiledTin) {
+  const HeightField f = real_field();
+  const Terrain t(f);
+  const float lo = *std::min_element(f.heights.begin(), f.heights.end());
+  const float hi = *std::max_element(f.heights.begin(), f.heights.end());
+  for (const std::uint32_t tiles : {1u, 3u}) {
+    const double e = 2.0;
+    const TerrainMesh whole = t.tin(e, tiles);
+    std::multiset<std::array<std::array<std::uint32_t, 2>, 3>> expected, got;
+    for (const Tri& tri : whole.triangles) {
+      std::array<std::array<std::uint32_t, 2>, 3> c{whole.samples[tri[0]], whole.samples[tri[1]], whole.samples[tri[2]]};
+      std::rotate(c.begin(), std::min_element(c.begin(), c.end()), c.end());
+      expected.insert(c);
+    }
+    const std::size_t W = f.width, H = f.height;
+    for (std::uint32_t ty = 0; ty < tiles; ++ty)
+      for (std::uint32_t tx = 0; tx < tiles; ++tx) {
+        const std::size_t x0 = tx * (W - 1) / tiles, x1 = (tx + 1) * (W - 1) / tiles;
+        const std::size_t y0 = ty * (H - 1) / tiles, y1 = (ty + 1) * (H - 1) / tiles;
+        std::vector<float> block;
+        for (std::size_t y = y0; y <= y1; ++y)
+          for (std::size_t x = x0; x <= x1; ++x) block.push_back(f.heights[y * W + x]);
+        const TerrainMesh m = tin_tile(block, x1 - x0 + 1, y1 - y0 + 1, e, tin_border_limit(e, lo, hi));
+        for (const Tri& tri : m.triangles) {
+          std::array<std::array<std::uint32_t, 2>, 3> c;
+          for (int k = 0; k < 3; ++k)
+            c[k] = {m.samples[tri[k]][0] + std::uint32_t(x0), m.samples[tri[k]][1] + std::uint32_t(y0)};
+          std::rotate(c.begin(), std::min_element(c.begin(), c.end()), c.end());
+          got.insert(c);
+        }
+      }
+    EXPECT_EQ(got, expected) << tiles;
+  }
+  const std::vector<float> z(4, 1.0f);
+  EXPECT_THROW(tin_tile(z, 2, 2, -1, 0), Error);
+  EXPECT_THROW(tin_tile(z, 4, 1, 1, 0), Error);
+  EXPECT_THROW(tin_tile(z, 2, 2, 1, 2), Error);
+  const std::vector<float> bad{1, 2, std::numeric_limits<float>::quiet_NaN(), 4};
+  EXPECT_THROW(tin_tile(bad, 2, 2, 1, 0), Error);
 }
 
 }  // namespace

@@ -469,5 +469,75 @@ TEST(Delaunay3, VertexNeighborsAreTheEdges) {
   EXPECT_EQ(total, edges.size());
 }
 
+// Flip-based insertion (1-4, 2-3, 3-2, 4-4) reaches the cavity insertion's
+// tetrahedralization: the same canonical arrays on every shape (cospherical,
+// lattice, coplanar-heavy and duplicate-heavy sets included), and the exact
+// empty-sphere check; every point the first four do not span is inserted by
+// exactly one 1-4, split or hull step.
+TEST(Delaunay3, FlipInsertionEqualsTheCavityInsertionOnEveryShape) {
+  const int threads = num_threads();
+  set_num_threads(1);
+  for (Shape shape : kShapes)
+    for (std::uint64_t seed : {1, 2}) {
+      SCOPED_TRACE("shape " + std::to_string(int(shape)) + " seed " + std::to_string(seed));
+      const bool extreme = shape == Shape::tiny || shape == Shape::huge || shape == Shape::mixed;
+      const auto p = make_points(shape, extreme ? 50 : 400, seed);
+      const Delaunay3 cavity(p, {.seed = seed});
+      const Delaunay3 flips(p, {.insertion = Delaunay3Insertion::flips, .seed = seed});
+      check_solid(p, flips);
+      if (!extreme) check_empty_spheres(flips);
+      EXPECT_EQ(flips.tetrahedra(), cavity.tetrahedra());
+      EXPECT_EQ(flips.neighbors(), cavity.neighbors());
+      for (std::uint32_t i = 0; i < p.size(); ++i) EXPECT_EQ(flips.representative(i), cavity.representative(i));
+      const Delaunay3Stats s = flips.stats(), c = cavity.stats();
+      EXPECT_EQ(s.flips_14 + s.splits + s.hull_inserts, s.vertices - 4);
+      EXPECT_EQ(s.duplicates, c.duplicates);
+      EXPECT_EQ(c.flips_14 + c.flips_23 + c.flips_32 + c.splits + c.hull_inserts, 0u);
+      EXPECT_EQ(s.flip_repairs, 0u);
+      if (shape == Shape::uniform) {
+        EXPECT_GT(s.flips_23, s.vertices);
+        EXPECT_GT(s.flips_32, 0u);
+      }
+      if (shape == Shape::lattice || shape == Shape::coplanar) {
+        EXPECT_GT(s.splits + s.flips_44, 0u);
+      }
+    }
+  set_num_threads(threads);
+}
+
+// Single-point insert() by flips, and the parallel build's halves and seam by flips.
+TEST(Delaunay3, FlipInsertOneByOneAndInParallel) {
+  for (Shape shape : {Shape::uniform, Shape::lattice, Shape::sphere, Shape::duplicates}) {
+    SCOPED_TRACE("shape " + std::to_string(int(shape)));
+    const auto p = make_points(shape, 300, 5);
+    const std::size_t half = p.size() / 2;
+    Delaunay3 dt(std::vector<Vec3d>(p.begin(), p.begin() + std::ptrdiff_t(half)),
+                 {.insertion = Delaunay3Insertion::flips});
+    for (std::size_t i = half; i < p.size(); ++i) dt.insert(p[i]);
+    ASSERT_NO_THROW(dt.validate());
+    EXPECT_GT(dt.stats().flips_14 + dt.stats().splits + dt.stats().hull_inserts, 0u);
+    const Delaunay3 whole(p);
+    EXPECT_EQ(sorted_tets(dt), sorted_tets(whole));
+    // A saved flip build goes on inserting by flips after load.
+    const std::filesystem::path file = std::filesystem::temp_directory_path() / "geods_delaunay3_flips_test.geods";
+    Delaunay3(std::vector<Vec3d>(p.begin(), p.end() - 1), {.insertion = Delaunay3Insertion::flips}).save(file);
+    Delaunay3 loaded = Delaunay3::load(file);
+    std::filesystem::remove(file);
+    const Delaunay3Stats before = loaded.stats();
+    loaded.insert(p.back());
+    const Delaunay3Stats after = loaded.stats();
+    if (whole.representative(std::uint32_t(p.size() - 1)) == p.size() - 1) {
+      EXPECT_EQ(after.flips_14 + after.splits + after.hull_inserts, before.flips_14 + before.splits + before.hull_inserts + 1);
+    }
+    EXPECT_EQ(loaded.tetrahedra().size(), whole.tetrahedra().size());
+    for (std::uint32_t i = 0; i < p.size(); ++i) EXPECT_EQ(dt.representative(i), whole.representative(i));
+    const int threads = num_threads();
+    set_num_threads(2);
+    const Delaunay3 parallel(p, {.insertion = Delaunay3Insertion::flips, .parallel_from = 16});
+    set_num_threads(threads);
+    EXPECT_EQ(parallel.tetrahedra(), whole.tetrahedra());
+  }
+}
+
 }  // namespace
 }  // namespace geods::voronoi

@@ -26,6 +26,7 @@
 #include <cstdint>
 #include <limits>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include "geods/core/grid3.hpp"
@@ -57,5 +58,16 @@ struct EdtResult {
 /// small or large that squared distances would underflow or overflow
 /// (below 1e-150, or above 1e150 times the side).
 EdtResult edt(const Grid3View<std::uint8_t>& mask, const EdtRequest& request = {});
+
+/// One separable pass of edt() on its own, in place: every line of g (x
+/// fastest, dims) along `axis` (0 x, 1 y, 2 z) becomes
+/// g'(q) = min_p g(p) + (spacing (q - p))^2 (+infinity: no sample to start
+/// from). From g = 0 on the background and +infinity elsewhere, one pass per
+/// axis gives the squared distances, each pass adding its axis's term in the
+/// order of the passes. Lines are independent, so a caller can run the passes
+/// over a volume cut in chunks, each chunk whole along the pass's axis
+/// (geods.dask.edt). Throws geods::Error for a bad axis or spacing, or a size
+/// mismatch.
+void edt_pass(std::span<double> g, const std::array<std::size_t, 3>& dims, int axis, double spacing);
 
 }  // namespace geods::field

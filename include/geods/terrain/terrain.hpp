@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <optional>
+#include <span>
 #include <string_view>
 #include <vector>
 
@@ -167,5 +168,22 @@ class Terrain {
   LayoutIndex index_;
   FlatArray<VertexRecord> records_;
 };
+
+/// The border tolerance of Terrain::tin for a field whose samples span [lo, hi]:
+/// a little less than max_error, so that a border sample (measured in 1D) is
+/// never picked in 2D, where rounding differs.
+double tin_border_limit(double max_error, double lo, double hi);
+
+/// One tile of Terrain::tin on its own: the greedy-insertion TIN of the
+/// width x height samples z (rows = y, finite), its four sides simplified to
+/// border_limit (tin_border_limit() of the whole field) and the inside to
+/// max_error. Vertices are (x, y, z) at the sample coordinates of the tile
+/// (samples set). The arithmetic uses coordinate differences only, so the
+/// tile [x0, x1] x [y0, y1] of tin(max_error, tiles) is this mesh of that
+/// block shifted by (x0, y0): tiles can be computed apart (geods.dask.terrain_tiles).
+/// Throws geods::Error for a bad max_error or border_limit, fewer than 2 x 2
+/// samples, a size mismatch or a non-finite sample.
+TerrainMesh tin_tile(std::span<const float> z, std::size_t width, std::size_t height, double max_error,
+                     double border_limit);
 
 }  // namespace geods::terrain

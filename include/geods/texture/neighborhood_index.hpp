@@ -22,6 +22,18 @@
 //   full distances); many make the tree slow in high dimension. This is the
 //   role of Wei and Levoy's PCA-reduced tree-structured vector quantization,
 //   with a guarantee.
+//
+// The projection is computed in exact integer arithmetic: the principal
+// directions are rounded to 16-bit integers (B), the vectors centred on the
+// rounded mean m, and the tree coordinates are B (v - m) / s, with s an upper
+// bound of B's largest singular value (Gershgorin on B B^T), so the map has
+// norm <= 1, plus the residual sqrt(|v - m|^2 - |B (v - m) / s|^2). Both
+// bounds above hold for any such map, so the rounded basis costs nothing in
+// correctness, and a query's projection is a few 16-bit multiply-adds per
+// value. The tree holds the coordinates rounded to float (half the memory of
+// doubles, faster leaves); the search widens its bound by the rounding, which
+// is at most |v - m| 2^-24 per point. With the default 8 components the tree
+// has a compile-time dimension of 9.
 #include <cstddef>
 #include <cstdint>
 #include <limits>
@@ -75,7 +87,8 @@ class NeighborhoodIndex {
 
   /// Per-thread buffers of nearest(), reused across queries.
   struct Scratch {
-    std::vector<double> projected, centred;
+    std::vector<float> projected;
+    std::vector<std::int16_t> centred;
     std::size_t full_distances = 0;  // full distances computed, summed over queries
   };
 
@@ -92,15 +105,22 @@ class NeighborhoodIndex {
   Match brute_force(const std::uint8_t* query, Scratch& scratch) const;
   // The coordinates of v (dimension() values) on the principal directions: reduced_dimension() values.
   // Candidates and queries go through this one computation, so equal vectors project bit-identically.
-  void project(const std::uint8_t* v, double* out, std::vector<double>& centred) const;
+  void project(const std::uint8_t* v, float* out, std::vector<std::int16_t>& centred) const;
 
   std::vector<std::uint8_t> vectors_;
   std::size_t count_ = 0, dim_ = 0, reduced_ = 0;
   double explained_ = 0;
-  std::vector<double> mean_;       // dim_
-  std::vector<double> basis_;      // dim_ rows of reduced_: the principal directions are its columns
-  std::vector<double> projected_;  // count_ rows of reduced_ + 1 (the components, the residual norm)
-  std::unique_ptr<spatial::KdTree<double>> tree_;
+  std::size_t padded_ = 0;          // dim_ rounded up to a multiple of 8 (the integer rows' stride)
+  std::vector<std::int16_t> mean_;  // padded_: the candidates' mean, rounded (0 in the padding)
+  std::vector<std::int16_t> basis_; // reduced_ rows of padded_: the principal directions, rounded to integers
+  double scale_ = 0;                // tree coordinate = (basis row . (v - mean)) * scale_
+  // count_ rows of reduced_ + 1 (the components, the residual norm), rounded to float: the searches
+  // widen their bound by the rounding (margin_), see nearest().
+  std::vector<float> projected_;
+  double margin_ = 0;
+  static constexpr std::size_t kFixedTreeDim = 9;  // 8 components (the synthesis' default) and the residual
+  std::unique_ptr<spatial::KdTree<float>> tree_;
+  std::unique_ptr<spatial::KdTree<float, int(kFixedTreeDim)>> fixed_tree_;
 };
 
 }  // namespace geods::texture

@@ -18,6 +18,11 @@
 // cavity, found by a breadth-first search from the one it lies in) are
 // replaced by the tetrahedra joining it to the cavity's boundary. Expected
 // O(n log n), near linear for uniform points.
+// Options::insertion = flips inserts by flips instead (delaunay3_flip.cpp):
+// the tetrahedron holding the point is split 1-4 (a point outside the hull is
+// joined to the hull triangles it sees), then the non-Delaunay faces of its
+// link are flipped 2-3, 3-2 or 4-4 in the stack order of Edelsbrunner-Shah;
+// same predicates and perturbation, so the same tetrahedralization.
 //
 // Degeneracies: in_sphere == 0 is decided by the symbolic perturbation of
 // CGAL's Delaunay_triangulation_3 (Devillers-Teillaud, "Perturbations and
@@ -68,10 +73,28 @@ struct Delaunay3Stats {
   std::size_t walk_steps = 0;      // tetrahedra visited by point location while inserting
   std::size_t conflicts = 0;       // tetrahedra replaced by insertions (cavity sizes summed)
   std::size_t seam_points = 0;     // parallel build: points of the seam retetrahedralized between the halves (0: sequential)
+  // Flip-based insertion (Options::insertion == flips; all 0 for cavity insertion):
+  std::size_t flips_14 = 0;      // 1-4 flips: a point inside a tetrahedron
+  std::size_t flips_23 = 0;      // 2-3 flips (Figure 48)
+  std::size_t flips_32 = 0;      // 3-2 flips
+  std::size_t flips_44 = 0;      // 4-4 flips (the point coplanar with the flipped face's edge and the apex)
+  std::size_t splits = 0;        // a point on a face (2-6) or an edge (n-2n) split every tetrahedron holding it
+  std::size_t hull_inserts = 0;  // a point outside the hull joined to the hull triangles it sees (1-k with the ghosts)
+  std::size_t unflippable = 0;   // non-Delaunay link faces whose flip was not possible when popped (resolved by later flips)
+  std::size_t flip_repairs = 0;  // insertions whose flips got stuck, finished by a cavity step from the star (expected 0)
   std::size_t bytes = 0;           // memory of all arrays
 };
 
+/// How Delaunay3 inserts a point (seed §5.3.1 names both): `cavity`
+/// (Bowyer-Watson: the tetrahedra whose circumsphere holds it are replaced by
+/// its star) or `flips` (Joe, Edelsbrunner-Shah: the tetrahedron holding it is
+/// split 1-4, then the non-Delaunay faces of its link are flipped 2-3, 3-2 or
+/// 4-4). The same predicates and perturbation decide both, so the result is
+/// the same tetrahedralization.
+enum class Delaunay3Insertion { cavity, flips };
+
 struct Delaunay3Options {
+  Delaunay3Insertion insertion = Delaunay3Insertion::cavity;  // also used by insert()
   std::uint64_t seed = 0x5eed;  // of the randomized insertion order (the result does not depend on it)
   /// With more than one thread (geods::num_threads()) and at least this many
   /// points, the two halves of the set (split at the median x) are
@@ -130,8 +153,9 @@ class Delaunay3 {
   std::vector<std::uint32_t> vertex_neighbors(std::uint32_t v) const;
 
   /// Inserts a point, returns its index (points().size() - 1 after the call).
-  /// A duplicate is merged into the existing point. Bowyer-Watson in place:
-  /// O(cavity) plus O(n) to renumber the public arrays.
+  /// A duplicate is merged into the existing point. Bowyer-Watson in place, or
+  /// flips with Options::insertion == flips: O(cavity) plus O(n) to renumber
+  /// the public arrays.
   std::uint32_t insert(const Vec3d& p);
   /// Removes point i (its index stays, representative(i) becomes no_index; an
   /// equal point, if any, stands for the place from then on). Local, after
@@ -192,6 +216,7 @@ class Delaunay3 {
 
   std::vector<std::uint32_t> tets_, free_slots_;
   std::size_t walk_steps_ = 0, conflicts_ = 0, rebuilds_ = 0, seam_points_ = 0;
+  std::array<std::size_t, 8> flip_counts_{};  // Tet3Mesh::FlipCount order
   std::uint32_t last_ = 0;                // the slot of the last insertion
   std::vector<std::uint32_t> vertex_slot_;  // per point: a slot holding its vertex
 

@@ -23,7 +23,10 @@ void for_each_field(const Delaunay3Stats& s, F&& f) {
   f("points", s.points), f("vertices", s.vertices), f("duplicates", s.duplicates), f("removed", s.removed);
   f("rebuilds", s.rebuilds), f("tetrahedra", s.tetrahedra);
   f("hull_triangles", s.hull_triangles), f("dimension", s.dimension), f("walk_steps", s.walk_steps);
-  f("conflicts", s.conflicts), f("seam_points", s.seam_points), f("bytes", s.bytes);
+  f("conflicts", s.conflicts), f("seam_points", s.seam_points);
+  f("flips_14", s.flips_14), f("flips_23", s.flips_23), f("flips_32", s.flips_32), f("flips_44", s.flips_44);
+  f("splits", s.splits), f("hull_inserts", s.hull_inserts), f("unflippable", s.unflippable);
+  f("flip_repairs", s.flip_repairs), f("bytes", s.bytes);
 }
 
 template <typename F>

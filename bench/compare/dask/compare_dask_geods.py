@@ -1,0 +1,9 @@
+"""The dask comparison (see dask_driver.py): the single-process geods baseline."""
+import os
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from dask_driver import main  # noqa: E402
+
+if __name__ == "__main__":
+    main(0)
