@@ -288,12 +288,14 @@ class Delaunay3:
     exact predicates with symbolic perturbation: any input, cospherical or coplanar
     sets included, gives a valid and unique result).
 
-    Delaunay3(points, seed=...) -- points (n, 3). Duplicates merge into their first
-    occurrence; fewer than four distinct points or all coplanar give no tetrahedra
-    (dimension < 3). NaN/inf raise geods.Error (ValueError).
+    Delaunay3(points, seed=..., insertion="cavity") -- points (n, 3). Duplicates merge
+    into their first occurrence; fewer than four distinct points or all coplanar give
+    no tetrahedra (dimension < 3). NaN/inf raise geods.Error (ValueError).
+    insertion="flips" inserts each point (here and in insert()) by 1-4, 2-3, 3-2
+    (and 4-4) flips instead of the Bowyer-Watson cavity: the same tetrahedra.
 
     """
-    def __init__(self, points: Any, seed: int = ...) -> None: ...
+    def __init__(self, points: Any, seed: int = ..., insertion: str = ...) -> None: ...
     @property
     def dimension(self) -> int:
         """affine dimension: -1 no points, 0 all equal, 1 collinear, 2 coplanar, 3 a solid
@@ -1118,6 +1120,13 @@ def edt(mask: Any, spacing: Any = ..., return_indices: bool = ..., squared: bool
     with integer spacings.
     """
 
+def edt_pass(g: ArrayLike, axis: int, spacing: float = ...) -> NDArray[numpy.float64]:
+    """One separable pass of edt on float64 squared distances g ((n,), (ny, nx) or (nz, ny, nx)): every line along `axis`
+    (geods order: 0 = x = the last array axis) becomes g'(q) = min_p g(p) + (spacing (q - p))^2
+    (inf: no sample). From 0 on the background and inf elsewhere, one pass per axis gives the squared
+    EDT; a chunk needs only be whole along the pass's axis (geods.dask.edt). Returns a new float64 array of the same shape.
+    """
+
 def emst(points: Any) -> tuple[Any, ...]:
     """Euclidean minimum spanning tree of (n, 2) or (n, 3) points: ((n - 1, 2) int64 edges by increasing length, total length).
     """
@@ -1353,6 +1362,18 @@ def synthesize_texture(sample: ArrayLike, size: Sequence[Sequence[int]], neighbo
     4). tile=True: a toroidal output that tiles without seams. The same seed
     gives the same bytes on any thread count. stats=True returns (image, stats).
     Raises geods.Error for a sample too small for the windows or bad options.
+    """
+
+def tin_border_limit(max_error: float, lo: float, hi: float) -> float:
+    """The side tolerance of Terrain.tin for a field whose samples span [lo, hi] (a little below max_error).
+    """
+
+def tin_tile(heights: Any, max_error: float, border_limit: float | None = ...) -> tuple[Any, ...]:
+    """(V, F): one tile of Terrain.tin computed on its own from the tile's block of heights (2-D, rows = y,
+    finite): vertices at the block's sample coordinates (x, y, z). border_limit: the sides' tolerance,
+    tin_border_limit(max_error, lo, hi) of the WHOLE field (default: of this block); with it, the tile
+    [x0, x1] x [y0, y1] of Terrain(h).tin(max_error, tiles) is this mesh of h[y0:y1+1, x0:x1+1] shifted
+    by (x0, y0) (geods.dask.terrain_tiles).
     """
 
 def voronoi3(points: Any, box: Any = ...) -> list[Any]:
