@@ -16,6 +16,8 @@ packages=(
   libgtest-dev libbenchmark-dev libgmp-dev libmpfr-dev
   python3 python3-dev python3-numpy python3-pytest pybind11-dev
   python3-scipy  # the oracle of python/tests/test_convex_hull.py (Qhull)
+  python3-mesonpy python3-venv  # pip install . (meson-python drives the CMake build; docs/install.md)
+  python3-mypy  # python/tests/test_stubs.py checks calls against the type stubs
   python3-dask python3-distributed  # geods.dask: volumes in chunks, collections, terrain tiles (BSD)
 )
 for arg in "$@"; do

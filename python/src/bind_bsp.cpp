@@ -69,7 +69,8 @@ for a closed, outward-oriented mesh.)doc")
              return without_gil([&] { return bsp::BspTree(t.vertices, t.triangles, o); });
            }),
            py::arg("V"), py::arg("F"), py::arg("heuristic") = "cost", py::arg("alpha") = d.alpha,
-           py::arg("beta") = d.beta, py::arg("k") = d.k, py::arg("seed") = d.seed)
+           py::arg("beta") = d.beta, py::arg("k") = d.k, py::arg("seed") = d.seed,
+           "V: float64 (n, 3) vertices, F: int64 (m, 3) triangles; heuristic: cost, random or balanced")
       .def(
           "classify",
           [](const bsp::BspTree& t, const py::handle& points) {
@@ -79,7 +80,7 @@ for a closed, outward-oriented mesh.)doc")
             if (rows.single) return py::object(py::int_(out.data()[0]));
             return py::object(out);
           },
-          py::arg("points"), "-1 inside, +1 outside, 0 on the boundary (exact for the snapped mesh); int8 per point")
+          py::arg("points"), "-1 inside, +1 outside, 0 on the boundary (exact for the snapped mesh) of points (n, 3) or one (x, y, z): int8 (n,) or an int")
       .def(
           "visibility_order",
           [](const bsp::BspTree& t, const py::handle& eye, bool back_to_front) {
@@ -89,10 +90,11 @@ for a closed, outward-oriented mesh.)doc")
             return index_array(tri);
           },
           py::arg("eye"), py::arg("back_to_front") = true,
-          "Input triangle of each fragment, in visibility order from eye (a split triangle appears once per fragment)")
+          "Input triangle of each fragment, in visibility order from eye = (x, y, z): int64 (fragments,) (a split "
+          "triangle appears once per fragment)")
       .def("stats", [](const bsp::BspTree& t) { return stats_dict(t.stats()); },
            "nodes, leaves, depth, polygons, fragments, expected_cost (equation (4)), build_s")
-      .def("validate", &bsp::BspTree::validate);
+      .def("validate", &bsp::BspTree::validate, "Checks every invariant; raises geods.Error if one fails.");
 
   m.def(
       "csg",

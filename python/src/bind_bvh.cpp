@@ -160,20 +160,22 @@ void bind_bvh(py::module_& m) {
       .def(py::init<const Rows<float>&, const Rows<std::int64_t>&, const std::string&, const std::string&, int, int>(),
            py::arg("V"), py::arg("F"), py::arg("builder") = "sah", py::arg("bv") = "aabb", py::arg("leaf_size") = 8,
            py::arg("arity") = 4,
+           "V: float32 (n, 3) vertices, F: int64 (m, 3) triangles; "
            "builder: sah, median, pca, bottom_up, tiling, insertion, boxtree ('bottomup': deprecated); "
            "bv: aabb, sphere, kdop6, kdop14, kdop18, kdop26, obb, obb_hull; arity 2, 4 or 8")
       .def("intersect", &PyBvh::intersect, py::arg("origins"), py::arg("directions"), py::arg("tmax") = inf,
-           "Closest hits: (t, prim, u, v); t = inf and prim = -1 on a miss. Rays in parallel.")
+           "Closest hits of rays origins, directions float32 (n, 3): (t float32 (n,), prim int64 (n,), u, v float32 (n,)); "
+           "t = inf and prim = -1 on a miss. Rays in parallel.")
       .def("occluded", &PyBvh::occluded, py::arg("origins"), py::arg("directions"), py::arg("tmax") = inf,
-           "Whether each ray hits anything with t in [0, tmax].")
+           "Whether each ray (origins, directions float32 (n, 3)) hits anything with t in [0, tmax]: bool (n,).")
       .def("closest_point", &PyBvh::closest_point, py::arg("points"),
-           "Closest points of the mesh: (points (n, 3), prim, distance).")
+           "Closest points of the mesh to points (n, 3): (points float32 (n, 3), prim int64 (n,), distance float32 (n,)).")
       .def("contains", &PyBvh::contains, py::arg("points"),
-           "Whether each point is inside the (closed) mesh: majority of ray parities.")
+           "Whether each point of points (n, 3) is inside the (closed) mesh, bool (n,): majority of ray parities.")
       .def("cull_box", &PyBvh::cull_box, py::arg("lo"), py::arg("hi"),
-           "Indices of the triangles that intersect the box [lo, hi], sorted.")
+           "Indices (int64 (k,)) of the triangles that intersect the box [lo, hi] (corners (x, y, z)), sorted.")
       .def("cull_frustum", &PyBvh::cull_frustum, py::arg("planes"),
-           "Indices of the triangles not entirely behind one of the planes, sorted; planes (k, 4): rows "
+           "Indices (int64 (j,)) of the triangles not entirely behind one of the planes, sorted; planes (k, 4): rows "
            "(nx, ny, nz, offset) of n.x = offset with n pointing into the frustum (conservative culling).")
       .def("stats", &PyBvh::stats,
            "dict: builder, bv, arity, leaf_size, triangles, nodes, leaves, depth, bytes, sah_cost, "

@@ -57,11 +57,12 @@ void bind_collide(py::module_& m) {
              return without_gil([&] { return std::make_shared<CollisionMesh>(mesh, o); });
            }),
            py::arg("V"), py::arg("F"), py::arg("bv") = "obb", py::arg("leaf_size") = 2, py::arg("builder") = "sah",
-           "bv: aabb, sphere, kdop6, kdop14, kdop18, kdop26, obb, obb_hull, boxtree")
+           "V: float32 (n, 3) vertices, F: int64 (m, 3) triangles; bv: aabb, sphere, kdop6, kdop14, kdop18, kdop26, obb, "
+           "obb_hull, boxtree")
       .def_property_readonly("num_triangles", &CollisionMesh::num_triangles)
       .def_property_readonly("bv", [](const CollisionMesh& c) { return std::string(to_string(c.options().bv)); });
 
-  py::class_<collide::CollideResult>(m, "CollideResult")
+  py::class_<collide::CollideResult>(m, "CollideResult", "What collide() found: colliding, pairs, stats; true if colliding")
       .def_readonly("colliding", &collide::CollideResult::colliding)
       .def_property_readonly("pairs",
                              [](const collide::CollideResult& r) {

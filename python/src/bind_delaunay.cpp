@@ -137,25 +137,25 @@ insertion="flips" inserts each point (here and in insert()) by 1-4, 2-3, 3-2
           [](const Delaunay3& dt, const py::handle& q) {
             return index_value(dt.locate(point_of<double, 3>(q, "Delaunay3.locate")));
           },
-          py::arg("q"), "index of a tetrahedron containing q (closed), -1 outside the hull")
+          py::arg("q"), "index of a tetrahedron containing q = (x, y, z) (closed), -1 outside the hull")
       .def(
           "nearest_vertex",
           [](const Delaunay3& dt, const py::handle& q) {
             return index_value(dt.nearest_vertex(point_of<double, 3>(q, "Delaunay3.nearest_vertex")));
           },
-          py::arg("q"), "index of the nearest point (a first occurrence), -1 if empty")
+          py::arg("q"), "index of the nearest point to q = (x, y, z) (a first occurrence), -1 if empty")
       .def(
           "vertex_neighbors",
           [](const Delaunay3& dt, std::int64_t v) {
             return index_array(dt.vertex_neighbors(point_index3(v, dt, "Delaunay3.vertex_neighbors")));
           },
-          py::arg("v"), "the Delaunay neighbours of point v, ascending")
+          py::arg("v"), "the Delaunay neighbours of point v, ascending: int64 (k,)")
       .def(
           "insert",
           [](Delaunay3& dt, const py::handle& p) {
             return std::int64_t(dt.insert(point_of<double, 3>(p, "Delaunay3.insert")));
           },
-          py::arg("p"), "inserts a point, returns its index")
+          py::arg("p"), "inserts a point p = (x, y, z), returns its index")
       .def(
           "remove", [](Delaunay3& dt, std::int64_t i) { dt.remove(point_index3(i, dt, "Delaunay3.remove")); },
           py::arg("i"), "removes point i (rebuilds: O(n log n))")
@@ -166,7 +166,7 @@ insertion="flips" inserts each point (here and in insert()) by 1-4, 2-3, 3-2
           "load", [](const std::filesystem::path& path) { return Delaunay3::load(path); }, py::arg("path"),
           "reads a tetrahedralization written by save() (checked exactly); insert and remove go on as before")
       .def("validate", &Delaunay3::validate, "checks every invariant (exact); raises geods.Error on a violation")
-      .def("stats", [](const Delaunay3& dt) { return stats_dict(dt.stats()); });
+      .def("stats", [](const Delaunay3& dt) { return stats_dict(dt.stats()); }, "dict of the DelaunayStats fields");
 
   m.def(
       "voronoi3",
@@ -289,21 +289,21 @@ new appended point (intersection_points). NaN/inf raise geods.Error (ValueError)
       .def(
           "locate",
           [](const Delaunay2& dt, const py::handle& q) { return as_index(dt.locate(as_point(q, "Delaunay2.locate"))); },
-          py::arg("q"), "index of a triangle containing q (closed), -1 outside the hull")
+          py::arg("q"), "index of a triangle containing q = (x, y) (closed), -1 outside the hull")
       .def(
           "nearest",
           [](const Delaunay2& dt, const py::handle& q) { return as_index(dt.nearest(as_point(q, "Delaunay2.nearest"))); },
-          py::arg("q"), "index of the nearest point (a first occurrence), -1 if empty")
+          py::arg("q"), "index of the nearest point to q = (x, y) (a first occurrence), -1 if empty")
       .def(
           "neighbors",
           [](const Delaunay2& dt, std::int64_t v) {
             const auto nb = dt.neighbors(vertex_index(v, dt, "Delaunay2.neighbors"));
             return index_array(nb);
           },
-          py::arg("v"), "Delaunay neighbours of vertex v, counter-clockwise")
+          py::arg("v"), "Delaunay neighbours of vertex v, counter-clockwise: int64 (k,)")
       .def(
           "insert", [](Delaunay2& dt, const py::handle& p) { return std::int64_t(dt.insert(as_point(p, "Delaunay2.insert"))); },
-          py::arg("p"), "inserts a point, returns its index")
+          py::arg("p"), "inserts a point p = (x, y), returns its index")
       .def(
           "remove", [](Delaunay2& dt, std::int64_t v) { dt.remove(vertex_index(v, dt, "Delaunay2.remove")); },
           py::arg("i"), "removes point i (not with segments)")
@@ -314,7 +314,7 @@ new appended point (intersection_points). NaN/inf raise geods.Error (ValueError)
           "load", [](const std::filesystem::path& path) { return Delaunay2::load(path); }, py::arg("path"),
                   "reads a triangulation written by save(); insert and remove go on as before")
       .def("validate", &Delaunay2::validate, "checks every invariant; raises geods.Error on a violation")
-      .def("stats", [](const Delaunay2& dt) { return stats_dict(dt.stats()); });
+      .def("stats", [](const Delaunay2& dt) { return stats_dict(dt.stats()); }, "dict of the Delaunay2Stats fields");
 }
 
 }  // namespace geods::python

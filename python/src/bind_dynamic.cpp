@@ -185,19 +185,20 @@ the stored slots are dead. insert returns new int64 ids, never reused; removing 
 is not stored raises ValueError and removes nothing.
 )doc")
       .def(py::init<std::size_t, const std::string&, double>(), py::arg("dim") = 3, py::arg("variant") = "amortized",
-           py::arg("max_dead_fraction") = 0.5)
+           py::arg("max_dead_fraction") = 0.5,
+           "An empty tree of points (d,) with d = dim; variant: amortized or worst_case")
       .def("insert", &PyDynamicKdTree::insert, py::arg("points"),
            "Inserts one point (d,) or rows (n, d); returns their ids (int64 array, or one int64 for one point).")
-      .def("remove", &PyDynamicKdTree::remove, py::arg("ids"), "Removes the items with these ids (int or 1-d array).")
+      .def("remove", &PyDynamicKdTree::remove, py::arg("ids"), "Removes the items with these ids (an int or int64 (n,)).")
       .def("query", &PyDynamicKdTree::query, py::arg("q"), py::arg("k") = 1, py::arg("eps") = 0.0,
            py::arg("max_distance") = std::numeric_limits<double>::infinity(),
            "k nearest stored points of one point (d,) or m points (m, d): (distances float64, ids int64), each (k,) "
            "or (m, k), ascending by distance, ties by id; -1 / inf where fewer than k are stored or within "
            "max_distance. eps > 0: each distance within (1 + eps) of the true one (as KdTree.query).")
       .def("query_radius", &PyDynamicKdTree::query_radius, py::arg("q"), py::arg("r"),
-           "Ids within distance r of q (inclusive), sorted by distance.")
+           "Ids (int64 (k,)) within distance r of q = (x, y, ...) (inclusive), sorted by distance.")
       .def("query_box", &PyDynamicKdTree::query_box, py::arg("lo"), py::arg("hi"),
-           "Ids (ascending) of the stored points p with lo <= p <= hi.")
+           "Ids (int64 (k,), ascending) of the stored points p with lo <= p <= hi (corners (d,)).")
       .def("validate", &PyDynamicKdTree::validate,
            "Checks the decomposition into trees of 2^i slots, the id locator and every tree; raises if one fails.")
       .def("rebuild", &PyDynamicKdTree::rebuild, "Rebuilds from the live points now, freeing deleted ones.")

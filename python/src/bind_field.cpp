@@ -182,13 +182,14 @@ void bind_field(py::module_& m) {
         "with integer spacings.");
 
   m.def("edt_pass", &edt_pass_py, py::arg("g"), py::arg("axis"), py::arg("spacing") = 1.0,
-        "One separable pass of edt on float64 squared distances g (1-, 2- or 3-D): every line along `axis`\n"
+        "One separable pass of edt on float64 squared distances g ((n,), (ny, nx) or (nz, ny, nx)): every line along `axis`\n"
         "(geods order: 0 = x = the last array axis) becomes g'(q) = min_p g(p) + (spacing (q - p))^2\n"
         "(inf: no sample). From 0 on the background and inf elsewhere, one pass per axis gives the squared\n"
-        "EDT; a chunk needs only be whole along the pass's axis (geods.dask.edt). Returns a new array.");
+        "EDT; a chunk needs only be whole along the pass's axis (geods.dask.edt). Returns a new float64 array of the same shape.");
   m.def("chamfer", &chamfer_py, py::arg("mask"), py::arg("size") = field::ChamferRequest{}.size,
         py::arg("spacing") = py::none(),
-        "Chamfer distance transform of a 1-, 2- or 3-D mask (nonzero = foreground; edt's convention): the\n"
+        "Chamfer distance transform of a 1-, 2- or 3-D mask, (n,), (ny, nx) or (nz, ny, nx) (nonzero =\n"
+        "foreground; edt's convention): the\n"
         "distance to the nearest zero sample approximated by a forward and a backward scan with the\n"
         "3x3x3 (size=3) or 5x5x5 (size=5) matrix of Euclidean step lengths (seed Figure 61), float64 of\n"
         "the mask's shape. Never below the exact distance, at most chamfer_max_error(size) above it\n"

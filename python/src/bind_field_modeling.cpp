@@ -174,9 +174,11 @@ void bind_field_modeling(py::module_& m) {
         "'union' min(a, b), 'intersection' max(a, b), 'difference' max(a, -b); blend > 0 rounds the\n"
         "crease with the polynomial smooth min / max of that radius. float32 of the fields' shape.");
   m.def("blend", &blend_py, py::arg("a"), py::arg("b"), py::arg("radius"), py::arg("op") = "union",
-        "Smooth union (or intersection, difference) of two signed distance fields with a blend radius > 0.");
+        "Smooth union (or intersection, difference) of two signed distance fields a, b of the same shape (nz, ny, nx)\n"
+        "with a blend radius > 0: float32 of their shape.");
   m.def("offset", &offset_py, py::arg("d"), py::arg("distance"),
-        "The offset field d - distance: its zero set is the surface moved outward by distance (inward if < 0).");
+        "The offset field d - distance of a field d (nz, ny, nx), float32 of its shape: its zero set is the surface\n"
+        "moved outward by distance (inward if < 0).");
   m.def("field_surface", &field_surface_py, py::arg("d"), py::arg("level") = 0.0,
         py::arg("origin") = std::array<double, 3>{0, 0, 0}, py::arg("spacing") = std::array<double, 3>{1, 1, 1},
         "The surface {d = level} of a signed distance field (nz, ny, nx), negative inside, by marching\n"

@@ -190,7 +190,7 @@ void bind_generalized_voronoi(py::module_& m) {
   py::class_<PyPowerDiagram>(m, "PowerDiagram",
                              "Power diagram of weighted points and its regular triangulation, cells clipped to box.")
       .def(py::init<const py::handle&, const py::handle&, const py::object&>(), py::arg("points"), py::arg("weights"),
-           py::arg("box") = py::none())
+           py::arg("box") = py::none(), "points: float64 (n, 2); weights: float64 (n,); box: (xmin, ymin, xmax, ymax)")
       .def_property_readonly("cells", &PyPowerDiagram::cells,
                              "One counter-clockwise (k, 2) polygon per input point (empty for redundant points).")
       .def_property_readonly("edges", &PyPowerDiagram::edges, "(sites (m, 2) int64, segments (m, 4) float64).")
@@ -201,34 +201,35 @@ void bind_generalized_voronoi(py::module_& m) {
                              "int64 per point: the first equal point of equal weight.")
       .def("stats", &PyPowerDiagram::stats,
            "dict: points, vertices, redundant, duplicates, triangles, hull, flips, removals, edges")
-      .def("validate", &PyPowerDiagram::validate);
+      .def("validate", &PyPowerDiagram::validate, "Checks every invariant; raises geods.Error if one fails.");
   m.def("power_diagram", [](const py::handle& p, const py::handle& w, const py::object& box) { return PyPowerDiagram(p, w, box); },
         py::arg("points"), py::arg("weights"), py::arg("box") = py::none(),
         "The power diagram of points (n, 2) with weights (n,) (power |x - p|^2 - w), clipped to box "
         "(default: the points' frame). Equal weights give the Voronoi diagram.");
 
   py::class_<PyFarthestVoronoi>(m, "FarthestVoronoi", "Farthest-point Voronoi diagram, cells clipped to box.")
-      .def(py::init<const py::handle&, const py::object&>(), py::arg("points"), py::arg("box") = py::none())
+      .def(py::init<const py::handle&, const py::object&>(), py::arg("points"), py::arg("box") = py::none(),
+           "points: float64 (n, 2); box: (xmin, ymin, xmax, ymax)")
       .def_property_readonly("cells", &PyFarthestVoronoi::cells,
                              "One counter-clockwise (k, 2) polygon per input point (empty unless a hull corner).")
       .def_property_readonly("edges", &PyFarthestVoronoi::edges, "(sites (m, 2) int64, segments (m, 4) float64).")
       .def_property_readonly("box", &PyFarthestVoronoi::box)
       .def_property_readonly("corners", &PyFarthestVoronoi::corners, "int64: the hull corners, counter-clockwise.")
       .def("stats", &PyFarthestVoronoi::stats, "dict: sites, distinct, corners, edges, cell_vertices")
-      .def("validate", &PyFarthestVoronoi::validate);
+      .def("validate", &PyFarthestVoronoi::validate, "Checks every invariant; raises geods.Error if one fails.");
   m.def("farthest_voronoi", [](const py::handle& p, const py::object& box) { return PyFarthestVoronoi(p, box); },
         py::arg("points"), py::arg("box") = py::none(),
         "The farthest-point Voronoi diagram of points (n, 2), clipped to box (default: the points' frame).");
 
   py::class_<PyKthOrderVoronoi>(m, "KthOrderVoronoi", "K-th order Voronoi diagram, regions clipped to box.")
       .def(py::init<const py::handle&, long, const py::object&>(), py::arg("points"), py::arg("k"),
-           py::arg("box") = py::none())
+           py::arg("box") = py::none(), "points: float64 (n, 2); box: (xmin, ymin, xmax, ymax)")
       .def_property_readonly("cells", &PyKthOrderVoronoi::cells, "One counter-clockwise (m, 2) polygon per region.")
       .def_property_readonly("sites", &PyKthOrderVoronoi::sites, "(regions, k) int64: each region's k nearest sites, ascending.")
       .def_property_readonly("k", &PyKthOrderVoronoi::k)
       .def_property_readonly("box", &PyKthOrderVoronoi::box)
       .def("stats", &PyKthOrderVoronoi::stats, "dict: sites, distinct, k, regions, pieces, region_vertices")
-      .def("validate", &PyKthOrderVoronoi::validate);
+      .def("validate", &PyKthOrderVoronoi::validate, "Checks every invariant; raises geods.Error if one fails.");
   m.def("kth_order_voronoi", [](const py::handle& p, long k, const py::object& box) { return PyKthOrderVoronoi(p, k, box); },
         py::arg("points"), py::arg("k"), py::arg("box") = py::none(),
         "The k-th order Voronoi diagram of points (n, 2): regions of equal k nearest sites, clipped to box.");
@@ -236,16 +237,17 @@ void bind_generalized_voronoi(py::module_& m) {
   py::class_<PyConstrainedVoronoi>(m, "ConstrainedVoronoi",
                                    "Constrained Voronoi diagram VD(S, L) (seed §5.3.2) as convex pieces tiling the box.")
       .def(py::init<const py::handle&, const py::handle&, const py::object&>(), py::arg("points"), py::arg("segments"),
-           py::arg("box") = py::none())
+           py::arg("box") = py::none(),
+           "points: float64 (n, 2); segments: int64 (m, 2) point indices; box: (xmin, ymin, xmax, ymax), default around the points")
       .def_property_readonly("cells", &PyConstrainedVoronoi::cells, "One counter-clockwise convex (k, 2) polygon per piece.")
       .def_property_readonly("sites", &PyConstrainedVoronoi::sites, "int64 per piece: the site whose region it is in.")
       .def_property_readonly("constraints", &PyConstrainedVoronoi::constraints,
                              "(m, 2) int64: the segments, split at sites on them.")
       .def_property_readonly("box", &PyConstrainedVoronoi::box)
       .def("visible", &PyConstrainedVoronoi::visible, py::arg("point"), py::arg("site"),
-           "Whether the segment from point to the site crosses no constraint.")
+           "Whether the segment from point = (x, y) to the site crosses no constraint.")
       .def("stats", &PyConstrainedVoronoi::stats, "dict: sites, distinct, segments, pieces, cells, max_candidates")
-      .def("validate", &PyConstrainedVoronoi::validate);
+      .def("validate", &PyConstrainedVoronoi::validate, "Checks every invariant; raises geods.Error if one fails.");
   m.def("constrained_voronoi",
         [](const py::handle& p, const py::handle& s, const py::object& box) { return PyConstrainedVoronoi(p, s, box); },
         py::arg("points"), py::arg("segments"), py::arg("box") = py::none(),

@@ -159,7 +159,8 @@ geods.isosurface. leaf_cells: cells per leaf along each axis, 1 to 32 (1: one
 cell per leaf, the textbook octree).)doc")
       .def(py::init<const py::array&, std::size_t, const std::array<double, 3>&, const std::array<double, 3>&>(),
            py::arg("volume"), py::arg("leaf_cells") = iso::MinMaxOctree<float>::kDefaultLeafCells,
-           py::arg("spacing") = ones, py::arg("origin") = zeros)
+           py::arg("spacing") = ones, py::arg("origin") = zeros,
+           "volume: (nz, ny, nx) of uint8, uint16, int16 or float32; spacing and origin (x, y, z)")
       .def("isosurface", &PyOctree::isosurface, py::arg("t"), py::arg("normals") = true,
            py::arg("coords") = py::none(), py::arg("sharing") = "block_masks",
            "(V, F, N) exactly as geods.isosurface(volume, t) gives them (in another order). sharing: how the\n"

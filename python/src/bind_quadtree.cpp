@@ -243,7 +243,8 @@ void bind_orthtree(py::module_& m, const char* doc) {
   using Py = PyOrthtree<Dim>;
   py::class_<Py>(m, Py::kName, doc)
       .def(py::init<const py::array&, std::size_t, const py::object&, const std::string&>(), py::arg("points"),
-           py::arg("bucket") = 1, py::arg("max_depth") = py::none(), py::arg("build") = "top_down")
+           py::arg("bucket") = 1, py::arg("max_depth") = py::none(), py::arg("build") = "top_down",
+           "points: (n, 2) for a Quadtree, (n, 3) for an Octree; float32 or float64 (kept as given)")
       .def("neighbor", &Py::neighbor, py::arg("node"), py::arg("direction"),
            "The deepest node of depth <= depth(node) across the face in `direction` ('N', 'S', 'E', 'W', '+x', "
            "'-x', '+y', '-y', '+z', '-z' or 0..5 = 2 * axis + negative); -1 at the boundary. O(depth).")
@@ -255,10 +256,10 @@ void bind_orthtree(py::module_& m, const char* doc) {
       .def_static("load", &Py::load, py::arg("path"),
                   "Maps a tree written by save(): its arrays are read in place from the file. Raises\n"
                   "ValueError for a truncated, corrupt or other file.")
-      .def("locate", &Py::locate, py::arg("p"), "The leaf whose cell contains p, or -1 outside the root cell.")
+      .def("locate", &Py::locate, py::arg("p"), "The leaf whose cell contains p = (x, y) or (x, y, z), or -1 outside the root cell.")
       .def("query_box", &Py::query_box, py::arg("lo"), py::arg("hi"),
-           "Indices (ascending) of the points p with lo <= p <= hi.")
-      .def("count_box", &Py::count_box, py::arg("lo"), py::arg("hi"), "Number of points with lo <= p <= hi.")
+           "Indices (int64 (k,), ascending) of the points p with lo <= p <= hi (corners (d,)).")
+      .def("count_box", &Py::count_box, py::arg("lo"), py::arg("hi"), "Number of points with lo <= p <= hi (corners (d,)).")
       .def("query", &Py::query, py::arg("q"), py::arg("k") = 1,
            "k nearest neighbours of one point or of m points: (distances float64, indices int64), each (k,) or "
            "(m, k), ascending by distance, ties by index; -1 / inf where fewer than k points exist.")
@@ -266,11 +267,11 @@ void bind_orthtree(py::module_& m, const char* doc) {
            "Indices within distance r (inclusive), sorted by distance (a list of arrays for (m, d) queries).")
       .def("node_bounds", &Py::node_bounds, py::arg("node"), "(lo, hi) of the node's square / cube, float64.")
       .def("children", &Py::children, py::arg("node"), "The node's children in slot order (bit a = high half of axis a); [] for a leaf.")
-      .def("is_leaf", &Py::is_leaf, py::arg("node"))
-      .def("depth", &Py::depth, py::arg("node"))
+      .def("is_leaf", &Py::is_leaf, py::arg("node"), "Whether the node is a leaf.")
+      .def("depth", &Py::depth, py::arg("node"), "The node's depth (the root is 0).")
       .def("parent", &Py::parent, py::arg("node"), "The parent node, -1 for the root.")
-      .def("node_points", &Py::node_points, py::arg("node"), "Indices of the points in the node's cell.")
-      .def("leaves", &Py::leaves, "Indices of all leaves.")
+      .def("node_points", &Py::node_points, py::arg("node"), "Indices of the points in the node's cell: int64 (k,).")
+      .def("leaves", &Py::leaves, "Indices of all leaves: int64 (leaves,).")
       .def("__len__", &Py::size)
       .def_property_readonly("num_nodes", &Py::num_nodes)
       .def_property_readonly("is_balanced", &Py::is_balanced)

@@ -114,12 +114,13 @@ void bind_ray(py::module_& m) {
                                "grid with mailboxes), 'octree' (Revelles' parametric traversal) or 'rays5d' (5D ray "
                                "classification). geods.RayAccelerator is its deprecated older name.")
       .def(py::init<const Rows<float>&, const Rows<std::int64_t>&, const std::string&>(), py::arg("V"),
-           py::arg("F"), py::arg("kind") = "bvh")
+           py::arg("F"), py::arg("kind") = "bvh",
+           "V: float32 (n, 3) vertices, F: int64 (m, 3) triangles; kind: bvh, grid, octree or rays5d")
       .def("intersect", &PyRayAccelerator::intersect, py::arg("origins"), py::arg("directions"),
            py::arg("tmax") = Rows<float>(py::ssize_t(1), &inf),
            "Closest hits of (n, 3) rays: (t, prim, u, v); t = inf and prim = -1 on a miss. tmax: one value or n.")
       .def("occluded", &PyRayAccelerator::occluded, py::arg("origins"), py::arg("directions"),
-           py::arg("tmax") = Rows<float>(py::ssize_t(1), &inf), "Whether each ray hits anything before tmax.")
+           py::arg("tmax") = Rows<float>(py::ssize_t(1), &inf), "Whether each ray hits anything before tmax: bool (n,) of rays origins, directions float32 (n, 3); tmax: one value or n.")
       .def("stats", &PyRayAccelerator::stats, "Nodes, leaves, triangle references, depth, bytes, build_s.")
       .def("validate", &PyRayAccelerator::validate, "Checks the structure's invariants; raises ValueError if broken.")
       .def("save", &PyRayAccelerator::save, py::arg("path"),

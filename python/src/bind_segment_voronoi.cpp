@@ -77,20 +77,20 @@ void bind_segment_voronoi(py::module_& m) {
         std::vector<Vec2d> p(v.num_points());
         for (std::uint32_t i = 0; i < p.size(); ++i) p[i] = v.point(i);
         return points_array(p);
-      }, "Point sites (input points and segment endpoints, each once), (k, 2)")
+      }, "Point sites (input points and segment endpoints, each once), float64 (k, 2)")
       .def("segments", [](const SegmentVoronoi& v) {
         std::vector<std::int64_t> s;
         for (std::uint32_t i = 0; i < v.num_segments(); ++i) s.insert(s.end(), {v.segment(i)[0], v.segment(i)[1]});
         return copy_array(s.data(), {static_cast<py::ssize_t>(v.num_segments()), 2});
-      }, "Segment sites as point ids, (m, 2); site id of segment j is num_points + j")
+      }, "Segment sites as point ids, int64 (m, 2); site id of segment j is num_points + j")
       .def_property_readonly("num_points", &SegmentVoronoi::num_points)
       .def_property_readonly("num_segments", &SegmentVoronoi::num_segments)
-      .def("split_count", &SegmentVoronoi::split_count)
+      .def("split_count", &SegmentVoronoi::split_count, "How many times input segments were split at points on them")
       .def("vertices", [](const SegmentVoronoi& v) {
         std::vector<double> x;
         for (const auto& p : v.vertices()) x.insert(x.end(), {p.position[0], p.position[1], p.clearance});
         return copy_array(x.data(), {static_cast<py::ssize_t>(v.vertices().size()), 3});
-      }, "Voronoi vertices as rows x, y, clearance")
+      }, "Voronoi vertices as rows (x, y, clearance): float64 (v, 3)")
       .def("edges", [](const SegmentVoronoi& v) {
         const auto& es = v.edges();
         std::vector<std::int64_t> sites, verts;
@@ -114,21 +114,21 @@ void bind_segment_voronoi(py::module_& m) {
         return out;
       }, "For each site, the ids of the edges bounding its cell")
       .def("medial_axis", [](const SegmentVoronoi& v) { return index_array(without_gil([&] { return v.medial_axis(); })); },
-           "Ids of the primary edges inside the polygons the segments bound (even-odd)")
+           "Ids of the primary edges inside the polygons the segments bound (even-odd): int64 (k,)")
       .def("sample_edge", [](const SegmentVoronoi& v, std::uint32_t e, double step, const py::object& box) {
         if (e >= v.edges().size()) throw Error("sample_edge: no edge " + std::to_string(e));
         return points_array(v.sample_edge(e, step, box_of(v, box)));
       }, py::arg("edge"), py::arg("step"), py::arg("box") = py::none(),
-           "Points along an edge, at most about `step` apart; unbounded ends clipped to box (x0, y0, x1, y1)")
+           "Points along an edge, at most about `step` apart, float64 (k, 2); unbounded ends clipped to box (x0, y0, x1, y1)")
       .def("edge_clearance", [](const SegmentVoronoi& v, std::uint32_t e) {
         if (e >= v.edges().size()) throw Error("edge_clearance: no edge " + std::to_string(e));
         return v.edge_clearance(e);
-      })
+      }, "Least distance from the edge to its two sites")
       .def("site_distance", [](const SegmentVoronoi& v, std::uint32_t site, const py::object& x) {
         if (site >= v.num_sites()) throw Error("site_distance: no site " + std::to_string(site));
         return v.site_distance(site, point_of<double, 2>(x, "site_distance"));
-      })
-      .def("validate", &SegmentVoronoi::validate)
+      }, "Distance from x = (x, y) to a site (point or segment)")
+      .def("validate", &SegmentVoronoi::validate, "Checks every invariant; raises geods.Error if one fails")
       .def("stats", [](const SegmentVoronoi& v) {
         const auto s = v.stats();
         py::dict d;
@@ -144,7 +144,7 @@ void bind_segment_voronoi(py::module_& m) {
         d["infinite_edges"] = s.infinite_edges;
         d["bytes"] = s.bytes;
         return d;
-      });
+      }, "dict: input_points, input_segments, points, segments, splits, vertices, edges, ..., bytes");
 
   py::class_<MotionPlanner, std::shared_ptr<MotionPlanner>>(m, "MotionPlanner",
                                                             "Disc robot planning among polygons on the segment Voronoi diagram")
@@ -159,7 +159,8 @@ void bind_segment_voronoi(py::module_& m) {
              o.bounds = AABB2d(Vec2d(c[0], c[1]), Vec2d(c[2], c[3]));
              return without_gil([&] { return std::make_shared<MotionPlanner>(polys, o); });
            }),
-           py::arg("obstacles"), py::arg("bounds"), py::arg("margin") = 0.25)
+           py::arg("obstacles"), py::arg("bounds"), py::arg("margin") = 0.25,
+           "obstacles: polygons, each float64 (k, 2); bounds: (x0, y0, x1, y1)")
       .def("plan", [](const MotionPlanner& p, const py::object& start, const py::object& goal, double radius) {
         const Vec2d s = point_of<double, 2>(start, "start"), g = point_of<double, 2>(goal, "goal");
         return plan_dict(without_gil([&] { return p.plan(s, g, radius); }));
@@ -167,8 +168,9 @@ void bind_segment_voronoi(py::module_& m) {
            "dict: found, reason, path (n, 2) or None, length, min_clearance, max_radius")
       .def("max_radius", [](const MotionPlanner& p, const py::object& start, const py::object& goal) {
         return p.max_radius(point_of<double, 2>(start, "start"), point_of<double, 2>(goal, "goal"));
-      })
-      .def("clearance", [](const MotionPlanner& p, const py::object& x) { return p.clearance(point_of<double, 2>(x, "x")); });
+      }, "The largest disc radius that can move from start to goal, each (x, y)")
+      .def("clearance", [](const MotionPlanner& p, const py::object& x) { return p.clearance(point_of<double, 2>(x, "x")); },
+           "Distance from x = (x, y) to the nearest obstacle");
 
   m.def("plan_path", [](const py::object& obstacles, const py::object& start, const py::object& goal, double radius,
                         double margin) {

@@ -85,7 +85,7 @@ void bind_shape(py::module_& m) {
                                          shape::parse_metric(metric), block);
       },
       py::arg("a"), py::arg("b"), py::arg("metric") = "l1", py::arg("block") = 0,
-      "Distance of two histograms: 'l1', 'l2', 'chi2' or 'emd' (the L1 distance of the cumulative histograms, "
+      "Distance of two histograms a, b (float32 (bins,)): 'l1', 'l2', 'chi2' or 'emd' (the L1 distance of the cumulative histograms, "
       "restarting every `block` bins for a combined descriptor).");
 
   py::class_<ShapeDatabase>(m, "ShapeDatabase",
@@ -96,7 +96,8 @@ void bind_shape(py::module_& m) {
              return ShapeDatabase(descriptor_options(descriptor, samples, bins, seed, normalization));
            }),
            py::arg("descriptor") = "d2", py::arg("samples") = shape::DistributionOptions{}.samples,
-           py::arg("bins") = shape::DistributionOptions{}.bins, py::arg("seed") = 0, py::arg("normalization") = "mean")
+           py::arg("bins") = shape::DistributionOptions{}.bins, py::arg("seed") = 0, py::arg("normalization") = "mean",
+           "An empty database of descriptor ('d1', 'd2', 'a3', 'd3', 'd4' or a combination) histograms of `bins` bins")
       .def("__len__", &ShapeDatabase::size)
       .def_property_readonly("dimension", &ShapeDatabase::dimension)
       .def_property_readonly("descriptor_name", [](const ShapeDatabase& db) { return shape::descriptor_name(db.options()); })
@@ -112,7 +113,7 @@ void bind_shape(py::module_& m) {
             return without_gil([&] { return db.add(name, mesh, label.value_or("")); });
           },
           py::arg("name"), py::arg("V"), py::arg("F"), py::arg("label") = py::none(),
-          "Adds one shape (through the dynamization); returns its id.")
+          "Adds one shape, V float32 (n, 3) and F int64 (m, 3) (through the dynamization); returns its id.")
       .def(
           "add_descriptors",
           [](ShapeDatabase& db, const std::vector<std::string>& names, const Rows<float>& descriptors,
@@ -125,17 +126,18 @@ void bind_shape(py::module_& m) {
             return index_array(without_gil([&] { return db.add_descriptors(names, rows, l); }));
           },
           py::arg("names"), py::arg("descriptors"), py::arg("labels") = py::none(),
-          "Adds precomputed descriptors (rows as describe() makes them) as one batch; returns their ids.")
+          "Adds precomputed descriptors, float32 (n, dimension) (rows as describe() makes them), as one batch; "
+          "returns their ids, int64 (n,).")
       .def(
           "describe",
           [](const ShapeDatabase& db, const Rows<float>& v, const Rows<std::int64_t>& f) {
             const TriMesh mesh = mesh_from_arrays(v, f, "ShapeDatabase.describe");
             return float_array(without_gil([&] { return db.describe(mesh); }));
           },
-          py::arg("V"), py::arg("F"), "The descriptor of a mesh under this database's options.")
+          py::arg("V"), py::arg("F"), "The descriptor of a mesh (V float32 (n, 3), F int64 (m, 3)) under this database's options: float32 (dimension,).")
       .def(
           "descriptor", [](const ShapeDatabase& db, std::uint64_t id) { return float_array(db.descriptor(id)); },
-          py::arg("id"), "The stored descriptor of shape `id`.")
+          py::arg("id"), "The stored descriptor of shape `id`: float32 (dimension,).")
       .def(
           "query",
           [](const ShapeDatabase& db, const Rows<float>& v, const Rows<std::int64_t>& f, std::size_t k, double eps) {
@@ -143,18 +145,21 @@ void bind_shape(py::module_& m) {
             return matches_list(without_gil([&] { return db.query(mesh, k, eps); }));
           },
           py::arg("V"), py::arg("F"), py::arg("k") = 5, py::arg("eps") = 0.0,
-          "The k nearest shapes: a list of {id, name, label, distance}, nearest first; eps > 0 approximates.")
+          "The k nearest shapes to a mesh (V float32 (n, 3), F int64 (m, 3)): a list of {id, name, label, distance}, "
+          "nearest first; eps > 0 approximates.")
       .def(
           "query_descriptor",
           [](const ShapeDatabase& db, const Rows<float>& d, std::size_t k, double eps) {
             const std::vector<float> q = vector_from(d, "ShapeDatabase.query_descriptor");
             return matches_list(without_gil([&] { return db.query_descriptor(q, k, eps); }));
           },
-          py::arg("descriptor"), py::arg("k") = 5, py::arg("eps") = 0.0)
-      .def("stats", [](const ShapeDatabase& db) { return stats_dict(db.stats()); })
-      .def("validate", &ShapeDatabase::validate)
+          py::arg("descriptor"), py::arg("k") = 5, py::arg("eps") = 0.0,
+          "As query(), for a descriptor float32 (dimension,).")
+      .def("stats", [](const ShapeDatabase& db) { return stats_dict(db.stats()); }, "dict of the ShapeStats fields")
+      .def("validate", &ShapeDatabase::validate, "Checks every invariant; raises geods.Error if one fails.")
       .def(
-          "save", [](const ShapeDatabase& db, const std::string& path) { db.save(path); }, py::arg("path"))
+          "save", [](const ShapeDatabase& db, const std::string& path) { db.save(path); }, py::arg("path"),
+          "Writes the database to a geods archive.")
       .def_static(
           "load", [](const std::string& path) { return ShapeDatabase::load(path); }, py::arg("path"),
           "A database written by save(), mapped in place. Raises ValueError for a bad file or another version.");

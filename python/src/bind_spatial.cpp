@@ -178,7 +178,8 @@ Built in O(n log n) by median splits on the axis of widest spread. The tree read
 row-contiguous `points` array in place (no copy): do not modify it while the tree is in use.
 Queries are thread-safe and release the GIL; batches run in parallel.
 )doc")
-      .def(py::init<const py::array&, std::size_t>(), py::arg("points"), py::arg("leaf_size") = 10)
+      .def(py::init<const py::array&, std::size_t>(), py::arg("points"), py::arg("leaf_size") = 10,
+           "points: (n, d), float32 or float64 (kept as given; other dtypes become float64)")
       .def("query", &PyKdTree::query, py::arg("q"), py::arg("k") = 1, py::arg("eps") = 0.0,
            "k nearest neighbours of one point (d,) or of m points (m, d): (distances float64, indices int64), "
            "each (k,) or (m, k), ascending by distance, ties by index; -1 / inf where fewer than k points exist. "
@@ -187,9 +188,9 @@ Queries are thread-safe and release the GIL; batches run in parallel.
            "Indices within distance r (inclusive), sorted by distance: an int64 array for one point, a list of "
            "arrays for (m, d) queries.")
       .def("query_box", &PyKdTree::query_box, py::arg("lo"), py::arg("hi"),
-           "Indices (ascending) of the points p with lo <= p <= hi.")
+           "Indices (int64 (k,), ascending) of the points p with lo <= p <= hi (corners (d,)).")
       .def("count_box", &PyKdTree::count_box, py::arg("lo"), py::arg("hi"),
-           "Number of points with lo <= p <= hi; for (m, d) corners an int64 array of m counts.")
+           "Number of points with lo <= p <= hi (corners (d,)); for (m, d) corners an int64 (m,) array of counts.")
       .def("stats", &PyKdTree::stats, "dict: points, nodes, leaves, depth, bytes")
       .def("validate", &PyKdTree::validate, "Checks every invariant of the tree; raises if one fails.")
       .def("save", &PyKdTree::save, py::arg("path"),

@@ -93,7 +93,7 @@ void bind_terrain(py::module_& m) {
            }),
            py::arg("heights"), py::arg("spacing") = std::array<double, 2>{1, 1}, py::arg("z_scale") = 1.0,
            py::arg("layout") = "interleaved",
-           "Builds the hierarchy of a 2-D array of heights (rows = y; NaN = missing, filled from the nearest "
+           "Builds the hierarchy of a 2-D array of heights, (ny, nx) of any float or int dtype (rows = y; NaN = missing, filled from the nearest "
            "valid sample) or of a height-field file (.png, .bmp, .npy, .ter, GeoTIFF...).")
       .def(
           "refine",
@@ -113,7 +113,7 @@ void bind_terrain(py::module_& m) {
           },
           py::arg("max_error") = py::none(), py::arg("camera") = py::none(), py::arg("pixel_error") = py::none(),
           py::arg("tiles") = 1,
-          "The same mesh as one generalized triangle strip: int64 indices into refine()'s V (degenerate "
+          "The same mesh as one generalized triangle strip: int64 (k,) indices into refine()'s V (degenerate "
           "triangles join and turn it; triangle k is counter-clockwise for even k).")
       .def(
           "tin",
@@ -124,7 +124,7 @@ void bind_terrain(py::module_& m) {
           "(V, F): a greedy-insertion Delaunay TIN within max_error of every sample (tiles x tiles, crack-free).")
       .def_property_readonly("width", &terrain::Terrain::width)
       .def_property_readonly("height", &terrain::Terrain::height)
-      .def("stats", [](const terrain::Terrain& t) { return stats_dict(t.stats()); })
+      .def("stats", [](const terrain::Terrain& t) { return stats_dict(t.stats()); }, "dict of the TerrainStats fields")
       .def("save", &terrain::Terrain::save, py::arg("path"), "Writes the terrain (memory-mapped by load()).")
       .def_static(
           "load", [](const std::filesystem::path& path) { return terrain::Terrain::load(path); }, py::arg("path"),

@@ -217,7 +217,8 @@ void bind_voronoi(py::module_& m) {
   py::class_<PyVoronoi2>(m, "Voronoi2",
                          "Voronoi diagram of 2D points, the dual of their Delaunay triangulation (seed §5.1).\n"
                          "box = (x0, y0, x1, y1) clips the cells (default: the points' bounding box grown by 25%).")
-      .def(py::init<const py::handle&, const py::object&>(), py::arg("points"), py::arg("box") = py::none())
+      .def(py::init<const py::handle&, const py::object&>(), py::arg("points"), py::arg("box") = py::none(),
+           "points: float64 (n, 2)")
       .def("__len__", &PyVoronoi2::size)
       .def("save", &PyVoronoi2::save, py::arg("path"), "Writes the diagram to a geods archive.")
       .def_static("load", &PyVoronoi2::load, py::arg("path"), py::arg("box") = py::none(),
@@ -235,14 +236,14 @@ void bind_voronoi(py::module_& m) {
       .def_property_readonly("edge_segments", &PyVoronoi2::edge_segments,
                              "(m, 4) each edge clipped to box: x0, y0, x1, y1 (NaN if outside).")
       .def_property_readonly("representatives", &PyVoronoi2::representatives, "First occurrence of each point.")
-      .def("neighbors", &PyVoronoi2::neighbors, py::arg("i"), "Delaunay neighbours of point i's site.")
+      .def("neighbors", &PyVoronoi2::neighbors, py::arg("i"), "Delaunay neighbours of point i's site: int64 (k,).")
       .def("nearest", &PyVoronoi2::nearest, py::arg("queries"), py::arg("method") = "walk",
            "Index of a nearest site of each query ((m, 2) -> (m,), or (2,) -> int): 'walk' (WalkLocator, "
            "O(n) memory) or 'slab' (SlabLocator, Theorem 8: O(log n) queries, up to O(n^1.5) memory).")
       .def("k_nearest", &PyVoronoi2::k_nearest, py::arg("query"), py::arg("k"),
-           "The k nearest distinct sites of one query point, nearest first.")
+           "The k nearest distinct sites of one query point (x, y), nearest first: int64 (k,).")
       .def("stats", &PyVoronoi2::stats, "dict: sites, distinct, vertices, edges, unbounded_cells, bytes")
-      .def("validate", &PyVoronoi2::validate);
+      .def("validate", &PyVoronoi2::validate, "Checks every invariant; raises geods.Error if one fails.");
 
   py::class_<PyLocator<voronoi::SlabLocator>>(
       m, "SlabLocator", "The slab structure of seed Theorem 8 over a Voronoi2: O(log n) nearest-site queries.")
@@ -261,14 +262,15 @@ void bind_voronoi(py::module_& m) {
   py::class_<PyMetricVoronoi>(m, "MetricVoronoi",
                               "Voronoi diagram under metric 'l1', 'linf' or 'l2', clipped to box (seed §5.3.3).")
       .def(py::init<const py::handle&, const std::string&, const py::object&>(), py::arg("points"),
-           py::arg("metric") = "l1", py::arg("box") = py::none())
+           py::arg("metric") = "l1", py::arg("box") = py::none(),
+           "points: float64 (n, 2); box: (xmin, ymin, xmax, ymax)")
       .def_property_readonly("metric", &PyMetricVoronoi::metric)
       .def_property_readonly("box", &PyMetricVoronoi::box)
       .def_property_readonly("cells", &PyMetricVoronoi::cells, "One counter-clockwise (k, 2) polygon per input point.")
       .def_property_readonly("edges", &PyMetricVoronoi::edges,
                              "(sites (m, 2) int64, segments (m, 4) float64): bisector pieces inside the box.")
       .def("stats", &PyMetricVoronoi::stats, "dict: sites, distinct, edges, cell_vertices, max_candidates")
-      .def("validate", &PyMetricVoronoi::validate);
+      .def("validate", &PyMetricVoronoi::validate, "Checks every invariant; raises geods.Error if one fails.");
 
   // (n, 3) points take the 3D versions (from Delaunay3), anything else the 2D ones.
   const auto three_columns = [](const py::handle& points) {
@@ -309,7 +311,7 @@ void bind_voronoi(py::module_& m) {
                                ? voronoi::all_nearest_neighbors(points_of<double, 3>(points, "all_nearest_neighbors"))
                                : voronoi::all_nearest_neighbors(to_points(points, "all_nearest_neighbors")));
       },
-      py::arg("points"), "For each of (n, 2) or (n, 3) points the index of its nearest other point.");
+      py::arg("points"), "For each of (n, 2) or (n, 3) points the index of its nearest other point: int64 (n,).");
   m.def(
       "largest_empty_circle",
       [](const py::handle& points) {

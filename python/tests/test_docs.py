@@ -27,7 +27,8 @@ def blocks(lang):
 
 def environment(cli):
     env = dict(os.environ)
-    env["PATH"] = f"{cli.parent}{os.pathsep}{env['PATH']}"
+    # python3 in a shell example is the Python under test.
+    env["PATH"] = f"{cli.parent}{os.pathsep}{os.path.dirname(sys.executable)}{os.pathsep}{env['PATH']}"
     python_dir = os.path.dirname(os.path.dirname(__import__("geods").__file__))
     env["PYTHONPATH"] = python_dir + os.pathsep + env.get("PYTHONPATH", "")
     return env
