@@ -161,7 +161,7 @@ void bind_bvh(py::module_& m) {
            py::arg("V"), py::arg("F"), py::arg("builder") = "sah", py::arg("bv") = "aabb", py::arg("leaf_size") = 8,
            py::arg("arity") = 4,
            "builder: sah, median, pca, bottom_up, tiling, insertion, boxtree ('bottomup': deprecated); "
-           "bv: aabb, sphere, kdop6, kdop14, kdop18, kdop26, obb, obb_hull; arity 2, 4 or 8")
+           "bv: aabb, sphere, kdop6, kdop14, kdop18, kdop26, obb, obb_hull, rss; arity 2, 4 or 8")
       .def("intersect", &PyBvh::intersect, py::arg("origins"), py::arg("directions"), py::arg("tmax") = inf,
            "Closest hits: (t, prim, u, v); t = inf and prim = -1 on a miss. Rays in parallel.")
       .def("occluded", &PyBvh::occluded, py::arg("origins"), py::arg("directions"), py::arg("tmax") = inf,

@@ -57,7 +57,7 @@ void bind_collide(py::module_& m) {
              return without_gil([&] { return std::make_shared<CollisionMesh>(mesh, o); });
            }),
            py::arg("V"), py::arg("F"), py::arg("bv") = "obb", py::arg("leaf_size") = 2, py::arg("builder") = "sah",
-           "bv: aabb, sphere, kdop6, kdop14, kdop18, kdop26, obb, obb_hull, boxtree")
+           "bv: aabb, sphere, kdop6, kdop14, kdop18, kdop26, obb, obb_hull, boxtree, rss")
       .def_property_readonly("num_triangles", &CollisionMesh::num_triangles)
       .def_property_readonly("bv", [](const CollisionMesh& c) { return std::string(to_string(c.options().bv)); });
 
