@@ -340,10 +340,11 @@ struct ObbTester {
     return g;
   }
   bool overlap(std::uint32_t i, std::uint32_t j) const { return gap<false>(i, j) <= f.eps; }
-  // A lower bound of the distance, positive iff the volumes are found apart:
-  // the spheres' gap, else the norm of the face-axis gaps, else the
-  // normalized cross axes (the first positive one stops).
-  double separation(std::uint32_t i, std::uint32_t j) const { return gap<true>(i, j, f.eps) - f.eps; }
+  // The gap along the first separating axis found (or the spheres'): a lower
+  // bound of the distance (an unnormalized cross axis, shorter than 1, only
+  // lowers it). Computing a larger bound (all face axes, normalized cross
+  // axes) lets incremental queries skip few more pairs and costs more than it saves.
+  double separation(std::uint32_t i, std::uint32_t j) const { return gap<false>(i, j) - f.eps; }
   double lower(std::uint32_t i, std::uint32_t j, double cutoff) const {
     return gap<true>(i, j, cutoff + f.eps) - f.eps;
   }
@@ -663,12 +664,14 @@ CollideResult IncrementalCollide::update(const Posed& pose_a, const Posed& pose_
   last_r_ = f.ab.r;
   last_t_ = f.ab.t;
   ++frame_;
-  if (slice_.empty()) slice_.push_back({0, 0, kNoIndex, 0, rot_, trans_, frame_});
+  rot_at_.push_back(rot_);
+  trans_at_.push_back(trans_);
+  if (slice_.empty()) slice_.push_back({0, 0, kNoIndex, frame_, 0.0f});
   auto opens_a = [&](std::uint32_t i, std::uint32_t j) {
     return open_a(na[i], nb[j], a_->sizes()[i], b_->sizes()[j], descend_);
   };
   auto moved = [&](const Entry& e) {
-    return ((rot_ - e.rot) * reach_b_[e.b] + (trans_ - e.trans)) * (1 + 1e-9);
+    return ((rot_ - rot_at_[e.frame]) * reach_b_[e.b] + (trans_ - trans_at_[e.frame])) * (1 + 1e-9);
   };
   LeafTriangles la, lb;
   std::vector<Entry> next;
@@ -691,7 +694,7 @@ CollideResult IncrementalCollide::update(const Posed& pose_a, const Posed& pose_
         ++result.stats.volume_tests;
         const double gap = tester.separation(p.a, p.b);
         if (gap > 0) {
-          next.push_back({p.a, p.b, p.parent, gap, rot_, trans_, frame_});
+          next.push_back({p.a, p.b, p.parent, frame_, key_below(gap)});
           continue;
         }
         if (na[p.a].leaf() && nb[p.b].leaf()) {
@@ -699,7 +702,7 @@ CollideResult IncrementalCollide::update(const Posed& pose_a, const Posed& pose_
             result.pairs.push_back(c);
             return true;
           });
-          next.push_back({p.a, p.b, p.parent, 0, rot_, trans_, frame_});
+          next.push_back({p.a, p.b, p.parent, frame_, 0.0f});
           continue;
         }
         std::uint32_t here;
@@ -713,10 +716,10 @@ CollideResult IncrementalCollide::update(const Posed& pose_a, const Posed& pose_
         }
         if (opens_a(p.a, p.b)) {
           for (std::uint32_t c = na[p.a].num_children; c-- > 0;)
-            stack.push_back({na[p.a].first_child + c, p.b, here, 0, rot_, trans_, frame_});
+            stack.push_back({na[p.a].first_child + c, p.b, here, frame_, 0.0f});
         } else {
           for (std::uint32_t c = nb[p.b].num_children; c-- > 0;)
-            stack.push_back({p.a, nb[p.b].first_child + c, here, 0, rot_, trans_, frame_});
+            stack.push_back({p.a, nb[p.b].first_child + c, here, frame_, 0.0f});
         }
       }
     }
@@ -739,7 +742,7 @@ CollideResult IncrementalCollide::update(const Posed& pose_a, const Posed& pose_
           ++result.stats.volume_tests;
           const double gap = tester.separation(i, j);
           if (gap > 0) {
-            next[w++] = {i, j, opened_[p].parent, gap, rot_, trans_, frame_};
+            next[w++] = {i, j, opened_[p].parent, frame_, key_below(gap)};
             free_.push_back(p);
             g = h;
             continue;

@@ -17,13 +17,28 @@ Posed motion(double s, const Vec3d& center, double size, double speed) {
   return p;
 }
 
+// The bunny and the teapot scaled to 0.8 of its size, centred on it.
+struct Scene {
+  TriMesh bunny, pot;
+  AABB3f bb;
+  double size;
+  Scene()
+      : bunny(io::read_mesh(std::string(GEODS_DATA_DIR) + "/bunny.ply")),
+        pot(io::read_mesh(std::string(GEODS_DATA_DIR) + "/teapot.obj")) {
+    bb = bunny.bounds();
+    const AABB3f tb = pot.bounds();
+    const float scale = 0.8f * (bb.hi - bb.lo).maxCoeff() / (tb.hi - tb.lo).maxCoeff();
+    for (auto& v : pot.vertices) v = (v - tb.center()) * scale + bb.center();
+    size = (bb.hi - bb.lo).maxCoeff();
+  }
+};
+
 TEST(Incremental, EqualsFromScratchOnEveryFrame) {
-  const TriMesh bunny = io::read_mesh(std::string(GEODS_DATA_DIR) + "/bunny.ply");
-  TriMesh pot = io::read_mesh(std::string(GEODS_DATA_DIR) + "/teapot.obj");
-  const AABB3f bb = bunny.bounds(), tb = pot.bounds();
-  const float scale = 0.8f * (bb.hi - bb.lo).maxCoeff() / (tb.hi - tb.lo).maxCoeff();
-  for (auto& v : pot.vertices) v = (v - tb.center()) * scale + bb.center();
-  const double size = (bb.hi - bb.lo).maxCoeff();
+  const Scene scene;
+  const TriMesh& bunny = scene.bunny;
+  const TriMesh& pot = scene.pot;
+  const AABB3f bb = scene.bb;
+  const double size = scene.size;
   for (const auto& [bv, rule] : {std::pair{CollisionVolume::obb, DescendRule::larger},
                                 std::pair{CollisionVolume::boxtree, DescendRule::count},
                                 std::pair{CollisionVolume::kdop18, DescendRule::b_first}}) {
@@ -60,13 +75,10 @@ TEST(Incremental, EqualsFromScratchOnEveryFrame) {
 // incremental queries test fewer volume pairs in all than queries from
 // scratch, with the same contacts.
 TEST(Incremental, SkipsPairsThatCannotHaveMovedIntoContact) {
-  const TriMesh bunny = io::read_mesh(std::string(GEODS_DATA_DIR) + "/bunny.ply");
-  TriMesh pot = io::read_mesh(std::string(GEODS_DATA_DIR) + "/teapot.obj");
-  const AABB3f bb = bunny.bounds(), tb = pot.bounds();
-  const float scale = 0.8f * (bb.hi - bb.lo).maxCoeff() / (tb.hi - tb.lo).maxCoeff();
-  for (auto& v : pot.vertices) v = (v - tb.center()) * scale + bb.center();
-  const double size = (bb.hi - bb.lo).maxCoeff();
-  const CollisionMesh a(bunny), b(pot);
+  const Scene scene;
+  const AABB3f bb = scene.bb;
+  const double size = scene.size;
+  const CollisionMesh a(scene.bunny), b(scene.pot);
   IncrementalCollide inc(a, b);
   std::size_t scratch_tests = 0, inc_tests = 0, skipped = 0;
   const int frames = 200;

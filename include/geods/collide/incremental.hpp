@@ -48,9 +48,8 @@ class IncrementalCollide {
   struct Entry {
     std::uint32_t a, b;
     std::uint32_t parent;  // the recursion-tree parent pair (its index in opened_), kNoIndex for the roots
-    double gap;            // > 0: apart, a lower bound of the volumes' distance when tested; else 0
-    double rot, trans;     // the summed motion (rot_, trans_) when tested
     std::uint32_t frame;   // the update that tested it
+    float gap;             // > 0: apart, a lower bound of the volumes' distance when tested; else 0
   };
   const CollisionMesh* a_;
   const CollisionMesh* b_;
@@ -59,6 +58,7 @@ class IncrementalCollide {
   std::vector<double> reach_b_;  // per node of B: farthest point of its box from B's origin
   // Summed motion of B in A's frame: |R_k+1 - R_k|_F and |t_k+1 - t_k| over the frames.
   double rot_ = 0, trans_ = 0;
+  std::vector<double> rot_at_{0.0}, trans_at_{0.0};  // rot_, trans_ after each update (16 bytes a frame)
   Eigen::Matrix3d last_r_ = Eigen::Matrix3d::Identity();
   Vec3d last_t_ = Vec3d::Zero();
   bool has_last_ = false;
