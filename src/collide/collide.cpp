@@ -724,16 +724,22 @@ CollideResult IncrementalCollide::update(const Posed& pose_a, const Posed& pose_
       }
     }
     // Up: a run of siblings that is the whole subtree of their parent, all
-    // apart, one of them tested this frame, becomes the parent if the
-    // parent's volumes are apart too (one level per frame).
+    // apart, one of them tested this frame or the last, becomes the parent
+    // if the parent's volumes are apart too; repeated while pairs rise, so
+    // that the slice follows a contact region that moves away.
+    // After the first pass only groups with a pair raised in the last pass are tried.
+    std::vector<char> risen, risen_next;
+    for (bool raised = true, first = true; raised; first = false) {
+    raised = false;
     std::size_t w = 0;
+    risen_next.assign(next.size(), 0);
     for (std::size_t g = 0; g < next.size();) {
       const std::uint32_t p = next[g].parent;
       bool apart = true, fresh = false;
       std::size_t h = g;
       for (; h < next.size() && next[h].parent == p; ++h) {
         apart = apart && next[h].gap > 0;
-        fresh = fresh || next[h].frame + 1 >= frame_;
+        fresh = fresh || (first ? next[h].frame + 1 >= frame_ : risen[h] != 0);
       }
       if (p != kNoIndex && apart && fresh) {
         const std::uint32_t i = opened_[p].a, j = opened_[p].b;
@@ -742,8 +748,10 @@ CollideResult IncrementalCollide::update(const Posed& pose_a, const Posed& pose_
           ++result.stats.volume_tests;
           const double gap = tester.separation(i, j);
           if (gap > 0) {
+            risen_next[w] = 1;
             next[w++] = {i, j, opened_[p].parent, frame_, key_below(gap)};
             free_.push_back(p);
+            raised = true;
             g = h;
             continue;
           }
@@ -752,6 +760,8 @@ CollideResult IncrementalCollide::update(const Posed& pose_a, const Posed& pose_
       for (; g < h; ++g) next[w++] = next[g];
     }
     next.resize(w);
+    risen.swap(risen_next);
+    }
     return 0;
   });
   slice_.swap(next);
