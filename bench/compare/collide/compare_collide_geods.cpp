@@ -57,7 +57,7 @@ std::vector<collide::Posed> motion(const collide_bench::Workload& w, std::size_t
   return out;
 }
 
-int run_motion(const compare::Args& args) {
+[[maybe_unused]] int run_motion(const compare::Args& args) {  // unused by the RSS program
   const collide_bench::Workload w = collide_bench::load(args);
   std::shared_ptr<collide::CollisionMesh> m;
   const double build_s = compare::median_time_s(args.reps, [&] { m = build(w); });
