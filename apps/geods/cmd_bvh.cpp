@@ -28,7 +28,7 @@ class BvhCommand : public Command {
   void add_options(CLI::App& app) override {
     add_input(app, "mesh", mesh_, "Triangle mesh (.ply, .obj, .off, .stl, .gltf)");
     app.add_option("--builder", builder_, "sah, median, pca, bottom_up, tiling, insertion or boxtree (bottomup: deprecated)");
-    app.add_option("--bv", bv_, "Bounding volume: aabb, sphere, kdop6, kdop14, kdop18, kdop26, obb or obb_hull");
+    app.add_option("--bv", bv_, "Bounding volume: aabb, sphere, kdop6, kdop14, kdop18, kdop26, obb, obb_hull or rss");
     app.add_option("--leaf-size", leaf_size_, "Most triangles per leaf (1..255)");
     app.add_option("--arity", arity_, "Children per node: 2, 4 or 8");
     app.add_option("--rays", rays_, "Rays, n x 6 (ox oy oz dx dy dz; .npy, .csv)");

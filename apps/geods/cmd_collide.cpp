@@ -32,7 +32,7 @@ class CollideCommand : public Command {
     app.add_option("--mode", mode_, "first: stop at the first contact; all: every intersecting triangle pair; "
                                     "distance: least distance and closest points")
         ->check(CLI::IsMember({"first", "all", "distance"}));
-    app.add_option("--bv", bv_, "Bounding volume: aabb, sphere, kdop6, kdop14, kdop18, kdop26, obb, obb_hull, "
+    app.add_option("--bv", bv_, "Bounding volume: aabb, sphere, kdop6, kdop14, kdop18, kdop26, obb, obb_hull, rss, "
                                 "boxtree (restricted boxtree, AABBs)");
     app.add_option("--descend", descend_, "Which node of a pair to open: larger, count, a_first, b_first");
     app.add_option("--leaf-size", leaf_size_, "Most triangles per leaf")->check(at_least(1));

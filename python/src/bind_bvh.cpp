@@ -162,7 +162,7 @@ void bind_bvh(py::module_& m) {
            py::arg("arity") = 4,
            "V: float32 (n, 3) vertices, F: int64 (m, 3) triangles; "
            "builder: sah, median, pca, bottom_up, tiling, insertion, boxtree ('bottomup': deprecated); "
-           "bv: aabb, sphere, kdop6, kdop14, kdop18, kdop26, obb, obb_hull; arity 2, 4 or 8")
+           "bv: aabb, sphere, kdop6, kdop14, kdop18, kdop26, obb, obb_hull, rss; arity 2, 4 or 8")
       .def("intersect", &PyBvh::intersect, py::arg("origins"), py::arg("directions"), py::arg("tmax") = inf,
            "Closest hits of rays origins, directions float32 (n, 3): (t float32 (n,), prim int64 (n,), u, v float32 (n,)); "
            "t = inf and prim = -1 on a miss. Rays in parallel.")

@@ -58,7 +58,7 @@ void bind_collide(py::module_& m) {
            }),
            py::arg("V"), py::arg("F"), py::arg("bv") = "obb", py::arg("leaf_size") = 2, py::arg("builder") = "sah",
            "V: float32 (n, 3) vertices, F: int64 (m, 3) triangles; bv: aabb, sphere, kdop6, kdop14, kdop18, kdop26, obb, "
-           "obb_hull, boxtree")
+           "obb_hull, boxtree, rss")
       .def_property_readonly("num_triangles", &CollisionMesh::num_triangles)
       .def_property_readonly("bv", [](const CollisionMesh& c) { return std::string(to_string(c.options().bv)); });
 

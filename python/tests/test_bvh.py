@@ -8,7 +8,7 @@ import pytest
 import geods
 
 BUILDERS = ["sah", "median", "pca", "bottomup", "tiling", "insertion", "boxtree"]
-VOLUMES = ["aabb", "sphere", "kdop6", "kdop14", "kdop18", "kdop26", "obb", "obb_hull"]
+VOLUMES = ["aabb", "sphere", "kdop6", "kdop14", "kdop18", "kdop26", "obb", "obb_hull", "rss"]
 
 
 @pytest.fixture(scope="module")

@@ -54,7 +54,7 @@ def world(V, pose):
     return np.rint(V.astype(float) @ R.T + np.array(pose[4:], dtype=float)).astype(np.int64)
 
 
-@pytest.mark.parametrize("bv", ["aabb", "sphere", "kdop18", "obb", "boxtree"])
+@pytest.mark.parametrize("bv", ["aabb", "sphere", "kdop18", "obb", "boxtree", "rss"])
 def test_collide_equals_exact_brute_force(bv):
     rng = np.random.default_rng(5)
     Va, Fa = integer_soup(rng, 25, 4)
@@ -87,7 +87,7 @@ def box(lo, hi):
     return V, np.array(F)
 
 
-@pytest.mark.parametrize("bv", ["aabb", "kdop14", "obb", "sphere"])
+@pytest.mark.parametrize("bv", ["aabb", "kdop14", "obb", "sphere", "rss"])
 def test_distance_of_boxes(bv):
     a = geods.CollisionMesh(*box((0, 0, 0), (1, 1, 1)), bv=bv)
     for gap in [0.5, 2.0]:

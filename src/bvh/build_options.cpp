@@ -17,14 +17,15 @@ constexpr std::array<std::pair<std::string_view, Builder>, 8> kBuilders = {{{"sa
                                                                             {"insertion", Builder::insertion},
                                                                             {"boxtree", Builder::boxtree},
                                                                             {"bottomup", Builder::bottom_up}}};
-constexpr std::array<std::pair<std::string_view, BoundingVolume>, 8> kVolumes = {{{"aabb", BoundingVolume::aabb},
+constexpr std::array<std::pair<std::string_view, BoundingVolume>, 9> kVolumes = {{{"aabb", BoundingVolume::aabb},
                                                                                  {"sphere", BoundingVolume::sphere},
                                                                                  {"kdop6", BoundingVolume::kdop6},
                                                                                  {"kdop14", BoundingVolume::kdop14},
                                                                                  {"kdop18", BoundingVolume::kdop18},
                                                                                  {"kdop26", BoundingVolume::kdop26},
                                                                                  {"obb", BoundingVolume::obb},
-                                                                                 {"obb_hull", BoundingVolume::obb_hull}}};
+                                                                                 {"obb_hull", BoundingVolume::obb_hull},
+                                                                                 {"rss", BoundingVolume::rss}}};
 
 // The current names (deprecated spellings left out).
 template <typename Table>

@@ -32,6 +32,8 @@ BV fit_points(std::span<const Vec3f> points) {
     return fit_sphere<float>(points);
   } else if constexpr (std::is_same_v<BV, Obb3f>) {
     return fit_obb<float>(points);
+  } else if constexpr (std::is_same_v<BV, Rss3f>) {
+    return fit_rss<float>(points);
   } else {
     return fit_kdop<float, BV::num_axes * 2>(points);
   }
@@ -39,7 +41,8 @@ BV fit_points(std::span<const Vec3f> points) {
 
 template <typename BV>
 std::pair<double, double> measures(const BV& bv) {
-  if constexpr (std::is_same_v<BV, AABB3f> || std::is_same_v<BV, Sphere3f> || std::is_same_v<BV, Obb3f>) {
+  if constexpr (std::is_same_v<BV, AABB3f> || std::is_same_v<BV, Sphere3f> || std::is_same_v<BV, Obb3f> ||
+                std::is_same_v<BV, Rss3f>) {
     return {double(volume(bv)), double(surface_area(bv))};
   } else {
     return kdop_measures(bv);
@@ -106,6 +109,7 @@ TriangleBvh TriangleBvh::build(const TriMesh& mesh, const BuildOptions& options)
     case BoundingVolume::kdop26: bvh.fit_volumes<Kdop<float, 26>>(); break;
     case BoundingVolume::obb: bvh.fit_volumes<Obb3f>(); break;
     case BoundingVolume::obb_hull: bvh.fit_hull_obbs(); break;
+    case BoundingVolume::rss: bvh.fit_volumes<Rss3f>(); break;
   }
   progress.update(2);
   if (options.bv == BoundingVolume::aabb && options.arity >= 4 && n > 0) bvh.build_wide();
@@ -125,7 +129,8 @@ void TriangleBvh::fit_volumes() {
       pts.push_back(triangles_[i].c);
     }
   };
-  constexpr bool mergeable = std::is_same_v<BV, AABB3f> || !(std::is_same_v<BV, Sphere3f> || std::is_same_v<BV, Obb3f>);
+  constexpr bool mergeable =
+      std::is_same_v<BV, AABB3f> || !(std::is_same_v<BV, Sphere3f> || std::is_same_v<BV, Obb3f> || std::is_same_v<BV, Rss3f>);
   if constexpr (mergeable) {
     // Boxes and k-DOPs merge exactly: fit the leaves, merge upwards (children follow parents).
     parallel_for(0, nodes.size(), 1024, [&](std::size_t b, std::size_t e) {
@@ -143,7 +148,7 @@ void TriangleBvh::fit_volumes() {
       vols[i] = v;
     }
   } else {
-    // Spheres and OBBs are fitted to all vertices below the node: much tighter than merging.
+    // Spheres, OBBs and RSS are fitted to all vertices below the node: much tighter than merging.
     parallel_for(0, nodes.size(), 16, [&](std::size_t b, std::size_t e) {
       std::vector<Vec3f> pts;
       for (std::size_t i = b; i < e; ++i) {
@@ -283,6 +288,7 @@ void with_volume_type(BoundingVolume bv, Fn&& fn) {
     case BoundingVolume::kdop26: return fn(Kdop<float, 26>{});
     case BoundingVolume::obb:
     case BoundingVolume::obb_hull: return fn(Obb3f{});
+    case BoundingVolume::rss: return fn(Rss3f{});
   }
 }
 
@@ -314,7 +320,7 @@ TriangleBvh TriangleBvh::from_sections(const Archive& in) {
   const auto builder = in.value<std::uint32_t>("builder");
   const auto bv = in.value<std::uint32_t>("bv");
   if (builder > std::uint32_t(Builder::boxtree)) throw in.error("unknown bvh builder " + std::to_string(builder));
-  if (bv > std::uint32_t(BoundingVolume::obb_hull)) throw in.error("unknown bounding volume " + std::to_string(bv));
+  if (bv > std::uint32_t(BoundingVolume::rss)) throw in.error("unknown bounding volume " + std::to_string(bv));
   bvh.options_.builder = Builder(builder);
   bvh.options_.bv = BoundingVolume(bv);
   bvh.options_.leaf_size = in.value<std::int32_t>("leaf_size");

@@ -20,7 +20,7 @@ constexpr std::pair<std::string_view, CollisionVolume> kVolumes[] = {
     {"aabb", CollisionVolume::aabb},     {"sphere", CollisionVolume::sphere}, {"kdop6", CollisionVolume::kdop6},
     {"kdop14", CollisionVolume::kdop14}, {"kdop18", CollisionVolume::kdop18}, {"kdop26", CollisionVolume::kdop26},
     {"obb", CollisionVolume::obb},       {"obb_hull", CollisionVolume::obb_hull},
-    {"boxtree", CollisionVolume::boxtree}};
+    {"boxtree", CollisionVolume::boxtree}, {"rss", CollisionVolume::rss}};
 constexpr std::pair<std::string_view, DescendRule> kRules[] = {{"larger", DescendRule::larger},
                                                                {"count", DescendRule::count},
                                                                {"a_first", DescendRule::a_first},
@@ -67,6 +67,7 @@ CollisionMesh::CollisionMesh(const TriMesh& mesh, const CollisionMeshOptions& op
     case CollisionVolume::kdop26: bo.bv = bvh::BoundingVolume::kdop26; break;
     case CollisionVolume::obb: bo.bv = bvh::BoundingVolume::obb; break;
     case CollisionVolume::obb_hull: bo.bv = bvh::BoundingVolume::obb_hull; break;
+    case CollisionVolume::rss: bo.bv = bvh::BoundingVolume::rss; break;
     case CollisionVolume::boxtree:
       bo.bv = bvh::BoundingVolume::aabb;
       bo.builder = bvh::Builder::boxtree;
@@ -89,6 +90,7 @@ CollisionMesh::CollisionMesh(const TriMesh& mesh, const CollisionMeshOptions& op
         using BV = std::decay_t<decltype(volumes[0])>;
         if constexpr (std::is_same_v<BV, bvh::Sphere3f>) balls_.resize(n);
         if constexpr (std::is_same_v<BV, bvh::Obb3f>) oriented_.resize(n);
+        if constexpr (std::is_same_v<BV, bvh::Rss3f>) swept_.resize(n);
         for (std::size_t i = 0; i < n; ++i) {
           const AABB3f box = bvh::bounds(volumes[i]);
           boxes_[i] = {((box.lo.cast<double>() + box.hi.cast<double>()) / 2),
@@ -102,6 +104,13 @@ CollisionMesh::CollisionMesh(const TriMesh& mesh, const CollisionMeshOptions& op
             oriented_[i] = {volumes[i].axes.template cast<double>(), volumes[i].center.template cast<double>(),
                             volumes[i].half.template cast<double>(), volumes[i].half.template cast<double>().norm()};
             sizes_[i] = 2 * oriented_[i].half.norm();
+          }
+          if constexpr (std::is_same_v<BV, bvh::Rss3f>) {
+            const auto& v = volumes[i];
+            const double h0 = v.half[0], h1 = v.half[1], r = v.radius;
+            swept_[i] = {v.axes.template cast<double>(), v.center.template cast<double>(), h0, h1, r,
+                         std::sqrt(h0 * h0 + h1 * h1) + r};
+            sizes_[i] = 2 * swept_[i].reach;
           }
         }
       },
@@ -170,6 +179,7 @@ struct BoxTester {
     return (c - a[i].center).cwiseAbs() - a[i].half - h;
   }
   bool overlap(std::uint32_t i, std::uint32_t j) const { return (gap(i, j).array() <= f.eps).all(); }
+  double separation(std::uint32_t i, std::uint32_t j) const { return gap(i, j).maxCoeff() - f.eps; }
   double lower(std::uint32_t i, std::uint32_t j, double) const {
     return gap(i, j).cwiseMax(Vec3d::Zero()).norm() - f.eps;
   }
@@ -186,6 +196,7 @@ struct BallTester {
   }
   bool overlap(std::uint32_t i, std::uint32_t j) const { return gap(i, j) <= f.eps; }
   double lower(std::uint32_t i, std::uint32_t j, double) const { return gap(i, j) - f.eps; }
+  double separation(std::uint32_t i, std::uint32_t j) const { return gap(i, j) - f.eps; }
 };
 
 // k-DOPs do not rotate: each side's k-DOP is tested against the rotated
@@ -241,6 +252,7 @@ struct KdopTester {
     return g;
   }
   bool overlap(std::uint32_t i, std::uint32_t j) const { return gap(i, j, true) <= f.eps; }
+  double separation(std::uint32_t i, std::uint32_t j) const { return gap(i, j, true) - f.eps; }
   double lower(std::uint32_t i, std::uint32_t j, double) const { return gap(i, j, false) - f.eps; }
 };
 
@@ -328,9 +340,47 @@ struct ObbTester {
     return g;
   }
   bool overlap(std::uint32_t i, std::uint32_t j) const { return gap<false>(i, j) <= f.eps; }
+  // The gap along the first separating axis found (or the spheres'): a lower
+  // bound of the distance (an unnormalized cross axis, shorter than 1, only
+  // lowers it). Computing a larger bound (all face axes, normalized cross
+  // axes) lets incremental queries skip few more pairs and costs more than it saves.
+  double separation(std::uint32_t i, std::uint32_t j) const { return gap<false>(i, j) - f.eps; }
   double lower(std::uint32_t i, std::uint32_t j, double cutoff) const {
     return gap<true>(i, j, cutoff + f.eps) - f.eps;
   }
+};
+
+// Rectangle swept spheres: the rectangles' distance (bvh::rectangle_distance,
+// exact) less both radii, after cheaper bounds that often settle the pair:
+// the bounding spheres, then the gaps along A's three axes.
+struct RssTester {
+  const Frames& f;
+  const CollisionMesh::Swept* a;
+  const CollisionMesh::Swept* b;
+  explicit RssTester(const Frames& fr) : f(fr), a(fr.a.swept().data()), b(fr.b.swept().data()) {}
+
+  // A lower bound of the distance between the volumes, exact if below `cutoff`.
+  double gap(std::uint32_t i, std::uint32_t j, double cutoff) const {
+    const CollisionMesh::Swept& A = a[i];
+    const CollisionMesh::Swept& B = b[j];
+    const Vec3d d = f.ab.r * B.center + f.ab.t - A.center;  // in A's model frame
+    const double reach = A.reach + B.reach;
+    const double d2 = d.squaredNorm();
+    if (d2 > (reach + cutoff) * (reach + cutoff)) return std::sqrt(d2) - reach;
+    const double rr = A.radius + B.radius;
+    // B's rectangle in A's rectangle frame.
+    const Vec3d c = A.axes.transpose() * d;
+    const Eigen::Matrix3d r = A.axes.transpose() * (f.ab.r * B.axes);
+    const double ha[3] = {A.half0, A.half1, 0};
+    double g = -std::numeric_limits<double>::infinity();
+    for (int k = 0; k < 3; ++k)
+      g = std::max(g, std::abs(c[k]) - ha[k] - std::abs(r(k, 0)) * B.half0 - std::abs(r(k, 1)) * B.half1 - rr);
+    if (g > cutoff) return g;
+    return bvh::rectangle_distance<double>(r, c, A.half0, A.half1, B.half0, B.half1) - rr;
+  }
+  bool overlap(std::uint32_t i, std::uint32_t j) const { return gap(i, j, f.eps) <= f.eps; }
+  double separation(std::uint32_t i, std::uint32_t j) const { return gap(i, j, f.eps) - f.eps; }
+  double lower(std::uint32_t i, std::uint32_t j, double cutoff) const { return gap(i, j, cutoff + f.eps) - f.eps; }
 };
 
 // ---- The traversal.
@@ -421,6 +471,7 @@ auto with_tester(const Frames& f, Fn&& fn) {
     return ia && ib;
   };
   if (same({CollisionVolume::obb, CollisionVolume::obb_hull})) return fn(ObbTester(f));
+  if (va == CollisionVolume::rss && vb == CollisionVolume::rss) return fn(RssTester(f));
   if (va == vb) {
     switch (va) {
       case CollisionVolume::sphere: return fn(BallTester(f));
@@ -585,42 +636,65 @@ DistanceResult distance(const CollisionMesh& a, const Posef& pose_a, const Colli
 // ---- Incremental collision detection.
 
 IncrementalCollide::IncrementalCollide(const CollisionMesh& a, const CollisionMesh& b, DescendRule descend)
-    : a_(&a), b_(&b), descend_(descend) {}
+    : a_(&a), b_(&b), descend_(descend) {
+  reach_b_.resize(b.boxes().size());
+  for (std::size_t j = 0; j < reach_b_.size(); ++j) reach_b_[j] = b.boxes()[j].center.norm() + b.boxes()[j].half.norm();
+}
 
 void IncrementalCollide::reset() {
   slice_.clear();
-  parent_.clear();
+  opened_.clear();
+  free_.clear();
 }
-
-namespace {
-constexpr std::uint64_t kNoPair = ~std::uint64_t(0);
-std::uint64_t pair_key(std::uint32_t a, std::uint32_t b) { return std::uint64_t(a) << 32 | b; }
-}  // namespace
 
 CollideResult IncrementalCollide::update(const Posed& pose_a, const Posed& pose_b) {
   const Frames f = frames(*a_, pose_a, *b_, pose_b);
   CollideResult result;
+  skipped_ = 0;
   const auto& na = a_->bvh().topology().nodes;
   const auto& nb = b_->bvh().topology().nodes;
   if (na.empty() || nb.empty()) return result;
-  if (slice_.empty()) slice_.push_back({0, 0, kNoPair, false});
+  // The motion since the last frame, summed: a point p of B's model frame
+  // moved in A's frame by |(R' - R) p + t' - t| <= |R' - R|_F |p| + |t' - t|.
+  if (has_last_) {
+    rot_ += (f.ab.r - last_r_).norm();
+    trans_ += (f.ab.t - last_t_).norm();
+  }
+  has_last_ = true;
+  last_r_ = f.ab.r;
+  last_t_ = f.ab.t;
+  ++frame_;
+  rot_at_.push_back(rot_);
+  trans_at_.push_back(trans_);
+  if (slice_.empty()) slice_.push_back({0, 0, kNoIndex, frame_, 0.0f});
   auto opens_a = [&](std::uint32_t i, std::uint32_t j) {
     return open_a(na[i], nb[j], a_->sizes()[i], b_->sizes()[j], descend_);
   };
+  auto moved = [&](const Entry& e) {
+    return ((rot_ - rot_at_[e.frame]) * reach_b_[e.b] + (trans_ - trans_at_[e.frame])) * (1 + 1e-9);
+  };
   LeafTriangles la, lb;
   std::vector<Entry> next;
-  next.reserve(slice_.size());
+  next.reserve(slice_.size() + 64);
   with_tester(f, [&](const auto& tester) {
-    // Down: each slice pair that overlaps now is replaced by the bottom slice of its subtree.
+    // Down: each slice pair that may overlap now is tested; one that does is
+    // replaced by the bottom slice of its subtree (in place: every subtree of
+    // the recursion tree stays a contiguous run of the slice).
     std::vector<Entry> stack;
     for (const Entry& e : slice_) {
+      if (e.gap > 0 && moved(e) < e.gap) {
+        next.push_back(e);
+        ++skipped_;
+        continue;
+      }
       stack.push_back(e);
       while (!stack.empty()) {
         const Entry p = stack.back();
         stack.pop_back();
         ++result.stats.volume_tests;
-        if (!tester.overlap(p.a, p.b)) {
-          next.push_back({p.a, p.b, p.parent, true});
+        const double gap = tester.separation(p.a, p.b);
+        if (gap > 0) {
+          next.push_back({p.a, p.b, p.parent, frame_, key_below(gap)});
           continue;
         }
         if (na[p.a].leaf() && nb[p.b].leaf()) {
@@ -628,54 +702,65 @@ CollideResult IncrementalCollide::update(const Posed& pose_a, const Posed& pose_
             result.pairs.push_back(c);
             return true;
           });
-          next.push_back({p.a, p.b, p.parent, false});
+          next.push_back({p.a, p.b, p.parent, frame_, 0.0f});
           continue;
         }
-        const std::uint64_t here = pair_key(p.a, p.b);
-        parent_[here] = p.parent;
-        if (opens_a(p.a, p.b)) {
-          for (std::uint32_t c = 0; c < na[p.a].num_children; ++c) stack.push_back({na[p.a].first_child + c, p.b, here, false});
+        std::uint32_t here;
+        if (!free_.empty()) {
+          here = free_.back();
+          free_.pop_back();
+          opened_[here] = {p.a, p.b, p.parent};
         } else {
-          for (std::uint32_t c = 0; c < nb[p.b].num_children; ++c) stack.push_back({p.a, nb[p.b].first_child + c, here, false});
+          here = std::uint32_t(opened_.size());
+          opened_.push_back({p.a, p.b, p.parent});
+        }
+        if (opens_a(p.a, p.b)) {
+          for (std::uint32_t c = na[p.a].num_children; c-- > 0;)
+            stack.push_back({na[p.a].first_child + c, p.b, here, frame_, 0.0f});
+        } else {
+          for (std::uint32_t c = nb[p.b].num_children; c-- > 0;)
+            stack.push_back({p.a, nb[p.b].first_child + c, here, frame_, 0.0f});
         }
       }
     }
-    // Up: siblings all apart, under a parent apart too, become the parent (one
-    // level per frame: a pair keeps rising while it stays apart).
-    std::vector<std::uint32_t> idx;
-    for (bool changed = true; changed;) {
-      if (!changed) break;
-      changed = false;
-      idx.clear();
-      for (std::uint32_t k = 0; k < next.size(); ++k)
-        if (next[k].apart && next[k].parent != kNoPair) idx.push_back(k);
-      std::sort(idx.begin(), idx.end(), [&](std::uint32_t x, std::uint32_t y) { return next[x].parent < next[y].parent; });
-      std::vector<bool> drop(next.size(), false);
-      std::vector<Entry> raised;
-      for (std::size_t g = 0; g < idx.size();) {
-        std::size_t h = g;
-        const std::uint64_t p = next[idx[g]].parent;
-        while (h < idx.size() && next[idx[h]].parent == p) ++h;
-        const auto i = std::uint32_t(p >> 32), j = std::uint32_t(p);
+    // Up: a run of siblings that is the whole subtree of their parent, all
+    // apart, one of them tested this frame or the last, becomes the parent
+    // if the parent's volumes are apart too; repeated while pairs rise, so
+    // that the slice follows a contact region that moves away.
+    // After the first pass only groups with a pair raised in the last pass are tried.
+    std::vector<char> risen, risen_next;
+    for (bool raised = true, first = true; raised; first = false) {
+    raised = false;
+    std::size_t w = 0;
+    risen_next.assign(next.size(), 0);
+    for (std::size_t g = 0; g < next.size();) {
+      const std::uint32_t p = next[g].parent;
+      bool apart = true, fresh = false;
+      std::size_t h = g;
+      for (; h < next.size() && next[h].parent == p; ++h) {
+        apart = apart && next[h].gap > 0;
+        fresh = fresh || (first ? next[h].frame + 1 >= frame_ : risen[h] != 0);
+      }
+      if (p != kNoIndex && apart && fresh) {
+        const std::uint32_t i = opened_[p].a, j = opened_[p].b;
         const std::uint32_t children = opens_a(i, j) ? na[i].num_children : nb[j].num_children;
         if (h - g == children) {
           ++result.stats.volume_tests;
-          if (!tester.overlap(i, j)) {
-            for (std::size_t k = g; k < h; ++k) drop[idx[k]] = true;
-            const auto it = parent_.find(p);
-            raised.push_back({i, j, it->second, true});
-            parent_.erase(it);
-            changed = true;
+          const double gap = tester.separation(i, j);
+          if (gap > 0) {
+            risen_next[w] = 1;
+            next[w++] = {i, j, opened_[p].parent, frame_, key_below(gap)};
+            free_.push_back(p);
+            raised = true;
+            g = h;
+            continue;
           }
         }
-        g = h;
       }
-      std::size_t w = 0;
-      for (std::size_t k = 0; k < next.size(); ++k)
-        if (!drop[k]) next[w++] = next[k];
-      next.resize(w);
-      next.insert(next.end(), raised.begin(), raised.end());
-      changed = false;  // one level
+      for (; g < h; ++g) next[w++] = next[g];
+    }
+    next.resize(w);
+    risen.swap(risen_next);
     }
     return 0;
   });

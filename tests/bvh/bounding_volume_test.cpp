@@ -11,6 +11,7 @@
 #include "geods/bvh/aabb_bv.hpp"
 #include "geods/bvh/kdop.hpp"
 #include "geods/bvh/obb.hpp"
+#include "geods/bvh/rss.hpp"
 #include "geods/bvh/sphere.hpp"
 #include "geods/core/rng.hpp"
 
@@ -93,6 +94,75 @@ TEST(BoundingVolumes, Obb) {
   check_volume<float>([](const auto& p) { return fit_obb<float>(p, ObbFit::hull); }, true);
   check_volume<double>([](const auto& p) { return fit_obb<double>(p, ObbFit::hull); }, true);
 }
+TEST(BoundingVolumes, Rss) {
+  check_volume<float>([](const auto& p) { return fit_rss<float>(p); }, true);
+  check_volume<double>([](const auto& p) { return fit_rss<double>(p); }, true);
+  // Flat, linear and single-point sets.
+  const std::vector<Vec3d> flat = {{0, 0, 0}, {2, 0, 0}, {2, 1, 0}, {0, 1, 0}, {1, 0.5, 0}};
+  const Rss3d f = fit_rss<double>(flat);
+  for (const Vec3d& p : flat) EXPECT_TRUE(contains(f, p));
+  EXPECT_LT(f.radius, 1e-5);
+  EXPECT_NEAR(surface_area(f), 4.0, 1e-3);  // both sides of the 2 x 1 rectangle
+  const std::vector<Vec3d> line = {{0, 0, 0}, {1, 2, 3}, {2, 4, 6}};
+  for (const Vec3d& p : line) EXPECT_TRUE(contains(fit_rss<double>(line), p));
+  EXPECT_TRUE(contains(fit_rss<double>(std::vector<Vec3d>{{5, 5, 5}}), Vec3d(5, 5, 5)));
+}
+
+// Distance from p to the rectangle {c + u e0 + v e1 : |u| <= h0, |v| <= h1} (projection, clamped).
+double point_rectangle(const Vec3d& p, const Vec3d& c, const Vec3d& e0, const Vec3d& e1, double h0, double h1) {
+  const Vec3d d = p - c;
+  const double u = std::clamp(d.dot(e0), -h0, h0), v = std::clamp(d.dot(e1), -h1, h1);
+  return (d - u * e0 - v * e1).norm();
+}
+
+// Oracle: the least distance from points sampled densely along each
+// rectangle's edges to the other rectangle (exact projection), and whether
+// a dense sample of one rectangle crosses the other's plane inside it. The
+// sampled distance is never below the true one and at most a sample step above.
+TEST(BoundingVolumes, RectangleDistanceMatchesSampling) {
+  Rng rng(17);
+  int touching = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    const double a0 = rng.uniform(0, 1), a1 = rng.uniform(0, 1), b0 = rng.uniform(0, 1), b1 = rng.uniform(0, 1);
+    Eigen::Matrix3d r = Eigen::Quaterniond(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1))
+                            .normalized()
+                            .toRotationMatrix();
+    if (trial % 10 == 0) r = Eigen::AngleAxisd(rng.uniform(0, 3), Vec3d::UnitZ()).toRotationMatrix();  // parallel planes
+    Vec3d c(rng.uniform(-2, 2), rng.uniform(-2, 2), rng.uniform(-1, 1));
+    if (trial % 10 == 0 && trial % 20 == 0) c[2] = 0;  // coplanar
+    const double got = rectangle_distance<double>(r, c, a0, a1, b0, b1);
+    const int n = 400;
+    double sampled = std::numeric_limits<double>::infinity();
+    const Vec3d ex = Vec3d::UnitX(), ey = Vec3d::UnitY(), o = Vec3d::Zero();
+    auto edges = [&](const Vec3d& cen, const Vec3d& e0, const Vec3d& e1, double h0, double h1, auto&& other) {
+      for (int k = 0; k <= n; ++k) {
+        const double t = -1 + 2.0 * k / n;
+        for (double s : {-1.0, 1.0}) {
+          sampled = std::min(sampled, other(cen + s * h0 * e0 + t * h1 * e1));
+          sampled = std::min(sampled, other(cen + t * h0 * e0 + s * h1 * e1));
+        }
+      }
+    };
+    edges(o, ex, ey, a0, a1, [&](const Vec3d& p) { return point_rectangle(p, c, r.col(0), r.col(1), b0, b1); });
+    edges(c, r.col(0), r.col(1), b0, b1, [&](const Vec3d& p) { return point_rectangle(p, o, ex, ey, a0, a1); });
+    const double step = 2.0 * std::max({a0, a1, b0, b1}) / n;
+    ASSERT_LE(got, sampled + 1e-12) << trial;
+    ASSERT_GE(got, sampled - step) << trial;
+    touching += got == 0;
+    // The volumes' overlap agrees: the swept spheres meet iff the distance is below both radii.
+    Rss3d A, B;
+    A.half = Vec2d(a0, a1);
+    A.radius = 0.1;
+    B.axes = r;
+    B.center = c;
+    B.half = Vec2d(b0, b1);
+    B.radius = 0.2;
+    EXPECT_EQ(overlaps(A, B), got <= 0.3) << trial;
+    EXPECT_NEAR(rectangle_distance(A, B), got, 1e-12);
+  }
+  EXPECT_GT(touching, 10);
+}
+
 // Volume of the box along the points' principal axes (the classic fit,
 // computed here independently as the oracle the hull fit must not exceed).
 double pca_box_volume(const std::vector<Vec3d>& pts) {

@@ -55,7 +55,8 @@ TEST(TriangleBvhArchive, EveryVolumeAndArityRoundTripsBitForBitInPlace) {
   const TriMesh bunny = test::data_mesh("bunny.ply");
   const BoundingVolume volumes[] = {BoundingVolume::aabb,   BoundingVolume::sphere, BoundingVolume::kdop6,
                                     BoundingVolume::kdop14, BoundingVolume::kdop18, BoundingVolume::kdop26,
-                                    BoundingVolume::obb,    BoundingVolume::obb_hull};
+                                    BoundingVolume::obb,    BoundingVolume::obb_hull,
+                                       BoundingVolume::rss};
   for (BoundingVolume bv : volumes)
     for (int arity : {2, 4, 8}) {
       if (bv != BoundingVolume::aabb && arity != 4) continue;  // the wide layouts are the AABB ones

@@ -18,7 +18,8 @@ constexpr Builder kBuilders[] = {Builder::sah,    Builder::median,    Builder::p
                                  Builder::tiling, Builder::insertion, Builder::boxtree};
 constexpr BoundingVolume kVolumes[] = {BoundingVolume::aabb,   BoundingVolume::sphere, BoundingVolume::kdop6,
                                        BoundingVolume::kdop14, BoundingVolume::kdop18, BoundingVolume::kdop26,
-                                       BoundingVolume::obb,    BoundingVolume::obb_hull};
+                                       BoundingVolume::obb,    BoundingVolume::obb_hull,
+                                       BoundingVolume::rss};
 
 // The closest hit must have the brute-force t, and its triangle must be hit
 // there. Where several triangles meet the ray at the same point (a ray through

@@ -20,7 +20,7 @@ namespace {
 constexpr CollisionVolume kAllVolumes[] = {CollisionVolume::aabb,   CollisionVolume::sphere, CollisionVolume::kdop6,
                                            CollisionVolume::kdop14, CollisionVolume::kdop18, CollisionVolume::kdop26,
                                            CollisionVolume::obb,    CollisionVolume::obb_hull,
-                                           CollisionVolume::boxtree};
+                                           CollisionVolume::boxtree, CollisionVolume::rss};
 
 TriMesh soup(std::size_t n, double size, std::uint64_t seed, bool degenerate = false) {
   Rng rng(seed);

@@ -21,8 +21,9 @@ enum class Builder {
 
 /// obb: principal axes of the vertices below a node (ObbFit::pca); obb_hull:
 /// the smallest of the hull-based candidates of ObbFit::hull (tighter, slower
-/// to build; the same Obb3f volumes and queries).
-enum class BoundingVolume { aabb, sphere, kdop6, kdop14, kdop18, kdop26, obb, obb_hull };
+/// to build; the same Obb3f volumes and queries). rss: rectangle swept
+/// spheres (rss.hpp) in the principal axes of the vertices below a node.
+enum class BoundingVolume { aabb, sphere, kdop6, kdop14, kdop18, kdop26, obb, obb_hull, rss };
 
 struct BuildOptions {
   Builder builder = Builder::sah;
@@ -40,7 +41,7 @@ struct BuildOptions {
 /// The enum value's name: "sah", "median", "pca", "bottom_up", "tiling", "insertion", "boxtree" ("bottomup":
 /// the deprecated spelling of bottom_up); throws geods::Error otherwise.
 Builder parse_builder(std::string_view name);
-/// "aabb", "sphere", "kdop6", "kdop14", "kdop18", "kdop26", "obb", "obb_hull"; throws geods::Error otherwise.
+/// "aabb", "sphere", "kdop6", "kdop14", "kdop18", "kdop26", "obb", "obb_hull", "rss"; throws geods::Error otherwise.
 BoundingVolume parse_bounding_volume(std::string_view name);
 std::string_view to_string(Builder builder);
 std::string_view to_string(BoundingVolume bv);

@@ -25,6 +25,7 @@
 #include "geods/bvh/kdop.hpp"
 #include "geods/bvh/obb.hpp"
 #include "geods/bvh/ray_triangle4.hpp"
+#include "geods/bvh/rss.hpp"
 #include "geods/bvh/sphere.hpp"
 #include "geods/bvh/topology.hpp"
 #include "geods/bvh/wide_node.hpp"
@@ -62,7 +63,7 @@ struct ClosestPoint {
 
 using VolumeArray = std::variant<FlatArray<AABB3f>, FlatArray<Sphere3f>, FlatArray<Kdop<float, 6>>,
                                  FlatArray<Kdop<float, 14>>, FlatArray<Kdop<float, 18>>,
-                                 FlatArray<Kdop<float, 26>>, FlatArray<Obb3f>>;
+                                 FlatArray<Kdop<float, 26>>, FlatArray<Obb3f>, FlatArray<Rss3f>>;
 
 /// A triangle of the mesh, copied into the hierarchy (TriangleBvh::Triangle).
 struct BvhTriangle {

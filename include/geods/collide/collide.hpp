@@ -55,9 +55,11 @@ using Posed = Pose<double>;
 
 /// The bounding volumes a CollisionMesh can use: those of the bvh module
 /// (obb: principal axes, obb_hull: the hull fit) and boxtree, the restricted
-/// boxtree of §4.1.5 (Zachmann's Minkowski-volume criterion, AABB volumes).
-enum class CollisionVolume { aabb, sphere, kdop6, kdop14, kdop18, kdop26, obb, obb_hull, boxtree };
-/// "aabb", ..., "boxtree"; throws geods::Error otherwise.
+/// boxtree of §4.1.5 (Zachmann's Minkowski-volume criterion, AABB volumes),
+/// and rss, rectangle swept spheres (bvh/rss.hpp), whose exact distance makes
+/// them the tightest bound for distance queries.
+enum class CollisionVolume { aabb, sphere, kdop6, kdop14, kdop18, kdop26, obb, obb_hull, boxtree, rss };
+/// "aabb", ..., "boxtree", "rss"; throws geods::Error otherwise.
 CollisionVolume parse_collision_volume(std::string_view name);
 std::string_view to_string(CollisionVolume bv);
 
@@ -100,9 +102,17 @@ class CollisionMesh {
     Vec3d center, half;
     double radius;  // |half|: the bounding sphere about the centre, a cheap first test
   };
+  struct Swept {
+    Eigen::Matrix3d axes;  // columns: the rectangle's axes, then its normal
+    Vec3d center;
+    double half0, half1;  // the rectangle's half lengths
+    double radius;        // of the swept sphere
+    double reach;         // |half| + radius: the bounding sphere about the centre
+  };
   const std::vector<Box>& boxes() const { return boxes_; }
   const std::vector<Ball>& balls() const { return balls_; }
   const std::vector<Oriented>& oriented() const { return oriented_; }
+  const std::vector<Swept>& swept() const { return swept_; }
   /// Where triangle `id` of the mesh sits in bvh().triangles() (leaf order).
   std::uint32_t leaf_position(std::uint32_t id) const { return leaf_position_[id]; }
   /// Per node, the size the "larger" descend rule compares (the volume's diameter).
@@ -116,6 +126,7 @@ class CollisionMesh {
   std::vector<Box> boxes_;         // every volume's bounding box (aabb, boxtree, k-DOPs)
   std::vector<Ball> balls_;        // sphere
   std::vector<Oriented> oriented_;  // obb, obb_hull
+  std::vector<Swept> swept_;        // rss
   std::vector<double> sizes_;
   std::vector<std::uint32_t> leaf_position_;
 };
