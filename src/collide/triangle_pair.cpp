@@ -148,29 +148,8 @@ bool triangles_intersect(const TriangleD& s, const TriangleD& t) {
 
 double segment_segment_closest(const Vec3d& p0, const Vec3d& p1, const Vec3d& q0, const Vec3d& q1, Vec3d& on_p,
                                Vec3d& on_q) {
-  const Vec3d d1 = p1 - p0, d2 = q1 - q0, r = p0 - q0;
-  const double a = d1.squaredNorm(), e = d2.squaredNorm(), f = d2.dot(r);
-  double s = 0, t = 0;
-  if (a <= 0 && e <= 0) {
-  } else if (a <= 0) {
-    t = std::clamp(f / e, 0.0, 1.0);
-  } else {
-    const double c = d1.dot(r);
-    if (e <= 0) {
-      s = std::clamp(-c / a, 0.0, 1.0);
-    } else {
-      const double b = d1.dot(d2), denom = a * e - b * b;
-      s = denom > 0 ? std::clamp((b * f - c * e) / denom, 0.0, 1.0) : 0.0;
-      t = (b * s + f) / e;
-      if (t < 0) {
-        t = 0;
-        s = std::clamp(-c / a, 0.0, 1.0);
-      } else if (t > 1) {
-        t = 1;
-        s = std::clamp((b - c) / a, 0.0, 1.0);
-      }
-    }
-  }
+  const Vec3d d1 = p1 - p0, d2 = q1 - q0;
+  const auto [s, t] = geods::segment_segment_closest(p0, d1, q0, d2);
   on_p = p0 + s * d1;
   on_q = q0 + t * d2;
   return (on_p - on_q).squaredNorm();

@@ -19,6 +19,7 @@
 
 #include "geods/bvh/aabb_bv.hpp"
 #include "geods/bvh/obb.hpp"
+#include "geods/core/triangle.hpp"
 
 namespace geods::bvh {
 
@@ -64,34 +65,11 @@ using Rss3f = Rss<float>;
 using Rss3d = Rss<double>;
 
 namespace detail {
-// Squared distance between the segments p + s d (s in [0, 1]) and q + t e
-// (t in [0, 1]); Ericson's closest points of two segments, 5.1.9.
+// Squared distance between the segments p + s d (s in [0, 1]) and q + t e (t in [0, 1]).
 template <typename T>
 T segment_distance2(const Vec<T, 3>& p, const Vec<T, 3>& d, const Vec<T, 3>& q, const Vec<T, 3>& e) {
-  const Vec<T, 3> r = p - q;
-  const T a = d.squaredNorm(), c2 = e.squaredNorm(), f = e.dot(r);
-  T s = 0, t = 0;
-  if (a <= T(0) && c2 <= T(0)) {
-  } else if (a <= T(0)) {
-    t = std::clamp(f / c2, T(0), T(1));
-  } else {
-    const T c = d.dot(r);
-    if (c2 <= T(0)) {
-      s = std::clamp(-c / a, T(0), T(1));
-    } else {
-      const T b = d.dot(e), denom = a * c2 - b * b;
-      s = denom > T(0) ? std::clamp((b * f - c * c2) / denom, T(0), T(1)) : T(0);
-      t = (b * s + f) / c2;
-      if (t < T(0)) {
-        t = 0;
-        s = std::clamp(-c / a, T(0), T(1));
-      } else if (t > T(1)) {
-        t = 1;
-        s = std::clamp((b - c) / a, T(0), T(1));
-      }
-    }
-  }
-  return (r + s * d - t * e).squaredNorm();
+  const auto [s, t] = segment_segment_closest(p, d, q, e);
+  return (p - q + s * d - t * e).squaredNorm();
 }
 
 // Whether an edge of the closed polygon p (4 corners, in the frame of the

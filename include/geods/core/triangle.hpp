@@ -1,6 +1,7 @@
 #pragma once
 // Small helpers on a single triangle (a, b, c).
 #include <algorithm>
+#include <array>
 #include <cstdint>
 
 #include "geods/core/aabb.hpp"
@@ -110,6 +111,38 @@ Vec<T, 3> closest_point_on_triangle(const Vec<T, 3>& p, const Vec<T, 3>& a, cons
                                     const Vec<T, 3>& c) {
   TriangleRegion region;
   return closest_point_on_triangle(p, a, b, c, region);
+}
+
+/// The closest points p + s d and q + t e (s, t in [0, 1]) of the segments
+/// from p along d and from q along e: {s, t} (Ericson, 5.1.9; degenerate
+/// segments are points).
+template <typename T>
+std::array<T, 2> segment_segment_closest(const Vec<T, 3>& p, const Vec<T, 3>& d, const Vec<T, 3>& q,
+                                         const Vec<T, 3>& e) {
+  const Vec<T, 3> r = p - q;
+  const T a = d.squaredNorm(), c2 = e.squaredNorm(), f = e.dot(r);
+  T s = 0, t = 0;
+  if (a <= T(0) && c2 <= T(0)) {
+  } else if (a <= T(0)) {
+    t = std::clamp(f / c2, T(0), T(1));
+  } else {
+    const T c = d.dot(r);
+    if (c2 <= T(0)) {
+      s = std::clamp(-c / a, T(0), T(1));
+    } else {
+      const T b = d.dot(e), denom = a * c2 - b * b;
+      s = denom > T(0) ? std::clamp((b * f - c * c2) / denom, T(0), T(1)) : T(0);
+      t = (b * s + f) / c2;
+      if (t < T(0)) {
+        t = 0;
+        s = std::clamp(-c / a, T(0), T(1));
+      } else if (t > T(1)) {
+        t = 1;
+        s = std::clamp((b - c) / a, T(0), T(1));
+      }
+    }
+  }
+  return {s, t};
 }
 
 }  // namespace geods
