@@ -447,7 +447,8 @@ struct LeafTriangles {
   std::vector<TriangleD> tri;
   std::vector<AABB3d> box;
   std::vector<std::uint32_t> id;
-  void load(const CollisionMesh& m, const Rigid& pose, const bvh::TopoNode& leaf) {
+  // The leaf's triangles carried by `pose` (nullptr: left in the model frame).
+  void load(const CollisionMesh& m, const Rigid* pose, const bvh::TopoNode& leaf) {
     tri.resize(leaf.prim_count);
     box.resize(leaf.prim_count);
     id.resize(leaf.prim_count);
@@ -455,7 +456,10 @@ struct LeafTriangles {
     const auto& ids = m.bvh().triangle_ids();
     for (std::uint32_t k = 0; k < leaf.prim_count; ++k) {
       const auto& t = tris[leaf.prim_first + k];
-      tri[k] = {to_world(pose, t.a), to_world(pose, t.b), to_world(pose, t.c)};
+      if (pose)
+        tri[k] = {to_world(*pose, t.a), to_world(*pose, t.b), to_world(*pose, t.c)};
+      else
+        tri[k] = {t.a.cast<double>(), t.b.cast<double>(), t.c.cast<double>()};
       box[k] = AABB3d(tri[k][0].cwiseMin(tri[k][1]).cwiseMin(tri[k][2]), tri[k][0].cwiseMax(tri[k][1]).cwiseMax(tri[k][2]));
       id[k] = ids[leaf.prim_first + k];
     }
@@ -491,8 +495,8 @@ template <typename OnContact>
 bool leaf_contacts(const Frames& f, LeafTriangles& la, LeafTriangles& lb, std::uint32_t i, std::uint32_t j,
                    CollideStats& stats, OnContact&& contact) {
   ++stats.leaf_pairs;
-  la.load(f.a, f.wa, f.a.bvh().topology().nodes[i]);
-  lb.load(f.b, f.wb, f.b.bvh().topology().nodes[j]);
+  la.load(f.a, &f.wa, f.a.bvh().topology().nodes[i]);
+  lb.load(f.b, &f.wb, f.b.bvh().topology().nodes[j]);
   for (std::size_t s = 0; s < la.tri.size(); ++s)
     for (std::size_t t = 0; t < lb.tri.size(); ++t) {
       if (!la.box[s].overlaps(lb.box[t])) continue;
@@ -584,8 +588,8 @@ DistanceResult distance_frames(const Frames& f, const DistanceRequest& request) 
         },
         [&](std::uint32_t i, std::uint32_t j) {
           ++result.stats.leaf_pairs;
-          la.load(f.a, f.wa, na[i]);
-          lb.load(f.b, f.wb, nb[j]);
+          la.load(f.a, nullptr, na[i]);  // in A's frame: only B's triangles move
+          lb.load(f.b, &f.ab, nb[j]);
           for (std::size_t s = 0; s < la.tri.size(); ++s)
             for (std::size_t t = 0; t < lb.tri.size(); ++t) {
               // The boxes' distance bounds the triangles' from below.
@@ -609,6 +613,8 @@ DistanceResult distance_frames(const Frames& f, const DistanceRequest& request) 
         [&](float key) { return double(key) < best; });
     return 0;
   });
+  result.point_a = f.wa.r * result.point_a + f.wa.t;  // A's frame -> world
+  result.point_b = f.wa.r * result.point_b + f.wa.t;
   result.within = within >= 0 && result.distance <= within;
   return result;
 }
