@@ -114,7 +114,7 @@ class Bvh:
     """Bounding volume hierarchy over the triangles (V, F) of a mesh (float32): C++ bvh::TriangleBvh. geods.Bvh is its deprecated older name.
     """
     def __init__(self, V: ArrayLike, F: ArrayLike, builder: str = ..., bv: str = ..., leaf_size: int = ..., arity: int = ...) -> None:
-        """V: float32 (n, 3) vertices, F: int64 (m, 3) triangles; builder: sah, median, pca, bottom_up, tiling, insertion, boxtree ('bottomup': deprecated); bv: aabb, sphere, kdop6, kdop14, kdop18, kdop26, obb, obb_hull; arity 2, 4 or 8
+        """V: float32 (n, 3) vertices, F: int64 (m, 3) triangles; builder: sah, median, pca, bottom_up, tiling, insertion, boxtree ('bottomup': deprecated); bv: aabb, sphere, kdop6, kdop14, kdop18, kdop26, obb, obb_hull, rss; arity 2, 4 or 8
         """
     def closest_point(self, points: Any) -> tuple[Any, ...]:
         """Closest points of the mesh to points (n, 3): (points float32 (n, 3), prim int64 (n,), distance float32 (n,)).
@@ -164,7 +164,7 @@ class CollisionMesh:
     """A triangle mesh with its bounding volume hierarchy, for collide() and distance()
     """
     def __init__(self, V: ArrayLike, F: ArrayLike, bv: str = ..., leaf_size: int = ..., builder: str = ...) -> None:
-        """V: float32 (n, 3) vertices, F: int64 (m, 3) triangles; bv: aabb, sphere, kdop6, kdop14, kdop18, kdop26, obb, obb_hull, boxtree
+        """V: float32 (n, 3) vertices, F: int64 (m, 3) triangles; bv: aabb, sphere, kdop6, kdop14, kdop18, kdop26, obb, obb_hull, boxtree, rss
         """
     @property
     def bv(self) -> str: ...
@@ -941,7 +941,7 @@ class TriangleBvh:
     """Bounding volume hierarchy over the triangles (V, F) of a mesh (float32): C++ bvh::TriangleBvh. geods.Bvh is its deprecated older name.
     """
     def __init__(self, V: ArrayLike, F: ArrayLike, builder: str = ..., bv: str = ..., leaf_size: int = ..., arity: int = ...) -> None:
-        """V: float32 (n, 3) vertices, F: int64 (m, 3) triangles; builder: sah, median, pca, bottom_up, tiling, insertion, boxtree ('bottomup': deprecated); bv: aabb, sphere, kdop6, kdop14, kdop18, kdop26, obb, obb_hull; arity 2, 4 or 8
+        """V: float32 (n, 3) vertices, F: int64 (m, 3) triangles; builder: sah, median, pca, bottom_up, tiling, insertion, boxtree ('bottomup': deprecated); bv: aabb, sphere, kdop6, kdop14, kdop18, kdop26, obb, obb_hull, rss; arity 2, 4 or 8
         """
     def closest_point(self, points: Any) -> tuple[Any, ...]:
         """Closest points of the mesh to points (n, 3): (points float32 (n, 3), prim int64 (n,), distance float32 (n,)).
