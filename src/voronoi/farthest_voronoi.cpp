@@ -44,9 +44,7 @@ FarthestVoronoi::FarthestVoronoi(std::span<const Vec2d> points, const AABB2d& bo
       detail::clip_halfplane(poly, p, -2 * d, -d.squaredNorm(), j);
       if (poly.points.empty()) break;
     }
-    for (std::size_t k = 0; k < poly.points.size(); ++k)
-      if (poly.labels[k] != detail::kBoxSide && site < poly.labels[k])
-        pieces[c].push_back({site, poly.labels[k], poly.points[k], poly.points[(k + 1) % poly.points.size()]});
+    detail::append_bisector_edges(poly, site, pieces[c]);
     cells_[site] = std::move(poly.points);
   }, 8);
   for (std::uint32_t i = 0; i < n; ++i)

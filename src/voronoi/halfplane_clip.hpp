@@ -7,6 +7,7 @@
 
 #include "geods/core/aabb.hpp"
 #include "geods/core/vec.hpp"
+#include "geods/voronoi/bisector_edge.hpp"
 
 namespace geods::voronoi::detail {
 
@@ -16,6 +17,14 @@ struct LabeledPolygon {
 };
 
 inline constexpr std::uint32_t kBoxSide = std::uint32_t(-1);
+
+// The edges of site's clipped cell that lie on a bisector with a larger site
+// (so that each edge between two cells is kept once), appended to `out`.
+inline void append_bisector_edges(const LabeledPolygon& cell, std::uint32_t site, std::vector<BisectorEdge>& out) {
+  for (std::size_t k = 0; k < cell.points.size(); ++k)
+    if (cell.labels[k] != kBoxSide && site < cell.labels[k])
+      out.push_back({site, cell.labels[k], cell.points[k], cell.points[(k + 1) % cell.points.size()]});
+}
 
 inline LabeledPolygon box_polygon(const AABB2d& box) {
   return {{box.lo, {box.hi[0], box.lo[1]}, box.hi, {box.lo[0], box.hi[1]}}, {kBoxSide, kBoxSide, kBoxSide, kBoxSide}};

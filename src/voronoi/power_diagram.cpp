@@ -475,9 +475,7 @@ PowerDiagram::PowerDiagram(RegularTriangulation triangulation, const AABB2d& box
       detail::clip_halfplane(poly, p, 2 * d, d.squaredNorm() + rt.weights()[site] - rt.weights()[j], j);
       if (poly.points.empty()) break;
     }
-    for (std::size_t k = 0; k < poly.points.size(); ++k)
-      if (poly.labels[k] != detail::kBoxSide && site < poly.labels[k])
-        pieces[i].push_back({site, poly.labels[k], poly.points[k], poly.points[(k + 1) % poly.points.size()]});
+    detail::append_bisector_edges(poly, site, pieces[i]);
     cells_[i] = std::move(poly.points);
   }, 64);
   for (std::uint32_t i = 0; i < n; ++i) {

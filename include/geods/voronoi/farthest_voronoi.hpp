@@ -17,6 +17,7 @@
 
 #include "geods/core/aabb.hpp"
 #include "geods/core/vec.hpp"
+#include "geods/voronoi/bisector_edge.hpp"
 
 namespace geods::voronoi {
 
@@ -27,10 +28,7 @@ struct FarthestVoronoiStats {
 class FarthestVoronoi {
  public:
   /// A piece of the bisector of corners a < b inside the box.
-  struct Edge {
-    std::uint32_t a, b;
-    Vec2d p0, p1;
-  };
+  using Edge = BisectorEdge;
 
   FarthestVoronoi(std::span<const Vec2d> points, const AABB2d& box);
 

@@ -35,6 +35,7 @@
 
 #include "geods/core/aabb.hpp"
 #include "geods/core/vec.hpp"
+#include "geods/voronoi/bisector_edge.hpp"
 
 namespace geods::voronoi {
 
@@ -57,10 +58,7 @@ struct MetricVoronoiStats {
 class MetricVoronoi {
  public:
   /// A piece of the diagram inside the box: part of the bisector of sites a < b (representatives).
-  struct Edge {
-    std::uint32_t a, b;
-    Vec2d p0, p1;
-  };
+  using Edge = BisectorEdge;
 
   /// Throws geods::Error for no points, non-finite coordinates or an empty box.
   MetricVoronoi(std::span<const Vec2d> points, Metric metric, const AABB2d& box);

@@ -40,6 +40,7 @@
 
 #include "geods/core/aabb.hpp"
 #include "geods/core/vec.hpp"
+#include "geods/voronoi/bisector_edge.hpp"
 
 namespace geods::voronoi {
 
@@ -131,10 +132,7 @@ struct PowerDiagramStats {
 class PowerDiagram {
  public:
   /// A piece of the power bisector of sites a < b inside the box.
-  struct Edge {
-    std::uint32_t a, b;
-    Vec2d p0, p1;
-  };
+  using Edge = BisectorEdge;
 
   /// Throws geods::Error as RegularTriangulation, or for an empty box.
   PowerDiagram(std::span<const Vec2d> points, std::span<const double> weights, const AABB2d& box);
