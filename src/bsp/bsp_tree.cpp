@@ -7,6 +7,7 @@
 #include <random>
 #include <string>
 
+#include "geods/core/archive.hpp"
 #include "geods/core/error.hpp"
 
 namespace geods::bsp {
@@ -15,7 +16,8 @@ Heuristic parse_heuristic(std::string_view name) {
   if (name == "cost") return Heuristic::cost;
   if (name == "random") return Heuristic::random;
   if (name == "balanced") return Heuristic::balanced;
-  throw Error("unknown BSP heuristic '" + std::string(name) + "' (cost, random or balanced)");
+  if (name == "custom") return Heuristic::custom;
+  throw Error("unknown BSP heuristic '" + std::string(name) + "' (cost, random, balanced or custom)");
 }
 
 std::string_view heuristic_name(Heuristic h) {
@@ -23,6 +25,7 @@ std::string_view heuristic_name(Heuristic h) {
     case Heuristic::cost: return "cost";
     case Heuristic::random: return "random";
     case Heuristic::balanced: return "balanced";
+    case Heuristic::custom: return "custom";
   }
   return "cost";
 }
@@ -110,6 +113,7 @@ namespace {
 struct Frag {
   Polygon poly;
   double area = 0;
+  double density = 0;  // custom: score per unit area (of the input polygon it comes from)
   std::array<double, 3> centroid{};
 };
 
@@ -164,6 +168,16 @@ void BspTree::build(const std::vector<Vec3d>& vertices, const std::vector<std::a
   if (!(options.alpha > 0) || !std::isfinite(options.alpha) || !(options.beta >= 0) || !std::isfinite(options.beta))
     throw Error("bsp: alpha must be > 0 and beta >= 0");
   if (options.k == 0) throw Error("bsp: k must be at least 1");
+  if (options.heuristic == Heuristic::custom) {
+    const RayQuery& r = options.rays;
+    if (r.directions.empty()) throw Error("bsp: the custom heuristic needs a sample of rays");
+    if (r.origins.size() != r.directions.size()) throw Error("bsp: the ray sample has as many origins as directions");
+    for (std::size_t i = 0; i < r.directions.size(); ++i) {
+      const double len = r.directions[i].norm();
+      if (!std::isfinite(len) || !(len > 0) || !r.origins[i].allFinite())
+        throw Error("bsp: a sample ray is not finite or has a zero direction");
+    }
+  }
   PlaneSet& planes = *planes_;
   std::vector<std::array<std::int64_t, 3>> snapped(vertices.size());
   std::vector<std::uint32_t> point_id(vertices.size(), kNoPoint);
@@ -190,6 +204,35 @@ void BspTree::build(const std::vector<Vec3d>& vertices, const std::vector<std::a
     pool.push_back(make_frag(planes, std::move(poly)));
   }
   if (pool.empty()) throw Error("bsp: every triangle is degenerate (at the grid's resolution)");
+  if (options.heuristic == Heuristic::custom) {
+    // §3.4.3: w(S, p, l) = sin^2(angle of ray l and p's plane) Area(p) / Area(S), summed over
+    // the sample rays l that can hit p (their line meets p's bounding sphere on the ray's
+    // side). density = the sum per unit area, the same for every fragment of p.
+    std::vector<Vec3d> o, d;
+    for (std::size_t i = 0; i < options.rays.origins.size(); ++i) {
+      o.push_back(grid_.to_grid(options.rays.origins[i]));
+      d.push_back(options.rays.directions[i].normalized());
+    }
+    for (Frag& f : pool) {
+      const Plane& h = planes[f.poly.support];
+      const Vec3d n = Vec3d(static_cast<double>(h.a), static_cast<double>(h.b), static_cast<double>(h.c)).normalized();
+      const Vec3d c(f.centroid[0], f.centroid[1], f.centroid[2]);
+      double r2 = 0;
+      for (auto q : f.poly.points) {
+        const auto& x = planes.integer_point(q);
+        r2 = std::max(r2, (Vec3d(static_cast<double>(x[0]), static_cast<double>(x[1]), static_cast<double>(x[2])) - c).squaredNorm());
+      }
+      double sum = 0;
+      for (std::size_t i = 0; i < o.size(); ++i) {
+        const Vec3d v = c - o[i];
+        const double t = v.dot(d[i]);
+        if (t * std::fabs(t) < -r2 || (v - t * d[i]).squaredNorm() > r2) continue;
+        const double cs = n.dot(d[i]);
+        sum += cs * cs;
+      }
+      f.density = sum / static_cast<double>(o.size());
+    }
+  }
   stats_ = BspStats{};
   stats_.polygons = pool.size();
 
@@ -198,9 +241,9 @@ void BspTree::build(const std::vector<Vec3d>& vertices, const std::vector<std::a
     std::vector<std::uint32_t> frags;
   };
   std::mt19937_64 rng(options.seed);
-  nodes_.clear();
+  std::vector<Node> nodes;
   fragments_.clear();
-  nodes_.emplace_back();
+  nodes.emplace_back();
   root_ = 0;
   std::vector<Task> stack;
   {
@@ -211,6 +254,7 @@ void BspTree::build(const std::vector<Vec3d>& vertices, const std::vector<std::a
   }
   std::vector<int> signs;
   std::vector<std::uint32_t> order, scored;
+  std::vector<std::pair<double, std::uint32_t>> ranked;
 
   // Sides of fragment f against plane h: -1 neg, +1 pos, 0 coplanar, 2 straddling.
   auto side_of = [&](std::uint32_t f, std::uint32_t h) {
@@ -268,6 +312,16 @@ void BspTree::build(const std::vector<Vec3d>& vertices, const std::vector<std::a
       }
       if (neg > 0 && pos > 0 && neg < frags.size() && pos < frags.size()) plane = h;
     }
+    if (options.heuristic == Heuristic::custom) {
+      // §3.4.3: score(p) = Area(p) * density (Area(S) is the same for every candidate of the
+      // node); the plane of a random one of the k best.
+      const std::size_t k = std::min<std::size_t>(options.k, frags.size());
+      ranked.clear();
+      for (auto f : frags) ranked.emplace_back(pool[f].density * pool[f].area, f);
+      std::partial_sort(ranked.begin(), ranked.begin() + static_cast<std::ptrdiff_t>(k), ranked.end(),
+                        [](const auto& a, const auto& b) { return a.first > b.first; });
+      plane = pool[ranked[rng() % k].second].poly.support;
+    }
     if (plane == kNoIndex) {
       // Candidates: the k largest fragments (cost) or k random ones (random).
       order = frags;
@@ -313,30 +367,34 @@ void BspTree::build(const std::vector<Vec3d>& vertices, const std::vector<std::a
         Polygon a, b;
         split(planes, pool[f].poly, plane, signs, a, b);
         negt.frags.push_back(static_cast<std::uint32_t>(pool.size()));
+        const double density = pool[f].density;
         pool.push_back(make_frag(planes, std::move(a)));
+        pool.back().density = density;
         post.frags.push_back(static_cast<std::uint32_t>(pool.size()));
         pool.push_back(make_frag(planes, std::move(b)));
+        pool.back().density = density;
       }
     }
     frags.clear();
     frags.shrink_to_fit();
-    nodes_[node].plane = plane;
-    nodes_[node].first = first;
-    nodes_[node].count = static_cast<std::uint32_t>(fragments_.size() - first);
+    nodes[node].plane = plane;
+    nodes[node].first = first;
+    nodes[node].count = static_cast<std::uint32_t>(fragments_.size() - first);
     for (int side : {-1, 1}) {
       Task& t = side < 0 ? negt : post;
-      const auto child = static_cast<std::uint32_t>(nodes_.size());
-      nodes_.emplace_back();
-      (side < 0 ? nodes_[node].neg : nodes_[node].pos) = child;
+      const auto child = static_cast<std::uint32_t>(nodes.size());
+      nodes.emplace_back();
+      (side < 0 ? nodes[node].neg : nodes[node].pos) = child;
       if (t.frags.empty()) {
         // Only at auto-partition nodes (balanced planes separate): behind a polygon is inside.
-        nodes_[child].label = side < 0 ? Label::inside : Label::outside;
+        nodes[child].label = side < 0 ? Label::inside : Label::outside;
       } else {
         t.node = child;
         stack.push_back(std::move(t));
       }
     }
   }
+  nodes_ = std::move(nodes);
   stats_.build_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   compute_stats();
 }
@@ -469,7 +527,16 @@ std::vector<std::uint32_t> BspTree::visibility_order(const Vec3d& eye, bool back
   return out;
 }
 
-BspTree::Hit BspTree::first_hit(const Vec3d& origin, const Vec3d& dir, double t_max) const {
+BspTree::Hit BspTree::first_hit(const Vec3d& origin, const Vec3d& dir, double t_max, std::size_t* nodes,
+                                std::size_t* tests) const {
+  std::size_t visited = 0, tested = 0;
+  struct Count {  // adds the work to the caller's counters on every return
+    std::size_t &visited, &tested, *nodes, *tests;
+    ~Count() {
+      if (nodes) *nodes += visited;
+      if (tests) *tests += tested;
+    }
+  } count{visited, tested, nodes, tests};
   Hit hit;
   if (root_ == kNoIndex) return hit;
   for (int i = 0; i < 3; ++i)
@@ -497,6 +564,7 @@ BspTree::Hit BspTree::first_hit(const Vec3d& origin, const Vec3d& dir, double t_
     Item it = stack.back();
     stack.pop_back();
     if (it.t0 > hit.t) continue;
+    ++visited;
     const Node& nd = nodes_[it.node];
     if (nd.leaf()) continue;
     const double so = eval(nd.plane, o), dn = dot(nd.plane, d);
@@ -512,6 +580,7 @@ BspTree::Hit BspTree::first_hit(const Vec3d& origin, const Vec3d& dir, double t_
     const Vec3d x = o + t * d;
     for (std::uint32_t i = 0; i < nd.count && t < hit.t; ++i) {
       const Polygon& f = fragments_[nd.first + i];
+      ++tested;
       bool inside = true;
       for (auto e : f.edges) inside &= eval(e, x) <= 1e-9 * std::max(1.0, std::fabs(dot(e, x)));
       if (inside) hit = {t, f.source};
@@ -519,6 +588,30 @@ BspTree::Hit BspTree::first_hit(const Vec3d& origin, const Vec3d& dir, double t_
     stack.push_back({near, it.t0, t});
   }
   return hit;
+}
+
+RayQueryResult BspTree::first_hits(const RayQuery& q) const {
+  if (q.origins.size() != q.directions.size())
+    throw Error("bsp first_hits: " + std::to_string(q.origins.size()) + " origins but " +
+                std::to_string(q.directions.size()) + " directions");
+  if (std::isnan(q.t_max)) throw Error("bsp first_hits: t_max is NaN");
+  const auto t0 = std::chrono::steady_clock::now();
+  RayQueryResult r;
+  r.t.resize(q.origins.size());
+  r.triangle.resize(q.origins.size());
+  std::size_t nodes = 0, tests = 0;
+  for (std::size_t i = 0; i < q.origins.size(); ++i) {
+    const Hit h = first_hit(q.origins[i], q.directions[i], q.t_max, &nodes, &tests);
+    r.t[i] = h.t;
+    r.triangle[i] = h.triangle;
+    r.stats.hits += h.triangle != kNoIndex;
+  }
+  r.stats.query_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  r.stats.rays = q.origins.size();
+  const double n = static_cast<double>(std::max<std::size_t>(1, r.stats.rays));
+  r.stats.nodes_per_ray = static_cast<double>(nodes) / n;
+  r.stats.tests_per_ray = static_cast<double>(tests) / n;
+  return r;
 }
 
 void BspTree::validate() const {
@@ -558,6 +651,121 @@ void BspTree::validate() const {
     stack.push_back({nd.neg, it.depth + 1, nd.plane});
     stack.push_back({nd.pos, it.depth + 1, nd.plane ^ kFlip});
   }
+}
+
+// ---------------------------------------------------------------- save, load
+
+void BspTree::save(const std::filesystem::path& path) const {
+  if (root_ == kNoIndex) throw Error("bsp save: an empty tree");
+  ArchiveWriter out(kArchiveKind, kArchiveVersion);
+  out.add_value("grid_shift", std::int32_t(grid_.shift));
+  out.add("grid_center", std::span<const std::int64_t>(grid_.center));
+  std::vector<Plane> planes(planes_->size());
+  for (std::size_t i = 0; i < planes.size(); ++i) planes[i] = (*planes_)[static_cast<std::uint32_t>(i)];
+  out.add("planes", planes);
+  // The fragments: support, source and plane lists (offsets into edges and points).
+  std::vector<std::uint32_t> support, source, offsets{0}, edges, points;
+  std::uint32_t point_count = 0;
+  for (const Polygon& f : fragments_) {
+    support.push_back(f.support);
+    source.push_back(f.source);
+    edges.insert(edges.end(), f.edges.begin(), f.edges.end());
+    points.insert(points.end(), f.points.begin(), f.points.end());
+    offsets.push_back(static_cast<std::uint32_t>(edges.size()));
+    for (auto q : f.points)
+      if (q != kNoPoint) point_count = std::max(point_count, q + 1);
+  }
+  std::vector<std::array<std::int64_t, 3>> coords(point_count);
+  for (std::uint32_t i = 0; i < point_count; ++i) coords[i] = planes_->integer_point(i);
+  out.add("points", coords);
+  out.add("nodes", nodes_);
+  out.add_value("root", root_);
+  out.add("fragment_support", support);
+  out.add("fragment_source", source);
+  out.add("fragment_offsets", offsets);
+  out.add("fragment_edges", edges);
+  out.add("fragment_points", points);
+  out.add_value("polygons", std::uint64_t(stats_.polygons));
+  out.add_value("build_s", stats_.build_s);
+  out.write(path);
+}
+
+BspTree BspTree::load(const std::filesystem::path& path) {
+  const Archive in = Archive::open(path, kArchiveKind, kArchiveVersion);
+  BspTree t;
+  t.grid_.shift = in.value<std::int32_t>("grid_shift");
+  const FlatArray<std::int64_t> center = in.array<std::int64_t>("grid_center", 3);
+  for (int i = 0; i < 3; ++i) t.grid_.center[std::size_t(i)] = center[std::size_t(i)];
+  if (t.grid_.shift < -1074 || t.grid_.shift > 1074) throw in.error("grid shift out of range");
+  const FlatArray<Plane> planes = in.array<Plane>("planes");
+  t.planes_ = std::make_shared<PlaneSet>();
+  if (planes.size() < t.planes_->size()) throw in.error("fewer planes than the universe box's");
+  for (std::size_t i = 0; i < planes.size(); ++i) {
+    const Plane& p = planes[i];
+    if (i < t.planes_->size()) {
+      const Plane& q = (*t.planes_)[static_cast<std::uint32_t>(i)];
+      if (p.a != q.a || p.b != q.b || p.c != q.c || p.d != q.d) throw in.error("the universe box's planes differ");
+      continue;
+    }
+    if (p.a == 0 && p.b == 0 && p.c == 0) throw in.error("plane " + std::to_string(i) + " has a zero normal");
+    t.planes_->add(p);
+  }
+  const FlatArray<std::array<std::int64_t, 3>> points = in.array<std::array<std::int64_t, 3>>("points");
+  for (const auto& q : points) {
+    for (auto c : q)
+      if (c > (std::int64_t{1} << kGridBits) || c < -(std::int64_t{1} << kGridBits))
+        throw in.error("a point outside the grid");
+    t.planes_->add_point(q);
+  }
+  const FlatArray<std::uint32_t> support = in.array<std::uint32_t>("fragment_support");
+  const std::size_t nf = support.size();
+  const FlatArray<std::uint32_t> source = in.array<std::uint32_t>("fragment_source", nf);
+  const FlatArray<std::uint32_t> offsets = in.array<std::uint32_t>("fragment_offsets", nf + 1);
+  const FlatArray<std::uint32_t> edges = in.array<std::uint32_t>("fragment_edges");
+  const FlatArray<std::uint32_t> fpoints = in.array<std::uint32_t>("fragment_points", edges.size());
+  const std::size_t np = planes.size();
+  auto plane_ok = [&](std::uint32_t ref) { return plane_index(ref) < np; };
+  if (offsets[0] != 0 || offsets[nf] != edges.size()) throw in.error("fragment offsets do not span the plane lists");
+  t.fragments_.resize(nf);
+  for (std::size_t i = 0; i < nf; ++i) {
+    if (offsets[i + 1] < offsets[i] + 3) throw in.error("fragment " + std::to_string(i) + " has fewer than 3 edges");
+    Polygon& f = t.fragments_[i];
+    f.support = support[i];
+    f.source = source[i];
+    f.edges.assign(edges.begin() + offsets[i], edges.begin() + offsets[i + 1]);
+    f.points.assign(fpoints.begin() + offsets[i], fpoints.begin() + offsets[i + 1]);
+    if (!plane_ok(f.support)) throw in.error("fragment " + std::to_string(i) + ": plane index out of range");
+    for (auto e : f.edges)
+      if (!plane_ok(e)) throw in.error("fragment " + std::to_string(i) + ": plane index out of range");
+    for (auto q : f.points)
+      if (q != kNoPoint && q >= points.size()) throw in.error("fragment " + std::to_string(i) + ": point out of range");
+  }
+  t.nodes_ = in.array<Node>("nodes");
+  t.root_ = in.value<std::uint32_t>("root");
+  // Indices in range and a tree: every node reached once from the root.
+  if (t.root_ >= t.nodes_.size()) throw in.error("root out of range");
+  std::vector<std::uint8_t> seen(t.nodes_.size(), 0);
+  std::vector<std::uint32_t> stack{t.root_};
+  while (!stack.empty()) {
+    const std::uint32_t n = stack.back();
+    stack.pop_back();
+    if (n >= t.nodes_.size() || seen[n]) throw in.error("the nodes do not form a tree");
+    seen[n] = 1;
+    const Node& nd = t.nodes_[n];
+    if (static_cast<unsigned>(nd.label) > static_cast<unsigned>(Label::outside)) throw in.error("a node label out of range");
+    if (std::uint64_t{nd.first} + nd.count > nf) throw in.error("a node's fragment range out of range");
+    if (nd.leaf()) {
+      if (nd.count != 0) throw in.error("a leaf stores fragments");
+      continue;
+    }
+    if (!plane_ok(nd.plane)) throw in.error("a node's plane out of range");
+    stack.push_back(nd.neg);
+    stack.push_back(nd.pos);
+  }
+  t.stats_.polygons = in.value<std::uint64_t>("polygons");
+  t.stats_.build_s = in.value<double>("build_s");
+  t.compute_stats();
+  return t;
 }
 
 Triangles BspTree::fragment_mesh() const {

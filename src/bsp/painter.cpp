@@ -3,10 +3,215 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
 
 #include "geods/core/error.hpp"
 
 namespace geods::bsp {
+
+namespace {
+
+using Point = ScreenBsp::Point;
+
+// The one edge test of the module: s * ((b - a) x (p - a)) with d = b - a; >= 0 is inside.
+inline double edge_value(const Point& a, const Point& d, double s, double x, double y) {
+  return s * (d[0] * (y - a[1]) - d[1] * (x - a[0]));
+}
+
+double signed_area(std::span<const Point> p) {
+  double area = 0;
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    const Point& a = p[k];
+    const Point& b = p[(k + 1) % p.size()];
+    area += a[0] * b[1] - a[1] * b[0];
+  }
+  return area / 2;
+}
+
+// Keeps the part of a convex polygon where keep * value + margin >= 0 (Sutherland–Hodgman).
+template <typename Value>
+void clip(const std::vector<Point>& in, Value&& value, double keep, double margin, std::vector<Point>& out) {
+  out.clear();
+  const std::size_t n = in.size();
+  for (std::size_t k = 0; k < n; ++k) {
+    const Point& p = in[k];
+    const Point& q = in[(k + 1) % n];
+    const double vp = keep * value(p) + margin, vq = keep * value(q) + margin;
+    if (vp >= 0) out.push_back(p);
+    if ((vp >= 0) != (vq >= 0)) {
+      const double t = vp / (vp - vq);
+      out.push_back({p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])});
+    }
+  }
+  if (out.size() < 3) out.clear();
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------- ScreenBsp
+
+ScreenBsp::ScreenBsp(int width, int height) : width_(width), height_(height) {
+  if (width <= 0 || height <= 0) throw Error("ScreenBsp: the screen size must be positive");
+  nodes_.emplace_back();  // one free leaf
+}
+
+std::size_t ScreenBsp::insert(std::span<const Point> polygon, std::vector<std::uint32_t>& pixels) {
+  for (const Point& p : polygon)
+    if (!std::isfinite(p[0]) || !std::isfinite(p[1])) throw Error("ScreenBsp insert: a vertex is not finite");
+  if (polygon.size() < 3) return 0;
+  const double area = signed_area(polygon);
+  if (!(area != 0)) return 0;
+  const double s = area > 0 ? 1 : -1;
+  std::vector<Line> edges;
+  for (std::size_t k = 0; k < polygon.size(); ++k) {
+    const Point& a = polygon[k];
+    const Point& b = polygon[(k + 1) % polygon.size()];
+    const Point d{b[0] - a[0], b[1] - a[1]};
+    if (d[0] != 0 || d[1] != 0) edges.push_back({a, d, s});  // a zero edge is inside everywhere
+  }
+  const double W = width_, H = height_;
+  const std::vector<Point> screen{{0, 0}, {W, 0}, {W, H}, {0, H}};
+  // The part on the screen (with a margin: pieces only route the polygon, pixels are tested exactly).
+  std::vector<Point> piece(polygon.begin(), polygon.end()), tmp;
+  auto box_value = [](int axis, double bound, double sign) {
+    return [=](const Point& p) { return sign * (p[std::size_t(axis)] - bound); };
+  };
+  for (int axis = 0; axis < 2; ++axis)
+    for (double sign : {1.0, -1.0}) {
+      const double bound = sign > 0 ? 0 : (axis == 0 ? W : H);
+      clip(piece, box_value(axis, bound, sign), 1, 1e-9 * (W + H), tmp);
+      piece.swap(tmp);
+      if (piece.empty()) return 0;
+    }
+  std::vector<Path> path;
+  return visit(0, piece, screen, edges, path, pixels);
+}
+
+std::size_t ScreenBsp::visit(std::uint32_t node, const std::vector<Point>& piece, const std::vector<Point>& cell,
+                             std::span<const Line> edges, std::vector<Path>& path, std::vector<std::uint32_t>& pixels) {
+  // Margin of a line over a piece: a bound far above the rounding of the edge test at any
+  // point of the piece, so that a pixel centre the test puts on one side is routed there.
+  auto margin = [](const Line& l, const std::vector<Point>& poly) {
+    double m = 0;
+    for (const Point& p : poly) m = std::max(m, std::fabs(l.d[0] * (p[1] - l.a[1])) + std::fabs(l.d[1] * (p[0] - l.a[0])));
+    return 1e-9 * m;
+  };
+  const Cell c = nodes_[node];
+  if (c.line != kNoIndex) {
+    const Line l = lines_[c.line];
+    auto value = [&](const Point& p) { return edge_value(l.a, l.d, l.s, p[0], p[1]); };
+    const double m = margin(l, piece);
+    double lo = 1e300, hi = -1e300;
+    for (const Point& p : piece) lo = std::min(lo, value(p)), hi = std::max(hi, value(p));
+    std::size_t written = 0;
+    std::vector<Point> sub, subcell;
+    for (const bool in : {true, false}) {
+      if (in ? !(hi > -m) : !(lo < m)) continue;
+      clip(piece, value, in ? 1 : -1, m, sub);
+      if (sub.empty()) continue;
+      clip(cell, value, in ? 1 : -1, 0, subcell);
+      path.push_back({c.line, in});
+      written += visit(in ? c.in : c.out, sub, subcell, edges, path, pixels);
+      path.pop_back();
+    }
+    return written;
+  }
+  if (c.occupied) return 0;
+
+  // A free leaf: the pixel centres of the cell inside the polygon.
+  double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300;
+  for (const Point& p : piece)
+    x0 = std::min(x0, p[0]), x1 = std::max(x1, p[0]), y0 = std::min(y0, p[1]), y1 = std::max(y1, p[1]);
+  const int ix0 = std::max(0, int(std::floor(x0 - 1))), ix1 = std::min(width_ - 1, int(std::ceil(x1)));
+  const int iy0 = std::max(0, int(std::floor(y0 - 1))), iy1 = std::min(height_ - 1, int(std::ceil(y1)));
+  std::size_t written = 0;
+  for (int y = iy0; y <= iy1; ++y)
+    for (int x = ix0; x <= ix1; ++x) {
+      const double cx = x + 0.5, cy = y + 0.5;
+      bool inside = true;
+      for (std::size_t k = 0; k < edges.size() && inside; ++k)
+        inside = edge_value(edges[k].a, edges[k].d, edges[k].s, cx, cy) >= 0;
+      for (std::size_t k = 0; k < path.size() && inside; ++k) {
+        const Line& l = lines_[path[k].line];
+        inside = (edge_value(l.a, l.d, l.s, cx, cy) >= 0) == path[k].in;
+      }
+      if (!inside) continue;
+      pixels.push_back(std::uint32_t(y) * std::uint32_t(width_) + std::uint32_t(x));
+      ++written;
+    }
+  if (written == 0 && std::fabs(signed_area(piece)) < 1e-9) return 0;  // a sliver between pixel centres
+
+  // Insert the polygon beneath the leaf: a chain of its edges that cross the cell, the
+  // outside of each a free leaf, the inside of the last one occupied.
+  std::uint32_t at = node;
+  for (const Line& e : edges) {
+    const double m = margin(e, cell);
+    bool crosses = false;
+    for (const Point& p : cell) crosses |= edge_value(e.a, e.d, e.s, p[0], p[1]) < m;
+    if (!crosses) continue;
+    const auto line = std::uint32_t(lines_.size());
+    lines_.push_back(e);
+    const auto in = std::uint32_t(nodes_.size());
+    nodes_.emplace_back();
+    nodes_.emplace_back();
+    nodes_[at].line = line;
+    nodes_[at].in = in;
+    nodes_[at].out = in + 1;
+    at = in;
+  }
+  nodes_[at].occupied = true;
+  return written;
+}
+
+bool ScreenBsp::occupied(double x, double y) const {
+  std::uint32_t n = 0;
+  while (nodes_[n].line != kNoIndex) {
+    const Line& l = lines_[nodes_[n].line];
+    n = edge_value(l.a, l.d, l.s, x, y) >= 0 ? nodes_[n].in : nodes_[n].out;
+  }
+  return nodes_[n].occupied;
+}
+
+double ScreenBsp::occupied_area() const {
+  const double W = width_, H = height_;
+  struct Item {
+    std::uint32_t node;
+    std::vector<Point> cell;
+  };
+  std::vector<Item> stack{{0, {{0, 0}, {W, 0}, {W, H}, {0, H}}}};
+  double area = 0;
+  std::vector<Point> sub;
+  while (!stack.empty()) {
+    Item it = std::move(stack.back());
+    stack.pop_back();
+    const Cell& c = nodes_[it.node];
+    if (c.line == kNoIndex) {
+      if (c.occupied) area += std::fabs(signed_area(it.cell));
+      continue;
+    }
+    const Line& l = lines_[c.line];
+    auto value = [&](const Point& p) { return edge_value(l.a, l.d, l.s, p[0], p[1]); };
+    for (const bool in : {true, false}) {
+      clip(it.cell, value, in ? 1 : -1, 0, sub);
+      if (!sub.empty()) stack.push_back({in ? c.in : c.out, sub});
+    }
+  }
+  return area;
+}
+
+std::size_t ScreenBsp::depth() const {
+  std::size_t depth = 0;
+  std::vector<std::pair<std::uint32_t, std::size_t>> stack{{0, 0}};
+  while (!stack.empty()) {
+    const auto [n, d] = stack.back();
+    stack.pop_back();
+    depth = std::max(depth, d);
+    if (nodes_[n].line != kNoIndex) stack.push_back({nodes_[n].in, d + 1}), stack.push_back({nodes_[n].out, d + 1});
+  }
+  return depth;
+}
+
+// ---------------------------------------------------------------- paint
 
 PainterResult paint(const BspTree& tree, const PainterView& view, bool back_to_front) {
   if (view.width <= 0 || view.height <= 0) throw Error("paint: image size must be positive");
@@ -29,10 +234,12 @@ PainterResult paint(const BspTree& tree, const PainterView& view, bool back_to_f
 
   PainterResult res;
   res.triangle.assign(std::size_t(W) * std::size_t(H), kNoIndex);
-  std::vector<std::uint8_t> covered(back_to_front ? 0 : res.triangle.size(), 0);
+  std::optional<ScreenBsp> screen;
+  if (!back_to_front) screen.emplace(W, H);
   const std::vector<std::uint32_t> order = tree.visibility_order(view.eye, back_to_front, frustum);
   res.fragments = order.size();
-  std::vector<std::array<double, 2>> p;
+  std::vector<Point> p;
+  std::vector<std::uint32_t> pixels;
   for (const std::uint32_t fi : order) {
     const Polygon& f = tree.fragments()[fi];
     p.clear();
@@ -49,34 +256,35 @@ PainterResult paint(const BspTree& tree, const PainterView& view, bool back_to_f
       p.push_back({(sx + 1) * 0.5 * W, (1 - sy) * 0.5 * H});
     }
     if (behind || p.size() < 3) continue;  // (the camera is outside the scene in the demo and tests)
-    double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300, area = 0;
-    for (std::size_t k = 0; k < p.size(); ++k) {
-      x0 = std::min(x0, p[k][0]), x1 = std::max(x1, p[k][0]), y0 = std::min(y0, p[k][1]), y1 = std::max(y1, p[k][1]);
-      const auto& a = p[k];
-      const auto& b = p[(k + 1) % p.size()];
-      area += a[0] * b[1] - a[1] * b[0];
+    if (!back_to_front) {
+      // Front to back: only the still-free parts, each pixel once.
+      pixels.clear();
+      screen->insert(p, pixels);
+      for (const std::uint32_t pix : pixels) res.triangle[pix] = f.source;
+      res.pixel_writes += pixels.size();
+      continue;
     }
+    const double area = signed_area(p);
     if (area == 0) continue;
+    double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300;
+    for (const Point& q : p) x0 = std::min(x0, q[0]), x1 = std::max(x1, q[0]), y0 = std::min(y0, q[1]), y1 = std::max(y1, q[1]);
     const int ix0 = std::max(0, int(std::floor(x0 - 0.5))), ix1 = std::min(W - 1, int(std::ceil(x1 - 0.5)));
     const int iy0 = std::max(0, int(std::floor(y0 - 0.5))), iy1 = std::min(H - 1, int(std::ceil(y1 - 0.5)));
     const double s = area > 0 ? 1 : -1;
     for (int y = iy0; y <= iy1; ++y)
       for (int x = ix0; x <= ix1; ++x) {
-        const std::size_t pix = std::size_t(y) * std::size_t(W) + std::size_t(x);
-        if (!back_to_front && covered[pix]) continue;
-        const double cx = x + 0.5, cy = y + 0.5;
         bool inside = true;
         for (std::size_t k = 0; k < p.size() && inside; ++k) {
-          const auto& a = p[k];
-          const auto& b = p[(k + 1) % p.size()];
-          inside = s * ((b[0] - a[0]) * (cy - a[1]) - (b[1] - a[1]) * (cx - a[0])) >= 0;
+          const Point& a = p[k];
+          const Point& b = p[(k + 1) % p.size()];
+          inside = edge_value(a, {b[0] - a[0], b[1] - a[1]}, s, x + 0.5, y + 0.5) >= 0;
         }
         if (!inside) continue;
-        res.triangle[pix] = f.source;
+        res.triangle[std::size_t(y) * std::size_t(W) + std::size_t(x)] = f.source;
         ++res.pixel_writes;
-        if (!back_to_front) covered[pix] = 1;
       }
   }
+  if (screen) res.screen_nodes = screen->nodes();
   return res;
 }
 

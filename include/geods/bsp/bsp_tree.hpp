@@ -14,12 +14,14 @@
 // Triangles that the snapping makes degenerate are dropped.
 #include <array>
 #include <cstdint>
+#include <filesystem>
 #include <limits>
 #include <memory>
 #include <string_view>
 #include <vector>
 
 #include "geods/bsp/plane_based.hpp"
+#include "geods/core/flat_array.hpp"
 #include "geods/core/tri_mesh.hpp"
 #include "geods/core/vec.hpp"
 
@@ -27,10 +29,28 @@ namespace geods::bsp {
 
 inline constexpr std::uint32_t kNoIndex = std::numeric_limits<std::uint32_t>::max();
 
-enum class Heuristic { cost, random, balanced };
-/// Parses "cost", "random" or "balanced"; throws geods::Error naming the choices.
+enum class Heuristic { cost, random, balanced, custom };
+/// Parses "cost", "random", "balanced" or "custom"; throws geods::Error naming the choices.
 Heuristic parse_heuristic(std::string_view name);
 std::string_view heuristic_name(Heuristic h);
+
+/// Rays for BspTree::first_hits (request): ray i is origins[i] + t directions[i], 0 <= t <= t_max.
+struct RayQuery {
+  std::vector<Vec3d> origins, directions;
+  double t_max = std::numeric_limits<double>::infinity();
+};
+struct RayQueryStats {
+  std::size_t rays = 0, hits = 0;
+  double nodes_per_ray = 0;   // tree nodes visited per ray (mean)
+  double tests_per_ray = 0;   // fragment (polygon) tests per ray (mean)
+  double query_s = 0;
+};
+/// Answers of first_hits (result): per ray the distance t and the input triangle (kNoIndex: no hit).
+struct RayQueryResult {
+  std::vector<double> t;
+  std::vector<std::uint32_t> triangle;
+  RayQueryStats stats;
+};
 
 struct BuildOptions {
   Heuristic heuristic = Heuristic::cost;
@@ -39,6 +59,13 @@ struct BuildOptions {
   std::uint32_t k = 8;      // candidates: the k largest (cost) or k random (random) polygons
   std::uint64_t seed = 1;   // random choices
   std::size_t sample = 128; // polygons a candidate is scored on (a random sample if more)
+  /// custom (§3.4.3, the customized BSP): a sample of the rays the tree will answer (t_max
+  /// unused). A polygon p scores Area(p) times the sum, over the sample rays whose line passes
+  /// p's bounding sphere ahead of the origin, of sin^2 of the angle between the ray and p's
+  /// plane ((n_p . r)^2 for unit n_p, r), divided by the sample size; each node takes the
+  /// plane of a random one of its k best-scoring polygons. Required (non-empty, finite rays,
+  /// non-zero directions) for custom; the cost is polygons x rays once.
+  RayQuery rays;
 };
 
 struct BspStats {
@@ -108,14 +135,30 @@ class BspTree {
     std::uint32_t triangle = kNoIndex;
   };
   /// First fragment hit by origin + t dir, 0 <= t <= t_max (front to back along the ray).
-  Hit first_hit(const Vec3d& origin, const Vec3d& dir, double t_max = std::numeric_limits<double>::infinity()) const;
+  /// If given, nodes and tests are increased by the nodes visited and the fragments tested.
+  Hit first_hit(const Vec3d& origin, const Vec3d& dir, double t_max = std::numeric_limits<double>::infinity(),
+                std::size_t* nodes = nullptr, std::size_t* tests = nullptr) const;
+  /// first_hit for every ray of the query, with the work per ray (nodes visited, fragments
+  /// tested) and the time. Throws geods::Error for sizes that differ or non-finite rays.
+  RayQueryResult first_hits(const RayQuery& query) const;
+
+  /// Archive kind and layout version of save().
+  static constexpr const char* kArchiveKind = "bsp.BspTree";
+  static constexpr std::uint32_t kArchiveVersion = 1;
+  /// Writes the tree (grid, plane table, nodes, fragments) to one archive (core/archive.hpp).
+  void save(const std::filesystem::path& path) const;
+  /// Reads a file written by save(): the nodes are viewed in place in the mapped file, the
+  /// plane table and the fragments' plane lists are read into memory. Throws geods::Error
+  /// for a missing, truncated, corrupt or wrong-version file, and checks that every index
+  /// it read is in range (children, planes, fragment ranges, points) and that the nodes form a tree.
+  static BspTree load(const std::filesystem::path& path);
 
   const BspStats& stats() const { return stats_; }
   /// Checks the structure (indices, plane references, every fragment on its node's plane
   /// and inside its node's cell, leaves labelled); throws geods::Error.
   void validate() const;
 
-  const std::vector<Node>& nodes() const { return nodes_; }
+  const FlatArray<Node>& nodes() const { return nodes_; }
   const std::vector<Polygon>& fragments() const { return fragments_; }
   std::uint32_t root() const { return root_; }
   const PlaneSet& planes() const { return *planes_; }
@@ -132,7 +175,7 @@ class BspTree {
 
   std::shared_ptr<PlaneSet> planes_;
   Grid grid_;
-  std::vector<Node> nodes_;
+  FlatArray<Node> nodes_;  // in place in the file after load()
   std::vector<Polygon> fragments_;
   std::uint32_t root_ = kNoIndex;
   BspStats stats_;
