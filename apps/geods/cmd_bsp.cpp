@@ -7,6 +7,7 @@
 #include "geods/bsp/stats_fields.hpp"
 #include "geods/core/error.hpp"
 #include "geods/io/mesh_io.hpp"
+#include "geods/io/npy.hpp"
 #include "stats_json.hpp"
 
 namespace geods::cli {
@@ -16,23 +17,44 @@ class BspCommand : public Command {
  public:
   std::string name() const override { return "bsp"; }
   std::string summary() const override {
-    return "BSP tree of a mesh (auto-partition by cost or random-k, or balanced planes): nodes, depth, fragments, "
-           "expected cost";
+    return "BSP tree of a mesh (auto-partition by cost or random-k, balanced planes, or customized for a ray "
+           "sample): nodes, depth, fragments, expected cost, work per ray";
   }
   void add_options(CLI::App& app) override {
     add_input(app, "mesh", mesh_, "Triangle mesh (.ply, .obj, .off, .stl, .gltf)");
-    app.add_option("--heuristic", heuristic_, "cost (equation (5)), random (k random, fewest splits) or balanced");
+    app.add_option("--heuristic", heuristic_,
+                   "cost (equation (5)), random (k random, fewest splits), balanced, or custom (customized for the "
+                   "rays of --rays, §3.4.3)");
     app.add_option("--alpha", options_.alpha, "Equation (5): weight |S-|^alpha + |S+|^alpha (> 0)");
     app.add_option("--beta", options_.beta, "Equation (5): penalty per split polygon (>= 0)");
     app.add_option("--k", k_, "Candidate polygons per node: the k largest (cost) or k random (random)")
         ->check(at_least(1));
     app.add_option("--seed", options_.seed, "Seed of the random choices");
+    app.add_option("--rays", rays_,
+                   "Rays (.npy, (n, 6): origin x y z, direction x y z): the sample of --heuristic custom; with any "
+                   "heuristic, first hits are computed for them and the work per ray reported");
+    add_save(app, save_, "the tree", "BspTree.load");
   }
   void run(const RunContext&, Report& report) override {
     options_.heuristic = bsp::parse_heuristic(heuristic_);
     options_.k = static_cast<std::uint32_t>(k_);
+    bsp::RayQuery rays;
+    if (!rays_.empty()) {
+      const io::NpyArray a = io::read_npy(rays_);
+      if (a.shape.size() != 2 || a.shape[1] != 6)
+        throw Error(fmt::format("{}: rays of shape ({}), expected (n, 6)", rays_, fmt::join(a.shape, ", ")));
+      const std::vector<double> r = a.to_vector<double>();
+      for (std::size_t i = 0; i < a.shape[0]; ++i) {
+        rays.origins.emplace_back(r[6 * i], r[6 * i + 1], r[6 * i + 2]);
+        rays.directions.emplace_back(r[6 * i + 3], r[6 * i + 4], r[6 * i + 5]);
+      }
+    } else if (options_.heuristic == bsp::Heuristic::custom) {
+      throw Error("bsp: --heuristic custom needs --rays");
+    }
+    if (options_.heuristic == bsp::Heuristic::custom) options_.rays = rays;
     const bsp::Triangles mesh = bsp::from_tri_mesh(io::read_mesh(mesh_));
     const bsp::BspTree tree(mesh.vertices, mesh.triangles, options_);
+    if (!save_.empty()) tree.save(save_);
     const bsp::BspStats& s = tree.stats();
     Json& j = report.json;
     j["mesh"] = mesh_;
@@ -46,10 +68,17 @@ class BspCommand : public Command {
                                        heuristic_, options_.alpha, options_.beta, k_));
     report.lines.push_back(fmt::format("  built in {:.3f} s: {} nodes ({} leaves), depth {}, {} fragments, expected cost {:.2f}",
                                        s.build_s, s.nodes, s.leaves, s.depth, s.fragments, s.expected_cost));
+    if (!rays.origins.empty()) {
+      const bsp::RayQueryStats r = tree.first_hits(rays).stats;
+      Json& jr = j["first_hits"];
+      put_stats(jr, r);
+      report.lines.push_back(fmt::format("  {} rays ({} hits): {:.1f} nodes visited and {:.1f} polygon tests per ray, {:.4f} s",
+                                         r.rays, r.hits, r.nodes_per_ray, r.tests_per_ray, r.query_s));
+    }
   }
 
  private:
-  std::string mesh_, heuristic_ = "cost";
+  std::string mesh_, heuristic_ = "cost", rays_, save_;
   long long k_ = 8;
   bsp::BuildOptions options_;
 };

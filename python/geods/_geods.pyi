@@ -92,13 +92,26 @@ class BspTree:
     polygons with the fewest splits ("random"), or balanced axis-aligned planes
     ("balanced"). Vertices are snapped to an integer grid (2^19 steps each side of
     the box's centre) and every side decision is exact. Leaves are inside/outside
-    for a closed, outward-oriented mesh.
+    for a closed, outward-oriented mesh. heuristic="custom" builds the customized
+    BSP of §3.4.3 for a sample of rays (rays=(origins, directions)): polygons
+    scored by Area times the sample's sin^2 of the ray-plane angle over the rays
+    passing near them, a random one of the k best at each node.
     """
-    def __init__(self, V: ArrayLike, F: ArrayLike, heuristic: str = ..., alpha: float = ..., beta: float = ..., k: int = ..., seed: int = ...) -> None:
-        """V: float64 (n, 3) vertices, F: int64 (m, 3) triangles; heuristic: cost, random or balanced
+    def __init__(self, V: ArrayLike, F: ArrayLike, heuristic: str = ..., alpha: float = ..., beta: float = ..., k: int = ..., seed: int = ..., rays: Any = ...) -> None:
+        """V: float64 (n, 3) vertices, F: int64 (m, 3) triangles; heuristic: cost, random, balanced or custom; rays: (origins float64 (r, 3), directions float64 (r, 3)), the sample of custom
         """
     def classify(self, points: Any) -> Any:
         """-1 inside, +1 outside, 0 on the boundary (exact for the snapped mesh) of points (n, 3) or one (x, y, z): int8 (n,) or an int
+        """
+    def first_hits(self, origins: Any, directions: Any, t_max: float = ..., stats: bool = ...) -> Any:
+        """First hits of rays origins + t directions (float64 (n, 3) each), 0 <= t <= t_max: (t float64 (n,), triangle int64 (n,)), inf and -1 on a miss (and a stats dict with stats=True: rays, hits, nodes_per_ray, tests_per_ray, query_s)
+        """
+    @staticmethod
+    def load(path: str | os.PathLike[str]) -> BspTree:
+        """Reads a tree written by save() (nodes mapped in place); raises geods.Error for a bad file.
+        """
+    def save(self, path: str | os.PathLike[str]) -> None:
+        """Writes the tree (grid, planes, nodes, fragments) to a geods archive.
         """
     def stats(self) -> dict[str, Any]:
         """nodes, leaves, depth, polygons, fragments, expected_cost (equation (4)), build_s

@@ -1,7 +1,10 @@
-// Python bindings of geods::bsp: BspTree (classify, visibility_order, stats) and csg.
+// Python bindings of geods::bsp: BspTree (classify, visibility_order, first_hits, stats, save/load) and csg.
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
 
+#include <filesystem>
+#include <limits>
 #include <string>
 
 #include "arrays.hpp"
@@ -32,11 +35,26 @@ bsp::Triangles triangles_from_arrays(const Rows<double>& v, const Rows<std::int6
   return t;
 }
 
+bsp::RayQuery ray_query(const py::handle& origins, const py::handle& directions, const std::string& what) {
+  bsp::RayQuery q;
+  q.origins = points_of<double, 3>(origins, what + " origins");
+  q.directions = points_of<double, 3>(directions, what + " directions");
+  if (q.origins.size() != q.directions.size())
+    throw Error(what + ": " + std::to_string(q.origins.size()) + " origins but " + std::to_string(q.directions.size()) +
+                " directions");
+  return q;
+}
+
 bsp::BuildOptions build_options(const std::string& heuristic, double alpha, double beta, std::uint32_t k,
-                                std::uint64_t seed) {
+                                std::uint64_t seed, const py::object& rays) {
   bsp::BuildOptions o;
   o.heuristic = bsp::parse_heuristic(heuristic);
   o.alpha = alpha, o.beta = beta, o.k = k, o.seed = seed;
+  if (!rays.is_none()) {
+    const py::tuple t = rays.cast<py::tuple>();
+    if (t.size() != 2) throw Error("BspTree: rays must be a pair (origins, directions)");
+    o.rays = ray_query(t[0], t[1], "BspTree rays");
+  }
   return o;
 }
 
@@ -61,16 +79,20 @@ largest polygons scored by 1 + |S-|^alpha + |S+|^alpha + beta * splits), k rando
 polygons with the fewest splits ("random"), or balanced axis-aligned planes
 ("balanced"). Vertices are snapped to an integer grid (2^19 steps each side of
 the box's centre) and every side decision is exact. Leaves are inside/outside
-for a closed, outward-oriented mesh.)doc")
+for a closed, outward-oriented mesh. heuristic="custom" builds the customized
+BSP of §3.4.3 for a sample of rays (rays=(origins, directions)): polygons
+scored by Area times the sample's sin^2 of the ray-plane angle over the rays
+passing near them, a random one of the k best at each node.)doc")
       .def(py::init([](const Rows<double>& v, const Rows<std::int64_t>& f, const std::string& heuristic, double alpha,
-                       double beta, std::uint32_t k, std::uint64_t seed) {
+                       double beta, std::uint32_t k, std::uint64_t seed, const py::object& rays) {
              const bsp::Triangles t = triangles_from_arrays(v, f, "BspTree");
-             const bsp::BuildOptions o = build_options(heuristic, alpha, beta, k, seed);
+             const bsp::BuildOptions o = build_options(heuristic, alpha, beta, k, seed, rays);
              return without_gil([&] { return bsp::BspTree(t.vertices, t.triangles, o); });
            }),
            py::arg("V"), py::arg("F"), py::arg("heuristic") = "cost", py::arg("alpha") = d.alpha,
-           py::arg("beta") = d.beta, py::arg("k") = d.k, py::arg("seed") = d.seed,
-           "V: float64 (n, 3) vertices, F: int64 (m, 3) triangles; heuristic: cost, random or balanced")
+           py::arg("beta") = d.beta, py::arg("k") = d.k, py::arg("seed") = d.seed, py::arg("rays") = py::none(),
+           "V: float64 (n, 3) vertices, F: int64 (m, 3) triangles; heuristic: cost, random, balanced or custom; "
+           "rays: (origins float64 (r, 3), directions float64 (r, 3)), the sample of custom")
       .def(
           "classify",
           [](const bsp::BspTree& t, const py::handle& points) {
@@ -92,6 +114,28 @@ for a closed, outward-oriented mesh.)doc")
           py::arg("eye"), py::arg("back_to_front") = true,
           "Input triangle of each fragment, in visibility order from eye = (x, y, z): int64 (fragments,) (a split "
           "triangle appears once per fragment)")
+      .def(
+          "first_hits",
+          [](const bsp::BspTree& t, const py::handle& origins, const py::handle& directions, double t_max, bool stats) {
+            bsp::RayQuery q = ray_query(origins, directions, "first_hits");
+            q.t_max = t_max;
+            const bsp::RayQueryResult r = without_gil([&] { return t.first_hits(q); });
+            py::array_t<double> dist(py::ssize_t(r.t.size()));
+            std::copy(r.t.begin(), r.t.end(), dist.mutable_data());
+            py::tuple out = py::make_tuple(dist, index_array(r.triangle));
+            if (!stats) return py::object(out);
+            return py::object(py::make_tuple(out[0], out[1], stats_dict(r.stats)));
+          },
+          py::arg("origins"), py::arg("directions"), py::arg("t_max") = std::numeric_limits<double>::infinity(),
+          py::arg("stats") = false,
+          "First hits of rays origins + t directions (float64 (n, 3) each), 0 <= t <= t_max: (t float64 (n,), "
+          "triangle int64 (n,)), inf and -1 on a miss (and a stats dict with stats=True: rays, hits, "
+          "nodes_per_ray, tests_per_ray, query_s)")
+      .def("save", [](const bsp::BspTree& t, const std::filesystem::path& path) { t.save(path); }, py::arg("path"),
+           "Writes the tree (grid, planes, nodes, fragments) to a geods archive.")
+      .def_static(
+          "load", [](const std::filesystem::path& path) { return bsp::BspTree::load(path); }, py::arg("path"),
+          "Reads a tree written by save() (nodes mapped in place); raises geods.Error for a bad file.")
       .def("stats", [](const bsp::BspTree& t) { return stats_dict(t.stats()); },
            "nodes, leaves, depth, polygons, fragments, expected_cost (equation (4)), build_s")
       .def("validate", &bsp::BspTree::validate, "Checks every invariant; raises geods.Error if one fails.");

@@ -153,3 +153,95 @@ def test_cli(tmp_path, data_dir):
         assert key in j
     r = run_cli("csg", str(a), "plus", str(b), "-o", str(out))
     assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1
+
+
+def skewed_rays(V, n, seed):
+    """Rays from a small patch in front (+z) of a spot of the box, aimed at it through a narrow cone."""
+    lo, hi = V.min(0), V.max(0)
+    e = (hi - lo).max()
+    spot = lo + np.array([0.3, 0.75, 0.5]) * (hi - lo)
+    rng = np.random.default_rng(seed)
+    o = spot + np.c_[0.05 * e * rng.standard_normal((n, 2)), np.full(n, 2 * e)]
+    return o, spot + 0.15 * e * rng.standard_normal((n, 3)) - o
+
+
+def brute_first_hit(V, F, o, d):
+    """Nearest t over all triangles (Moller-Trumbore, vectorized over triangles)."""
+    a, b, c = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
+    e1, e2 = b - a, c - a
+    p = np.cross(d, e2)
+    det = np.einsum("ij,ij->i", e1, p)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        s = o - a
+        u = np.einsum("ij,ij->i", s, p) / det
+        q = np.cross(s, e1)
+        v = q @ d / det
+        t = np.einsum("ij,ij->i", e2, q) / det
+    ok = (det != 0) & (u >= 0) & (v >= 0) & (u + v <= 1) & (t >= 0)
+    return t[ok].min() if ok.any() else np.inf
+
+
+def test_custom_first_hits_match_oblivious_and_brute_force():
+    V, F = torus(n=24, m=12)
+    sample, rays = skewed_rays(V, 300, 1), skewed_rays(V, 400, 2)
+    c = geods.BspTree(V, F, heuristic="custom", rays=sample, k=4)
+    o = geods.BspTree(V, F)
+    c.validate()
+    tc, ic, sc = c.first_hits(*rays, stats=True)
+    to, io_ = o.first_hits(*rays)
+    assert tc.dtype == np.float64 and ic.dtype == np.int64 and tc.shape == (400,)
+    np.testing.assert_array_equal(np.isinf(tc), np.isinf(to))
+    np.testing.assert_allclose(tc[np.isfinite(tc)], to[np.isfinite(to)], rtol=1e-9)
+    assert ((ic == -1) == np.isinf(tc)).all() and 50 < sc["hits"] < 400
+    for key in ["rays", "hits", "nodes_per_ray", "tests_per_ray", "query_s"]:
+        assert key in sc
+    # The snapped surface is within a grid step of the input: brute force on the input mesh.
+    tb = np.array([brute_first_hit(V, F, rays[0][i], rays[1][i]) for i in range(100)])
+    same = np.isinf(tb) == np.isinf(tc[:100])
+    assert same.sum() >= 98
+    both = same & np.isfinite(tb)
+    np.testing.assert_allclose(tc[:100][both], tb[both], atol=1e-4)
+    with pytest.raises(ValueError):
+        geods.BspTree(V, F, heuristic="custom")
+    with pytest.raises(ValueError):
+        c.first_hits(rays[0], rays[1][:10])
+
+
+def test_save_load(tmp_path):
+    V, F = torus()
+    t = geods.BspTree(V, F, heuristic="balanced")
+    path = tmp_path / "t.geods"
+    t.save(str(path))
+    u = geods.BspTree.load(str(path))
+    u.validate()
+    assert u.stats() == {**t.stats()}
+    P = np.random.default_rng(4).uniform(-2, 2, (200, 3))
+    np.testing.assert_array_equal(u.classify(P), t.classify(P))
+    np.testing.assert_array_equal(u.visibility_order([3, 2, 1]), t.visibility_order([3, 2, 1]))
+    np.testing.assert_array_equal(u.first_hits(P, -P)[1], t.first_hits(P, -P)[1])
+    data = path.read_bytes()
+    cut = tmp_path / "cut.geods"
+    cut.write_bytes(data[: len(data) // 2])
+    with pytest.raises(ValueError):
+        geods.BspTree.load(str(cut))
+    with pytest.raises(ValueError):
+        geods.BspTree.load(str(tmp_path / "missing.geods"))
+
+
+def test_cli_custom_rays_and_save(tmp_path, data_dir):
+    V, F = geods.read_mesh(str(data_dir / "bunny.ply"))
+    rays = tmp_path / "rays.npy"
+    np.save(rays, np.hstack(skewed_rays(V.astype(np.float64), 500, 3)))
+    out = tmp_path / "t.geods"
+    r = run_cli("bsp", str(data_dir / "bunny.ply"), "--heuristic", "custom", "--rays", str(rays), "--save", str(out),
+                "--json")
+    assert r.returncode == 0, r.stderr
+    j = json.loads(r.stdout)
+    assert j["first_hits"]["rays"] == 500 and j["first_hits"]["hits"] > 100
+    u = geods.BspTree.load(str(out))
+    assert u.stats()["nodes"] == j["nodes"]
+    r = run_cli("bsp", str(data_dir / "bunny.ply"), "--heuristic", "custom")
+    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1
+    np.save(rays, np.zeros((4, 5)))
+    r = run_cli("bsp", str(data_dir / "bunny.ply"), "--rays", str(rays))
+    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1

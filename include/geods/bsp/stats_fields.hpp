@@ -1,5 +1,5 @@
 #pragma once
-// The fields of BspStats and CsgStats, named once (see spatial/stats_fields.hpp).
+// The fields of BspStats, RayQueryStats and CsgStats, named once (see spatial/stats_fields.hpp).
 #include "geods/bsp/csg.hpp"
 
 namespace geods::bsp {
@@ -9,6 +9,12 @@ template <typename F>
 void for_each_field(const BspStats& s, F&& f) {
   f("nodes", s.nodes), f("leaves", s.leaves), f("depth", s.depth), f("polygons", s.polygons),
       f("fragments", s.fragments), f("expected_cost", s.expected_cost), f("build_s", s.build_s);
+}
+
+template <typename F>
+void for_each_field(const RayQueryStats& s, F&& f) {
+  f("rays", s.rays), f("hits", s.hits), f("nodes_per_ray", s.nodes_per_ray), f("tests_per_ray", s.tests_per_ray),
+      f("query_s", s.query_s);
 }
 
 template <typename F>
