@@ -50,6 +50,14 @@ void clip(const std::vector<Point>& in, Value&& value, double keep, double margi
 
 // ---------------------------------------------------------------- ScreenBsp
 
+// Margin of a line over a polygon: a bound far above the rounding of the edge test at any of
+// its points, so that a pixel centre the test puts on one side is routed there.
+double ScreenBsp::margin(const Line& l, const std::vector<Point>& poly) {
+  double m = 0;
+  for (const Point& p : poly) m = std::max(m, std::fabs(l.d[0] * (p[1] - l.a[1])) + std::fabs(l.d[1] * (p[0] - l.a[0])));
+  return 1e-9 * m;
+}
+
 ScreenBsp::ScreenBsp(int width, int height) : width_(width), height_(height) {
   if (width <= 0 || height <= 0) throw Error("ScreenBsp: the screen size must be positive");
   nodes_.emplace_back();  // one free leaf
@@ -70,7 +78,6 @@ std::size_t ScreenBsp::insert(std::span<const Point> polygon, std::vector<std::u
     if (d[0] != 0 || d[1] != 0) edges.push_back({a, d, s});  // a zero edge is inside everywhere
   }
   const double W = width_, H = height_;
-  const std::vector<Point> screen{{0, 0}, {W, 0}, {W, H}, {0, H}};
   // The part on the screen (with a margin: pieces only route the polygon, pixels are tested exactly).
   std::vector<Point> piece(polygon.begin(), polygon.end()), tmp;
   auto box_value = [](int axis, double bound, double sign) {
@@ -84,38 +91,53 @@ std::size_t ScreenBsp::insert(std::span<const Point> polygon, std::vector<std::u
       if (piece.empty()) return 0;
     }
   std::vector<Path> path;
-  return visit(0, piece, screen, edges, path, pixels);
+  std::vector<std::vector<Point>> scratch;
+  return visit(0, piece, edges, path, scratch, pixels);
 }
 
-std::size_t ScreenBsp::visit(std::uint32_t node, const std::vector<Point>& piece, const std::vector<Point>& cell,
-                             std::span<const Line> edges, std::vector<Path>& path, std::vector<std::uint32_t>& pixels) {
-  // Margin of a line over a piece: a bound far above the rounding of the edge test at any
-  // point of the piece, so that a pixel centre the test puts on one side is routed there.
-  auto margin = [](const Line& l, const std::vector<Point>& poly) {
-    double m = 0;
-    for (const Point& p : poly) m = std::max(m, std::fabs(l.d[0] * (p[1] - l.a[1])) + std::fabs(l.d[1] * (p[0] - l.a[0])));
-    return 1e-9 * m;
-  };
-  const Cell c = nodes_[node];
-  if (c.line != kNoIndex) {
+std::size_t ScreenBsp::visit(std::uint32_t node, const std::vector<Point>& piece, std::span<const Line> edges,
+                             std::vector<Path>& path, std::vector<std::vector<Point>>& scratch,
+                             std::vector<std::uint32_t>& pixels) {
+  // Down the tree while the piece lies on one side of the lines (no clipping needed).
+  const std::size_t depth0 = path.size();
+  std::size_t written = 0;
+  for (;;) {
+    const Cell c = nodes_[node];
+    if (c.line == kNoIndex) break;
     const Line l = lines_[c.line];
     auto value = [&](const Point& p) { return edge_value(l.a, l.d, l.s, p[0], p[1]); };
     const double m = margin(l, piece);
     double lo = 1e300, hi = -1e300;
     for (const Point& p : piece) lo = std::min(lo, value(p)), hi = std::max(hi, value(p));
-    std::size_t written = 0;
-    std::vector<Point> sub, subcell;
-    for (const bool in : {true, false}) {
-      if (in ? !(hi > -m) : !(lo < m)) continue;
-      clip(piece, value, in ? 1 : -1, m, sub);
-      if (sub.empty()) continue;
-      clip(cell, value, in ? 1 : -1, 0, subcell);
-      path.push_back({c.line, in});
-      written += visit(in ? c.in : c.out, sub, subcell, edges, path, pixels);
-      path.pop_back();
+    const bool to_in = hi > -m, to_out = lo < m;
+    if (to_in != to_out) {
+      path.push_back({c.line, to_in});
+      node = to_in ? c.in : c.out;
+      continue;
     }
+    if (to_in) {
+      if (scratch.size() <= path.size()) scratch.resize(path.size() + 1);
+      for (const bool in : {true, false}) {
+        std::vector<Point>& sub = scratch[path.size()];
+        clip(piece, value, in ? 1 : -1, m, sub);
+        if (sub.empty()) continue;
+        const std::vector<Point> part = sub;  // (scratch[path.size()] is reused below)
+        path.push_back({c.line, in});
+        written += visit(in ? c.in : c.out, part, edges, path, scratch, pixels);
+        path.pop_back();
+      }
+    }
+    path.resize(depth0);
     return written;
   }
+  const std::size_t leaf_written = leaf(node, piece, edges, path, pixels);
+  path.resize(depth0);
+  return leaf_written;
+}
+
+std::size_t ScreenBsp::leaf(std::uint32_t node, const std::vector<Point>& piece, std::span<const Line> edges,
+                            const std::vector<Path>& path, std::vector<std::uint32_t>& pixels) {
+  const Cell c = nodes_[node];
   if (c.occupied) return 0;
 
   // A free leaf: the pixel centres of the cell inside the polygon.
@@ -141,12 +163,20 @@ std::size_t ScreenBsp::visit(std::uint32_t node, const std::vector<Point>& piece
     }
   if (written == 0 && std::fabs(signed_area(piece)) < 1e-9) return 0;  // a sliver between pixel centres
 
-  // Insert the polygon beneath the leaf: a chain of its edges that cross the cell, the
-  // outside of each a free leaf, the inside of the last one occupied.
+  // Insert the polygon beneath the leaf: a chain of its edges that cross the cell (the
+  // screen clipped by the path's lines), the outside of each a free leaf, the inside of the
+  // last one occupied.
+  std::vector<Point> cell = screen_rect(), sub;
+  for (const Path& q : path) {
+    const Line& l = lines_[q.line];
+    clip(cell, [&](const Point& p) { return edge_value(l.a, l.d, l.s, p[0], p[1]); }, q.in ? 1 : -1, 0, sub);
+    cell.swap(sub);
+    if (cell.empty()) break;
+  }
   std::uint32_t at = node;
   for (const Line& e : edges) {
     const double m = margin(e, cell);
-    bool crosses = false;
+    bool crosses = cell.empty();
     for (const Point& p : cell) crosses |= edge_value(e.a, e.d, e.s, p[0], p[1]) < m;
     if (!crosses) continue;
     const auto line = std::uint32_t(lines_.size());
@@ -163,6 +193,11 @@ std::size_t ScreenBsp::visit(std::uint32_t node, const std::vector<Point>& piece
   return written;
 }
 
+std::vector<Point> ScreenBsp::screen_rect() const {
+  const double W = width_, H = height_;
+  return {{0, 0}, {W, 0}, {W, H}, {0, H}};
+}
+
 bool ScreenBsp::occupied(double x, double y) const {
   std::uint32_t n = 0;
   while (nodes_[n].line != kNoIndex) {
@@ -173,12 +208,11 @@ bool ScreenBsp::occupied(double x, double y) const {
 }
 
 double ScreenBsp::occupied_area() const {
-  const double W = width_, H = height_;
   struct Item {
     std::uint32_t node;
     std::vector<Point> cell;
   };
-  std::vector<Item> stack{{0, {{0, 0}, {W, 0}, {W, H}, {0, H}}}};
+  std::vector<Item> stack{{0, screen_rect()}};
   double area = 0;
   std::vector<Point> sub;
   while (!stack.empty()) {

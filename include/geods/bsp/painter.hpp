@@ -57,8 +57,12 @@ class ScreenBsp {
     std::uint32_t line;
     bool in;
   };
-  std::size_t visit(std::uint32_t node, const std::vector<Point>& piece, const std::vector<Point>& cell,
-                    std::span<const Line> edges, std::vector<Path>& path, std::vector<std::uint32_t>& pixels);
+  std::size_t visit(std::uint32_t node, const std::vector<Point>& piece, std::span<const Line> edges,
+                    std::vector<Path>& path, std::vector<std::vector<Point>>& scratch, std::vector<std::uint32_t>& pixels);
+  std::size_t leaf(std::uint32_t node, const std::vector<Point>& piece, std::span<const Line> edges,
+                   const std::vector<Path>& path, std::vector<std::uint32_t>& pixels);
+  std::vector<Point> screen_rect() const;
+  static double margin(const Line& l, const std::vector<Point>& poly);
 
   int width_, height_;
   std::vector<Line> lines_;
