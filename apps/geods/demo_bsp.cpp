@@ -1,5 +1,6 @@
 // Demo steps of the bsp module: the bunny drawn without a z-buffer from its BSP tree
-// (painter's algorithm) next to the ray module's ray-traced image, and a boolean of the
+// (painter's algorithm, and front to back through the screen BSP) next to the ray
+// module's ray-traced image, and a boolean of the
 // bunny and a moved copy (difference and union), ray traced.
 #include <fmt/format.h>
 
@@ -55,6 +56,27 @@ Image8 painter_image(const bsp::Triangles& m, const bsp::PainterResult& r, const
   return out;
 }
 
+// Front to back through the screen BSP: each pixel coloured by when it was written (the
+// rank of its fragment in front-to-back order: blue first, red last).
+Image8 write_order_image(const bsp::BspTree& tree, std::size_t triangles, const bsp::PainterResult& r,
+                         const bsp::PainterView& v) {
+  const std::vector<std::uint32_t> order = tree.visibility_order(v.eye, false);
+  std::vector<double> rank(triangles, -1);
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    double& q = rank[tree.fragments()[order[i]].source];
+    if (q < 0) q = double(i) / double(std::max<std::size_t>(1, order.size() - 1));
+  }
+  Image8 out(std::size_t(v.width), std::size_t(v.height), 3, 255);
+  for (std::size_t i = 0; i < r.triangle.size(); ++i) {
+    if (r.triangle[i] == bsp::kNoIndex) continue;
+    const double q = std::clamp(rank[r.triangle[i]], 0.0, 1.0);
+    const std::uint8_t c[3] = {std::uint8_t(40 + 215 * q), std::uint8_t(60 + 120 * (1 - std::fabs(2 * q - 1))),
+                               std::uint8_t(255 - 215 * q)};
+    for (std::size_t k = 0; k < 3; ++k) out(i % std::size_t(v.width), i / std::size_t(v.width), k) = c[k];
+  }
+  return out;
+}
+
 void run_painter(const DemoContext& context, DemoResult& result) {
   const bsp::Triangles bunny = bsp::from_tri_mesh(io::read_mesh(context.data_dir / "bunny.ply"));
   const bsp::BspTree tree(bunny.vertices, bunny.triangles);
@@ -66,17 +88,19 @@ void run_painter(const DemoContext& context, DemoResult& result) {
   const bsp::PainterResult b2f = bsp::paint(tree, view, true);
   const bsp::PainterResult f2b = bsp::paint(tree, view, false);
   const Image8 painted = painter_image(bunny, b2f, view);
+  const Image8 written = write_order_image(tree, bunny.triangles.size(), f2b, view);
   ray::RenderOptions ro;
   ro.width = ro.height = 384;
   ro.camera = cam;
   const ray::RenderResult traced = ray::render(bsp::to_tri_mesh(bunny), ro);
-  io::write_png(context.out_dir / "bsp_painter.png", side_by_side({&painted, &traced.image}));
+  io::write_png(context.out_dir / "bsp_painter.png", side_by_side({&painted, &written, &traced.image}));
   result.figures.push_back(
       {"bsp_painter.png",
        fmt::format("left: the bunny's BSP fragments drawn back to front without a z-buffer (flat shading), {} pixel "
-                   "writes for {} covered pixels; front to back with a coverage mask: {} writes. Right: the ray "
-                   "module's ray-traced image from the same camera.",
-                   b2f.pixel_writes, f2b.pixel_writes, f2b.pixel_writes)});
+                   "writes for {} covered pixels. Middle: front to back through a 2D screen BSP of free/occupied "
+                   "cells ({} nodes at the end), each pixel written once, coloured by when it was written (blue "
+                   "first, red last). Right: the ray module's ray-traced image from the same camera.",
+                   b2f.pixel_writes, f2b.pixel_writes, f2b.screen_nodes)});
   result.stat("bunny tree", stats_text(tree.stats()));
   result.timing("BSP construction", tree.stats().build_s);
   result.text =
