@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 import geods
+from test_bvh import brute_intersect  # Moller-Trumbore over all triangles, float64
 
 
 def box(lo, hi):
@@ -165,22 +166,6 @@ def skewed_rays(V, n, seed):
     return o, spot + 0.15 * e * rng.standard_normal((n, 3)) - o
 
 
-def brute_first_hit(V, F, o, d):
-    """Nearest t over all triangles (Moller-Trumbore, vectorized over triangles)."""
-    a, b, c = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
-    e1, e2 = b - a, c - a
-    p = np.cross(d, e2)
-    det = np.einsum("ij,ij->i", e1, p)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        s = o - a
-        u = np.einsum("ij,ij->i", s, p) / det
-        q = np.cross(s, e1)
-        v = q @ d / det
-        t = np.einsum("ij,ij->i", e2, q) / det
-    ok = (det != 0) & (u >= 0) & (v >= 0) & (u + v <= 1) & (t >= 0)
-    return t[ok].min() if ok.any() else np.inf
-
-
 def test_custom_first_hits_match_oblivious_and_brute_force():
     V, F = torus(n=24, m=12)
     sample, rays = skewed_rays(V, 300, 1), skewed_rays(V, 400, 2)
@@ -196,7 +181,7 @@ def test_custom_first_hits_match_oblivious_and_brute_force():
     for key in ["rays", "hits", "nodes_per_ray", "tests_per_ray", "query_s"]:
         assert key in sc
     # The snapped surface is within a grid step of the input: brute force on the input mesh.
-    tb = np.array([brute_first_hit(V, F, rays[0][i], rays[1][i]) for i in range(100)])
+    tb = brute_intersect(V, F, rays[0][:100], rays[1][:100])
     same = np.isinf(tb) == np.isinf(tc[:100])
     assert same.sum() >= 98
     both = same & np.isfinite(tb)
