@@ -161,18 +161,20 @@ std::size_t ScreenBsp::leaf(std::uint32_t node, const std::vector<Point>& piece,
       pixels.push_back(std::uint32_t(y) * std::uint32_t(width_) + std::uint32_t(x));
       ++written;
     }
-  if (written == 0 && std::fabs(signed_area(piece)) < 1e-9) return 0;  // a sliver between pixel centres
-
-  // Insert the polygon beneath the leaf: a chain of its edges that cross the cell (the
-  // screen clipped by the path's lines), the outside of each a free leaf, the inside of the
-  // last one occupied.
-  std::vector<Point> cell = screen_rect(), sub;
+  // The cell (the screen clipped by the path's lines) and, without margins, the polygon's
+  // part in it. A part of no pixel centre and of almost no area (a sliver the margins let
+  // through along a line the polygon shares) leaves the leaf free.
+  std::vector<Point> cell = screen_rect(), part = piece, sub;
   for (const Path& q : path) {
     const Line& l = lines_[q.line];
-    clip(cell, [&](const Point& p) { return edge_value(l.a, l.d, l.s, p[0], p[1]); }, q.in ? 1 : -1, 0, sub);
-    cell.swap(sub);
-    if (cell.empty()) break;
+    auto value = [&](const Point& p) { return edge_value(l.a, l.d, l.s, p[0], p[1]); };
+    if (!cell.empty()) clip(cell, value, q.in ? 1 : -1, 0, sub), cell.swap(sub);
+    if (!part.empty()) clip(part, value, q.in ? 1 : -1, 0, sub), part.swap(sub);
   }
+  if (written == 0 && (part.empty() || std::fabs(signed_area(part)) < 1e-6)) return 0;
+
+  // Insert the polygon beneath the leaf: a chain of its edges that cross the cell, the
+  // outside of each a free leaf, the inside of the last one occupied.
   std::uint32_t at = node;
   for (const Line& e : edges) {
     const double m = margin(e, cell);
