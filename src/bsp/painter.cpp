@@ -78,12 +78,17 @@ std::size_t ScreenBsp::insert(std::span<const Point> polygon, std::vector<std::u
     if (d[0] != 0 || d[1] != 0) edges.push_back({a, d, s});  // a zero edge is inside everywhere
   }
   const double W = width_, H = height_;
-  // The part on the screen (with a margin: pieces only route the polygon, pixels are tested exactly).
+  // The part on the screen, a superset of polygon ∩ screen (with a margin: pieces only route
+  // the polygon, pixels are tested exactly). For a polygon far larger than the screen,
+  // clipping would lose the screen to cancellation: the piece is then the screen itself.
   std::vector<Point> piece(polygon.begin(), polygon.end()), tmp;
+  bool huge = false;
+  for (const Point& p : polygon) huge |= std::max(std::fabs(p[0]), std::fabs(p[1])) > 1e6 * (W + H);
+  if (huge) piece = screen_rect();
   auto box_value = [](int axis, double bound, double sign) {
     return [=](const Point& p) { return sign * (p[std::size_t(axis)] - bound); };
   };
-  for (int axis = 0; axis < 2; ++axis)
+  for (int axis = 0; axis < 2 && !huge; ++axis)
     for (double sign : {1.0, -1.0}) {
       const double bound = sign > 0 ? 0 : (axis == 0 ? W : H);
       clip(piece, box_value(axis, bound, sign), 1, 1e-9 * (W + H), tmp);
@@ -144,8 +149,9 @@ std::size_t ScreenBsp::leaf(std::uint32_t node, const std::vector<Point>& piece,
   double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300;
   for (const Point& p : piece)
     x0 = std::min(x0, p[0]), x1 = std::max(x1, p[0]), y0 = std::min(y0, p[1]), y1 = std::max(y1, p[1]);
-  const int ix0 = std::max(0, int(std::floor(x0 - 1))), ix1 = std::min(width_ - 1, int(std::ceil(x1)));
-  const int iy0 = std::max(0, int(std::floor(y0 - 1))), iy1 = std::min(height_ - 1, int(std::ceil(y1)));
+  // (clamped as doubles: huge or non-finite clipped coordinates never reach an int conversion)
+  const int ix0 = int(std::max(0.0, std::floor(x0 - 1))), ix1 = int(std::min(double(width_ - 1), std::ceil(x1)));
+  const int iy0 = int(std::max(0.0, std::floor(y0 - 1))), iy1 = int(std::min(double(height_ - 1), std::ceil(y1)));
   std::size_t written = 0;
   for (int y = iy0; y <= iy1; ++y)
     for (int x = ix0; x <= ix1; ++x) {
@@ -304,8 +310,8 @@ PainterResult paint(const BspTree& tree, const PainterView& view, bool back_to_f
     if (area == 0) continue;
     double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300;
     for (const Point& q : p) x0 = std::min(x0, q[0]), x1 = std::max(x1, q[0]), y0 = std::min(y0, q[1]), y1 = std::max(y1, q[1]);
-    const int ix0 = std::max(0, int(std::floor(x0 - 0.5))), ix1 = std::min(W - 1, int(std::ceil(x1 - 0.5)));
-    const int iy0 = std::max(0, int(std::floor(y0 - 0.5))), iy1 = std::min(H - 1, int(std::ceil(y1 - 0.5)));
+    const int ix0 = int(std::max(0.0, std::floor(x0 - 0.5))), ix1 = int(std::min(double(W - 1), std::ceil(x1 - 0.5)));
+    const int iy0 = int(std::max(0.0, std::floor(y0 - 0.5))), iy1 = int(std::min(double(H - 1), std::ceil(y1 - 0.5)));
     const double s = area > 0 ? 1 : -1;
     for (int y = iy0; y <= iy1; ++y)
       for (int x = ix0; x <= ix1; ++x) {

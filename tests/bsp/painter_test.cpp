@@ -150,6 +150,14 @@ TEST(ScreenBsp, OccupiedIsUnionAndPixelsOnce) {
   EXPECT_NEAR(screen.occupied_area(), estimate, 4 * sigma + 1e-9);
   EXPECT_GT(screen.depth(), 2u);
 
+  // A polygon far larger than the screen covers it; then nothing is left to write.
+  ScreenBsp big(8, 6);
+  const std::vector<P2> huge{{-1e100, -1e100}, {1e100, -1e100}, {0, 1e100}};
+  pixels.clear();
+  EXPECT_EQ(big.insert(huge, pixels), 48u);
+  EXPECT_EQ(big.insert(huge, pixels), 0u);
+  EXPECT_NEAR(big.occupied_area(), 48.0, 1e-9);
+
   std::vector<P2> bad{{0, 0}, {std::nan(""), 1}, {1, 1}};
   EXPECT_THROW(screen.insert(bad, pixels), Error);
   EXPECT_THROW(ScreenBsp(0, 5), Error);
