@@ -27,7 +27,8 @@ class BspCommand : public Command {
                    "rays of --rays, §3.4.3)");
     app.add_option("--alpha", options_.alpha, "Equation (5): weight |S-|^alpha + |S+|^alpha (> 0)");
     app.add_option("--beta", options_.beta, "Equation (5): penalty per split polygon (>= 0)");
-    app.add_option("--k", k_, "Candidate polygons per node: the k largest (cost) or k random (random)")
+    app.add_option("--k", k_, "Candidate polygons per node: the k largest (cost), k random (random) or the k best-scoring, one "
+                   "taken at random (custom)")
         ->check(at_least(1));
     app.add_option("--seed", options_.seed, "Seed of the random choices");
     app.add_option("--rays", rays_,

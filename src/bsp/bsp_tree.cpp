@@ -271,13 +271,14 @@ void BspTree::build(const std::vector<Vec3d>& vertices, const std::vector<std::a
     stack.pop_back();
     auto& frags = task.frags;
     // Fragments scored for a candidate: all, or a random sample.
-    scored = frags;
+    scored.clear();
+    if (options.heuristic != Heuristic::custom) scored = frags;  // (custom scores no splits)
     if (scored.size() > options.sample) {
       for (std::size_t i = 0; i < options.sample; ++i)
         std::swap(scored[i], scored[i + rng() % (scored.size() - i)]);
       scored.resize(options.sample);
     }
-    const double scale = static_cast<double>(frags.size()) / static_cast<double>(scored.size());
+    const double scale = static_cast<double>(frags.size()) / static_cast<double>(std::max<std::size_t>(1, scored.size()));
 
     std::uint32_t plane = kNoIndex;
     if (options.heuristic == Heuristic::balanced && frags.size() > 1) {

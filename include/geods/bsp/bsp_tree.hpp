@@ -56,7 +56,7 @@ struct BuildOptions {
   Heuristic heuristic = Heuristic::cost;
   double alpha = 0.8;       // equation (5): weight of |S-|^alpha + |S+|^alpha
   double beta = 0.5;        // equation (5): penalty per split polygon
-  std::uint32_t k = 8;      // candidates: the k largest (cost) or k random (random) polygons
+  std::uint32_t k = 8;      // candidates: the k largest (cost), k random (random) or k best-scoring (custom) polygons
   std::uint64_t seed = 1;   // random choices
   std::size_t sample = 128; // polygons a candidate is scored on (a random sample if more)
   /// custom (§3.4.3, the customized BSP): a sample of the rays the tree will answer (t_max
