@@ -335,6 +335,7 @@ struct ObbTester {
         }
         g = std::max(g, s);
         if (!Lower && g > eps) return g;
+        if (Lower && g >= cutoff) return g;
       }
     }
     return g;
@@ -352,7 +353,9 @@ struct ObbTester {
 
 // Rectangle swept spheres: the rectangles' distance (bvh::rectangle_distance,
 // exact) less both radii, after cheaper bounds that often settle the pair:
-// the bounding spheres, then the gaps along A's three axes.
+// the bounding spheres, then the boxes' distances in A's and B's frames; and
+// a pair whose distance is surely below the cutoff (B's centre is that near
+// A's rectangle) keeps the cheaper bound as its key.
 struct RssTester {
   const Frames& f;
   const CollisionMesh::Swept* a;
@@ -371,11 +374,30 @@ struct RssTester {
     // B's rectangle in A's rectangle frame.
     const Vec3d c = A.axes.transpose() * d;
     const Eigen::Matrix3d r = A.axes.transpose() * (f.ab.r * B.axes);
+    // B's rectangle bounded by a box in A's frame: the distance from A's
+    // rectangle to that box (the norm of the gaps along A's axes) bounds the
+    // rectangles' distance from below; the same in B's frame.
     const double ha[3] = {A.half0, A.half1, 0};
-    double g = -std::numeric_limits<double>::infinity();
-    for (int k = 0; k < 3; ++k)
-      g = std::max(g, std::abs(c[k]) - ha[k] - std::abs(r(k, 0)) * B.half0 - std::abs(r(k, 1)) * B.half1 - rr);
+    double sa = 0;
+    for (int k = 0; k < 3; ++k) {
+      const double s = std::abs(c[k]) - ha[k] - std::abs(r(k, 0)) * B.half0 - std::abs(r(k, 1)) * B.half1;
+      if (s > 0) sa += s * s;
+    }
+    double g = std::sqrt(sa) - rr;
     if (g > cutoff) return g;
+    const double hb[3] = {B.half0, B.half1, 0};
+    double sb = 0;
+    for (int l = 0; l < 3; ++l) {
+      const double cl = r(0, l) * c[0] + r(1, l) * c[1] + r(2, l) * c[2];
+      const double s = std::abs(cl) - hb[l] - std::abs(r(0, l)) * A.half0 - std::abs(r(1, l)) * A.half1;
+      if (s > 0) sb += s * s;
+    }
+    g = std::max(g, std::sqrt(sb) - rr);
+    if (g > cutoff) return g;
+    // An upper bound below the cutoff: the pair is kept whatever its exact
+    // distance, and the lower bound serves as its key.
+    const double dx = std::max(std::abs(c[0]) - A.half0, 0.0), dy = std::max(std::abs(c[1]) - A.half1, 0.0);
+    if (std::sqrt(dx * dx + dy * dy + c[2] * c[2]) - rr < cutoff) return g;
     return bvh::rectangle_distance<double>(r, c, A.half0, A.half1, B.half0, B.half1) - rr;
   }
   bool overlap(std::uint32_t i, std::uint32_t j) const { return gap(i, j, f.eps) <= f.eps; }
@@ -404,7 +426,10 @@ bool open_a(const bvh::TopoNode& na, const bvh::TopoNode& nb, double size_a, dou
 
 // Runs the simultaneous traversal. accept(i, j, key) tests a node pair and
 // sets its key; leaf(i, j) handles two leaves (false stops); still_needed(key).
-template <bool Ordered, typename Accept, typename Leaf, typename StillNeeded>
+// BestFirst: the pairs wait on a heap by key, the one of smallest key is
+// opened next (distance queries: still_needed must be monotone in the key);
+// else depth-first in no order (collision queries).
+template <bool BestFirst, typename Accept, typename Leaf, typename StillNeeded>
 void traverse_pairs(const Frames& f, DescendRule rule, Accept&& accept, Leaf&& leaf, StillNeeded&& still_needed) {
   const bvh::Topology& ta = f.a.bvh().topology();
   const bvh::Topology& tb = f.b.bvh().topology();
@@ -415,31 +440,37 @@ void traverse_pairs(const Frames& f, DescendRule rule, Accept&& accept, Leaf&& l
   const bvh::TopoNode* nb = tb.nodes.data();
   const double* sa = f.a.sizes().data();
   const double* sb = f.b.sizes().data();
-  const int arity = std::max(f.a.options().arity, f.b.options().arity);
-  bvh::TraversalStack<PairRef> stack(
-      bvh::traversal_stack_size(f.a.depth() + f.b.depth(), arity));
-  bvh::traverse<8, Ordered>(
-      root, stack, [&](const PairRef& e) { return na[e.a].leaf() && nb[e.b].leaf(); },
-      [&](const PairRef& e, float* keys) {
-        const bvh::TopoNode& x = na[e.a];
-        const bvh::TopoNode& y = nb[e.b];
-        unsigned bits = 0;
-        if (open_a(x, y, sa[e.a], sb[e.b], rule)) {
-          for (std::uint32_t c = 0; c < x.num_children; ++c)
-            if ((keys[c] = 0.0f, accept(x.first_child + c, e.b, keys[c]))) bits |= 1u << c;
-        } else {
-          for (std::uint32_t c = 0; c < y.num_children; ++c)
-            if ((keys[c] = 0.0f, accept(e.a, y.first_child + c, keys[c]))) bits |= 1u << c;
-        }
-        return bits;
-      },
-      [&](const PairRef& e, int c, float key) {
-        const bvh::TopoNode& x = na[e.a];
-        const bvh::TopoNode& y = nb[e.b];
-        if (open_a(x, y, sa[e.a], sb[e.b], rule)) return PairRef{x.first_child + std::uint32_t(c), e.b, key};
-        return PairRef{e.a, y.first_child + std::uint32_t(c), key};
-      },
-      [&](const PairRef& e) { return leaf(e.a, e.b); }, [&](const PairRef& e) { return still_needed(e.key); });
+  auto is_leaf = [&](const PairRef& e) { return na[e.a].leaf() && nb[e.b].leaf(); };
+  auto children = [&](const PairRef& e, float* keys) {
+    const bvh::TopoNode& x = na[e.a];
+    const bvh::TopoNode& y = nb[e.b];
+    unsigned bits = 0;
+    if (open_a(x, y, sa[e.a], sb[e.b], rule)) {
+      for (std::uint32_t c = 0; c < x.num_children; ++c)
+        if ((keys[c] = 0.0f, accept(x.first_child + c, e.b, keys[c]))) bits |= 1u << c;
+    } else {
+      for (std::uint32_t c = 0; c < y.num_children; ++c)
+        if ((keys[c] = 0.0f, accept(e.a, y.first_child + c, keys[c]))) bits |= 1u << c;
+    }
+    return bits;
+  };
+  auto child = [&](const PairRef& e, int c, float key) {
+    const bvh::TopoNode& x = na[e.a];
+    const bvh::TopoNode& y = nb[e.b];
+    if (open_a(x, y, sa[e.a], sb[e.b], rule)) return PairRef{x.first_child + std::uint32_t(c), e.b, key};
+    return PairRef{e.a, y.first_child + std::uint32_t(c), key};
+  };
+  auto at_leaf = [&](const PairRef& e) { return leaf(e.a, e.b); };
+  auto needed = [&](const PairRef& e) { return still_needed(e.key); };
+  if constexpr (BestFirst) {
+    std::vector<PairRef> heap;
+    heap.reserve(256);
+    bvh::traverse_best_first<8>(root, heap, is_leaf, children, child, at_leaf, needed);
+  } else {
+    const int arity = std::max(f.a.options().arity, f.b.options().arity);
+    bvh::TraversalStack<PairRef> stack(bvh::traversal_stack_size(f.a.depth() + f.b.depth(), arity));
+    bvh::traverse<8, false>(root, stack, is_leaf, children, child, at_leaf, needed);
+  }
 }
 
 // The world triangles of a leaf, computed once per visit.

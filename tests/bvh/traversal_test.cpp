@@ -90,6 +90,63 @@ TEST(Traversal, OrderedQueryFindsTheNearestAndVisitsLeavesNearFirst) {
   }
 }
 
+// Best-first (a heap by key): the nearest triangle box again; the leaves come
+// in the order of their keys, none above the answer; a leaf callback
+// returning false stops it.
+TEST(Traversal, BestFirstQueryVisitsLeavesInKeyOrderUpToTheAnswer) {
+  const TriMesh soup = test::random_soup(3000, 75);
+  Rng rng(76);
+  for (int arity : {2, 4}) {
+    BuildOptions options;
+    options.arity = arity;
+    const TriangleBvh bvh = TriangleBvh::build(soup, options);
+    const auto& boxes = std::get<FlatArray<AABB3f>>(bvh.volumes());
+    const TopoNode* nodes = bvh.topology().nodes.data();
+    std::vector<NodeRef> heap;
+    for (int q = 0; q < 50; ++q) {
+      const Vec3f c = test::random_point(rng, -2, 2);
+      float want = std::numeric_limits<float>::infinity();
+      for (std::size_t t = 0; t < soup.num_triangles(); ++t) want = std::min(want, triangle_box(soup, t).squared_distance(c));
+      float best = std::numeric_limits<float>::infinity(), last = -1;
+      int leaves = 0;
+      auto leaf = [&](const NodeRef& e) {
+        ++leaves;
+        EXPECT_GE(e.key, last) << "key order";
+        EXPECT_LE(e.key, want) << "a leaf beyond the answer";
+        last = e.key;
+        const TopoNode& n = nodes[e.node];
+        for (std::uint32_t i = n.prim_first; i < n.prim_first + n.prim_count; ++i)
+          best = std::min(best, triangle_box(soup, bvh.triangle_ids()[i]).squared_distance(c));
+      };
+      auto children = [&](const NodeRef& e, float* keys) {
+        unsigned bits = 0;
+        for (std::uint32_t k = 0; k < nodes[e.node].num_children; ++k) {
+          keys[k] = boxes[nodes[e.node].first_child + k].squared_distance(c);
+          if (keys[k] < best) bits |= 1u << k;
+        }
+        return bits;
+      };
+      auto child = [&](const NodeRef& e, int k, float key) { return NodeRef{nodes[e.node].first_child + std::uint32_t(k), key}; };
+      auto is_leaf = [&](const NodeRef& e) { return nodes[e.node].leaf(); };
+      const NodeRef root{0, boxes[0].squared_distance(c)};
+      EXPECT_TRUE(traverse_best_first<8>(root, heap, is_leaf, children, child, leaf,
+                                         [&](const NodeRef& e) { return e.key < best; }));
+      ASSERT_EQ(best, want) << q;
+      // Only leaves whose key is at most the answer can be visited (branch and bound at its best).
+      int below = 0;
+      for (std::size_t n = 0; n < bvh.topology().nodes.size(); ++n) below += nodes[n].leaf() && boxes[n].squared_distance(c) <= want;
+      EXPECT_LE(leaves, below) << q;
+      // Stopped by the leaf callback after two leaves.
+      int calls = 0;
+      best = std::numeric_limits<float>::infinity();
+      EXPECT_FALSE(traverse_best_first<8>(root, heap, is_leaf, children, child,
+                                          [&](const NodeRef&) { return ++calls < 2; },
+                                          [](const NodeRef&) { return true; }));
+      EXPECT_EQ(calls, 2);
+    }
+  }
+}
+
 TEST(Traversal, StopsWhenTheLeafCallbackSaysSoAndHandlesTinyTrees) {
   const TriMesh soup = test::random_soup(500, 75);
   const TriangleBvh bvh = TriangleBvh::build(soup);

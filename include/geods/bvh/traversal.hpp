@@ -5,6 +5,7 @@
 // `traverse_topology`, the wide SIMD nodes of TriangleBvh), every query a
 // small callback on it; and the simultaneous traversal of two hierarchies
 // (seed §4.2's traverse(A, B)) that collision detection builds on.
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -127,6 +128,56 @@ GEODS_BVH_INLINE bool traverse(Entry root, TraversalStack<Entry>& stack, IsLeaf&
       more = still_needed(cur);
     }
     if (!more) return true;
+  }
+}
+
+/// Best-first traversal (branch and bound), the callbacks of `traverse`:
+/// every waiting entry is on a min-heap by key, and the entry of smallest
+/// key is visited next, so that with keys that are lower bounds of what a
+/// subtree can give, no entry is visited whose key is above the final bound
+/// (the depth-first order of `traverse` opens many such entries before its
+/// bound is tight). still_needed(e) must be monotone in the key: false for the
+/// entry taken ends the traversal (every other waiting entry has a key at
+/// least as large). `heap` is cleared first and grows as needed. Returns
+/// false if leaf stopped it. Cost: O(log n) heap work per entry visited.
+template <int MaxChildren, typename Entry, typename IsLeaf, typename Children, typename Child, typename Leaf,
+          typename StillNeeded>
+GEODS_BVH_INLINE bool traverse_best_first(Entry root, std::vector<Entry>& heap, IsLeaf&& is_leaf, Children&& children,
+                                          Child&& child, Leaf&& leaf, StillNeeded&& still_needed) {
+  static_assert(MaxChildren >= 2 && MaxChildren <= 32, "children are reported as 32-bit masks");
+  const auto later = [](const Entry& x, const Entry& y) { return x.key > y.key; };  // min-heap
+  heap.clear();
+  Entry cur = root;
+  for (;;) {
+    if (!is_leaf(cur)) {
+      float keys[MaxChildren];
+      unsigned bits = children(cur, keys);
+      if (bits != 0) {
+        // The nearest child goes on without heap traffic if nothing waiting is nearer.
+        int near = __builtin_ctz(bits);
+        for (unsigned b = bits & (bits - 1); b != 0; b &= b - 1)
+          if (keys[__builtin_ctz(b)] < keys[near]) near = __builtin_ctz(b);
+        for (unsigned b = bits & ~(1u << near); b != 0; b &= b - 1) {
+          const int i = __builtin_ctz(b);
+          heap.push_back(child(cur, i, keys[i]));
+          std::push_heap(heap.begin(), heap.end(), later);
+        }
+        const Entry next = child(cur, near, keys[near]);
+        if (heap.empty() || !(heap.front().key < next.key)) {
+          cur = next;
+          continue;
+        }
+        heap.push_back(next);
+        std::push_heap(heap.begin(), heap.end(), later);
+      }
+    } else if (!detail::keep_going(leaf, cur)) {
+      return false;
+    }
+    if (heap.empty()) return true;
+    std::pop_heap(heap.begin(), heap.end(), later);
+    cur = heap.back();
+    heap.pop_back();
+    if (!still_needed(cur)) return true;
   }
 }
 
