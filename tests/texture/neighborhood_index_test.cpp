@@ -146,7 +146,9 @@ TEST(NeighborhoodIndex, TheTightStartOfLargeSets) {
       }
     }
     EXPECT_GT(within_budget, 100u) << "dim " << dim;
-    if (dim == 65) EXPECT_GT(beyond, 0u);  // neighbourhoods spend their budget on some queries (3-vectors on none)
+    if (dim == 65) {  // neighbourhoods spend their budget on some queries (3-vectors on none)
+      EXPECT_GT(beyond, 0u);
+    }
   }
   EXPECT_EQ(NeighborhoodIndex(clustered(4096, 65, 33), 65, 8).tight_budget(), 0u);
 }
