@@ -23,6 +23,12 @@ constexpr std::size_t kCovarianceSamples = 2048;
 // coordinates, 4 is 10 to 13 % faster than 8 on the bench's samples at the
 // same error (means over seeds 1 to 5 within the spread over seeds).
 constexpr std::size_t kLeafSize = 4;
+// The approximate search's tight start (see the header): a query prunes with
+// eps / kTightEpsDivisor until it has computed count / kTightShare - kTightBase
+// full distances (nothing below 4096 candidates), then with eps.
+constexpr double kTightEpsDivisor = 4;
+constexpr std::size_t kTightShare = 256;
+constexpr std::size_t kTightBase = 16;
 
 }  // namespace
 
@@ -180,6 +186,10 @@ void NeighborhoodIndex::project(const std::uint8_t* v, float* out, std::vector<s
   out[reduced_] = float(std::sqrt(std::max(double(norm) - kept, 0.0)));
 }
 
+std::size_t NeighborhoodIndex::tight_budget() const {
+  return count_ / kTightShare > kTightBase ? count_ / kTightShare - kTightBase : 0;
+}
+
 std::uint32_t NeighborhoodIndex::squared_distance(const std::uint8_t* query, std::size_t i) const {
   const std::uint8_t* v = candidate(i);
   std::uint32_t d = 0;
@@ -222,15 +232,24 @@ NeighborhoodIndex::Match NeighborhoodIndex::nearest(const std::uint8_t* query, N
   // distance sums (a relative 1e-5, far above float's (dim + 2) 2^-24): so
   // rounding can never prune a candidate as near as the best, and the
   // (1 + eps) guarantee holds.
+  //
+  // The tight start of the approximate search: the tree prunes a subtree when
+  // its bound exceeds worst() / (1 + eps)^2, so while the query is within its
+  // budget worst() is the best bound times ((1 + eps) / (1 + tight))^2, which
+  // makes that bound / (1 + tight)^2; insert() then filters the leaf points by
+  // the best bound itself (a point beyond it cannot be nearer).
   struct Refine {
     const NeighborhoodIndex& index;
     const std::uint8_t* query;
     std::size_t& evaluations;
+    std::size_t tight_until;  // evaluations at which the tight start ends
+    float widen;              // ((1 + eps) / (1 + tight))^2, or 1
     Match best;
     float bound = std::numeric_limits<float>::infinity();
     bool full() const { return best.candidate != std::numeric_limits<std::uint32_t>::max(); }
-    float worst() const { return bound; }
-    void insert(std::uint32_t i, float) {
+    float worst() const { return evaluations < tight_until ? bound * widen : bound; }
+    void insert(std::uint32_t i, float tree_distance) {
+      if (tree_distance > bound) return;
       ++evaluations;
       const std::uint32_t d = index.squared_distance(query, i);
       if (Match{i, d}.before(best)) set(i, d);
@@ -240,7 +259,16 @@ NeighborhoodIndex::Match NeighborhoodIndex::nearest(const std::uint8_t* query, N
       const double r = std::sqrt(double(d) + 0.5) + index.margin_;
       bound = float(r * r * (1 + 1e-5));
     }
-  } refine{*this, query, scratch.full_distances, {}};
+  };
+  const std::size_t budget = tight_budget();
+  const double tight = eps / kTightEpsDivisor;
+  const bool tight_start = search == NeighborSearch::approx && budget > 0 && eps > 0;
+  Refine refine{*this,
+                query,
+                scratch.full_distances,
+                tight_start ? scratch.full_distances + budget : 0,
+                tight_start ? float(((1 + eps) / (1 + tight)) * ((1 + eps) / (1 + tight))) : 1.0f,
+                {}};
   if (start.candidate < count_) refine.set(start.candidate, start.squared_distance);
   if (fixed_tree_)
     fixed_tree_->search_nearest(scratch.projected.data(), refine, eps);
