@@ -321,46 +321,46 @@ class GridSolver {
       // no farther from p than any of them, so each block's list keeps only
       // the faces that pass the corner test against every one of them.
       std::array<Vec3f, 1 + kBlocks> anchors;
-      std::size_t num_anchors = 0, num_blocks = 0;
+      std::size_t num_anchors = 0;
       std::array<Closest, kBlocks> block_closest;
       anchors[num_anchors++] = centre.closest;
-      for (std::size_t bz = box.lo[2]; bz < box.hi[2]; bz += kBlock)
-        for (std::size_t by = box.lo[1]; by < box.hi[1]; by += kBlock)
-          for (std::size_t bx = box.lo[0]; bx < box.hi[0]; bx += kBlock) {
-            const SampleBox block(grid_, {bx, by, bz},
-                                  {std::min(bx + kBlock, box.hi[0]), std::min(by + kBlock, box.hi[1]),
-                                   std::min(bz + kBlock, box.hi[2])});
-            const InBlock centre_in_tile = in_box(box, block.centre);
-            block_closest[num_blocks] = closest_in(tile_list, block.centre, &centre_in_tile);
-            if (block_closest[num_blocks].leaf != kNoIndex) anchors[num_anchors++] = block_closest[num_blocks].point;
-            ++num_blocks;
-          }
-      num_blocks = 0;
-      for (std::size_t bz = box.lo[2]; bz < box.hi[2]; bz += kBlock)
-        for (std::size_t by = box.lo[1]; by < box.hi[1]; by += kBlock)
-          for (std::size_t bx = box.lo[0]; bx < box.hi[0]; bx += kBlock) {
-            const SampleBox block(grid_, {bx, by, bz},
-                                  {std::min(bx + kBlock, box.hi[0]), std::min(by + kBlock, box.hi[1]),
-                                   std::min(bz + kBlock, box.hi[2])});
-            const Closest& c = block_closest[num_blocks++];
-            if (std::sqrt(c.d2) - block.radius > band_ + margin_) continue;
-            filter(tile_list, block, c.point, block_list, kept, true, &box, std::span(anchors.data(), num_anchors));
-            std::size_t seed = 0;  // the group of the previous sample's nearest face
-            for (std::size_t k = block.lo[2]; k < block.hi[2]; ++k)
-              for (std::size_t j = block.lo[1]; j < block.hi[1]; ++j)
-                for (std::size_t i = block.lo[0]; i < block.hi[0]; ++i) {
-                  const Vec3f p = grid_.position(i, j, k);
-                  const InBlock at_p = in_box(block, p);
-                  const Closest s = closest_in(block_list, p, &at_p, seed);
-                  seed = s.slot / 8;
-                  const float d = std::sqrt(s.d2);
-                  if (d > band_) continue;
-                  stats.candidates_per_sample += double(block_list.size);
-                  ud[local(i, j, k)] = d;
-                  best[local(i, j, k)] = s;
-                  ++stats.in_band;
-                }
-          }
+      std::array<std::size_t, 3> blocks;  // along each axis
+      for (int a = 0; a < 3; ++a) blocks[a] = (box.hi[a] - box.lo[a] + kBlock - 1) / kBlock;
+      const std::size_t num_blocks = blocks[0] * blocks[1] * blocks[2];
+      const auto block_box = [&](std::size_t b) {
+        const std::array<std::size_t, 3> lo{box.lo[0] + kBlock * (b % blocks[0]), box.lo[1] + kBlock * (b / blocks[0] % blocks[1]),
+                                            box.lo[2] + kBlock * (b / (blocks[0] * blocks[1]))};
+        return SampleBox(grid_, lo,
+                         {std::min(lo[0] + kBlock, box.hi[0]), std::min(lo[1] + kBlock, box.hi[1]),
+                          std::min(lo[2] + kBlock, box.hi[2])});
+      };
+      for (std::size_t b = 0; b < num_blocks; ++b) {
+        const Vec3f block_centre = block_box(b).centre;
+        const InBlock centre_in_tile = in_box(box, block_centre);
+        block_closest[b] = closest_in(tile_list, block_centre, &centre_in_tile);
+        if (block_closest[b].leaf != kNoIndex) anchors[num_anchors++] = block_closest[b].point;
+      }
+      for (std::size_t b = 0; b < num_blocks; ++b) {
+        const SampleBox block = block_box(b);
+        const Closest& c = block_closest[b];
+        if (std::sqrt(c.d2) - block.radius > band_ + margin_) continue;
+        filter(tile_list, block, c.point, block_list, kept, true, &box, std::span(anchors.data(), num_anchors));
+        std::size_t seed = 0;  // the group of the previous sample's nearest face
+        for (std::size_t k = block.lo[2]; k < block.hi[2]; ++k)
+          for (std::size_t j = block.lo[1]; j < block.hi[1]; ++j)
+            for (std::size_t i = block.lo[0]; i < block.hi[0]; ++i) {
+              const Vec3f p = grid_.position(i, j, k);
+              const InBlock at_p = in_box(block, p);
+              const Closest s = closest_in(block_list, p, &at_p, seed);
+              seed = s.slot / 8;
+              const float d = std::sqrt(s.d2);
+              if (d > band_) continue;
+              stats.candidates_per_sample += double(block_list.size);
+              ud[local(i, j, k)] = d;
+              best[local(i, j, k)] = s;
+              ++stats.in_band;
+            }
+      }
     } else {
       ++stats.tiles_outside;
     }
