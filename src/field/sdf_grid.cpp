@@ -7,6 +7,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstring>
+#include <span>
 #include <string>
 
 #include <fmt/format.h>
@@ -20,6 +21,7 @@ namespace {
 
 constexpr std::size_t kTile = 8;   // samples along a tile's side
 constexpr std::size_t kBlock = 4;  // samples along a block's side (within a tile)
+constexpr std::size_t kBlocks = (kTile / kBlock) * (kTile / kBlock) * (kTile / kBlock);  // per tile
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
 using bvh::BvhTriangle;
@@ -138,18 +140,35 @@ struct Kept {
   std::array<float, 8> k;
 };
 
-// The entries of t within bound2[k] of some corner k, appended to `kept`,
-// eight entries at a time.
+// The entries of t within bound2[0][k] of some corner k, appended to `kept`,
+// eight entries at a time; with sets > 1, only those that are also within
+// bound2[j][k] of some corner k for every j < sets.
+// With `reach2` (t being a tile's list, with its corner distances k0..k7):
+// an entry farther than reach2[m] from tile corner m cannot pass (see
+// GridSolver::filter); groups of 8 such entries are skipped unmeasured.
 __attribute__((target_clones("avx2", "default"))) void corner_test(const Packed& t, const std::array<Vec3f, 8>& corners,
-                                                                  const std::array<float, 8>& bound2,
+                                                                  const std::array<float, 8>* bound2, int sets,
+                                                                  const std::array<float, 8>* reach2,
                                                                   std::vector<Kept>& kept) {
   const I8 size = I8{} + std::int32_t(t.size), lanes = I8{0, 1, 2, 3, 4, 5, 6, 7};
   for (std::size_t i = 0; i < t.size; i += 8) {
+    if (reach2) {
+      I8 near = I8{} - 1;
+      for (int m = 0; m < 8; ++m) near &= load8(t.f[Packed::k0 + m].data() + i) <= (*reach2)[m];
+      bool any = false;
+      for (int l = 0; l < 8; ++l) any |= near[l] != 0;
+      if (!any) continue;
+    }
     V8 d[8];
     I8 pass = I8{};
     for (int k = 0; k < 8; ++k) {
       distance8(t.f, i, V8{} + corners[k].x(), V8{} + corners[k].y(), V8{} + corners[k].z(), d[k]);
-      pass |= d[k] <= bound2[k];
+      pass |= d[k] <= bound2[0][k];
+    }
+    for (int j = 1; j < sets; ++j) {
+      I8 also = I8{};
+      for (int k = 0; k < 8; ++k) also |= d[k] <= bound2[j][k];
+      pass &= also;
     }
     pass &= (lanes + std::int32_t(i)) < size;
     for (int l = 0; l < 8; ++l) {
@@ -297,32 +316,51 @@ class GridSolver {
       thread_local Scratch scratch;
       auto& [tile_list, block_list, near, kept, found] = scratch;
       gather(box, centre.closest, tile_list, near, found, kept);
-      for (std::size_t bz = box.lo[2]; bz < box.hi[2]; bz += kBlock)
-        for (std::size_t by = box.lo[1]; by < box.hi[1]; by += kBlock)
-          for (std::size_t bx = box.lo[0]; bx < box.hi[0]; bx += kBlock) {
-            const SampleBox block(grid_, {bx, by, bz},
-                                  {std::min(bx + kBlock, box.hi[0]), std::min(by + kBlock, box.hi[1]),
-                                   std::min(bz + kBlock, box.hi[2])});
-            const InBlock centre_in_tile = in_box(box, block.centre);
-            const Closest c = closest_in(tile_list, block.centre, &centre_in_tile);
-            if (std::sqrt(c.d2) - block.radius > band_ + margin_) continue;
-            filter(tile_list, block, c.point, block_list, kept, true);
-            std::size_t seed = 0;  // the group of the previous sample's nearest face
-            for (std::size_t k = block.lo[2]; k < block.hi[2]; ++k)
-              for (std::size_t j = block.lo[1]; j < block.hi[1]; ++j)
-                for (std::size_t i = block.lo[0]; i < block.hi[0]; ++i) {
-                  const Vec3f p = grid_.position(i, j, k);
-                  const InBlock at_p = in_box(block, p);
-                  const Closest s = closest_in(block_list, p, &at_p, seed);
-                  seed = s.slot / 8;
-                  const float d = std::sqrt(s.d2);
-                  if (d > band_) continue;
-                  stats.candidates_per_sample += double(block_list.size);
-                  ud[local(i, j, k)] = d;
-                  best[local(i, j, k)] = s;
-                  ++stats.in_band;
-                }
-          }
+      // Surface points: the closest points of the tile's centre and of the
+      // blocks' centres. A face that can be nearest to a sample p of a block is
+      // no farther from p than any of them, so each block's list keeps only
+      // the faces that pass the corner test against every one of them.
+      std::array<Vec3f, 1 + kBlocks> anchors;
+      std::size_t num_anchors = 0;
+      std::array<Closest, kBlocks> block_closest;
+      anchors[num_anchors++] = centre.closest;
+      std::array<std::size_t, 3> blocks;  // along each axis
+      for (int a = 0; a < 3; ++a) blocks[a] = (box.hi[a] - box.lo[a] + kBlock - 1) / kBlock;
+      const std::size_t num_blocks = blocks[0] * blocks[1] * blocks[2];
+      const auto block_box = [&](std::size_t b) {
+        const std::array<std::size_t, 3> lo{box.lo[0] + kBlock * (b % blocks[0]), box.lo[1] + kBlock * (b / blocks[0] % blocks[1]),
+                                            box.lo[2] + kBlock * (b / (blocks[0] * blocks[1]))};
+        return SampleBox(grid_, lo,
+                         {std::min(lo[0] + kBlock, box.hi[0]), std::min(lo[1] + kBlock, box.hi[1]),
+                          std::min(lo[2] + kBlock, box.hi[2])});
+      };
+      for (std::size_t b = 0; b < num_blocks; ++b) {
+        const Vec3f block_centre = block_box(b).centre;
+        const InBlock centre_in_tile = in_box(box, block_centre);
+        block_closest[b] = closest_in(tile_list, block_centre, &centre_in_tile);
+        if (block_closest[b].leaf != kNoIndex) anchors[num_anchors++] = block_closest[b].point;
+      }
+      for (std::size_t b = 0; b < num_blocks; ++b) {
+        const SampleBox block = block_box(b);
+        const Closest& c = block_closest[b];
+        if (std::sqrt(c.d2) - block.radius > band_ + margin_) continue;
+        filter(tile_list, block, c.point, block_list, kept, true, &box, std::span(anchors.data(), num_anchors));
+        std::size_t seed = 0;  // the group of the previous sample's nearest face
+        for (std::size_t k = block.lo[2]; k < block.hi[2]; ++k)
+          for (std::size_t j = block.lo[1]; j < block.hi[1]; ++j)
+            for (std::size_t i = block.lo[0]; i < block.hi[0]; ++i) {
+              const Vec3f p = grid_.position(i, j, k);
+              const InBlock at_p = in_box(block, p);
+              const Closest s = closest_in(block_list, p, &at_p, seed);
+              seed = s.slot / 8;
+              const float d = std::sqrt(s.d2);
+              if (d > band_) continue;
+              stats.candidates_per_sample += double(block_list.size);
+              ud[local(i, j, k)] = d;
+              best[local(i, j, k)] = s;
+              ++stats.in_band;
+            }
+      }
     } else {
       ++stats.tiles_outside;
     }
@@ -430,9 +468,29 @@ class GridSolver {
   // the group's faces (by the concavity above: at least the smallest corner
   // distance less the largest spread).
   void filter(const Packed& in, const SampleBox& box, const Vec3f& q, Packed& out, std::vector<Kept>& kept,
-              bool sorted) const {
+              bool sorted, const SampleBox* tile = nullptr, std::span<const Vec3f> more = {}) const {
     kept.clear();
-    corner_test(in, box.corners, bounds_from(box, q), kept);
+    std::array<std::array<float, 8>, 2 + kBlocks> sets;
+    const int num_sets = 1 + int(std::min<std::size_t>(more.size(), sets.size() - 1));
+    sets[0] = bounds_from(box, q);
+    for (int j = 1; j < num_sets; ++j) sets[j] = bounds_from(box, more[j - 1]);
+    // Within a tile (`in` has the distances from the tile's corners t_m): an
+    // entry f that passes is within b = min_j max_k sqrt(sets[j][k]) of a
+    // corner c_k, so |f - t_m| <= b + max_k |c_k - t_m| for every m (triangle
+    // inequality).
+    std::array<float, 8> reach2;
+    if (tile) {
+      float b = kInf;
+      for (int j = 0; j < num_sets; ++j)
+        b = std::min(b, std::sqrt(*std::max_element(sets[j].begin(), sets[j].end())));
+      for (int m = 0; m < 8; ++m) {
+        float r = 0;
+        for (int k = 0; k < 8; ++k) r = std::max(r, (box.corners[k] - tile->corners[m]).norm());
+        const float reach = (b + r) * (1 + 1e-4f) + margin_;
+        reach2[m] = reach * reach * (1 + 1e-4f) + slack_;
+      }
+    }
+    corner_test(in, box.corners, sets.data(), num_sets, tile ? &reach2 : nullptr, kept);
     if (sorted)
       std::sort(kept.begin(), kept.end(),
                 [](const Kept& a, const Kept& b) { return a.key < b.key || (a.key == b.key && a.index < b.index); });
