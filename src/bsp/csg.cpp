@@ -46,19 +46,32 @@ double signed_volume(const Triangles& m) {
 }
 
 bool is_closed(const Triangles& m) {
-  // The directed edges and the reversed ones are the same multiset.
-  std::vector<std::uint64_t> fwd, bwd;
-  fwd.reserve(m.triangles.size() * 3);
-  bwd.reserve(m.triangles.size() * 3);
+  // At every vertex, the multiset of the ends of its outgoing edges equals that of the
+  // starts of its incoming ones.
+  std::uint32_t nv = 0;
+  for (const auto& t : m.triangles) nv = std::max({nv, t[0] + 1, t[1] + 1, t[2] + 1});
+  std::vector<std::uint32_t> out_start(nv + 1, 0), in_start(nv + 1, 0);
   for (const auto& t : m.triangles)
-    for (int k = 0; k < 3; ++k) {
-      const std::uint64_t u = t[k], v = t[(k + 1) % 3];
-      fwd.push_back((u << 32) | v);
-      bwd.push_back((v << 32) | u);
-    }
-  std::sort(fwd.begin(), fwd.end());
-  std::sort(bwd.begin(), bwd.end());
-  return fwd == bwd;
+    for (int k = 0; k < 3; ++k) ++out_start[t[k] + 1], ++in_start[t[(k + 1) % 3] + 1];
+  for (std::uint32_t v = 0; v < nv; ++v) {
+    if (out_start[v + 1] != in_start[v + 1]) return false;
+    out_start[v + 1] += out_start[v], in_start[v + 1] += in_start[v];
+  }
+  std::vector<std::uint32_t> outs(out_start[nv]), ins(in_start[nv]);
+  {
+    std::vector<std::uint32_t> fo(out_start.begin(), out_start.end() - 1), fi(in_start.begin(), in_start.end() - 1);
+    for (const auto& t : m.triangles)
+      for (int k = 0; k < 3; ++k) {
+        const std::uint32_t u = t[k], v = t[(k + 1) % 3];
+        outs[fo[u]++] = v;
+        ins[fi[v]++] = u;
+      }
+  }
+  for (std::uint32_t v = 0; v < nv; ++v) {
+    std::sort(outs.begin() + out_start[v], outs.begin() + out_start[v + 1]);
+    std::sort(ins.begin() + in_start[v], ins.begin() + in_start[v + 1]);
+  }
+  return outs == ins;
 }
 
 // Pushes a polygon down the tree at `root` (nodes with plane, neg, pos, label, leaf()):
@@ -336,10 +349,12 @@ Triangles to_mesh(const PlaneSet& planes, const Grid& grid, const std::vector<Po
   at_point.reserve(verts.size() / 4);
   std::vector<std::uint32_t> order;
   bool wide = false;
+  std::vector<std::uint32_t> rec_of_point(planes.point_count(), kNoIndex);  // a record of each point id
   for (std::uint32_t i = 0; i < verts.size(); ++i) {
     if (verts[i].v.point != kNoPoint) {
-      auto [it, fresh] = at_point.try_emplace(key_of(planes.integer_point(verts[i].v.point)), i);
-      if (!fresh) parent[i] = find(it->second);
+      std::uint32_t& r = rec_of_point[verts[i].v.point];
+      if (r == kNoIndex) r = at_point.try_emplace(key_of(planes.integer_point(verts[i].v.point)), i).first->second;
+      if (r != i) parent[i] = find(r);
     } else {
       order.push_back(i);
       wide |= !(verts[i].rad < 0.5);
@@ -558,6 +573,44 @@ Operand snap_operand(PlaneSet& planes, const Grid& grid, const Triangles& m,
     op.corner.push_back(c);
   }
   if (op.tri.empty()) throw Error("csg: every triangle of an operand is degenerate (at the grid's resolution)");
+  // Pairs of opposite triangles on the same points (a part thinner than the grid's step,
+  // flattened by the snapping) bound no volume: both go (their edges cancel).
+  struct Key {
+    std::array<std::uint32_t, 3> c;
+    bool operator==(const Key& o) const { return c == o.c; }
+  };
+  struct Hash {
+    std::size_t operator()(const Key& k) const {
+      return std::hash<std::uint64_t>()((std::uint64_t{k.c[0]} << 42) ^ (std::uint64_t{k.c[1]} << 21) ^ k.c[2]);
+    }
+  };
+  auto canonical = [](std::uint32_t a, std::uint32_t b, std::uint32_t c) {
+    if (b < a && b < c) return Key{{b, c, a}};
+    if (c < a && c < b) return Key{{c, a, b}};
+    return Key{{a, b, c}};
+  };
+  std::unordered_map<Key, std::vector<std::uint32_t>, Hash> open;
+  std::vector<char> drop(op.tri.size(), 0);
+  std::size_t dropped = 0;
+  for (std::uint32_t t = 0; t < op.tri.size(); ++t) {
+    const auto& c = op.corner[t];
+    auto it = open.find(canonical(c[0], c[2], c[1]));
+    if (it != open.end() && !it->second.empty()) {
+      drop[t] = drop[it->second.back()] = 1, dropped += 2;
+      it->second.pop_back();
+    } else {
+      open[canonical(c[0], c[1], c[2])].push_back(t);
+    }
+  }
+  if (dropped > 0) {
+    Operand kept;
+    for (std::size_t t = 0; t < op.tri.size(); ++t)
+      if (!drop[t]) {
+        kept.tri.push_back(std::move(op.tri[t]));
+        kept.lo.push_back(op.lo[t]), kept.hi.push_back(op.hi[t]), kept.corner.push_back(op.corner[t]);
+      }
+    op = std::move(kept);
+  }
   return op;
 }
 
@@ -565,6 +618,7 @@ Operand snap_operand(PlaneSet& planes, const Grid& grid, const Triangles& m,
 class BoxGrid {
  public:
   explicit BoxGrid(const Operand& o) : o_(o) {
+    if (o.lo.empty()) return;  // n_ = 0: every query is empty
     lo_ = o.lo[0];
     std::array<std::int64_t, 3> hi = o.hi[0];
     double ext = 0;
@@ -715,10 +769,12 @@ Label locate(const PlaneSet& planes, const std::vector<LocalNode>& nodes, std::u
   return nodes[n].label;
 }
 
-// The pieces of operand x (is_a: x is A) that bound the result, y the other operand.
+// The pieces of operand x (is_a: x is A) that bound the result, y the other operand: the
+// pieces of the cut triangles into pieces, the triangles kept whole (index, +1 as they are or
+// -1 reversed) into kept.
 void local_pieces(PlaneSet& planes, const std::shared_ptr<PlaneSet>& shared, const Grid& grid, const Operand& x,
-                  const Operand& y, const Triangles& y_mesh, bool is_a, CsgOp op, const BuildOptions& options,
-                  std::vector<Polygon>& pieces, std::vector<char>& whole_piece, CsgStats& st) {
+                  const Operand& y, bool is_a, CsgOp op, const BuildOptions& options,
+                  std::vector<Polygon>& pieces, std::vector<std::pair<std::uint32_t, int>>& kept, CsgStats& st) {
   BoxGrid boxes(y);
   const std::size_t n = x.tri.size();
   // Cells: the triangle's box grown by one step; the other operand's triangles clipped to it.
@@ -749,16 +805,15 @@ void local_pieces(PlaneSet& planes, const std::shared_ptr<PlaneSet>& shared, con
     touched[t] = !local[t].empty();
   }
   // Components of the untouched triangles (through shared points); each is one label.
-  std::unordered_map<std::uint32_t, std::uint32_t> comp;  // point -> union-find index
+  std::vector<std::uint32_t> comp(planes.point_count(), kNoIndex);  // point -> union-find index
   std::vector<std::uint32_t> parent;
   auto find = [&](std::uint32_t i) {
     while (parent[i] != i) i = parent[i] = parent[parent[i]];
     return i;
   };
   auto node_of = [&](std::uint32_t p) {
-    auto [it, fresh] = comp.try_emplace(p, static_cast<std::uint32_t>(parent.size()));
-    if (fresh) parent.push_back(it->second);
-    return it->second;
+    if (comp[p] == kNoIndex) comp[p] = static_cast<std::uint32_t>(parent.size()), parent.push_back(comp[p]);
+    return comp[p];
   };
   for (std::size_t t = 0; t < n; ++t)
     if (!touched[t]) {
@@ -770,18 +825,23 @@ void local_pieces(PlaneSet& planes, const std::shared_ptr<PlaneSet>& shared, con
     }
   std::vector<Label> comp_label(parent.size(), Label::none);
 
-  auto emit = [&](const Polygon& p, Label front, Label back) {
+  // +1: keep the piece as it is, -1: reversed, 0: drop it.
+  auto orientation = [&](Label front, Label back) {
     bool fin, bin;
     if (is_a) {
       fin = member(op, false, front == Label::inside);
       bin = member(op, true, back == Label::inside);
     } else {
-      if (front != back) return;  // on A's boundary: A's pieces decide
+      if (front != back) return 0;  // on A's boundary: A's pieces decide
       fin = member(op, front == Label::inside, false);
       bin = member(op, front == Label::inside, true);
     }
-    if (!fin && bin) pieces.push_back(p);
-    else if (fin && !bin) pieces.push_back(p.reversed());
+    return !fin && bin ? 1 : (fin && !bin ? -1 : 0);
+  };
+  auto emit = [&](const Polygon& p, Label front, Label back) {
+    const int o = orientation(front, back);
+    if (o > 0) pieces.push_back(p);
+    else if (o < 0) pieces.push_back(p.reversed());
   };
   std::vector<LocalNode> nodes;
   for (std::size_t t = 0; t < n; ++t) {
@@ -790,30 +850,39 @@ void local_pieces(PlaneSet& planes, const std::shared_ptr<PlaneSet>& shared, con
     local[t] = {};
     st.bsp_nodes += nodes.size();
     for (auto p : x.corner[t]) {
-      auto it = comp.find(p);
-      if (it == comp.end()) continue;
-      const std::uint32_t r = find(it->second);
+      if (comp[p] == kNoIndex) continue;
+      const std::uint32_t r = find(comp[p]);
       if (comp_label[r] == Label::none) comp_label[r] = locate(planes, nodes, p);
     }
     push_polygon(planes, nodes, 0, x.tri[t], emit);
   }
   std::unique_ptr<BspTree> whole;  // of y, for components far from it
-  const std::size_t first_whole = pieces.size();
   for (std::size_t t = 0; t < n; ++t) {
     if (touched[t]) continue;
-    const std::uint32_t r = find(comp.at(x.corner[t][0]));
+    const std::uint32_t r = find(comp[x.corner[t][0]]);
     if (comp_label[r] == Label::none) {
-      if (!whole) whole = std::make_unique<BspTree>(shared, grid, y_mesh.vertices, y_mesh.triangles, options);
+      if (y.tri.empty()) {  // y is empty at the grid's resolution
+        comp_label[r] = Label::outside;
+      } else if (!whole) {
+        // The BSP of y as snapped (flattened parts removed): its points are exact in world coordinates.
+        Triangles ym;
+        for (std::uint32_t i = 0; i < planes.point_count(); ++i) {
+          const auto& q = planes.integer_point(i);
+          ym.vertices.push_back(grid.to_world({static_cast<double>(q[0]), static_cast<double>(q[1]), static_cast<double>(q[2])}));
+        }
+        ym.triangles = y.corner;
+        whole = std::make_unique<BspTree>(shared, grid, ym.vertices, ym.triangles, options);
+      }
+    }
+    if (comp_label[r] == Label::none) {
       const auto& q = planes.integer_point(x.corner[t][0]);
       const int s = whole->classify(
           grid.to_world({static_cast<double>(q[0]), static_cast<double>(q[1]), static_cast<double>(q[2])}));
       if (s == 0) throw Error("csg: a vertex off the other surface classified on it (internal error)");
       comp_label[r] = s < 0 ? Label::inside : Label::outside;
     }
-    emit(x.tri[t], comp_label[r], comp_label[r]);
+    if (const int o = orientation(comp_label[r], comp_label[r])) kept.push_back({static_cast<std::uint32_t>(t), o});
   }
-  whole_piece.resize(first_whole, 0);
-  whole_piece.resize(pieces.size(), 1);
 }
 
 double operand_volume(const PlaneSet& planes, const Grid& grid, const Operand& o) {
@@ -846,12 +915,18 @@ CsgResult csg(const Triangles& a, const Triangles& b, CsgOp op, const BuildOptio
   std::vector<char> whole;  // per piece: an input triangle kept whole (local method)
   if (method == CsgMethod::local) {
     std::unordered_map<std::uint64_t, std::uint32_t> point_of;
-    const Operand oa = snap_operand(*planes, grid, a, point_of);
-    const Operand ob = snap_operand(*planes, grid, b, point_of);
-    local_pieces(*planes, planes, grid, oa, ob, b, true, op, options, pieces, whole, res.stats);
-    local_pieces(*planes, planes, grid, ob, oa, a, false, op, options, pieces, whole, res.stats);
+    planes->reserve(6 + 10 * (a.triangles.size() + b.triangles.size()), a.vertices.size() + b.vertices.size());
+    Operand oa = snap_operand(*planes, grid, a, point_of);
+    Operand ob = snap_operand(*planes, grid, b, point_of);
+    std::vector<std::pair<std::uint32_t, int>> kept_a, kept_b;
+    local_pieces(*planes, planes, grid, oa, ob, true, op, options, pieces, kept_a, res.stats);
+    local_pieces(*planes, planes, grid, ob, oa, false, op, options, pieces, kept_b, res.stats);
     res.stats.volume_a = operand_volume(*planes, grid, oa);
     res.stats.volume_b = operand_volume(*planes, grid, ob);
+    whole.assign(pieces.size(), 0);
+    for (auto [o, kept] : {std::pair{&oa, &kept_a}, std::pair{&ob, &kept_b}})
+      for (auto [t, orient] : *kept) pieces.push_back(orient > 0 ? std::move(o->tri[t]) : o->tri[t].reversed());
+    whole.resize(pieces.size(), 1);
   } else {
     const BspTree ta(planes, grid, a.vertices, a.triangles, options);
     const BspTree tb(planes, grid, b.vertices, b.triangles, options);

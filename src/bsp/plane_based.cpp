@@ -154,6 +154,7 @@ int expansion_sign(const double* terms, int n) {
 int PlaneSet::side(std::uint32_t h, std::uint32_t p, std::uint32_t q, std::uint32_t r) const {
   const int flip = (h & kFlip) ? -1 : 1;
   h = plane_index(h), p = plane_index(p), q = plane_index(q), r = plane_index(r);
+  if (h == p || h == q || h == r) return 0;  // one of the planes through the point
   const double* x = approx_[p].data();
   const double* y = approx_[q].data();
   const double* z = approx_[r].data();
@@ -227,6 +228,12 @@ int PlaneSet::side(std::uint32_t h, const double* x) const {
   t[6] = dhi;
   t[7] = static_cast<double>(P.d - static_cast<std::int64_t>(dhi));
   return flip * expansion_sign(t, 8);
+}
+
+void PlaneSet::reserve(std::size_t planes, std::size_t points) {
+  planes_.reserve(planes);
+  approx_.reserve(planes);
+  points_.reserve(points);
 }
 
 std::uint32_t PlaneSet::add_point(const std::array<std::int64_t, 3>& q) {

@@ -75,6 +75,8 @@ class PlaneSet {
   std::array<double, 3> point(const Vertex& v, double* radius = nullptr) const;
   std::uint32_t add_point(const std::array<std::int64_t, 3>& q);
   const std::array<std::int64_t, 3>& integer_point(std::uint32_t i) const { return points_[i]; }
+  std::size_t point_count() const { return points_.size(); }
+  void reserve(std::size_t planes, std::size_t points);
   /// Sign of the dot product of the normals of planes p and q (exact).
   int normal_dot_sign(std::uint32_t p, std::uint32_t q) const;
   /// Double approximation of the point where p, q, r meet (grid coordinates).
