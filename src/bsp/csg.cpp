@@ -544,6 +544,8 @@ struct Operand {
 Operand snap_operand(PlaneSet& planes, const Grid& grid, const Triangles& m,
                      std::unordered_map<std::uint64_t, std::uint32_t>& point_of) {
   Operand op;
+  op.tri.reserve(m.triangles.size()), op.lo.reserve(m.triangles.size()), op.hi.reserve(m.triangles.size());
+  op.corner.reserve(m.triangles.size());
   std::vector<std::uint32_t> id(m.vertices.size(), kNoPoint);
   auto point = [&](std::uint32_t v) {
     if (id[v] == kNoPoint) {
@@ -575,32 +577,34 @@ Operand snap_operand(PlaneSet& planes, const Grid& grid, const Triangles& m,
   if (op.tri.empty()) throw Error("csg: every triangle of an operand is degenerate (at the grid's resolution)");
   // Pairs of opposite triangles on the same points (a part thinner than the grid's step,
   // flattened by the snapping) bound no volume: both go (their edges cancel).
+  // Keys: the corners rotated to start at the smallest point id; a triangle and its
+  // opposite have keys (a, b, c) and (a, c, b).
   struct Key {
-    std::array<std::uint32_t, 3> c;
-    bool operator==(const Key& o) const { return c == o.c; }
+    std::uint64_t ab;
+    std::uint32_t c, t;
+    bool operator<(const Key& o) const { return ab != o.ab ? ab < o.ab : (c != o.c ? c < o.c : t < o.t); }
   };
-  struct Hash {
-    std::size_t operator()(const Key& k) const {
-      return std::hash<std::uint64_t>()((std::uint64_t{k.c[0]} << 42) ^ (std::uint64_t{k.c[1]} << 21) ^ k.c[2]);
-    }
+  auto key = [](std::uint32_t a, std::uint32_t b, std::uint32_t c, std::uint32_t t) {
+    if (b < a && b < c) return Key{(std::uint64_t{b} << 32) | c, a, t};
+    if (c < a && c < b) return Key{(std::uint64_t{c} << 32) | a, b, t};
+    return Key{(std::uint64_t{a} << 32) | b, c, t};
   };
-  auto canonical = [](std::uint32_t a, std::uint32_t b, std::uint32_t c) {
-    if (b < a && b < c) return Key{{b, c, a}};
-    if (c < a && c < b) return Key{{c, a, b}};
-    return Key{{a, b, c}};
-  };
-  std::unordered_map<Key, std::vector<std::uint32_t>, Hash> open;
+  std::vector<Key> keys(op.tri.size());
+  for (std::uint32_t t = 0; t < op.tri.size(); ++t) keys[t] = key(op.corner[t][0], op.corner[t][1], op.corner[t][2], t);
+  std::sort(keys.begin(), keys.end());
   std::vector<char> drop(op.tri.size(), 0);
   std::size_t dropped = 0;
-  for (std::uint32_t t = 0; t < op.tri.size(); ++t) {
-    const auto& c = op.corner[t];
-    auto it = open.find(canonical(c[0], c[2], c[1]));
-    if (it != open.end() && !it->second.empty()) {
-      drop[t] = drop[it->second.back()] = 1, dropped += 2;
-      it->second.pop_back();
-    } else {
-      open[canonical(c[0], c[1], c[2])].push_back(t);
+  for (std::size_t i = 0; i < keys.size();) {
+    std::size_t j = i;
+    while (j < keys.size() && keys[j].ab == keys[i].ab && keys[j].c == keys[i].c) ++j;
+    const auto a = static_cast<std::uint32_t>(keys[i].ab >> 32), b = static_cast<std::uint32_t>(keys[i].ab), c = keys[i].c;
+    if (b < c) {  // each pair of opposite groups once
+      const Key r{(std::uint64_t{a} << 32) | c, b, 0};
+      auto k = std::lower_bound(keys.begin(), keys.end(), r);
+      for (std::size_t m = i; m < j && k != keys.end() && k->ab == r.ab && k->c == r.c; ++m, ++k)
+        drop[keys[m].t] = drop[k->t] = 1, dropped += 2;
     }
+    i = j;
   }
   if (dropped > 0) {
     Operand kept;
