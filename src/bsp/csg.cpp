@@ -301,29 +301,40 @@ class Merger {
 
 namespace {
 
-// Welds exact vertices, inserts T-junction vertices, fans the pieces. whole[i] (if given):
-// piece i is an input triangle away from the other operand; its corners lie inside no
-// other piece's side (for inputs without T-junctions or self-intersections), so they are
-// not searched for on the sides.
-Triangles to_mesh(const PlaneSet& planes, const Grid& grid, const std::vector<Polygon>& pieces, CsgStats& st,
-                  const std::vector<char>& whole = {}) {
+// Welds exact vertices, inserts T-junction vertices, fans the pieces and the whole
+// triangles (snapped point ids, in output orientation). The corners of whole triangles lie
+// inside no other piece's side (for inputs without T-junctions or self-intersections), so
+// they are not searched for on the sides; a whole triangle's planes are made only if a
+// vertex may lie on one of its sides.
+Triangles to_mesh(PlaneSet& planes, const Grid& grid, const std::vector<Polygon>& pieces, CsgStats& st,
+                  const std::vector<std::array<std::uint32_t, 3>>& wholes = {}) {
   struct V {
     Vertex v;
     std::array<double, 3> x;
     double rad;
   };
   std::vector<V> verts;
-  std::vector<std::uint32_t> first(pieces.size() + 1, 0);
-  for (std::size_t i = 0; i < pieces.size(); ++i) {
+  const std::size_t np = pieces.size(), total = np + wholes.size();
+  std::vector<std::uint32_t> first(total + 1, 0);
+  verts.reserve(3 * total);
+  for (std::size_t i = 0; i < total; ++i) {
     first[i] = static_cast<std::uint32_t>(verts.size());
-    const Polygon& f = pieces[i];
-    for (std::size_t k = 0; k < f.size(); ++k) {
-      V v{f.vertex(k), {}, 0};
-      v.x = planes.point(v.v, &v.rad);
-      verts.push_back(v);
+    if (i < np) {
+      const Polygon& f = pieces[i];
+      for (std::size_t k = 0; k < f.size(); ++k) {
+        V v{f.vertex(k), {}, 0};
+        v.x = planes.point(v.v, &v.rad);
+        verts.push_back(v);
+      }
+    } else {
+      for (auto p : wholes[i - np]) {
+        V v{Vertex{0, 0, 0, p}, {}, 0};
+        v.x = planes.point(v.v, &v.rad);
+        verts.push_back(v);
+      }
     }
   }
-  first[pieces.size()] = static_cast<std::uint32_t>(verts.size());
+  first[total] = static_cast<std::uint32_t>(verts.size());
   auto same = [&](const V& a, const V& b) {
     if (a.v.point != kNoPoint && b.v.point != kNoPoint)
       return planes.integer_point(a.v.point) == planes.integer_point(b.v.point);
@@ -412,7 +423,7 @@ Triangles to_mesh(const PlaneSet& planes, const Grid& grid, const std::vector<Po
   for (auto r : rep)
     for (int ax = 0; ax < 3; ++ax) glo[ax] = std::min(glo[ax], verts[r].x[ax]), ghi[ax] = std::max(ghi[ax], verts[r].x[ax]);
   double edge_sum = 0;
-  for (std::size_t i = 0; i < pieces.size(); ++i)
+  for (std::size_t i = 0; i < total; ++i)
     for (std::uint32_t k = first[i]; k < first[i + 1]; ++k) {
       const auto& pa = verts[k].x;
       const auto& pb = verts[k + 1 < first[i + 1] ? k + 1 : first[i]].x;
@@ -433,10 +444,8 @@ Triangles to_mesh(const PlaneSet& planes, const Grid& grid, const std::vector<Po
   auto cell_index = [&](const std::array<double, 3>& x) {
     return (cell_of(x[2], 2) * gn[1] + cell_of(x[1], 1)) * gn[0] + cell_of(x[0], 0);
   };
-  std::vector<char> candidate(rep.size(), whole.empty());
-  for (std::size_t i = 0; i < pieces.size() && !whole.empty(); ++i)
-    if (!whole[i])
-      for (std::uint32_t k = first[i]; k < first[i + 1]; ++k) candidate[id[k]] = 1;
+  std::vector<char> candidate(rep.size(), 0);
+  for (std::uint32_t k = 0; k < first[np]; ++k) candidate[id[k]] = 1;
   for (std::uint32_t w = 0; w < rep.size(); ++w)
     if (candidate[w]) ++cstart[cell_index(verts[rep[w]].x) + 1];
   for (std::size_t c = 1; c < cstart.size(); ++c) cstart[c] += cstart[c - 1];
@@ -453,9 +462,12 @@ Triangles to_mesh(const PlaneSet& planes, const Grid& grid, const std::vector<Po
   std::vector<std::pair<double, std::uint32_t>> inserted;
   std::vector<int> side_has;
   std::vector<std::size_t> corner_pos;
-  for (std::size_t i = 0; i < pieces.size(); ++i) {
-    const Polygon& f = pieces[i];
-    const std::size_t n = f.size();
+  Polygon tri;  // a whole triangle's planes, when needed
+  for (std::size_t i = 0; i < total; ++i) {
+    const bool whole = i >= np;
+    bool made = false;
+    const Polygon& f = whole ? tri : pieces[i];
+    const std::size_t n = first[i + 1] - first[i];
     ring.clear();
     side_has.assign(n, 0);
     corner_pos.clear();
@@ -486,6 +498,12 @@ Triangles to_mesh(const PlaneSet& planes, const Grid& grid, const std::vector<Po
               bool in_box = true;
               for (int ax = 0; ax < 3; ++ax) in_box &= c.x[ax] >= elo[ax] && c.x[ax] <= ehi[ax];
               if (!in_box) continue;
+              if (whole && !made) {
+                const auto& ids = wholes[i - np];
+                triangle_polygon(planes, planes.integer_point(ids[0]), planes.integer_point(ids[1]),
+                                 planes.integer_point(ids[2]), ids, tri);
+                made = true;
+              }
               if (planes.side(f.support, c.v) != 0 || planes.side(f.edges[k], c.v) != 0) continue;
               if (planes.side(f.prev_edge(k), c.v) >= 0 || planes.side(f.edges[(k + 1) % n], c.v) >= 0) continue;
               const double t = (c.x[0] - pa[0]) * d[0] + (c.x[1] - pa[1]) * d[1] + (c.x[2] - pa[2]) * d[2];
@@ -536,9 +554,18 @@ bool member(CsgOp op, bool a, bool b) {
 // One operand snapped: its non-degenerate triangles as polygons, their integer boxes and
 // their corners' point ids (points with equal coordinates share one id).
 struct Operand {
-  std::vector<Polygon> tri;
+  std::vector<Polygon> tri;  // made when first needed (polygon())
   std::vector<std::array<std::int64_t, 3>> lo, hi;
   std::vector<std::array<std::uint32_t, 3>> corner;
+
+  const Polygon& polygon(PlaneSet& planes, std::uint32_t t) {
+    Polygon& p = tri[t];
+    if (p.edges.empty()) {
+      const auto& c = corner[t];
+      triangle_polygon(planes, planes.integer_point(c[0]), planes.integer_point(c[1]), planes.integer_point(c[2]), c, p);
+    }
+    return p;
+  }
 };
 
 Operand snap_operand(PlaneSet& planes, const Grid& grid, const Triangles& m,
@@ -564,12 +591,12 @@ Operand snap_operand(PlaneSet& planes, const Grid& grid, const Triangles& m,
     const auto& p0 = planes.integer_point(c[0]);
     const auto& p1 = planes.integer_point(c[1]);
     const auto& p2 = planes.integer_point(c[2]);
-    Polygon poly;
-    if (!triangle_polygon(planes, p0, p1, p2, c, poly)) continue;
-    poly.source = static_cast<std::uint32_t>(t);
+    const Plane support = PlaneSet::through(p0, p1, p2);
+    if (support.a == 0 && support.b == 0 && support.c == 0) continue;  // degenerate after snapping
     std::array<std::int64_t, 3> lo, hi;
     for (int k = 0; k < 3; ++k) lo[k] = std::min({p0[k], p1[k], p2[k]}), hi[k] = std::max({p0[k], p1[k], p2[k]});
-    op.tri.push_back(std::move(poly));
+    op.tri.emplace_back();
+    op.tri.back().source = static_cast<std::uint32_t>(t);
     op.lo.push_back(lo);
     op.hi.push_back(hi);
     op.corner.push_back(c);
@@ -776,8 +803,8 @@ Label locate(const PlaneSet& planes, const std::vector<LocalNode>& nodes, std::u
 // The pieces of operand x (is_a: x is A) that bound the result, y the other operand: the
 // pieces of the cut triangles into pieces, the triangles kept whole (index, +1 as they are or
 // -1 reversed) into kept.
-void local_pieces(PlaneSet& planes, const std::shared_ptr<PlaneSet>& shared, const Grid& grid, const Operand& x,
-                  const Operand& y, bool is_a, CsgOp op, const BuildOptions& options,
+void local_pieces(PlaneSet& planes, const std::shared_ptr<PlaneSet>& shared, const Grid& grid, Operand& x,
+                  Operand& y, bool is_a, CsgOp op, const BuildOptions& options,
                   std::vector<Polygon>& pieces, std::vector<std::pair<std::uint32_t, int>>& kept, CsgStats& st) {
   BoxGrid boxes(y);
   const std::size_t n = x.tri.size();
@@ -801,7 +828,7 @@ void local_pieces(PlaneSet& planes, const std::shared_ptr<PlaneSet>& shared, con
       cell[2 * k + 1] = planes.add(down);
     }
     for (auto c : cand) {
-      Polygon p = y.tri[c];
+      Polygon p = y.polygon(planes, c);
       bool ok = true;
       for (int k = 0; k < 6 && ok; ++k) ok = clip(planes, p, cell[k], -1);
       if (ok) local[t].push_back(std::move(p));
@@ -858,7 +885,7 @@ void local_pieces(PlaneSet& planes, const std::shared_ptr<PlaneSet>& shared, con
       const std::uint32_t r = find(comp[p]);
       if (comp_label[r] == Label::none) comp_label[r] = locate(planes, nodes, p);
     }
-    push_polygon(planes, nodes, 0, x.tri[t], emit);
+    push_polygon(planes, nodes, 0, x.polygon(planes, static_cast<std::uint32_t>(t)), emit);
   }
   std::unique_ptr<BspTree> whole;  // of y, for components far from it
   for (std::size_t t = 0; t < n; ++t) {
@@ -916,7 +943,7 @@ CsgResult csg(const Triangles& a, const Triangles& b, CsgOp op, const BuildOptio
   auto planes = std::make_shared<PlaneSet>();
   CsgResult res;
   std::vector<Polygon> pieces;
-  std::vector<char> whole;  // per piece: an input triangle kept whole (local method)
+  std::vector<std::array<std::uint32_t, 3>> wholes;  // input triangles kept whole (local method)
   if (method == CsgMethod::local) {
     std::unordered_map<std::uint64_t, std::uint32_t> point_of;
     planes->reserve(6 + 10 * (a.triangles.size() + b.triangles.size()), a.vertices.size() + b.vertices.size());
@@ -927,10 +954,11 @@ CsgResult csg(const Triangles& a, const Triangles& b, CsgOp op, const BuildOptio
     local_pieces(*planes, planes, grid, ob, oa, false, op, options, pieces, kept_b, res.stats);
     res.stats.volume_a = operand_volume(*planes, grid, oa);
     res.stats.volume_b = operand_volume(*planes, grid, ob);
-    whole.assign(pieces.size(), 0);
     for (auto [o, kept] : {std::pair{&oa, &kept_a}, std::pair{&ob, &kept_b}})
-      for (auto [t, orient] : *kept) pieces.push_back(orient > 0 ? std::move(o->tri[t]) : o->tri[t].reversed());
-    whole.resize(pieces.size(), 1);
+      for (auto [t, orient] : *kept) {
+        const auto& c = o->corner[t];
+        wholes.push_back(orient > 0 ? c : std::array<std::uint32_t, 3>{c[0], c[2], c[1]});
+      }
   } else {
     const BspTree ta(planes, grid, a.vertices, a.triangles, options);
     const BspTree tb(planes, grid, b.vertices, b.triangles, options);
@@ -954,8 +982,8 @@ CsgResult csg(const Triangles& a, const Triangles& b, CsgOp op, const BuildOptio
     res.stats.volume_b = signed_volume(tb.fragment_mesh());
     res.stats.bsp_nodes = m.count_nodes(root);
   }
-  res.stats.pieces = pieces.size();
-  res.mesh = to_mesh(*planes, grid, pieces, res.stats, whole);
+  res.stats.pieces = pieces.size() + wholes.size();
+  res.mesh = to_mesh(*planes, grid, pieces, res.stats, wholes);
   res.stats.vertices = res.mesh.vertices.size();
   res.stats.triangles = res.mesh.triangles.size();
   res.stats.closed = is_closed(res.mesh);
