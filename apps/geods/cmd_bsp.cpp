@@ -88,7 +88,7 @@ class CsgCommand : public Command {
  public:
   std::string name() const override { return "csg"; }
   std::string summary() const override {
-    return "boolean operation (union, intersection, difference, xor) of two closed meshes by merging BSP trees";
+    return "boolean operation (union, intersection, difference, xor) of two closed meshes (local BSPs or BSP merging)";
   }
   void add_options(CLI::App& app) override {
     app.add_option("a", a_, "First closed mesh")->required();
@@ -97,15 +97,18 @@ class CsgCommand : public Command {
     add_output(app, "-o,--output", output_, "Output: the closed result mesh", io::OutputKind::mesh)->required();
     app.add_option("--heuristic", heuristic_, "BSP construction of the operands: cost, random or balanced");
     app.add_option("--k", k_, "Candidate polygons per node")->check(at_least(1));
+    app.add_option("--method", method_,
+                   "local (cut only near the other operand, local BSPs) or bsp_merge (merge the operands' BSP trees)");
   }
   void run(const RunContext&, Report& report) override {
     const bsp::CsgOp op = bsp::parse_csg_op(op_);
+    const bsp::CsgMethod method = bsp::parse_csg_method(method_);
     const bsp::Triangles a = bsp::from_tri_mesh(io::read_mesh(a_));
     const bsp::Triangles b = bsp::from_tri_mesh(io::read_mesh(b_));
     bsp::BuildOptions options;
     options.heuristic = bsp::parse_heuristic(heuristic_);
     options.k = static_cast<std::uint32_t>(k_);
-    const bsp::CsgResult r = bsp::csg(a, b, op, options);
+    const bsp::CsgResult r = bsp::csg(a, b, op, options, method);
     io::write_mesh(output_, bsp::to_tri_mesh(r.mesh));
     const bsp::CsgStats& s = r.stats;
     Json& j = report.json;
@@ -113,16 +116,17 @@ class CsgCommand : public Command {
     j["op"] = op_;
     j["b"] = b_;
     j["output"] = output_;
+    j["method"] = method_;
     put_stats(j, s);
     report.lines.push_back(fmt::format("csg: {} {} {} -> {}", a_, op_, b_, output_));
     report.lines.push_back(fmt::format("  {} vertices, {} triangles, {}, volume {:.6g} (operands {:.6g}, {:.6g}), "
-                                       "{} merged BSP nodes, {:.3f} s",
+                                       "{} BSP nodes ({}), {:.3f} s",
                                        s.vertices, s.triangles, s.closed ? "closed" : "NOT closed", s.volume,
-                                       s.volume_a, s.volume_b, s.bsp_nodes, s.compute_s));
+                                       s.volume_a, s.volume_b, s.bsp_nodes, method_, s.compute_s));
   }
 
  private:
-  std::string a_, op_, b_, output_, heuristic_ = "cost";
+  std::string a_, op_, b_, output_, heuristic_ = "cost", method_ = "local";
   long long k_ = 8;
 };
 

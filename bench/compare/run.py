@@ -43,7 +43,8 @@ declares them with geods_compare_program(), and a compare.json read here:
               count / time * scale in the rows of that metric (default query_s)
   agree       optional {"field": "sign_hash", "anchors": ["geods", "cgal"], "label": "..."}:
               that field must be equal across these anchors for each (variant, threads)
-  args        optional extra command-line arguments for every program
+  args        optional extra command-line arguments for every program (a program entry may add its
+              own "args", e.g. ["--reps", "1"] for a peer that takes minutes)
   rounds      optional number of interleaved rounds when --rounds is not given (default 1)
   timeout_s   optional per-program time limit (default 1800)
 
@@ -198,7 +199,7 @@ def run_comparison(c, bin_dir, data_dir, threads_list, rounds, reps, scale, stat
                         continue
                     cmd = [os.path.join(bin_dir, prog)]
                 cmd += ["--data", data_dir, "--threads", str(threads), "--reps", str(reps)]
-                cmd += [str(a) for a in c["args"]]
+                cmd += [str(a) for a in c["args"]] + [str(a) for a in p.get("args", [])]
                 if scale != 1.0:
                     cmd += ["--scale", repr(scale)]
                 log(f"{c['workload']}: {prog} threads={threads} round={rnd + 1}/{rounds}")

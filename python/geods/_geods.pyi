@@ -1106,9 +1106,10 @@ def convex_hull(points: Any) -> tuple[Any, ...]:
     for NaN or infinite coordinates.
     """
 
-def csg(VA: ArrayLike, FA: ArrayLike, VB: ArrayLike, FB: ArrayLike, op: str, heuristic: str = ..., stats: bool = ...) -> Any:
+def csg(VA: ArrayLike, FA: ArrayLike, VB: ArrayLike, FB: ArrayLike, op: str, heuristic: str = ..., stats: bool = ..., method: str = ...) -> Any:
     """A op B for closed, outward-oriented meshes; op is "union", "intersection",
-    "difference" (A minus B) or "xor". Returns (V float64 (n, 3), F int64 (m, 3)), a
+    "difference" (A minus B) or "xor"; method "local" (cuts only near the other operand)
+    or "bsp_merge" (merges the operands' BSP trees, seed §3.3). Returns (V float64 (n, 3), F int64 (m, 3)), a
     closed, consistently oriented mesh (and a stats dict with stats=True: vertices,
     triangles, closed, volume, volume_a, volume_b, bsp_nodes, pieces, t_junctions, compute_s).
     """

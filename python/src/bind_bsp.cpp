@@ -143,21 +143,23 @@ passing near them, a random one of the k best at each node.)doc")
   m.def(
       "csg",
       [](const Rows<double>& va, const Rows<std::int64_t>& fa, const Rows<double>& vb, const Rows<std::int64_t>& fb,
-         const std::string& op, const std::string& heuristic, bool stats) {
+         const std::string& op, const std::string& heuristic, bool stats, const std::string& method) {
         const bsp::Triangles a = triangles_from_arrays(va, fa, "csg A");
         const bsp::Triangles b = triangles_from_arrays(vb, fb, "csg B");
         const bsp::CsgOp o = bsp::parse_csg_op(op);
         bsp::BuildOptions options;
         options.heuristic = bsp::parse_heuristic(heuristic);
-        const bsp::CsgResult r = without_gil([&] { return bsp::csg(a, b, o, options); });
+        const bsp::CsgMethod me = bsp::parse_csg_method(method);
+        const bsp::CsgResult r = without_gil([&] { return bsp::csg(a, b, o, options, me); });
         py::tuple vf = triangles_arrays(r.mesh);
         if (!stats) return py::object(vf);
         return py::object(py::make_tuple(vf[0], vf[1], stats_dict(r.stats)));
       },
       py::arg("VA"), py::arg("FA"), py::arg("VB"), py::arg("FB"), py::arg("op"), py::arg("heuristic") = "cost",
-      py::arg("stats") = false,
+      py::arg("stats") = false, py::arg("method") = "local",
       R"doc(A op B for closed, outward-oriented meshes; op is "union", "intersection",
-"difference" (A minus B) or "xor". Returns (V float64 (n, 3), F int64 (m, 3)), a
+"difference" (A minus B) or "xor"; method "local" (cuts only near the other operand)
+or "bsp_merge" (merges the operands' BSP trees, seed §3.3). Returns (V float64 (n, 3), F int64 (m, 3)), a
 closed, consistently oriented mesh (and a stats dict with stats=True: vertices,
 triangles, closed, volume, volume_a, volume_b, bsp_nodes, pieces, t_junctions, compute_s).)doc");
 }

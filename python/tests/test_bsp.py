@@ -84,11 +84,13 @@ def test_visibility_order_lists_every_fragment():
     assert f2b == order.tolist()[::-1] or max(f2b.index(t) for t in (22, 23)) < min(f2b.index(10), f2b.index(11))
 
 
+@pytest.mark.parametrize("method", ["local", "bsp_merge"])
 @pytest.mark.parametrize("shift", [(1.0, 1.0, 1.0), (1e-9, 0, 0), (1.0, 0, 0), (0.5, 0.25, 0)])
-def test_csg_volume_identities(shift):
+def test_csg_volume_identities(shift, method):
     VA, FA = box([0, 0, 0], [2, 2, 2])
     VB, FB = box(np.array([0, 0, 0]) + shift, np.array([2, 2, 2]) + shift)
-    res = {op: geods.csg(VA, FA, VB, FB, op, stats=True) for op in ["union", "intersection", "difference", "xor"]}
+    res = {op: geods.csg(VA, FA, VB, FB, op, stats=True, method=method)
+           for op in ["union", "intersection", "difference", "xor"]}
     for op, (V, F, s) in res.items():
         assert V.dtype == np.float64 and F.dtype == np.int64
         assert s["closed"] and (len(F) == 0 or closed(F)), op
@@ -126,6 +128,8 @@ def test_bad_input():
     with pytest.raises(ValueError):
         geods.csg(V, F, V, F, "plus")
     with pytest.raises(ValueError):
+        geods.csg(V, F, V, F, "union", method="fast")
+    with pytest.raises(ValueError):
         geods.csg(V, F, np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64), "union")
 
 
@@ -152,7 +156,13 @@ def test_cli(tmp_path, data_dir):
     assert j["closed"] and abs(j["volume"] - (2 - 0.125)) < 1e-6 and j["bsp_nodes"] > 0 and j["triangles"] > 0
     for key in ["vertices", "triangles", "closed", "volume", "bsp_nodes", "compute_s"]:
         assert key in j
+    r = run_cli("csg", str(a), "union", str(b), "-o", str(out), "--method", "bsp_merge", "--json")
+    assert r.returncode == 0, r.stderr
+    j2 = json.loads(r.stdout)
+    assert j2["method"] == "bsp_merge" and j2["closed"] and abs(j2["volume"] - j["volume"]) < 1e-9
     r = run_cli("csg", str(a), "plus", str(b), "-o", str(out))
+    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1
+    r = run_cli("csg", str(a), "union", str(b), "-o", str(out), "--method", "fast")
     assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1
 
 

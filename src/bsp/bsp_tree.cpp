@@ -125,23 +125,6 @@ Frag make_frag(const PlaneSet& planes, Polygon&& p) {
   return f;
 }
 
-// Plane through edge a->b of a triangle with opposite corner c, containing the dominant
-// normal axis; the triangle's inside is its negative side.
-Plane edge_plane(const std::array<std::int64_t, 3>& a, const std::array<std::int64_t, 3>& b,
-                 const std::array<std::int64_t, 3>& c, int axis) {
-  const std::int64_t u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-  std::int64_t e[3] = {0, 0, 0};
-  e[axis] = 1;
-  Plane m;
-  m.a = u[1] * e[2] - u[2] * e[1];
-  m.b = u[2] * e[0] - u[0] * e[2];
-  m.c = u[0] * e[1] - u[1] * e[0];
-  const std::int64_t s = m.a * (c[0] - a[0]) + m.b * (c[1] - a[1]) + m.c * (c[2] - a[2]);
-  if (s > 0) m.a = -m.a, m.b = -m.b, m.c = -m.c;
-  m.d = -(m.a * a[0] + m.b * a[1] + m.c * a[2]);
-  return m;
-}
-
 }  // namespace
 
 BspTree::BspTree(const std::vector<Vec3d>& vertices, const std::vector<std::array<std::uint32_t, 3>>& triangles,

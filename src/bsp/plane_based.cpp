@@ -154,6 +154,7 @@ int expansion_sign(const double* terms, int n) {
 int PlaneSet::side(std::uint32_t h, std::uint32_t p, std::uint32_t q, std::uint32_t r) const {
   const int flip = (h & kFlip) ? -1 : 1;
   h = plane_index(h), p = plane_index(p), q = plane_index(q), r = plane_index(r);
+  if (h == p || h == q || h == r) return 0;  // one of the planes through the point
   const double* x = approx_[p].data();
   const double* y = approx_[q].data();
   const double* z = approx_[r].data();
@@ -227,6 +228,12 @@ int PlaneSet::side(std::uint32_t h, const double* x) const {
   t[6] = dhi;
   t[7] = static_cast<double>(P.d - static_cast<std::int64_t>(dhi));
   return flip * expansion_sign(t, 8);
+}
+
+void PlaneSet::reserve(std::size_t planes, std::size_t points) {
+  planes_.reserve(planes);
+  approx_.reserve(planes);
+  points_.reserve(points);
 }
 
 std::uint32_t PlaneSet::add_point(const std::array<std::int64_t, 3>& q) {
@@ -324,6 +331,34 @@ bool clip(const PlaneSet& planes, Polygon& poly, std::uint32_t h, int keep) {
   Polygon neg, pos;
   split(planes, poly, h, signs, neg, pos);
   poly = keep < 0 ? std::move(neg) : std::move(pos);
+  return true;
+}
+
+Plane edge_plane(const std::array<std::int64_t, 3>& a, const std::array<std::int64_t, 3>& b,
+                 const std::array<std::int64_t, 3>& c, int axis) {
+  const std::int64_t u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+  std::int64_t e[3] = {0, 0, 0};
+  e[axis] = 1;
+  Plane m;
+  m.a = u[1] * e[2] - u[2] * e[1];
+  m.b = u[2] * e[0] - u[0] * e[2];
+  m.c = u[0] * e[1] - u[1] * e[0];
+  const std::int64_t s = m.a * (c[0] - a[0]) + m.b * (c[1] - a[1]) + m.c * (c[2] - a[2]);
+  if (s > 0) m.a = -m.a, m.b = -m.b, m.c = -m.c;
+  m.d = -(m.a * a[0] + m.b * a[1] + m.c * a[2]);
+  return m;
+}
+
+bool triangle_polygon(PlaneSet& planes, const std::array<std::int64_t, 3>& p0, const std::array<std::int64_t, 3>& p1,
+                      const std::array<std::int64_t, 3>& p2, std::array<std::uint32_t, 3> ids, Polygon& out) {
+  const Plane s = PlaneSet::through(p0, p1, p2);
+  if (s.a == 0 && s.b == 0 && s.c == 0) return false;
+  const std::int64_t an[3] = {s.a < 0 ? -s.a : s.a, s.b < 0 ? -s.b : s.b, s.c < 0 ? -s.c : s.c};
+  const int axis = an[0] >= an[1] && an[0] >= an[2] ? 0 : (an[1] >= an[2] ? 1 : 2);
+  out.support = planes.add(s);
+  out.edges = {planes.add(edge_plane(p0, p1, p2, axis)), planes.add(edge_plane(p1, p2, p0, axis)),
+               planes.add(edge_plane(p2, p0, p1, axis))};
+  out.points = {ids[0], ids[1], ids[2]};
   return true;
 }
 

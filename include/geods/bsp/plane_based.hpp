@@ -75,6 +75,8 @@ class PlaneSet {
   std::array<double, 3> point(const Vertex& v, double* radius = nullptr) const;
   std::uint32_t add_point(const std::array<std::int64_t, 3>& q);
   const std::array<std::int64_t, 3>& integer_point(std::uint32_t i) const { return points_[i]; }
+  std::size_t point_count() const { return points_.size(); }
+  void reserve(std::size_t planes, std::size_t points);
   /// Sign of the dot product of the normals of planes p and q (exact).
   int normal_dot_sign(std::uint32_t p, std::uint32_t q) const;
   /// Double approximation of the point where p, q, r meet (grid coordinates).
@@ -115,6 +117,14 @@ Side classify(const PlaneSet& planes, const Polygon& poly, std::uint32_t h, std:
 /// Splits a straddling polygon by h into its negative and positive parts.
 void split(const PlaneSet& planes, const Polygon& poly, std::uint32_t h, const std::vector<int>& signs, Polygon& neg,
            Polygon& pos);
+/// Plane through edge a->b of a triangle with opposite corner c, containing the dominant
+/// normal axis `axis`; the triangle's inside is its negative side.
+Plane edge_plane(const std::array<std::int64_t, 3>& a, const std::array<std::int64_t, 3>& b,
+                 const std::array<std::int64_t, 3>& c, int axis);
+/// The triangle p0 p1 p2 of snapped points (ids i0 i1 i2 of planes.add_point) as a polygon
+/// (support plane and three edge planes added to planes); false if it is degenerate.
+bool triangle_polygon(PlaneSet& planes, const std::array<std::int64_t, 3>& p0, const std::array<std::int64_t, 3>& p1,
+                      const std::array<std::int64_t, 3>& p2, std::array<std::uint32_t, 3> ids, Polygon& out);
 /// The polygon h ∩ universe box, normal = h's normal.
 Polygon universe_polygon(const PlaneSet& planes, std::uint32_t h);
 /// Keeps the part of poly on side `keep` (-1 or +1) of h; returns false if nothing of positive area is left.
