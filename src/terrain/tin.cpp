@@ -277,23 +277,34 @@ TerrainMesh Terrain::tin(double max_error, std::uint32_t tiles) const {
   for (std::uint32_t k = 0; k <= tiles; ++k) xs[k] = std::int64_t(k) * (W - 1) / tiles, ys[k] = std::int64_t(k) * (H - 1) / tiles;
 
   TerrainMesh mesh;
-  std::unordered_map<std::uint64_t, std::uint32_t> vertex_of;  // sample id -> vertex
-  auto vertex = [&](P2 p) {
-    const std::uint64_t id = std::uint64_t(p.y) * width_ + std::uint64_t(p.x);
-    auto [it, added] = vertex_of.try_emplace(id, std::uint32_t(mesh.vertices.size()));
-    if (added) {
-      mesh.samples.push_back({std::uint32_t(p.x), std::uint32_t(p.y)});
-      mesh.vertices.push_back(Vec3f(float(origin_[0] + double(p.x) * spacing_[0]),
-                                    float(origin_[1] + double(p.y) * spacing_[1]), z[id]));
-    }
-    return it->second;
+  // A tile's points are distinct; only those on its border are shared with its
+  // neighbours, and only those go through the map.
+  std::unordered_map<std::uint64_t, std::uint32_t> border_vertex;  // sample id -> vertex
+  auto add_vertex = [&](P2 p) {
+    mesh.samples.push_back({std::uint32_t(p.x), std::uint32_t(p.y)});
+    mesh.vertices.push_back(Vec3f(float(origin_[0] + double(p.x) * spacing_[0]),
+                                  float(origin_[1] + double(p.y) * spacing_[1]),
+                                  z[std::uint64_t(p.y) * width_ + std::uint64_t(p.x)]));
+    return std::uint32_t(mesh.vertices.size() - 1);
   };
 
+  std::vector<std::uint32_t> vertex_of;  // of the tile's points
   for (std::uint32_t ty = 0; ty < tiles; ++ty)
     for (std::uint32_t tx = 0; tx < tiles; ++tx) {
       const GreedyTin g = tile_tin(z.data(), width_, P2{xs[tx], ys[ty]}, P2{xs[tx + 1], ys[ty + 1]}, limit, border_limit);
+      vertex_of.resize(g.pts_.size());
+      for (std::size_t i = 0; i < g.pts_.size(); ++i) {
+        const P2 p = g.pts_[i];
+        if (p.x != xs[tx] && p.x != xs[tx + 1] && p.y != ys[ty] && p.y != ys[ty + 1]) {
+          vertex_of[i] = add_vertex(p);
+          continue;
+        }
+        const std::uint64_t id = std::uint64_t(p.y) * width_ + std::uint64_t(p.x);
+        const auto it = border_vertex.find(id);
+        vertex_of[i] = it != border_vertex.end() ? it->second : (border_vertex[id] = add_vertex(p));
+      }
       for (std::size_t k = 0; k + 2 < g.tri_.size(); k += 3)
-        mesh.triangles.push_back({vertex(g.pts_[g.tri_[k]]), vertex(g.pts_[g.tri_[k + 1]]), vertex(g.pts_[g.tri_[k + 2]])});
+        mesh.triangles.push_back({vertex_of[g.tri_[k]], vertex_of[g.tri_[k + 1]], vertex_of[g.tri_[k + 2]]});
     }
   return mesh;
 }
