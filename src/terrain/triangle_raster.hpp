@@ -90,6 +90,25 @@ inline void for_each_triangle_row(const float* z, std::uint64_t n, P2 a, P2 b, P
   if (det < 0) std::swap(v[1], v[2]);
   const std::int64_t y0 = std::min({a.y, b.y, c.y}), y1 = std::max({a.y, b.y, c.y});
   const std::int64_t xmin = std::min({a.x, b.x, c.x}), xmax = std::max({a.x, b.x, c.x});
+  if (xmax - xmin <= 2 && y1 - y0 <= 2) {
+    // At most 3 x 3 samples (most of the 4-8 triangles): each one tested.
+    auto inside = [&](std::int64_t x, std::int64_t y) {
+      for (int e = 0; e < 3; ++e) {
+        const P2 p = v[e], q = v[(e + 1) % 3];
+        if ((q.x - p.x) * (y - p.y) - (q.y - p.y) * (x - p.x) < 0) return false;
+      }
+      return true;
+    };
+    for (std::int64_t y = y0; y <= y1; ++y) {
+      std::int64_t lo = xmin;
+      while (lo <= xmax && !inside(lo, y)) ++lo;
+      if (lo > xmax) continue;
+      std::int64_t hi = lo;
+      while (hi < xmax && inside(hi + 1, y)) ++hi;
+      f(y, lo, hi, za + gy * double(y - a.y), gx);
+    }
+    return;
+  }
   FloorStep upper[3], lower[3];  // x <= floor(B / A) (A > 0); x >= -floor(B / -A) (A < 0)
   int uppers = 0, lowers = 0;
   std::int64_t flat_b[3], flat_d[3];  // A == 0: the row is empty where B < 0
