@@ -1,5 +1,5 @@
-// The terrain module's triangle rasterizer (row bounds stepped in integers, SIMD
-// row maxima) against brute force: every sample of the bounding box tested with
+// The terrain module's triangle rasterizers (the per-sample path of small
+// triangles, SIMD row maxima, the scalar worst-sample scan) against brute force: every sample of the bounding box tested with
 // exact integer edge functions, the same plane; the largest distance and the
 // first sample (row order) holding it.
 #include <gtest/gtest.h>
@@ -51,13 +51,6 @@ TEST(TriangleRaster, WorstSampleEqualsBruteForce) {
     ++checked;
   }
   EXPECT_GT(checked, 15000);
-}
-
-TEST(TriangleRaster, FloorDivision) {
-  for (std::int64_t b = -50; b <= 50; ++b)
-    for (std::int64_t a = 1; a <= 9; ++a) EXPECT_EQ(floor_div(b, a), std::int64_t(std::floor(double(b) / double(a))));
-  EXPECT_EQ(floor_div(std::int64_t(1) << 60, 3), (std::int64_t(1) << 60) / 3);
-  EXPECT_EQ(floor_div(-(std::int64_t(1) << 60) - 1, 7), -(((std::int64_t(1) << 60) + 1 + 6) / 7));
 }
 
 }  // namespace
