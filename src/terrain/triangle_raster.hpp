@@ -48,48 +48,32 @@ inline double row_max(const float* row, std::int64_t lo, std::int64_t hi, double
   return m;
 }
 
-// Calls f(y, lo, hi, base, gx) for every row y of the closed triangle (a, b, c)
-// (integer grid coordinates) with samples lo..hi inside it; the plane through
-// the three heights is z = base + gx (x - a.x) on that row. Triangles of at
-// most 3 x 3 samples (most of the 4-8 hierarchy's) test each sample.
-template <class F>
-inline void for_each_triangle_row(const float* z, std::uint64_t n, P2 a, P2 b, P2 c, F&& f) {
-  const double za = z[a.y * n + a.x], zb = z[b.y * n + b.x], zc = z[c.y * n + c.x];
-  // Plane z = za + gx (x - ax) + gy (y - ay).
-  const double ux = double(b.x - a.x), uy = double(b.y - a.y), vx = double(c.x - a.x), vy = double(c.y - a.y);
-  const double det = ux * vy - uy * vx;
-  const double gx = ((zb - za) * vy - (zc - za) * uy) / det;
-  const double gy = ((zc - za) * ux - (zb - za) * vx) / det;
-  // Edge functions, made >= 0 inside: E(x, y) = (q.x - p.x) (y - p.y) - (q.y - p.y) (x - p.x)
-  // >= 0, i.e. A x <= B(y) with A = q.y - p.y, B(y) = (q.x - p.x) (y - p.y) + A p.x.
-  P2 v[3] = {a, b, c};
-  if (det < 0) std::swap(v[1], v[2]);
-  const std::int64_t y0 = std::min({a.y, b.y, c.y}), y1 = std::max({a.y, b.y, c.y});
-  const std::int64_t xmin = std::min({a.x, b.x, c.x}), xmax = std::max({a.x, b.x, c.x});
-  if (xmax - xmin <= 2 && y1 - y0 <= 2) {
-    // At most 3 x 3 samples (most of the 4-8 triangles): each one tested.
-    auto inside = [&](std::int64_t x, std::int64_t y) {
-      for (int e = 0; e < 3; ++e) {
-        const P2 p = v[e], q = v[(e + 1) % 3];
-        if ((q.x - p.x) * (y - p.y) - (q.y - p.y) * (x - p.x) < 0) return false;
-      }
-      return true;
-    };
-    for (std::int64_t y = y0; y <= y1; ++y) {
-      std::int64_t lo = xmin;
-      while (lo <= xmax && !inside(lo, y)) ++lo;
-      if (lo > xmax) continue;
-      std::int64_t hi = lo;
-      while (hi < xmax && inside(hi + 1, y)) ++hi;
-      f(y, lo, hi, za + gy * double(y - a.y), gx);
-    }
-    return;
+// A grid triangle (a, b, c): the plane through its three heights,
+// z = za + gx (x - a.x) + gy (y - a.y), and the samples of each of its rows.
+struct GridTriangle {
+  double za, gx, gy;
+  P2 v[3];  // counter-clockwise
+  std::int64_t y0, y1, xmin, xmax;
+
+  GridTriangle(const float* z, std::uint64_t n, P2 a, P2 b, P2 c) {
+    za = z[a.y * n + a.x];
+    const double zb = z[b.y * n + b.x], zc = z[c.y * n + c.x];
+    const double ux = double(b.x - a.x), uy = double(b.y - a.y), vx = double(c.x - a.x), vy = double(c.y - a.y);
+    const double det = ux * vy - uy * vx;
+    gx = ((zb - za) * vy - (zc - za) * uy) / det;
+    gy = ((zc - za) * ux - (zb - za) * vx) / det;
+    v[0] = a, v[1] = b, v[2] = c;
+    if (det < 0) std::swap(v[1], v[2]);
+    y0 = std::min({a.y, b.y, c.y}), y1 = std::max({a.y, b.y, c.y});
+    xmin = std::min({a.x, b.x, c.x}), xmax = std::max({a.x, b.x, c.x});
   }
-  for (std::int64_t y = y0; y <= y1; ++y) {
-    std::int64_t lo = xmin, hi = xmax;
+  // The samples lo..hi of row y inside the closed triangle (lo > hi: none):
+  // every edge function E(x, y) = (q.x - p.x) (y - p.y) - (q.y - p.y) (x - p.x)
+  // >= 0, i.e. A x <= B with A = q.y - p.y, in exact integer division.
+  void row(std::int64_t y, std::int64_t& lo, std::int64_t& hi) const {
+    lo = xmin, hi = xmax;
     for (int e = 0; e < 3; ++e) {
       const P2 p = v[e], q = v[(e + 1) % 3];
-      // E(x, y) = (q.x - p.x) (y - p.y) - (q.y - p.y) (x - p.x) >= 0, i.e. A x <= B.
       const std::int64_t A = q.y - p.y, B = (q.x - p.x) * (y - p.y) + (q.y - p.y) * p.x;
       if (A > 0)
         hi = std::min(hi, B >= 0 ? B / A : -((-B + A - 1) / A));
@@ -98,42 +82,32 @@ inline void for_each_triangle_row(const float* z, std::uint64_t n, P2 a, P2 b, P
       else if (B < 0)
         lo = hi + 1;
     }
-    if (lo > hi) continue;
-    // Relative to a: the same rounding wherever the triangle lies (tin_tile() of a block equals the tile of tin()).
-    f(y, lo, hi, za + gy * double(y - a.y), gx);
   }
-}
+  bool inside(std::int64_t x, std::int64_t y) const {
+    for (int e = 0; e < 3; ++e) {
+      const P2 p = v[e], q = v[(e + 1) % 3];
+      if ((q.x - p.x) * (y - p.y) - (q.y - p.y) * (x - p.x) < 0) return false;
+    }
+    return true;
+  }
+  // The plane on row y is base(y) + gx (x - a.x); relative to a, the same
+  // rounding wherever the triangle lies (tin_tile() of a block equals the tile of tin()).
+  double base(std::int64_t y, std::int64_t ay) const { return za + gy * double(y - ay); }
+};
 
 // The largest |z(sample) - plane(sample)| over the grid samples in the closed
 // triangle (a, b, c) (integer grid coordinates) of an n-wide matrix of heights,
 // and the sample where it is (the first such in row order). One scalar pass per
 // row: for the greedy TIN's triangles of every shape this measured faster than
-// the SIMD row maxima of triangle_error() followed by a search.
+// SIMD row maxima followed by a search.
 inline Worst triangle_worst(const float* z, std::uint64_t n, P2 a, P2 b, P2 c) {
-  const double za = z[a.y * n + a.x], zb = z[b.y * n + b.x], zc = z[c.y * n + c.x];
-  const double ux = double(b.x - a.x), uy = double(b.y - a.y), vx = double(c.x - a.x), vy = double(c.y - a.y);
-  const double det = ux * vy - uy * vx;
-  const double gx = ((zb - za) * vy - (zc - za) * uy) / det;
-  const double gy = ((zc - za) * ux - (zb - za) * vx) / det;
-  P2 v[3] = {a, b, c};
-  if (det < 0) std::swap(v[1], v[2]);
-  const std::int64_t y0 = std::min({a.y, b.y, c.y}), y1 = std::max({a.y, b.y, c.y});
-  const std::int64_t xmin = std::min({a.x, b.x, c.x}), xmax = std::max({a.x, b.x, c.x});
+  const GridTriangle t(z, n, a, b, c);
   Worst worst;
-  for (std::int64_t y = y0; y <= y1; ++y) {
-    std::int64_t lo = xmin, hi = xmax;
-    for (int e = 0; e < 3; ++e) {
-      const P2 p = v[e], q = v[(e + 1) % 3];
-      const std::int64_t A = q.y - p.y, B = (q.x - p.x) * (y - p.y) + (q.y - p.y) * p.x;
-      if (A > 0)
-        hi = std::min(hi, B >= 0 ? B / A : -((-B + A - 1) / A));
-      else if (A < 0)
-        lo = std::max(lo, (-B) >= 0 ? ((-B) + (-A) - 1) / (-A) : -((B) / (-A)));
-      else if (B < 0)
-        lo = hi + 1;
-    }
+  for (std::int64_t y = t.y0; y <= t.y1; ++y) {
+    std::int64_t lo, hi;
+    t.row(y, lo, hi);
     const float* row = z + y * std::int64_t(n);
-    const double base = za + gy * double(y - a.y);
+    const double base = t.base(y, a.y), gx = t.gx;
     for (std::int64_t x = lo; x <= hi; ++x) {
       const double d = std::abs(double(row[x]) - (base + gx * double(x - a.x)));
       if (d > worst.error) worst = {d, {x, y}};
@@ -142,11 +116,23 @@ inline Worst triangle_worst(const float* z, std::uint64_t n, P2 a, P2 b, P2 c) {
   return worst;
 }
 
+// The same largest distance alone (equal to triangle_worst().error): triangles
+// of at most 3 x 3 samples (most of the 4-8 hierarchy's) test each sample,
+// larger ones take row maxima two doubles at a time.
 inline double triangle_error(const float* z, std::uint64_t n, P2 a, P2 b, P2 c) {
+  const GridTriangle t(z, n, a, b, c);
   double worst = 0;
-  for_each_triangle_row(z, n, a, b, c, [&](std::int64_t y, std::int64_t lo, std::int64_t hi, double base, double gx) {
-    worst = std::max(worst, row_max(z + y * std::int64_t(n), lo, hi, base, gx, a.x));
-  });
+  const bool small = t.xmax - t.xmin <= 2 && t.y1 - t.y0 <= 2;
+  for (std::int64_t y = t.y0; y <= t.y1; ++y) {
+    std::int64_t lo, hi;
+    if (small) {
+      for (lo = t.xmin; lo <= t.xmax && !t.inside(lo, y);) ++lo;
+      for (hi = lo; hi < t.xmax && t.inside(hi + 1, y);) ++hi;
+    } else {
+      t.row(y, lo, hi);
+    }
+    if (lo <= hi) worst = std::max(worst, row_max(z + y * std::int64_t(n), lo, hi, t.base(y, a.y), t.gx, a.x));
+  }
   return worst;
 }
 
