@@ -101,6 +101,14 @@ def write_furniture_subset():
             out.writestr(member, src.read(member))
 
 
+def write_dem_bmp(elevation):
+    """jacksboro_dem_crop.bmp: the DEM's top-left 128 x 96 samples as (z - 236) // 4, a
+    24-bit BMP grey in all channels (the terrain module's BMP input test)."""
+    from PIL import Image
+    g = ((elevation[:96, :128].astype(np.int32) - 236) // 4).astype(np.uint8)
+    Image.fromarray(np.stack([g, g, g], axis=-1), "RGB").save(os.path.join(DST, "jacksboro_dem_crop.bmp"))
+
+
 def main():
     os.makedirs(DST, exist_ok=True)
     V, F = npm_arrays("meshes/bunny-1.0.1.tgz", "package/index.js")
@@ -113,6 +121,7 @@ def main():
     shutil.copy(os.path.join(SRC, "volumes/KmeansTest_T1UCharRaw.nii.gz"), os.path.join(DST, "t1_head.nii.gz"))
     dem = np.load(os.path.join(SRC, "heightfields/jacksboro_fault_dem.npz"))
     np.save(os.path.join(DST, "jacksboro_dem.npy"), np.ascontiguousarray(dem["elevation"]))
+    write_dem_bmp(dem["elevation"])
     arcs = land_arcs()
     points = np.unique(np.concatenate(arcs), axis=0)
     segments = np.concatenate([np.hstack([a[:-1], a[1:]]) for a in arcs if len(a) > 1])

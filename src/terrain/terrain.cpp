@@ -25,9 +25,10 @@ using detail::triangle_error;
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
+// The smallest float >= v, for v >= 0 (or +inf).
 float round_up(double v) {
   float f = float(v);
-  if (double(f) < v) f = std::nextafter(f, kInf);
+  if (double(f) < v) f = std::bit_cast<float>(std::bit_cast<std::uint32_t>(f) + 1);
   return f;
 }
 

@@ -50,7 +50,8 @@ void simplify_segment(const float* z, std::uint64_t w, P2 p, P2 q, double limit,
 // error per triangle, refined by greedy insertion.
 class GreedyTin {
  public:
-  GreedyTin(const float* z, std::uint64_t w, double limit) : z_(z), w_(w), limit_(limit) {}
+  GreedyTin(const float* z, std::uint64_t w, double limit, std::int64_t extent)
+      : z_(z), w_(w), limit_(limit), small_(extent <= (std::int64_t(1) << 14)) {}
 
   // The rectangle [a, c] (corners ccw from a) as two triangles, then the border
   // samples `border` inserted on its sides.
@@ -83,7 +84,7 @@ class GreedyTin {
       queue_.pop();
       if (top.version != version_[top.triangle]) continue;  // the triangle changed since
       const std::uint32_t t = top.triangle;
-      const P2 p = top.at;
+      const P2 p = candidate_[t];
       const std::uint32_t p_index = add_point(p);
       std::uint32_t on_edge = kNone;
       for (std::uint32_t k = 0; k < 3; ++k) {
@@ -103,16 +104,28 @@ class GreedyTin {
 
  private:
   static constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
-  struct Entry {
+  struct Entry {  // 16 bytes; the sample is the triangle's candidate_ while the version matches
     double error;
     std::uint32_t triangle, version;
-    P2 at;
     bool operator<(const Entry& o) const { return error < o.error; }
   };
   static std::uint32_t next(std::uint32_t e) { return e % 3 == 2 ? e - 2 : e + 1; }
   static std::uint32_t prev(std::uint32_t e) { return e % 3 == 0 ? e + 2 : e - 1; }
-  static double orient(P2 a, P2 b, P2 c) {
-    return orient2d(Vec2d(double(a.x), double(a.y)), Vec2d(double(b.x), double(b.y)), Vec2d(double(c.x), double(c.y)));
+  static std::int64_t orient(P2 a, P2 b, P2 c) {  // exact in integers (|coordinates| < 2^31)
+    return (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+  }
+  // Whether d is strictly inside the circle through a, b, c (counter-clockwise):
+  // exact in 64-bit integers when the coordinates span at most 2^14 (every term
+  // below 2^62), else core's exact incircle.
+  bool in_circle(P2 a, P2 b, P2 c, P2 d) const {
+    if (!small_) {
+      auto v = [](P2 p) { return Vec2d(double(p.x), double(p.y)); };
+      return incircle(v(a), v(b), v(c), v(d)) > 0;
+    }
+    const std::int64_t adx = a.x - d.x, ady = a.y - d.y, bdx = b.x - d.x, bdy = b.y - d.y, cdx = c.x - d.x,
+                       cdy = c.y - d.y;
+    const std::int64_t al = adx * adx + ady * ady, bl = bdx * bdx + bdy * bdy, cl = cdx * cdx + cdy * cdy;
+    return al * (bdx * cdy - cdx * bdy) + bl * (cdx * ady - adx * cdy) + cl * (adx * bdy - bdx * ady) > 0;
   }
   std::uint32_t add_point(P2 p) {
     pts_.push_back(p);
@@ -122,6 +135,7 @@ class GreedyTin {
     tri_.resize(tri_.size() + 3, 0);
     twin_.resize(twin_.size() + 3, kNone);
     version_.push_back(0);
+    candidate_.emplace_back();
     return std::uint32_t(version_.size() - 1);
   }
   void link(std::uint32_t a, std::uint32_t b) {
@@ -177,8 +191,7 @@ class GreedyTin {
     const std::uint32_t a0 = a - a % 3, b0 = b - b % 3;
     const std::uint32_t al = a0 + (a + 1) % 3, ar = a0 + (a + 2) % 3, bl = b0 + (b + 2) % 3, br = b0 + (b + 1) % 3;
     const std::uint32_t p0 = tri_[ar], pr = tri_[a], pl = tri_[al], p1 = tri_[bl];
-    auto v = [&](std::uint32_t i) { return Vec2d(double(pts_[i].x), double(pts_[i].y)); };
-    if (!(incircle(v(pr), v(pl), v(p0), v(p1)) > 0)) return;
+    if (!in_circle(pts_[pr], pts_[pl], pts_[p0], pts_[p1])) return;
     const std::uint32_t hal = twin_[al], har = twin_[ar], hbl = twin_[bl], hbr = twin_[br];
     const std::uint32_t t0 = a0 / 3, t1 = b0 / 3;
     set(t0, p0, p1, pl, kNone, hbl, hal);
@@ -195,7 +208,8 @@ class GreedyTin {
       const detail::Worst w = detail::triangle_worst(z_, w_, a, b, c);
       const bool corner = (w.at.x == a.x && w.at.y == a.y) || (w.at.x == b.x && w.at.y == b.y) ||
                           (w.at.x == c.x && w.at.y == c.y);
-      if (w.error > limit_ && !corner) queue_.push({w.error, t, version_[t], w.at});
+      candidate_[t] = w.at;
+      if (w.error > limit_ && !corner) queue_.push({w.error, t, version_[t]});
     }
     touched_.clear();
   }
@@ -203,7 +217,9 @@ class GreedyTin {
   const float* z_;
   std::uint64_t w_;
   double limit_;
+  bool small_;  // coordinates within 2^14 of each other: integer incircle
   std::vector<std::uint32_t> twin_, version_, touched_;
+  std::vector<P2> candidate_;  // per triangle: its worst sample
   std::priority_queue<Entry> queue_;
 };
 
@@ -222,7 +238,7 @@ GreedyTin tile_tin(const float* z, std::uint64_t w, P2 c00, P2 c11, double limit
   simplify_segment(z, w, c10, c11, border_limit, start);
   simplify_segment(z, w, c01, c11, border_limit, start);
   simplify_segment(z, w, c00, c01, border_limit, start);
-  GreedyTin g(z, w, limit);
+  GreedyTin g(z, w, limit, std::max(c11.x - c00.x, c11.y - c00.y));
   g.start(c00, c10, c11, c01, std::vector<P2>(start.begin() + 4, start.end()));
   g.refine();
   return g;
@@ -277,23 +293,34 @@ TerrainMesh Terrain::tin(double max_error, std::uint32_t tiles) const {
   for (std::uint32_t k = 0; k <= tiles; ++k) xs[k] = std::int64_t(k) * (W - 1) / tiles, ys[k] = std::int64_t(k) * (H - 1) / tiles;
 
   TerrainMesh mesh;
-  std::unordered_map<std::uint64_t, std::uint32_t> vertex_of;  // sample id -> vertex
-  auto vertex = [&](P2 p) {
-    const std::uint64_t id = std::uint64_t(p.y) * width_ + std::uint64_t(p.x);
-    auto [it, added] = vertex_of.try_emplace(id, std::uint32_t(mesh.vertices.size()));
-    if (added) {
-      mesh.samples.push_back({std::uint32_t(p.x), std::uint32_t(p.y)});
-      mesh.vertices.push_back(Vec3f(float(origin_[0] + double(p.x) * spacing_[0]),
-                                    float(origin_[1] + double(p.y) * spacing_[1]), z[id]));
-    }
-    return it->second;
+  // A tile's points are distinct; only those on its border are shared with its
+  // neighbours, and only those go through the map.
+  std::unordered_map<std::uint64_t, std::uint32_t> border_vertex;  // sample id -> vertex
+  auto add_vertex = [&](P2 p) {
+    mesh.samples.push_back({std::uint32_t(p.x), std::uint32_t(p.y)});
+    mesh.vertices.push_back(Vec3f(float(origin_[0] + double(p.x) * spacing_[0]),
+                                  float(origin_[1] + double(p.y) * spacing_[1]),
+                                  z[std::uint64_t(p.y) * width_ + std::uint64_t(p.x)]));
+    return std::uint32_t(mesh.vertices.size() - 1);
   };
 
+  std::vector<std::uint32_t> vertex_of;  // of the tile's points
   for (std::uint32_t ty = 0; ty < tiles; ++ty)
     for (std::uint32_t tx = 0; tx < tiles; ++tx) {
       const GreedyTin g = tile_tin(z.data(), width_, P2{xs[tx], ys[ty]}, P2{xs[tx + 1], ys[ty + 1]}, limit, border_limit);
+      vertex_of.resize(g.pts_.size());
+      for (std::size_t i = 0; i < g.pts_.size(); ++i) {
+        const P2 p = g.pts_[i];
+        if (p.x != xs[tx] && p.x != xs[tx + 1] && p.y != ys[ty] && p.y != ys[ty + 1]) {
+          vertex_of[i] = add_vertex(p);
+          continue;
+        }
+        const std::uint64_t id = std::uint64_t(p.y) * width_ + std::uint64_t(p.x);
+        const auto it = border_vertex.find(id);
+        vertex_of[i] = it != border_vertex.end() ? it->second : (border_vertex[id] = add_vertex(p));
+      }
       for (std::size_t k = 0; k + 2 < g.tri_.size(); k += 3)
-        mesh.triangles.push_back({vertex(g.pts_[g.tri_[k]]), vertex(g.pts_[g.tri_[k + 1]]), vertex(g.pts_[g.tri_[k + 2]])});
+        mesh.triangles.push_back({vertex_of[g.tri_[k]], vertex_of[g.tri_[k + 1]], vertex_of[g.tri_[k + 2]]});
     }
   return mesh;
 }

@@ -37,11 +37,18 @@ TEST(HeightField, ImagesAndArrays) {
   const std::vector<std::int16_t> i16{-5, 2, 3, 4};
   io::write_npy(temp("i.npy"), std::span<const std::int16_t>(i16), {2, 2});
   EXPECT_EQ(read_height_field(temp("i.npy"))(0, 0), -5.0f);
-  // Real data: the Jacksboro DEM and a game height map (24-bit BMP: the first channel).
-  EXPECT_EQ(read_height_field(std::filesystem::path(GEODS_DATA_DIR) / "jacksboro_dem.npy").width, 403u);
-  const HeightField bmp = read_height_field(std::filesystem::path(GEODS_DATA_DIR) / "scorched3d_denali.bmp");
-  EXPECT_EQ(bmp.width, 256u);
-  EXPECT_EQ(bmp.height, 256u);
+  // Real data: the Jacksboro DEM, and a 24-bit BMP (grey in all channels; the first
+  // one is read) written from its top-left 128 x 96 samples as (z - 236) / 4
+  // (integer division): sample for sample the same field, rows in the same order.
+  const HeightField dem = read_height_field(std::filesystem::path(GEODS_DATA_DIR) / "jacksboro_dem.npy");
+  EXPECT_EQ(dem.width, 403u);
+  EXPECT_EQ(dem.height, 344u);
+  const HeightField bmp = read_height_field(std::filesystem::path(GEODS_DATA_DIR) / "jacksboro_dem_crop.bmp");
+  ASSERT_EQ(bmp.width, 128u);
+  ASSERT_EQ(bmp.height, 96u);
+  for (std::size_t y = 0; y < bmp.height; ++y)
+    for (std::size_t x = 0; x < bmp.width; ++x)
+      ASSERT_EQ(bmp(x, y), float((int(dem(x, y)) - 236) / 4)) << x << "," << y;
 }
 
 TEST(HeightField, GeoTiffThroughGdal) {

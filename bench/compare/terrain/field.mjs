@@ -1,51 +1,31 @@
 // Shared by the node programs of the terrain comparison: the same 1025^2 field as
-// compare_terrain_geods (data/trigger_tropic_h.png, 8-bit, padded by repeating its last row
-// and column), the arguments, timing, the error of a mesh against every sample, JSON lines.
+// compare_terrain_geods (the USGS Jacksboro DEM, data/jacksboro_dem.npy, mirrored into 1025^2),
+// the arguments, timing, the error of a mesh against every sample, JSON lines.
 import fs from 'node:fs';
 import path from 'node:path';
-import zlib from 'node:zlib';
 import { fileURLToPath } from 'node:url';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
 
-// A non-interlaced 8-bit PNG (grey, grey+alpha, RGB, RGBA): its first channel.
-function readPng(file) {
+// A little-endian int16 .npy in C order (the Jacksboro DEM): its shape and samples.
+function readNpyInt16(file) {
   const b = fs.readFileSync(file);
-  let pos = 8, width = 0, height = 0, channels = 0;
-  const idat = [];
-  while (pos < b.length) {
-    const len = b.readUInt32BE(pos), type = b.toString('latin1', pos + 4, pos + 8), data = b.subarray(pos + 8, pos + 8 + len);
-    if (type === 'IHDR') {
-      width = data.readUInt32BE(0); height = data.readUInt32BE(4);
-      if (data[8] !== 8 || data[12] !== 0) throw new Error(`${file}: only 8-bit non-interlaced PNG`);
-      channels = { 0: 1, 2: 3, 4: 2, 6: 4 }[data[9]];
-    } else if (type === 'IDAT') idat.push(data);
-    else if (type === 'IEND') break;
-    pos += 12 + len;
-  }
-  const raw = zlib.inflateSync(Buffer.concat(idat)), stride = width * channels;
-  const out = new Uint8Array(stride * height), prev = new Uint8Array(stride);
-  for (let y = 0; y < height; y++) {
-    const f = raw[y * (stride + 1)], row = raw.subarray(y * (stride + 1) + 1, (y + 1) * (stride + 1));
-    const cur = out.subarray(y * stride, (y + 1) * stride), up = y ? out.subarray((y - 1) * stride, y * stride) : prev;
-    for (let i = 0; i < stride; i++) {
-      const a = i >= channels ? cur[i - channels] : 0, u = up[i], c = i >= channels ? up[i - channels] : 0;
-      let v = row[i];
-      if (f === 1) v += a; else if (f === 2) v += u; else if (f === 3) v += (a + u) >> 1;
-      else if (f === 4) { const p = a + u - c, pa = Math.abs(p - a), pb = Math.abs(p - u), pc = Math.abs(p - c); v += pa <= pb && pa <= pc ? a : pb <= pc ? u : c; }
-      cur[i] = v & 255;
-    }
-  }
-  const grey = new Float32Array(width * height);
-  for (let i = 0; i < width * height; i++) grey[i] = out[i * channels];
-  return { width, height, grey };
+  const headerLen = b.readUInt16LE(8), header = b.toString('latin1', 10, 10 + headerLen);
+  if (!header.includes("'<i2'") || !header.includes("'fortran_order': False")) throw new Error(`${file}: not a C-order <i2 .npy`);
+  const [rows, cols] = header.match(/'shape': \((\d+), (\d+)\)/).slice(1).map(Number);
+  const data = new Int16Array(rows * cols);
+  for (let i = 0; i < rows * cols; i++) data[i] = b.readInt16LE(10 + headerLen + 2 * i);
+  return { rows, cols, data };
 }
 
+// i reflected into 0..n-1 (period 2n - 2, the border samples not repeated).
+const reflect = (i, n) => { const p = 2 * (n - 1), k = i % p; return k < n ? k : p - k; };
+
 export function field1025() {
-  const im = readPng(path.join(here, '..', '..', '..', 'data', 'trigger_tropic_h.png'));
+  const dem = readNpyInt16(path.join(here, '..', '..', '..', 'data', 'jacksboro_dem.npy'));
   const n = 1025, z = new Float32Array(n * n);
   for (let y = 0; y < n; y++)
-    for (let x = 0; x < n; x++) z[y * n + x] = im.grey[Math.min(y, im.height - 1) * im.width + Math.min(x, im.width - 1)];
+    for (let x = 0; x < n; x++) z[y * n + x] = dem.data[reflect(y, dem.rows) * dem.cols + reflect(x, dem.cols)];
   return { n, z };
 }
 
@@ -104,4 +84,4 @@ export function record(anchor, variant, threads, build_s, query_s, count, median
   process.stdout.write(JSON.stringify({ workload: 'terrain', anchor, variant, threads, build_s, query_s, count, median_of, ...extra, ok }) + '\n');
 }
 
-export const targets = [1, 2, 4, 8, 16];
+export const targets = [2, 4, 8, 16, 32];
