@@ -59,6 +59,17 @@ concept HasEps = requires(const typename Lib::Index& i, const float* q, std::uin
   Lib::knn_eps(i, q, std::size_t(1), 0.5f, ix, d);
 };
 
+// body(b, e) over the queries [0, m): one call on one thread, else split with tbb::parallel_for.
+template <class Body>
+void for_queries(const Args& args, std::size_t m, const Body& body) {
+  if (args.threads == 1) {
+    body(0, m);
+  } else {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m, 256),
+                      [&](const tbb::blocked_range<std::size_t>& r) { body(r.begin(), r.end()); });
+  }
+}
+
 inline double squared_distance_d(const float* p, const float* q) {
   double s = 0;
   for (int a = 0; a < 3; ++a) s += (double(p[a]) - q[a]) * (double(p[a]) - q[a]);
@@ -98,12 +109,7 @@ void run_radius(const Args& args, const std::string& input, const std::string& v
         hashes[i] = set_hash(out);
       }
     };
-    if (args.threads == 1) {
-      body(0, m);
-    } else {
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m, 256),
-                        [&](const tbb::blocked_range<std::size_t>& r) { body(r.begin(), r.end()); });
-    }
+    for_queries(args, m, body);
   };
   const double query_s = median_time_s(args.reps, query_all);
   bool ok = true;
@@ -173,12 +179,7 @@ void run_variant(const Args& args, const std::string& variant) {
       }
       for (std::size_t i = b; i < e; ++i) Lib::knn(*index, &queries[3 * i], kK, &indices[i * kK], &distances[i * kK]);
     };
-    if (args.threads == 1) {
-      body(0, m);
-    } else {
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m, 256),
-                        [&](const tbb::blocked_range<std::size_t>& r) { body(r.begin(), r.end()); });
-    }
+    for_queries(args, m, body);
   };
   const double query_s = median_time_s(args.reps, query_all);
 
