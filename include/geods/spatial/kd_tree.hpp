@@ -6,7 +6,9 @@
 // Layout: a flat array of nodes in depth-first order (the left child of node i is
 // i + 1, the right child is stored) with 32-bit indices, and a permutation of the
 // point indices so that every node owns a contiguous range of it. The points stay
-// in the caller's array (zero-copy, PointView) or in one the tree owns. The node
+// in the caller's array (PointView) or in one the tree owns; by default
+// (PointLayout::tree_order) the tree also keeps a copy of them in leaf order,
+// which the queries read contiguously (PointLayout::zero_copy: no copy). The node
 // array and the permutation are FlatArrays: a tree loaded from a file (load())
 // reads them, and its points, in place from the mapped file.
 //
