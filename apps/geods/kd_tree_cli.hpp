@@ -20,6 +20,7 @@ namespace geods::cli {
 struct KdTreeInput {
   std::string points, tree, save;
   std::size_t leaf_size = spatial::KdTree<double>::kDefaultLeafSize;
+  std::string layout = "tree_order";
 
   void add_options(CLI::App& app) {
     // Not add_input: the points are optional when --tree gives a saved tree instead.
@@ -30,6 +31,9 @@ struct KdTreeInput {
         ->excludes(positional)
         ->excludes(named);
     app.add_option("--leaf-size", leaf_size, "Points per leaf of the k-d tree")->check(at_least(1));
+    app.add_option("--layout", layout,
+                   "tree_order (default: the tree keeps a copy of the points in leaf order, faster queries) or "
+                   "zero_copy (reads the points in place: half the memory; a --tree file is then not copied)");
     app.add_option("--save", save, "Output: the k-d tree and its points as a geods archive, for --tree");
   }
   /// The file the points come from.
@@ -40,6 +44,7 @@ struct KdTreeInput {
   template <typename Fn>
   void with_tree(const std::string& command, const Fn& fn) const {
     if (points.empty() == tree.empty()) throw Error(command + ": give the points as the first argument, or --tree");
+    const spatial::PointLayout point_layout = spatial::parse_point_layout(layout);
     auto use = [&](const auto& t, double build_s) {
       if (!save.empty()) t.save(save);
       fn(t, build_s);
@@ -48,15 +53,16 @@ struct KdTreeInput {
       const spatial::KdTreeFileInfo info = spatial::read_kd_tree_info(tree);
       const auto visit = [&](const auto& loaded) { std::visit([&](const auto& t) { use(t, 0.0); }, loaded); };
       if (info.scalar == DType::f32)
-        visit(spatial::load_kd_tree<float>(tree, info.dim));
+        visit(spatial::load_kd_tree<float>(tree, info.dim, point_layout));
       else
-        visit(spatial::load_kd_tree<double>(tree, info.dim));  // KdTree::load names any other type
+        visit(spatial::load_kd_tree<double>(tree, info.dim, point_layout));  // KdTree::load names any other type
       return;
     }
     const io::Table table = io::read_table(points, "point");
     Stopwatch build_watch;
     const auto built =
-        spatial::make_kd_tree(spatial::PointView<double>(table.values.data(), table.rows, table.cols), leaf_size);
+        spatial::make_kd_tree(spatial::PointView<double>(table.values.data(), table.rows, table.cols), leaf_size,
+                               point_layout);
     const double build_s = build_watch.seconds();
     std::visit([&](const auto& t) { use(t, build_s); }, built);
   }

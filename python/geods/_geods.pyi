@@ -447,13 +447,16 @@ class KdTree:
     """
     Balanced k-d tree over n points of dimension d (float32 or float64; other dtypes become float64).
 
-    Built in O(n log n) by median splits on the axis of widest spread. The tree reads a
-    row-contiguous `points` array in place (no copy): do not modify it while the tree is in use.
+    Built in O(n log n) by median splits on the axis of widest spread. The tree keeps a reference
+    to a row-contiguous `points` array (no copy of it): do not modify it while the tree is in use.
+    layout="tree_order" (the default) also keeps a copy of the points in leaf order, which the
+    k-NN, radius and box queries read contiguously; layout="zero_copy" reads them in place
+    (half the memory, slower queries on large inputs).
     Queries are thread-safe and release the GIL; batches run in parallel.
 
     """
-    def __init__(self, points: ArrayLike, leaf_size: int = ...) -> None:
-        """points: (n, d), float32 or float64 (kept as given; other dtypes become float64)
+    def __init__(self, points: ArrayLike, leaf_size: int = ..., layout: str = ...) -> None:
+        """points: (n, d), float32 or float64 (kept as given; other dtypes become float64); layout: tree_order or zero_copy
         """
     def __len__(self) -> int: ...
     def count_box(self, lo: Any, hi: Any) -> Any:
@@ -464,11 +467,16 @@ class KdTree:
     @property
     def dtype(self) -> numpy.dtype[Any]: ...
     @property
+    def layout(self) -> str:
+        """tree_order or zero_copy (see the constructor)
+        """
+    @property
     def leaf_size(self) -> int: ...
     @staticmethod
-    def load(path: str | os.PathLike[str]) -> KdTree:
+    def load(path: str | os.PathLike[str], layout: str = ...) -> KdTree:
         """Maps a tree written by save() (float32 or float64, any dimension): its arrays are read in
-        place from the file. Raises ValueError for a truncated, corrupt or other file.
+        place from the file (layout="tree_order": its points are then copied in leaf order).
+        Raises ValueError for a truncated, corrupt or other file.
         """
     def query(self, q: Any, k: int = ..., eps: float = ...) -> tuple[Any, ...]:
         """k nearest neighbours of one point (d,) or of m points (m, d): (distances float64, indices int64), each (k,) or (m, k), ascending by distance, ties by index; -1 / inf where fewer than k points exist. eps > 0: each distance within (1 + eps) of the true one.

@@ -29,22 +29,24 @@ using AnyTree = std::variant<AnyKdTree<float>, AnyKdTree<double>>;
 
 class PyKdTree {
  public:
-  PyKdTree(const py::array& points, std::size_t leaf_size) {
+  PyKdTree(const py::array& points, std::size_t leaf_size, const std::string& layout) {
+    const spatial::PointLayout point_layout = spatial::parse_point_layout(layout);
     if (points.ndim() != 2) throw Error("KdTree: points must be an (n, d) array, got " + std::to_string(points.ndim()) +
                                         " dimensions");
     if (points.dtype().equal(py::dtype::of<float>())) {
-      build<float>(points, leaf_size);
+      build<float>(points, leaf_size, point_layout);
     } else {
-      build<double>(points, leaf_size);
+      build<double>(points, leaf_size, point_layout);
     }
   }
   explicit PyKdTree(AnyTree tree) : tree_(std::move(tree)) {}
 
-  static PyKdTree load(const std::filesystem::path& path) {
+  static PyKdTree load(const std::filesystem::path& path, const std::string& layout) {
+    const spatial::PointLayout point_layout = spatial::parse_point_layout(layout);
     const spatial::KdTreeFileInfo info = spatial::read_kd_tree_info(path);
     py::gil_scoped_release release;
-    if (info.scalar == DType::f32) return PyKdTree(AnyTree(spatial::load_kd_tree<float>(path, info.dim)));
-    return PyKdTree(AnyTree(spatial::load_kd_tree<double>(path, info.dim)));
+    if (info.scalar == DType::f32) return PyKdTree(AnyTree(spatial::load_kd_tree<float>(path, info.dim, point_layout)));
+    return PyKdTree(AnyTree(spatial::load_kd_tree<double>(path, info.dim, point_layout)));
   }
 
   // f(tree) with the tree's concrete KdTree<T, Dim>.
@@ -58,6 +60,9 @@ class PyKdTree {
   }
   std::size_t dim() const {
     return visit([](const auto& t) { return t.dim(); });
+  }
+  std::string layout() const {
+    return visit([](const auto& t) { return std::string(spatial::to_string(t.layout())); });
   }
   std::size_t leaf_size() const {
     return visit([](const auto& t) { return t.leaf_size(); });
@@ -144,7 +149,7 @@ class PyKdTree {
 
  private:
   template <typename T>
-  void build(const py::array& points, std::size_t leaf_size) {
+  void build(const py::array& points, std::size_t leaf_size, spatial::PointLayout layout) {
     // Zero-copy when every row is contiguous; otherwise one converted C-order copy.
     py::array_t<T> rows;
     const auto item = py::ssize_t(sizeof(T));
@@ -159,7 +164,7 @@ class PyKdTree {
     const spatial::PointView<T> view(rows.data(), n, d, std::max(stride, d));
     {
       py::gil_scoped_release release;
-      tree_ = spatial::make_kd_tree<T>(view, leaf_size);
+      tree_ = spatial::make_kd_tree<T>(view, leaf_size, layout);
     }
     points_ = rows;  // the tree reads the array in place: keep it alive
   }
@@ -174,12 +179,17 @@ void bind_spatial(py::module_& m) {
   py::class_<PyKdTree>(m, "KdTree", R"doc(
 Balanced k-d tree over n points of dimension d (float32 or float64; other dtypes become float64).
 
-Built in O(n log n) by median splits on the axis of widest spread. The tree reads a
-row-contiguous `points` array in place (no copy): do not modify it while the tree is in use.
+Built in O(n log n) by median splits on the axis of widest spread. The tree keeps a reference
+to a row-contiguous `points` array (no copy of it): do not modify it while the tree is in use.
+layout="tree_order" (the default) also keeps a copy of the points in leaf order, which the
+k-NN, radius and box queries read contiguously; layout="zero_copy" reads them in place
+(half the memory, slower queries on large inputs).
 Queries are thread-safe and release the GIL; batches run in parallel.
 )doc")
-      .def(py::init<const py::array&, std::size_t>(), py::arg("points"), py::arg("leaf_size") = 10,
-           "points: (n, d), float32 or float64 (kept as given; other dtypes become float64)")
+      .def(py::init<const py::array&, std::size_t, const std::string&>(), py::arg("points"),
+           py::arg("leaf_size") = 10, py::arg("layout") = "tree_order",
+           "points: (n, d), float32 or float64 (kept as given; other dtypes become float64); "
+           "layout: tree_order or zero_copy")
       .def("query", &PyKdTree::query, py::arg("q"), py::arg("k") = 1, py::arg("eps") = 0.0,
            "k nearest neighbours of one point (d,) or of m points (m, d): (distances float64, indices int64), "
            "each (k,) or (m, k), ascending by distance, ties by index; -1 / inf where fewer than k points exist. "
@@ -195,9 +205,11 @@ Queries are thread-safe and release the GIL; batches run in parallel.
       .def("validate", &PyKdTree::validate, "Checks every invariant of the tree; raises if one fails.")
       .def("save", &PyKdTree::save, py::arg("path"),
            "Writes the tree and its points to a geods archive (the file format of every structure).")
-      .def_static("load", &PyKdTree::load, py::arg("path"),
+      .def_static("load", &PyKdTree::load, py::arg("path"), py::arg("layout") = "zero_copy",
                   "Maps a tree written by save() (float32 or float64, any dimension): its arrays are read in\n"
-                  "place from the file. Raises ValueError for a truncated, corrupt or other file.")
+                  "place from the file (layout=\"tree_order\": its points are then copied in leaf order).\n"
+                  "Raises ValueError for a truncated, corrupt or other file.")
+      .def_property_readonly("layout", &PyKdTree::layout, "tree_order or zero_copy (see the constructor)")
       .def("__len__", &PyKdTree::size)
       .def_property_readonly("dim", &PyKdTree::dim)
       .def_property_readonly("leaf_size", &PyKdTree::leaf_size)

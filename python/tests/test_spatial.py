@@ -101,6 +101,31 @@ def test_zero_copy_views_and_strided_input():
     assert geods.KdTree(ints).dtype == np.float64
 
 
+def test_layouts_give_identical_answers(tmp_path):
+    rng = np.random.default_rng(6)
+    pts = rng.random((2000, 3)).astype(np.float32)
+    ordered = geods.KdTree(pts)  # default: a copy in leaf order
+    plain = geods.KdTree(pts, layout="zero_copy")
+    assert ordered.layout == "tree_order" and plain.layout == "zero_copy"
+    assert ordered.stats()["bytes"] == plain.stats()["bytes"] + pts.nbytes
+    q = rng.random((40, 3))
+    for a, b in zip(ordered.query(q, 7), plain.query(q, 7)):
+        np.testing.assert_array_equal(a, b)
+    d, i = ordered.query(q, 7)
+    brute = np.sort(np.linalg.norm(pts[None, :, :].astype(np.float64) - q[:, None, :], axis=2), axis=1)[:, :7]
+    np.testing.assert_allclose(d, brute, rtol=1e-5)
+    for a, b in zip(ordered.query_radius(q, 0.1), plain.query_radius(q, 0.1)):
+        np.testing.assert_array_equal(a, b)
+    path = tmp_path / "tree.geods"
+    ordered.save(path)
+    assert geods.KdTree.load(path).layout == "zero_copy"  # mapped points read in place
+    copied = geods.KdTree.load(path, layout="tree_order")
+    assert copied.layout == "tree_order"
+    np.testing.assert_array_equal(copied.query(q, 7)[1], i)
+    with pytest.raises(ERRORS, match="point layout"):
+        geods.KdTree(pts, layout="sorted")
+
+
 def test_stats_save_load(tmp_path):
     rng = np.random.default_rng(5)
     pts = rng.random((3000, 3)).astype(np.float32)

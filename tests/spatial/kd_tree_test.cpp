@@ -222,27 +222,38 @@ TEST(KdTree, OwnedPointsAndEigenViews) {
   EXPECT_EQ(copy.count_box(AABB3f({-0.5f, -0.5f, -0.5f}, {0.5f, 1.5f, 1.5f})), 3u);
 }
 
-// store_points_in_tree_order() only changes where leaves read their points:
-// every k-NN (exact, approximate, limited) and radius result must be identical.
+// The layout only changes where leaves read their points: every k-NN (exact,
+// approximate, limited), radius and box result must be identical between the
+// default tree_order tree (its copy made by the build), a zero_copy one, and a
+// zero_copy one turned into tree_order by store_points_in_tree_order().
 template <typename T, int Dim>
 void check_tree_order_copy(Shape shape, std::size_t d) {
   SCOPED_TRACE(name(shape) + " d=" + std::to_string(d) + (sizeof(T) == 4 ? " float" : " double"));
   constexpr std::size_t n = 3000;
   const std::vector<T> pts = make_points<T>(shape, n, d, 29 + d);
-  const KdTree<T, Dim> plain(PointView<T>(pts.data(), n, d), 8);
-  KdTree<T, Dim> ordered = plain;
-  ordered.store_points_in_tree_order();
-  ASSERT_TRUE(ordered.stores_points_in_tree_order());
-  ASSERT_FALSE(plain.stores_points_in_tree_order());
+  const KdTree<T, Dim> plain(PointView<T>(pts.data(), n, d), 8, PointLayout::zero_copy);
+  const KdTree<T, Dim> ordered(PointView<T>(pts.data(), n, d), 8);
+  KdTree<T, Dim> converted = plain;
+  converted.store_points_in_tree_order();
+  ASSERT_EQ(ordered.layout(), PointLayout::tree_order);
+  ASSERT_EQ(converted.layout(), PointLayout::tree_order);
+  ASSERT_EQ(plain.layout(), PointLayout::zero_copy);
+  ASSERT_NO_THROW(ordered.validate());  // checks the copy against the points
+  ASSERT_NO_THROW(converted.validate());
+  EXPECT_EQ(ordered.bytes(), plain.bytes() + n * d * sizeof(T));
   const std::vector<T> qs = make_queries(pts, n, d, 60, 31);
   for (std::size_t i = 0; i < 60; ++i) {
     const std::span<const T> q(&qs[i * d], d);
     for (std::size_t k : {1u, 10u, 37u}) {
       EXPECT_EQ(plain.query(q, k), ordered.query(q, k));
+      EXPECT_EQ(plain.query(q, k), converted.query(q, k));
       EXPECT_EQ(plain.query(q, k, 0.5), ordered.query(q, k, 0.5));
       EXPECT_EQ(plain.query(q, KnnRequest{k, 0, 0.3}), ordered.query(q, KnnRequest{k, 0, 0.3}));
     }
     EXPECT_EQ(plain.query_radius(q, 0.2), ordered.query_radius(q, 0.2));
+    std::vector<T> lo(q.begin(), q.end()), hi(q.begin(), q.end());
+    for (std::size_t a = 0; a < d; ++a) lo[a] -= T(0.1), hi[a] += T(0.15);
+    EXPECT_EQ(plain.query_box(lo, hi), ordered.query_box(lo, hi));
   }
 }
 
@@ -398,9 +409,12 @@ TEST(KdTree, LoadedTreesAnswerLikeTheOriginal) {
       loaded.validate();
       EXPECT_TRUE(loaded.points().data != pts.data());
       expect_same_answers(tree, loaded, qs, 20, 3);
-      // Points in tree order are a copy made after loading; answers stay the same.
-      auto ordered = KdTree<double, 3>::load(path);
-      ordered.store_points_in_tree_order();
+      // A loaded tree reads the mapped points in place unless asked for tree_order
+      // (a copy made after loading); answers stay the same.
+      EXPECT_EQ(loaded.layout(), PointLayout::zero_copy);
+      const auto ordered = KdTree<double, 3>::load(path, Archive::Verify::checksums, PointLayout::tree_order);
+      EXPECT_EQ(ordered.layout(), PointLayout::tree_order);
+      ordered.validate();
       expect_same_answers(tree, ordered, qs, 20, 3);
     }
   }
@@ -641,6 +655,8 @@ TEST(KdTree, BadInputThrows) {
   EXPECT_THROW((KdTree<double, 3>(PointView<double>(pts.data(), 3, 2))), Error);  // dimension mismatch
   EXPECT_THROW((KdTree<double, 2>(PointView<double>(pts.data(), 3, 2), 0)), Error);  // leaf size 0
   EXPECT_THROW((KdTree<double, Dynamic>(std::vector<double>(5, 0.0), 2)), Error);  // not rows
+  EXPECT_THROW(parse_point_layout("ordered"), Error);
+  EXPECT_EQ(parse_point_layout(to_string(PointLayout::zero_copy)), PointLayout::zero_copy);
   pts[3] = std::nan("");
   EXPECT_THROW((KdTree<double, 2>(PointView<double>(pts.data(), 3, 2))), Error);
   pts[3] = INFINITY;

@@ -24,6 +24,19 @@ struct Nanoflann {
     result.init(indices, distances);
     index.tree.findNeighbors(result, q, nanoflann::SearchParams());
   }
+  static void knn_eps(const Index& index, const float* q, std::size_t k, float eps, std::uint32_t* indices,
+                      float* distances) {
+    nanoflann::KNNResultSet<float, std::uint32_t> result(k);
+    result.init(indices, distances);
+    index.tree.findNeighbors(result, q, nanoflann::SearchParams(32, eps));
+  }
+  // radiusSearch (L2: the squared radius) into a reused vector, sorted by distance (SearchParams' default).
+  static void radius(const Index& index, const float* q, float squared_radius, std::vector<std::uint32_t>& out) {
+    thread_local std::vector<std::pair<std::uint32_t, float>> matches;
+    matches.clear();
+    index.tree.radiusSearch(q, squared_radius, matches, nanoflann::SearchParams());
+    for (const auto& m : matches) out.push_back(m.first);
+  }
 };
 
 }  // namespace

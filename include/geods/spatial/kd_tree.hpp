@@ -6,7 +6,9 @@
 // Layout: a flat array of nodes in depth-first order (the left child of node i is
 // i + 1, the right child is stored) with 32-bit indices, and a permutation of the
 // point indices so that every node owns a contiguous range of it. The points stay
-// in the caller's array (zero-copy, PointView) or in one the tree owns. The node
+// in the caller's array (PointView) or in one the tree owns; by default
+// (PointLayout::tree_order) the tree also keeps a copy of them in leaf order,
+// which the queries read contiguously (PointLayout::zero_copy: no copy). The node
 // array and the permutation are FlatArrays: a tree loaded from a file (load())
 // reads them, and its points, in place from the mapped file.
 //
@@ -57,6 +59,26 @@ namespace geods::spatial {
 /// The dimension template argument for a dimension known only at run time (as in Eigen).
 inline constexpr int Dynamic = -1;
 
+/// How a k-d tree reads its points in k-NN and radius queries.
+enum class PointLayout : std::uint8_t {
+  /// The default: the tree keeps a copy of the points in leaf order (size() *
+  /// dim() values, made during the build), so a leaf's points are read
+  /// contiguously; queries are about 1.4x faster on large inputs.
+  tree_order,
+  /// No copy: the points are read in place, through the permutation, from the
+  /// caller's array (or the tree's own, or a mapped file). Half the memory.
+  zero_copy,
+};
+inline std::string_view to_string(PointLayout layout) {
+  return layout == PointLayout::tree_order ? "tree_order" : "zero_copy";
+}
+/// "tree_order" or "zero_copy"; throws geods::Error for any other name.
+inline PointLayout parse_point_layout(std::string_view name) {
+  if (name == "tree_order") return PointLayout::tree_order;
+  if (name == "zero_copy") return PointLayout::zero_copy;
+  throw Error("unknown point layout '" + std::string(name) + "' (tree_order or zero_copy)");
+}
+
 /// The archive kind and layout version of a saved k-d tree (KdTree::save).
 inline constexpr std::string_view kKdTreeArchiveKind = "spatial.KdTree";
 inline constexpr std::uint32_t kKdTreeArchiveVersion = 1;
@@ -105,20 +127,25 @@ class KdTree {
   /// An empty tree (queries return nothing).
   KdTree() = default;
 
-  /// Builds over the caller's points without copying them: the array must
-  /// outlive the tree, unchanged. Throws geods::Error for NaN/inf coordinates,
-  /// a dimension other than Dim, leaf_size 0 or 2^32 - 1 points or more.
-  explicit KdTree(PointView<T> points, std::size_t leaf_size = kDefaultLeafSize) : view_(points) {
-    build(leaf_size);
+  /// Builds over the caller's points, which must outlive the tree, unchanged
+  /// (point(i) reads them; with PointLayout::zero_copy the queries do too; the
+  /// default, tree_order, also keeps a copy in leaf order for the queries).
+  /// Throws geods::Error for NaN/inf coordinates, a dimension other than Dim,
+  /// leaf_size 0 or 2^32 - 1 points or more.
+  explicit KdTree(PointView<T> points, std::size_t leaf_size = kDefaultLeafSize,
+                  PointLayout layout = PointLayout::tree_order)
+      : view_(points) {
+    build(leaf_size, layout);
   }
 
   /// Builds over points the tree owns: `coordinates` holds n * dim values, row by row.
-  KdTree(std::vector<T> coordinates, std::size_t dim, std::size_t leaf_size = kDefaultLeafSize) {
+  KdTree(std::vector<T> coordinates, std::size_t dim, std::size_t leaf_size = kDefaultLeafSize,
+         PointLayout layout = PointLayout::tree_order) {
     if (dim == 0 || coordinates.size() % dim != 0)
       throw Error("KdTree: " + std::to_string(coordinates.size()) + " coordinates are not rows of dimension " +
                   std::to_string(dim));
     adopt(std::move(coordinates), dim);
-    build(leaf_size);
+    build(leaf_size, layout);
   }
 
   // ---------------------------------------------------------------- accessors
@@ -133,18 +160,23 @@ class KdTree {
   /// Point indices in tree order: node v owns permutation()[v.begin, v.end).
   const FlatArray<std::uint32_t>& permutation() const { return perm_; }
 
-  /// Opt-in speed-up for large inputs: keeps a copy of the points in tree order
-  /// (size() * dim() values, shared by copies of the tree) so that k-NN and radius
-  /// queries read each leaf's points contiguously instead of through the
-  /// permutation. Results are identical. The default stays zero-copy; a loaded
-  /// tree has no copy until this is called.
+  /// Turns a zero-copy tree (PointLayout::zero_copy, a loaded one, a stepped
+  /// build's) into a tree_order one: makes the copy of the points in leaf order
+  /// (size() * dim() values, shared by copies of the tree) that k-NN and radius
+  /// queries then read contiguously instead of through the permutation. Results
+  /// are identical. Does nothing if the tree has the copy.
   void store_points_in_tree_order() {
-    auto ordered = std::make_shared<std::vector<T>>(perm_.size() * dim());
-    T* out = ordered->data();
-    for (std::size_t i = 0; i < perm_.size(); ++i, out += dim()) std::copy_n(point(perm_[i]), dim(), out);
+    if (ordered_ || empty()) return;
+    auto ordered = std::make_shared_for_overwrite<T[]>(perm_.size() * dim());
+    T* out = ordered.get();
+    parallel_for(0, perm_.size(), 4096, [&](std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i) std::copy_n(point(perm_[i]), dim(), out + i * dim());
+    });
     ordered_ = std::move(ordered);
   }
   bool stores_points_in_tree_order() const { return ordered_ != nullptr; }
+  /// tree_order when the tree keeps the copy of its points in leaf order, else zero_copy.
+  PointLayout layout() const { return ordered_ || empty() ? PointLayout::tree_order : PointLayout::zero_copy; }
   /// Bounding box of all points (empty vectors for an empty tree).
   const std::vector<T>& bounds_lo() const { return root_lo_; }
   const std::vector<T>& bounds_hi() const { return root_hi_; }
@@ -332,7 +364,7 @@ class KdTree {
   /// Bytes held: nodes, permutation, owned points and their copy in tree order; O(1).
   std::size_t bytes() const {
     return nodes_.size() * sizeof(Node) + perm_.size() * sizeof(std::uint32_t) +
-           (owned_ ? owned_->size() * sizeof(T) : 0) + (ordered_ ? ordered_->size() * sizeof(T) : 0) +
+           (owned_ ? owned_->size() * sizeof(T) : 0) + (ordered_ ? size() * dim() * sizeof(T) : 0) +
            2 * root_lo_.size() * sizeof(T);
   }
 
@@ -417,9 +449,8 @@ class KdTree {
     if (visited != nodes_.size()) fail("unreachable nodes");
     if (covered != n) fail("leaves do not cover all points");
     if (ordered_) {
-      if (ordered_->size() != n * dim()) fail("points in tree order: wrong size");
       for (std::size_t i = 0; i < n; ++i)
-        if (!std::equal(point(perm_[i]), point(perm_[i]) + dim(), ordered_->data() + i * dim()))
+        if (!std::equal(point(perm_[i]), point(perm_[i]) + dim(), ordered_.get() + i * dim()))
           fail("points in tree order differ from the points");
     }
   }
@@ -494,10 +525,15 @@ class KdTree {
   /// naming the file for another scalar type or dimension, a truncated or
   /// corrupt file (checksums, unless `verify` says structure_only) or contents
   /// that fail validate().
-  static KdTree load(const std::filesystem::path& path, Archive::Verify verify = Archive::Verify::checksums) {
+  /// A loaded tree is zero_copy by default: it reads its points in place from
+  /// the mapped file; `layout` tree_order copies them in leaf order after loading.
+  static KdTree load(const std::filesystem::path& path, Archive::Verify verify = Archive::Verify::checksums,
+                     PointLayout layout = PointLayout::zero_copy) {
     const Archive a = Archive::open(path, kKdTreeArchiveKind, kKdTreeArchiveVersion, verify);
     a.require_dtype<T>("scalar", "k-d tree");
-    return from_sections(a, "", std::size_t(a.value<std::uint64_t>("dim")));
+    KdTree tree = from_sections(a, "", std::size_t(a.value<std::uint64_t>("dim")));
+    if (layout == PointLayout::tree_order) tree.store_points_in_tree_order();
+    return tree;
   }
 
  private:
@@ -536,7 +572,7 @@ class KdTree {
   }
 
   // ---------------------------------------------------------------- build
-  void build(std::size_t leaf_size) {
+  void build(std::size_t leaf_size, PointLayout layout) {
     if (leaf_size == 0 || leaf_size > std::numeric_limits<std::uint32_t>::max())
       throw Error("KdTree: leaf_size must be >= 1");
     if (view_.dim == 0 || (Dim != Dynamic && view_.dim != std::size_t(Dim)))
@@ -574,21 +610,35 @@ class KdTree {
         std::array<T, Dim> p;
         std::uint32_t index;
       };
-      std::vector<Record> records(n);
-      parallel_for_each_index(0, n, [&](std::size_t i) {
-        std::copy(view_[i], view_[i] + Dim, records[i].p.begin());
-        records[i].index = std::uint32_t(i);
+      // The records end in tree order: the copy of tree_order is read off them.
+      const auto records = std::make_unique_for_overwrite<Record[]>(n);
+      parallel_for(0, n, 4096, [&](std::size_t b, std::size_t e) {
+        for (std::size_t i = b; i < e; ++i) {
+          std::copy(view_[i], view_[i] + Dim, records[i].p.begin());
+          records[i].index = std::uint32_t(i);
+        }
       });
-      builder.node(records.data(), [](const Record& r) { return r.p.data(); }, 0, 0, std::uint32_t(n),
+      builder.node(records.get(), [](const Record& r) { return r.p.data(); }, 0, 0, std::uint32_t(n),
                    root_lo_.data(), root_hi_.data());
-      parallel_for_each_index(0, n, [&](std::size_t i) { perm[i] = records[i].index; });
+      std::shared_ptr<T[]> ordered;
+      if (layout == PointLayout::tree_order) ordered = std::make_shared_for_overwrite<T[]>(n * Dim);
+      parallel_for(0, n, 4096, [&](std::size_t b, std::size_t e) {
+        for (std::size_t i = b; i < e; ++i) {
+          perm[i] = records[i].index;
+          if (ordered) std::copy_n(records[i].p.data(), Dim, ordered.get() + i * Dim);
+        }
+      });
+      ordered_ = std::move(ordered);
+      nodes_ = std::move(nodes);
+      perm_ = std::move(perm);
     } else {
       std::iota(perm.begin(), perm.end(), 0u);
       builder.node(perm.data(), [this](std::uint32_t i) { return point(i); }, 0, 0, std::uint32_t(n),
                    root_lo_.data(), root_hi_.data());
+      nodes_ = std::move(nodes);
+      perm_ = std::move(perm);
+      if (layout == PointLayout::tree_order) store_points_in_tree_order();
     }
-    nodes_ = std::move(nodes);
-    perm_ = std::move(perm);
   }
 
   // The split axis of a node whose points span [lo, hi]: the first of widest spread.
@@ -735,7 +785,7 @@ class KdTree {
       if (node.leaf()) {
         T limit = search.limit();  // cheap rejection first; a k-best list breaks exact ties by index
         const std::size_t dim = tree.dim();
-        const T* next = Ordered ? tree.ordered_->data() + std::size_t(node.begin) * dim : nullptr;
+        const T* next = Ordered ? tree.ordered_.get() + std::size_t(node.begin) * dim : nullptr;
         for (std::uint32_t i = node.begin; i < node.end; ++i) {
           const T* p;
           if constexpr (Ordered) {
@@ -818,7 +868,7 @@ class KdTree {
         const std::uint32_t j = perm_[i];
         if constexpr (!kSkipsNothing<Skip>)
           if (skip(j)) continue;
-        const T* p = point(j);
+        const T* p = ordered_ ? ordered_.get() + std::size_t(i) * dim() : point(j);
         bool in = true;
         for (std::size_t a = 0; a < dim() && in; ++a) in = lo[a] <= p[a] && p[a] <= hi[a];
         if (in) visit.point(j);
@@ -838,7 +888,7 @@ class KdTree {
 
   PointView<T> view_;
   std::shared_ptr<const FlatArray<T>> owned_;  // the points, when the tree owns or maps them (shared by copies)
-  std::shared_ptr<const std::vector<T>> ordered_;  // opt-in copy in tree order (store_points_in_tree_order)
+  std::shared_ptr<const T[]> ordered_;  // size() * dim() values in tree order (PointLayout::tree_order)
   std::size_t leaf_size_ = kDefaultLeafSize;
   FlatArray<Node> nodes_;
   FlatArray<std::uint32_t> perm_;

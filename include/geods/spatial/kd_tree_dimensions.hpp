@@ -26,16 +26,19 @@ decltype(auto) dispatch_kd_dimension(std::size_t dim, Fn&& fn) {
 
 /// The tree over `points` (read in place: they must outlive it) for their dimension.
 template <typename T>
-AnyKdTree<T> make_kd_tree(PointView<T> points, std::size_t leaf_size = KdTree<T>::kDefaultLeafSize) {
+AnyKdTree<T> make_kd_tree(PointView<T> points, std::size_t leaf_size = KdTree<T>::kDefaultLeafSize,
+                          PointLayout layout = PointLayout::tree_order) {
   return dispatch_kd_dimension(points.dim, [&]<int Dim>() {
-    return AnyKdTree<T>(std::in_place_type<KdTree<T, Dim>>, points, leaf_size);
+    return AnyKdTree<T>(std::in_place_type<KdTree<T, Dim>>, points, leaf_size, layout);
   });
 }
 
 /// A tree written by KdTree<T, *>::save of dimension `dim` (read_kd_tree_info gives the dimension).
 template <typename T>
-AnyKdTree<T> load_kd_tree(const std::filesystem::path& path, std::size_t dim) {
-  return dispatch_kd_dimension(dim, [&]<int Dim>() { return AnyKdTree<T>(KdTree<T, Dim>::load(path)); });
+AnyKdTree<T> load_kd_tree(const std::filesystem::path& path, std::size_t dim,
+                          PointLayout layout = PointLayout::zero_copy) {
+  return dispatch_kd_dimension(
+      dim, [&]<int Dim>() { return AnyKdTree<T>(KdTree<T, Dim>::load(path, Archive::Verify::checksums, layout)); });
 }
 
 }  // namespace geods::spatial
