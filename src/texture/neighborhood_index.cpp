@@ -121,11 +121,9 @@ NeighborhoodIndex::NeighborhoodIndex(std::vector<std::uint8_t> vectors, std::siz
   if (tree_dim == kFixedTreeDim) {
     fixed_tree_ = std::make_unique<spatial::KdTree<float, kFixedTreeDim>>(
         spatial::PointView<float>(projected_.data(), count_, tree_dim), kLeafSize);
-    fixed_tree_->store_points_in_tree_order();
   } else {
     tree_ = std::make_unique<spatial::KdTree<float>>(spatial::PointView<float>(projected_.data(), count_, tree_dim),
                                                       kLeafSize);
-    tree_->store_points_in_tree_order();
   }
 }
 
