@@ -31,13 +31,24 @@ bool collinear(const Vec3d& a, const Vec3d& b, const Vec3d& c) {
   return true;
 }
 
-// kEdgeOf[f][j]: the two indices of a tetrahedron other than f and j.
-constexpr std::uint8_t kEdgeOf[4][4][2] = {
-    {{0, 0}, {2, 3}, {1, 3}, {1, 2}},
-    {{2, 3}, {0, 0}, {0, 3}, {0, 2}},
-    {{1, 3}, {0, 3}, {0, 0}, {0, 1}},
-    {{1, 2}, {0, 2}, {0, 1}, {0, 0}},
+// kEdgeFrom[f][j]: the face opposite index j of a tetrahedron whose index f
+// is the new point holds it and an edge, here its two indices in the order
+// they follow f counter-clockwise seen from j's side (Tet3Mesh::face_towards):
+// the tetrahedron across that face holds the same edge the other way round.
+struct EdgeFrom {
+  std::uint8_t at[4][4][2] = {};
+  constexpr EdgeFrom() {
+    for (int f = 0; f < 4; ++f)
+      for (int j = 0; j < 4; ++j) {
+        if (j == f) continue;
+        const int face[3] = {(j + 1) % 4, j % 2 == 0 ? (j + 3) % 4 : (j + 2) % 4, j % 2 == 0 ? (j + 2) % 4 : (j + 3) % 4};
+        const int k = face[0] == f ? 0 : face[1] == f ? 1 : 2;
+        at[f][j][0] = std::uint8_t(face[(k + 1) % 3]);
+        at[f][j][1] = std::uint8_t(face[(k + 2) % 3]);
+      }
+  }
 };
+constexpr EdgeFrom kEdgeFrom;
 
 std::string tet_name(std::uint32_t t) { return "tetrahedron slot " + std::to_string(t); }
 
@@ -227,35 +238,50 @@ std::uint32_t Tet3Mesh::insert(std::uint32_t pv) {
     for (std::size_t k = 0; k < more; ++k) cavity.push_back(new_slot());
     T = tets.data();
   }
-  edges.begin(boundary.size());
+  // Each new tetrahedron's three faces through p are matched by their directed
+  // edges: all stored first, then each looks its twin up (see EdgeTable).
+  edges.begin(3 * boundary.size());
+  EdgeTable::Entry* E = edges.entries.data();
+  const std::size_t mask = edges.mask;
+  const std::uint32_t stamp = edges.stamp;
   std::uint32_t newest = kNone;
   for (std::size_t i = 0; i < boundary.size(); ++i) {
     const Boundary& b = boundary[i];
     const std::uint32_t s = cavity[i];
-    std::copy_n(b.v, 4, &T[8 * std::size_t(s)]);
-    T[8 * std::size_t(s) + 4 + b.face] = b.outer;
+    std::uint32_t* w = &T[8 * std::size_t(s)];
+    std::copy_n(b.v, 4, w);
+    w[4 + b.face] = b.outer;
     T[entry(b.outer)] = 4 * s + b.face;
     for (std::uint32_t j = 0; j < 4; ++j) {
       if (j == b.face) continue;
-      // face j holds p and the edge of the two vertices other than b.face and j
-      const std::uint32_t u = b.v[kEdgeOf[b.face][j][0]], w = b.v[kEdgeOf[b.face][j][1]];
-      const std::uint32_t other = edges.match(u < w ? (std::uint64_t(u) << 32 | w) : (std::uint64_t(w) << 32 | u),
-                                              4 * s + j);
-      if (other != kNone) {
-        T[8 * std::size_t(s) + 4 + j] = other;
-        T[entry(other)] = 4 * s + j;
-      }
+      const std::uint64_t key = std::uint64_t(b.v[kEdgeFrom.at[b.face][j][0]]) << 32 | b.v[kEdgeFrom.at[b.face][j][1]];
+      std::size_t h = EdgeTable::hash(key) & mask;
+      while (E[h].stamp == stamp) h = (h + 1) & mask;
+      E[h] = {key, 4 * s + j, stamp};
     }
     if (newest == kNone || ((b.v[0] | b.v[1] | b.v[2] | b.v[3]) & kGhostBit) == 0) newest = s;
+  }
+  for (std::size_t i = 0; i < boundary.size(); ++i) {
+    const Boundary& b = boundary[i];
+    std::uint32_t* w = &T[8 * std::size_t(cavity[i])];
+    for (std::uint32_t j = 0; j < 4; ++j) {
+      if (j == b.face) continue;
+      const std::uint64_t twin = std::uint64_t(b.v[kEdgeFrom.at[b.face][j][1]]) << 32 | b.v[kEdgeFrom.at[b.face][j][0]];
+      std::size_t h = EdgeTable::hash(twin) & mask;
+      // There, before an empty entry: the cavity's boundary is a closed surface.
+      for (; E[h].key != twin || E[h].stamp != stamp; h = (h + 1) & mask)
+        if (E[h].stamp != stamp) throw Error("Delaunay3: internal error, a cavity face without a neighbour");
+      w[4 + j] = E[h].value;
+    }
   }
   for (std::size_t i = boundary.size(); i < cavity.size(); ++i) free_slot(cavity[i]);
   last = newest;
   return kNone;
 }
 
-void Tet3Mesh::EdgeTable::begin(std::size_t faces) {
+void Tet3Mesh::EdgeTable::begin(std::size_t edges) {
   std::size_t want = 64;
-  while (want < 4 * faces) want *= 2;
+  while (want < 2 * edges) want *= 2;
   if (want > entries.size()) entries.assign(want, Entry{});
   mask = want - 1;
   if (++stamp == 0) {  // wrapped: forget every old stamp
