@@ -31,13 +31,24 @@ bool collinear(const Vec3d& a, const Vec3d& b, const Vec3d& c) {
   return true;
 }
 
-// kEdgeOf[f][j]: the two indices of a tetrahedron other than f and j.
-constexpr std::uint8_t kEdgeOf[4][4][2] = {
-    {{0, 0}, {2, 3}, {1, 3}, {1, 2}},
-    {{2, 3}, {0, 0}, {0, 3}, {0, 2}},
-    {{1, 3}, {0, 3}, {0, 0}, {0, 1}},
-    {{1, 2}, {0, 2}, {0, 1}, {0, 0}},
+// kEdgeFrom[f][j]: the face opposite index j of a tetrahedron whose index f
+// is the new point holds it and an edge, here its two indices in the order
+// they follow f counter-clockwise seen from j's side (Tet3Mesh::face_towards):
+// the tetrahedron across that face holds the same edge the other way round.
+struct EdgeFrom {
+  std::uint8_t at[4][4][2] = {};
+  constexpr EdgeFrom() {
+    for (int f = 0; f < 4; ++f)
+      for (int j = 0; j < 4; ++j) {
+        if (j == f) continue;
+        const int face[3] = {(j + 1) % 4, j % 2 == 0 ? (j + 3) % 4 : (j + 2) % 4, j % 2 == 0 ? (j + 2) % 4 : (j + 3) % 4};
+        const int k = face[0] == f ? 0 : face[1] == f ? 1 : 2;
+        at[f][j][0] = std::uint8_t(face[(k + 1) % 3]);
+        at[f][j][1] = std::uint8_t(face[(k + 2) % 3]);
+      }
+  }
 };
+constexpr EdgeFrom kEdgeFrom;
 
 std::string tet_name(std::uint32_t t) { return "tetrahedron slot " + std::to_string(t); }
 
@@ -227,35 +238,50 @@ std::uint32_t Tet3Mesh::insert(std::uint32_t pv) {
     for (std::size_t k = 0; k < more; ++k) cavity.push_back(new_slot());
     T = tets.data();
   }
-  edges.begin(boundary.size());
+  // Each new tetrahedron's three faces through p are matched by their directed
+  // edges: all stored first, then each looks its twin up (see EdgeTable).
+  edges.begin(3 * boundary.size());
+  EdgeTable::Entry* E = edges.entries.data();
+  const std::size_t mask = edges.mask;
+  const std::uint32_t stamp = edges.stamp;
   std::uint32_t newest = kNone;
   for (std::size_t i = 0; i < boundary.size(); ++i) {
     const Boundary& b = boundary[i];
     const std::uint32_t s = cavity[i];
-    std::copy_n(b.v, 4, &T[8 * std::size_t(s)]);
-    T[8 * std::size_t(s) + 4 + b.face] = b.outer;
+    std::uint32_t* w = &T[8 * std::size_t(s)];
+    std::copy_n(b.v, 4, w);
+    w[4 + b.face] = b.outer;
     T[entry(b.outer)] = 4 * s + b.face;
     for (std::uint32_t j = 0; j < 4; ++j) {
       if (j == b.face) continue;
-      // face j holds p and the edge of the two vertices other than b.face and j
-      const std::uint32_t u = b.v[kEdgeOf[b.face][j][0]], w = b.v[kEdgeOf[b.face][j][1]];
-      const std::uint32_t other = edges.match(u < w ? (std::uint64_t(u) << 32 | w) : (std::uint64_t(w) << 32 | u),
-                                              4 * s + j);
-      if (other != kNone) {
-        T[8 * std::size_t(s) + 4 + j] = other;
-        T[entry(other)] = 4 * s + j;
-      }
+      const std::uint64_t key = std::uint64_t(b.v[kEdgeFrom.at[b.face][j][0]]) << 32 | b.v[kEdgeFrom.at[b.face][j][1]];
+      std::size_t h = EdgeTable::hash(key) & mask;
+      while (E[h].stamp == stamp) h = (h + 1) & mask;
+      E[h] = {key, 4 * s + j, stamp};
     }
     if (newest == kNone || ((b.v[0] | b.v[1] | b.v[2] | b.v[3]) & kGhostBit) == 0) newest = s;
+  }
+  for (std::size_t i = 0; i < boundary.size(); ++i) {
+    const Boundary& b = boundary[i];
+    std::uint32_t* w = &T[8 * std::size_t(cavity[i])];
+    for (std::uint32_t j = 0; j < 4; ++j) {
+      if (j == b.face) continue;
+      const std::uint64_t twin = std::uint64_t(b.v[kEdgeFrom.at[b.face][j][1]]) << 32 | b.v[kEdgeFrom.at[b.face][j][0]];
+      std::size_t h = EdgeTable::hash(twin) & mask;
+      // There, before an empty entry: the cavity's boundary is a closed surface.
+      for (; E[h].key != twin || E[h].stamp != stamp; h = (h + 1) & mask)
+        if (E[h].stamp != stamp) throw Error("Delaunay3: internal error, a cavity face without a neighbour");
+      w[4 + j] = E[h].value;
+    }
   }
   for (std::size_t i = boundary.size(); i < cavity.size(); ++i) free_slot(cavity[i]);
   last = newest;
   return kNone;
 }
 
-void Tet3Mesh::EdgeTable::begin(std::size_t faces) {
+void Tet3Mesh::EdgeTable::begin(std::size_t edges) {
   std::size_t want = 64;
-  while (want < 4 * faces) want *= 2;
+  while (want < 2 * edges) want *= 2;
   if (want > entries.size()) entries.assign(want, Entry{});
   mask = want - 1;
   if (++stamp == 0) {  // wrapped: forget every old stamp
@@ -531,59 +557,119 @@ void RegionFill::write(std::vector<std::uint32_t>& tets) const {
 // the insertion order or the thread count), so that every build gives the same
 // arrays: each tetrahedron starts at its smallest vertex, then the smallest of
 // the other three in its orientation (an even permutation, so it stays
-// positive), and the slots are sorted by their vertices (a counting sort on
-// the first, then each bucket); ghosts sort among them (the ghost is the
-// largest vertex), free slots go. Memory bound: the keys are sorted where they
-// lie, and the slots are then scattered in their own (spatially coherent)
-// order, so that a slot's neighbours are mostly in cache.
+// positive), and the slots are sorted by their vertices; ghosts sort among
+// them (the ghost is the largest vertex), free slots go. Memory bound, and the
+// vertex ids are random in space, so the sort avoids random access where it
+// can: the keys are first streamed into partitions by the high bits of their
+// first vertex (a few hundred partitions, each a sequential stream; blocks of
+// slots in parallel, each with its own counts), then each partition is sorted
+// within cache (a counting sort on the first vertex, then each bucket), and
+// the slots are scattered in their own (spatially coherent) order, so that a
+// slot's neighbours are mostly in cache.
+namespace {
+// position[i]: the entry of tetrahedron v that is its canonical entry i: its
+// smallest vertex first, then the smallest of the other three, in an even
+// permutation of the four (the orientation stays positive).
+inline void canonical_positions(const std::uint32_t* v, std::uint8_t position[4]) {
+  // The even permutations that bring each index first: (0123), (1032), (2301), (3210); then a rotation of the rest.
+  static constexpr std::uint8_t kEven[4][4] = {{0, 1, 2, 3}, {1, 0, 3, 2}, {2, 3, 0, 1}, {3, 2, 1, 0}};
+  const int m = int(std::min_element(v, v + 4) - v);
+  const std::uint8_t* r = &kEven[m][1];
+  int k = 0;
+  for (int i = 1; i < 3; ++i)
+    if (v[r[i]] < v[r[k]]) k = i;
+  position[0] = kEven[m][0], position[1] = r[k], position[2] = r[(k + 1) % 3], position[3] = r[(k + 2) % 3];
+}
+}  // namespace
+
 void Delaunay3::canonicalize() {
   const std::size_t slots = tets_.size() / 8;
   const std::size_t n = points_.size();
-  std::vector<std::array<std::uint8_t, 4>> position(slots);  // canonical entry i of slot s = tets_[8s + position[s][i]]
-  std::vector<std::array<std::uint8_t, 4>> place(slots);     // its inverse: where entry j of slot s goes
-  parallel_for(0, slots, 1 << 14, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t s = begin; s < end; ++s) {
-      const std::uint32_t* v = &tets_[8 * s];
-      if (v[0] == kNone) continue;
-      // The even permutations that bring each index first: (0123), (1032), (2301), (3210); then a rotation of the rest.
-      static constexpr std::uint8_t kEven[4][4] = {{0, 1, 2, 3}, {1, 0, 3, 2}, {2, 3, 0, 1}, {3, 2, 1, 0}};
-      const int m = int(std::min_element(v, v + 4) - v);
-      const std::uint8_t* r = &kEven[m][1];
-      int k = 0;
-      for (int i = 1; i < 3; ++i)
-        if (v[r[i]] < v[r[k]]) k = i;
-      position[s] = {kEven[m][0], r[k], r[(k + 1) % 3], r[(k + 2) % 3]};
-      for (int i = 0; i < 4; ++i) place[s][position[s][i]] = std::uint8_t(i);
-    }
-  });
-  std::vector<std::uint32_t> count(n + 1, 0);
-  for (std::size_t s = 0; s < slots; ++s)
-    if (tets_[8 * s] != kNone) ++count[tets_[8 * s + position[s][0]] + 1];
-  for (std::size_t i = 0; i < n; ++i) count[i + 1] += count[i];
-  struct Key {  // a slot's other three canonical vertices (the bucket is the first)
-    std::uint32_t v[3];
+  std::vector<std::array<std::uint8_t, 4>> place(slots);  // where entry j of slot s goes
+  struct Key {  // a slot's canonical vertices
+    std::uint32_t v[4];
     std::uint32_t slot;
   };
-  std::vector<Key> keys(count[n]);
-  {
-    std::vector<std::uint32_t> next(count.begin(), count.end() - 1);
-    for (std::size_t s = 0; s < slots; ++s) {
-      const std::uint32_t* v = &tets_[8 * s];
-      if (v[0] == kNone) continue;
-      const std::array<std::uint8_t, 4>& at = position[s];
-      keys[next[v[at[0]]]++] = {{v[at[1]], v[at[2]], v[at[3]]}, std::uint32_t(s)};
-    }
+  int shift = 0;  // partition of a key: its first vertex >> shift (at most ~1024 vertices each)
+  while ((n >> shift) > 1024) ++shift;
+  const std::size_t parts = (n >> shift) + 1;
+  constexpr std::size_t kBlock = 1 << 13;  // slots per block (fixed: the layout does not depend on the threads)
+  const std::size_t blocks = (slots + kBlock - 1) / kBlock;
+  if (blocks == 0) {
+    free_slots_.clear();
+    last_ = 0;
+    return;
   }
+  std::vector<std::uint32_t> offset(blocks * parts + 1, 0);  // per (partition, block): where its keys start
+  // The canonical order of each slot's entries, and the keys per partition per block.
+  parallel_for_each_index(
+      0, blocks,
+      [&](std::size_t block) {
+        std::uint32_t* count = &offset[block * parts];
+        for (std::size_t s = block * kBlock; s < std::min(slots, (block + 1) * kBlock); ++s) {
+          const std::uint32_t* v = &tets_[8 * s];
+          if (v[0] == kNone) continue;
+          std::uint8_t position[4];
+          canonical_positions(v, position);
+          for (int i = 0; i < 4; ++i) place[s][position[i]] = std::uint8_t(i);
+          ++count[v[position[0]] >> shift];
+        }
+      },
+      1);
+  // Exclusive prefix in (partition, block) order: the keys of a partition are contiguous.
+  {
+    std::uint32_t total = 0;
+    for (std::size_t p = 0; p < parts; ++p)
+      for (std::size_t block = 0; block < blocks; ++block) {
+        std::uint32_t& c = offset[block * parts + p];
+        const std::uint32_t here = c;
+        c = total;
+        total += here;
+      }
+    offset[blocks * parts] = total;
+  }
+  const std::size_t live = offset[blocks * parts];
+  std::vector<Key> keys(live);
+  parallel_for_each_index(
+      0, blocks,
+      [&](std::size_t block) {
+        std::uint32_t* next = &offset[block * parts];
+        for (std::size_t s = block * kBlock; s < std::min(slots, (block + 1) * kBlock); ++s) {
+          const std::uint32_t* v = &tets_[8 * s];
+          if (v[0] == kNone) continue;
+          std::uint8_t position[4];  // (again rather than from place: reads, no stores to forward)
+          canonical_positions(v, position);
+          const Key key = {{v[position[0]], v[position[1]], v[position[2]], v[position[3]]}, std::uint32_t(s)};
+          keys[next[key.v[0] >> shift]++] = key;
+        }
+      },
+      1);
+  // offset[block * parts + p] is now the end of (p, block): block 0's start of p + 1 is p's end.
+  const auto part_begin = [&](std::size_t p) -> std::size_t {
+    return p == 0 ? 0 : offset[(blocks - 1) * parts + p - 1];
+  };
   std::vector<std::uint32_t> new_of(slots, kNone);
-  parallel_for(0, n, 1 << 12, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t v = begin; v < end; ++v) {
-      std::sort(keys.begin() + count[v], keys.begin() + count[v + 1], [](const Key& a, const Key& b) {
-        return std::lexicographical_compare(a.v, a.v + 3, b.v, b.v + 3);
-      });
-      for (std::size_t t = count[v]; t < count[v + 1]; ++t) new_of[keys[t].slot] = std::uint32_t(t);
-    }
-  });
-  std::vector<std::uint32_t> out(8 * keys.size());
+  parallel_for_each_index(
+      0, parts,
+      [&](std::size_t p) {
+        const std::size_t begin = part_begin(p), end = offset[(blocks - 1) * parts + p];
+        if (begin == end) return;
+        // A counting sort on the first vertex, then each bucket by the other three.
+        const std::uint32_t first = std::uint32_t(p << shift);
+        const std::size_t width = std::size_t(1) << shift;
+        std::vector<std::uint32_t> count(width + 1, 0);
+        for (std::size_t t = begin; t < end; ++t) ++count[keys[t].v[0] - first + 1];
+        for (std::size_t i = 0; i < width; ++i) count[i + 1] += count[i];
+        std::vector<Key> sorted(end - begin);
+        for (std::size_t t = begin; t < end; ++t) sorted[count[keys[t].v[0] - first]++] = keys[t];
+        for (std::size_t i = 0, from = 0; i < width; from = count[i++]) {
+          std::sort(sorted.begin() + std::ptrdiff_t(from), sorted.begin() + std::ptrdiff_t(count[i]),
+                    [](const Key& a, const Key& b) { return std::lexicographical_compare(a.v + 1, a.v + 4, b.v + 1, b.v + 4); });
+        }
+        for (std::size_t t = 0; t < sorted.size(); ++t) new_of[sorted[t].slot] = std::uint32_t(begin + t);
+      },
+      1);
+  std::vector<std::uint32_t> out(8 * live);
   parallel_for(0, slots, 1 << 14, [&](std::size_t begin, std::size_t end) {
     for (std::size_t s = begin; s < end; ++s) {
       const std::size_t t = new_of[s];

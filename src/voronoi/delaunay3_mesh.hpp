@@ -105,7 +105,12 @@ struct Tet3Mesh {
     std::uint32_t face;  // its face on the cavity's boundary
     std::uint32_t outer;  // the adjacency across it
   };
-  /// The faces of the new tetrahedra around p, matched by their edge opposite p.
+  /// The faces of the new tetrahedra around p, matched by their edge opposite
+  /// p. Directed: the face of new tetrahedron s opposite its vertex j holds p
+  /// and an edge u -> w (its order seen from s's side); the neighbour across
+  /// it holds the same edge as w -> u. All faces are stored first, then each
+  /// looks its twin up, so that no branch depends on which of two faces comes
+  /// first (a coin toss the branch predictor loses).
   struct EdgeTable {
     struct Entry {
       std::uint64_t key = 0;
@@ -114,18 +119,9 @@ struct Tet3Mesh {
     std::vector<Entry> entries;
     std::size_t mask = 0;
     std::uint32_t stamp = 0;
-    void begin(std::size_t faces);
-    /// The value stored with key, or kNone after storing `value` with it.
-    std::uint32_t match(std::uint64_t key, std::uint32_t value) {
-      for (std::size_t h = std::size_t((key * 0x9E3779B97F4A7C15ull) >> 40) & mask;; h = (h + 1) & mask) {
-        Entry& e = entries[h];
-        if (e.stamp != stamp) {
-          e = {key, value, stamp};
-          return kNone;
-        }
-        if (e.key == key) return e.value;  // each edge is shared by exactly two new tetrahedra
-      }
-    }
+    /// Empties the table for `edges` directed edges (load at most 1/2).
+    void begin(std::size_t edges);
+    static std::size_t hash(std::uint64_t key) { return std::size_t((key * 0x9E3779B97F4A7C15ull) >> 40); }
   };
   std::vector<std::uint32_t> stack, cavity;
   std::vector<Boundary> boundary;

@@ -39,6 +39,28 @@ std::uint32_t extreme_vertex(const std::vector<std::vector<std::uint32_t>>& adja
   return best;
 }
 
+constexpr std::size_t kBlock = 1 << 14;  // slots per block of the parallel passes over a half's slots
+
+// fn(s, out) for every slot s < slots, in blocks in parallel; the blocks'
+// outputs concatenated in slot order (the same whatever the threads).
+template <class T, class Fn>
+std::vector<T> gather_slots(std::size_t slots, const Fn& fn) {
+  const std::size_t blocks = (slots + kBlock - 1) / kBlock;
+  std::vector<std::vector<T>> part(blocks);
+  parallel_for_each_index(
+      0, blocks,
+      [&](std::size_t b) {
+        for (std::size_t s = b * kBlock; s < std::min(slots, (b + 1) * kBlock); ++s) fn(s, part[b]);
+      },
+      1);
+  std::size_t total = 0;
+  for (const std::vector<T>& p : part) total += p.size();
+  std::vector<T> out;
+  out.reserve(total);
+  for (const std::vector<T>& p : part) out.insert(out.end(), p.begin(), p.end());
+  return out;
+}
+
 }  // namespace
 
 bool Delaunay3::build_split(const std::vector<std::uint32_t>& active) {
@@ -170,45 +192,80 @@ bool Delaunay3::build_split(const std::vector<std::uint32_t>& active) {
   }
   // The seam: every vertex of a doubtful slot; its own tetrahedralization.
   std::vector<std::uint32_t> seam;
-  for (int h = 0; h < 2; ++h)
-    for (std::size_t s = 0; s < valid[h].size(); ++s) {
-      const std::uint32_t* v = &half[h].tets_[8 * s];
-      if (v[0] == kNone || valid[h][s]) continue;
-      for (int k = 0; k < 4; ++k)
-        if (v[k] != kGhost) seam.push_back(global[h][v[k]]);
-    }
+  for (int h = 0; h < 2; ++h) {
+    const std::vector<std::uint32_t> more =
+        gather_slots<std::uint32_t>(valid[h].size(), [&](std::size_t s, std::vector<std::uint32_t>& out) {
+          const std::uint32_t* v = &half[h].tets_[8 * s];
+          if (v[0] == kNone || valid[h][s]) return;
+          for (int k = 0; k < 4; ++k)
+            if (v[k] != kGhost) out.push_back(global[h][v[k]]);
+        });
+    seam.insert(seam.end(), more.begin(), more.end());
+  }
   std::sort(seam.begin(), seam.end());
   seam.erase(std::unique(seam.begin(), seam.end()), seam.end());
   if (seam.empty()) return false;
+  // The seam's own tetrahedralization (one thread) while the other numbers
+  // the kept slots and collects the seam's boundary.
   Delaunay3 filler;
   filler.options_ = options_;
   filler.points_.resize(seam.size());
   for (std::size_t k = 0; k < seam.size(); ++k) filler.points_[k] = points_[seam[k]];
-  filler.build(options_, false);
-  if (filler.dimension_ < 3) return false;
-
-  // New slot numbers: the kept slots of half 0, then of half 1, then the fill.
   std::array<std::vector<std::uint32_t>, 2> renumber;
   std::uint32_t next = 0;
-  for (int h = 0; h < 2; ++h) {
-    renumber[h].assign(valid[h].size(), kNone);
-    for (std::size_t s = 0; s < valid[h].size(); ++s)
-      if (valid[h][s] && half[h].tets_[8 * s] != kNone) renumber[h][s] = next++;
-  }
-  const auto to_global = [&](int h, std::uint32_t v) { return v == kGhost ? kGhost : global[h][v]; };
-  // The seam region's boundary: kept slots' faces towards doubtful ones, seen from the seam's side.
   RegionFill seam_fill;  // its boundary: the face and the adjacency across it (new numbers)
-  for (int h = 0; h < 2; ++h)
-    for (std::size_t s = 0; s < valid[h].size(); ++s) {
-      if (renumber[h][s] == kNone) continue;
-      for (std::uint32_t f = 0; f < 4; ++f) {
-        const std::uint32_t a = half[h].tets_[8 * s + 4 + f], u = a >> 2;
-        if (valid[h][u]) continue;
-        std::uint32_t w[4];
-        for (int k = 0; k < 4; ++k) w[k] = to_global(h, half[h].tets_[8 * std::size_t(u) + k]);
-        seam_fill.boundary.push_back({RegionFill::face_of(w, int(a & 3)), 4 * renumber[h][s] + f});
-      }
+  const auto to_global = [&](int h, std::uint32_t v) { return v == kGhost ? kGhost : global[h][v]; };
+  const auto number_kept = [&] {
+    // New slot numbers: the kept slots of half 0, then of half 1, then the fill.
+    for (int h = 0; h < 2; ++h) {
+      const std::size_t slots = valid[h].size(), blocks = (slots + kBlock - 1) / kBlock;
+      const auto keep = [&](std::size_t s) { return valid[h][s] && half[h].tets_[8 * s] != kNone; };
+      std::vector<std::uint32_t> first(blocks + 1, 0);  // per block: its first new number
+      parallel_for_each_index(
+          0, blocks,
+          [&](std::size_t b) {
+            for (std::size_t s = b * kBlock; s < std::min(slots, (b + 1) * kBlock); ++s) first[b + 1] += keep(s);
+          },
+          1);
+      first[0] = next;
+      for (std::size_t b = 0; b < blocks; ++b) first[b + 1] += first[b];
+      renumber[h].resize(slots);
+      parallel_for_each_index(
+          0, blocks,
+          [&](std::size_t b) {
+            std::uint32_t k = first[b];
+            for (std::size_t s = b * kBlock; s < std::min(slots, (b + 1) * kBlock); ++s) renumber[h][s] = keep(s) ? k++ : kNone;
+          },
+          1);
+      next = first[blocks];
     }
+    // The seam region's boundary: kept slots' faces towards doubtful ones, seen from the seam's side.
+    using BoundaryFace = std::pair<RegionFill::Face, std::uint32_t>;
+    for (int h = 0; h < 2; ++h) {
+      const std::vector<BoundaryFace> faces =
+          gather_slots<BoundaryFace>(valid[h].size(), [&](std::size_t s, std::vector<BoundaryFace>& out) {
+            if (renumber[h][s] == kNone) return;
+            for (std::uint32_t f = 0; f < 4; ++f) {
+              const std::uint32_t a = half[h].tets_[8 * s + 4 + f], u = a >> 2;
+              if (valid[h][u]) continue;
+              std::uint32_t w[4];
+              for (int k = 0; k < 4; ++k) w[k] = to_global(h, half[h].tets_[8 * std::size_t(u) + k]);
+              out.push_back({RegionFill::face_of(w, int(a & 3)), 4 * renumber[h][s] + f});
+            }
+          });
+      seam_fill.boundary.insert(seam_fill.boundary.end(), faces.begin(), faces.end());
+    }
+  };
+  parallel_for_each_index(
+      0, 2,
+      [&](std::size_t task) {
+        if (task == 0)
+          filler.build(options_, false);
+        else
+          number_kept();
+      },
+      1);
+  if (filler.dimension_ < 3) return false;
 
   // Nothing kept next to the seam (a small or flat half), or a face unmatched (not expected): build sequentially.
   if (!seam_fill.match(filler.tets_, seam)) return false;

@@ -422,6 +422,16 @@ TEST(Delaunay3, ParallelBuildEqualsTheSequentialOne) {
     EXPECT_EQ(parallel.tetrahedra(), sequential.tetrahedra());
     EXPECT_EQ(parallel.neighbors(), sequential.neighbors());
     for (std::uint32_t i = 0; i < p.size(); ++i) EXPECT_EQ(parallel.representative(i), sequential.representative(i));
+    // The documented canonical order: each tetrahedron starts at its smallest
+    // vertex, then the smallest of the other three; strictly ascending.
+    const std::vector<std::uint32_t>& t = sequential.tetrahedra();
+    for (std::size_t k = 0; k < t.size(); k += 4) {
+      ASSERT_LT(t[k], std::min({t[k + 1], t[k + 2], t[k + 3]})) << "tetrahedron " << k / 4;
+      ASSERT_LT(t[k + 1], std::min(t[k + 2], t[k + 3])) << "tetrahedron " << k / 4;
+      if (k > 0) {
+        ASSERT_TRUE(std::lexicographical_compare(&t[k - 4], &t[k], &t[k], &t[k + 4])) << "tetrahedron " << k / 4;
+      }
+    }
   }
 }
 
