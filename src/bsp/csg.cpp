@@ -551,6 +551,12 @@ bool member(CsgOp op, bool a, bool b) {
   return false;
 }
 
+// Snapped point `i` of the plane set in world coordinates (exact: grid points are doubles).
+Vec3d world_point(const PlaneSet& planes, const Grid& grid, std::uint32_t i) {
+  const auto& q = planes.integer_point(i);
+  return grid.to_world({static_cast<double>(q[0]), static_cast<double>(q[1]), static_cast<double>(q[2])});
+}
+
 // One operand snapped: its non-degenerate triangles as polygons, their integer boxes and
 // their corners' point ids (points with equal coordinates share one id).
 struct Operand {
@@ -897,18 +903,13 @@ void local_pieces(PlaneSet& planes, const std::shared_ptr<PlaneSet>& shared, con
       } else if (!whole) {
         // The BSP of y as snapped (flattened parts removed): its points are exact in world coordinates.
         Triangles ym;
-        for (std::uint32_t i = 0; i < planes.point_count(); ++i) {
-          const auto& q = planes.integer_point(i);
-          ym.vertices.push_back(grid.to_world({static_cast<double>(q[0]), static_cast<double>(q[1]), static_cast<double>(q[2])}));
-        }
+        for (std::uint32_t i = 0; i < planes.point_count(); ++i) ym.vertices.push_back(world_point(planes, grid, i));
         ym.triangles = y.corner;
         whole = std::make_unique<BspTree>(shared, grid, ym.vertices, ym.triangles, options);
       }
     }
     if (comp_label[r] == Label::none) {
-      const auto& q = planes.integer_point(x.corner[t][0]);
-      const int s = whole->classify(
-          grid.to_world({static_cast<double>(q[0]), static_cast<double>(q[1]), static_cast<double>(q[2])}));
+      const int s = whole->classify(world_point(planes, grid, x.corner[t][0]));
       if (s == 0) throw Error("csg: a vertex off the other surface classified on it (internal error)");
       comp_label[r] = s < 0 ? Label::inside : Label::outside;
     }
@@ -920,10 +921,7 @@ double operand_volume(const PlaneSet& planes, const Grid& grid, const Operand& o
   double v = 0;
   for (const auto& c : o.corner) {
     Vec3d p[3];
-    for (int k = 0; k < 3; ++k) {
-      const auto& q = planes.integer_point(c[k]);
-      p[k] = grid.to_world({static_cast<double>(q[0]), static_cast<double>(q[1]), static_cast<double>(q[2])});
-    }
+    for (int k = 0; k < 3; ++k) p[k] = world_point(planes, grid, c[k]);
     v += p[0].dot(p[1].cross(p[2]));
   }
   return v / 6;
