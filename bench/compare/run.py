@@ -19,6 +19,9 @@ geods program found there is run too, interleaved with the others, as anchor "<a
 ratio column is then its time / the same program's time now (> 1: faster now), so that a change
 shows before/after ratios measured in one run.
 
+With --report-only, nothing is built or run: the report is rewritten from performance.jsonl and
+performance-runs.json (after merging the results of separate runs, say).
+
 With --only W --update, only W is re-run; the other workloads (and, with --no-micro, the micro
 benchmarks) keep their earlier results from performance.jsonl / performance-runs.json, and each
 section of the report says which run measured it. Ratios are still taken within one run.
@@ -490,7 +493,7 @@ def load_previous(jsonl, comps):
 
 
 def write_report(out, jsonl, cmdline, info, versions, verify, comps, results, status, micro, data_dir,
-                 rounds, reps, threads_list, started, runs, early_problems=()):
+                 rounds, reps, threads_list, started, runs, early_problems=(), rewritten=False):
     L = []
     L.append("# geods performance\n")
     L.append("Written by `bench/compare/run.py` (`make bench`); do not edit by hand. Every ratio is "
@@ -499,11 +502,16 @@ def write_report(out, jsonl, cmdline, info, versions, verify, comps, results, st
              "`bench/compare/gen_workloads.py`).\n")
     L.append(f"Command: `{cmdline}`\n")
     L.append("## Machine and run\n")
-    L.append(f"- Date: {started.strftime('%Y-%m-%d %H:%M %Z').strip()} (run took "
-             f"{(datetime.datetime.now(datetime.timezone.utc) - started).total_seconds() / 60:.1f} min)")
+    if rewritten:
+        L.append(f"- Date: {started.strftime('%Y-%m-%d %H:%M %Z').strip()}: report rewritten from the stored "
+                 "results (`--report-only`), no program run; each section below names the run that measured it")
+    else:
+        L.append(f"- Date: {started.strftime('%Y-%m-%d %H:%M %Z').strip()} (run took "
+                 f"{(datetime.datetime.now(datetime.timezone.utc) - started).total_seconds() / 60:.1f} min)")
     L.append(f"- CPU: {info['cpu']}, {info['cores']} logical cores; memory {info['memory']}")
-    L.append(f"- Load average at start: {info['load'][0]:.2f} / {info['load'][1]:.2f} / {info['load'][2]:.2f} "
-             "(other jobs on the machine disturb the timings)")
+    if not rewritten:
+        L.append(f"- Load average at start: {info['load'][0]:.2f} / {info['load'][1]:.2f} / {info['load'][2]:.2f} "
+                 "(other jobs on the machine disturb the timings)")
     L.append(f"- OS: {info['os']}, kernel {info['kernel']}")
     L.append(f"- Compiler: {info['compiler']}; geods and every comparison program built with `{info['flags']}`")
     L.append(f"- geods: `{info['git']}`")
@@ -595,6 +603,25 @@ def write_report(out, jsonl, cmdline, info, versions, verify, comps, results, st
     return problems_all
 
 
+def rewrite_report(out, jsonl, cmdline, build_dir, data_dir, comps, threads_list, reps):
+    """--report-only: the report again from the stored results, every section from its own run."""
+    started = datetime.datetime.now(datetime.timezone.utc)
+    results, runs = load_previous(jsonl, comps)
+    micro = runs.get("micro_results") or []
+    try:
+        with open(os.path.join(data_dir, "VERIFY.json")) as f:
+            verify = json.load(f)
+    except OSError:
+        verify = {"reference": None}
+    problems = write_report(out, jsonl, cmdline, machine_info(build_dir), anchor_versions(), verify,
+                            [c for c in comps if c["workload"] in results], results, {}, micro,
+                            rel(data_dir) if data_dir.startswith(REPO) else data_dir, None, reps,
+                            threads_list, started, runs, rewritten=True)
+    for p in problems:
+        log("PROBLEM:", p)
+    return 1 if problems else 0
+
+
 # ----------------------------------------------------------------------------- main
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
@@ -615,6 +642,8 @@ def main():
     ap.add_argument("--no-micro", action="store_true", help="skip the Google Benchmark programs")
     ap.add_argument("--before", metavar="DIR[=LABEL]", help="also run the geods programs of an older build "
                     "(its build/compare/bin) as <anchor>@before, interleaved; LABEL names its revision")
+    ap.add_argument("--report-only", action="store_true", help="rewrite the report from the stored "
+                    "results (performance.jsonl, performance-runs.json) without building or running")
     ap.add_argument("--update", action="store_true", help="with --only: keep the other workloads' "
                     "earlier results (and the micro benchmarks with --no-micro) in the report")
     args = ap.parse_args()
@@ -630,6 +659,8 @@ def main():
                     else sorted({1, ncpu}))
 
     all_comps = comps = discover()
+    if args.report_only:
+        return rewrite_report(out, jsonl, cmdline, build_dir, data_dir, all_comps, threads_list, args.reps)
     if args.update and not args.only:
         raise SystemExit("--update needs --only (the workloads to re-run)")
     if args.only:
