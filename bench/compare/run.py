@@ -410,6 +410,41 @@ def tabulate(c, records):
     return "\n".join(lines), summary, labels
 
 
+def speedup_rows(c, records, labels, run):
+    """Rows of the all-cores table: every geods program's time on one thread / on the most threads
+    measured in the same run, per variant and timing metric, beside the peers' same ratio."""
+    times = {}  # (anchor, variant, metric) -> threads -> [time]
+    for r in records:
+        a = str(r.get("anchor"))
+        if a.endswith(BEFORE):
+            continue
+        for m in c["metrics"]:
+            t = r.get(m)
+            if isinstance(t, (int, float)) and t > 0:
+                times.setdefault((a, r.get("variant", ""), m), {}).setdefault(int(r.get("threads", 1)), []).append(t)
+
+    def speedup(key):
+        by = times.get(key, {})
+        most = max(by, default=1)
+        if 1 not in by or most == 1:
+            return None, most
+        return statistics.median(by[1]) / statistics.median(by[most]), most
+    rows = []
+    load = " / ".join(f"{x:.1f}" for x in run["load"]) if run else "?"
+    for (a, v, m) in times:
+        if not a.startswith("geods"):
+            continue
+        s, most = speedup((a, v, m))
+        if s is None:
+            continue
+        peers = [f"{labels.get(b, b)} {ps:.2f}" for b in labels if not b.startswith("geods")
+                 for ps, _ in [speedup((b, v, m))] if ps]
+        mark = f"**{s:.2f}**" if s >= 1.6 else f"{s:.2f} (< 1.6)"
+        rows.append(f"| {c['workload']} | {md_escape(labels.get(a, a))} | `{v}` | {m} | {most} | {mark} | "
+                    f"{md_escape(', '.join(peers)) or '–'} | {load} |")
+    return rows
+
+
 def agreement_failures(c, records):
     agree = c.get("agree")
     if not agree:
@@ -542,6 +577,7 @@ def write_report(out, jsonl, cmdline, info, versions, verify, comps, results, st
     L.append("| workload | anchor | threads | geomean ratio |")
     L.append("|---|---|---|---|")
     sections = []
+    all_cores = []
     problems_all = list(early_problems)
     for c in comps:
         recs, raw, problems = results.get(c["workload"], ([], [], []))
@@ -551,6 +587,7 @@ def write_report(out, jsonl, cmdline, info, versions, verify, comps, results, st
                             f"({'; '.join(problems) or 'programs unavailable'}).\n")
             continue
         table, summary, labels = tabulate(c, recs)
+        all_cores += speedup_rows(c, recs, labels, runs.get(c["workload"]))
         for (a, t), g in sorted(summary.items(), key=lambda kv: (kv[0][1], kv[0][0])):
             L.append(f"| {c['workload']} | {labels.get(a, a)} | {t} | **{g:.2f}** |")
         s = [f"## {c['workload']} — {c['title']}\n", c["about"] + "\n"]
@@ -565,6 +602,15 @@ def write_report(out, jsonl, cmdline, info, versions, verify, comps, results, st
         if problems:
             s.append("Problems: " + "; ".join(problems) + "\n")
         sections.append("\n".join(s))
+    L.append("")
+    L.append("## All cores\n")
+    L.append("Speed-up of every geods program measured on one thread and on all threads in the same run: "
+             "time on 1 thread / time on N threads (N = the machine's cores), with the peers' speed-up on the "
+             "same variant for comparison and the load average of that run (a loaded machine cannot show a "
+             "speed-up: compare with the peers' column).\n")
+    L.append("| workload | program | variant | metric | threads | speed-up | peers' speed-up | load |")
+    L.append("|---|---|---|---|---|---|---|---|")
+    L += all_cores
     L.append("")
     if problems_all:
         L.append("**Problems in this run:**\n")
