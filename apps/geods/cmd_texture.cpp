@@ -29,7 +29,7 @@ class TextureCommand : public Command {
                    "Odd side of the window one level coarser (default: neighborhood/2 rounded up to odd)");
     app.add_option("--levels", options_.levels, "Gaussian pyramid levels, 1 to 4 (default: from the sample size)");
     app.add_option("--search", search_, "Nearest-neighborhood search: approx (default), exact or brute");
-    app.add_option("--eps", options_.eps, "approx: matches within (1 + eps) of the nearest (default 8)");
+    app.add_option("--eps", options_.eps, "approx: matches within (1 + eps) of the nearest (default 24)");
     app.add_option("--reduced-dimension", options_.reduced_dimension,
                    "Principal components in the k-d tree (default 8)");
     app.add_option("--refinement-passes,--refine", options_.refinement_passes,

@@ -73,7 +73,7 @@ void run_synthesis(const DemoContext& context, DemoResult& result) {
       "the value of the sample pixel whose neighbourhood is nearest to its own: the causal 9 x 9 window at its "
       "level of a Gaussian pyramid and a 5 x 5 window one level coarser. The nearest-neighbour search is the "
       "project's k-d tree over 8 principal components of the neighbourhoods and the norm of the rest, with the "
-      "(1 + eps) approximate search (eps = 8), full distances at the leaves, and a start from the coherent "
+      "(1 + eps) approximate search (eps = 24, pruning harder as a query's work grows), full distances at the leaves, and a start from the coherent "
       "candidate (the patch the neighbours copy, continued). Samples: the 512 x 512 textures of data/ reduced to "
       "128 x 128 by the pyramid.";
 }

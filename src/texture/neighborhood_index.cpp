@@ -23,12 +23,14 @@ constexpr std::size_t kCovarianceSamples = 2048;
 // coordinates, 4 is 10 to 13 % faster than 8 on the bench's samples at the
 // same error (means over seeds 1 to 5 within the spread over seeds).
 constexpr std::size_t kLeafSize = 4;
-// The approximate search's tight start (see the header): a query prunes with
+// The approximate search's schedule (see the header): a query prunes with
 // eps / kTightEpsDivisor until it has computed count / kTightShare - kTightBase
-// full distances (nothing below 4096 candidates), then with eps.
-constexpr double kTightEpsDivisor = 4;
+// full distances (the tight start: nothing below 4096 candidates), then with
+// eps / kStartEpsDivisor for kStartDistances more, then with eps.
+constexpr double kTightEpsDivisor = 12;
 constexpr std::size_t kTightShare = 256;
 constexpr std::size_t kTightBase = 16;
+constexpr double kStartEpsDivisor = 3;
 
 }  // namespace
 
@@ -231,21 +233,30 @@ NeighborhoodIndex::Match NeighborhoodIndex::nearest(const std::uint8_t* query, N
   // rounding can never prune a candidate as near as the best, and the
   // (1 + eps) guarantee holds.
   //
-  // The tight start of the approximate search: the tree prunes a subtree when
-  // its bound exceeds worst() / (1 + eps)^2, so while the query is within its
-  // budget worst() is the best bound times ((1 + eps) / (1 + tight))^2, which
-  // makes that bound / (1 + tight)^2; insert() then filters the leaf points by
-  // the best bound itself (a point beyond it cannot be nearer).
+  // The approximate search's schedule: the tree is searched with eps' = eps / 3
+  // and prunes a subtree when its bound exceeds worst() / (1 + eps')^2, and
+  // worst() is the best bound times ((1 + eps') / (1 + e))^2, which makes that
+  // bound / (1 + e)^2, with e = eps / 12 during the tight start, eps' for the
+  // next kStartDistances full distances, eps from then on. In the tight start
+  // and the next distances worst() >= bound and insert() filters the leaf
+  // points by the best bound itself (a point beyond it cannot be nearer); after
+  // them the leaves' limit worst() skips points whose bound exceeds the best's
+  // ((1 + eps') / (1 + eps))^2 >= 1 / (1 + eps)^2 times: none of them is nearer
+  // than the best / (1 + eps), so the (1 + eps) guarantee holds.
   struct Refine {
     const NeighborhoodIndex& index;
     const std::uint8_t* query;
     std::size_t& evaluations;
     std::size_t tight_until;  // evaluations at which the tight start ends
-    float widen;              // ((1 + eps) / (1 + tight))^2, or 1
+    std::size_t start_until;  // evaluations at which the search relaxes to eps
+    float widen;              // ((1 + eps') / (1 + eps / 12))^2, or 1
+    float relax;              // ((1 + eps') / (1 + eps))^2, or 1
     Match best;
     float bound = std::numeric_limits<float>::infinity();
     bool full() const { return best.candidate != std::numeric_limits<std::uint32_t>::max(); }
-    float worst() const { return evaluations < tight_until ? bound * widen : bound; }
+    float worst() const {
+      return evaluations < tight_until ? bound * widen : evaluations < start_until ? bound : bound * relax;
+    }
     void insert(std::uint32_t i, float tree_distance) {
       if (tree_distance > bound) return;
       ++evaluations;
@@ -259,19 +270,23 @@ NeighborhoodIndex::Match NeighborhoodIndex::nearest(const std::uint8_t* query, N
     }
   };
   const std::size_t budget = tight_budget();
-  const double tight = eps / kTightEpsDivisor;
+  const double tight = eps / kTightEpsDivisor, middle = eps / kStartEpsDivisor;
   const bool tight_start = search == NeighborSearch::approx && budget > 0 && eps > 0;
+  const std::size_t tight_until = tight_start ? scratch.full_distances + budget : 0;
+  auto squared = [](double x) { return float(x * x); };
   Refine refine{*this,
                 query,
                 scratch.full_distances,
-                tight_start ? scratch.full_distances + budget : 0,
-                tight_start ? float(((1 + eps) / (1 + tight)) * ((1 + eps) / (1 + tight))) : 1.0f,
+                tight_until,
+                std::max(tight_until, scratch.full_distances) + kStartDistances,
+                tight_start ? squared((1 + middle) / (1 + tight)) : 1.0f,
+                squared((1 + middle) / (1 + eps)),
                 {}};
   if (start.candidate < count_) refine.set(start.candidate, start.squared_distance);
   if (fixed_tree_)
-    fixed_tree_->search_nearest(scratch.projected.data(), refine, eps);
+    fixed_tree_->search_nearest(scratch.projected.data(), refine, middle);
   else
-    tree_->search_nearest(scratch.projected.data(), refine, eps);
+    tree_->search_nearest(scratch.projected.data(), refine, middle);
   return refine.best;
 }
 

@@ -18,16 +18,19 @@
 // - approx: the same descent with the k-d tree's (1 + eps) pruning: a subtree
 //   is skipped when its projected lower bound exceeds best / (1 + eps), so the
 //   distance found is within (1 + eps) of the nearest, in the full space.
-//   Its eps adapts per query ("tight start"): the descent prunes with the
-//   smaller eps / 4 until the query has computed tight_budget() full
-//   distances, a share of a brute-force scan that grows with the candidates
-//   (1/256 of them, less the 16 a (1 + eps) search takes anyway: none up to
-//   4096 candidates), and with eps from then on. A query that finishes within
-//   its budget is within (1 + eps / 4) of the nearest; every query within
-//   (1 + eps). Where brute force is cheap the search stays as fast as it can;
-//   where it is dear, part of the saving buys nearer matches, which matter
-//   because synthesis compounds them: a match a few per cent worse makes the
-//   next pixels' neighbourhoods worse too (docs/texture.md).
+//   Its eps grows with the query's work (a schedule): the descent prunes with
+//   eps / 12 until the query has computed tight_budget() full distances (the
+//   "tight start"), a share of a brute-force scan that grows with the
+//   candidates (1/256 of them, less 16: none up to 4096 candidates), then
+//   with eps / 3 for kStartDistances more, and with eps from then on. A query
+//   that finishes within its budget is within (1 + eps / 12) of the nearest,
+//   one that finishes within kStartDistances more within (1 + eps / 3), every
+//   query within (1 + eps). The first full distances find a near match, and
+//   the rest of the descent, which on noise-like samples visits many leaves
+//   for little gain, is pruned harder. Where brute force is dear, part of the
+//   saving buys nearer matches, which matter because synthesis compounds
+//   them: a match a few per cent worse makes the next pixels' neighbourhoods
+//   worse too (docs/texture.md).
 //   Few principal components make the tree shallow and the bound loose (more
 //   full distances); many make the tree slow in high dimension. This is the
 //   role of Wei and Levoy's PCA-reduced tree-structured vector quantization,
@@ -92,8 +95,10 @@ class NeighborhoodIndex {
   const std::uint8_t* candidate(std::size_t i) const { return vectors_.data() + i * dim_; }
   NeighborhoodIndexStats stats() const;
 
-  /// Full distances an approximate query computes with eps / 4 before it relaxes to eps (see above).
+  /// Full distances an approximate query computes with eps / 12 before it relaxes to eps / 3 (see above).
   std::size_t tight_budget() const;
+  /// Full distances an approximate query computes with eps / 3, after its tight budget, before it relaxes to eps.
+  static constexpr std::size_t kStartDistances = 8;
 
   /// The exact squared distance of a query to candidate i.
   std::uint32_t squared_distance(const std::uint8_t* query, std::size_t i) const;

@@ -44,7 +44,7 @@ struct SynthesisOptions {
   std::size_t parent_neighborhood = 0;  // odd window side one level coarser; 0: n/2 rounded up to odd (5 for 9)
   std::size_t levels = 0;               // pyramid levels; 0: as many as the sample allows, at most 4
   NeighborSearch search = NeighborSearch::approx;
-  double eps = 8;                       // approx: distances within (1 + eps) of the nearest (docs/texture.md: why 8)
+  double eps = 24;                      // approx: distances within (1 + eps) of the nearest (docs/texture.md: why 24)
   std::size_t reduced_dimension = 0;    // principal components in the k-d tree; 0: 8
   std::size_t refinement_passes = 0;
   std::uint64_t seed = 0;
