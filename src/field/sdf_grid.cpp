@@ -143,22 +143,11 @@ struct Kept {
 // The entries of t within bound2[0][k] of some corner k, appended to `kept`,
 // eight entries at a time; with sets > 1, only those that are also within
 // bound2[j][k] of some corner k for every j < sets.
-// With `reach2` (t being a tile's list, with its corner distances k0..k7):
-// an entry farther than reach2[m] from tile corner m cannot pass (see
-// GridSolver::filter); groups of 8 such entries are skipped unmeasured.
 __attribute__((target_clones("avx2", "default"))) void corner_test(const Packed& t, const std::array<Vec3f, 8>& corners,
                                                                   const std::array<float, 8>* bound2, int sets,
-                                                                  const std::array<float, 8>* reach2,
                                                                   std::vector<Kept>& kept) {
   const I8 size = I8{} + std::int32_t(t.size), lanes = I8{0, 1, 2, 3, 4, 5, 6, 7};
   for (std::size_t i = 0; i < t.size; i += 8) {
-    if (reach2) {
-      I8 near = I8{} - 1;
-      for (int m = 0; m < 8; ++m) near &= load8(t.f[Packed::k0 + m].data() + i) <= (*reach2)[m];
-      bool any = false;
-      for (int l = 0; l < 8; ++l) any |= near[l] != 0;
-      if (!any) continue;
-    }
     V8 d[8];
     I8 pass = I8{};
     for (int k = 0; k < 8; ++k) {
@@ -180,6 +169,60 @@ __attribute__((target_clones("avx2", "default"))) void corner_test(const Packed&
     }
   }
 }
+
+// The corners of a tile's blocks as a lattice of the tile's box: along
+// each axis two positions per block (its first and last samples), their
+// trilinear weights in the tile, and at each lattice point the spread of
+// the tile's corners about it (rounded up, plus the rounding slack); with
+// each block's corners as lattice indices and its squared distance bounds.
+struct Lattice {
+  std::array<int, 3> n{};                    // positions along each axis (2 per block)
+  std::array<std::array<float, 4>, 3> w{};   // their weights
+  std::array<float, 64> spread{};            // at lattice point ix + 4 (iy + 4 iz)
+  std::size_t blocks = 0;
+  std::array<std::array<int, 8>, kBlocks> corner{};
+  std::array<std::array<float, 8>, kBlocks> bound2{};
+};
+
+// For every entry of t (a tile's list, with its squared distances from the
+// tile's corners k0..k7), the blocks where it may pass the corner test:
+// by the concavity of dist^2(p, f) - |p|^2, dist^2(c, f) at a block corner
+// c is at least the trilinear interpolation of the tile-corner values less
+// the spread, so an entry whose bound exceeds the block's bound2 at each of
+// the block's corners fails the test there and is not listed. One pass over
+// t serves all the blocks (the interpolation is shared along the lattice's
+// rows); out[b] receives the indices of block b's survivors, in order.
+__attribute__((target_clones("avx2", "default"))) void lattice_filter(const Packed& t, const Lattice& lat,
+                                                                     std::array<std::vector<std::uint32_t>, kBlocks>& out) {
+  const I8 size = I8{} + std::int32_t(t.size), lanes = I8{0, 1, 2, 3, 4, 5, 6, 7};
+  const int nx = lat.n[0], ny = lat.n[1], nz = lat.n[2];
+  for (std::size_t b = 0; b < lat.blocks; ++b) out[b].clear();
+  for (std::size_t i = 0; i < t.size; i += 8) {
+    V8 x[4][4], y[2][4][4], lb[64];
+    for (int e = 0; e < 4; ++e) {
+      const V8 lo = load8(t.f[Packed::k0 + 2 * e].data() + i), hi = load8(t.f[Packed::k0 + 2 * e + 1].data() + i);
+      for (int a = 0; a < nx; ++a) x[e][a] = lo + lat.w[0][a] * (hi - lo);
+    }
+    for (int z = 0; z < 2; ++z)
+      for (int b = 0; b < ny; ++b)
+        for (int a = 0; a < nx; ++a) y[z][b][a] = x[2 * z][a] + lat.w[1][b] * (x[2 * z + 1][a] - x[2 * z][a]);
+    for (int c = 0; c < nz; ++c)
+      for (int b = 0; b < ny; ++b)
+        for (int a = 0; a < nx; ++a) {
+          const int l = a + 4 * (b + 4 * c);
+          lb[l] = (y[0][b][a] + lat.w[2][c] * (y[1][b][a] - y[0][b][a])) * (1 - 1e-4f) - lat.spread[l];
+        }
+    const I8 valid = (lanes + std::int32_t(i)) < size;
+    for (std::size_t b = 0; b < lat.blocks; ++b) {
+      I8 pass = I8{};
+      for (int k = 0; k < 8; ++k) pass |= lb[lat.corner[b][k]] <= lat.bound2[b][k];
+      pass &= valid;
+      for (int l = 0; l < 8; ++l)
+        if (pass[l]) out[b].push_back(std::uint32_t(i + std::size_t(l)));
+    }
+  }
+}
+
 
 // The smallest of 8 lanes, in three halving steps.
 // (__builtin_shufflevector: GCC 12 and clang both have it; the fuzz build is clang.)
@@ -265,6 +308,7 @@ struct Scratch {
   Packed tile_list, block_list, near;
   std::vector<Kept> kept;
   std::vector<std::uint32_t> found;
+  std::array<std::vector<std::uint32_t>, kBlocks> survivors;
 };
 
 class GridSolver {
@@ -314,7 +358,7 @@ class GridSolver {
     if (!(centre.distance - box.radius > band_ + margin_)) {
       // Scratch lists of this thread, kept from tile to tile: no allocation or zeroing per tile.
       thread_local Scratch scratch;
-      auto& [tile_list, block_list, near, kept, found] = scratch;
+      auto& [tile_list, block_list, near, kept, found, survivors] = scratch;
       gather(box, centre.closest, tile_list, near, found, kept);
       // Surface points: the closest points of the tile's centre and of the
       // blocks' centres. A face that can be nearest to a sample p of a block is
@@ -340,11 +384,48 @@ class GridSolver {
         block_closest[b] = closest_in(tile_list, block_centre, &centre_in_tile);
         if (block_closest[b].leaf != kNoIndex) anchors[num_anchors++] = block_closest[b].point;
       }
+      // Each block's candidates: the tile's entries that may pass its corner
+      // test by the interpolated bounds, then the exact test on those.
+      Lattice lat;
+      lat.blocks = num_blocks;
+      {
+        const Vec3f extent = box.corners[7] - box.corners[0];
+        std::array<std::array<float, 4>, 3> part{};  // per axis, each position's term of the spread
+        for (int a = 0; a < 3; ++a) {
+          lat.n[a] = int(2 * blocks[a]);
+          for (int m = 0; m < lat.n[a]; ++m) {
+            const std::size_t at = box.lo[a] + kBlock * std::size_t(m / 2) +
+                                   (m % 2 ? std::min(kBlock, box.hi[a] - box.lo[a] - kBlock * std::size_t(m / 2)) - 1 : 0);
+            const float p = grid_.origin[a] + float(at) * grid_.spacing[a];
+            const float w = extent[a] > 0 ? std::clamp((p - box.corners[0][a]) / extent[a], 0.0f, 1.0f) : 0.0f;
+            lat.w[a][m] = w;
+            part[a][m] = extent[a] * extent[a] * w * (1 - w);
+          }
+        }
+        for (int c = 0; c < lat.n[2]; ++c)
+          for (int b = 0; b < lat.n[1]; ++b)
+            for (int a = 0; a < lat.n[0]; ++a)
+              lat.spread[a + 4 * (b + 4 * c)] =
+                  (part[0][a] + part[1][b] + part[2][c]) * (1 + 1e-4f) + margin_ * margin_ + slack_;
+        for (std::size_t b = 0; b < num_blocks; ++b) {
+          const std::array<std::size_t, 3> bc{b % blocks[0], b / blocks[0] % blocks[1], b / (blocks[0] * blocks[1])};
+          const SampleBox block = block_box(b);
+          const Closest& c = block_closest[b];
+          const bool skip = std::sqrt(c.d2) - block.radius > band_ + margin_;
+          lat.bound2[b] = bounds_from(block, c.point);
+          for (int k = 0; k < 8; ++k) {
+            lat.corner[b][k] = int(2 * bc[0] + (k & 1)) + 4 * (int(2 * bc[1] + (k >> 1 & 1)) + 4 * int(2 * bc[2] + (k >> 2 & 1)));
+            if (skip) lat.bound2[b][k] = -kInf;
+          }
+        }
+      }
+      lattice_filter(tile_list, lat, survivors);
       for (std::size_t b = 0; b < num_blocks; ++b) {
         const SampleBox block = block_box(b);
         const Closest& c = block_closest[b];
         if (std::sqrt(c.d2) - block.radius > band_ + margin_) continue;
-        filter(tile_list, block, c.point, block_list, kept, true, &box, std::span(anchors.data(), num_anchors));
+        select(tile_list, survivors[b], near, Packed::k0);
+        filter(near, block, c.point, block_list, kept, true, std::span(anchors.data(), num_anchors));
         std::size_t seed = 0;  // the group of the previous sample's nearest face
         for (std::size_t k = block.lo[2]; k < block.hi[2]; ++k)
           for (std::size_t j = block.lo[1]; j < block.hi[1]; ++j)
@@ -449,16 +530,21 @@ class GridSolver {
               [](float) { return true; });
         },
         mesh_.bvh().volumes());
-    near.clear();
-    near.reserve(found.size());
-    for (int k = 0; k < Packed::kFields; ++k) {
-      const float* in = all_.f[k].data();
-      float* o = near.f[k].data();
-      for (std::size_t j = 0; j < found.size(); ++j) o[j] = in[found[j]];
-    }
-    for (std::size_t j = 0; j < found.size(); ++j) near.face[j] = all_.face[found[j]], near.leaf.push_back(found[j]);
-    near.size = found.size();
+    select(all_, found, near, Packed::k0);
     filter(near, box, q, out, kept, false);
+  }
+
+  // out = the entries `index` of `in` (the first `fields` quantities, faces and leaves).
+  static void select(const Packed& in, std::span<const std::uint32_t> index, Packed& out, int fields) {
+    out.clear();
+    out.reserve(index.size());
+    for (int k = 0; k < fields; ++k) {
+      const float* src = in.f[k].data();
+      float* o = out.f[k].data();
+      for (std::size_t j = 0; j < index.size(); ++j) o[j] = src[index[j]];
+    }
+    for (std::size_t j = 0; j < index.size(); ++j) out.face[j] = in.face[index[j]], out.leaf.push_back(in.leaf[index[j]]);
+    out.size = index.size();
   }
 
   // The entries of `in` that pass the corner test of `box` with the surface
@@ -468,29 +554,13 @@ class GridSolver {
   // the group's faces (by the concavity above: at least the smallest corner
   // distance less the largest spread).
   void filter(const Packed& in, const SampleBox& box, const Vec3f& q, Packed& out, std::vector<Kept>& kept,
-              bool sorted, const SampleBox* tile = nullptr, std::span<const Vec3f> more = {}) const {
+              bool sorted, std::span<const Vec3f> more = {}) const {
     kept.clear();
     std::array<std::array<float, 8>, 2 + kBlocks> sets;
     const int num_sets = 1 + int(std::min<std::size_t>(more.size(), sets.size() - 1));
     sets[0] = bounds_from(box, q);
     for (int j = 1; j < num_sets; ++j) sets[j] = bounds_from(box, more[j - 1]);
-    // Within a tile (`in` has the distances from the tile's corners t_m): an
-    // entry f that passes is within b = min_j max_k sqrt(sets[j][k]) of a
-    // corner c_k, so |f - t_m| <= b + max_k |c_k - t_m| for every m (triangle
-    // inequality).
-    std::array<float, 8> reach2;
-    if (tile) {
-      float b = kInf;
-      for (int j = 0; j < num_sets; ++j)
-        b = std::min(b, std::sqrt(*std::max_element(sets[j].begin(), sets[j].end())));
-      for (int m = 0; m < 8; ++m) {
-        float r = 0;
-        for (int k = 0; k < 8; ++k) r = std::max(r, (box.corners[k] - tile->corners[m]).norm());
-        const float reach = (b + r) * (1 + 1e-4f) + margin_;
-        reach2[m] = reach * reach * (1 + 1e-4f) + slack_;
-      }
-    }
-    corner_test(in, box.corners, sets.data(), num_sets, tile ? &reach2 : nullptr, kept);
+    corner_test(in, box.corners, sets.data(), num_sets, kept);
     if (sorted)
       std::sort(kept.begin(), kept.end(),
                 [](const Kept& a, const Kept& b) { return a.key < b.key || (a.key == b.key && a.index < b.index); });

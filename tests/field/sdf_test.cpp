@@ -105,6 +105,21 @@ TEST(SdfGrid, BunnyEverySampleOfASmallGrid) {
   expect_grid(bunny, grid, {SignMethod::winding, SignMethod::pseudonormal}, true);
 }
 
+TEST(SdfGrid, BunnyEverySampleOfThinGrids) {
+  // Grids one or a few samples thick along some axes: tiles and blocks of
+  // 1 to 3 samples, boxes without extent along an axis (the block lists'
+  // interpolated bounds then rest on coincident corners).
+  const TriMesh bunny = data_mesh("bunny.ply");
+  const Grid3Geometry base = sdf_grid_geometry(bunny.bounds(), 14, 0, 1);
+  for (const std::array<std::size_t, 3> dims : {std::array<std::size_t, 3>{1, 14, 11}, {13, 1, 2}, {3, 6, 1}}) {
+    Grid3Geometry grid = base;
+    grid.dims = dims;
+    for (int a = 0; a < 3; ++a)
+      if (dims[a] < 4) grid.origin[a] += 0.4f * float(base.dims[a]) * grid.spacing[a];  // through the middle
+    expect_grid(bunny, grid, {SignMethod::winding}, true);
+  }
+}
+
 TEST(SdfGrid, BunnyRandomSamplesOfALargerGrid) {
   const TriMesh bunny = data_mesh("bunny.ply");
   const Grid3Geometry grid = sdf_grid_geometry(bunny.bounds(), 56, 0, 4);

@@ -17,6 +17,14 @@
 //   every point of the box and is nobody's closest face there. q is the
 //   closest point to the box's centre: for far boxes the test then passes
 //   only faces within a small fraction of a sample of the true distance.
+// - Block lists: the same concavity bounds a face's squared distance at a
+//   block corner from below by the trilinear interpolation of its distances
+//   from the tile's corners less the spread of those corners about the
+//   block corner; one vectorized pass over the tile's list evaluates these
+//   bounds on the 4^3 lattice of block corners (shared along its rows) and
+//   keeps, for each block, only the faces whose bound passes the block's
+//   corner test, and only those get exact corner distances (on the sdf
+//   workload a third of the tile's list instead of all of it).
 // - Samples (§6.1.1's neighbour start): a sample's search starts from the
 //   group of 8 faces that held its predecessor's closest face (within the
 //   neighbour's distance + the spacing); by the same concavity, dist^2(p, f)
