@@ -214,7 +214,12 @@ std::uint32_t Tet3Mesh::insert_by_flips(std::uint32_t pv) {
   // The flips.
   Quad made[4];
   std::uint32_t gone[4];
+  std::size_t flips_made = 0;
   while (!flip_stack.empty()) {
+    if (flips_made == flip_budget) {  // (tests: leave the rest to the repair below)
+      flip_skipped.insert(flip_skipped.end(), flip_stack.begin(), flip_stack.end());
+      break;
+    }
     const std::uint32_t code = flip_stack.back();
     flip_stack.pop_back();
     const std::uint32_t t0 = code >> 2;
@@ -349,6 +354,7 @@ std::uint32_t Tet3Mesh::insert_by_flips(std::uint32_t pv) {
         }
       }
     }
+    flips_made += done;
     if (!done) {
       ++flip_counts[flip_unflippable];
       flip_skipped.push_back(code);
