@@ -22,8 +22,12 @@
 // With the exact predicates and the symbolic perturbation the flips end at the
 // unique perturbed Delaunay tetrahedralization, the cavity's. Should a link
 // face still be non-Delaunay when the stack is empty (a degenerate
-// configuration the flips cannot untangle), the insertion is finished by the
-// cavity step from the point's star (counted in stats().flip_repairs).
+// configuration the flips cannot untangle: none is known, nor a proof that
+// none exists, as the perturbation does not remove coplanarities), the
+// insertion is finished by the cavity step from the point's star (counted in
+// stats().flip_repairs). That step is right from any state of the flips (the
+// star and its conflicting neighbours are the old cavity); the tests reach it
+// by stopping the flips early (flip_budget).
 #include <algorithm>
 
 #include "delaunay3_mesh.hpp"
