@@ -31,25 +31,6 @@ bool collinear(const Vec3d& a, const Vec3d& b, const Vec3d& c) {
   return true;
 }
 
-// kEdgeFrom[f][j]: the face opposite index j of a tetrahedron whose index f
-// is the new point holds it and an edge, here its two indices in the order
-// they follow f counter-clockwise seen from j's side (Tet3Mesh::face_towards):
-// the tetrahedron across that face holds the same edge the other way round.
-struct EdgeFrom {
-  std::uint8_t at[4][4][2] = {};
-  constexpr EdgeFrom() {
-    for (int f = 0; f < 4; ++f)
-      for (int j = 0; j < 4; ++j) {
-        if (j == f) continue;
-        const int face[3] = {(j + 1) % 4, j % 2 == 0 ? (j + 3) % 4 : (j + 2) % 4, j % 2 == 0 ? (j + 2) % 4 : (j + 3) % 4};
-        const int k = face[0] == f ? 0 : face[1] == f ? 1 : 2;
-        at[f][j][0] = std::uint8_t(face[(k + 1) % 3]);
-        at[f][j][1] = std::uint8_t(face[(k + 2) % 3]);
-      }
-  }
-};
-constexpr EdgeFrom kEdgeFrom;
-
 std::string tet_name(std::uint32_t t) { return "tetrahedron slot " + std::to_string(t); }
 
 }  // namespace
@@ -190,11 +171,13 @@ std::uint32_t Tet3Mesh::insert(std::uint32_t pv) {
       }
     }
   // The cavity: the tetrahedra in conflict with p, depth first from t. Raw
-  // pointers: nothing below grows the arrays until the new tetrahedra.
+  // pointers: nothing below grows the arrays until the new tetrahedra. A
+  // cavity slot's mark is `in` with the bits of its faces on the cavity's
+  // boundary (set once all four are tested).
   const Vec3d* C = coords.data();
   std::uint32_t* T = tets.data();
   std::uint8_t* M = mark.data();
-  constexpr std::uint8_t in = 1, out = 2;
+  constexpr std::uint8_t in = 0x10, out = 2;
   stack.clear();
   cavity.clear();
   boundary.clear();
@@ -209,10 +192,11 @@ std::uint32_t Tet3Mesh::insert(std::uint32_t pv) {
       __builtin_prefetch(&T[8 * std::size_t(adjacent[f] >> 2)]);
       __builtin_prefetch(&M[adjacent[f] >> 2]);
     }
+    std::uint8_t faces = 0;
     for (std::uint32_t f = 0; f < 4; ++f) {
       const std::uint32_t a = adjacent[f], n = a >> 2;
       const std::uint8_t m = M[n];
-      if (m == in) continue;
+      if (m & in) continue;
       if (m != out) {
         if (conflict(C, T, n, p)) {
           M[n] = in;
@@ -226,68 +210,65 @@ std::uint32_t Tet3Mesh::insert(std::uint32_t pv) {
       b.v[f] = pv;
       b.face = f;
       b.outer = a;
+      b.cell = c;
+      std::fill_n(b.adjacent, 4, kNone);
+      faces |= std::uint8_t(1u << f);
     }
+    M[c] = in | faces;
   }
-  // Marks back to untested: the cavity's slots and the tetrahedra tested around it.
-  for (const std::uint32_t c : cavity) M[c] = 0;
-  for (const Boundary& b : boundary) M[b.outer >> 2] = 0;
   conflicts += cavity.size();
   // The new tetrahedra: each boundary face joined to p, in the cavity's slots first.
   if (boundary.size() > cavity.size()) {
     const std::size_t more = boundary.size() - cavity.size();
     for (std::size_t k = 0; k < more; ++k) cavity.push_back(new_slot());
     T = tets.data();
+    M = mark.data();
   }
-  // Each new tetrahedron's three faces through p are matched by their directed
-  // edges: all stored first, then each looks its twin up (see EdgeTable).
-  edges.begin(3 * boundary.size());
-  EdgeTable::Entry* E = edges.entries.data();
-  const std::size_t mask = edges.mask;
-  const std::uint32_t stamp = edges.stamp;
+  // New tetrahedron i (cavity slot c with p for its vertex f) has three faces
+  // through p, each with an edge of c's; its neighbour across the one opposite
+  // j is found by turning about that edge from c's face j through the cavity
+  // until a boundary face: the new tetrahedron made from that face. The cavity
+  // slots' boundary faces point to their new tetrahedra meanwhile (no hashing:
+  // the old tetrahedra are the map), and each pair is linked from both sides at once.
+  for (std::size_t i = 0; i < boundary.size(); ++i) {
+    const Boundary& b = boundary[i];
+    T[8 * std::size_t(b.cell) + 4 + b.face] = std::uint32_t(i);
+  }
+  for (std::size_t i = 0; i < boundary.size(); ++i) {
+    Boundary& b = boundary[i];
+    for (std::uint32_t j = 0; j < 4; ++j) {
+      if (j == b.face || b.adjacent[j] != kNone) continue;
+      std::uint32_t cell = b.cell, from = b.face, across = j;  // the faces of `cell` about the edge
+      while (!(M[cell] >> across & 1)) {
+        const std::uint32_t a = T[8 * std::size_t(cell) + 4 + across];
+        const std::uint32_t x = T[8 * std::size_t(cell) + from];  // on the face crossed, off the edge
+        cell = a >> 2;
+        from = a & 3;
+        const std::uint32_t* w = &T[8 * std::size_t(cell)];
+        across = std::uint32_t(w[1] == x) | std::uint32_t(w[2] == x) << 1 | std::uint32_t(w[3] == x) * 3;
+      }
+      const std::uint32_t k = T[8 * std::size_t(cell) + 4 + across];
+      b.adjacent[j] = 4 * cavity[k] + from;
+      boundary[k].adjacent[from] = 4 * cavity[i] + j;
+    }
+  }
   std::uint32_t newest = kNone;
   for (std::size_t i = 0; i < boundary.size(); ++i) {
     const Boundary& b = boundary[i];
     const std::uint32_t s = cavity[i];
     std::uint32_t* w = &T[8 * std::size_t(s)];
     std::copy_n(b.v, 4, w);
+    std::copy_n(b.adjacent, 4, w + 4);
     w[4 + b.face] = b.outer;
     T[entry(b.outer)] = 4 * s + b.face;
-    for (std::uint32_t j = 0; j < 4; ++j) {
-      if (j == b.face) continue;
-      const std::uint64_t key = std::uint64_t(b.v[kEdgeFrom.at[b.face][j][0]]) << 32 | b.v[kEdgeFrom.at[b.face][j][1]];
-      std::size_t h = EdgeTable::hash(key) & mask;
-      while (E[h].stamp == stamp) h = (h + 1) & mask;
-      E[h] = {key, 4 * s + j, stamp};
-    }
     if (newest == kNone || ((b.v[0] | b.v[1] | b.v[2] | b.v[3]) & kGhostBit) == 0) newest = s;
   }
-  for (std::size_t i = 0; i < boundary.size(); ++i) {
-    const Boundary& b = boundary[i];
-    std::uint32_t* w = &T[8 * std::size_t(cavity[i])];
-    for (std::uint32_t j = 0; j < 4; ++j) {
-      if (j == b.face) continue;
-      const std::uint64_t twin = std::uint64_t(b.v[kEdgeFrom.at[b.face][j][1]]) << 32 | b.v[kEdgeFrom.at[b.face][j][0]];
-      std::size_t h = EdgeTable::hash(twin) & mask;
-      // There, before an empty entry: the cavity's boundary is a closed surface.
-      for (; E[h].key != twin || E[h].stamp != stamp; h = (h + 1) & mask)
-        if (E[h].stamp != stamp) throw Error("Delaunay3: internal error, a cavity face without a neighbour");
-      w[4 + j] = E[h].value;
-    }
-  }
+  // Marks back to untested: the cavity's slots and the tetrahedra tested around it.
+  for (const std::uint32_t c : cavity) M[c] = 0;
+  for (const Boundary& b : boundary) M[b.outer >> 2] = 0;
   for (std::size_t i = boundary.size(); i < cavity.size(); ++i) free_slot(cavity[i]);
   last = newest;
   return kNone;
-}
-
-void Tet3Mesh::EdgeTable::begin(std::size_t edges) {
-  std::size_t want = 64;
-  while (want < 2 * edges) want *= 2;
-  if (want > entries.size()) entries.assign(want, Entry{});
-  mask = want - 1;
-  if (++stamp == 0) {  // wrapped: forget every old stamp
-    for (Entry& e : entries) e.stamp = 0;
-    stamp = 1;
-  }
 }
 
 // ------------------------------------------------------------------ Delaunay3

@@ -30,7 +30,7 @@ struct Tet3Mesh {
   std::vector<Vec3d>& coords;
   std::vector<std::uint32_t>& tets;
   std::vector<std::uint32_t>& free_slots;
-  std::vector<std::uint8_t> mark;  // per slot, during an insertion: 1 in the cavity, 2 tested and not; else 0
+  std::vector<std::uint8_t> mark;  // per slot, during an insertion: in the cavity (0x10 | its boundary faces, or 1 in the flips), 2 tested and not; else 0
   std::uint32_t last = 0;  // where the next walk starts
   std::uint32_t random = 2463534242u;
   std::size_t walk_steps = 0, conflicts = 0;
@@ -102,36 +102,23 @@ struct Tet3Mesh {
 
   struct Boundary {
     std::uint32_t v[4];  // the new tetrahedron: the cavity one with p in place of the vertex facing out
+    std::uint32_t adjacent[4];  // its adjacencies (kNone until linked)
     std::uint32_t face;  // its face on the cavity's boundary
     std::uint32_t outer;  // the adjacency across it
-  };
-  /// The faces of the new tetrahedra around p, matched by their edge opposite
-  /// p. Directed: the face of new tetrahedron s opposite its vertex j holds p
-  /// and an edge u -> w (its order seen from s's side); the neighbour across
-  /// it holds the same edge as w -> u. All faces are stored first, then each
-  /// looks its twin up, so that no branch depends on which of two faces comes
-  /// first (a coin toss the branch predictor loses).
-  struct EdgeTable {
-    struct Entry {
-      std::uint64_t key = 0;
-      std::uint32_t value = 0, stamp = 0;  // stamp == the table's: occupied
-    };
-    std::vector<Entry> entries;
-    std::size_t mask = 0;
-    std::uint32_t stamp = 0;
-    /// Empties the table for `edges` directed edges (load at most 1/2).
-    void begin(std::size_t edges);
-    static std::size_t hash(std::uint64_t key) { return std::size_t((key * 0x9E3779B97F4A7C15ull) >> 40); }
+    std::uint32_t cell;  // the cavity slot it is made from
   };
   std::vector<std::uint32_t> stack, cavity;
   std::vector<Boundary> boundary;
-  EdgeTable edges;
 
   // Flip-based insertion (delaunay3_flip.cpp): insert() defers to
   // insert_by_flips() when `flips` is set; same answer, same tetrahedralization.
   enum FlipCount { flip_14, flip_23, flip_32, flip_44, flip_split, flip_hull, flip_unflippable, flip_repair };
   bool flips = false;
   std::array<std::size_t, 8> flip_counts{};
+  /// Flips per insertion after which the rest of the stack is left to the
+  /// repair step (a cavity step from the star, as if the flips were stuck):
+  /// unlimited in Delaunay3; tests lower it to exercise the repair.
+  std::size_t flip_budget = std::size_t(-1);
   std::uint32_t insert_by_flips(std::uint32_t pv);
   std::vector<std::uint32_t> flip_stack, flip_skipped;
   struct FaceKey {

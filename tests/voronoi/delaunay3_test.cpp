@@ -18,6 +18,7 @@
 #include "geods/core/parallel.hpp"
 #include "geods/core/rng.hpp"
 #include "geods/voronoi/delaunay3.hpp"
+#include "../../src/voronoi/delaunay3_mesh.hpp"
 
 namespace geods::voronoi {
 namespace {
@@ -513,6 +514,65 @@ TEST(Delaunay3, FlipInsertionEqualsTheCavityInsertionOnEveryShape) {
       }
     }
   set_num_threads(threads);
+}
+
+// The flip insertion's repair step (a cavity step from the new point's star
+// when a link face is still not Delaunay after the flips): never needed on the
+// shapes above, so reached here by stopping the flips early, after `budget`
+// flips per insertion (0: the 1-4 split or hull join only). From any such
+// state the tetrahedra without the point are tetrahedra of the old
+// triangulation, the star of the point covers only tetrahedra in conflict
+// with it, and the repair must end at the same tetrahedralization as the
+// cavity insertion (compared as sets of oriented tetrahedra).
+TEST(Delaunay3, FlipRepairFinishesFromAnyStateOfTheFlips) {
+  for (Shape shape : {Shape::uniform, Shape::sphere, Shape::lattice, Shape::coplanar})
+    for (std::size_t budget : {0, 1, 3}) {
+      SCOPED_TRACE("shape " + std::to_string(int(shape)) + " budget " + std::to_string(budget));
+      const auto p = make_points(shape, 200, 5);
+      const Delaunay3 cavity(p);
+      // The points in an order whose first four span a solid, inserted one by one.
+      std::vector<Vec3d> coords(p.begin(), p.end());
+      for (std::size_t k = 3; k < coords.size() && orient3d(coords[0], coords[1], coords[2], coords[3]) == 0; ++k)
+        std::swap(coords[3], coords[k]);
+      for (std::size_t k = 2; k < coords.size() && orient3d(coords[0], coords[1], coords[2], coords[3]) == 0; ++k)
+        std::swap(coords[2], coords[k]);
+      ASSERT_NE(orient3d(coords[0], coords[1], coords[2], coords[3]), 0);
+      std::vector<std::uint32_t> tets, free_slots;
+      Tet3Mesh mesh(coords, tets, free_slots);
+      mesh.flips = true;
+      mesh.flip_budget = budget;
+      mesh.make_first(0, 1, 2, 3);
+      std::size_t merged = 0;
+      for (std::uint32_t k = 4; k < coords.size(); ++k) merged += mesh.insert(k) != Tet3Mesh::kNone;
+      EXPECT_EQ(merged, cavity.duplicate_count());
+      EXPECT_GT(mesh.flip_counts[Tet3Mesh::flip_repair], 0u);
+      // Both as sets of tetrahedra over coordinates, each rotated to an even
+      // permutation starting at its lexicographically smallest corner.
+      using Tet = std::array<std::array<double, 3>, 4>;
+      const auto canonical = [](std::array<Vec3d, 4> v) {
+        const auto key = [](const Vec3d& a) { return std::array<double, 3>{a[0], a[1], a[2]}; };
+        const int m = int(std::min_element(v.begin(), v.end(), [&](const Vec3d& a, const Vec3d& b) { return key(a) < key(b); }) - v.begin());
+        static constexpr int kEven[4][4] = {{0, 1, 2, 3}, {1, 0, 3, 2}, {2, 3, 0, 1}, {3, 2, 1, 0}};
+        Tet t;
+        for (int i = 0; i < 4; ++i) t[i] = key(v[kEven[m][i]]);
+        // the three after the first: rotate so that the smallest is second (a rotation is even)
+        const int r = int(std::min_element(t.begin() + 1, t.end()) - t.begin()) - 1;
+        std::rotate(t.begin() + 1, t.begin() + 1 + r, t.end());
+        return t;
+      };
+      std::set<Tet> by_flips, by_cavity;
+      for (std::size_t s = 0; s < tets.size() / 8; ++s) {
+        const std::uint32_t* v = &tets[8 * s];
+        if (((v[0] | v[1] | v[2] | v[3]) & Tet3Mesh::kGhostBit) != 0) continue;
+        ASSERT_GT(Tet3Mesh::orient(coords[v[0]], coords[v[1]], coords[v[2]], coords[v[3]]), 0);
+        by_flips.insert(canonical({coords[v[0]], coords[v[1]], coords[v[2]], coords[v[3]]}));
+      }
+      const auto& t = cavity.tetrahedra();
+      for (std::size_t k = 0; k < t.size(); k += 4)
+        by_cavity.insert(canonical({p[t[k]], p[t[k + 1]], p[t[k + 2]], p[t[k + 3]]}));
+      EXPECT_EQ(by_flips.size(), cavity.tetrahedron_count());
+      EXPECT_TRUE(by_flips == by_cavity);
+    }
 }
 
 // Single-point insert() by flips, and the parallel build's halves and seam by flips.
