@@ -505,8 +505,14 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray, 
     }
     return true;
   };
-  traverse<W, true>(WideEntry{0, 0, tmin}, stack, [](const WideEntry& e) { return e.count != 0; }, children, child, leaf,
-                    [&](const WideEntry& e) GEODS_BVH_INLINE_LAMBDA { return may_hit_before(e.key, tmax); });
+  const auto is_leaf = [](const WideEntry& e) GEODS_BVH_INLINE_LAMBDA { return e.count != 0; };
+  const auto still_needed = [&](const WideEntry& e) GEODS_BVH_INLINE_LAMBDA { return may_hit_before(e.key, tmax); };
+  // Any hit ends the traversal, so the order of the children does not matter.
+  if (any) {
+    traverse<W, false>(WideEntry{0, 0, tmin}, stack, is_leaf, children, child, leaf, still_needed);
+  } else {
+    traverse<W, true>(WideEntry{0, 0, tmin}, stack, is_leaf, children, child, leaf, still_needed);
+  }
   return hit;
 }
 
