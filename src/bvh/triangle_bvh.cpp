@@ -14,6 +14,7 @@
 #endif
 
 #include "geods/bvh/ray_triangle4.hpp"
+#include "geods/bvh/simd_level.hpp"
 #include "geods/bvh/traversal.hpp"
 #include "geods/core/convex_hull3.hpp"
 #include "geods/core/error.hpp"
@@ -390,31 +391,41 @@ inline unsigned lane_bits(Mask m) {
   return bits;
 }
 
-// Whether the CPU runs AVX code, for the ray queries compiled for it too
-// (the build targets plain x86-64 or x86-64-v2). No FMA: AVX code does the
-// same IEEE operations as SSE code, so the results are identical.
-#if defined(__x86_64__) && !defined(__AVX__) && defined(__GNUC__)
-#define GEODS_BVH_AVX_DISPATCH 1
-const bool kCpuHasAvx = [] {
-  __builtin_cpu_init();  // this runs during static initialization
-  return __builtin_cpu_supports("avx") != 0;
-}();
-#endif
-
 }  // namespace
 
-#if defined(GEODS_BVH_AVX_DISPATCH)
+// The traversal compiled once more per instruction set (simd_level.hpp), the
+// whole call tree inlined into it (flatten), and the choice between them at
+// run time. No FMA: these levels do the same IEEE operations as the portable
+// code (this file is compiled with -ffp-contract=off, so that AVX-512's FMA
+// instructions are not used to contract a * b + c), so the hits are identical.
+#if defined(__x86_64__) && defined(__GNUC__)
+#define GEODS_BVH_SIMD_DISPATCH 1
 template <int W>
 __attribute__((target("avx"), flatten)) RayHit TriangleBvh::intersect_wide_avx(const WideNodes<W>& nodes,
                                                                                const Ray3f& ray, bool any) const {
+  return intersect_wide(nodes, ray, any);
+}
+template <int W>
+__attribute__((target("avx2,bmi,bmi2,lzcnt,popcnt"), flatten)) RayHit TriangleBvh::intersect_wide_avx2(
+    const WideNodes<W>& nodes, const Ray3f& ray, bool any) const {
+  return intersect_wide(nodes, ray, any);
+}
+template <int W>
+__attribute__((target("avx512f,avx512vl,avx512bw,avx512dq,avx2,bmi,bmi2,lzcnt,popcnt"), flatten)) RayHit
+TriangleBvh::intersect_wide_avx512(const WideNodes<W>& nodes, const Ray3f& ray, bool any) const {
   return intersect_wide(nodes, ray, any);
 }
 #endif
 
 template <int W>
 RayHit TriangleBvh::intersect_wide_best(const WideNodes<W>& nodes, const Ray3f& ray, bool any) const {
-#if defined(GEODS_BVH_AVX_DISPATCH)
-  if (kCpuHasAvx) return intersect_wide_avx(nodes, ray, any);
+#if defined(GEODS_BVH_SIMD_DISPATCH)
+  switch (simd_level()) {
+    case SimdLevel::avx512: return intersect_wide_avx512(nodes, ray, any);
+    case SimdLevel::avx2: return intersect_wide_avx2(nodes, ray, any);
+    case SimdLevel::avx: return intersect_wide_avx(nodes, ray, any);
+    case SimdLevel::portable: break;
+  }
 #endif
   return intersect_wide(nodes, ray, any);
 }
@@ -441,13 +452,18 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray, 
   vf tmin_v;
   for (int i = 0; i < W; ++i) tmin_v[i] = tmin;
   TraversalStack<WideEntry> stack(traversal_stack_size(depth_, W));
-  // Start fetching what a child needs; the cache misses on nodes and
-  // triangles dominate incoherent rays.
+  // Start fetching what a child needs, every cache line of it (a node: 2 or
+  // 4 lines; a leaf: its groups of 160 bytes, which straddle lines); the cache
+  // misses on nodes and triangles dominate incoherent rays.
   auto prefetch = [&](const WideEntry& e) GEODS_BVH_INLINE_LAMBDA {
-    const char* p = e.count ? reinterpret_cast<const char*>(&groups_[e.child])
-                            : reinterpret_cast<const char*>(&nodes[e.child]);
-    __builtin_prefetch(p);
-    __builtin_prefetch(p + 64);
+    if (e.count == 0) {
+      const char* p = reinterpret_cast<const char*>(&nodes[e.child]);
+      for (std::size_t k = 0; k < sizeof(WideNode<W>); k += 64) __builtin_prefetch(p + k);
+      return;
+    }
+    const std::uintptr_t first = reinterpret_cast<std::uintptr_t>(&groups_[e.child]) & ~std::uintptr_t(63);
+    const std::uintptr_t last = reinterpret_cast<std::uintptr_t>(&groups_[e.child] + e.count) - 1;
+    for (std::uintptr_t p = first; p <= last; p += 64) __builtin_prefetch(reinterpret_cast<const void*>(p));
   };
   // The children whose boxes the ray enters before tmax, all W at once.
   auto children = [&](const WideEntry& e, float* keys) GEODS_BVH_INLINE_LAMBDA {
@@ -489,8 +505,14 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray, 
     }
     return true;
   };
-  traverse<W, true>(WideEntry{0, 0, tmin}, stack, [](const WideEntry& e) { return e.count != 0; }, children, child, leaf,
-                    [&](const WideEntry& e) GEODS_BVH_INLINE_LAMBDA { return may_hit_before(e.key, tmax); });
+  const auto is_leaf = [](const WideEntry& e) GEODS_BVH_INLINE_LAMBDA { return e.count != 0; };
+  const auto still_needed = [&](const WideEntry& e) GEODS_BVH_INLINE_LAMBDA { return may_hit_before(e.key, tmax); };
+  // Any hit ends the traversal, so the order of the children does not matter.
+  if (any) {
+    traverse<W, false>(WideEntry{0, 0, tmin}, stack, is_leaf, children, child, leaf, still_needed);
+  } else {
+    traverse<W, true>(WideEntry{0, 0, tmin}, stack, is_leaf, children, child, leaf, still_needed);
+  }
   return hit;
 }
 

@@ -144,9 +144,14 @@ class TriangleBvh {
   using WideNodes = FlatArray<WideNode<W>>;  // built in huge pages (HugePageAllocator)
   template <int W>
   RayHit intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray, bool any) const;
-  // The same compiled for AVX, and the choice between the two by the CPU.
+  // The same compiled for AVX, AVX2 and AVX-512, and the choice between them
+  // by simd_level() (simd_level.hpp).
   template <int W>
   RayHit intersect_wide_avx(const WideNodes<W>& nodes, const Ray3f& ray, bool any) const;
+  template <int W>
+  RayHit intersect_wide_avx2(const WideNodes<W>& nodes, const Ray3f& ray, bool any) const;
+  template <int W>
+  RayHit intersect_wide_avx512(const WideNodes<W>& nodes, const Ray3f& ray, bool any) const;
   template <int W>
   RayHit intersect_wide_best(const WideNodes<W>& nodes, const Ray3f& ray, bool any) const;
   template <typename BV>
