@@ -12,7 +12,7 @@
 // array and the permutation are FlatArrays: a tree loaded from a file (load())
 // reads them, and its points, in place from the mapped file.
 //
-// Split rule: each node splits its points at the median (std::nth_element) along
+// Split rule: each node splits its points at the median (select_nth) along
 // the axis of widest spread of those points. Median splits bound the depth by
 // ceil(log2(n / leaf_size)) whatever the distribution; the widest-spread axis
 // (rather than cycling axes) keeps cells from becoming slivers on clustered and

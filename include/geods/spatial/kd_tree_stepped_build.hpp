@@ -104,7 +104,7 @@ class KdTreeSteppedBuild {
 
   /// Completes the build if needed and hands the tree over. If no step ran,
   /// the whole build runs at once without pauses: KdTree's own recursion
-  /// (std::nth_element), about three times faster than the steps, the same
+  /// (its median selection), about three times faster than the steps, the same
   /// tree up to the order of points of equal coordinates.
   Result finish() {
     if (!started_) return build_at_once(*state_);
