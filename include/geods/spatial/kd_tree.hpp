@@ -670,7 +670,8 @@ class KdTree {
   // predictor loses) and put the keys below the pivot first; when k lies
   // past them and none were below (the pivot is the least key), a second
   // pass gathers the keys equal to it, so equal keys cost one pass more, not
-  // a quadratic time. Ranges of at most 16 are insertion-sorted.
+  // a quadratic time. Ranges of at most 16 are insertion-sorted; a range
+  // still larger after 64 passes goes to std::nth_element.
   template <typename Item, typename Key>
   static void select_nth(Item* a, std::ptrdiff_t k, std::ptrdiff_t n, const Key& key) {
     std::ptrdiff_t left = 0, right = n;  // k lies in [left, right)
@@ -686,8 +687,11 @@ class KdTree {
       }
       return store;
     };
-    int passes = 0;  // after 64 passes that only cut off keys below the pivot, equal keys are pulled out too
-    while (right - left > 16) {
+    for (int pass = 0; right - left > 16; ++pass) {
+      if (pass == 64) {  // pivots that keep missing (adversarial orders): O(n log n) at worst
+        std::nth_element(a + left, a + k, a + right, [&](const Item& x, const Item& y) { return key(x) < key(y); });
+        return;
+      }
       const std::ptrdiff_t size = right - left;
       T t;
       if (size > 600) {
@@ -707,7 +711,7 @@ class KdTree {
         right = less;
         continue;
       }
-      if (less > left && ++passes < 64) {  // else t is the range's least key: equal keys need a pass of their own
+      if (less > left) {  // else t is the range's least key: equal keys need a pass of their own
         left = less;
         continue;
       }
