@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -211,6 +212,50 @@ TEST(DynamicKdTree, AmortizedDecompositionFollowsTheBinaryRepresentation) {
     for (std::size_t i = 0; i < 12; ++i)
       ASSERT_EQ(i < s.per_level.size() ? s.per_level[i] : 0, (n >> i) & 1) << "n = " << n << ", level " << i;
     tree.validate();
+  }
+}
+
+// A batch (amortized variant) rebuilds only the levels its carry reaches, once:
+// the structures above the highest bit where the slot count changes stay as
+// they are, the levels still follow the binary representation, and the answers
+// are brute force's.
+TEST(DynamicKdTree, AmortizedBatchRebuildsOnlyTheCarriedLevels) {
+  Tree tree;
+  Oracle oracle;
+  Rng rng(17);
+  auto add = [&](std::size_t count) {
+    std::vector<double> coords;
+    for (std::size_t i = 0; i < count; ++i) {
+      const P p = random_point(rng);
+      coords.insert(coords.end(), p.begin(), p.end());
+    }
+    const std::vector<Id> ids = tree.insert(spatial::PointView<double>(coords.data(), count, 2));
+    for (std::size_t i = 0; i < count; ++i) oracle.items[ids[i]] = {coords[2 * i], coords[2 * i + 1]};
+  };
+  for (std::size_t i = 0; i < 700; ++i) add(1);
+  std::vector<Id> gone;
+  for (Id id = 0; id < 700; id += 3) gone.push_back(id), oracle.items.erase(id);
+  tree.remove(gone);  // dead slots travel with their structures
+  for (const std::size_t batch : {2, 5, 37, 64, 1, 300, 129}) {
+    const std::size_t slots = tree.size() + tree.structure().dead(), total = slots + batch;
+    const std::size_t kept = std::size_t(2) << (std::bit_width(slots ^ total) - 1);  // structures this large stay
+    std::vector<const Tree::Block*> before, after;
+    tree.structure().for_each([&](const Tree::Block& b, std::span<const Id>) {
+      if (b.size() >= kept) before.push_back(&b);
+    });
+    add(batch);
+    tree.structure().for_each([&](const Tree::Block& b, std::span<const Id>) {
+      if (b.size() >= kept) after.push_back(&b);
+    });
+    EXPECT_EQ(after, before) << "batch " << batch;
+    const DynamizedStats s = tree.stats().structure;
+    for (std::size_t i = 0; i < 12; ++i)
+      ASSERT_EQ(i < s.per_level.size() ? s.per_level[i] : 0, (total >> i) & 1) << "batch " << batch << ", level " << i;
+    ASSERT_NO_THROW(tree.validate());
+    for (int k = 0; k < 20; ++k) {
+      const P q = random_point(rng);
+      ASSERT_EQ(tree.query(q, 7), oracle.nearest(q, 7));
+    }
   }
 }
 

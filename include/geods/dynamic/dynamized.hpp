@@ -191,7 +191,10 @@ class Dynamized {
   }
 
   /// Inserts items in order; returns their ids. A batch at least as large as
-  /// what is stored is one Build(W, D) over everything (Lemma 10) instead.
+  /// what is stored is one Build(W, D) over everything (Lemma 10) instead;
+  /// in the amortized variant a smaller one rebuilds only the levels its
+  /// carry reaches, once (insert_batch_amortized), and ends with the same
+  /// levels as inserting its items one by one.
   std::vector<Id> insert(std::vector<Item> items) {
     std::vector<Id> ids(items.size());
     if (!items.empty() && items.size() >= size() + dead_) {
@@ -200,6 +203,11 @@ class Dynamized {
       all.insert(all.end(), std::make_move_iterator(items.begin()), std::make_move_iterator(items.end()));
       all_ids.insert(all_ids.end(), ids.begin(), ids.end());
       build_all(std::move(all), std::move(all_ids));
+      return ids;
+    }
+    if (options_.variant == Variant::amortized && items.size() > 1) {
+      for (Id& id : ids) id = next_id_++;
+      insert_batch_amortized(std::move(items), ids);
       return ids;
     }
     for (std::size_t i = 0; i < items.size(); ++i) ids[i] = insert(std::move(items[i]));
@@ -643,6 +651,40 @@ class Dynamized {
     items.push_back(std::move(item));
     ids.push_back(id);
     add(j, make_part(j, build_counted(std::move(items)), std::move(ids)));
+  }
+
+  // A batch of b items at once, as b inserts one by one would end: the slot
+  // count s becomes s + b, whose binary representation keeps the bits above
+  // the highest one where the two differ (level p). So the structures above p
+  // stay, and those at or below it are rebuilt, with the batch, as one
+  // structure per set bit of (s + b) mod 2^(p + 1), largest first. Each item
+  // is built into a structure of its final level once, not once per level it
+  // passes: the levels below log2(b) are not built b times over.
+  void insert_batch_amortized(std::vector<Item> batch, const std::vector<Id>& batch_ids) {
+    const std::size_t slots = size() + dead_, total = slots + batch.size();
+    const std::size_t p = std::size_t(std::bit_width(slots ^ total)) - 1;
+    const std::size_t count = total & ((std::size_t(2) << p) - 1);
+    std::vector<Item> items;
+    std::vector<Id> ids;
+    items.reserve(count);
+    ids.reserve(count);
+    for (std::size_t i = std::min(p + 1, levels_.size()); i-- > 0;) {
+      if (levels_[i].empty()) continue;
+      append(levels_[i].front(), items, &ids);
+      levels_[i].clear();
+    }
+    items.insert(items.end(), std::make_move_iterator(batch.begin()), std::make_move_iterator(batch.end()));
+    ids.insert(ids.end(), batch_ids.begin(), batch_ids.end());
+    std::size_t offset = 0;
+    for (std::size_t i = p + 1; i-- > 0;) {
+      const std::size_t n = std::size_t(1) << i;
+      if (!((count >> i) & 1)) continue;
+      std::vector<Item> chunk(std::make_move_iterator(items.begin() + offset),
+                              std::make_move_iterator(items.begin() + offset + n));
+      add(i, make_part(i, build_counted(std::move(chunk)),
+                       std::vector<Id>(ids.begin() + offset, ids.begin() + offset + n)));
+      offset += n;
+    }
   }
 
   // Theorem 14: advance the builds in progress, add {d} on level 0, start

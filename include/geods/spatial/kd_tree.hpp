@@ -12,7 +12,7 @@
 // array and the permutation are FlatArrays: a tree loaded from a file (load())
 // reads them, and its points, in place from the mapped file.
 //
-// Split rule: each node splits its points at the median (std::nth_element) along
+// Split rule: each node splits its points at the median (select_nth) along
 // the axis of widest spread of those points. Median splits bound the depth by
 // ceil(log2(n / leaf_size)) whatever the distribution; the widest-spread axis
 // (rather than cycling axes) keeps cells from becoming slivers on clustered and
@@ -27,6 +27,9 @@
 // hides its deleted points this way). kd_tree_stepped_build.hpp builds the
 // same tree in pauses.
 #include <tbb/parallel_invoke.h>
+#if defined(__SSE__)
+#include <xmmintrin.h>
+#endif
 
 #include <algorithm>
 #include <array>
@@ -657,6 +660,74 @@ class KdTree {
     return c;
   }
 
+  // Puts into a[k] the item a sorted (by key(item)) sequence a[0, n) would
+  // have there, smaller-or-equal keys before it and larger-or-equal after
+  // (as std::nth_element, about twice as fast on the build's random keys).
+  // The pivot of a large range is selected, recursively, on a part of it
+  // around k (Floyd and Rivest's SELECT), so one pass leaves about n^(2/3)
+  // to look at; a small range takes the median of three. Partitions are
+  // branchless (comparisons against a median are coin flips a branch
+  // predictor loses) and put the keys below the pivot first; when k lies
+  // past them and none were below (the pivot is the least key), a second
+  // pass gathers the keys equal to it, so equal keys cost one pass more, not
+  // a quadratic time. Ranges of at most 16 are insertion-sorted; a range
+  // still larger after 64 passes goes to std::nth_element.
+  template <typename Item, typename Key>
+  static void select_nth(Item* a, std::ptrdiff_t k, std::ptrdiff_t n, const Key& key) {
+    std::ptrdiff_t left = 0, right = n;  // k lies in [left, right)
+    // Moves the items of [begin, end) for which below(key) holds to its front; returns their end.
+    auto partition = [&](std::ptrdiff_t begin, std::ptrdiff_t end, const auto& below) {
+      std::ptrdiff_t store = begin;
+      for (std::ptrdiff_t i = begin; i < end; ++i) {
+        const Item x = a[i];
+        const bool take = below(key(x));
+        a[i] = a[store];
+        a[store] = x;
+        store += take;
+      }
+      return store;
+    };
+    for (int pass = 0; right - left > 16; ++pass) {
+      if (pass == 64) {  // pivots that keep missing (adversarial orders): O(n log n) at worst
+        std::nth_element(a + left, a + k, a + right, [&](const Item& x, const Item& y) { return key(x) < key(y); });
+        return;
+      }
+      const std::ptrdiff_t size = right - left;
+      T t;
+      if (size > 600) {
+        const double z = std::log(double(size)), s = 0.5 * std::exp(2 * z / 3);
+        const double i = double(k - left + 1);
+        const double sd = 0.5 * std::sqrt(z * s * (double(size) - s) / double(size)) * (i < double(size) / 2 ? -1 : 1);
+        const std::ptrdiff_t l = std::max(left, std::ptrdiff_t(double(k) - i * s / double(size) + sd));
+        const std::ptrdiff_t r = std::min(right - 1, std::ptrdiff_t(double(k) + (double(size) - i) * s / double(size) + sd));
+        select_nth(a + l, k - l, r - l + 1, key);
+        t = key(a[k]);
+      } else {
+        const T x = key(a[left]), y = key(a[k]), z = key(a[right - 1]);
+        t = std::max(std::min(x, y), std::min(std::max(x, y), z));
+      }
+      const std::ptrdiff_t less = partition(left, right, [t](T v) { return v < t; });
+      if (k < less) {
+        right = less;
+        continue;
+      }
+      if (less > left) {  // else t is the range's least key: equal keys need a pass of their own
+        left = less;
+        continue;
+      }
+      const std::ptrdiff_t equal = partition(less, right, [t](T v) { return v == t; });
+      if (k < equal) return;  // a[k] == t, smaller keys before, larger after
+      left = equal;
+    }
+    for (std::ptrdiff_t i = left + 1; i < right; ++i) {
+      const Item x = a[i];
+      const T v = key(x);
+      std::ptrdiff_t j = i;
+      for (; j > left && v < key(a[j - 1]); --j) a[j] = a[j - 1];
+      a[j] = x;
+    }
+  }
+
   // Median-split recursion over a sequence of items (point records or point
   // indices) whose coordinates coords(item) returns.
   struct Builder {
@@ -680,8 +751,8 @@ class KdTree {
       if (m <= tree->leaf_size_) return;
       const std::uint32_t axis = widest_axis(lo, hi, dim);
       const std::uint32_t mid = begin + std::uint32_t(m / 2);
-      std::nth_element(items + begin, items + mid, items + end,
-                       [&](const Item& a, const Item& b) { return coords(a)[axis] < coords(b)[axis]; });
+      select_nth(items + begin, std::ptrdiff_t(mid - begin), std::ptrdiff_t(m),
+                 [&](const Item& item) { return coords(item)[axis]; });
       const std::size_t left_count = m / 2;
       const std::uint32_t right = v + 1 + (left_count <= tree->leaf_size_ ? 1 : subtree_nodes.at(left_count));
       node.right = right;
@@ -701,6 +772,43 @@ class KdTree {
 
     template <typename Item, typename Coords>
     void bounds(const Item* items, const Coords& coords, std::uint32_t begin, std::uint32_t end, T* lo, T* hi) const {
+#if defined(__SSE__)
+      if constexpr (std::is_same_v<T, float> && Dim == 3 && sizeof(Item) == 4 * sizeof(float) &&
+                    !std::is_integral_v<Item>) {
+        // A record {x, y, z, index} is one SSE register: min/max of four lanes, the fourth ignored.
+        if (coords(items[begin]) == reinterpret_cast<const T*>(items + begin)) {
+          const float* p = reinterpret_cast<const float*>(items + begin);
+          __m128 l = _mm_loadu_ps(p), h = l;
+          for (std::uint32_t i = begin + 1; i < end; ++i) {
+            const __m128 v = _mm_loadu_ps(reinterpret_cast<const float*>(items + i));
+            l = _mm_min_ps(l, v);
+            h = _mm_max_ps(h, v);
+          }
+          alignas(16) float lv[4], hv[4];
+          _mm_store_ps(lv, l);
+          _mm_store_ps(hv, h);
+          std::copy_n(lv, 3, lo);
+          std::copy_n(hv, 3, hi);
+          return;
+        }
+      }
+#endif
+      if constexpr (Dim != Dynamic) {
+        // In registers: through lo/hi the compiler would store every step (they might alias the items).
+        std::array<T, std::size_t(Dim)> l, h;
+        const T* p = coords(items[begin]);
+        for (int a = 0; a < Dim; ++a) l[a] = h[a] = p[a];
+        for (std::uint32_t i = begin + 1; i < end; ++i) {
+          p = coords(items[i]);
+          for (int a = 0; a < Dim; ++a) {
+            l[a] = std::min(l[a], p[a]);
+            h[a] = std::max(h[a], p[a]);
+          }
+        }
+        std::copy(l.begin(), l.end(), lo);
+        std::copy(h.begin(), h.end(), hi);
+        return;
+      }
       const std::size_t dim = tree->dim();
       const T* p = coords(items[begin]);
       for (std::size_t a = 0; a < dim; ++a) lo[a] = hi[a] = p[a];
