@@ -105,7 +105,10 @@ class GreedyTin {
     const std::uint32_t i = ins_.insert(Vec2d(double(p.x), double(p.y)), near);
     if (i != pts_.size()) throw Error("terrain tin: a sample was inserted twice");
     pts_.push_back(p);
-    if (scan) rescan(ins_.changed());
+    if (!scan) return;
+    // The next insertion likely starts at the queue's top: fetch its triangle while this one is rescanned.
+    if (!queue_.empty()) ins_.prefetch(queue_.top().triangle);
+    rescan(ins_.changed());
   }
   // Scans every triangle.
   void scan_all() {
@@ -122,6 +125,7 @@ class GreedyTin {
     while (!queue_.empty()) {
       const Entry top = queue_.top();
       queue_.pop();
+      if (!queue_.empty()) __builtin_prefetch(&state_[queue_.top().triangle]);  // read next, after this insertion
       const State& s = state_[top.triangle];
       // An entry is stale once its triangle changed: unless the triangle has
       // the same error again (then the entry is as good as the new one).

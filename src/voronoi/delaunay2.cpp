@@ -594,6 +594,14 @@ std::uint32_t Delaunay2::Inserter::insert(const Vec2d& p, std::uint32_t near) {
   return i;
 }
 
+void Delaunay2::Inserter::prefetch(std::uint32_t h) const {
+  const DelaunayCore& core = editor_->core;
+  if (h >= core.vert.size() / 3) return;
+  __builtin_prefetch(&core.twin[3 * h]);
+  for (std::uint32_t e = 3 * h; e < 3 * h + 3; ++e)
+    if (core.vert[e] < core.coords.size()) __builtin_prefetch(&core.coords[core.vert[e]]);
+}
+
 std::uint32_t Delaunay2::Inserter::handle_count() const { return std::uint32_t(editor_->core.vert.size() / 3); }
 
 bool Delaunay2::Inserter::is_triangle(std::uint32_t h) const {

@@ -266,6 +266,9 @@ class Delaunay2::Inserter {
   /// the triangles with the new point as a corner, read while they are in
   /// cache, so that rescanning them costs no lookups.
   std::span<const Triangle> changed() const { return changed_; }
+  /// A hint that a coming insert() starts at triangle h: its arrays and
+  /// corners are fetched into the cache meanwhile (they lie anywhere in memory).
+  void prefetch(std::uint32_t h) const;
   /// One more than the largest handle.
   std::uint32_t handle_count() const;
   /// Whether handle h names a finite triangle now.
