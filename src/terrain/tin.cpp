@@ -3,6 +3,12 @@
 // O(1) expected per point, exact predicates), tiled without cracks.
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <memory>
+#include <new>
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
 #include <limits>
 #include <span>
 #include <string>
@@ -46,6 +52,36 @@ void simplify_segment(const float* z, std::uint64_t w, P2 p, P2 q, double limit,
 // triangles farther than the limit, and an insertion rescans only the
 // triangles it changed. The point's triangle is known (it is that triangle's
 // candidate), so the insertion walks no steps.
+// An allocator that asks for transparent huge pages for large blocks (the
+// queue and the per-triangle state are read at random: with 4 KiB pages
+// nearly every read also misses the TLB; the kernel may leave THP to madvise).
+template <class T>
+struct HugePageAllocator {
+  using value_type = T;
+  HugePageAllocator() = default;
+  template <class U>
+  HugePageAllocator(const HugePageAllocator<U>&) {}
+  T* allocate(std::size_t n) {
+    constexpr std::size_t kHuge = std::size_t(1) << 21;
+    const std::size_t bytes = n * sizeof(T);
+    if (bytes < kHuge) return std::allocator<T>().allocate(n);
+    void* p = std::aligned_alloc(kHuge, (bytes + kHuge - 1) / kHuge * kHuge);
+    if (!p) throw std::bad_alloc();
+#if defined(MADV_HUGEPAGE)
+    madvise(p, (bytes + kHuge - 1) / kHuge * kHuge, MADV_HUGEPAGE);
+#endif
+    return static_cast<T*>(p);
+  }
+  void deallocate(T* p, std::size_t n) {
+    if (n * sizeof(T) < (std::size_t(1) << 21))
+      std::allocator<T>().deallocate(p, n);
+    else
+      std::free(p);
+  }
+  template <class U>
+  bool operator==(const HugePageAllocator<U>&) const { return true; }
+};
+
 // A queue entry: a triangle and its error. 16 bytes.
 struct Entry {
   double error;
@@ -91,7 +127,7 @@ class MaxHeap4 {
   }
 
  private:
-  std::vector<Entry> heap_;
+  std::vector<Entry, HugePageAllocator<Entry>> heap_;
 };
 
 class GreedyTin {
@@ -172,7 +208,7 @@ class GreedyTin {
   double limit_;
   Inserter& ins_;
   std::vector<P2>& pts_;  // per point of the triangulation
-  std::vector<State> state_;
+  std::vector<State, HugePageAllocator<State>> state_;
   MaxHeap4 queue_;
 };
 
@@ -201,6 +237,7 @@ TileTin tile_tin(const float* z, std::uint64_t w, P2 c00, P2 c11, double limit, 
   voronoi::Delaunay2 dt(corners);
   {
     voronoi::Delaunay2::Inserter ins(dt);
+    ins.reserve(std::size_t(c11.x - c00.x + 1) * std::size_t(c11.y - c00.y + 1));  // at most every sample
     GreedyTin g(z, w, limit, ins, tin.pts_);
     for (const P2& p : border) g.insert(p, voronoi::Delaunay2::no_edge, false);
     g.scan_all();

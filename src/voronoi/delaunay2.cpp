@@ -11,6 +11,9 @@
 #include <numeric>
 #include <optional>
 #include <type_traits>
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
 
 #include "brio_order.hpp"
 #include "constrained_delaunay.hpp"
@@ -592,6 +595,36 @@ std::uint32_t Delaunay2::Inserter::insert(const Vec2d& p, std::uint32_t near) {
     changed_.push_back({t, {core.at(core.vert[3 * t]), core.at(core.vert[3 * t + 1]), core.at(core.vert[3 * t + 2])}});
   }
   return i;
+}
+
+namespace {
+
+// Asks for transparent huge pages for the storage of v (a hint; the kernel may
+// be set to use them only where asked).
+template <class T>
+void advise_huge_pages(const std::vector<T>& v) {
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+  constexpr std::uintptr_t kPage = 4096;
+  const auto first = (reinterpret_cast<std::uintptr_t>(v.data()) + kPage - 1) & ~(kPage - 1);
+  const auto last = (reinterpret_cast<std::uintptr_t>(v.data() + v.capacity())) & ~(kPage - 1);
+  if (last - first >= (std::uintptr_t(1) << 21) && last > first)
+    madvise(reinterpret_cast<void*>(first), last - first, MADV_HUGEPAGE);
+#else
+  (void)v;
+#endif
+}
+
+}  // namespace
+
+void Delaunay2::Inserter::reserve(std::size_t more) {
+  Editor& e = *editor_;
+  const std::size_t n = e.points.size() + more, half_edges = 6 * n + 12;  // a closed triangulation: 2n - 2 triangles
+  const auto grow = [](auto& v, std::size_t size) {
+    v.reserve(size);
+    advise_huge_pages(v);
+  };
+  grow(e.points, n), grow(e.rep, n), grow(e.original_of, n), grow(e.internal_of, n);
+  grow(e.core.coords, n), grow(e.core.vertex_edge, n), grow(e.core.vert, half_edges), grow(e.core.twin, half_edges);
 }
 
 void Delaunay2::Inserter::prefetch(std::uint32_t h) const {

@@ -447,6 +447,7 @@ TEST(Delaunay2, InserterAtKnownTriangles) {
   Delaunay2 dt(p);
   {
     Delaunay2::Inserter ins(dt);
+    ins.reserve(300);
     for (int k = 0; k < 300; ++k) {
       const Vec2d q{rng.uniform(0, 1), rng.uniform(0, 1)};
       std::uint32_t holder = kNone;

@@ -266,6 +266,11 @@ class Delaunay2::Inserter {
   /// the triangles with the new point as a corner, read while they are in
   /// cache, so that rescanning them costs no lookups.
   std::span<const Triangle> changed() const { return changed_; }
+  /// Room for `more` points without reallocation, the large arrays on
+  /// transparent huge pages where the system allows (insertions read them at
+  /// random; with 4 KiB pages nearly every read also misses the TLB). The
+  /// memory is only touched as the triangulation grows.
+  void reserve(std::size_t more);
   /// A hint that a coming insert() starts at triangle h: its arrays and
   /// corners are fetched into the cache meanwhile (they lie anywhere in memory).
   void prefetch(std::uint32_t h) const;
