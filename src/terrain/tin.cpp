@@ -237,7 +237,8 @@ TileTin tile_tin(const float* z, std::uint64_t w, P2 c00, P2 c11, double limit, 
   voronoi::Delaunay2 dt(corners);
   {
     voronoi::Delaunay2::Inserter ins(dt);
-    ins.reserve(std::size_t(c11.x - c00.x + 1) * std::size_t(c11.y - c00.y + 1));  // at most every sample
+    // Room for every sample, up to 2^22 (a few hundred MB of address space; larger tiles grow as needed).
+    ins.reserve(std::min(std::size_t(c11.x - c00.x + 1) * std::size_t(c11.y - c00.y + 1), std::size_t(1) << 22));
     GreedyTin g(z, w, limit, ins, tin.pts_);
     for (const P2& p : border) g.insert(p, voronoi::Delaunay2::no_edge, false);
     g.scan_all();
