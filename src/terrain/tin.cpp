@@ -1,21 +1,17 @@
 // Triangulated irregular networks by greedy insertion (Garland & Heckbert) into
-// a Delaunay triangulation, tiled without cracks. The triangulation is a small
-// half-edge structure of its own (as delatin's) rather than voronoi::Delaunay2,
-// whose insert() renumbers its public arrays (O(n) per point, O(n^2) for a TIN):
-// here the point's triangle is known (it is that triangle's candidate), so an
-// insertion is a split and Lawson flips with the exact incircle test, O(1)
-// expected, and only the triangles it changed get new candidates.
+// a Delaunay triangulation (voronoi::Delaunay2, grown through its Inserter:
+// O(1) expected per point, exact predicates), tiled without cracks.
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <queue>
 #include <span>
 #include <string>
 #include <unordered_map>
 
 #include "geods/core/error.hpp"
+#include "geods/core/huge_page_allocator.hpp"
 #include "geods/terrain/terrain.hpp"
-#include "geods/core/predicates.hpp"
+#include "geods/voronoi/delaunay2.hpp"
 #include "triangle_raster.hpp"
 
 namespace geods::terrain {
@@ -46,202 +42,175 @@ void simplify_segment(const float* z, std::uint64_t w, P2 p, P2 q, double limit,
   simplify_segment(z, w, m, q, limit, out);
 }
 
-// A Delaunay triangulation of grid samples with the sample of largest vertical
-// error per triangle, refined by greedy insertion.
-class GreedyTin {
- public:
-  GreedyTin(const float* z, std::uint64_t w, double limit, std::int64_t extent)
-      : z_(z), w_(w), limit_(limit), small_(extent <= (std::int64_t(1) << 14)) {}
+// Greedy insertion into a voronoi::Delaunay2 through its Inserter: each
+// triangle keeps its worst sample (its candidate), the queue holds the
+// triangles farther than the limit, and an insertion rescans only the
+// triangles it changed. The point's triangle is known (it is that triangle's
+// candidate), so the insertion walks no steps.
+// A queue entry: a triangle and its error. 16 bytes.
+struct Entry {
+  double error;
+  std::uint32_t triangle;
+};
 
-  // The rectangle [a, c] (corners ccw from a) as two triangles, then the border
-  // samples `border` inserted on its sides.
-  void start(P2 c00, P2 c10, P2 c11, P2 c01, const std::vector<P2>& border) {
-    const std::uint32_t a = add_point(c00), b = add_point(c10), c = add_point(c11), d = add_point(c01);
-    const std::uint32_t t0 = new_triangle(), t1 = new_triangle();
-    set(t0, a, b, c, kNone, kNone, 3 * t1 + 2);
-    set(t1, c, d, a, kNone, kNone, 3 * t0 + 2);
-    legalize(3 * t0 + 2);
-    for (const P2& p : border) {
-      // Its hull edge: the one it lies on.
-      for (std::uint32_t e = 0; e < tri_.size(); ++e) {
-        if (twin_[e] != kNone) continue;
-        const P2 u = pts_[tri_[e]], v = pts_[tri_[next(e)]];
-        if ((u.x == v.x && p.x == u.x && (p.y - u.y) * (p.y - v.y) < 0) ||
-            (u.y == v.y && p.y == u.y && (p.x - u.x) * (p.x - v.x) < 0)) {
-          insert_on_edge(add_point(p), e);
-          break;
-        }
-      }
+// A 4-ary max-heap of entries by error: the four children of a node share a
+// cache line, so a pop misses half as often as in a binary heap (the queue of
+// a fine TIN holds millions of entries).
+class MaxHeap4 {
+ public:
+  bool empty() const { return heap_.empty(); }
+  const Entry& top() const { return heap_.front(); }
+  void push(const Entry& e) {
+    std::size_t i = heap_.size();
+    heap_.push_back(e);
+    while (i > 0) {
+      const std::size_t parent = (i - 1) / 4;
+      if (!(heap_[parent].error < e.error)) break;
+      heap_[i] = heap_[parent];
+      i = parent;
     }
-    for (std::uint32_t t = 0; t < tri_.size() / 3; ++t) touched_.push_back(t);
-    update_candidates();
+    heap_[i] = e;
+  }
+  void pop() {
+    const Entry last = heap_.back();
+    heap_.pop_back();
+    const std::size_t n = heap_.size();
+    if (n == 0) return;
+    std::size_t i = 0;
+    for (;;) {
+      const std::size_t first = 4 * i + 1;
+      if (first >= n) break;
+      std::size_t best = first;
+      const std::size_t end = std::min(first + 4, n);
+      for (std::size_t c = first + 1; c < end; ++c)
+        if (heap_[best].error < heap_[c].error) best = c;
+      if (!(last.error < heap_[best].error)) break;
+      heap_[i] = heap_[best];
+      i = best;
+    }
+    heap_[i] = last;
   }
 
+ private:
+  std::vector<Entry, HugePageAllocator<Entry>> heap_;
+};
+
+class GreedyTin {
+ public:
+  using Inserter = voronoi::Delaunay2::Inserter;
+  GreedyTin(const float* z, std::uint64_t w, double limit, Inserter& ins, std::vector<P2>& pts)
+      : z_(z), w_(w), limit_(limit), ins_(ins), pts_(pts) {}
+
+  // Inserts a sample, then rescans the triangles it changed (if `scan`).
+  void insert(P2 p, std::uint32_t near = voronoi::Delaunay2::no_edge, bool scan = true) {
+    const std::uint32_t i = ins_.insert(Vec2d(double(p.x), double(p.y)), near);
+    if (i != pts_.size()) throw Error("terrain tin: a sample was inserted twice");
+    pts_.push_back(p);
+    if (!scan) return;
+    // The next insertion likely starts at the queue's top: fetch its triangle while this one is rescanned.
+    if (!queue_.empty()) ins_.prefetch(queue_.top().triangle);
+    rescan(ins_.changed());
+  }
+  // Scans every triangle.
+  void scan_all() {
+    std::vector<Inserter::Triangle> all;
+    for (std::uint32_t h = 0; h < ins_.handle_count(); ++h) {
+      if (!ins_.is_triangle(h)) continue;
+      const auto corners = ins_.triangle(h);
+      all.push_back({h, {ins_.points()[corners[0]], ins_.points()[corners[1]], ins_.points()[corners[2]]}});
+    }
+    rescan(all);
+  }
   // Inserts the worst sample while it is farther than the limit.
   void refine() {
     while (!queue_.empty()) {
       const Entry top = queue_.top();
       queue_.pop();
-      if (top.version != version_[top.triangle]) continue;  // the triangle changed since
-      const std::uint32_t t = top.triangle;
-      const P2 p = candidate_[t];
-      const std::uint32_t p_index = add_point(p);
-      std::uint32_t on_edge = kNone;
-      for (std::uint32_t k = 0; k < 3; ++k) {
-        const std::uint32_t e = 3 * t + k;
-        if (orient(pts_[tri_[e]], pts_[tri_[next(e)]], p) == 0) on_edge = e;
-      }
-      if (on_edge == kNone)
-        insert_inside(p_index, t);
-      else
-        insert_on_edge(p_index, on_edge);
-      update_candidates();
+      if (!queue_.empty()) __builtin_prefetch(&state_[queue_.top().triangle]);  // read next, after this insertion
+      const State& s = state_[top.triangle];
+      // An entry is stale once its triangle changed: unless the triangle has
+      // the same error again (then the entry is as good as the new one).
+      if (top.error != s.error) continue;
+      insert(P2{s.x, s.y}, top.triangle);
     }
   }
-
-  std::vector<P2> pts_;
-  std::vector<std::uint32_t> tri_;  // per half-edge its start vertex; triangle t is half-edges 3t..3t+2 (ccw)
 
  private:
-  static constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
-  struct Entry {  // 16 bytes; the sample is the triangle's candidate_ while the version matches
-    double error;
-    std::uint32_t triangle, version;
-    bool operator<(const Entry& o) const { return error < o.error; }
+  struct State {  // per triangle handle: its worst sample and its error in the queue (-1: none)
+    std::int32_t x = 0, y = 0;
+    double error = -1;
   };
-  static std::uint32_t next(std::uint32_t e) { return e % 3 == 2 ? e - 2 : e + 1; }
-  static std::uint32_t prev(std::uint32_t e) { return e % 3 == 0 ? e + 2 : e - 1; }
-  static std::int64_t orient(P2 a, P2 b, P2 c) {  // exact in integers (|coordinates| < 2^31)
-    return (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
-  }
-  // Whether d is strictly inside the circle through a, b, c (counter-clockwise):
-  // exact in 64-bit integers when the coordinates span at most 2^14 (every term
-  // below 2^62), else core's exact incircle.
-  bool in_circle(P2 a, P2 b, P2 c, P2 d) const {
-    if (!small_) {
-      auto v = [](P2 p) { return Vec2d(double(p.x), double(p.y)); };
-      return incircle(v(a), v(b), v(c), v(d)) > 0;
+
+  void rescan(std::span<const Inserter::Triangle> triangles) {
+    const std::size_t handles = ins_.handle_count();
+    if (state_.size() < handles) state_.resize(std::max(handles, 2 * state_.size()));
+    const auto p2 = [](const Vec2d& v) { return P2{std::int64_t(v[0]), std::int64_t(v[1])}; };
+    // The triangles lie anywhere in the field: ask for their first samples and states ahead.
+    for (const Inserter::Triangle& t : triangles) {
+      __builtin_prefetch(&state_[t.handle]);
+      for (const Vec2d& c : t.corners) __builtin_prefetch(z_ + std::uint64_t(c[1]) * w_ + std::uint64_t(c[0]));
     }
-    const std::int64_t adx = a.x - d.x, ady = a.y - d.y, bdx = b.x - d.x, bdy = b.y - d.y, cdx = c.x - d.x,
-                       cdy = c.y - d.y;
-    const std::int64_t al = adx * adx + ady * ady, bl = bdx * bdx + bdy * bdy, cl = cdx * cdx + cdy * cdy;
-    return al * (bdx * cdy - cdx * bdy) + bl * (cdx * ady - adx * cdy) + cl * (adx * bdy - bdx * ady) > 0;
-  }
-  std::uint32_t add_point(P2 p) {
-    pts_.push_back(p);
-    return std::uint32_t(pts_.size() - 1);
-  }
-  std::uint32_t new_triangle() {
-    tri_.resize(tri_.size() + 3, 0);
-    twin_.resize(twin_.size() + 3, kNone);
-    version_.push_back(0);
-    candidate_.emplace_back();
-    return std::uint32_t(version_.size() - 1);
-  }
-  void link(std::uint32_t a, std::uint32_t b) {
-    twin_[a] = b;
-    if (b != kNone) twin_[b] = a;
-  }
-  // Triangle t := (i0, i1, i2) with the twins of its half-edges.
-  void set(std::uint32_t t, std::uint32_t i0, std::uint32_t i1, std::uint32_t i2, std::uint32_t a, std::uint32_t b,
-           std::uint32_t c) {
-    tri_[3 * t] = i0, tri_[3 * t + 1] = i1, tri_[3 * t + 2] = i2;
-    link(3 * t, a), link(3 * t + 1, b), link(3 * t + 2, c);
-    ++version_[t];
-    touched_.push_back(t);
-  }
-
-  // p strictly inside triangle t = (a, b, c): (a, b, p), (b, c, p), (c, a, p).
-  void insert_inside(std::uint32_t p, std::uint32_t t) {
-    const std::uint32_t a = tri_[3 * t], b = tri_[3 * t + 1], c = tri_[3 * t + 2];
-    const std::uint32_t ha = twin_[3 * t], hb = twin_[3 * t + 1], hc = twin_[3 * t + 2];
-    const std::uint32_t t1 = new_triangle(), t2 = new_triangle();
-    set(t, a, b, p, ha, 3 * t1 + 2, 3 * t2 + 1);
-    set(t1, b, c, p, hb, 3 * t2 + 2, 3 * t + 1);
-    set(t2, c, a, p, hc, 3 * t + 2, 3 * t1 + 1);
-    legalize(3 * t), legalize(3 * t1), legalize(3 * t2);
-  }
-
-  // p on half-edge e = (a -> b) of triangle t = (a, b, c), twin in (b, a, d) if any.
-  void insert_on_edge(std::uint32_t p, std::uint32_t e) {
-    const std::uint32_t t = e / 3, a = tri_[e], b = tri_[next(e)], c = tri_[prev(e)];
-    const std::uint32_t hbc = twin_[next(e)], hca = twin_[prev(e)], f = twin_[e];
-    if (f == kNone) {
-      const std::uint32_t t1 = new_triangle();
-      set(t, b, c, p, hbc, 3 * t1 + 2, kNone);      // (b, c, p)
-      set(t1, c, a, p, hca, kNone, 3 * t + 1);      // (c, a, p)
-      legalize(3 * t), legalize(3 * t1);
-      return;
-    }
-    const std::uint32_t u = f / 3, d = tri_[prev(f)];
-    const std::uint32_t had = twin_[next(f)], hdb = twin_[prev(f)];
-    const std::uint32_t t1 = new_triangle(), u1 = new_triangle();
-    set(t, b, c, p, hbc, 3 * t1 + 2, 3 * u1 + 1);   // (b, c, p)
-    set(t1, c, a, p, hca, 3 * u + 2, 3 * t + 1);    // (c, a, p)
-    set(u, a, d, p, had, 3 * u1 + 2, 3 * t1 + 1);   // (a, d, p)
-    set(u1, d, b, p, hdb, 3 * t + 2, 3 * u + 1);    // (d, b, p)
-    legalize(3 * t), legalize(3 * t1), legalize(3 * u), legalize(3 * u1);
-  }
-
-  // Half-edge a has the new point opposite; flip it while the point across is
-  // inside the circle (exact incircle), then the two far edges (Lawson).
-  void legalize(std::uint32_t a) {
-    const std::uint32_t b = twin_[a];
-    if (b == kNone) return;
-    const std::uint32_t a0 = a - a % 3, b0 = b - b % 3;
-    const std::uint32_t al = a0 + (a + 1) % 3, ar = a0 + (a + 2) % 3, bl = b0 + (b + 2) % 3, br = b0 + (b + 1) % 3;
-    const std::uint32_t p0 = tri_[ar], pr = tri_[a], pl = tri_[al], p1 = tri_[bl];
-    if (!in_circle(pts_[pr], pts_[pl], pts_[p0], pts_[p1])) return;
-    const std::uint32_t hal = twin_[al], har = twin_[ar], hbl = twin_[bl], hbr = twin_[br];
-    const std::uint32_t t0 = a0 / 3, t1 = b0 / 3;
-    set(t0, p0, p1, pl, kNone, hbl, hal);
-    set(t1, p1, p0, pr, 3 * t0, har, hbr);
-    legalize(3 * t0 + 1);
-    legalize(3 * t1 + 2);
-  }
-
-  void update_candidates() {
-    std::sort(touched_.begin(), touched_.end());
-    touched_.erase(std::unique(touched_.begin(), touched_.end()), touched_.end());
-    for (const std::uint32_t t : touched_) {
-      const P2 a = pts_[tri_[3 * t]], b = pts_[tri_[3 * t + 1]], c = pts_[tri_[3 * t + 2]];
+    for (const Inserter::Triangle& t : triangles) {
+      const P2 a = p2(t.corners[0]), b = p2(t.corners[1]), c = p2(t.corners[2]);
+      State& s = state_[t.handle];
+      s.error = -1;
+      // Twice the area 1: by Pick's theorem no sample but the corners, whose
+      // error never counts (most triangles of a fine TIN are such).
+      if ((b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x) == 1) continue;
       const detail::Worst w = detail::triangle_worst(z_, w_, a, b, c);
       const bool corner = (w.at.x == a.x && w.at.y == a.y) || (w.at.x == b.x && w.at.y == b.y) ||
                           (w.at.x == c.x && w.at.y == c.y);
-      candidate_[t] = w.at;
-      if (w.error > limit_ && !corner) queue_.push({w.error, t, version_[t]});
+      s.x = std::int32_t(w.at.x), s.y = std::int32_t(w.at.y);
+      if (w.error > limit_ && !corner) {
+        s.error = w.error;
+        queue_.push({s.error, t.handle});
+      }
     }
-    touched_.clear();
   }
 
   const float* z_;
   std::uint64_t w_;
   double limit_;
-  bool small_;  // coordinates within 2^14 of each other: integer incircle
-  std::vector<std::uint32_t> twin_, version_, touched_;
-  std::vector<P2> candidate_;  // per triangle: its worst sample
-  std::priority_queue<Entry> queue_;
+  Inserter& ins_;
+  std::vector<P2>& pts_;  // per point of the triangulation
+  std::vector<State, HugePageAllocator<State>> state_;
+  MaxHeap4 queue_;
 };
 
-}  // namespace
-
-namespace {
+// A tile's TIN: its samples and triangles (indices into them, counter-clockwise).
+struct TileTin {
+  std::vector<P2> pts_;
+  std::vector<std::uint32_t> tri_;
+};
 
 // The greedy TIN of the tile [c00, c11] of the row-major samples z (row length w):
 // its four sides simplified on their own to border_limit (the neighbour does the
-// same), then the inside to limit. Only differences of coordinates enter the
-// arithmetic, so a block holding the tile gives the same triangles, shifted.
-GreedyTin tile_tin(const float* z, std::uint64_t w, P2 c00, P2 c11, double limit, double border_limit) {
+// same), then the inside to limit. The Delaunay decisions are exact and the
+// errors use only differences of coordinates, so a block holding the tile gives
+// the same triangles, shifted.
+TileTin tile_tin(const float* z, std::uint64_t w, P2 c00, P2 c11, double limit, double border_limit) {
   const P2 c10{c11.x, c00.y}, c01{c00.x, c11.y};
-  std::vector<P2> start{c00, c10, c11, c01};
-  simplify_segment(z, w, c00, c10, border_limit, start);
-  simplify_segment(z, w, c10, c11, border_limit, start);
-  simplify_segment(z, w, c01, c11, border_limit, start);
-  simplify_segment(z, w, c00, c01, border_limit, start);
-  GreedyTin g(z, w, limit, std::max(c11.x - c00.x, c11.y - c00.y));
-  g.start(c00, c10, c11, c01, std::vector<P2>(start.begin() + 4, start.end()));
-  g.refine();
-  return g;
+  std::vector<P2> border;
+  simplify_segment(z, w, c00, c10, border_limit, border);
+  simplify_segment(z, w, c10, c11, border_limit, border);
+  simplify_segment(z, w, c01, c11, border_limit, border);
+  simplify_segment(z, w, c00, c01, border_limit, border);
+  TileTin tin;
+  tin.pts_ = {c00, c10, c11, c01};
+  std::vector<Vec2d> corners;
+  for (const P2& p : tin.pts_) corners.emplace_back(double(p.x), double(p.y));
+  voronoi::Delaunay2 dt(corners);
+  {
+    voronoi::Delaunay2::Inserter ins(dt);
+    // Room for every sample, up to 2^22 (a few hundred MB of address space; larger tiles grow as needed).
+    ins.reserve(std::min(std::size_t(c11.x - c00.x + 1) * std::size_t(c11.y - c00.y + 1), std::size_t(1) << 22));
+    GreedyTin g(z, w, limit, ins, tin.pts_);
+    for (const P2& p : border) g.insert(p, voronoi::Delaunay2::no_edge, false);
+    g.scan_all();
+    g.refine();
+  }
+  tin.tri_.assign(dt.triangles().begin(), dt.triangles().end());
+  return tin;
 }
 
 void check_max_error(double max_error, const char* what) {
@@ -268,7 +237,7 @@ TerrainMesh tin_tile(std::span<const float> z, std::size_t width, std::size_t he
     throw Error("terrain tin_tile: border_limit must be finite and <= max_error");
   for (const float v : z)
     if (!std::isfinite(v)) throw Error("terrain tin_tile: the heights hold a NaN or infinite sample");
-  const GreedyTin g = tile_tin(z.data(), width, P2{0, 0}, P2{std::int64_t(width) - 1, std::int64_t(height) - 1},
+  const TileTin g = tile_tin(z.data(), width, P2{0, 0}, P2{std::int64_t(width) - 1, std::int64_t(height) - 1},
                                max_error, border_limit);
   TerrainMesh mesh;
   for (const P2& p : g.pts_) {
@@ -307,7 +276,7 @@ TerrainMesh Terrain::tin(double max_error, std::uint32_t tiles) const {
   std::vector<std::uint32_t> vertex_of;  // of the tile's points
   for (std::uint32_t ty = 0; ty < tiles; ++ty)
     for (std::uint32_t tx = 0; tx < tiles; ++tx) {
-      const GreedyTin g = tile_tin(z.data(), width_, P2{xs[tx], ys[ty]}, P2{xs[tx + 1], ys[ty + 1]}, limit, border_limit);
+      const TileTin g = tile_tin(z.data(), width_, P2{xs[tx], ys[ty]}, P2{xs[tx + 1], ys[ty + 1]}, limit, border_limit);
       vertex_of.resize(g.pts_.size());
       for (std::size_t i = 0; i < g.pts_.size(); ++i) {
         const P2 p = g.pts_[i];

@@ -10,6 +10,10 @@
 #include <cmath>
 #include <numeric>
 #include <optional>
+#include <type_traits>
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
 
 #include "brio_order.hpp"
 #include "constrained_delaunay.hpp"
@@ -91,7 +95,9 @@ struct Delaunay2::Editor {
   Editor& operator=(const Editor&) = delete;
 
   void init(std::span<const Vec2d> given, std::span<const Segment> given_segments, Options chosen);
-  std::uint32_t insert(const Vec2d& p);
+  // With `touched`, the triangles the insertion touched are appended to it and
+  // the public arrays are left as they were (the Inserter publishes once).
+  std::uint32_t insert(const Vec2d& p, std::uint32_t start = kNone, std::vector<std::uint32_t>* touched = nullptr);
   void remove(std::uint32_t v);
 
   void build();
@@ -470,25 +476,60 @@ std::uint32_t Delaunay2::nearest(const Vec2d& q) const {
 
 // ------------------------------------------------------------------ updates
 
-std::uint32_t Delaunay2::Editor::insert(const Vec2d& p) {
+namespace {
+
+// Hooks that note the triangles each step touches, then pass it on.
+template <class Inner>
+struct ChangeLog {
+  Inner& inner;
+  std::vector<std::uint32_t>& touched;
+  void split_triangle(std::uint32_t t, std::uint32_t t1, std::uint32_t t2) {
+    touched.insert(touched.end(), {t, t1, t2});
+    inner.split_triangle(t, t1, t2);
+  }
+  void split_edge(std::uint32_t e, std::uint32_t twin, std::uint32_t t1, std::uint32_t t2) {
+    touched.insert(touched.end(), {e / 3, twin / 3, t1, t2});
+    inner.split_edge(e, twin, t1, t2);
+  }
+  void flip(std::uint32_t e, std::uint32_t f) {
+    touched.insert(touched.end(), {e / 3, f / 3});
+    inner.flip(e, f);
+  }
+  bool fixed(std::uint32_t e) const { return inner.fixed(e); }
+};
+
+}  // namespace
+
+std::uint32_t Delaunay2::Editor::insert(const Vec2d& p, std::uint32_t start, std::vector<std::uint32_t>* touched) {
   require_finite(p, points.size(), "Delaunay2::insert");
   if (points.size() + 1 >= (std::size_t(1) << 30)) throw Error("Delaunay2::insert: too many points");
   const std::uint32_t i = std::uint32_t(points.size());
   points.push_back(p);
   rep.push_back(i);
   if (internal_triangle.empty()) {
-    build();
-  } else {
-    const std::uint32_t k = add_vertex(i);
-    if (has_constraints) {
-      ConstrainedDelaunay constraints(core, fixed);
-      insert_vertex(k, core.last_triangle, constraints);
-    } else {
-      NoHooks plain;
-      insert_vertex(k, core.last_triangle, plain);
-    }
-    publish();
+    build();  // publishes
+    if (touched)
+      for (std::uint32_t t = 0; t < core.vert.size() / 3; ++t) touched->push_back(t);
+    return i;
   }
+  const std::uint32_t k = add_vertex(i);
+  if (start == kNone) start = core.last_triangle;
+  const auto insert_with = [&](auto& hooks) {
+    if (touched) {
+      ChangeLog<std::remove_reference_t<decltype(hooks)>> log{hooks, *touched};
+      insert_vertex(k, start, log);
+    } else {
+      insert_vertex(k, start, hooks);
+    }
+  };
+  if (has_constraints) {
+    ConstrainedDelaunay constraints(core, fixed);
+    insert_with(constraints);
+  } else {
+    NoHooks plain;
+    insert_with(plain);
+  }
+  if (!touched) publish();
   return i;
 }
 
@@ -530,6 +571,85 @@ void Delaunay2::Editor::remove(std::uint32_t v) {
 std::uint32_t Delaunay2::insert(const Vec2d& p) { return Editor(*this).insert(p); }
 
 void Delaunay2::remove(std::uint32_t v) { Editor(*this).remove(v); }
+
+// ------------------------------------------------------------------ Inserter
+
+Delaunay2::Inserter::Inserter(Delaunay2& dt) : editor_(std::make_unique<Editor>(dt)) {}
+
+Delaunay2::Inserter::~Inserter() {
+  // The arrays changed without publish() unless the set is still degenerate.
+  if (!editor_->internal_triangle.empty()) editor_->publish();
+}
+
+std::uint32_t Delaunay2::Inserter::insert(const Vec2d& p, std::uint32_t near) {
+  const DelaunayCore& core = editor_->core;
+  if (near != kNone && (near >= core.vert.size() / 3 || core.vert[3 * near] == DelaunayCore::none))
+    throw Error("Delaunay2::Inserter::insert: " + std::to_string(near) + " is not a triangle handle");
+  touched_.clear();
+  const std::uint32_t i = editor_->insert(p, near, &touched_);
+  std::sort(touched_.begin(), touched_.end());
+  changed_.clear();
+  for (std::size_t k = 0; k < touched_.size(); ++k) {
+    const std::uint32_t t = touched_[k];
+    if ((k > 0 && touched_[k - 1] == t) || core.vert[3 * t] == DelaunayCore::none || core.is_ghost_triangle(t)) continue;
+    changed_.push_back({t, {core.at(core.vert[3 * t]), core.at(core.vert[3 * t + 1]), core.at(core.vert[3 * t + 2])}});
+  }
+  return i;
+}
+
+namespace {
+
+// Asks for transparent huge pages for the storage of v (a hint; the kernel may
+// be set to use them only where asked).
+template <class T>
+void advise_huge_pages(const std::vector<T>& v) {
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+  constexpr std::uintptr_t kPage = 4096;
+  const auto first = (reinterpret_cast<std::uintptr_t>(v.data()) + kPage - 1) & ~(kPage - 1);
+  const auto last = (reinterpret_cast<std::uintptr_t>(v.data() + v.capacity())) & ~(kPage - 1);
+  if (last - first >= (std::uintptr_t(1) << 21) && last > first)
+    madvise(reinterpret_cast<void*>(first), last - first, MADV_HUGEPAGE);
+#else
+  (void)v;
+#endif
+}
+
+}  // namespace
+
+void Delaunay2::Inserter::reserve(std::size_t more) {
+  Editor& e = *editor_;
+  const std::size_t n = e.points.size() + more, half_edges = 6 * n + 12;  // a closed triangulation: 2n - 2 triangles
+  const auto grow = [](auto& v, std::size_t size) {
+    v.reserve(size);
+    advise_huge_pages(v);
+  };
+  grow(e.points, n), grow(e.rep, n), grow(e.original_of, n), grow(e.internal_of, n);
+  grow(e.core.coords, n), grow(e.core.vertex_edge, n), grow(e.core.vert, half_edges), grow(e.core.twin, half_edges);
+}
+
+void Delaunay2::Inserter::prefetch(std::uint32_t h) const {
+  const DelaunayCore& core = editor_->core;
+  if (h >= core.vert.size() / 3) return;
+  __builtin_prefetch(&core.twin[3 * h]);
+  for (std::uint32_t e = 3 * h; e < 3 * h + 3; ++e)
+    if (core.vert[e] < core.coords.size()) __builtin_prefetch(&core.coords[core.vert[e]]);
+}
+
+std::uint32_t Delaunay2::Inserter::handle_count() const { return std::uint32_t(editor_->core.vert.size() / 3); }
+
+bool Delaunay2::Inserter::is_triangle(std::uint32_t h) const {
+  const DelaunayCore& core = editor_->core;
+  return h < core.vert.size() / 3 && core.vert[3 * h] != DelaunayCore::none && !core.is_ghost_triangle(h);
+}
+
+std::array<std::uint32_t, 3> Delaunay2::Inserter::triangle(std::uint32_t h) const {
+  if (!is_triangle(h)) throw Error("Delaunay2::Inserter::triangle: " + std::to_string(h) + " is not a triangle handle");
+  const auto& v = editor_->core.vert;
+  const auto& o = editor_->original_of;
+  return {o[v[3 * h]], o[v[3 * h + 1]], o[v[3 * h + 2]]};
+}
+
+std::span<const Vec2d> Delaunay2::Inserter::points() const { return editor_->points; }
 
 std::vector<std::uint8_t> Delaunay2::inside() const {
   // Even-odd: a breadth-first search from the hull, the parity flipping across

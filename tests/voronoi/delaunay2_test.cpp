@@ -387,6 +387,102 @@ TEST(Delaunay2, InsertKeepsDelaunay) {
   }
 }
 
+// The Inserter gives the same arrays as insert() point by point (it walks from
+// the same place when given no triangle), and after each insertion its changed()
+// list is exactly the triangles with the new point as a corner (brute force over
+// every handle), while every other handle keeps its triangle.
+TEST(Delaunay2, InserterMatchesInsertAndReportsTheStar) {
+  for (Shape shape : {Shape::uniform, Shape::grid, Shape::circle, Shape::line, Shape::duplicates}) {
+    SCOPED_TRACE(int(shape));
+    const std::vector<Vec2d> all = make_points(shape, 200, 9);
+    const std::span<const Vec2d> first(all.data(), shape == Shape::line ? 0 : 20);
+    Delaunay2 one_by_one(first), batched(first);
+    for (std::size_t i = first.size(); i < all.size(); ++i) one_by_one.insert(all[i]);
+    {
+      Delaunay2::Inserter ins(batched);
+      std::map<std::uint32_t, std::array<std::uint32_t, 3>> before;
+      for (std::uint32_t h = 0; h < ins.handle_count(); ++h)
+        if (ins.is_triangle(h)) before[h] = ins.triangle(h);
+      for (std::size_t i = first.size(); i < all.size(); ++i) {
+        ASSERT_EQ(ins.insert(all[i]), i);
+        std::set<std::uint32_t> star, listed;
+        for (std::uint32_t h = 0; h < ins.handle_count(); ++h) {
+          if (!ins.is_triangle(h)) continue;
+          const auto t = ins.triangle(h);
+          if (t[0] == i || t[1] == i || t[2] == i) star.insert(h);
+        }
+        for (const auto& t : ins.changed()) {
+          listed.insert(t.handle);
+          const auto corners = ins.triangle(t.handle);
+          for (int k = 0; k < 3; ++k) ASSERT_EQ(t.corners[k], ins.points()[corners[k]]);
+        }
+        if (before.empty()) {  // the first triangles: all of them are new
+          std::set<std::uint32_t> every;
+          for (std::uint32_t h = 0; h < ins.handle_count(); ++h)
+            if (ins.is_triangle(h)) every.insert(h);
+          ASSERT_EQ(listed, every);
+        } else {  // empty for a duplicate, which is no corner
+          ASSERT_EQ(listed, star) << "point " << i;
+        }
+        for (const auto& [h, t] : before)
+          if (!listed.count(h)) ASSERT_TRUE(ins.is_triangle(h) && ins.triangle(h) == t) << "handle " << h;
+        before.clear();
+        for (std::uint32_t h = 0; h < ins.handle_count(); ++h)
+          if (ins.is_triangle(h)) before[h] = ins.triangle(h);
+      }
+    }
+    check_delaunay(batched, all);
+    ASSERT_EQ(std::vector<std::uint32_t>(batched.triangles().begin(), batched.triangles().end()),
+              std::vector<std::uint32_t>(one_by_one.triangles().begin(), one_by_one.triangles().end()));
+    ASSERT_EQ(std::vector<std::uint32_t>(batched.hull().begin(), batched.hull().end()),
+              std::vector<std::uint32_t>(one_by_one.hull().begin(), one_by_one.hull().end()));
+  }
+}
+
+// Inserting at a known triangle (the handle holding the point) walks no steps
+// and gives a valid triangulation; a bad handle or a NaN is a geods::Error.
+TEST(Delaunay2, InserterAtKnownTriangles) {
+  Rng rng(12);
+  std::vector<Vec2d> p = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  Delaunay2 dt(p);
+  {
+    Delaunay2::Inserter ins(dt);
+    ins.reserve(300);
+    for (int k = 0; k < 300; ++k) {
+      const Vec2d q{rng.uniform(0, 1), rng.uniform(0, 1)};
+      std::uint32_t holder = kNone;
+      for (std::uint32_t h = 0; h < ins.handle_count() && holder == kNone; ++h) {
+        if (!ins.is_triangle(h)) continue;
+        const auto t = ins.triangle(h);
+        if (orient2d(p[t[0]], p[t[1]], q) >= 0 && orient2d(p[t[1]], p[t[2]], q) >= 0 && orient2d(p[t[2]], p[t[0]], q) >= 0)
+          holder = h;
+      }
+      ASSERT_NE(holder, kNone);
+      ins.insert(q, holder);
+      p.push_back(q);
+    }
+    EXPECT_THROW(ins.insert({0.5, 0.5}, ins.handle_count()), Error);
+    EXPECT_THROW(ins.insert({std::nan(""), 0.5}), Error);
+    EXPECT_THROW(ins.triangle(ins.handle_count()), Error);
+  }
+  check_delaunay(dt, p);
+}
+
+// A constrained triangulation keeps its segments through an Inserter.
+TEST(Delaunay2Constrained, InserterKeepsConstraints) {
+  const std::vector<Vec2d> p = {{0, 0}, {10, 0}, {10, 10}, {0, 10}};
+  const std::vector<Delaunay2::Segment> segments = {{0, 2}};
+  Delaunay2 dt(p, segments);
+  Rng rng(5);
+  {
+    Delaunay2::Inserter ins(dt);
+    for (int i = 0; i < 100; ++i) ins.insert({rng.uniform(0, 10), rng.uniform(0, 10)});
+    for (int i = 1; i < 10; ++i) ins.insert({double(i), double(i)});  // on the segment
+  }
+  ASSERT_NO_THROW(dt.validate());
+  EXPECT_EQ(dt.constrained_edges().size(), 10u);
+}
+
 // After removals: a Delaunay triangulation of the points still present.
 void check_after_removal(const Delaunay2& dt, const std::vector<char>& removed) {
   ASSERT_NO_THROW(dt.validate());

@@ -31,6 +31,7 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -157,6 +158,8 @@ class Delaunay2 {
   /// A duplicate is merged into the existing point. Keeps the triangulation
   /// Delaunay; O(expected degree) flips plus O(n) to renumber the public arrays.
   std::uint32_t insert(const Vec2d& p);
+  class Inserter;
+
   /// Removes vertex v (a representative; not supported with segments; removing a duplicate only drops the
   /// alias, removing a vertex that has aliases promotes the next alias). The hole
   /// is retriangulated by flipping v's edges away (Delaunay ears, Devillers),
@@ -228,6 +231,62 @@ class Delaunay2 {
   FlatArray<std::uint8_t> constrained_;
   FlatArray<std::uint32_t> public_triangle_;    // internal triangle -> public index or no_edge
   FlatArray<std::uint32_t> internal_triangle_;  // public -> internal
+};
+
+/// Many insertions in a row at O(1) expected each, for algorithms that grow a
+/// triangulation point by point and look at the triangles each point makes
+/// (greedy TIN refinement, Ruppert-style refinement): Delaunay2::insert()
+/// renumbers the public arrays after every point (O(n)); an Inserter takes the
+/// triangulation's arrays, inserts into them, reports the triangles each
+/// insertion created or changed, and renumbers the public arrays once, when it
+/// goes. The Delaunay2 must not be used while an Inserter on it lives.
+///
+/// Triangles are named by handles (the internal slots: in [0, handle_count()),
+/// not the public numbers). A handle keeps naming the same triangle until an
+/// insertion lists it in changed(); insertions only add handles.
+class Delaunay2::Inserter {
+ public:
+  explicit Inserter(Delaunay2& dt);
+  ~Inserter();  // renumbers the public arrays
+  Inserter(const Inserter&) = delete;
+  Inserter& operator=(const Inserter&) = delete;
+
+  /// Inserts p as Delaunay2::insert() does (same checks, duplicates merged) and
+  /// returns its point index. `near` is the handle of a triangle at or near p
+  /// (the walk to p starts there; no_edge: where the last change was), so a
+  /// caller that knows p's triangle pays no point location.
+  std::uint32_t insert(const Vec2d& p, std::uint32_t near = no_edge);
+  /// A finite triangle: its handle and its corners, counter-clockwise.
+  struct Triangle {
+    std::uint32_t handle;
+    std::array<Vec2d, 3> corners;
+  };
+  /// The finite triangles the last insert() created or changed, each once (in
+  /// increasing handle order; all of them when it made the first triangles):
+  /// the triangles with the new point as a corner, read while they are in
+  /// cache, so that rescanning them costs no lookups.
+  std::span<const Triangle> changed() const { return changed_; }
+  /// Room for `more` points without reallocation, the large arrays on
+  /// transparent huge pages where the system allows (insertions read them at
+  /// random; with 4 KiB pages nearly every read also misses the TLB). The
+  /// memory is only touched as the triangulation grows.
+  void reserve(std::size_t more);
+  /// A hint that a coming insert() starts at triangle h: its arrays and
+  /// corners are fetched into the cache meanwhile (they lie anywhere in memory).
+  void prefetch(std::uint32_t h) const;
+  /// One more than the largest handle.
+  std::uint32_t handle_count() const;
+  /// Whether handle h names a finite triangle now.
+  bool is_triangle(std::uint32_t h) const;
+  /// The point indices of triangle h, counter-clockwise.
+  std::array<std::uint32_t, 3> triangle(std::uint32_t h) const;
+  /// The points (the input ones and those inserted so far).
+  std::span<const Vec2d> points() const;
+
+ private:
+  std::unique_ptr<Editor> editor_;
+  std::vector<std::uint32_t> touched_;
+  std::vector<Triangle> changed_;
 };
 
 }  // namespace geods::voronoi

@@ -221,6 +221,11 @@ void DelaunayCore::flip(std::uint32_t e, Hooks& hooks) {
 template <class Hooks>
 void DelaunayCore::legalize(std::uint32_t p, Hooks& hooks) {
   const Vec2d point = at(p);
+  // The triangles across the new edges and their far vertices lie anywhere in
+  // memory: ask for all of them at once rather than one miss after another.
+  for (const std::uint32_t e : flip_stack_) __builtin_prefetch(&vert[prev(twin[e])]);
+  for (const std::uint32_t e : flip_stack_)
+    if (const std::uint32_t v = vert[prev(twin[e])]; v < coords.size()) __builtin_prefetch(&coords[v]);
   while (!flip_stack_.empty()) {
     const std::uint32_t e = flip_stack_.back();  // opposite p in its triangle
     flip_stack_.pop_back();
