@@ -27,13 +27,153 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 
 // The smallest float >= v, for v >= 0 (or +inf).
 float round_up(double v) {
-  float f = float(v);
-  if (double(f) < v) f = std::bit_cast<float>(std::bit_cast<std::uint32_t>(f) + 1);
-  return f;
+  const float f = float(v);
+  return std::bit_cast<float>(std::bit_cast<std::uint32_t>(f) + std::uint32_t(double(f) < v));  // no branch
 }
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// The largest |z - plane| over the samples of a triangle whose corner a is the
+// plane's origin: rows a.y + r0 + r for r in [0, rows), row r covering
+// x in [a.x + lo0 + dlo r, a.x + hi0 + dhi r]. Every term rounded as
+// triangle_error() rounds it, so the same value.
+template <int S>
+[[gnu::always_inline]] inline double rows_error(const float* z, std::int64_t n, const detail::Plane& p, P2 a,
+                                               std::int64_t r0, std::int64_t rows, std::int64_t lo0, std::int64_t dlo,
+                                               std::int64_t hi0, std::int64_t dhi) {
+  double m = 0;
+  for (std::int64_t r = 0; r < rows; ++r) {
+    const std::int64_t dy = r0 + r;
+    const float* row = z + (a.y + dy) * n;
+    if constexpr (S > 0) {  // spans of at most 2 S + 1 samples: straight-line code
+      const double base = p.base(dy);
+      for (std::int64_t dx = lo0 + dlo * r; dx <= hi0 + dhi * r; ++dx) {
+        const double d = std::abs(double(row[a.x + dx]) - (base + p.gx * double(dx)));
+        if (d > m) m = d;
+      }
+    } else {
+      m = std::max(m, detail::row_max(row, a.x + lo0 + dlo * r, a.x + hi0 + dhi * r, p.base(dy), p.gx, a.x));
+    }
+  }
+  return m;
+}
+
+// The own errors of the vertices of spacing s = 2^t (S = s when it is a small
+// compile-time constant, else 0): red ones (square centres) split the two
+// halves of their 2s-square, blue ones the quarters of 2s-squares on both
+// sides of their edge. err[y n + x] = the largest error of the triangles,
+// rounded up to a float; +inf when a corner of one lies outside W x H.
+template <int S>
+void level_errors(const float* z, std::int64_t n, std::int64_t W, std::int64_t H, std::uint32_t t, float* err) {
+  const std::int64_t s = S ? S : std::int64_t(1) << t, N = n - 1, c = N / 2;
+  auto in = [&](P2 p) { return p.x <= W - 1 && p.y <= H - 1; };
+  // Red: rows y = s, 3s, ...; x = s, 3s, ... The parents (the apexes) are the
+  // square's corners on the diagonal that is not the hypotenuse.
+  parallel_for(0, std::size_t(N / (2 * s)), S ? 8 : 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t ry = b; ry < e; ++ry) {
+      const std::int64_t y = (2 * std::int64_t(ry) + 1) * s;
+      for (std::int64_t x = s; x < N; x += 2 * s) {
+        if (x == c && y == c) continue;  // the centre is always in the mesh
+        const bool main_parents = ((((x - s) >> (t + 1)) + ((y - s) >> (t + 1))) & 1) != 0;
+        double worst;
+        if (main_parents) {  // hypotenuse (x-s, y+s) - (x+s, y-s)
+          const P2 a{x - s, y + s}, b{x + s, y - s}, c0{x - s, y - s}, c1{x + s, y + s};
+          if (!in(a) || !in(b) || !in(c0) || !in(c1)) {
+            worst = kInf;
+          } else {
+            worst = std::max(rows_error<S>(z, n, detail::Plane(z, std::uint64_t(n), a, b, c0), a, -2 * s, 2 * s + 1, 0, 0, 2 * s, -1),
+                             rows_error<S>(z, n, detail::Plane(z, std::uint64_t(n), a, b, c1), a, -2 * s, 2 * s + 1, 2 * s, -1, 2 * s, 0));
+          }
+        } else {  // hypotenuse (x-s, y-s) - (x+s, y+s)
+          const P2 a{x - s, y - s}, b{x + s, y + s}, c0{x - s, y + s}, c1{x + s, y - s};
+          if (!in(a) || !in(b) || !in(c0) || !in(c1)) {
+            worst = kInf;
+          } else {
+            worst = std::max(rows_error<S>(z, n, detail::Plane(z, std::uint64_t(n), a, b, c0), a, 0, 2 * s + 1, 0, 0, 0, 1),
+                             rows_error<S>(z, n, detail::Plane(z, std::uint64_t(n), a, b, c1), a, 0, 2 * s + 1, 0, 1, 2 * s, 0));
+          }
+        }
+        err[y * n + x] = round_up(worst);
+      }
+    }
+  });
+  // Blue on horizontal edges: rows y = 0, 2s, ..., N; x = s, 3s, ...; the
+  // hypotenuse (x-s, y) - (x+s, y), apexes (x, y -+ s).
+  parallel_for(0, std::size_t(N / (2 * s) + 1), S ? 8 : 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t ry = b; ry < e; ++ry) {
+      const std::int64_t y = 2 * std::int64_t(ry) * s;
+      for (std::int64_t x = s; x < N; x += 2 * s) {
+        const P2 a{x - s, y}, bb{x + s, y};
+        double worst = 0;
+        if (!in(a) || !in(bb)) {
+          worst = kInf;
+        } else {
+          if (y - s >= 0) {
+            const P2 cc{x, y - s};
+            worst = in(cc) ? std::max(worst, rows_error<S>(z, n, detail::Plane(z, std::uint64_t(n), a, bb, cc), a, -s, s + 1, s, -1, s, 1)) : kInf;
+          }
+          if (y + s <= N && worst != kInf) {
+            const P2 cc{x, y + s};
+            worst = in(cc) ? std::max(worst, rows_error<S>(z, n, detail::Plane(z, std::uint64_t(n), a, bb, cc), a, 0, s + 1, 0, 1, 2 * s, -1)) : kInf;
+          }
+        }
+        err[y * n + x] = round_up(worst);
+      }
+    }
+  });
+  // Blue on vertical edges: rows y = s, 3s, ...; x = 0, 2s, ..., N; the
+  // hypotenuse (x, y-s) - (x, y+s), apexes (x -+ s, y); each triangle's rows
+  // in two runs (widening, then narrowing).
+  parallel_for(0, std::size_t(N / (2 * s)), S ? 8 : 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t ry = b; ry < e; ++ry) {
+      const std::int64_t y = (2 * std::int64_t(ry) + 1) * s;
+      for (std::int64_t x = 0; x <= N; x += 2 * s) {
+        const P2 a{x, y - s}, bb{x, y + s};
+        double worst = 0;
+        if (!in(a) || !in(bb)) {
+          worst = kInf;
+        } else {
+          if (x - s >= 0) {
+            const P2 cc{x - s, y};
+            if (in(cc)) {
+              const detail::Plane p(z, std::uint64_t(n), a, bb, cc);
+              worst = std::max({worst, rows_error<S>(z, n, p, a, 0, s + 1, 0, -1, 0, 0),
+                                rows_error<S>(z, n, p, a, s + 1, s, 1 - s, 1, 0, 0)});
+            } else {
+              worst = kInf;
+            }
+          }
+          if (x + s <= N && worst != kInf) {
+            const P2 cc{x + s, y};
+            if (in(cc)) {
+              const detail::Plane p(z, std::uint64_t(n), a, bb, cc);
+              worst = std::max({worst, rows_error<S>(z, n, p, a, 0, s + 1, 0, 0, 0, 1),
+                                rows_error<S>(z, n, p, a, s + 1, s, 0, 0, s - 1, -1)});
+            } else {
+              worst = kInf;
+            }
+          }
+        }
+        err[y * n + x] = round_up(worst);
+      }
+    }
+  });
+}
+
+// The own errors of every vertex but the corners and the centre (0 there).
+void own_errors(const float* z, std::int64_t n, std::int64_t W, std::int64_t H, std::uint32_t K, float* err) {
+  for (std::uint32_t t = 0; t < K; ++t) {
+    if (t == 0)
+      level_errors<1>(z, n, W, H, t, err);
+    else if (t == 1)
+      level_errors<2>(z, n, W, H, t, err);
+    else if (t == 2)
+      level_errors<4>(z, n, W, H, t, err);
+    else
+      level_errors<0>(z, n, W, H, t, err);
+  }
 }
 
 }  // namespace
@@ -82,7 +222,7 @@ std::uint64_t LayoutIndex::interleaved_slot(std::uint32_t x, std::uint32_t y) co
     X = c + ex, Y = c + ey;
   }
   const std::int64_t m = N >> t;
-  const std::int64_t u = (X + Y) >> t, v = (X - Y) / s;  // odd, u in (0, 2m), v in (-m, m)
+  const std::int64_t u = (X + Y) >> t, v = (X - Y) >> t;  // exact; odd, u in (0, 2m), v in (-m, m)
   const std::uint64_t i = std::uint64_t((u - 1) / 2), j = std::uint64_t((v + m - 1) / 2);
   return base_[std::size_t(t)] + morton2d_encode64(std::uint32_t(i), std::uint32_t(j));
 }
@@ -120,50 +260,13 @@ Terrain::Terrain(HeightField field, TerrainOptions options) {
   field.heights = {};
 
   const std::int64_t N = std::int64_t(n) - 1, c = N / 2;
-  auto inside = [&](P2 p) { return p.x <= W - 1 && p.y <= H - 1; };
   // Own error of each vertex: the largest vertical distance between the grid and
   // the triangles it splits (its diamond); +inf where the diamond leaves the
   // field (the padding), so that those vertices are always refined and no
-  // final triangle straddles the field's border.
+  // final triangle straddles the field's border. Level by level, every
+  // triangle's rows as spans known by arithmetic (no point-in-triangle tests).
   std::vector<float> err(n * n, 0.0f);
-  parallel_for(0, n, 1, [&](std::size_t b, std::size_t e) {
-    for (std::size_t yy = b; yy < e; ++yy)
-      for (std::size_t xx = 0; xx < n; ++xx) {
-        const std::int64_t x = std::int64_t(xx), y = std::int64_t(yy);
-        if ((x == 0 || x == N) && (y == 0 || y == N)) continue;
-        if (x == c && y == c) continue;  // the centre is always in the mesh
-        const int t = std::countr_zero(std::uint64_t(x | y));
-        const std::int64_t s = std::int64_t(1) << t;
-        P2 h0, h1, apex[2];
-        int apexes = 0;
-        if (((x >> t) & 1) && ((y >> t) & 1)) {  // red: square centre
-          const bool main_parents = ((((x - s) >> (t + 1)) + ((y - s) >> (t + 1))) & 1) != 0;
-          if (main_parents) {  // parents (x-s, y-s), (x+s, y+s); hypotenuse the other diagonal
-            apex[0] = {x - s, y - s}, apex[1] = {x + s, y + s}, h0 = {x - s, y + s}, h1 = {x + s, y - s};
-          } else {
-            apex[0] = {x - s, y + s}, apex[1] = {x + s, y - s}, h0 = {x - s, y - s}, h1 = {x + s, y + s};
-          }
-          apexes = 2;
-        } else if ((x >> t) & 1) {  // blue on a horizontal edge
-          h0 = {x - s, y}, h1 = {x + s, y};
-          if (y - s >= 0) apex[apexes++] = {x, y - s};
-          if (y + s <= N) apex[apexes++] = {x, y + s};
-        } else {  // blue on a vertical edge
-          h0 = {x, y - s}, h1 = {x, y + s};
-          if (x - s >= 0) apex[apexes++] = {x - s, y};
-          if (x + s <= N) apex[apexes++] = {x + s, y};
-        }
-        double worst = 0;
-        for (int k = 0; k < apexes; ++k) {
-          if (!inside(h0) || !inside(h1) || !inside(apex[k])) {
-            worst = kInf;
-            break;
-          }
-          worst = std::max(worst, triangle_error(z.data(), n, h0, h1, apex[k]));
-        }
-        err[yy * n + xx] = round_up(worst);
-      }
-  });
+  own_errors(z.data(), std::int64_t(n), W, H, K, err.data());
 
   // Nesting, finest level first: error = max(own, children's); radius = max over
   // children of (distance + child's radius), rounded up, so that a child's
@@ -201,11 +304,40 @@ Terrain::Terrain(HeightField field, TerrainOptions options) {
   }
 
   std::vector<VertexRecord> records(index_.slots());
-  parallel_for(0, n, 16, [&](std::size_t b, std::size_t e) {
-    for (std::size_t y = b; y < e; ++y)
-      for (std::size_t x = 0; x < n; ++x)
-        records[index_.slot(std::uint32_t(x), std::uint32_t(y))] = {z[y * n + x], err[y * n + x], rad[y * n + x]};
-  });
+  auto put = [&](std::size_t slot, std::size_t g) { records[slot] = {z[g], err[g], rad[g]}; };
+  if (index_.layout() == Layout::matrix) {
+    parallel_for(0, n * n, 4096, [&](std::size_t b, std::size_t e) {
+      for (std::size_t g = b; g < e; ++g) put(g, g);
+    });
+  } else {
+    // Level by level; along a row of blue vertices of spacing s (step 2 s)
+    // both coordinates of the level's Morton code grow by one.
+    for (const std::size_t g : {std::size_t(0), std::size_t(N), std::size_t(N) * n, std::size_t(N) * n + std::size_t(N),
+                                std::size_t(c) * n + std::size_t(c)})
+      put(index_.interleaved_slot(std::uint32_t(g % n), std::uint32_t(g / n)), g);
+    constexpr std::uint64_t kEven = 0x5555555555555555ull, kOdd = ~kEven;
+    for (std::uint32_t t = 0; t < K; ++t) {
+      const std::int64_t s = std::int64_t(1) << t;
+      const std::uint64_t base = index_.level_base(t);
+      // Rows k s: blue at x = s, 3s, ... (k even) or x = 0, 2s, ... (k odd);
+      // red at x = s, 3s, ... (k odd).
+      parallel_for(0, std::size_t(N / s + 1), 4, [&](std::size_t b, std::size_t e) {
+        for (std::size_t k = b; k < e; ++k) {
+          const std::int64_t y = std::int64_t(k) * s, row = y * std::int64_t(n);
+          const std::int64_t x0 = (k & 1) ? 0 : s;
+          std::uint64_t m = index_.interleaved_slot(std::uint32_t(x0), std::uint32_t(y)) - base;
+          for (std::int64_t x = x0; x <= N; x += 2 * s) {
+            put(base + m, std::size_t(row + x));
+            m = (((m | kOdd) + 1) & kEven) | (((m | kEven) + 2) & kOdd);
+          }
+          if (k & 1)
+            for (std::int64_t x = s; x < N; x += 2 * s)
+              if (x != c || y != c)
+                put(index_.interleaved_slot(std::uint32_t(x), std::uint32_t(y)), std::size_t(row + x));
+        }
+      });
+    }
+  }
   records_ = FlatArray<VertexRecord>(std::move(records));
   build_s_ = seconds_since(t0);
 }

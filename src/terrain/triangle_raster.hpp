@@ -48,22 +48,31 @@ inline double row_max(const float* row, std::int64_t lo, std::int64_t hi, double
   return m;
 }
 
-// A grid triangle (a, b, c): the plane through its three heights,
-// z = za + gx (x - a.x) + gy (y - a.y), and the samples of each of its rows.
-struct GridTriangle {
+// The plane through the heights of the grid points a, b, c (not collinear) of
+// an n-wide matrix of heights: z = za + gx (x - a.x) + gy (y - a.y).
+struct Plane {
   double za, gx, gy;
-  P2 v[3];  // counter-clockwise
-  std::int64_t y0, y1, xmin, xmax;
 
-  GridTriangle(const float* z, std::uint64_t n, P2 a, P2 b, P2 c) {
+  [[gnu::always_inline]] Plane(const float* z, std::uint64_t n, P2 a, P2 b, P2 c) {
     za = z[a.y * n + a.x];
     const double zb = z[b.y * n + b.x], zc = z[c.y * n + c.x];
     const double ux = double(b.x - a.x), uy = double(b.y - a.y), vx = double(c.x - a.x), vy = double(c.y - a.y);
     const double det = ux * vy - uy * vx;
     gx = ((zb - za) * vy - (zc - za) * uy) / det;
     gy = ((zc - za) * ux - (zb - za) * vx) / det;
+  }
+  // The plane on the row dy = y - a.y is base(dy) + gx (x - a.x).
+  double base(std::int64_t dy) const { return za + gy * double(dy); }
+};
+
+// A grid triangle (a, b, c): its plane and the samples of each of its rows.
+struct GridTriangle : Plane {
+  P2 v[3];  // counter-clockwise
+  std::int64_t y0, y1, xmin, xmax;
+
+  GridTriangle(const float* z, std::uint64_t n, P2 a, P2 b, P2 c) : Plane(z, n, a, b, c) {
     v[0] = a, v[1] = b, v[2] = c;
-    if (det < 0) std::swap(v[1], v[2]);
+    if ((b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x) < 0) std::swap(v[1], v[2]);
     y0 = std::min({a.y, b.y, c.y}), y1 = std::max({a.y, b.y, c.y});
     xmin = std::min({a.x, b.x, c.x}), xmax = std::max({a.x, b.x, c.x});
   }
@@ -92,7 +101,7 @@ struct GridTriangle {
   }
   // The plane on row y is base(y) + gx (x - a.x); relative to a, the same
   // rounding wherever the triangle lies (tin_tile() of a block equals the tile of tin()).
-  double base(std::int64_t y, std::int64_t ay) const { return za + gy * double(y - ay); }
+  double base(std::int64_t y, std::int64_t ay) const { return Plane::base(y - ay); }
 };
 
 // The largest |z(sample) - plane(sample)| over the grid samples in the closed
