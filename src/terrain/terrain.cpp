@@ -13,6 +13,7 @@
 #include <string>
 
 #include "geods/core/error.hpp"
+#include "geods/core/huge_page_allocator.hpp"
 #include "geods/core/morton.hpp"
 #include "geods/core/parallel.hpp"
 #include "triangle_raster.hpp"
@@ -247,7 +248,7 @@ Terrain::Terrain(HeightField field, TerrainOptions options) {
   index_ = LayoutIndex(options.layout, K);
 
   // Heights of the padded grid (the padding repeats the last row and column).
-  std::vector<float> z(n * n);
+  std::vector<float, HugePageAllocator<float>> z(n * n);
   parallel_for(0, n, 16, [&](std::size_t b, std::size_t e) {
     for (std::size_t y = b; y < e; ++y)
       for (std::size_t x = 0; x < n; ++x) {
@@ -265,45 +266,74 @@ Terrain::Terrain(HeightField field, TerrainOptions options) {
   // field (the padding), so that those vertices are always refined and no
   // final triangle straddles the field's border. Level by level, every
   // triangle's rows as spans known by arithmetic (no point-in-triangle tests).
-  std::vector<float> err(n * n, 0.0f);
+  std::vector<float, HugePageAllocator<float>> err(n * n, 0.0f);
   own_errors(z.data(), std::int64_t(n), W, H, K, err.data());
 
   // Nesting, finest level first: error = max(own, children's); radius = max over
   // children of (distance + child's radius), rounded up, so that a child's
   // sphere lies in its parent's.
-  std::vector<float> rad(n * n, 0.0f);
+  std::vector<float, HugePageAllocator<float>> rad(n * n, 0.0f);
   const double sx = std::abs(spacing_[0]), sy = std::abs(spacing_[1]);
-  auto nest = [&](std::int64_t x, std::int64_t y, P2 child) {
-    if (child.x < 0 || child.y < 0 || child.x > N || child.y > N) return;
-    const std::size_t v = std::size_t(y * std::int64_t(n) + x), w = std::size_t(child.y * std::int64_t(n) + child.x);
-    err[v] = std::max(err[v], err[w]);
-    const double dx = double(child.x - x) * sx, dy = double(child.y - y) * sy, dz = double(z[w]) - double(z[v]);
-    rad[v] = std::max(rad[v], round_up(std::sqrt(dx * dx + dy * dy + dz * dz) + double(rad[w])));
+  // Vertex (x, y) from its children at offsets off[k] (skipped outside the
+  // grid); the radius is rounded up once (rounding up is monotone).
+  auto nest = [&](std::int64_t x, std::int64_t y, const std::array<P2, 4>& off) {
+    const std::size_t v = std::size_t(y * std::int64_t(n) + x);
+    std::size_t w[4];
+    double d2[4];
+    int k = 0;
+    for (const P2 o : off) {
+      const P2 ch{x + o.x, y + o.y};
+      if (ch.x < 0 || ch.y < 0 || ch.x > N || ch.y > N) continue;
+      const double dx = double(o.x) * sx, dy = double(o.y) * sy;
+      w[k] = std::size_t(ch.y * std::int64_t(n) + ch.x), d2[k++] = dx * dx + dy * dy;
+    }
+    float e = err[v];
+    for (int j = 0; j < k; ++j) e = std::max(e, err[w[j]]);
+    err[v] = e;
+    const double zv = z[v];
+    double best = 0;
+#if defined(__SSE2__)
+    if (k == 4) {  // two square roots at a time
+      const __m128d vz = _mm_set1_pd(zv);
+      const __m128d a = _mm_sub_pd(_mm_set_pd(z[w[1]], z[w[0]]), vz), b = _mm_sub_pd(_mm_set_pd(z[w[3]], z[w[2]]), vz);
+      const __m128d ra = _mm_add_pd(_mm_sqrt_pd(_mm_add_pd(_mm_set_pd(d2[1], d2[0]), _mm_mul_pd(a, a))),
+                                    _mm_set_pd(rad[w[1]], rad[w[0]]));
+      const __m128d rb = _mm_add_pd(_mm_sqrt_pd(_mm_add_pd(_mm_set_pd(d2[3], d2[2]), _mm_mul_pd(b, b))),
+                                    _mm_set_pd(rad[w[3]], rad[w[2]]));
+      const __m128d m = _mm_max_pd(ra, rb);
+      best = std::max(_mm_cvtsd_f64(m), _mm_cvtsd_f64(_mm_unpackhi_pd(m, m)));
+      k = 0;
+    }
+#endif
+    for (int j = 0; j < k; ++j) {
+      const double dz = double(z[w[j]]) - zv;
+      best = std::max(best, std::sqrt(d2[j] + dz * dz) + double(rad[w[j]]));
+    }
+    rad[v] = round_up(best);
   };
   for (std::uint32_t t = 0; t < K; ++t) {
     const std::int64_t s = std::int64_t(1) << t;
-    // Blue vertices of spacing s: children are the red ones of spacing s / 2.
-    parallel_for(0, std::size_t(N / s + 1), 4, [&](std::size_t b, std::size_t e) {
-      for (std::size_t r = b; r < e; ++r) {
-        const std::int64_t y = std::int64_t(r) * s;
-        for (std::int64_t x = ((r & 1) ? 0 : s); x <= N; x += 2 * s) {
-          if (s < 2) continue;
-          const std::int64_t h = s / 2;
-          for (const P2 ch : {P2{x - h, y - h}, P2{x + h, y - h}, P2{x - h, y + h}, P2{x + h, y + h}}) nest(x, y, ch);
+    // Blue vertices of spacing s >= 2: children are the red ones of spacing s / 2.
+    if (s >= 2) {
+      parallel_for(0, std::size_t(N / s + 1), 4, [&](std::size_t b, std::size_t e) {
+        for (std::size_t r = b; r < e; ++r) {
+          const std::int64_t y = std::int64_t(r) * s, h = s / 2;
+          for (std::int64_t x = ((r & 1) ? 0 : s); x <= N; x += 2 * s)
+            nest(x, y, {P2{-h, -h}, P2{h, -h}, P2{-h, h}, P2{h, h}});
         }
-      }
-    });
+      });
+    }
     // Red vertices of spacing s (square centres): children the blue ones of spacing s.
     parallel_for(0, std::size_t(N / (2 * s)), 4, [&](std::size_t b, std::size_t e) {
       for (std::size_t r = b; r < e; ++r) {
         const std::int64_t y = std::int64_t(2 * r + 1) * s;
         for (std::int64_t x = s; x < N; x += 2 * s)
-          for (const P2 ch : {P2{x - s, y}, P2{x + s, y}, P2{x, y - s}, P2{x, y + s}}) nest(x, y, ch);
+          nest(x, y, {P2{-s, 0}, P2{s, 0}, P2{0, -s}, P2{0, s}});
       }
     });
   }
 
-  std::vector<VertexRecord> records(index_.slots());
+  std::vector<VertexRecord, HugePageAllocator<VertexRecord>> records(index_.slots());
   auto put = [&](std::size_t slot, std::size_t g) { records[slot] = {z[g], err[g], rad[g]}; };
   if (index_.layout() == Layout::matrix) {
     parallel_for(0, n * n, 4096, [&](std::size_t b, std::size_t e) {
