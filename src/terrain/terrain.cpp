@@ -45,19 +45,36 @@ template <int S>
                                                std::int64_t r0, std::int64_t rows, std::int64_t lo0, std::int64_t dlo,
                                                std::int64_t hi0, std::int64_t dhi) {
   double m = 0;
+#if defined(__SSE2__)
+  __m128d m2 = _mm_setzero_pd();
+  const __m128d sign = _mm_set1_pd(-0.0), gx = _mm_set1_pd(p.gx);
+#endif
   for (std::int64_t r = 0; r < rows; ++r) {
     const std::int64_t dy = r0 + r;
     const float* row = z + (a.y + dy) * n;
     if constexpr (S > 0) {  // spans of at most 2 S + 1 samples: straight-line code
       const double base = p.base(dy);
-      for (std::int64_t dx = lo0 + dlo * r; dx <= hi0 + dhi * r; ++dx) {
+      std::int64_t dx = lo0 + dlo * r;
+      const std::int64_t hi = hi0 + dhi * r;
+#if defined(__SSE2__)
+      const __m128d b2 = _mm_set1_pd(base);
+      for (; dx + 1 <= hi; dx += 2) {  // two neighbours at a time
+        const __m128d h = _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(row + a.x + dx))));
+        const __m128d x2 = _mm_set_pd(double(dx + 1), double(dx));
+        m2 = _mm_max_pd(_mm_andnot_pd(sign, _mm_sub_pd(h, _mm_add_pd(b2, _mm_mul_pd(gx, x2)))), m2);
+      }
+#endif
+      for (; dx <= hi; ++dx) {
         const double d = std::abs(double(row[a.x + dx]) - (base + p.gx * double(dx)));
-        if (d > m) m = d;
+        m = std::max(m, d);  // maxsd, no branch
       }
     } else {
       m = std::max(m, detail::row_max(row, a.x + lo0 + dlo * r, a.x + hi0 + dhi * r, p.base(dy), p.gx, a.x));
     }
   }
+#if defined(__SSE2__)
+  m = std::max({m, _mm_cvtsd_f64(m2), _mm_cvtsd_f64(_mm_unpackhi_pd(m2, m2))});
+#endif
   return m;
 }
 
@@ -177,6 +194,17 @@ void own_errors(const float* z, std::int64_t n, std::int64_t W, std::int64_t H, 
   }
 }
 
+// The quarter turns R^-1 that take (dx, dy) (a red vertex relative to the
+// centre) into the bottom quarter Q0 of interleaved_slot(); dx, dy turned.
+int red_turns(std::int64_t& dx, std::int64_t& dy) {
+  int q = 0;
+  while (!(dy < 0 && (-dy > std::abs(dx) || (-dy == std::abs(dx) && dx < 0)))) {
+    const std::int64_t t0 = dx;
+    dx = dy, dy = -t0, ++q;  // R^-1
+  }
+  return q;
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------- layout
@@ -210,11 +238,7 @@ std::uint64_t LayoutIndex::interleaved_slot(std::uint32_t x, std::uint32_t y) co
     // (x + s, -y), rotate back: the image is a blue-lattice point outside the
     // grid but inside the blue quadtree's root diamond, and distinct per vertex.
     std::int64_t dx = X - c, dy = Y - c;
-    int q = 0;
-    while (!(dy < 0 && (-dy > std::abs(dx) || (-dy == std::abs(dx) && dx < 0)))) {
-      const std::int64_t t0 = dx;
-      dx = dy, dy = -t0, ++q;  // R^-1
-    }
+    const int q = red_turns(dx, dy);
     std::int64_t ex = dx + s, ey = -2 * c - dy;
     for (int k = 0; k < q; ++k) {
       const std::int64_t t0 = ex;
@@ -276,16 +300,32 @@ Terrain::Terrain(HeightField field, TerrainOptions options) {
   const double sx = std::abs(spacing_[0]), sy = std::abs(spacing_[1]);
   // Vertex (x, y) from its children at offsets off[k] (skipped outside the
   // grid); the radius is rounded up once (rounding up is monotone).
-  auto nest = [&](std::int64_t x, std::int64_t y, const std::array<P2, 4>& off) {
+  struct Children {
+    std::array<P2, 4> off;
+    std::array<std::ptrdiff_t, 4> dw;  // index offsets
+    std::array<double, 4> d2;          // squared horizontal distances
+  };
+  auto children = [&](const std::array<P2, 4>& off) {
+    Children ch{off, {}, {}};
+    for (int k = 0; k < 4; ++k) {
+      const double dx = double(off[k].x) * sx, dy = double(off[k].y) * sy;
+      ch.dw[k] = off[k].y * std::ptrdiff_t(n) + off[k].x, ch.d2[k] = dx * dx + dy * dy;
+    }
+    return ch;
+  };
+  auto nest = [&](std::int64_t x, std::int64_t y, const Children& ch, bool interior) {
     const std::size_t v = std::size_t(y * std::int64_t(n) + x);
     std::size_t w[4];
     double d2[4];
     int k = 0;
-    for (const P2 o : off) {
-      const P2 ch{x + o.x, y + o.y};
-      if (ch.x < 0 || ch.y < 0 || ch.x > N || ch.y > N) continue;
-      const double dx = double(o.x) * sx, dy = double(o.y) * sy;
-      w[k] = std::size_t(ch.y * std::int64_t(n) + ch.x), d2[k++] = dx * dx + dy * dy;
+    if (interior) {
+      for (; k < 4; ++k) w[k] = std::size_t(std::ptrdiff_t(v) + ch.dw[k]), d2[k] = ch.d2[k];
+    } else {
+      for (int j = 0; j < 4; ++j) {
+        const P2 c{x + ch.off[j].x, y + ch.off[j].y};
+        if (c.x < 0 || c.y < 0 || c.x > N || c.y > N) continue;
+        w[k] = std::size_t(std::ptrdiff_t(v) + ch.dw[j]), d2[k++] = ch.d2[j];
+      }
     }
     float e = err[v];
     for (int j = 0; j < k; ++j) e = std::max(e, err[w[j]]);
@@ -315,20 +355,22 @@ Terrain::Terrain(HeightField field, TerrainOptions options) {
     const std::int64_t s = std::int64_t(1) << t;
     // Blue vertices of spacing s >= 2: children are the red ones of spacing s / 2.
     if (s >= 2) {
+      const std::int64_t h = s / 2;
+      const Children ch = children({P2{-h, -h}, P2{h, -h}, P2{-h, h}, P2{h, h}});
       parallel_for(0, std::size_t(N / s + 1), 4, [&](std::size_t b, std::size_t e) {
         for (std::size_t r = b; r < e; ++r) {
-          const std::int64_t y = std::int64_t(r) * s, h = s / 2;
-          for (std::int64_t x = ((r & 1) ? 0 : s); x <= N; x += 2 * s)
-            nest(x, y, {P2{-h, -h}, P2{h, -h}, P2{-h, h}, P2{h, h}});
+          const std::int64_t y = std::int64_t(r) * s;
+          const bool inner_row = y > 0 && y < N;
+          for (std::int64_t x = ((r & 1) ? 0 : s); x <= N; x += 2 * s) nest(x, y, ch, inner_row && x > 0 && x < N);
         }
       });
     }
     // Red vertices of spacing s (square centres): children the blue ones of spacing s.
+    const Children ch = children({P2{-s, 0}, P2{s, 0}, P2{0, -s}, P2{0, s}});
     parallel_for(0, std::size_t(N / (2 * s)), 4, [&](std::size_t b, std::size_t e) {
       for (std::size_t r = b; r < e; ++r) {
         const std::int64_t y = std::int64_t(2 * r + 1) * s;
-        for (std::int64_t x = s; x < N; x += 2 * s)
-          nest(x, y, {P2{-s, 0}, P2{s, 0}, P2{0, -s}, P2{0, s}});
+        for (std::int64_t x = s; x < N; x += 2 * s) nest(x, y, ch, true);
       }
     });
   }
@@ -360,10 +402,24 @@ Terrain::Terrain(HeightField field, TerrainOptions options) {
             put(base + m, std::size_t(row + x));
             m = (((m | kOdd) + 1) & kEven) | (((m | kEven) + 2) & kOdd);
           }
+          // Red ones: within a run of the same quarter turns the ghost slot
+          // moves by a reflection of the step, both Morton coordinates by +1
+          // (an even number of turns) or -1 (odd).
+          int run = -1;
           if (k & 1)
-            for (std::int64_t x = s; x < N; x += 2 * s)
-              if (x != c || y != c)
-                put(index_.interleaved_slot(std::uint32_t(x), std::uint32_t(y)), std::size_t(row + x));
+            for (std::int64_t x = s; x < N; x += 2 * s) {
+              if (x == c && y == c) continue;
+              std::int64_t dx = x - c, dy = y - c;
+              const int q = red_turns(dx, dy);
+              if (q != run) {
+                m = index_.interleaved_slot(std::uint32_t(x), std::uint32_t(y)) - base, run = q;
+              } else if (q & 1) {
+                m = (((m & kEven) - 1) & kEven) | (((m & kOdd) - 2) & kOdd);
+              } else {
+                m = (((m | kOdd) + 1) & kEven) | (((m | kEven) + 2) & kOdd);
+              }
+              put(base + m, std::size_t(row + x));
+            }
         }
       });
     }

@@ -43,7 +43,7 @@ inline double row_max(const float* row, std::int64_t lo, std::int64_t hi, double
 #endif
   for (; x <= hi; ++x) {
     const double d = std::abs(double(row[x]) - (base + gx * double(x - ax)));
-    if (d > m) m = d;
+    m = std::max(m, d);  // maxsd, no branch
   }
   return m;
 }
