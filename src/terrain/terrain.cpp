@@ -69,7 +69,14 @@ template <int S>
         m = std::max(m, d);  // maxsd, no branch
       }
     } else {
-      m = std::max(m, detail::row_max(row, a.x + lo0 + dlo * r, a.x + hi0 + dhi * r, p.base(dy), p.gx, a.x));
+      const std::int64_t lo = a.x + lo0 + dlo * r, hi = a.x + hi0 + dhi * r;
+#if defined(__x86_64__) && defined(__GNUC__)
+      if (hi - lo >= 7 && detail::has_avx2()) {
+        m = std::max(m, detail::row_max_avx2(row, lo, hi, p.base(dy), p.gx, a.x));
+        continue;
+      }
+#endif
+      m = std::max(m, detail::row_max(row, lo, hi, p.base(dy), p.gx, a.x));
     }
   }
 #if defined(__SSE2__)
