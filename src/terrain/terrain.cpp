@@ -281,13 +281,21 @@ Terrain::Terrain(HeightField field, TerrainOptions options) {
   // Heights of the padded grid (the padding repeats the last row and column).
   std::vector<float, HugePageAllocator<float>> z(n * n);
   parallel_for(0, n, 16, [&](std::size_t b, std::size_t e) {
-    for (std::size_t y = b; y < e; ++y)
-      for (std::size_t x = 0; x < n; ++x) {
-        const double v = double(field.heights[std::min<std::size_t>(y, height_ - 1) * width_ +
-                                              std::min<std::size_t>(x, width_ - 1)]) * z_scale_;
-        if (!std::isfinite(float(v))) throw Error("terrain: a height times z_scale overflows a float");
-        z[y * n + x] = float(v);
+    bool finite = true;
+    for (std::size_t y = b; y < e; ++y) {
+      const float* src = field.heights.data() + std::min<std::size_t>(y, height_ - 1) * width_;
+      float* dst = z.data() + y * n;
+      if (z_scale_ == 1) {
+        std::copy(src, src + width_, dst);  // finite (checked, missing ones filled)
+      } else {
+        for (std::size_t x = 0; x < width_; ++x) {
+          dst[x] = float(double(src[x]) * z_scale_);
+          finite &= std::isfinite(dst[x]);
+        }
       }
+      std::fill(dst + width_, dst + n, dst[width_ - 1]);
+    }
+    if (!finite) throw Error("terrain: a height times z_scale overflows a float");
   });
   field.heights = {};
 
@@ -382,7 +390,7 @@ Terrain::Terrain(HeightField field, TerrainOptions options) {
     });
   }
 
-  std::vector<VertexRecord, HugePageAllocator<VertexRecord>> records(index_.slots());
+  std::vector<VertexRecord> records(index_.slots());  // (huge pages here stalled now and then on a loaded machine)
   auto put = [&](std::size_t slot, std::size_t g) { records[slot] = {z[g], err[g], rad[g]}; };
   if (index_.layout() == Layout::matrix) {
     parallel_for(0, n * n, 4096, [&](std::size_t b, std::size_t e) {
