@@ -13,6 +13,7 @@
 #include <string>
 
 #include "geods/core/error.hpp"
+#include "geods/core/huge_page_allocator.hpp"
 #include "geods/core/morton.hpp"
 #include "geods/core/parallel.hpp"
 #include "triangle_raster.hpp"
@@ -27,13 +28,188 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 
 // The smallest float >= v, for v >= 0 (or +inf).
 float round_up(double v) {
-  float f = float(v);
-  if (double(f) < v) f = std::bit_cast<float>(std::bit_cast<std::uint32_t>(f) + 1);
-  return f;
+  const float f = float(v);
+  return std::bit_cast<float>(std::bit_cast<std::uint32_t>(f) + std::uint32_t(double(f) < v));  // no branch
 }
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// The largest |z - plane| over the samples of a triangle whose corner a is the
+// plane's origin: rows a.y + r0 + r for r in [0, rows), row r covering
+// x in [a.x + lo0 + dlo r, a.x + hi0 + dhi r]. Every term rounded as
+// triangle_error() rounds it, so the same value.
+template <int S>
+[[gnu::always_inline]] inline double rows_error(const float* z, std::int64_t n, const detail::Plane& p, P2 a,
+                                               std::int64_t r0, std::int64_t rows, std::int64_t lo0, std::int64_t dlo,
+                                               std::int64_t hi0, std::int64_t dhi) {
+  double m = 0;
+#if defined(__SSE2__)
+  __m128d m2 = _mm_setzero_pd();
+  const __m128d sign = _mm_set1_pd(-0.0), gx = _mm_set1_pd(p.gx);
+#endif
+  for (std::int64_t r = 0; r < rows; ++r) {
+    const std::int64_t dy = r0 + r;
+    const float* row = z + (a.y + dy) * n;
+    if constexpr (S > 0) {  // spans of at most 2 S + 1 samples: straight-line code
+      const double base = p.base(dy);
+      std::int64_t dx = lo0 + dlo * r;
+      const std::int64_t hi = hi0 + dhi * r;
+#if defined(__SSE2__)
+      const __m128d b2 = _mm_set1_pd(base);
+      for (; dx + 1 <= hi; dx += 2) {  // two neighbours at a time
+        const __m128d h = _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(row + a.x + dx))));
+        const __m128d x2 = _mm_set_pd(double(dx + 1), double(dx));
+        m2 = _mm_max_pd(_mm_andnot_pd(sign, _mm_sub_pd(h, _mm_add_pd(b2, _mm_mul_pd(gx, x2)))), m2);
+      }
+#endif
+      for (; dx <= hi; ++dx) {
+        const double d = std::abs(double(row[a.x + dx]) - (base + p.gx * double(dx)));
+        m = std::max(m, d);  // maxsd, no branch
+      }
+    } else {
+      const std::int64_t lo = a.x + lo0 + dlo * r, hi = a.x + hi0 + dhi * r;
+#if defined(__x86_64__) && defined(__GNUC__)
+      if (hi - lo >= 7 && detail::has_avx2()) {
+        m = std::max(m, detail::row_max_avx2(row, lo, hi, p.base(dy), p.gx, a.x));
+        continue;
+      }
+#endif
+      m = std::max(m, detail::row_max(row, lo, hi, p.base(dy), p.gx, a.x));
+    }
+  }
+#if defined(__SSE2__)
+  m = std::max({m, _mm_cvtsd_f64(m2), _mm_cvtsd_f64(_mm_unpackhi_pd(m2, m2))});
+#endif
+  return m;
+}
+
+// The own errors of the vertices of spacing s = 2^t (S = s when it is a small
+// compile-time constant, else 0): red ones (square centres) split the two
+// halves of their 2s-square, blue ones the quarters of 2s-squares on both
+// sides of their edge. err[y n + x] = the largest error of the triangles,
+// rounded up to a float; +inf when a corner of one lies outside W x H.
+template <int S>
+void level_errors(const float* z, std::int64_t n, std::int64_t W, std::int64_t H, std::uint32_t t, float* err) {
+  const std::int64_t s = S ? S : std::int64_t(1) << t, N = n - 1, c = N / 2;
+  auto in = [&](P2 p) { return p.x <= W - 1 && p.y <= H - 1; };
+  // Red: rows y = s, 3s, ...; x = s, 3s, ... The parents (the apexes) are the
+  // square's corners on the diagonal that is not the hypotenuse.
+  parallel_for(0, std::size_t(N / (2 * s)), S ? 8 : 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t ry = b; ry < e; ++ry) {
+      const std::int64_t y = (2 * std::int64_t(ry) + 1) * s;
+      for (std::int64_t x = s; x < N; x += 2 * s) {
+        if (x == c && y == c) continue;  // the centre is always in the mesh
+        const bool main_parents = ((((x - s) >> (t + 1)) + ((y - s) >> (t + 1))) & 1) != 0;
+        double worst;
+        if (main_parents) {  // hypotenuse (x-s, y+s) - (x+s, y-s)
+          const P2 a{x - s, y + s}, b{x + s, y - s}, c0{x - s, y - s}, c1{x + s, y + s};
+          if (!in(a) || !in(b) || !in(c0) || !in(c1)) {
+            worst = kInf;
+          } else {
+            worst = std::max(rows_error<S>(z, n, detail::Plane(z, std::uint64_t(n), a, b, c0), a, -2 * s, 2 * s + 1, 0, 0, 2 * s, -1),
+                             rows_error<S>(z, n, detail::Plane(z, std::uint64_t(n), a, b, c1), a, -2 * s, 2 * s + 1, 2 * s, -1, 2 * s, 0));
+          }
+        } else {  // hypotenuse (x-s, y-s) - (x+s, y+s)
+          const P2 a{x - s, y - s}, b{x + s, y + s}, c0{x - s, y + s}, c1{x + s, y - s};
+          if (!in(a) || !in(b) || !in(c0) || !in(c1)) {
+            worst = kInf;
+          } else {
+            worst = std::max(rows_error<S>(z, n, detail::Plane(z, std::uint64_t(n), a, b, c0), a, 0, 2 * s + 1, 0, 0, 0, 1),
+                             rows_error<S>(z, n, detail::Plane(z, std::uint64_t(n), a, b, c1), a, 0, 2 * s + 1, 0, 1, 2 * s, 0));
+          }
+        }
+        err[y * n + x] = round_up(worst);
+      }
+    }
+  });
+  // Blue on horizontal edges: rows y = 0, 2s, ..., N; x = s, 3s, ...; the
+  // hypotenuse (x-s, y) - (x+s, y), apexes (x, y -+ s).
+  parallel_for(0, std::size_t(N / (2 * s) + 1), S ? 8 : 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t ry = b; ry < e; ++ry) {
+      const std::int64_t y = 2 * std::int64_t(ry) * s;
+      for (std::int64_t x = s; x < N; x += 2 * s) {
+        const P2 a{x - s, y}, bb{x + s, y};
+        double worst = 0;
+        if (!in(a) || !in(bb)) {
+          worst = kInf;
+        } else {
+          if (y - s >= 0) {
+            const P2 cc{x, y - s};
+            worst = in(cc) ? std::max(worst, rows_error<S>(z, n, detail::Plane(z, std::uint64_t(n), a, bb, cc), a, -s, s + 1, s, -1, s, 1)) : kInf;
+          }
+          if (y + s <= N && worst != kInf) {
+            const P2 cc{x, y + s};
+            worst = in(cc) ? std::max(worst, rows_error<S>(z, n, detail::Plane(z, std::uint64_t(n), a, bb, cc), a, 0, s + 1, 0, 1, 2 * s, -1)) : kInf;
+          }
+        }
+        err[y * n + x] = round_up(worst);
+      }
+    }
+  });
+  // Blue on vertical edges: rows y = s, 3s, ...; x = 0, 2s, ..., N; the
+  // hypotenuse (x, y-s) - (x, y+s), apexes (x -+ s, y); each triangle's rows
+  // in two runs (widening, then narrowing).
+  parallel_for(0, std::size_t(N / (2 * s)), S ? 8 : 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t ry = b; ry < e; ++ry) {
+      const std::int64_t y = (2 * std::int64_t(ry) + 1) * s;
+      for (std::int64_t x = 0; x <= N; x += 2 * s) {
+        const P2 a{x, y - s}, bb{x, y + s};
+        double worst = 0;
+        if (!in(a) || !in(bb)) {
+          worst = kInf;
+        } else {
+          if (x - s >= 0) {
+            const P2 cc{x - s, y};
+            if (in(cc)) {
+              const detail::Plane p(z, std::uint64_t(n), a, bb, cc);
+              worst = std::max({worst, rows_error<S>(z, n, p, a, 0, s + 1, 0, -1, 0, 0),
+                                rows_error<S>(z, n, p, a, s + 1, s, 1 - s, 1, 0, 0)});
+            } else {
+              worst = kInf;
+            }
+          }
+          if (x + s <= N && worst != kInf) {
+            const P2 cc{x + s, y};
+            if (in(cc)) {
+              const detail::Plane p(z, std::uint64_t(n), a, bb, cc);
+              worst = std::max({worst, rows_error<S>(z, n, p, a, 0, s + 1, 0, 0, 0, 1),
+                                rows_error<S>(z, n, p, a, s + 1, s, 0, 0, s - 1, -1)});
+            } else {
+              worst = kInf;
+            }
+          }
+        }
+        err[y * n + x] = round_up(worst);
+      }
+    }
+  });
+}
+
+// The own errors of every vertex but the corners and the centre (0 there).
+void own_errors(const float* z, std::int64_t n, std::int64_t W, std::int64_t H, std::uint32_t K, float* err) {
+  for (std::uint32_t t = 0; t < K; ++t) {
+    if (t == 0)
+      level_errors<1>(z, n, W, H, t, err);
+    else if (t == 1)
+      level_errors<2>(z, n, W, H, t, err);
+    else if (t == 2)
+      level_errors<4>(z, n, W, H, t, err);
+    else
+      level_errors<0>(z, n, W, H, t, err);
+  }
+}
+
+// The quarter turns R^-1 that take (dx, dy) (a red vertex relative to the
+// centre) into the bottom quarter Q0 of interleaved_slot(); dx, dy turned.
+int red_turns(std::int64_t& dx, std::int64_t& dy) {
+  int q = 0;
+  while (!(dy < 0 && (-dy > std::abs(dx) || (-dy == std::abs(dx) && dx < 0)))) {
+    const std::int64_t t0 = dx;
+    dx = dy, dy = -t0, ++q;  // R^-1
+  }
+  return q;
 }
 
 }  // namespace
@@ -69,11 +245,7 @@ std::uint64_t LayoutIndex::interleaved_slot(std::uint32_t x, std::uint32_t y) co
     // (x + s, -y), rotate back: the image is a blue-lattice point outside the
     // grid but inside the blue quadtree's root diamond, and distinct per vertex.
     std::int64_t dx = X - c, dy = Y - c;
-    int q = 0;
-    while (!(dy < 0 && (-dy > std::abs(dx) || (-dy == std::abs(dx) && dx < 0)))) {
-      const std::int64_t t0 = dx;
-      dx = dy, dy = -t0, ++q;  // R^-1
-    }
+    const int q = red_turns(dx, dy);
     std::int64_t ex = dx + s, ey = -2 * c - dy;
     for (int k = 0; k < q; ++k) {
       const std::int64_t t0 = ex;
@@ -82,7 +254,7 @@ std::uint64_t LayoutIndex::interleaved_slot(std::uint32_t x, std::uint32_t y) co
     X = c + ex, Y = c + ey;
   }
   const std::int64_t m = N >> t;
-  const std::int64_t u = (X + Y) >> t, v = (X - Y) / s;  // odd, u in (0, 2m), v in (-m, m)
+  const std::int64_t u = (X + Y) >> t, v = (X - Y) >> t;  // exact; odd, u in (0, 2m), v in (-m, m)
   const std::uint64_t i = std::uint64_t((u - 1) / 2), j = std::uint64_t((v + m - 1) / 2);
   return base_[std::size_t(t)] + morton2d_encode64(std::uint32_t(i), std::uint32_t(j));
 }
@@ -107,105 +279,166 @@ Terrain::Terrain(HeightField field, TerrainOptions options) {
   index_ = LayoutIndex(options.layout, K);
 
   // Heights of the padded grid (the padding repeats the last row and column).
-  std::vector<float> z(n * n);
+  std::vector<float, HugePageAllocator<float>> z(n * n);
   parallel_for(0, n, 16, [&](std::size_t b, std::size_t e) {
-    for (std::size_t y = b; y < e; ++y)
-      for (std::size_t x = 0; x < n; ++x) {
-        const double v = double(field.heights[std::min<std::size_t>(y, height_ - 1) * width_ +
-                                              std::min<std::size_t>(x, width_ - 1)]) * z_scale_;
-        if (!std::isfinite(float(v))) throw Error("terrain: a height times z_scale overflows a float");
-        z[y * n + x] = float(v);
+    bool finite = true;
+    for (std::size_t y = b; y < e; ++y) {
+      const float* src = field.heights.data() + std::min<std::size_t>(y, height_ - 1) * width_;
+      float* dst = z.data() + y * n;
+      if (z_scale_ == 1) {
+        std::copy(src, src + width_, dst);  // finite (checked, missing ones filled)
+      } else {
+        for (std::size_t x = 0; x < width_; ++x) {
+          dst[x] = float(double(src[x]) * z_scale_);
+          finite &= std::isfinite(dst[x]);
+        }
       }
+      std::fill(dst + width_, dst + n, dst[width_ - 1]);
+    }
+    if (!finite) throw Error("terrain: a height times z_scale overflows a float");
   });
   field.heights = {};
 
   const std::int64_t N = std::int64_t(n) - 1, c = N / 2;
-  auto inside = [&](P2 p) { return p.x <= W - 1 && p.y <= H - 1; };
   // Own error of each vertex: the largest vertical distance between the grid and
   // the triangles it splits (its diamond); +inf where the diamond leaves the
   // field (the padding), so that those vertices are always refined and no
-  // final triangle straddles the field's border.
-  std::vector<float> err(n * n, 0.0f);
-  parallel_for(0, n, 1, [&](std::size_t b, std::size_t e) {
-    for (std::size_t yy = b; yy < e; ++yy)
-      for (std::size_t xx = 0; xx < n; ++xx) {
-        const std::int64_t x = std::int64_t(xx), y = std::int64_t(yy);
-        if ((x == 0 || x == N) && (y == 0 || y == N)) continue;
-        if (x == c && y == c) continue;  // the centre is always in the mesh
-        const int t = std::countr_zero(std::uint64_t(x | y));
-        const std::int64_t s = std::int64_t(1) << t;
-        P2 h0, h1, apex[2];
-        int apexes = 0;
-        if (((x >> t) & 1) && ((y >> t) & 1)) {  // red: square centre
-          const bool main_parents = ((((x - s) >> (t + 1)) + ((y - s) >> (t + 1))) & 1) != 0;
-          if (main_parents) {  // parents (x-s, y-s), (x+s, y+s); hypotenuse the other diagonal
-            apex[0] = {x - s, y - s}, apex[1] = {x + s, y + s}, h0 = {x - s, y + s}, h1 = {x + s, y - s};
-          } else {
-            apex[0] = {x - s, y + s}, apex[1] = {x + s, y - s}, h0 = {x - s, y - s}, h1 = {x + s, y + s};
-          }
-          apexes = 2;
-        } else if ((x >> t) & 1) {  // blue on a horizontal edge
-          h0 = {x - s, y}, h1 = {x + s, y};
-          if (y - s >= 0) apex[apexes++] = {x, y - s};
-          if (y + s <= N) apex[apexes++] = {x, y + s};
-        } else {  // blue on a vertical edge
-          h0 = {x, y - s}, h1 = {x, y + s};
-          if (x - s >= 0) apex[apexes++] = {x - s, y};
-          if (x + s <= N) apex[apexes++] = {x + s, y};
-        }
-        double worst = 0;
-        for (int k = 0; k < apexes; ++k) {
-          if (!inside(h0) || !inside(h1) || !inside(apex[k])) {
-            worst = kInf;
-            break;
-          }
-          worst = std::max(worst, triangle_error(z.data(), n, h0, h1, apex[k]));
-        }
-        err[yy * n + xx] = round_up(worst);
-      }
-  });
+  // final triangle straddles the field's border. Level by level, every
+  // triangle's rows as spans known by arithmetic (no point-in-triangle tests).
+  std::vector<float, HugePageAllocator<float>> err(n * n, 0.0f);
+  own_errors(z.data(), std::int64_t(n), W, H, K, err.data());
 
   // Nesting, finest level first: error = max(own, children's); radius = max over
   // children of (distance + child's radius), rounded up, so that a child's
   // sphere lies in its parent's.
-  std::vector<float> rad(n * n, 0.0f);
+  std::vector<float, HugePageAllocator<float>> rad(n * n, 0.0f);
   const double sx = std::abs(spacing_[0]), sy = std::abs(spacing_[1]);
-  auto nest = [&](std::int64_t x, std::int64_t y, P2 child) {
-    if (child.x < 0 || child.y < 0 || child.x > N || child.y > N) return;
-    const std::size_t v = std::size_t(y * std::int64_t(n) + x), w = std::size_t(child.y * std::int64_t(n) + child.x);
-    err[v] = std::max(err[v], err[w]);
-    const double dx = double(child.x - x) * sx, dy = double(child.y - y) * sy, dz = double(z[w]) - double(z[v]);
-    rad[v] = std::max(rad[v], round_up(std::sqrt(dx * dx + dy * dy + dz * dz) + double(rad[w])));
+  // Vertex (x, y) from its children at offsets off[k] (skipped outside the
+  // grid); the radius is rounded up once (rounding up is monotone).
+  struct Children {
+    std::array<P2, 4> off;
+    std::array<std::ptrdiff_t, 4> dw;  // index offsets
+    std::array<double, 4> d2;          // squared horizontal distances
+  };
+  auto children = [&](const std::array<P2, 4>& off) {
+    Children ch{off, {}, {}};
+    for (int k = 0; k < 4; ++k) {
+      const double dx = double(off[k].x) * sx, dy = double(off[k].y) * sy;
+      ch.dw[k] = off[k].y * std::ptrdiff_t(n) + off[k].x, ch.d2[k] = dx * dx + dy * dy;
+    }
+    return ch;
+  };
+  auto nest = [&](std::int64_t x, std::int64_t y, const Children& ch, bool interior) {
+    const std::size_t v = std::size_t(y * std::int64_t(n) + x);
+    std::size_t w[4];
+    double d2[4];
+    int k = 0;
+    if (interior) {
+      for (; k < 4; ++k) w[k] = std::size_t(std::ptrdiff_t(v) + ch.dw[k]), d2[k] = ch.d2[k];
+    } else {
+      for (int j = 0; j < 4; ++j) {
+        const P2 c{x + ch.off[j].x, y + ch.off[j].y};
+        if (c.x < 0 || c.y < 0 || c.x > N || c.y > N) continue;
+        w[k] = std::size_t(std::ptrdiff_t(v) + ch.dw[j]), d2[k++] = ch.d2[j];
+      }
+    }
+    float e = err[v];
+    for (int j = 0; j < k; ++j) e = std::max(e, err[w[j]]);
+    err[v] = e;
+    const double zv = z[v];
+    double best = 0;
+#if defined(__SSE2__)
+    if (k == 4) {  // two square roots at a time
+      const __m128d vz = _mm_set1_pd(zv);
+      const __m128d a = _mm_sub_pd(_mm_set_pd(z[w[1]], z[w[0]]), vz), b = _mm_sub_pd(_mm_set_pd(z[w[3]], z[w[2]]), vz);
+      const __m128d ra = _mm_add_pd(_mm_sqrt_pd(_mm_add_pd(_mm_set_pd(d2[1], d2[0]), _mm_mul_pd(a, a))),
+                                    _mm_set_pd(rad[w[1]], rad[w[0]]));
+      const __m128d rb = _mm_add_pd(_mm_sqrt_pd(_mm_add_pd(_mm_set_pd(d2[3], d2[2]), _mm_mul_pd(b, b))),
+                                    _mm_set_pd(rad[w[3]], rad[w[2]]));
+      const __m128d m = _mm_max_pd(ra, rb);
+      best = std::max(_mm_cvtsd_f64(m), _mm_cvtsd_f64(_mm_unpackhi_pd(m, m)));
+      k = 0;
+    }
+#endif
+    for (int j = 0; j < k; ++j) {
+      const double dz = double(z[w[j]]) - zv;
+      best = std::max(best, std::sqrt(d2[j] + dz * dz) + double(rad[w[j]]));
+    }
+    rad[v] = round_up(best);
   };
   for (std::uint32_t t = 0; t < K; ++t) {
     const std::int64_t s = std::int64_t(1) << t;
-    // Blue vertices of spacing s: children are the red ones of spacing s / 2.
-    parallel_for(0, std::size_t(N / s + 1), 4, [&](std::size_t b, std::size_t e) {
-      for (std::size_t r = b; r < e; ++r) {
-        const std::int64_t y = std::int64_t(r) * s;
-        for (std::int64_t x = ((r & 1) ? 0 : s); x <= N; x += 2 * s) {
-          if (s < 2) continue;
-          const std::int64_t h = s / 2;
-          for (const P2 ch : {P2{x - h, y - h}, P2{x + h, y - h}, P2{x - h, y + h}, P2{x + h, y + h}}) nest(x, y, ch);
+    // Blue vertices of spacing s >= 2: children are the red ones of spacing s / 2.
+    if (s >= 2) {
+      const std::int64_t h = s / 2;
+      const Children ch = children({P2{-h, -h}, P2{h, -h}, P2{-h, h}, P2{h, h}});
+      parallel_for(0, std::size_t(N / s + 1), 4, [&](std::size_t b, std::size_t e) {
+        for (std::size_t r = b; r < e; ++r) {
+          const std::int64_t y = std::int64_t(r) * s;
+          const bool inner_row = y > 0 && y < N;
+          for (std::int64_t x = ((r & 1) ? 0 : s); x <= N; x += 2 * s) nest(x, y, ch, inner_row && x > 0 && x < N);
         }
-      }
-    });
+      });
+    }
     // Red vertices of spacing s (square centres): children the blue ones of spacing s.
+    const Children ch = children({P2{-s, 0}, P2{s, 0}, P2{0, -s}, P2{0, s}});
     parallel_for(0, std::size_t(N / (2 * s)), 4, [&](std::size_t b, std::size_t e) {
       for (std::size_t r = b; r < e; ++r) {
         const std::int64_t y = std::int64_t(2 * r + 1) * s;
-        for (std::int64_t x = s; x < N; x += 2 * s)
-          for (const P2 ch : {P2{x - s, y}, P2{x + s, y}, P2{x, y - s}, P2{x, y + s}}) nest(x, y, ch);
+        for (std::int64_t x = s; x < N; x += 2 * s) nest(x, y, ch, true);
       }
     });
   }
 
-  std::vector<VertexRecord> records(index_.slots());
-  parallel_for(0, n, 16, [&](std::size_t b, std::size_t e) {
-    for (std::size_t y = b; y < e; ++y)
-      for (std::size_t x = 0; x < n; ++x)
-        records[index_.slot(std::uint32_t(x), std::uint32_t(y))] = {z[y * n + x], err[y * n + x], rad[y * n + x]};
-  });
+  std::vector<VertexRecord> records(index_.slots());  // (huge pages here stalled now and then on a loaded machine)
+  auto put = [&](std::size_t slot, std::size_t g) { records[slot] = {z[g], err[g], rad[g]}; };
+  if (index_.layout() == Layout::matrix) {
+    parallel_for(0, n * n, 4096, [&](std::size_t b, std::size_t e) {
+      for (std::size_t g = b; g < e; ++g) put(g, g);
+    });
+  } else {
+    // Level by level; along a row of blue vertices of spacing s (step 2 s)
+    // both coordinates of the level's Morton code grow by one.
+    for (const std::size_t g : {std::size_t(0), std::size_t(N), std::size_t(N) * n, std::size_t(N) * n + std::size_t(N),
+                                std::size_t(c) * n + std::size_t(c)})
+      put(index_.interleaved_slot(std::uint32_t(g % n), std::uint32_t(g / n)), g);
+    constexpr std::uint64_t kEven = 0x5555555555555555ull, kOdd = ~kEven;
+    for (std::uint32_t t = 0; t < K; ++t) {
+      const std::int64_t s = std::int64_t(1) << t;
+      const std::uint64_t base = index_.level_base(t);
+      // Rows k s: blue at x = s, 3s, ... (k even) or x = 0, 2s, ... (k odd);
+      // red at x = s, 3s, ... (k odd).
+      parallel_for(0, std::size_t(N / s + 1), 4, [&](std::size_t b, std::size_t e) {
+        for (std::size_t k = b; k < e; ++k) {
+          const std::int64_t y = std::int64_t(k) * s, row = y * std::int64_t(n);
+          const std::int64_t x0 = (k & 1) ? 0 : s;
+          std::uint64_t m = index_.interleaved_slot(std::uint32_t(x0), std::uint32_t(y)) - base;
+          for (std::int64_t x = x0; x <= N; x += 2 * s) {
+            put(base + m, std::size_t(row + x));
+            m = (((m | kOdd) + 1) & kEven) | (((m | kEven) + 2) & kOdd);
+          }
+          // Red ones: within a run of the same quarter turns the ghost slot
+          // moves by a reflection of the step, both Morton coordinates by +1
+          // (an even number of turns) or -1 (odd).
+          int run = -1;
+          if (k & 1)
+            for (std::int64_t x = s; x < N; x += 2 * s) {
+              if (x == c && y == c) continue;
+              std::int64_t dx = x - c, dy = y - c;
+              const int q = red_turns(dx, dy);
+              if (q != run) {
+                m = index_.interleaved_slot(std::uint32_t(x), std::uint32_t(y)) - base, run = q;
+              } else if (q & 1) {
+                m = (((m & kEven) - 1) & kEven) | (((m & kOdd) - 2) & kOdd);
+              } else {
+                m = (((m | kOdd) + 1) & kEven) | (((m | kEven) + 2) & kOdd);
+              }
+              put(base + m, std::size_t(row + x));
+            }
+        }
+      });
+    }
+  }
   records_ = FlatArray<VertexRecord>(std::move(records));
   build_s_ = seconds_since(t0);
 }

@@ -281,6 +281,83 @@ TEST(Terrain, NestedErrorsAndSpheresOverTheBruteForceDag) {
   }
 }
 
+// The largest |sample - plane| over the samples of the closed triangle (a, b, c),
+// by brute force: every sample of the bounding box located by exact integer
+// orientation tests, the plane by barycentric weights.
+double triangle_error_brute(const Terrain& t, std::array<std::int64_t, 2> a, std::array<std::int64_t, 2> b,
+                            std::array<std::int64_t, 2> c) {
+  auto orient = [](auto p, auto q, auto r) { return (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0]); };
+  if (orient(a, b, c) < 0) std::swap(b, c);
+  const double area = double(orient(a, b, c));
+  auto h = [&](auto p) { return double(t.sample(std::uint32_t(p[0]), std::uint32_t(p[1]))); };
+  double worst = 0;
+  for (std::int64_t y = std::min({a[1], b[1], c[1]}); y <= std::max({a[1], b[1], c[1]}); ++y)
+    for (std::int64_t x = std::min({a[0], b[0], c[0]}); x <= std::max({a[0], b[0], c[0]}); ++x) {
+      const std::array<std::int64_t, 2> p{x, y};
+      const std::int64_t wa = orient(b, c, p), wb = orient(c, a, p), wc = orient(a, b, p);
+      if (wa < 0 || wb < 0 || wc < 0) continue;
+      const double plane = (double(wa) * h(a) + double(wb) * h(b) + double(wc) * h(c)) / area;
+      worst = std::max(worst, std::abs(h(p) - plane));
+    }
+  return worst;
+}
+
+TEST(Terrain, NestedErrorsEqualTheBruteForceErrorsOverTheDag) {
+  // Own error of a split vertex = the largest error of the triangles it splits
+  // (infinite when one leaves the field), nested over its descendants in the
+  // DAG of explicit longest-edge bisection.
+  const std::vector<std::pair<std::string, HeightField>> fields = {
+      {"noise 33x33", noise(33, 33, 11)},
+      {"noise 23x11 (padded)", noise(23, 11, 12, 1000)},
+      {"spikes", field_of(33, 33, [](double x, double y) { return (int(x) % 7 == 3 && int(y) % 5 == 1) ? 100.0 : 0.0; })},
+      {"real 70x45 (padded)", real_field()},
+  };
+  for (const auto& [name, f] : fields) {
+    SCOPED_TRACE(name);
+    const Terrain t(f, {.z_scale = 1.5});
+    const std::int64_t N = std::int64_t(t.layout().n()) - 1, c = N / 2, n = N + 1;
+    using P = std::array<std::int64_t, 2>;
+    struct T {
+      P apex, l, r;
+    };
+    std::vector<T> stack = {{{c, c}, {0, 0}, {N, 0}}, {{c, c}, {N, 0}, {N, N}}, {{c, c}, {N, N}, {0, N}}, {{c, c}, {0, N}, {0, 0}}};
+    std::vector<double> nested(std::size_t(n * n), 0.0);
+    std::set<std::pair<std::int64_t, std::int64_t>> edges;  // (parent, child) as y n + x
+    auto inside = [&](P p) { return p[0] < std::int64_t(t.width()) && p[1] < std::int64_t(t.height()); };
+    while (!stack.empty()) {
+      const T tri = stack.back();
+      stack.pop_back();
+      if ((tri.l[0] + tri.r[0]) % 2 || (tri.l[1] + tri.r[1]) % 2) continue;
+      const P m{(tri.l[0] + tri.r[0]) / 2, (tri.l[1] + tri.r[1]) / 2};
+      double& own = nested[std::size_t(m[1] * n + m[0])];
+      own = std::max(own, inside(tri.apex) && inside(tri.l) && inside(tri.r)
+                              ? triangle_error_brute(t, tri.l, tri.r, tri.apex)
+                              : std::numeric_limits<double>::infinity());
+      edges.insert({tri.apex[1] * n + tri.apex[0], m[1] * n + m[0]});
+      stack.push_back({m, tri.l, tri.apex});
+      stack.push_back({m, tri.apex, tri.r});
+    }
+    for (bool changed = true; changed;) {  // nest to a fixed point
+      changed = false;
+      for (const auto& [p, ch] : edges)
+        if (nested[std::size_t(ch)] > nested[std::size_t(p)]) nested[std::size_t(p)] = nested[std::size_t(ch)], changed = true;
+    }
+    std::size_t infinite = 0;
+    for (std::int64_t y = 0; y <= N; ++y)
+      for (std::int64_t x = 0; x <= N; ++x) {
+        const double want = nested[std::size_t(y * n + x)], got = t.record(std::uint32_t(x), std::uint32_t(y)).error;
+        if (std::isinf(want)) {
+          ASSERT_TRUE(std::isinf(got)) << x << "," << y;
+          ++infinite;
+        } else {
+          ASSERT_GE(got, want * (1 - 1e-12)) << x << "," << y << ": not a bound";
+          ASSERT_LE(got, want * (1 + 1e-6) + 1e-9) << x << "," << y << ": not tight";
+        }
+      }
+    EXPECT_EQ(infinite > 0, t.width() != std::uint64_t(n) || t.height() != std::uint64_t(n));
+  }
+}
+
 TEST(Terrain, InterleavedLayoutSlotsAgainstBruteForce) {
   for (std::uint32_t K = 1; K <= 7; ++K) {
     SCOPED_TRACE(K);

@@ -4,7 +4,9 @@
 // Variants: e<T>: the 4-8 mesh within T of every sample (build_s = the hierarchy, query_s =
 // the refinement); tin_e<T>: the greedy TIN within T; view: view-dependent refinement
 // (tau = 1 pixel, 1024 x 768, 60 degrees) from 16 low viewpoints, query_s = per view;
-// view_matrix: the same with the matrix layout. Every mesh's error is measured against
+// view_matrix: the same with the matrix layout; stream_bound: the floor of the exact nested
+// errors, one streaming pass per level (2 log2(n - 1) passes) of the library's row kernel
+// max |z - plane| over every row of the grid. Every mesh's error is measured against
 // every sample (max_error) and must be <= T.
 #include <cmath>
 #include <cstdio>
@@ -12,6 +14,7 @@
 
 #include "common.hpp"
 #include "geods/terrain/terrain.hpp"
+#include "triangle_raster.hpp"
 
 using namespace geods;
 
@@ -37,6 +40,26 @@ int main(int argc, char** argv) {
   const terrain::HeightField field = field_1025();
   terrain::Terrain t;
   const double build_s = compare::median_time_s(args.reps, [&] { t = terrain::Terrain(field); });
+  if (args.wants("stream_bound")) {
+    // What the exact errors cost at least: every sample against one plane per level,
+    // as whole rows (no triangle boundaries, no planes to set up, nothing to nest).
+    const std::int64_t n = 1025;
+    const int passes = 2 * 10;
+    double worst = 0;
+    const double s = compare::median_time_s(args.reps, [&] {
+      worst = 0;
+      for (int level = 0; level < passes; ++level)
+        for (std::int64_t y = 0; y < n; ++y)
+          worst = std::max(worst, terrain::detail::row_max(field.heights.data() + y * n, 0, n - 1, 300.0 + 0.01 * double(y),
+                                                           1e-3 * level, 0));
+    });
+    compare::Record("terrain", "geods", "stream_bound", args.threads)
+        .timing(s, 0, std::size_t(passes) * std::size_t(n * n), args.reps)
+        .set("passes", passes)
+        .set("samples", std::size_t(passes) * std::size_t(n * n))
+        .set("ns_per_sample", 1e9 * s / double(passes * n * n))
+        .print(worst > 0);
+  }
   for (const double target : {2.0, 4.0, 8.0, 16.0, 32.0}) {
     const std::string e = std::to_string(int(target));
     if (args.wants("e" + e)) {
