@@ -42,7 +42,12 @@ def test_distance_within_the_bound(checks, bound):
     assert np.abs(d - box_sdf(p.astype(np.float64))).max() <= bound * error
     s = adf.stats()
     assert set(s) >= {"cells", "leaves", "depth", "bytes", "dense_bytes", "unresolved", "exact_queries"}
-    assert s["unresolved"] == 0 and s["bytes"] == 4 * (s["cells"] + 8 * s["leaves"])
+    # Every byte: tree bits and ranks (12 bytes per 64 cells), buckets, a 16-bit key part and value per
+    # distinct corner (shared: fewer than 8 a leaf).
+    words = (s["cells"] + 63) // 64
+    assert s["unresolved"] == 0 and s["value_bits"] == 16 and 0 < s["quantum"] <= error / 8
+    assert 4 * s["corners"] + 12 * words < s["bytes"] <= 4 * s["corners"] + 12 * words + 4 * (s["corners"] // 32 + 2)
+    assert s["corners"] < 8 * s["leaves"]
     assert s["dense_bytes"] == 4 * (2 ** s["depth"] + 1) ** 3
 
 
