@@ -20,7 +20,7 @@ namespace geods::field {
 namespace {
 
 constexpr char kKind[] = "field.Adf";
-// 2: shared 16-bit corners, one bit a cell (version 1: 32-bit nodes and 8 floats a leaf).
+// 2: shared quantized corners, one bit a cell (version 1: 32-bit nodes and 8 floats a leaf).
 constexpr std::uint32_t kVersion = 2;
 // The build's temporary node: the leaf bit, else the first child's index.
 constexpr std::uint32_t kLeaf = 0x80000000u;
@@ -33,9 +33,22 @@ struct Params {
   double origin[3];
   double size;
   std::uint64_t cells, corners;
-  std::int32_t depth, shift, key_words, value_bits;
+  std::int32_t depth, shift, value_bits, reserved2;
   double value_lo, quantum;
 };
+
+// n fields of `bits` bits packed in 64-bit words, with a word of padding (see Adf::unpack).
+std::size_t packed_words(std::size_t n, int bits) { return (n * std::size_t(bits) + 63) / 64 + 1; }
+
+std::vector<std::uint64_t> pack(const std::vector<std::uint64_t>& fields, int bits) {
+  std::vector<std::uint64_t> words(packed_words(fields.size(), bits), 0);
+  for (std::size_t i = 0; i < fields.size(); ++i) {
+    const std::size_t at = i * std::size_t(bits), w = at >> 6, o = at & 63;
+    words[w] |= fields[i] << o;
+    if (o + std::size_t(bits) > 64) words[w + 1] |= fields[i] >> (64 - o);
+  }
+  return words;
+}
 
 // The key of lattice point (x, y, z) on the (n + 1)^3 lattice.
 std::uint64_t lattice_key(std::uint64_t x, std::uint64_t y, std::uint64_t z, std::uint64_t n) {
@@ -181,12 +194,16 @@ Adf Adf::build(const TriMesh& source, const MeshDistance& mesh, const AdfOptions
   for (const float v : level[0].corners) range = std::max(range, double(std::abs(v)));
   range = (range + adf.size_ * std::sqrt(3.0) / 2) * (1 + 1e-6);
   if (std::isfinite(options.band)) range = std::min(range, 2 * options.band);
-  // 16-bit steps of [-range, range] when a step is at most E / 8; the test
-  // then leaves a step of the error (half for the rounding, half for the
-  // float differences of one vertex computed from different cells).
-  const double quantum = 2 * range / 65535;
-  const bool quantize = quantum <= options.error / 8;
-  const float error = float(quantize ? options.error - quantum : options.error);
+  // b-bit steps of [-range, range], the fewest bits (at most 16) whose step
+  // is at most E / 8; the test then leaves a step of the error (half for the
+  // rounding, half for the float differences of one vertex computed from
+  // different cells). Floats when 16 bits are too coarse.
+  int value_bits = 1;
+  while (value_bits <= 16 && 2 * range / double((1 << value_bits) - 1) > options.error / 8) ++value_bits;
+  const bool quantize = value_bits <= 16;
+  const double quantum = quantize ? 2 * range / double((1 << value_bits) - 1) : 0;
+  if (!quantize) value_bits = 32;
+  const float error = float(options.error - quantum);
   std::vector<CellResult> results;
   const double memory = physical_memory();
 
@@ -281,7 +298,7 @@ Adf Adf::build(const TriMesh& source, const MeshDistance& mesh, const AdfOptions
     }
     std::swap(level, next);
   }
-  adf.store(nodes, values, quantize ? quantum : 0, -range);
+  adf.store(nodes, values, value_bits, quantum, -range);
   adf.stats_.exact_queries = queries;
   adf.stats_.unresolved = unresolved;
   adf.stats_.signs = signs;
@@ -289,7 +306,8 @@ Adf Adf::build(const TriMesh& source, const MeshDistance& mesh, const AdfOptions
   return adf;
 }
 
-void Adf::store(const std::vector<std::uint32_t>& nodes, const std::vector<float>& values, double quantum, double lo) {
+void Adf::store(const std::vector<std::uint32_t>& nodes, const std::vector<float>& values, int value_bits, double quantum,
+                double lo) {
   cells_ = nodes.size();
   std::vector<std::uint64_t> inner((cells_ + 63) / 64, 0);
   for (std::size_t i = 0; i < cells_; ++i)
@@ -337,40 +355,38 @@ void Adf::store(const std::vector<std::uint32_t>& nodes, const std::vector<float
                 corners.end());
   corners_ = corners.size();
   if (corners_ >= kNoIndex) throw Error("adf: more than 2^32 distinct corners: a larger error or a smaller max_depth");
-  // Buckets of about 32 keys (a byte of offsets per 8 corners), or of 2^16
-  // lattice points when that table is not larger than 2 bytes a corner.
+  // Buckets of about 32 keys (32 bits of offset for 32 corners: the fewest
+  // bits a corner, offsets and key parts together, are at about 22).
   const std::uint64_t last = lattice_key(n, n, n, n);
   const std::uint64_t target = std::max<std::uint64_t>(1, corners_ / 32);
   shift_ = 0;
   while ((last >> shift_) + 1 > target) ++shift_;
-  if (shift_ > 16 && (last >> 16) + 1 <= std::max<std::uint64_t>(1, corners_ / 2)) shift_ = 16;
-  key_words_ = shift_ <= 16 ? 1 : shift_ <= 32 ? 2 : 4;
   const std::uint64_t mask = shift_ >= 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << shift_) - 1;
   std::vector<std::uint32_t> buckets(std::size_t(last >> shift_) + 2, 0);
-  std::vector<std::uint16_t> keys(corners_ * std::size_t(key_words_));
+  std::vector<std::uint64_t> fields(corners_);
   for (std::size_t i = 0; i < corners_; ++i) {
     ++buckets[std::size_t(corners[i].first >> shift_) + 1];
-    const std::uint64_t low = corners[i].first & mask;
-    for (int w = 0; w < key_words_; ++w) keys[i * std::size_t(key_words_) + std::size_t(w)] = std::uint16_t(low >> (16 * w));
+    fields[i] = corners[i].first & mask;
   }
   for (std::size_t b = 1; b < buckets.size(); ++b) buckets[b] += buckets[b - 1];
+  keys_ = FlatArray<std::uint64_t>(pack(fields, shift_));
+  value_bits_ = value_bits;
   quantum_ = quantum;
   value_lo_ = quantum > 0 ? lo : 0;
   if (quantum > 0) {
-    std::vector<std::uint16_t> q(corners_);
+    const long long top = (1LL << value_bits) - 1;
     for (std::size_t i = 0; i < corners_; ++i)
-      q[i] = std::uint16_t(std::clamp(std::llround((double(corners[i].second) - lo) / quantum), 0LL, 65535LL));
-    values16_ = FlatArray<std::uint16_t>(std::move(q));
+      fields[i] = std::uint64_t(std::clamp(std::llround((double(corners[i].second) - lo) / quantum), 0LL, top));
+    values_ = FlatArray<std::uint64_t>(pack(fields, value_bits));
     values32_ = {};
   } else {
     std::vector<float> v(corners_);
     for (std::size_t i = 0; i < corners_; ++i) v[i] = corners[i].second;
     values32_ = FlatArray<float>(std::move(v));
-    values16_ = {};
+    values_ = {};
   }
   inner_ = FlatArray<std::uint64_t>(std::move(inner));
   buckets_ = FlatArray<std::uint32_t>(std::move(buckets));
-  keys_ = FlatArray<std::uint16_t>(std::move(keys));
   make_ranks();
 }
 
@@ -389,22 +405,13 @@ std::size_t Adf::find_corner(std::uint64_t key) const {
   if (b + 1 >= buckets_.size()) return kNoIndex;
   const std::uint64_t low = shift_ >= 64 ? key : key & ((std::uint64_t(1) << shift_) - 1);
   std::size_t lo = buckets_[b], hi = buckets_[b + 1];
-  if (key_words_ == 1) {
-    const std::uint16_t* k = keys_.data();
-    const std::uint16_t* it = std::lower_bound(k + lo, k + hi, std::uint16_t(low));
-    return it != k + hi && *it == low ? std::size_t(it - k) : kNoIndex;
-  }
-  auto at = [&](std::size_t i) {
-    std::uint64_t v = 0;
-    for (int w = 0; w < key_words_; ++w) v |= std::uint64_t(keys_[i * std::size_t(key_words_) + std::size_t(w)]) << (16 * w);
-    return v;
-  };
+  const std::uint64_t* k = keys_.data();
   while (lo < hi) {
     const std::size_t mid = lo + (hi - lo) / 2;
-    if (at(mid) < low) lo = mid + 1;
+    if (unpack(k, mid, shift_) < low) lo = mid + 1;
     else hi = mid;
   }
-  return lo < std::size_t(buckets_[b + 1]) && at(lo) == low ? lo : kNoIndex;
+  return lo < std::size_t(buckets_[b + 1]) && unpack(k, lo, shift_) == low ? lo : kNoIndex;
 }
 
 void Adf::cell_corners(int level, std::uint64_t x, std::uint64_t y, std::uint64_t z, float out[8]) const {
@@ -426,9 +433,10 @@ void Adf::finish_stats() {
   stats_.leaves = cells_ - inner;
   stats_.depth = std::size_t(depth_);
   stats_.corners = corners_;
-  stats_.value_bits = values16_.empty() ? 32 : 16;
+  stats_.value_bits = std::size_t(value_bits_);
+  stats_.key_bits = std::size_t(shift_);
   stats_.quantum = quantum_;
-  stats_.bytes = 8 * inner_.size() + 4 * rank_.size() + 4 * buckets_.size() + 2 * keys_.size() + 2 * values16_.size() +
+  stats_.bytes = 8 * inner_.size() + 4 * rank_.size() + 4 * buckets_.size() + 8 * keys_.size() + 8 * values_.size() +
                  4 * values32_.size();
   const double side = double(std::uint64_t(1) << depth_) + 1;
   stats_.dense_bytes = std::size_t(4 * side * side * side);
@@ -458,33 +466,30 @@ void Adf::validate() const {
     throw Error(fmt::format("adf: the tree has depth {}, recorded {} (max_depth {})", levels - 1, depth_, options_.max_depth));
   // Buckets and keys.
   const std::uint64_t n = std::uint64_t(1) << depth_, last = lattice_key(n, n, n, n);
-  if (shift_ < 0 || shift_ > 64 || !(key_words_ == 1 || key_words_ == 2 || key_words_ == 4) || shift_ > 16 * key_words_)
-    throw Error(fmt::format("adf: bad key layout (shift {}, {} words)", shift_, key_words_));
-  if (buckets_.size() != std::size_t(last >> shift_) + 2 || buckets_[0] != 0 || buckets_.back() != corners_ ||
-      keys_.size() != corners_ * std::size_t(key_words_))
+  if (shift_ < 0 || shift_ > 64) throw Error(fmt::format("adf: bad key layout (shift {})", shift_));
+  if (buckets_.size() != std::size_t(shift_ >= 64 ? 0 : last >> shift_) + 2 || buckets_[0] != 0 || buckets_.back() != corners_ ||
+      keys_.size() != packed_words(corners_, shift_))
     throw Error(fmt::format("adf: {} buckets and {} key words for {} corners do not match", buckets_.size(), keys_.size(), corners_));
   for (std::size_t b = 0; b + 1 < buckets_.size(); ++b) {
     if (buckets_[b] > buckets_[b + 1]) throw Error(fmt::format("adf: bucket {} starts after the next one", b));
     for (std::size_t i = buckets_[b]; i < buckets_[b + 1]; ++i) {
-      std::uint64_t low = 0, prev = 0;
-      for (int w = 0; w < key_words_; ++w) {
-        low |= std::uint64_t(keys_[i * std::size_t(key_words_) + std::size_t(w)]) << (16 * w);
-        if (i > buckets_[b]) prev |= std::uint64_t(keys_[(i - 1) * std::size_t(key_words_) + std::size_t(w)]) << (16 * w);
-      }
+      const std::uint64_t low = unpack(keys_.data(), i, shift_);
       const std::uint64_t key = shift_ >= 64 ? low : (std::uint64_t(b) << shift_) | low;
-      if ((shift_ < 64 && low >> shift_) || key > last || (i > buckets_[b] && prev >= low))
+      if (key > last || (i > buckets_[b] && unpack(keys_.data(), i - 1, shift_) >= low))
         throw Error(fmt::format("adf: corner key {} is out of order or out of range", i));
     }
   }
   // Values.
   const float outer = std::isfinite(options_.band) ? float(2 * options_.band) : std::numeric_limits<float>::max();
-  if (values16_.empty() == values32_.empty()) throw Error("adf: the values are neither 16-bit nor float");
-  if (!values16_.empty()) {
-    if (values16_.size() != corners_ || !std::isfinite(value_lo_) || !std::isfinite(quantum_) || !(quantum_ > 0) ||
-        !(std::abs(value_lo_) <= 1.01 * double(outer)) || !(std::abs(value_lo_ + 65535 * quantum_) <= 1.01 * double(outer)))
-      throw Error(fmt::format("adf: bad 16-bit values ({} for {} corners, from {} by {})", values16_.size(), corners_, value_lo_,
-                              quantum_));
+  if (value_bits_ <= 16) {
+    const double top = value_lo_ + double((1 << value_bits_) - 1) * quantum_;
+    if (value_bits_ < 1 || values_.size() != packed_words(corners_, value_bits_) || !values32_.empty() ||
+        !std::isfinite(value_lo_) || !std::isfinite(quantum_) || !(quantum_ > 0) ||
+        !(std::abs(value_lo_) <= 1.01 * double(outer)) || !(std::abs(top) <= 1.01 * double(outer)))
+      throw Error(fmt::format("adf: bad {}-bit values ({} words for {} corners, from {} by {})", value_bits_, values_.size(),
+                              corners_, value_lo_, quantum_));
   } else {
+    if (value_bits_ != 32 || !values_.empty()) throw Error(fmt::format("adf: {}-bit values are not 1 to 16 or 32", value_bits_));
     if (values32_.size() != corners_) throw Error(fmt::format("adf: {} values for {} corners", values32_.size(), corners_));
     for (std::size_t i = 0; i < corners_; ++i)
       if (!(std::abs(values32_[i]) <= outer))
@@ -585,8 +590,8 @@ void Adf::save(const std::filesystem::path& path) const {
            corners_,
            depth_,
            shift_,
-           key_words_,
-           values16_.empty() ? 32 : 16,
+           value_bits_,
+           0,
            value_lo_,
            quantum_};
   ArchiveWriter w(kKind, kVersion);
@@ -595,8 +600,8 @@ void Adf::save(const std::filesystem::path& path) const {
   w.add("inner", inner_);
   w.add("buckets", buckets_);
   w.add("keys", keys_);
-  if (values16_.empty()) w.add("values", values32_);
-  else w.add("values", values16_);
+  if (values_.empty()) w.add("values", values32_);
+  else w.add("values", values_);
   w.write(path);
 }
 
@@ -618,15 +623,15 @@ Adf Adf::load(const std::filesystem::path& path, Archive::Verify verify) {
   adf.corners_ = std::size_t(p.corners);
   adf.depth_ = p.depth;
   adf.shift_ = p.shift;
-  adf.key_words_ = p.key_words;
+  adf.value_bits_ = p.value_bits;
   adf.value_lo_ = p.value_lo;
   adf.quantum_ = p.quantum;
   adf.inner_ = a.array<std::uint64_t>("inner");
   adf.buckets_ = a.array<std::uint32_t>("buckets");
-  adf.keys_ = a.array<std::uint16_t>("keys");
-  if (p.value_bits == 16) adf.values16_ = a.array<std::uint16_t>("values");
+  adf.keys_ = a.array<std::uint64_t>("keys");
+  if (p.value_bits >= 1 && p.value_bits <= 16) adf.values_ = a.array<std::uint64_t>("values");
   else if (p.value_bits == 32) adf.values32_ = a.array<float>("values");
-  else throw a.error(fmt::format("{}-bit values are not 16 or 32", p.value_bits));
+  else throw a.error(fmt::format("{}-bit values are not 1 to 16 or 32", p.value_bits));
   const AdfStats stored = a.value<AdfStats>("stats");
   a.check([&] {
     if (adf.inner_.size() != (adf.cells_ + 63) / 64) throw Error("adf: the tree bits do not match the cells");

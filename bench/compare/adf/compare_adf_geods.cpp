@@ -77,13 +77,13 @@ int main(int argc, char** argv) {
   const geods::field::AdfStats st = adf.stats();
   const std::size_t dense_bytes = dense.distance.size() * sizeof(float);
   // The same measured max error: rebuilt with E scaled by dense / measured
-  // while the ADF's measured max error exceeds the dense grid's (at most 3 times).
+  // while the ADF's measured max error exceeds the dense grid's (at most 5 times).
   geods::field::AdfError matched_error = e;
   geods::field::Adf matched = adf;
   double matched_e = options.error;
-  for (int round = 0; round < 3 && matched_error.max_error > dense_error; ++round) {
+  for (int round = 0; round < 5 && matched_error.max_error > dense_error; ++round) {
     geods::field::AdfOptions o = options;
-    o.error = matched_e = matched_e * dense_error / matched_error.max_error * 0.98;
+    o.error = matched_e = matched_e * dense_error / matched_error.max_error * 0.97;
     matched = geods::field::Adf::build(mesh, md, o);
     matched_error = geods::field::measure_adf_error(matched, mesh, md, 20000);
   }
@@ -102,6 +102,7 @@ int main(int argc, char** argv) {
       .set("depth", st.depth)
       .set("corners", st.corners)
       .set("value_bits", st.value_bits)
+      .set("key_bits", st.key_bits)
       .set("quantum", st.quantum)
       .set("float_leaf_ratio", double(dense_bytes) / float_leaf_bytes)
       .set("matched_error", matched_e)

@@ -37,11 +37,12 @@
 // stored once per distinct octree vertex (shared by the up to 8 leaves that
 // meet there), sorted by their key x + (N + 1) (y + (N + 1) z) on the lattice
 // of the finest cells (N = 2^depth): the key's high bits select a bucket (an
-// offset table), its low bits are stored in 16-bit words and found by binary
+// offset table, about 32 corners a bucket), its low bits are stored and found by binary
 // search, so a leaf finds its corners from its position without any index.
-// The values are 16-bit steps of [-R, R] (R bounds |distance| over the root
-// cube) when that step is at most E / 8, else floats; the build's test uses
-// E less one step, so the stored ADF stays within E at the test points.
+// The values are b-bit steps of [-R, R] (R bounds |distance| over the root
+// cube) with the fewest bits b <= 16 whose step is at most E / 8, else
+// floats; the build's test uses E less one step, so the stored ADF stays
+// within E at the test points. Key parts and values are bit-packed.
 // Across a level change (a T-junction) each leaf interpolates its own corners
 // (exact samples, shared where leaves meet at a vertex): a coarse leaf's face
 // does not pass through a finer neighbour's corner in its middle, so the field
@@ -91,8 +92,9 @@ struct AdfStats {
   std::size_t exact_queries = 0;  // exact distances computed by the build
   std::size_t signs = 0;          // of them, signs computed (the others: a neighbour's, see adf.cpp)
   std::size_t corners = 0;        // distinct leaf corners (octree vertices), each stored once
-  std::size_t value_bits = 0;     // 16 (quantized) or 32 (float) a corner value
-  double quantum = 0;             // the 16-bit step (0 for floats): a corner is within half of it
+  std::size_t value_bits = 0;     // bits a quantized corner value (at most 16), or 32 (floats)
+  std::size_t key_bits = 0;       // bits of key stored a corner (the rest is the bucket)
+  double quantum = 0;             // the quantization step (0 for floats): a corner is within half of it
   std::size_t bytes = 0;          // every array the ADF holds: tree bits, ranks, buckets, keys, values
   std::size_t dense_bytes = 0;    // a float grid of the finest leaves' spacing over the root cube: 4 (2^depth + 1)^3
 };
@@ -156,14 +158,22 @@ class Adf {
   /// The distinct corners' values in key order (decoded), and their number.
   std::size_t num_corners() const { return corners_; }
   float corner_value(std::size_t i) const {
-    return values16_.empty() ? values32_[i] : float(value_lo_ + quantum_ * double(values16_[i]));
+    return values32_.empty() ? float(value_lo_ + quantum_ * double(unpack(values_.data(), i, value_bits_))) : values32_[i];
+  }
+  /// Element i of an array of `bits`-bit fields packed in 64-bit words (and one word of padding).
+  static std::uint64_t unpack(const std::uint64_t* words, std::size_t i, int bits) {
+    const std::size_t at = i * std::size_t(bits), w = at >> 6, o = at & 63;
+    std::uint64_t v = words[w] >> o;
+    if (o + std::size_t(bits) > 64) v |= words[w + 1] << (64 - o);
+    return bits >= 64 ? v : v & ((std::uint64_t(1) << bits) - 1);
   }
   /// The 8 corner values (x + 2y + 4z) of the cell at integer position (x, y, z) of `level`.
   void cell_corners(int level, std::uint64_t x, std::uint64_t y, std::uint64_t z, float out[8]) const;
 
  private:
   // Takes the build's tree (per node: kLeaf | leaf, or the first child) and 8 values a leaf.
-  void store(const std::vector<std::uint32_t>& nodes, const std::vector<float>& values, double quantum, double lo);
+  void store(const std::vector<std::uint32_t>& nodes, const std::vector<float>& values, int value_bits, double quantum,
+             double lo);
   void finish_stats();
   void make_ranks();
   std::size_t find_corner(std::uint64_t key) const;
@@ -174,13 +184,13 @@ class Adf {
   std::size_t cells_ = 0, corners_ = 0;
   int depth_ = 0;             // the finest leaves' level: keys are on the (2^depth + 1)^3 lattice
   int shift_ = 0;             // a key's bucket is key >> shift; its low shift bits are stored
-  int key_words_ = 1;         // 16-bit words a stored key part
+  int value_bits_ = 32;       // bits a packed value, or 32: floats
   double value_lo_ = 0, quantum_ = 0;
   FlatArray<std::uint64_t> inner_;
   FlatArray<std::uint32_t> rank_;      // inner cells before each word of inner_ (computed on load)
   FlatArray<std::uint32_t> buckets_;   // first corner of each bucket, and the count at the end
-  FlatArray<std::uint16_t> keys_;      // the low shift bits of each corner's key, key_words_ words each
-  FlatArray<std::uint16_t> values16_;  // quantized values, or empty
+  FlatArray<std::uint64_t> keys_;      // the low shift bits of each corner's key, packed
+  FlatArray<std::uint64_t> values_;    // quantized values (value_bits_ each), packed, or empty
   FlatArray<float> values32_;          // float values when the quantum would be too coarse
   AdfStats stats_;
 };
