@@ -47,7 +47,7 @@ def test_distance_within_the_bound(checks, bound):
     def words(n, bits):
         return (n * bits + 63) // 64 + 1
     fixed = 12 * ((s["cells"] + 63) // 64) + 8 * words(s["corners"], s["key_bits"]) + 8 * words(s["corners"], s["value_bits"])
-    assert s["unresolved"] == 0 and s["value_bits"] <= 16 and error / 16 < s["quantum"] <= error / 8
+    assert s["unresolved"] == 0 and s["value_bits"] <= 16 and error / 64 < s["quantum"] <= error / 32
     assert fixed < s["bytes"] <= fixed + 4 * (s["corners"] // 32 + 2)
     assert s["corners"] < 8 * s["leaves"]
     assert s["dense_bytes"] == 4 * (2 ** s["depth"] + 1) ** 3

@@ -83,8 +83,8 @@ TEST(Adf, EveryLeafIsWithinTheErrorAtItsTestPoints) {
     // and values bit-packed in 64-bit words with a word of padding each.
     ASSERT_LE(s.value_bits, 16u);
     ASSERT_GT(s.quantum, 0.0);
-    ASSERT_LE(s.quantum, o.error / 8);
-    ASSERT_GT(s.quantum, o.error / 16);  // the fewest bits
+    ASSERT_LE(s.quantum, o.error / 32);
+    ASSERT_GT(s.quantum, o.error / 64);  // the fewest bits
     auto words = [](std::size_t n, std::size_t bits) { return (n * bits + 63) / 64 + 1; };
     const std::size_t fixed = 12 * ((s.cells + 63) / 64) + 8 * words(s.corners, s.key_bits) + 8 * words(s.corners, s.value_bits);
     ASSERT_GT(s.bytes, fixed);
@@ -380,7 +380,7 @@ TEST(Adf, OpenAndDegenerateMeshes) {
   const Adf shallow = Adf::build(t, o);
   EXPECT_EQ(shallow.stats().depth, 3u);
   EXPECT_GT(shallow.stats().unresolved, 0u);
-  // An error below 8 16-bit steps keeps float values.
+  // An error below 32 16-bit steps keeps float values.
   EXPECT_EQ(shallow.stats().value_bits, 32u);
   EXPECT_EQ(shallow.stats().quantum, 0.0);
   EXPECT_EQ(shallow.stats().dense_bytes, 4u * 9 * 9 * 9);

@@ -40,7 +40,7 @@
 // offset table, about 32 corners a bucket), its low bits are stored and found by binary
 // search, so a leaf finds its corners from its position without any index.
 // The values are b-bit steps of [-R, R] (R bounds |distance| over the root
-// cube) with the fewest bits b <= 16 whose step is at most E / 8, else
+// cube) with the fewest bits b <= 16 whose step is at most E / 32, else
 // floats; the build's test uses E less one step, so the stored ADF stays
 // within E at the test points. Key parts and values are bit-packed.
 // Across a level change (a T-junction) each leaf interpolates its own corners
