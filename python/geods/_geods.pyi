@@ -78,7 +78,7 @@ class Adf:
         """Side of the root cube.
         """
     def stats(self) -> dict[str, Any]:
-        """dict: cells, leaves, depth, unresolved, exact_queries, signs, bytes, dense_bytes
+        """dict: cells, leaves, depth, unresolved, exact_queries, signs, corners, value_bits, key_bits, quantum, bytes, dense_bytes
         """
     def validate(self) -> None:
         """Checks the tree; raises geods.Error if it is broken.

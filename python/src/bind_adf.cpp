@@ -85,7 +85,7 @@ void bind_adf(py::module_& m) {
           "The surface at distance `offset` (negative: inside) as (V, F), by marching cubes on the ADF sampled\n"
           "at res samples along the root cube's side (0: 2^min(depth, 8) + 1).")
       .def("stats", [](const field::Adf& adf) { return stats_dict(adf.stats()); },
-           "dict: cells, leaves, depth, unresolved, exact_queries, signs, bytes, dense_bytes")
+           "dict: cells, leaves, depth, unresolved, exact_queries, signs, corners, value_bits, key_bits, quantum, bytes, dense_bytes")
       .def("validate", &field::Adf::validate, "Checks the tree; raises geods.Error if it is broken.")
       .def_property_readonly("origin", [](const field::Adf& adf) { return py::make_tuple(adf.origin().x(), adf.origin().y(), adf.origin().z()); },
                              "Low corner of the root cube.")

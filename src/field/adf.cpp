@@ -20,16 +20,40 @@ namespace geods::field {
 namespace {
 
 constexpr char kKind[] = "field.Adf";
-constexpr std::uint32_t kVersion = 1;
+// 2: shared quantized corners, one bit a cell (version 1: 32-bit nodes and 8 floats a leaf).
+constexpr std::uint32_t kVersion = 2;
+// The build's temporary node: the leaf bit, else the first child's index.
+constexpr std::uint32_t kLeaf = 0x80000000u;
 
-// The options and the root cube, one archive record.
+// The options, the root cube and the storage's layout, one archive record.
 struct Params {
   double error, band, padding;
   std::int32_t max_depth, checks;
   std::uint32_t sign, reserved;
   double origin[3];
   double size;
+  std::uint64_t cells, corners;
+  std::int32_t depth, shift, value_bits, reserved2;
+  double value_lo, quantum;
 };
+
+// n fields of `bits` bits packed in 64-bit words, with a word of padding (see Adf::unpack).
+std::size_t packed_words(std::size_t n, int bits) { return (n * std::size_t(bits) + 63) / 64 + 1; }
+
+std::vector<std::uint64_t> pack(const std::vector<std::uint64_t>& fields, int bits) {
+  std::vector<std::uint64_t> words(packed_words(fields.size(), bits), 0);
+  for (std::size_t i = 0; i < fields.size(); ++i) {
+    const std::size_t at = i * std::size_t(bits), w = at >> 6, o = at & 63;
+    words[w] |= fields[i] << o;
+    if (o + std::size_t(bits) > 64) words[w + 1] |= fields[i] >> (64 - o);
+  }
+  return words;
+}
+
+// The key of lattice point (x, y, z) on the (n + 1)^3 lattice.
+std::uint64_t lattice_key(std::uint64_t x, std::uint64_t y, std::uint64_t z, std::uint64_t n) {
+  return x + (n + 1) * (y + (n + 1) * z);
+}
 
 double physical_memory() { return double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGE_SIZE)); }
 
@@ -155,7 +179,6 @@ Adf Adf::build(const TriMesh& source, const MeshDistance& mesh, const AdfOptions
   const float band = std::isfinite(options.band) ? float(options.band) : std::numeric_limits<float>::infinity();
   auto clamp_band = [band](float v) { return std::clamp(v, -band, band); };
   const int n = options.checks, m = (n - 1) / 2;
-  const float error = float(options.error);
   std::vector<std::uint32_t> nodes;
   std::vector<float> values;
   std::size_t queries = 0, unresolved = 0;
@@ -166,6 +189,23 @@ Adf Adf::build(const TriMesh& source, const MeshDistance& mesh, const AdfOptions
   for (int c = 0; c < 8; ++c)
     level[0].corners[c] = exact(adf.origin_ + Vec3d(c & 1, (c >> 1) & 1, (c >> 2) & 1) * adf.size_, {}, signs);
   queries += 8;
+  // The values' range: |d(p)| <= |d(c)| + |p - c| for the corner c nearest p.
+  double range = 0;
+  for (const float v : level[0].corners) range = std::max(range, double(std::abs(v)));
+  range = (range + adf.size_ * std::sqrt(3.0) / 2) * (1 + 1e-6);
+  if (std::isfinite(options.band)) range = std::min(range, 2 * options.band);
+  // b-bit steps of [-range, range], the fewest bits (at most 16) whose step
+  // is at most E / 32; the test then leaves a step of the error (half for
+  // the rounding, half for the float differences of one vertex computed from
+  // different cells). Floats when 16 bits are too coarse. (mesh_100k at
+  // E = 0.01: E / 8 gives 13 bits, 54,349 leaves, 299 kB; E / 32 15 bits,
+  // 47,916 leaves, 285 kB; with the whole E, 46,285 leaves.)
+  int value_bits = 1;
+  while (value_bits <= 16 && 2 * range / double((1 << value_bits) - 1) > options.error / 32) ++value_bits;
+  const bool quantize = value_bits <= 16;
+  const double quantum = quantize ? 2 * range / double((1 << value_bits) - 1) : 0;
+  if (!quantize) value_bits = 32;
+  const float error = float(options.error - quantum);
   std::vector<CellResult> results;
   const double memory = physical_memory();
 
@@ -260,8 +300,7 @@ Adf Adf::build(const TriMesh& source, const MeshDistance& mesh, const AdfOptions
     }
     std::swap(level, next);
   }
-  adf.nodes_ = FlatArray<std::uint32_t>(std::move(nodes));
-  adf.values_ = FlatArray<float>(std::move(values));
+  adf.store(nodes, values, value_bits, quantum, -range);
   adf.stats_.exact_queries = queries;
   adf.stats_.unresolved = unresolved;
   adf.stats_.signs = signs;
@@ -269,58 +308,197 @@ Adf Adf::build(const TriMesh& source, const MeshDistance& mesh, const AdfOptions
   return adf;
 }
 
-void Adf::finish_stats() {
-  stats_.cells = nodes_.size();
-  stats_.leaves = values_.size() / 8;
-  // Levels are consecutive node ranges: the children of one level's inner nodes make the next.
-  std::size_t begin = 0, end = nodes_.empty() ? 0 : 1, inner = 0, depth = 0;
-  while (true) {
-    const std::size_t inner_begin = inner;
-    for (std::size_t i = begin; i < end; ++i) inner += !(nodes_[i] & kLeaf);
-    if (inner == inner_begin) break;
-    begin = end;
-    end = 1 + 8 * inner;
-    ++depth;
+void Adf::store(const std::vector<std::uint32_t>& nodes, const std::vector<float>& values, int value_bits, double quantum,
+                double lo) {
+  cells_ = nodes.size();
+  std::vector<std::uint64_t> inner((cells_ + 63) / 64, 0);
+  for (std::size_t i = 0; i < cells_; ++i)
+    if (!(nodes[i] & kLeaf)) inner[i >> 6] |= std::uint64_t(1) << (i & 63);
+  // The leaves' positions, level by level.
+  struct Leaf {
+    int level;
+    std::uint64_t x, y, z;
+    std::uint32_t leaf;
+  };
+  struct Cell {
+    std::uint32_t node;
+    std::uint64_t x, y, z;
+  };
+  std::vector<Leaf> leaves;
+  std::vector<Cell> level{{0, 0, 0, 0}}, next;
+  depth_ = 0;
+  for (int l = 0; !level.empty(); ++l) {
+    next.clear();
+    for (const Cell& c : level) {
+      const std::uint32_t v = nodes[c.node];
+      if (v & kLeaf) {
+        leaves.push_back({l, c.x, c.y, c.z, v & ~kLeaf});
+        depth_ = std::max(depth_, l);
+      } else {
+        for (std::uint32_t o = 0; o < 8; ++o)
+          next.push_back({v + o, 2 * c.x + (o & 1), 2 * c.y + ((o >> 1) & 1), 2 * c.z + ((o >> 2) & 1)});
+      }
+    }
+    std::swap(level, next);
   }
-  stats_.depth = depth;
-  stats_.bytes = 4 * (nodes_.size() + values_.size());
-  const double side = double(std::uint64_t(1) << depth) + 1;
+  // Every leaf corner's key with its value; one value a key (a vertex computed
+  // from different cells may differ in the last float bit: the smallest wins).
+  const std::uint64_t n = std::uint64_t(1) << depth_;
+  std::vector<std::pair<std::uint64_t, float>> corners;
+  corners.reserve(8 * leaves.size());
+  for (const Leaf& f : leaves) {
+    const int s = depth_ - f.level;
+    for (int c = 0; c < 8; ++c)
+      corners.emplace_back(lattice_key((f.x + (c & 1)) << s, (f.y + ((c >> 1) & 1)) << s, (f.z + ((c >> 2) & 1)) << s, n),
+                           values[std::size_t(f.leaf) * 8 + c]);
+  }
+  std::sort(corners.begin(), corners.end());
+  corners.erase(std::unique(corners.begin(), corners.end(), [](const auto& a, const auto& b) { return a.first == b.first; }),
+                corners.end());
+  corners_ = corners.size();
+  if (corners_ >= kNoIndex) throw Error("adf: more than 2^32 distinct corners: a larger error or a smaller max_depth");
+  // Buckets of about 32 keys (32 bits of offset for 32 corners: the fewest
+  // bits a corner, offsets and key parts together, are at about 22).
+  const std::uint64_t last = lattice_key(n, n, n, n);
+  const std::uint64_t target = std::max<std::uint64_t>(1, corners_ / 32);
+  shift_ = 0;
+  while ((last >> shift_) + 1 > target) ++shift_;
+  const std::uint64_t mask = shift_ >= 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << shift_) - 1;
+  std::vector<std::uint32_t> buckets(std::size_t(last >> shift_) + 2, 0);
+  std::vector<std::uint64_t> fields(corners_);
+  for (std::size_t i = 0; i < corners_; ++i) {
+    ++buckets[std::size_t(corners[i].first >> shift_) + 1];
+    fields[i] = corners[i].first & mask;
+  }
+  for (std::size_t b = 1; b < buckets.size(); ++b) buckets[b] += buckets[b - 1];
+  keys_ = FlatArray<std::uint64_t>(pack(fields, shift_));
+  value_bits_ = value_bits;
+  quantum_ = quantum;
+  value_lo_ = quantum > 0 ? lo : 0;
+  if (quantum > 0) {
+    const long long top = (1LL << value_bits) - 1;
+    for (std::size_t i = 0; i < corners_; ++i)
+      fields[i] = std::uint64_t(std::clamp(std::llround((double(corners[i].second) - lo) / quantum), 0LL, top));
+    values_ = FlatArray<std::uint64_t>(pack(fields, value_bits));
+    values32_ = {};
+  } else {
+    std::vector<float> v(corners_);
+    for (std::size_t i = 0; i < corners_; ++i) v[i] = corners[i].second;
+    values32_ = FlatArray<float>(std::move(v));
+    values_ = {};
+  }
+  inner_ = FlatArray<std::uint64_t>(std::move(inner));
+  buckets_ = FlatArray<std::uint32_t>(std::move(buckets));
+  make_ranks();
+}
+
+void Adf::make_ranks() {
+  std::vector<std::uint32_t> rank(inner_.size());
+  std::uint32_t count = 0;
+  for (std::size_t w = 0; w < inner_.size(); ++w) {
+    rank[w] = count;
+    count += std::uint32_t(std::popcount(inner_[w]));
+  }
+  rank_ = FlatArray<std::uint32_t>(std::move(rank));
+}
+
+std::size_t Adf::find_corner(std::uint64_t key) const {
+  const std::uint64_t b = key >> shift_;
+  if (b + 1 >= buckets_.size()) return kNoIndex;
+  const std::uint64_t low = shift_ >= 64 ? key : key & ((std::uint64_t(1) << shift_) - 1);
+  std::size_t lo = buckets_[b], hi = buckets_[b + 1];
+  const std::uint64_t* k = keys_.data();
+  while (lo < hi) {
+    const std::size_t mid = lo + (hi - lo) / 2;
+    if (unpack(k, mid, shift_) < low) lo = mid + 1;
+    else hi = mid;
+  }
+  return lo < std::size_t(buckets_[b + 1]) && unpack(k, lo, shift_) == low ? lo : kNoIndex;
+}
+
+void Adf::cell_corners(int level, std::uint64_t x, std::uint64_t y, std::uint64_t z, float out[8]) const {
+  if (level < 0 || level > depth_) throw Error(fmt::format("adf: no cell at level {} (depth {})", level, depth_));
+  const int s = depth_ - level;
+  const std::uint64_t n = std::uint64_t(1) << depth_;
+  for (int c = 0; c < 8; ++c) {
+    const std::uint64_t cx = (x + (c & 1)) << s, cy = (y + ((c >> 1) & 1)) << s, cz = (z + ((c >> 2) & 1)) << s;
+    const std::size_t i = cx <= n && cy <= n && cz <= n ? find_corner(lattice_key(cx, cy, cz, n)) : kNoIndex;
+    if (i == kNoIndex) throw Error(fmt::format("adf: the corner ({}, {}, {}) of a level-{} cell is not stored", cx, cy, cz, level));
+    out[c] = corner_value(i);
+  }
+}
+
+void Adf::finish_stats() {
+  std::size_t inner = 0;
+  for (const std::uint64_t w : inner_) inner += std::size_t(std::popcount(w));
+  stats_.cells = cells_;
+  stats_.leaves = cells_ - inner;
+  stats_.depth = std::size_t(depth_);
+  stats_.corners = corners_;
+  stats_.value_bits = std::size_t(value_bits_);
+  stats_.key_bits = std::size_t(shift_);
+  stats_.quantum = quantum_;
+  stats_.bytes = 8 * inner_.size() + 4 * rank_.size() + 4 * buckets_.size() + 8 * keys_.size() + 8 * values_.size() +
+                 4 * values32_.size();
+  const double side = double(std::uint64_t(1) << depth_) + 1;
   stats_.dense_bytes = std::size_t(4 * side * side * side);
 }
 
 void Adf::validate() const {
   check_options(options_);
   if (!origin_.allFinite() || !std::isfinite(size_) || !(size_ > 0)) throw Error("adf: the root cube is not finite");
-  if (nodes_.empty() || nodes_.size() >= kLeaf) throw Error("adf: no nodes, or more than 2^31");
-  std::size_t inner = 0, leaves = 0;
-  for (std::size_t i = 0; i < nodes_.size(); ++i) {
-    const std::uint32_t v = nodes_[i];
-    if (v & kLeaf) {
-      if ((v & ~kLeaf) != leaves) throw Error(fmt::format("adf: node {} names leaf {}, expected {}", i, v & ~kLeaf, leaves));
-      ++leaves;
-    } else {
-      if (v != 1 + 8 * inner || std::size_t(v) + 8 > nodes_.size())
-        throw Error(fmt::format("adf: node {} has its children at {}, expected {}", i, v, 1 + 8 * inner));
-      ++inner;
+  if (cells_ == 0 || cells_ >= kLeaf) throw Error("adf: no cells, or more than 2^31");
+  if (inner_.size() != (cells_ + 63) / 64 || rank_.size() != inner_.size())
+    throw Error(fmt::format("adf: {} tree words for {} cells", inner_.size(), cells_));
+  if (cells_ % 64 && inner_.back() >> (cells_ % 64)) throw Error("adf: tree bits beyond the last cell");
+  std::size_t inner = 0;
+  for (const std::uint64_t w : inner_) inner += std::size_t(std::popcount(w));
+  if (cells_ != 1 + 8 * inner) throw Error(fmt::format("adf: {} cells with {} inner ones is not an octree", cells_, inner));
+  // The levels are consecutive cell ranges: the deepest one is the depth.
+  std::size_t begin = 0, end = 1;
+  int levels = 0;
+  while (begin < end) {
+    std::size_t level_inner = 0;
+    for (std::size_t i = begin; i < end; ++i) level_inner += is_inner(i);
+    begin = end;
+    end += 8 * level_inner;
+    ++levels;
+  }
+  if (levels - 1 != depth_ || depth_ > options_.max_depth)
+    throw Error(fmt::format("adf: the tree has depth {}, recorded {} (max_depth {})", levels - 1, depth_, options_.max_depth));
+  // Buckets and keys.
+  const std::uint64_t n = std::uint64_t(1) << depth_, last = lattice_key(n, n, n, n);
+  if (shift_ < 0 || shift_ > 64) throw Error(fmt::format("adf: bad key layout (shift {})", shift_));
+  if (buckets_.size() != std::size_t(shift_ >= 64 ? 0 : last >> shift_) + 2 || buckets_[0] != 0 || buckets_.back() != corners_ ||
+      keys_.size() != packed_words(corners_, shift_))
+    throw Error(fmt::format("adf: {} buckets and {} key words for {} corners do not match", buckets_.size(), keys_.size(), corners_));
+  for (std::size_t b = 0; b + 1 < buckets_.size(); ++b) {
+    if (buckets_[b] > buckets_[b + 1]) throw Error(fmt::format("adf: bucket {} starts after the next one", b));
+    for (std::size_t i = buckets_[b]; i < buckets_[b + 1]; ++i) {
+      const std::uint64_t low = unpack(keys_.data(), i, shift_);
+      const std::uint64_t key = shift_ >= 64 ? low : (std::uint64_t(b) << shift_) | low;
+      if (key > last || (i > buckets_[b] && unpack(keys_.data(), i - 1, shift_) >= low))
+        throw Error(fmt::format("adf: corner key {} is out of order or out of range", i));
     }
   }
-  if (nodes_.size() != 1 + 8 * inner) throw Error("adf: the nodes are not an octree in level order");
-  if (values_.size() != 8 * leaves)
-    throw Error(fmt::format("adf: {} values for {} leaves, expected {}", values_.size(), leaves, 8 * leaves));
+  // Values.
   const float outer = std::isfinite(options_.band) ? float(2 * options_.band) : std::numeric_limits<float>::max();
-  for (std::size_t i = 0; i < values_.size(); ++i)
-    if (!(std::abs(values_[i]) <= outer)) throw Error(fmt::format("adf: value {} is {} (not finite or beyond the band)", i, values_[i]));
-  // The depth (levels are consecutive node ranges, see finish_stats).
-  std::size_t begin = 0, end = 1, counted = 0;
-  for (int depth = 0;; ++depth) {
-    std::size_t level_inner = 0;
-    for (std::size_t i = begin; i < end; ++i) level_inner += !(nodes_[i] & kLeaf);
-    if (level_inner == 0) break;
-    if (depth + 1 > options_.max_depth) throw Error(fmt::format("adf: cells deeper than max_depth {}", options_.max_depth));
-    counted += level_inner;
-    begin = end;
-    end = 1 + 8 * counted;
+  if (value_bits_ <= 16) {
+    const double top = value_lo_ + double((1 << value_bits_) - 1) * quantum_;
+    if (value_bits_ < 1 || values_.size() != packed_words(corners_, value_bits_) || !values32_.empty() ||
+        !std::isfinite(value_lo_) || !std::isfinite(quantum_) || !(quantum_ > 0) ||
+        !(std::abs(value_lo_) <= 1.01 * double(outer)) || !(std::abs(top) <= 1.01 * double(outer)))
+      throw Error(fmt::format("adf: bad {}-bit values ({} words for {} corners, from {} by {})", value_bits_, values_.size(),
+                              corners_, value_lo_, quantum_));
+  } else {
+    if (value_bits_ != 32 || !values_.empty()) throw Error(fmt::format("adf: {}-bit values are not 1 to 16 or 32", value_bits_));
+    if (values32_.size() != corners_) throw Error(fmt::format("adf: {} values for {} corners", values32_.size(), corners_));
+    for (std::size_t i = 0; i < corners_; ++i)
+      if (!(std::abs(values32_[i]) <= outer))
+        throw Error(fmt::format("adf: value {} is {} (not finite or beyond the band)", i, values32_[i]));
   }
+  // Every leaf finds its 8 corners (cell_corners throws otherwise).
+  for_each_leaf([](int, const Vec3d&, double, const float*) {});
 }
 
 AdfSample Adf::sample(const Vec3f& p) const {
@@ -329,17 +507,22 @@ AdfSample Adf::sample(const Vec3f& p) const {
   const Vec3d inside = u.cwiseMax(0.0).cwiseMin(1.0);
   const Vec3d outside = (u - inside) * size_;  // p - (nearest point of the cube)
   u = inside;
-  std::uint32_t node = nodes_[0];
+  std::size_t node = 0;
+  std::uint64_t cx = 0, cy = 0, cz = 0;
+  int level = 0;
   double side = size_;
-  while (!(node & kLeaf)) {
-    std::uint32_t child = 0;
+  while (is_inner(node)) {
+    std::size_t child = 0;
     for (int a = 0; a < 3; ++a)
-      if (u[a] >= 0.5) child |= 1u << a, u[a] = 2 * u[a] - 1;
+      if (u[a] >= 0.5) child |= std::size_t(1) << a, u[a] = 2 * u[a] - 1;
       else u[a] = 2 * u[a];
-    node = nodes_[node + child];
+    node = first_child(node) + child;
+    cx = 2 * cx + (child & 1), cy = 2 * cy + ((child >> 1) & 1), cz = 2 * cz + ((child >> 2) & 1);
     side /= 2;
+    ++level;
   }
-  const float* c = &values_[std::size_t(node & ~kLeaf) * 8];
+  float c[8];
+  cell_corners(level, cx, cy, cz, c);
   AdfSample s;
   s.distance = trilinear(c, u.x(), u.y(), u.z());
   // The derivatives of the trilinear interpolation along x, y, z.
@@ -396,13 +579,31 @@ TriMesh Adf::isosurface(double offset, std::size_t res) const {
 }
 
 void Adf::save(const std::filesystem::path& path) const {
-  Params p{options_.error, options_.band, options_.padding, options_.max_depth, options_.checks,
-           std::uint32_t(options_.sign), 0, {origin_.x(), origin_.y(), origin_.z()}, size_};
+  Params p{options_.error,
+           options_.band,
+           options_.padding,
+           options_.max_depth,
+           options_.checks,
+           std::uint32_t(options_.sign),
+           0,
+           {origin_.x(), origin_.y(), origin_.z()},
+           size_,
+           cells_,
+           corners_,
+           depth_,
+           shift_,
+           value_bits_,
+           0,
+           value_lo_,
+           quantum_};
   ArchiveWriter w(kKind, kVersion);
   w.add_value("params", p);
   w.add_value("stats", stats_);
-  w.add("nodes", nodes_);
-  w.add("values", values_);
+  w.add("inner", inner_);
+  w.add("buckets", buckets_);
+  w.add("keys", keys_);
+  if (values_.empty()) w.add("values", values32_);
+  else w.add("values", values_);
   w.write(path);
 }
 
@@ -419,10 +620,26 @@ Adf Adf::load(const std::filesystem::path& path, Archive::Verify verify) {
   adf.options_.sign = SignMethod(p.sign);
   adf.origin_ = Vec3d(p.origin[0], p.origin[1], p.origin[2]);
   adf.size_ = p.size;
-  adf.nodes_ = a.array<std::uint32_t>("nodes");
-  adf.values_ = a.array<float>("values");
+  if (p.depth < 0 || p.depth > kAdfMaxDepth) throw a.error(fmt::format("depth {} is out of range", p.depth));
+  adf.cells_ = std::size_t(p.cells);
+  adf.corners_ = std::size_t(p.corners);
+  adf.depth_ = p.depth;
+  adf.shift_ = p.shift;
+  adf.value_bits_ = p.value_bits;
+  adf.value_lo_ = p.value_lo;
+  adf.quantum_ = p.quantum;
+  adf.inner_ = a.array<std::uint64_t>("inner");
+  adf.buckets_ = a.array<std::uint32_t>("buckets");
+  adf.keys_ = a.array<std::uint64_t>("keys");
+  if (p.value_bits >= 1 && p.value_bits <= 16) adf.values_ = a.array<std::uint64_t>("values");
+  else if (p.value_bits == 32) adf.values32_ = a.array<float>("values");
+  else throw a.error(fmt::format("{}-bit values are not 1 to 16 or 32", p.value_bits));
   const AdfStats stored = a.value<AdfStats>("stats");
-  a.check([&] { adf.validate(); });
+  a.check([&] {
+    if (adf.inner_.size() != (adf.cells_ + 63) / 64) throw Error("adf: the tree bits do not match the cells");
+    adf.make_ranks();
+    adf.validate();
+  });
   adf.stats_.exact_queries = stored.exact_queries;
   adf.stats_.unresolved = stored.unresolved;
   adf.stats_.signs = stored.signs;

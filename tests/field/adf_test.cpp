@@ -4,7 +4,9 @@
 // for the build's criterion, and brute-force distances to the extracted surfaces.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
+#include <map>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -75,10 +77,30 @@ TEST(Adf, EveryLeafIsWithinTheErrorAtItsTestPoints) {
     const AdfStats s = adf.stats();
     ASSERT_EQ(s.unresolved, 0u);
     ASSERT_GT(s.leaves, 50u);
-    ASSERT_EQ(s.cells, adf.nodes().size());
-    ASSERT_EQ(s.bytes, 4 * (s.cells + 8 * s.leaves));
+    ASSERT_EQ(s.cells, adf.num_cells());
+    // Every byte: one bit a cell (whole 64-bit words) with a 32-bit rank a
+    // word, the bucket offsets (one per 32 corners, at most), the key parts
+    // and values bit-packed in 64-bit words with a word of padding each.
+    ASSERT_LE(s.value_bits, 16u);
+    ASSERT_GT(s.quantum, 0.0);
+    ASSERT_LE(s.quantum, o.error / 32);
+    ASSERT_GT(s.quantum, o.error / 64);  // the fewest bits
+    auto words = [](std::size_t n, std::size_t bits) { return (n * bits + 63) / 64 + 1; };
+    const std::size_t fixed = 12 * ((s.cells + 63) / 64) + 8 * words(s.corners, s.key_bits) + 8 * words(s.corners, s.value_bits);
+    ASSERT_GT(s.bytes, fixed);
+    ASSERT_LE(s.bytes, fixed + 4 * (s.corners / 32 + 2));
+    ASSERT_LT(s.corners, 8 * s.leaves / 2);  // shared
     std::size_t points = 0;
+    // The distinct corners: each leaf corner's value is the one stored for its vertex.
+    std::map<std::array<long long, 3>, float> seen;
+    const double finest = adf.size() / double(1 << s.depth);
     adf.for_each_leaf([&](int, const Vec3d& lo, double side, const float* c) {
+      for (int k = 0; k < 8; ++k) {
+        const Vec3d v = lo + Vec3d(k & 1, (k >> 1) & 1, (k >> 2) & 1) * side - adf.origin();
+        const std::array<long long, 3> key{std::llround(v.x() / finest), std::llround(v.y() / finest), std::llround(v.z() / finest)};
+        const auto [it, fresh] = seen.emplace(key, c[k]);
+        ASSERT_EQ(it->second, c[k]);
+      }
       // The corners are exact; the checks^3 lattice interpolates within the error.
       for (int k = 0; k < checks; ++k)
         for (int j = 0; j < checks; ++j)
@@ -89,14 +111,17 @@ TEST(Adf, EveryLeafIsWithinTheErrorAtItsTestPoints) {
             if (std::isnan(e)) continue;
             const bool is_corner = (i % (checks - 1) == 0) && (j % (checks - 1) == 0) && (k % (checks - 1) == 0);
             if (is_corner) {
-              ASSERT_NEAR(c[(i ? 1 : 0) + (j ? 2 : 0) + (k ? 4 : 0)], e, 1e-5);
+              // Exact within half a 16-bit step (and the float rounding).
+              ASSERT_NEAR(c[(i ? 1 : 0) + (j ? 2 : 0) + (k ? 4 : 0)], e, s.quantum / 2 + 1e-5);
             }
             // (Not adf.distance(p): a point on the leaf's boundary may belong to a neighbour.)
-            ASSERT_NEAR(interpolate(c, t), e, o.error + 1e-5) << "checks " << checks << " leaf at " << lo.transpose();
+            // The bound holds with the quantized corners: the build left a step of the error.
+            ASSERT_NEAR(interpolate(c, t), e, o.error + 1e-6) << "checks " << checks << " leaf at " << lo.transpose();
             ++points;
           }
     });
     ASSERT_GT(points, 27 * s.leaves / 2);
+    ASSERT_EQ(seen.size(), s.corners);
   }
 }
 
@@ -140,7 +165,7 @@ TEST(Adf, BandClampsAndKeepsTheTreeSmall) {
   o.band = 0.05;
   const Adf banded = Adf::build(m, o);
   EXPECT_LT(banded.stats().leaves, whole.stats().leaves);
-  for (const float v : banded.values()) ASSERT_LE(std::abs(v), 0.1f);
+  for (std::size_t i = 0; i < banded.num_corners(); ++i) ASSERT_LE(std::abs(banded.corner_value(i)), 0.1f + 1e-5f);
   EXPECT_FLOAT_EQ(banded.distance(Vec3f(0, 0, 0)), -0.05f);
   EXPECT_FLOAT_EQ(banded.distance(Vec3f(1.15f, 0, 0)), 0.05f);
   EXPECT_LE(max_random_error(banded, m, 2000, 3), 2 * o.error);
@@ -211,7 +236,9 @@ TEST(Adf, SaveAndLoadGiveTheSameAnswers) {
   const auto path = dir / "a.geodsadf";
   adf.save(path);
   const Adf loaded = Adf::load(path);
-  EXPECT_TRUE(loaded.nodes().mapped());
+  EXPECT_TRUE(loaded.inner_bits().mapped());
+  EXPECT_EQ(loaded.stats().bytes, adf.stats().bytes);
+  EXPECT_EQ(loaded.stats().corners, adf.stats().corners);
   EXPECT_EQ(loaded.stats().cells, adf.stats().cells);
   EXPECT_EQ(loaded.stats().exact_queries, adf.stats().exact_queries);
   EXPECT_EQ(loaded.options().sign, SignMethod::pseudonormal);
@@ -244,6 +271,54 @@ TEST(Adf, SaveAndLoadGiveTheSameAnswers) {
   std::filesystem::remove_all(dir);
 }
 
+TEST(Adf, DeepSparseTreesAndOldFiles) {
+  // A small sphere in a cube 41x its size: a deep tree with few corners on a
+  // large lattice (keys of more than 16 bits), against the brute-force field.
+  const TriMesh m = shape::icosphere(1);
+  AdfOptions o;
+  o.error = 0.01;
+  o.band = 0.1;
+  o.padding = 20;
+  o.max_depth = 12;
+  const Adf adf = Adf::build(m, o);
+  EXPECT_GE(adf.stats().depth, 9u);
+  EXPECT_LE(adf.stats().value_bits, 16u);
+  EXPECT_GT(adf.stats().key_bits, 16u);  // a sparse lattice of 2049^3 points
+  std::printf("deep: depth %zu, %zu corners, %zu bytes\n", adf.stats().depth, adf.stats().corners, adf.stats().bytes);
+  Rng rng(21);
+  for (int i = 0; i < 300; ++i) {
+    const Vec3f p = near_surface(m, rng, 0.2);
+    const double e = exact(m, p, o.band);
+    if (std::isnan(e)) continue;
+    ASSERT_NEAR(adf.distance(p), e, 2 * o.error) << p.transpose();
+  }
+  const auto dir = std::filesystem::temp_directory_path() / ("geods_adf_old_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  adf.save(dir / "deep.geodsadf");
+  const Adf loaded = Adf::load(dir / "deep.geodsadf");
+  for (int i = 0; i < 100; ++i) {
+    const Vec3f p = near_surface(m, rng, 0.2);
+    ASSERT_EQ(loaded.distance(p), adf.distance(p));
+  }
+  // A version-1 file (32-bit nodes, 8 floats a leaf) is refused with a clear error.
+  {
+    const std::vector<std::uint32_t> nodes{0x80000000u};
+    const std::vector<float> values(8, 0.0f);
+    ArchiveWriter w("field.Adf", 1);  // (it keeps views of the arrays)
+    w.add_value("params", std::uint64_t(0));
+    w.add("nodes", nodes);
+    w.add("values", values);
+    w.write(dir / "v1.geodsadf");
+  }
+  try {
+    Adf::load(dir / "v1.geodsadf");
+    ADD_FAILURE() << "a version-1 file loaded";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("version"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove_all(dir);
+}
+
 TEST(Adf, SameTreeForAnyThreadCount) {
   const TriMesh m = shape::icosphere(2);
   AdfOptions o;
@@ -252,9 +327,10 @@ TEST(Adf, SameTreeForAnyThreadCount) {
   const Adf one = Adf::build(m, o);
   set_num_threads(0);
   const Adf all = Adf::build(m, o);
-  ASSERT_EQ(one.nodes().size(), all.nodes().size());
-  ASSERT_TRUE(std::equal(one.nodes().begin(), one.nodes().end(), all.nodes().begin()));
-  ASSERT_TRUE(std::equal(one.values().begin(), one.values().end(), all.values().begin()));
+  ASSERT_EQ(one.num_cells(), all.num_cells());
+  ASSERT_TRUE(std::equal(one.inner_bits().begin(), one.inner_bits().end(), all.inner_bits().begin()));
+  ASSERT_EQ(one.num_corners(), all.num_corners());
+  for (std::size_t i = 0; i < one.num_corners(); ++i) ASSERT_EQ(one.corner_value(i), all.corner_value(i));
 }
 
 TEST(Adf, IsosurfacesAtZeroAndAtAnOffset) {
@@ -304,6 +380,9 @@ TEST(Adf, OpenAndDegenerateMeshes) {
   const Adf shallow = Adf::build(t, o);
   EXPECT_EQ(shallow.stats().depth, 3u);
   EXPECT_GT(shallow.stats().unresolved, 0u);
+  // An error below 32 16-bit steps keeps float values.
+  EXPECT_EQ(shallow.stats().value_bits, 32u);
+  EXPECT_EQ(shallow.stats().quantum, 0.0);
   EXPECT_EQ(shallow.stats().dense_bytes, 4u * 9 * 9 * 9);
 }
 

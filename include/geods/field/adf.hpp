@@ -30,14 +30,34 @@
 // from the surface is one leaf without test points. Refinement thus happens
 // only within about B of the surface.
 //
+// Storage: every byte counted in AdfStats::bytes. The tree is one bit a
+// cell in level order (set: inner), with a rank table (the inner cells
+// before each 64-bit word): the children of inner cell i are the 8 cells from
+// 1 + 8 rank(i), so no pointers and no leaf indices. The corner values are
+// stored once per distinct octree vertex (shared by the up to 8 leaves that
+// meet there), sorted by their key x + (N + 1) (y + (N + 1) z) on the lattice
+// of the finest cells (N = 2^depth): the key's high bits select a bucket (an
+// offset table, about 32 corners a bucket), its low bits are stored and found by binary
+// search, so a leaf finds its corners from its position without any index.
+// The values are b-bit steps of [-R, R] (R bounds |distance| over the root
+// cube) with the fewest bits b <= 16 whose step is at most E / 32, else
+// floats; the build's test uses E less one step, so the stored ADF stays
+// within E at the test points. Key parts and values are bit-packed.
+// Across a level change (a T-junction) each leaf interpolates its own corners
+// (exact samples, shared where leaves meet at a vertex): a coarse leaf's face
+// does not pass through a finer neighbour's corner in its middle, so the field
+// can jump there, by at most the two leaves' errors (2E at test points).
+//
 // Queries: distance (the trilinear interpolation in the leaf holding the
 // point), gradient (that of the interpolation: piecewise, not continuous
 // across cells), closest point (p - d g / |g|: on the ADF's zero set to first
 // order, at distance |d| from p). Outside the root cube the distance is the
 // one at the nearest point c of the cube plus |p - c|.
+#include <bit>
 #include <cstdint>
 #include <filesystem>
 #include <limits>
+#include <vector>
 
 #include "geods/core/archive.hpp"
 #include "geods/core/flat_array.hpp"
@@ -71,7 +91,11 @@ struct AdfStats {
   std::size_t unresolved = 0;     // leaves at max_depth whose test points exceed the error
   std::size_t exact_queries = 0;  // exact distances computed by the build
   std::size_t signs = 0;          // of them, signs computed (the others: a neighbour's, see adf.cpp)
-  std::size_t bytes = 0;          // the ADF's arrays: 4 bytes a cell + 32 a leaf
+  std::size_t corners = 0;        // distinct leaf corners (octree vertices), each stored once
+  std::size_t value_bits = 0;     // bits a quantized corner value (at most 16), or 32 (floats)
+  std::size_t key_bits = 0;       // bits of key stored a corner (the rest is the bucket)
+  double quantum = 0;             // the quantization step (0 for floats): a corner is within half of it
+  std::size_t bytes = 0;          // every array the ADF holds: tree bits, ranks, buckets, keys, values
   std::size_t dense_bytes = 0;    // a float grid of the finest leaves' spacing over the root cube: 4 (2^depth + 1)^3
 };
 
@@ -83,11 +107,6 @@ struct AdfSample {
 
 class Adf {
  public:
-  /// A node is a leaf if this bit is set (the rest: the leaf's index), else
-  /// the index of its first child (the 8 children are consecutive, in the
-  /// order x + 2y + 4z of their octants).
-  static constexpr std::uint32_t kLeaf = 0x80000000u;
-
   Adf() = default;
 
   /// Builds the ADF of the mesh behind `mesh`. Throws geods::Error for a
@@ -110,15 +129,16 @@ class Adf {
   /// offset, one outside the band, res < 2 or a grid the memory cannot hold.
   TriMesh isosurface(double offset, std::size_t res = 0) const;
 
-  /// Calls f(level, lo, size, corners) for each leaf in node order: its
+  /// Calls f(level, lo, size, corners) for each leaf in level order: its
   /// cube's low corner, side and 8 corner distances (order x + 2y + 4z).
   template <typename F>
   void for_each_leaf(F&& f) const;
 
   void save(const std::filesystem::path& path) const;
   static Adf load(const std::filesystem::path& path, Archive::Verify verify = Archive::Verify::checksums);
-  /// Throws geods::Error unless the nodes form a tree in level order, leaf
-  /// indices are consecutive, values are finite (within twice the band) and the cube is finite.
+  /// Throws geods::Error unless the tree bits, buckets and keys are consistent
+  /// (keys sorted, every leaf's corners present), values are finite (within
+  /// twice the band) and the cube is finite.
   void validate() const;
 
   AdfStats stats() const { return stats_; }
@@ -126,17 +146,52 @@ class Adf {
   /// The root cube: low corner and side.
   const Vec3d& origin() const { return origin_; }
   double size() const { return size_; }
-  const FlatArray<std::uint32_t>& nodes() const { return nodes_; }
-  const FlatArray<float>& values() const { return values_; }
+  /// Cells in level order; cell i is inner (its 8 children from first_child(i), order x + 2y + 4z) or a leaf.
+  std::size_t num_cells() const { return cells_; }
+  bool is_inner(std::size_t i) const { return (inner_[i >> 6] >> (i & 63)) & 1; }
+  std::size_t first_child(std::size_t i) const {
+    const std::uint64_t below = inner_[i >> 6] & ((std::uint64_t(1) << (i & 63)) - 1);
+    return 1 + 8 * (std::size_t(rank_[i >> 6]) + std::size_t(std::popcount(below)));
+  }
+  /// The tree bits (bit i of word i / 64: cell i is inner).
+  const FlatArray<std::uint64_t>& inner_bits() const { return inner_; }
+  /// The distinct corners' values in key order (decoded), and their number.
+  std::size_t num_corners() const { return corners_; }
+  float corner_value(std::size_t i) const {
+    return values32_.empty() ? float(value_lo_ + quantum_ * double(unpack(values_.data(), i, value_bits_))) : values32_[i];
+  }
+  /// Element i of an array of `bits`-bit fields packed in 64-bit words (and one word of padding).
+  static std::uint64_t unpack(const std::uint64_t* words, std::size_t i, int bits) {
+    const std::size_t at = i * std::size_t(bits), w = at >> 6, o = at & 63;
+    std::uint64_t v = words[w] >> o;
+    if (o + std::size_t(bits) > 64) v |= words[w + 1] << (64 - o);
+    return bits >= 64 ? v : v & ((std::uint64_t(1) << bits) - 1);
+  }
+  /// The 8 corner values (x + 2y + 4z) of the cell at integer position (x, y, z) of `level`.
+  void cell_corners(int level, std::uint64_t x, std::uint64_t y, std::uint64_t z, float out[8]) const;
 
  private:
+  // Takes the build's tree (per node: kLeaf | leaf, or the first child) and 8 values a leaf.
+  void store(const std::vector<std::uint32_t>& nodes, const std::vector<float>& values, int value_bits, double quantum,
+             double lo);
   void finish_stats();
+  void make_ranks();
+  std::size_t find_corner(std::uint64_t key) const;
 
   AdfOptions options_;
   Vec3d origin_ = Vec3d::Zero();
   double size_ = 1;
-  FlatArray<std::uint32_t> nodes_;
-  FlatArray<float> values_;
+  std::size_t cells_ = 0, corners_ = 0;
+  int depth_ = 0;             // the finest leaves' level: keys are on the (2^depth + 1)^3 lattice
+  int shift_ = 0;             // a key's bucket is key >> shift; its low shift bits are stored
+  int value_bits_ = 32;       // bits a packed value, or 32: floats
+  double value_lo_ = 0, quantum_ = 0;
+  FlatArray<std::uint64_t> inner_;
+  FlatArray<std::uint32_t> rank_;      // inner cells before each word of inner_ (computed on load)
+  FlatArray<std::uint32_t> buckets_;   // first corner of each bucket, and the count at the end
+  FlatArray<std::uint64_t> keys_;      // the low shift bits of each corner's key, packed
+  FlatArray<std::uint64_t> values_;    // quantized values (value_bits_ each), packed, or empty
+  FlatArray<float> values32_;          // float values when the quantum would be too coarse
   AdfStats stats_;
 };
 
@@ -153,22 +208,24 @@ AdfError measure_adf_error(const Adf& adf, const TriMesh& source, const MeshDist
 
 template <typename F>
 void Adf::for_each_leaf(F&& f) const {
-  // Level order: walk the levels with the cubes of the current one.
+  // Level order: walk the levels with the positions of the current one.
   struct Cell {
-    std::uint32_t node;
-    Vec3d lo;
+    std::size_t node;
+    std::uint64_t x, y, z;
   };
-  std::vector<Cell> level{{0, origin_}}, next;
+  std::vector<Cell> level{{0, 0, 0, 0}}, next;
   double side = size_;
+  float corners[8];
   for (int l = 0; !level.empty(); ++l, side /= 2) {
     next.clear();
     for (const Cell& c : level) {
-      const std::uint32_t n = nodes_[c.node];
-      if (n & kLeaf) {
-        f(l, c.lo, side, &values_[std::size_t(n & ~kLeaf) * 8]);
+      if (!is_inner(c.node)) {
+        cell_corners(l, c.x, c.y, c.z, corners);
+        f(l, Vec3d(origin_ + Vec3d(double(c.x), double(c.y), double(c.z)) * side), side, static_cast<const float*>(corners));
       } else {
-        for (std::uint32_t o = 0; o < 8; ++o)
-          next.push_back({n + o, c.lo + Vec3d(o & 1, (o >> 1) & 1, (o >> 2) & 1) * (side / 2)});
+        const std::size_t first = first_child(c.node);
+        for (std::uint64_t o = 0; o < 8; ++o)
+          next.push_back({first + o, 2 * c.x + (o & 1), 2 * c.y + ((o >> 1) & 1), 2 * c.z + ((o >> 2) & 1)});
       }
     }
     std::swap(level, next);

@@ -29,7 +29,8 @@ void for_each_field(const MorphStats& s, F&& f) {
 template <typename F>
 void for_each_field(const AdfStats& s, F&& f) {
   f("cells", s.cells), f("leaves", s.leaves), f("depth", s.depth), f("unresolved", s.unresolved),
-      f("exact_queries", s.exact_queries), f("signs", s.signs), f("bytes", s.bytes), f("dense_bytes", s.dense_bytes);
+      f("exact_queries", s.exact_queries), f("signs", s.signs), f("corners", s.corners),
+      f("value_bits", s.value_bits), f("key_bits", s.key_bits), f("quantum", s.quantum), f("bytes", s.bytes), f("dense_bytes", s.dense_bytes);
 }
 
 }  // namespace geods::field
