@@ -14,7 +14,7 @@
 #endif
 
 #include "geods/bvh/ray_triangle4.hpp"
-#include "geods/bvh/simd_level.hpp"
+#include "geods/core/simd_level.hpp"
 #include "geods/bvh/traversal.hpp"
 #include "geods/core/convex_hull3.hpp"
 #include "geods/core/error.hpp"

@@ -15,6 +15,7 @@
 #include "geods/core/error.hpp"
 #include "geods/core/huge_page_allocator.hpp"
 #include "geods/core/morton.hpp"
+#include "geods/core/simd_level.hpp"
 #include "geods/core/parallel.hpp"
 #include "triangle_raster.hpp"
 
@@ -45,6 +46,9 @@ template <int S>
                                                std::int64_t r0, std::int64_t rows, std::int64_t lo0, std::int64_t dlo,
                                                std::int64_t hi0, std::int64_t dhi) {
   double m = 0;
+#if defined(__x86_64__) && defined(__GNUC__)
+  const bool avx2 = S == 0 && simd_level() >= SimdLevel::avx2;  // long rows only
+#endif
 #if defined(__SSE2__)
   __m128d m2 = _mm_setzero_pd();
   const __m128d sign = _mm_set1_pd(-0.0), gx = _mm_set1_pd(p.gx);
@@ -71,7 +75,7 @@ template <int S>
     } else {
       const std::int64_t lo = a.x + lo0 + dlo * r, hi = a.x + hi0 + dhi * r;
 #if defined(__x86_64__) && defined(__GNUC__)
-      if (hi - lo >= 7 && detail::has_avx2()) {
+      if (hi - lo >= 7 && avx2) {
         m = std::max(m, detail::row_max_avx2(row, lo, hi, p.base(dy), p.gx, a.x));
         continue;
       }

@@ -70,7 +70,8 @@ struct Plane {
 
 #if defined(__x86_64__) && defined(__GNUC__)
 // row_max() four doubles at a time where the CPU has AVX2 (the same terms, the
-// same rounding: no FMA): for long rows, the caller checks has_avx2().
+// same rounding: no FMA): for long rows, when simd_level() (core/simd_level.hpp)
+// is avx2 or above.
 __attribute__((target("avx2"))) inline double row_max_avx2(const float* row, std::int64_t lo, std::int64_t hi, double base,
                                                            double gx, std::int64_t ax) {
   const __m256d vg = _mm256_set1_pd(gx), vb = _mm256_set1_pd(base), sign = _mm256_set1_pd(-0.0), eight = _mm256_set1_pd(8.0);
@@ -89,10 +90,6 @@ __attribute__((target("avx2"))) inline double row_max_avx2(const float* row, std
   double m = std::max(_mm_cvtsd_f64(m2), _mm_cvtsd_f64(_mm_unpackhi_pd(m2, m2)));
   for (; i <= hi; ++i) m = std::max(m, std::abs(double(row[i]) - (base + gx * double(i - ax))));
   return m;
-}
-inline bool has_avx2() {
-  static const bool yes = __builtin_cpu_supports("avx2");
-  return yes;
 }
 #endif
 

@@ -1,4 +1,4 @@
-// The wide ray traversal at every SIMD level the CPU runs (bvh/simd_level.hpp)
+// The wide ray traversal at every SIMD level the CPU runs (core/simd_level.hpp)
 // against the portable path on the same inputs: bit-identical hits (t, u, v,
 // triangle) and occlusion, 4 and 8 wide; and the level switch itself.
 #include <gtest/gtest.h>
@@ -6,7 +6,7 @@
 #include <cstring>
 
 #include "bvh/bvh_test_util.hpp"
-#include "geods/bvh/simd_level.hpp"
+#include "geods/core/simd_level.hpp"
 #include "geods/core/error.hpp"
 
 namespace geods::bvh {

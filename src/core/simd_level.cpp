@@ -1,12 +1,12 @@
-// Run-time choice of the instruction set of the wide ray traversal.
-#include "geods/bvh/simd_level.hpp"
+// Run-time choice of the instruction set of the multi-versioned kernels.
+#include "geods/core/simd_level.hpp"
 
 #include <atomic>
 #include <cstdlib>
 
 #include "geods/core/error.hpp"
 
-namespace geods::bvh {
+namespace geods {
 namespace {
 
 SimdLevel detect() {
@@ -44,7 +44,7 @@ SimdLevel simd_level() { return SimdLevel(current().load(std::memory_order_relax
 
 void set_simd_level(SimdLevel level) {
   if (level > best_simd_level())
-    throw Error("bvh: this CPU does not run " + simd_level_name(level) + " (best: " +
+    throw Error("simd: this CPU does not run " + simd_level_name(level) + " (best: " +
                 simd_level_name(best_simd_level()) + ")");
   current().store(int(level), std::memory_order_relaxed);
 }
@@ -62,7 +62,7 @@ std::string simd_level_name(SimdLevel level) {
 SimdLevel parse_simd_level(const std::string& name) {
   for (SimdLevel l : {SimdLevel::portable, SimdLevel::avx, SimdLevel::avx2, SimdLevel::avx512})
     if (simd_level_name(l) == name) return l;
-  throw Error("bvh: unknown SIMD level '" + name + "' (portable, avx, avx2, avx512)");
+  throw Error("simd: unknown SIMD level '" + name + "' (portable, avx, avx2, avx512)");
 }
 
-}  // namespace geods::bvh
+}  // namespace geods
