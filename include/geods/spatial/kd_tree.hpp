@@ -1132,6 +1132,11 @@ class KdTree {
     }
   };
 
+  struct BoxAt {
+    std::uint32_t node, group;   // index in nodes_, or in packed_->nodes and the first point group
+    std::uint32_t begin, count;  // the node's points are permutation()[begin, begin + count)
+  };
+
   void check_box(std::span<const T> lo, std::span<const T> hi) const {
     check_point(lo, "box low corner");
     check_point(hi, "box high corner");
@@ -1147,13 +1152,19 @@ class KdTree {
     std::copy(root_lo_.begin(), root_lo_.end(), cell_lo.data());
     std::copy(root_hi_.begin(), root_hi_.end(), cell_hi.data());
     std::size_t nodes = 0;
-    box_node(0, lo, hi, cell_lo.data(), cell_hi.data(), visit, skip, nodes);
+    const BoxAt root{0, 0, 0, std::uint32_t(size())};
+    if (packed_)
+      box_node<true>(root, lo, hi, cell_lo.data(), cell_hi.data(), visit, skip, nodes);
+    else
+      box_node<false>(root, lo, hi, cell_lo.data(), cell_hi.data(), visit, skip, nodes);
     return nodes;
   }
 
-  // cell_lo/cell_hi bound the points of node v; they are restored on return.
-  template <typename Visit, typename Skip>
-  void box_node(std::uint32_t v, const T* lo, const T* hi, T* cell_lo, T* cell_hi, Visit& visit, const Skip& skip,
+  // cell_lo/cell_hi bound the points of node `at`; they are restored on return.
+  // Packed: at.node indexes packed_->nodes (inner nodes only; leaves are told by
+  // their count) and the leaf points are read from packed_->groups, else nodes_.
+  template <bool Packed, typename Visit, typename Skip>
+  void box_node(const BoxAt& at, const T* lo, const T* hi, T* cell_lo, T* cell_hi, Visit& visit, const Skip& skip,
                 std::size_t& visited) const {
     ++visited;
     bool inside = true;
@@ -1161,36 +1172,60 @@ class KdTree {
       if (cell_lo[a] > hi[a] || cell_hi[a] < lo[a]) return;
       inside = inside && lo[a] <= cell_lo[a] && cell_hi[a] <= hi[a];
     }
-    const Node& node = nodes_[v];
+    const std::uint32_t begin = at.begin, end = at.begin + at.count;
     if (inside) {
       if constexpr (kSkipsNothing<Skip>) {
-        visit.range(node.begin, node.end);
+        visit.range(begin, end);
       } else {
-        for (std::uint32_t i = node.begin; i < node.end; ++i)
+        for (std::uint32_t i = begin; i < end; ++i)
           if (!skip(perm_[i])) visit.point(perm_[i]);
       }
       return;
     }
-    if (node.leaf()) {
-      for (std::uint32_t i = node.begin; i < node.end; ++i) {
-        const std::uint32_t j = perm_[i];
-        if constexpr (!kSkipsNothing<Skip>)
-          if (skip(j)) continue;
-        const T* p = ordered_ ? ordered_.get() + std::size_t(i) * dim() : point(j);
-        bool in = true;
-        for (std::size_t a = 0; a < dim() && in; ++a) in = lo[a] <= p[a] && p[a] <= hi[a];
-        if (in) visit.point(j);
+    if (at.count <= leaf_size_) {  // a leaf (validate() checks that leaves are the nodes this small)
+      if constexpr (Packed) {
+        const Group* g = packed_->groups.data() + at.group;
+        for (std::uint32_t i = begin; i < end; i += 4, ++g) {
+          for (std::uint32_t l = 0; l < 4 && i + l < end; ++l) {
+            if constexpr (!kSkipsNothing<Skip>)
+              if (skip(g->index[l])) continue;
+            bool in = true;
+            for (int a = 0; a < kGroupDim; ++a) in = in && lo[a] <= g->x[a][l] && g->x[a][l] <= hi[a];
+            if (in) visit.point(g->index[l]);
+          }
+        }
+      } else {
+        for (std::uint32_t i = begin; i < end; ++i) {
+          const std::uint32_t j = perm_[i];
+          if constexpr (!kSkipsNothing<Skip>)
+            if (skip(j)) continue;
+          const T* p = ordered_ ? ordered_.get() + std::size_t(i) * dim() : point(j);
+          bool in = true;
+          for (std::size_t a = 0; a < dim() && in; ++a) in = lo[a] <= p[a] && p[a] <= hi[a];
+          if (in) visit.point(j);
+        }
       }
       return;
     }
-    const std::uint32_t axis = node.axis;
+    std::uint32_t axis;
+    T low, high;
+    BoxAt left{at.node + 1, at.group, begin, at.count / 2}, right{0, 0, begin + at.count / 2, at.count - at.count / 2};
+    if constexpr (Packed) {
+      const PackedNode& node = packed_->nodes[at.node];
+      axis = node.right >> 30, low = node.low, high = node.high;
+      right.node = node.right & kChildMask, right.group = node.right_group;
+    } else {
+      const Node& node = nodes_[at.node];
+      axis = node.axis, low = node.low, high = node.high;
+      right.node = node.right;
+    }
     const T saved_hi = cell_hi[axis];
-    cell_hi[axis] = node.low;
-    box_node(v + 1, lo, hi, cell_lo, cell_hi, visit, skip, visited);
+    cell_hi[axis] = low;
+    box_node<Packed>(left, lo, hi, cell_lo, cell_hi, visit, skip, visited);
     cell_hi[axis] = saved_hi;
     const T saved_lo = cell_lo[axis];
-    cell_lo[axis] = node.high;
-    box_node(node.right, lo, hi, cell_lo, cell_hi, visit, skip, visited);
+    cell_lo[axis] = high;
+    box_node<Packed>(right, lo, hi, cell_lo, cell_hi, visit, skip, visited);
     cell_lo[axis] = saved_lo;
   }
 
