@@ -8,8 +8,10 @@
 // point indices so that every node owns a contiguous range of it. The points stay
 // in the caller's array (PointView) or in one the tree owns; by default
 // (PointLayout::tree_order) the tree also keeps a copy of them in leaf order,
-// which the queries read contiguously (PointLayout::zero_copy: no copy). The node
-// array and the permutation are FlatArrays: a tree loaded from a file (load())
+// which the queries read contiguously (PointLayout::zero_copy: no copy); with
+// a dimension fixed at compile time (up to 4) that copy is the packed layout
+// (see "packed tree order" below: inner nodes only, leaf points in SIMD
+// groups). The node array and the permutation are FlatArrays: a tree loaded from a file (load())
 // reads them, and its points, in place from the mapped file.
 //
 // Split rule: each node splits its points at the median (select_nth) along
@@ -65,9 +67,12 @@ inline constexpr int Dynamic = -1;
 
 /// How a k-d tree reads its points in k-NN and radius queries.
 enum class PointLayout : std::uint8_t {
-  /// The default: the tree keeps a copy of the points in leaf order (size() *
-  /// dim() values, made during the build), so a leaf's points are read
-  /// contiguously; queries are about 1.4x faster on large inputs.
+  /// The default: the tree keeps a copy of the points in leaf order, so a
+  /// leaf's points are read contiguously: for a dimension fixed at compile
+  /// time up to 4, the packed layout (groups of 4 points axis by axis with
+  /// their indices, and 16-byte inner nodes for float: about 1.2 * (dim + 1)
+  /// values per point), else size() * dim() values. Queries are about 1.5-2x faster
+  /// on large inputs.
   tree_order,
   /// No copy: the points are read in place, through the permutation, from the
   /// caller's array (or the tree's own, or a mapped file). Half the memory.
