@@ -240,7 +240,17 @@ void check_tree_order_copy(Shape shape, std::size_t d) {
   ASSERT_EQ(plain.layout(), PointLayout::zero_copy);
   ASSERT_NO_THROW(ordered.validate());  // checks the copy against the points
   ASSERT_NO_THROW(converted.validate());
-  EXPECT_EQ(ordered.bytes(), plain.bytes() + n * d * sizeof(T));
+  if constexpr (Dim == Dynamic) {
+    EXPECT_EQ(ordered.bytes(), plain.bytes() + n * d * sizeof(T));
+  } else {
+    // The packed layout: 16 or 24 bytes per inner node; per leaf, its points in
+    // groups of 4 (d x 4 coordinates and 4 indices, 16-byte aligned; 64 for float 3D).
+    std::size_t inner = 0, groups = 0;
+    for (const auto& node : plain.nodes()) node.leaf() ? groups += (node.end - node.begin + 3) / 4 : ++inner;
+    const std::size_t group_bytes = (4 * d * sizeof(T) + 16 + 15) / 16 * 16;
+    EXPECT_EQ(ordered.bytes(), plain.bytes() + inner * (2 * sizeof(T) + 8) + groups * group_bytes);
+    EXPECT_EQ(converted.bytes(), ordered.bytes());
+  }
   const std::vector<T> qs = make_queries(pts, n, d, 60, 31);
   for (std::size_t i = 0; i < 60; ++i) {
     const std::span<const T> q(&qs[i * d], d);
@@ -261,6 +271,9 @@ TEST(KdTree, TreeOrderCopyGivesIdenticalResults) {
   for (Shape shape : {Shape::uniform, Shape::clustered, Shape::duplicated, Shape::identical}) {
     check_tree_order_copy<float, 3>(shape, 3);
     check_tree_order_copy<double, 2>(shape, 2);
+    check_tree_order_copy<float, 2>(shape, 2);  // packed groups of 2 x 4 floats (SSE), 3D above
+    check_tree_order_copy<float, 4>(shape, 4);
+    check_tree_order_copy<double, 1>(shape, 1);  // packed, scalar lanes
     check_tree_order_copy<double, Dynamic>(shape, 5);
   }
 }
