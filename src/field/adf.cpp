@@ -20,8 +20,10 @@ namespace geods::field {
 namespace {
 
 constexpr char kKind[] = "field.Adf";
-// 2: shared quantized corners, one bit a cell (version 1: 32-bit nodes and 8 floats a leaf).
-constexpr std::uint32_t kVersion = 2;
+// 3: a leaf's low corner stored at the leaf's rank, only the other corners
+// keyed (2: every corner keyed, read and converted; 1: 32-bit nodes and 8
+// floats a leaf, refused).
+constexpr std::uint32_t kVersion = 3;
 // The build's temporary node: the leaf bit, else the first child's index.
 constexpr std::uint32_t kLeaf = 0x80000000u;
 
@@ -314,6 +316,8 @@ void Adf::store(const std::vector<std::uint32_t>& nodes, const std::vector<float
   std::vector<std::uint64_t> inner((cells_ + 63) / 64, 0);
   for (std::size_t i = 0; i < cells_; ++i)
     if (!(nodes[i] & kLeaf)) inner[i >> 6] |= std::uint64_t(1) << (i & 63);
+  inner_ = FlatArray<std::uint64_t>(std::move(inner));
+  make_ranks();
   // The leaves' positions, level by level.
   struct Leaf {
     int level;
@@ -355,41 +359,92 @@ void Adf::store(const std::vector<std::uint32_t>& nodes, const std::vector<float
   std::sort(corners.begin(), corners.end());
   corners.erase(std::unique(corners.begin(), corners.end(), [](const auto& a, const auto& b) { return a.first == b.first; }),
                 corners.end());
-  corners_ = corners.size();
-  if (corners_ >= kNoIndex) throw Error("adf: more than 2^32 distinct corners: a larger error or a smaller max_depth");
-  // Buckets of about 32 keys (32 bits of offset for 32 corners: the fewest
-  // bits a corner, offsets and key parts together, are at about 22).
-  const std::uint64_t last = lattice_key(n, n, n, n);
-  const std::uint64_t target = std::max<std::uint64_t>(1, corners_ / 32);
-  shift_ = 0;
-  while ((last >> shift_) + 1 > target) ++shift_;
-  const std::uint64_t mask = shift_ >= 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << shift_) - 1;
-  std::vector<std::uint32_t> buckets(std::size_t(last >> shift_) + 2, 0);
-  std::vector<std::uint64_t> fields(corners_);
-  for (std::size_t i = 0; i < corners_; ++i) {
-    ++buckets[std::size_t(corners[i].first >> shift_) + 1];
-    fields[i] = corners[i].first & mask;
-  }
-  for (std::size_t b = 1; b < buckets.size(); ++b) buckets[b] += buckets[b - 1];
-  keys_ = FlatArray<std::uint64_t>(pack(fields, shift_));
+  if (corners.size() >= kNoIndex) throw Error("adf: more than 2^32 distinct corners: a larger error or a smaller max_depth");
+  std::vector<std::uint64_t> keys(corners.size()), fields;
+  std::vector<float> floats;
+  for (std::size_t i = 0; i < corners.size(); ++i) keys[i] = corners[i].first;
   value_bits_ = value_bits;
   quantum_ = quantum;
   value_lo_ = quantum > 0 ? lo : 0;
   if (quantum > 0) {
     const long long top = (1LL << value_bits) - 1;
-    for (std::size_t i = 0; i < corners_; ++i)
+    fields.resize(corners.size());
+    for (std::size_t i = 0; i < corners.size(); ++i)
       fields[i] = std::uint64_t(std::clamp(std::llround((double(corners[i].second) - lo) / quantum), 0LL, top));
-    values_ = FlatArray<std::uint64_t>(pack(fields, value_bits));
+  } else {
+    floats.resize(corners.size());
+    for (std::size_t i = 0; i < corners.size(); ++i) floats[i] = corners[i].second;
+  }
+  lay_out(keys, fields, floats);
+}
+
+void Adf::lay_out(const std::vector<std::uint64_t>& keys, const std::vector<std::uint64_t>& fields,
+                  const std::vector<float>& floats) {
+  // Each leaf's low corner: its value goes to the leaf's rank, unkeyed.
+  const std::uint64_t n = std::uint64_t(1) << depth_;
+  std::size_t inner = 0;
+  for (const std::uint64_t w : inner_) inner += std::size_t(std::popcount(w));
+  leaves_ = cells_ - inner;
+  std::vector<std::size_t> of_leaf(leaves_, kNoIndex);
+  std::vector<char> regular(keys.size(), 0);
+  struct Cell {
+    std::size_t node;
+    std::uint64_t x, y, z;
+  };
+  std::vector<Cell> level{{0, 0, 0, 0}}, next;
+  for (int l = 0; !level.empty() && l <= depth_; ++l) {
+    next.clear();
+    for (const Cell& c : level) {
+      if (is_inner(c.node)) {
+        const std::size_t first = first_child(c.node);
+        for (std::uint64_t o = 0; o < 8; ++o)
+          next.push_back({first + o, 2 * c.x + (o & 1), 2 * c.y + ((o >> 1) & 1), 2 * c.z + ((o >> 2) & 1)});
+        continue;
+      }
+      const int s = depth_ - l;
+      const std::uint64_t key = lattice_key(c.x << s, c.y << s, c.z << s, n);
+      const auto it = std::lower_bound(keys.begin(), keys.end(), key);
+      if (it == keys.end() || *it != key)
+        throw Error(fmt::format("adf: the low corner of the level-{} leaf at ({}, {}, {}) is not stored", l, c.x, c.y, c.z));
+      const std::size_t i = std::size_t(it - keys.begin());
+      regular[i] = 1;
+      of_leaf[leaf_rank(c.node)] = i;
+    }
+    std::swap(level, next);
+  }
+  if (!level.empty()) throw Error(fmt::format("adf: the tree is deeper than its recorded depth {}", depth_));
+  std::vector<std::size_t> order(of_leaf);
+  std::vector<std::uint64_t> keyed;
+  for (std::size_t i = 0; i < keys.size(); ++i)
+    if (!regular[i]) order.push_back(i), keyed.push_back(keys[i]);
+  corners_ = order.size();
+  // The keyed corners: buckets of about 32 keys (32 bits of offset for 32
+  // corners: the fewest bits a corner, offsets and key parts together).
+  const std::uint64_t last = lattice_key(n, n, n, n);
+  const std::uint64_t target = std::max<std::uint64_t>(1, keyed.size() / 32);
+  shift_ = 0;
+  while ((last >> shift_) + 1 > target) ++shift_;
+  const std::uint64_t mask = shift_ >= 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << shift_) - 1;
+  std::vector<std::uint32_t> buckets(std::size_t(last >> shift_) + 2, 0);
+  std::vector<std::uint64_t> low(keyed.size());
+  for (std::size_t i = 0; i < keyed.size(); ++i) {
+    ++buckets[std::size_t(keyed[i] >> shift_) + 1];
+    low[i] = keyed[i] & mask;
+  }
+  for (std::size_t b = 1; b < buckets.size(); ++b) buckets[b] += buckets[b - 1];
+  keys_ = FlatArray<std::uint64_t>(pack(low, shift_));
+  buckets_ = FlatArray<std::uint32_t>(std::move(buckets));
+  if (value_bits_ <= 16) {
+    std::vector<std::uint64_t> v(corners_);
+    for (std::size_t i = 0; i < corners_; ++i) v[i] = fields[order[i]];
+    values_ = FlatArray<std::uint64_t>(pack(v, value_bits_));
     values32_ = {};
   } else {
     std::vector<float> v(corners_);
-    for (std::size_t i = 0; i < corners_; ++i) v[i] = corners[i].second;
+    for (std::size_t i = 0; i < corners_; ++i) v[i] = floats[order[i]];
     values32_ = FlatArray<float>(std::move(v));
     values_ = {};
   }
-  inner_ = FlatArray<std::uint64_t>(std::move(inner));
-  buckets_ = FlatArray<std::uint32_t>(std::move(buckets));
-  make_ranks();
 }
 
 void Adf::make_ranks() {
@@ -402,8 +457,9 @@ void Adf::make_ranks() {
   rank_ = FlatArray<std::uint32_t>(std::move(rank));
 }
 
+// The index (into the keyed corners) of `key`, or kNoIndex.
 std::size_t Adf::find_corner(std::uint64_t key) const {
-  const std::uint64_t b = key >> shift_;
+  const std::uint64_t b = shift_ >= 64 ? 0 : key >> shift_;
   if (b + 1 >= buckets_.size()) return kNoIndex;
   const std::uint64_t low = shift_ >= 64 ? key : key & ((std::uint64_t(1) << shift_) - 1);
   std::size_t lo = buckets_[b], hi = buckets_[b + 1];
@@ -416,23 +472,63 @@ std::size_t Adf::find_corner(std::uint64_t key) const {
   return lo < std::size_t(buckets_[b + 1]) && unpack(k, lo, shift_) == low ? lo : kNoIndex;
 }
 
+std::size_t Adf::corner_below(std::size_t node, int level, std::uint64_t x, std::uint64_t y, std::uint64_t z) const {
+  // Down to the leaf holding (x, y, z) (half-open cells): the vertex is its low corner, or keyed.
+  while (is_inner(node)) {
+    const int s = depth_ - level - 1;
+    node = first_child(node) + ((x >> s) & 1) + 2 * ((y >> s) & 1) + 4 * ((z >> s) & 1);
+    ++level;
+  }
+  const std::uint64_t below = (std::uint64_t(1) << (depth_ - level)) - 1;
+  if (((x | y | z) & below) == 0) return leaf_rank(node);
+  const std::size_t i = find_corner(lattice_key(x, y, z, std::uint64_t(1) << depth_));
+  return i == kNoIndex ? kNoIndex : leaves_ + i;
+}
+
+std::size_t Adf::corner_index(std::uint64_t x, std::uint64_t y, std::uint64_t z) const {
+  const std::uint64_t n = std::uint64_t(1) << depth_;
+  if (x > n || y > n || z > n) return kNoIndex;
+  if (x < n && y < n && z < n) return corner_below(0, 0, x, y, z);
+  const std::size_t i = find_corner(lattice_key(x, y, z, n));  // on the cube's high faces: keyed
+  return i == kNoIndex ? kNoIndex : leaves_ + i;
+}
+
+void Adf::leaf_corners(const std::size_t* path, int level, std::uint64_t x, std::uint64_t y, std::uint64_t z,
+                       float out[8]) const {
+  const int s = depth_ - level;
+  const std::uint64_t n = std::uint64_t(1) << depth_;
+  out[0] = corner_value(leaf_rank(path[level]));
+  for (int c = 1; c < 8; ++c) {
+    const std::uint64_t ox = c & 1, oy = (c >> 1) & 1, oz = (c >> 2) & 1;
+    const std::uint64_t vx = (x + ox) << s, vy = (y + oy) << s, vz = (z + oz) << s;
+    std::size_t i;
+    if (vx < n && vy < n && vz < n) {
+      // The deepest ancestor holding the corner too: above the highest bit where x and x + 1 differ.
+      const int up = int(std::max({std::bit_width((x + ox) ^ x), std::bit_width((y + oy) ^ y), std::bit_width((z + oz) ^ z)}));
+      i = corner_below(path[level - up], level - up, vx, vy, vz);
+    } else {
+      i = find_corner(lattice_key(vx, vy, vz, n));
+      if (i != kNoIndex) i += leaves_;
+    }
+    if (i == kNoIndex) throw Error(fmt::format("adf: the corner ({}, {}, {}) of a level-{} cell is not stored", vx, vy, vz, level));
+    out[c] = corner_value(i);
+  }
+}
+
 void Adf::cell_corners(int level, std::uint64_t x, std::uint64_t y, std::uint64_t z, float out[8]) const {
   if (level < 0 || level > depth_) throw Error(fmt::format("adf: no cell at level {} (depth {})", level, depth_));
   const int s = depth_ - level;
-  const std::uint64_t n = std::uint64_t(1) << depth_;
   for (int c = 0; c < 8; ++c) {
     const std::uint64_t cx = (x + (c & 1)) << s, cy = (y + ((c >> 1) & 1)) << s, cz = (z + ((c >> 2) & 1)) << s;
-    const std::size_t i = cx <= n && cy <= n && cz <= n ? find_corner(lattice_key(cx, cy, cz, n)) : kNoIndex;
+    const std::size_t i = corner_index(cx, cy, cz);
     if (i == kNoIndex) throw Error(fmt::format("adf: the corner ({}, {}, {}) of a level-{} cell is not stored", cx, cy, cz, level));
     out[c] = corner_value(i);
   }
 }
 
 void Adf::finish_stats() {
-  std::size_t inner = 0;
-  for (const std::uint64_t w : inner_) inner += std::size_t(std::popcount(w));
   stats_.cells = cells_;
-  stats_.leaves = cells_ - inner;
+  stats_.leaves = leaves_;
   stats_.depth = std::size_t(depth_);
   stats_.corners = corners_;
   stats_.value_bits = std::size_t(value_bits_);
@@ -444,43 +540,65 @@ void Adf::finish_stats() {
   stats_.dense_bytes = std::size_t(4 * side * side * side);
 }
 
-void Adf::validate() const {
-  check_options(options_);
-  if (!origin_.allFinite() || !std::isfinite(size_) || !(size_ > 0)) throw Error("adf: the root cube is not finite");
-  if (cells_ == 0 || cells_ >= kLeaf) throw Error("adf: no cells, or more than 2^31");
-  if (inner_.size() != (cells_ + 63) / 64 || rank_.size() != inner_.size())
-    throw Error(fmt::format("adf: {} tree words for {} cells", inner_.size(), cells_));
-  if (cells_ % 64 && inner_.back() >> (cells_ % 64)) throw Error("adf: tree bits beyond the last cell");
+// The tree's checks: word count, bits beyond the last cell, an octree, level count = depth.
+static void check_tree(std::size_t cells, const FlatArray<std::uint64_t>& inner_bits, int depth, int max_depth) {
+  if (cells == 0 || cells >= kLeaf) throw Error("adf: no cells, or more than 2^31");
+  if (inner_bits.size() != (cells + 63) / 64) throw Error(fmt::format("adf: {} tree words for {} cells", inner_bits.size(), cells));
+  if (cells % 64 && inner_bits.back() >> (cells % 64)) throw Error("adf: tree bits beyond the last cell");
   std::size_t inner = 0;
-  for (const std::uint64_t w : inner_) inner += std::size_t(std::popcount(w));
-  if (cells_ != 1 + 8 * inner) throw Error(fmt::format("adf: {} cells with {} inner ones is not an octree", cells_, inner));
+  for (const std::uint64_t w : inner_bits) inner += std::size_t(std::popcount(w));
+  if (cells != 1 + 8 * inner) throw Error(fmt::format("adf: {} cells with {} inner ones is not an octree", cells, inner));
   // The levels are consecutive cell ranges: the deepest one is the depth.
   std::size_t begin = 0, end = 1;
   int levels = 0;
   while (begin < end) {
     std::size_t level_inner = 0;
-    for (std::size_t i = begin; i < end; ++i) level_inner += is_inner(i);
+    for (std::size_t i = begin; i < end; ++i) level_inner += (inner_bits[i >> 6] >> (i & 63)) & 1;
     begin = end;
     end += 8 * level_inner;
     ++levels;
   }
-  if (levels - 1 != depth_ || depth_ > options_.max_depth)
-    throw Error(fmt::format("adf: the tree has depth {}, recorded {} (max_depth {})", levels - 1, depth_, options_.max_depth));
-  // Buckets and keys.
-  const std::uint64_t n = std::uint64_t(1) << depth_, last = lattice_key(n, n, n, n);
-  if (shift_ < 0 || shift_ > 64) throw Error(fmt::format("adf: bad key layout (shift {})", shift_));
-  if (buckets_.size() != std::size_t(shift_ >= 64 ? 0 : last >> shift_) + 2 || buckets_[0] != 0 || buckets_.back() != corners_ ||
-      keys_.size() != packed_words(corners_, shift_))
-    throw Error(fmt::format("adf: {} buckets and {} key words for {} corners do not match", buckets_.size(), keys_.size(), corners_));
-  for (std::size_t b = 0; b + 1 < buckets_.size(); ++b) {
-    if (buckets_[b] > buckets_[b + 1]) throw Error(fmt::format("adf: bucket {} starts after the next one", b));
-    for (std::size_t i = buckets_[b]; i < buckets_[b + 1]; ++i) {
-      const std::uint64_t low = unpack(keys_.data(), i, shift_);
-      const std::uint64_t key = shift_ >= 64 ? low : (std::uint64_t(b) << shift_) | low;
-      if (key > last || (i > buckets_[b] && unpack(keys_.data(), i - 1, shift_) >= low))
+  if (levels - 1 != depth || depth > max_depth)
+    throw Error(fmt::format("adf: the tree has depth {}, recorded {} (max_depth {})", levels - 1, depth, max_depth));
+}
+
+// The bucketed keys' checks (buckets, word count, keys sorted within the lattice); calls f(i, key) for each.
+template <typename F>
+static void check_keys(const FlatArray<std::uint32_t>& buckets, const FlatArray<std::uint64_t>& keys, std::size_t count,
+                       int shift, std::uint64_t last, F&& f) {
+  if (shift < 0 || shift > 64) throw Error(fmt::format("adf: bad key layout (shift {})", shift));
+  if (buckets.size() != std::size_t(shift >= 64 ? 0 : last >> shift) + 2 || buckets[0] != 0 || buckets.back() != count ||
+      keys.size() != packed_words(count, shift))
+    throw Error(fmt::format("adf: {} buckets and {} key words for {} keyed corners do not match", buckets.size(), keys.size(), count));
+  for (std::size_t b = 0; b + 1 < buckets.size(); ++b)
+    if (buckets[b] > buckets[b + 1]) throw Error(fmt::format("adf: bucket {} starts after the next one", b));
+  for (std::size_t b = 0; b + 1 < buckets.size(); ++b) {
+    for (std::size_t i = buckets[b]; i < buckets[b + 1]; ++i) {
+      const std::uint64_t low = Adf::unpack(keys.data(), i, shift);
+      const std::uint64_t key = shift >= 64 ? low : (std::uint64_t(b) << shift) | low;
+      if (key > last || (i > buckets[b] && Adf::unpack(keys.data(), i - 1, shift) >= low))
         throw Error(fmt::format("adf: corner key {} is out of order or out of range", i));
+      f(i, key);
     }
   }
+}
+
+void Adf::validate() const {
+  check_options(options_);
+  if (!origin_.allFinite() || !std::isfinite(size_) || !(size_ > 0)) throw Error("adf: the root cube is not finite");
+  check_tree(cells_, inner_, depth_, options_.max_depth);
+  if (rank_.size() != inner_.size()) throw Error("adf: the rank table does not match the tree");
+  std::size_t inner = 0;
+  for (const std::uint64_t w : inner_) inner += std::size_t(std::popcount(w));
+  if (leaves_ != cells_ - inner || corners_ < leaves_)
+    throw Error(fmt::format("adf: {} corners for {} leaves", corners_, cells_ - inner));
+  // The keyed corners: sorted, on the lattice, none a leaf's low corner (stored unkeyed).
+  const std::uint64_t n = std::uint64_t(1) << depth_, last = lattice_key(n, n, n, n);
+  check_keys(buckets_, keys_, corners_ - leaves_, shift_, last, [&](std::size_t i, std::uint64_t key) {
+    const std::uint64_t x = key % (n + 1), y = key / (n + 1) % (n + 1), z = key / (n + 1) / (n + 1);
+    if (x < n && y < n && z < n && corner_below(0, 0, x, y, z) != leaves_ + i)
+      throw Error(fmt::format("adf: keyed corner {} at ({}, {}, {}) is a leaf's low corner", i, x, y, z));
+  });
   // Values.
   const float outer = std::isfinite(options_.band) ? float(2 * options_.band) : std::numeric_limits<float>::max();
   if (value_bits_ <= 16) {
@@ -500,14 +618,14 @@ void Adf::validate() const {
   // Every leaf finds its 8 corners (cell_corners throws otherwise).
   for_each_leaf([](int, const Vec3d&, double, const float*) {});
 }
-
 AdfSample Adf::sample(const Vec3f& p) const {
   if (!p.allFinite()) throw Error("adf: a query point is not finite");
   Vec3d u = (p.cast<double>() - origin_) / size_;
   const Vec3d inside = u.cwiseMax(0.0).cwiseMin(1.0);
   const Vec3d outside = (u - inside) * size_;  // p - (nearest point of the cube)
   u = inside;
-  std::size_t node = 0;
+  std::size_t node = 0, path[kAdfMaxDepth + 1];
+  path[0] = 0;
   std::uint64_t cx = 0, cy = 0, cz = 0;
   int level = 0;
   double side = size_;
@@ -519,10 +637,10 @@ AdfSample Adf::sample(const Vec3f& p) const {
     node = first_child(node) + child;
     cx = 2 * cx + (child & 1), cy = 2 * cy + ((child >> 1) & 1), cz = 2 * cz + ((child >> 2) & 1);
     side /= 2;
-    ++level;
+    path[++level] = node;
   }
   float c[8];
-  cell_corners(level, cx, cy, cz, c);
+  leaf_corners(path, level, cx, cy, cz, c);
   AdfSample s;
   s.distance = trilinear(c, u.x(), u.y(), u.z());
   // The derivatives of the trilinear interpolation along x, y, z.
@@ -608,7 +726,9 @@ void Adf::save(const std::filesystem::path& path) const {
 }
 
 Adf Adf::load(const std::filesystem::path& path, Archive::Verify verify) {
-  const Archive a = Archive::open(path, kKind, kVersion, verify);
+  // Version 2 (every corner keyed) is read and laid out anew; any other but 3 is refused by open.
+  const bool v2 = Archive::peek(path).version == 2;
+  const Archive a = Archive::open(path, kKind, v2 ? 2 : kVersion, verify);
   const Params p = a.value<Params>("params");
   Adf adf;
   adf.options_.error = p.error;
@@ -636,8 +756,29 @@ Adf Adf::load(const std::filesystem::path& path, Archive::Verify verify) {
   else throw a.error(fmt::format("{}-bit values are not 1 to 16 or 32", p.value_bits));
   const AdfStats stored = a.value<AdfStats>("stats");
   a.check([&] {
-    if (adf.inner_.size() != (adf.cells_ + 63) / 64) throw Error("adf: the tree bits do not match the cells");
+    check_tree(adf.cells_, adf.inner_, adf.depth_, adf.options_.max_depth);
     adf.make_ranks();
+    std::size_t inner = 0;
+    for (const std::uint64_t w : adf.inner_) inner += std::size_t(std::popcount(w));
+    adf.leaves_ = adf.cells_ - inner;
+    if (v2) {
+      // Every corner keyed, in key order: decode and lay out.
+      const std::uint64_t n = std::uint64_t(1) << adf.depth_;
+      std::vector<std::uint64_t> keys(adf.corners_), fields;
+      std::vector<float> floats;
+      check_keys(adf.buckets_, adf.keys_, adf.corners_, adf.shift_, lattice_key(n, n, n, n),
+                 [&](std::size_t i, std::uint64_t key) { keys[i] = key; });
+      if (adf.value_bits_ <= 16) {
+        if (adf.values_.size() != packed_words(adf.corners_, adf.value_bits_))
+          throw Error(fmt::format("adf: {} value words for {} corners", adf.values_.size(), adf.corners_));
+        fields.resize(adf.corners_);
+        for (std::size_t i = 0; i < adf.corners_; ++i) fields[i] = unpack(adf.values_.data(), i, adf.value_bits_);
+      } else {
+        if (adf.values32_.size() != adf.corners_) throw Error(fmt::format("adf: {} values for {} corners", adf.values32_.size(), adf.corners_));
+        floats.assign(adf.values32_.begin(), adf.values32_.end());
+      }
+      adf.lay_out(keys, fields, floats);
+    }
     adf.validate();
   });
   adf.stats_.exact_queries = stored.exact_queries;
