@@ -106,6 +106,7 @@ int main(int argc, char** argv) {
       .set("leaves", st.leaves)
       .set("depth", st.depth)
       .set("corners", st.corners)
+      .set("keyed", st.corners - st.leaves)
       .set("value_bits", st.value_bits)
       .set("key_bits", st.key_bits)
       .set("quantum", st.quantum)
