@@ -52,6 +52,12 @@ std::vector<std::uint64_t> pack(const std::vector<std::uint64_t>& fields, int bi
   return words;
 }
 
+// Bits of the Elias-Fano high part of m keys up to `last` whose low `shift` bits are stored apart.
+std::uint64_t high_length(std::uint64_t m, std::uint64_t last, int shift) { return m + (last >> shift) + 1; }
+
+// Every this many zeros of the high part, the position of one is sampled for select0.
+constexpr std::uint64_t kSelectStep = 128;
+
 // The key of lattice point (x, y, z) on the (n + 1)^3 lattice.
 std::uint64_t lattice_key(std::uint64_t x, std::uint64_t y, std::uint64_t z, std::uint64_t n) {
   return x + (n + 1) * (y + (n + 1) * z);
@@ -418,22 +424,25 @@ void Adf::lay_out(const std::vector<std::uint64_t>& keys, const std::vector<std:
   for (std::size_t i = 0; i < keys.size(); ++i)
     if (!regular[i]) order.push_back(i), keyed.push_back(keys[i]);
   corners_ = order.size();
-  // The keyed corners: buckets of about 32 keys (32 bits of offset for 32
-  // corners: the fewest bits a corner, offsets and key parts together).
+  // The keyed corners, Elias-Fano coded: key = (high << shift) | low with
+  // shift = floor(log2(lattice / keyed)); the lows bit-packed, the highs in
+  // unary (keyed i sets bit high_i + i of `high`), found by select0.
   const std::uint64_t last = lattice_key(n, n, n, n);
-  const std::uint64_t target = std::max<std::uint64_t>(1, keyed.size() / 32);
   shift_ = 0;
-  while ((last >> shift_) + 1 > target) ++shift_;
-  const std::uint64_t mask = shift_ >= 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << shift_) - 1;
-  std::vector<std::uint32_t> buckets(std::size_t(last >> shift_) + 2, 0);
+  while (shift_ < 62 && (last >> (shift_ + 1)) >= std::max<std::uint64_t>(1, keyed.size())) ++shift_;
+  const std::uint64_t mask = (std::uint64_t(1) << shift_) - 1;
   std::vector<std::uint64_t> low(keyed.size());
+  high_bits_ = high_length(keyed.size(), last, shift_);
+  if (high_bits_ >= (std::uint64_t(1) << 32)) throw Error("adf: more than 2^32 bits of keys: a larger error or a smaller max_depth");
+  std::vector<std::uint64_t> high((high_bits_ + 63) / 64, 0);
   for (std::size_t i = 0; i < keyed.size(); ++i) {
-    ++buckets[std::size_t(keyed[i] >> shift_) + 1];
     low[i] = keyed[i] & mask;
+    const std::uint64_t at = (keyed[i] >> shift_) + i;
+    high[at >> 6] |= std::uint64_t(1) << (at & 63);
   }
-  for (std::size_t b = 1; b < buckets.size(); ++b) buckets[b] += buckets[b - 1];
   keys_ = FlatArray<std::uint64_t>(pack(low, shift_));
-  buckets_ = FlatArray<std::uint32_t>(std::move(buckets));
+  high_ = FlatArray<std::uint64_t>(std::move(high));
+  make_selects();
   if (value_bits_ <= 16) {
     std::vector<std::uint64_t> v(corners_);
     for (std::size_t i = 0; i < corners_; ++i) v[i] = fields[order[i]];
@@ -457,19 +466,49 @@ void Adf::make_ranks() {
   rank_ = FlatArray<std::uint32_t>(std::move(rank));
 }
 
+void Adf::make_selects() {
+  // The position of every kSelectStep-th zero of `high`.
+  std::vector<std::uint32_t> select;
+  std::uint64_t zeros = 0;
+  for (std::size_t w = 0; w < high_.size(); ++w) {
+    std::uint64_t z = ~high_[w];
+    if (w + 1 == high_.size() && high_bits_ % 64) z &= (std::uint64_t(1) << (high_bits_ % 64)) - 1;
+    for (; z; z &= z - 1, ++zeros)
+      if (zeros % kSelectStep == 0) select.push_back(std::uint32_t(64 * w + std::size_t(std::countr_zero(z))));
+  }
+  select_ = FlatArray<std::uint32_t>(std::move(select));
+}
+
+// The position in `high` of zero number r (from 0; r below the zeros' count).
+std::uint64_t Adf::select0(std::uint64_t r) const {
+  const std::uint64_t pos = select_[r / kSelectStep];
+  std::uint64_t left = r % kSelectStep;
+  if (!left) return pos;
+  std::size_t w = pos >> 6;
+  std::uint64_t z = ~high_[w] & (~std::uint64_t(0) << (pos & 63));
+  z &= z - 1;  // past zero number r - left
+  for (;;) {
+    const auto c = std::uint64_t(std::popcount(z));
+    if (left <= c) {
+      for (; left > 1; --left) z &= z - 1;
+      return 64 * w + std::uint64_t(std::countr_zero(z));
+    }
+    left -= c;
+    z = ~high_[++w];
+  }
+}
+
 // The index (into the keyed corners) of `key`, or kNoIndex.
 std::size_t Adf::find_corner(std::uint64_t key) const {
-  const std::uint64_t b = shift_ >= 64 ? 0 : key >> shift_;
-  if (b + 1 >= buckets_.size()) return kNoIndex;
-  const std::uint64_t low = shift_ >= 64 ? key : key & ((std::uint64_t(1) << shift_) - 1);
-  std::size_t lo = buckets_[b], hi = buckets_[b + 1];
-  const std::uint64_t* k = keys_.data();
-  while (lo < hi) {
-    const std::size_t mid = lo + (hi - lo) / 2;
-    if (unpack(k, mid, shift_) < low) lo = mid + 1;
-    else hi = mid;
+  const std::uint64_t h = key >> shift_, low = key & ((std::uint64_t(1) << shift_) - 1);
+  if (h >= high_bits_ - (corners_ - leaves_)) return kNoIndex;  // beyond the zeros: no such high part
+  // The keyed corners of high part h: the ones between zero h - 1 and zero h.
+  std::uint64_t at = h == 0 ? 0 : select0(h - 1) + 1;
+  for (std::size_t i = std::size_t(at - h); (high_[at >> 6] >> (at & 63)) & 1; ++at, ++i) {
+    const std::uint64_t l = unpack(keys_.data(), i, shift_);
+    if (l >= low) return l == low ? i : kNoIndex;
   }
-  return lo < std::size_t(buckets_[b + 1]) && unpack(k, lo, shift_) == low ? lo : kNoIndex;
+  return kNoIndex;
 }
 
 std::size_t Adf::corner_below(std::size_t node, int level, std::uint64_t x, std::uint64_t y, std::uint64_t z) const {
@@ -534,7 +573,7 @@ void Adf::finish_stats() {
   stats_.value_bits = std::size_t(value_bits_);
   stats_.key_bits = std::size_t(shift_);
   stats_.quantum = quantum_;
-  stats_.bytes = 8 * inner_.size() + 4 * rank_.size() + 4 * buckets_.size() + 8 * keys_.size() + 8 * values_.size() +
+  stats_.bytes = 8 * inner_.size() + 4 * rank_.size() + 8 * high_.size() + 4 * select_.size() + 8 * keys_.size() + 8 * values_.size() +
                  4 * values32_.size();
   const double side = double(std::uint64_t(1) << depth_) + 1;
   stats_.dense_bytes = std::size_t(4 * side * side * side);
@@ -583,6 +622,34 @@ static void check_keys(const FlatArray<std::uint32_t>& buckets, const FlatArray<
   }
 }
 
+template <typename F>
+void Adf::for_each_keyed(std::size_t count, std::uint64_t last, F&& f) const {
+  // The Elias-Fano structure's checks: its size, `count` ones, the zeros of
+  // every high part, keys increasing within the lattice; f(i, key) for each.
+  if (shift_ < 0 || shift_ > 62) throw Error(fmt::format("adf: bad key layout (shift {})", shift_));
+  if (high_bits_ != high_length(count, last, shift_) || high_.size() != (high_bits_ + 63) / 64 ||
+      keys_.size() != packed_words(count, shift_))
+    throw Error(fmt::format("adf: {} bits of high parts and {} key words for {} keyed corners do not match", high_bits_,
+                            keys_.size(), count));
+  if (high_bits_ % 64 && high_.back() >> (high_bits_ % 64)) throw Error("adf: key bits beyond the last");
+  std::size_t ones = 0;
+  for (const std::uint64_t w : high_) ones += std::size_t(std::popcount(w));
+  if (ones != count || select_.size() != (high_bits_ - count + kSelectStep - 1) / kSelectStep)
+    throw Error(fmt::format("adf: {} keyed corners in the high parts, {} recorded", ones, count));
+  std::uint64_t zeros = 0, previous = 0;
+  std::size_t i = 0;
+  for (std::uint64_t at = 0; at < high_bits_; ++at) {
+    if (!((high_[at >> 6] >> (at & 63)) & 1)) {
+      ++zeros;
+      continue;
+    }
+    const std::uint64_t key = (zeros << shift_) | unpack(keys_.data(), i, shift_);
+    if (key > last || (i > 0 && key <= previous)) throw Error(fmt::format("adf: corner key {} is out of order or out of range", i));
+    previous = key;
+    f(i++, key);
+  }
+}
+
 void Adf::validate() const {
   check_options(options_);
   if (!origin_.allFinite() || !std::isfinite(size_) || !(size_ > 0)) throw Error("adf: the root cube is not finite");
@@ -594,10 +661,11 @@ void Adf::validate() const {
     throw Error(fmt::format("adf: {} corners for {} leaves", corners_, cells_ - inner));
   // The keyed corners: sorted, on the lattice, none a leaf's low corner (stored unkeyed).
   const std::uint64_t n = std::uint64_t(1) << depth_, last = lattice_key(n, n, n, n);
-  check_keys(buckets_, keys_, corners_ - leaves_, shift_, last, [&](std::size_t i, std::uint64_t key) {
+  for_each_keyed(corners_ - leaves_, last, [&](std::size_t i, std::uint64_t key) {
     const std::uint64_t x = key % (n + 1), y = key / (n + 1) % (n + 1), z = key / (n + 1) / (n + 1);
     if (x < n && y < n && z < n && corner_below(0, 0, x, y, z) != leaves_ + i)
       throw Error(fmt::format("adf: keyed corner {} at ({}, {}, {}) is a leaf's low corner", i, x, y, z));
+    if (find_corner(key) != i) throw Error(fmt::format("adf: keyed corner {} is not found", i));
   });
   // Values.
   const float outer = std::isfinite(options_.band) ? float(2 * options_.band) : std::numeric_limits<float>::max();
@@ -718,7 +786,7 @@ void Adf::save(const std::filesystem::path& path) const {
   w.add_value("params", p);
   w.add_value("stats", stats_);
   w.add("inner", inner_);
-  w.add("buckets", buckets_);
+  w.add("high", high_);
   w.add("keys", keys_);
   if (values_.empty()) w.add("values", values32_);
   else w.add("values", values_);
@@ -749,7 +817,9 @@ Adf Adf::load(const std::filesystem::path& path, Archive::Verify verify) {
   adf.value_lo_ = p.value_lo;
   adf.quantum_ = p.quantum;
   adf.inner_ = a.array<std::uint64_t>("inner");
-  adf.buckets_ = a.array<std::uint32_t>("buckets");
+  FlatArray<std::uint32_t> buckets;  // version 2
+  if (v2) buckets = a.array<std::uint32_t>("buckets");
+  else adf.high_ = a.array<std::uint64_t>("high");
   adf.keys_ = a.array<std::uint64_t>("keys");
   if (p.value_bits >= 1 && p.value_bits <= 16) adf.values_ = a.array<std::uint64_t>("values");
   else if (p.value_bits == 32) adf.values32_ = a.array<float>("values");
@@ -766,7 +836,7 @@ Adf Adf::load(const std::filesystem::path& path, Archive::Verify verify) {
       const std::uint64_t n = std::uint64_t(1) << adf.depth_;
       std::vector<std::uint64_t> keys(adf.corners_), fields;
       std::vector<float> floats;
-      check_keys(adf.buckets_, adf.keys_, adf.corners_, adf.shift_, lattice_key(n, n, n, n),
+      check_keys(buckets, adf.keys_, adf.corners_, adf.shift_, lattice_key(n, n, n, n),
                  [&](std::size_t i, std::uint64_t key) { keys[i] = key; });
       if (adf.value_bits_ <= 16) {
         if (adf.values_.size() != packed_words(adf.corners_, adf.value_bits_))
@@ -778,6 +848,13 @@ Adf Adf::load(const std::filesystem::path& path, Archive::Verify verify) {
         floats.assign(adf.values32_.begin(), adf.values32_.end());
       }
       adf.lay_out(keys, fields, floats);
+    } else {
+      if (adf.corners_ < adf.leaves_ || adf.shift_ < 0 || adf.shift_ > 62)
+        throw Error(fmt::format("adf: {} corners for {} leaves, key shift {}", adf.corners_, adf.leaves_, adf.shift_));
+      const std::uint64_t n = std::uint64_t(1) << adf.depth_;
+      adf.high_bits_ = high_length(adf.corners_ - adf.leaves_, lattice_key(n, n, n, n), adf.shift_);
+      if (adf.high_.size() != (adf.high_bits_ + 63) / 64) throw Error("adf: the keys' high parts do not match the corners");
+      adf.make_selects();
     }
     adf.validate();
   });

@@ -79,9 +79,11 @@ TEST(Adf, EveryLeafIsWithinTheErrorAtItsTestPoints) {
     ASSERT_GT(s.leaves, 50u);
     ASSERT_EQ(s.cells, adf.num_cells());
     // Every byte: one bit a cell (whole 64-bit words) with a 32-bit rank a
-    // word, the bucket offsets (one per 32 keyed corners, at most), the key
-    // parts of the keyed corners (all but the leaves' low corners) and all
-    // values bit-packed in 64-bit words with a word of padding each.
+    // word; the keys of the keyed corners (all but the leaves' low corners),
+    // Elias-Fano: key_bits = floor(log2(lattice / keyed)) low bits each, the
+    // high parts in unary (keyed + lattice / 2^key_bits bits) and a 32-bit
+    // select sample per 128 zeros; all values bit-packed. Packed fields in
+    // 64-bit words with a word of padding each.
     ASSERT_LE(s.value_bits, 16u);
     ASSERT_GT(s.quantum, 0.0);
     ASSERT_LE(s.quantum, o.error / 32);
@@ -89,9 +91,13 @@ TEST(Adf, EveryLeafIsWithinTheErrorAtItsTestPoints) {
     auto words = [](std::size_t n, std::size_t bits) { return (n * bits + 63) / 64 + 1; };
     ASSERT_GT(s.corners, s.leaves);
     const std::size_t keyed = s.corners - s.leaves;
-    const std::size_t fixed = 12 * ((s.cells + 63) / 64) + 8 * words(keyed, s.key_bits) + 8 * words(s.corners, s.value_bits);
-    ASSERT_GT(s.bytes, fixed);
-    ASSERT_LE(s.bytes, fixed + 4 * (keyed / 32 + 2));
+    const std::size_t lattice = std::size_t(std::pow((1 << s.depth) + 1, 3));
+    ASSERT_LE(keyed << s.key_bits, lattice);
+    ASSERT_GE(keyed << (s.key_bits + 1), lattice);
+    const std::size_t zeros = ((lattice - 1) >> s.key_bits) + 1;
+    const std::size_t fixed = 12 * ((s.cells + 63) / 64) + 8 * words(keyed, s.key_bits) + 8 * words(s.corners, s.value_bits) +
+                              8 * ((keyed + zeros + 63) / 64) + 4 * ((zeros + 127) / 128);
+    ASSERT_EQ(s.bytes, fixed);
     // Leaves' low corners are distinct: the corner_value order starts with them, leaf by leaf.
     std::size_t leaf = 0;
     adf.for_each_leaf([&](int, const Vec3d&, double, const float* c) { ASSERT_EQ(c[0], adf.corner_value(leaf++)); });

@@ -40,9 +40,9 @@
 // leaf's rank among the leaves (i - rank(i)): no key. The others (a vertex
 // in the middle of a larger leaf's low face or edge, or on the cube's high
 // faces) follow in the order of their key x + (N + 1) (y + (N + 1) z) on the
-// lattice of the finest cells (N = 2^depth): the key's high bits select a
-// bucket (an offset table, about 32 keys a bucket), its low bits are stored
-// and found by binary search. A leaf finds its corner c from its position:
+// lattice of the finest cells (N = 2^depth), Elias-Fano coded: the low
+// floor(log2(lattice / keyed)) bits of each key bit-packed, the rest in
+// unary, with the position of every 128th zero kept for select. A leaf finds its corner c from its position:
 // the leaf holding the corner (from the deepest ancestor that holds both,
 // down) has the corner as its low corner, or the corner is keyed.
 // The values are b-bit steps of [-R, R] (R bounds |distance| over the root
@@ -99,9 +99,9 @@ struct AdfStats {
   std::size_t signs = 0;          // of them, signs computed (the others: a neighbour's, see adf.cpp)
   std::size_t corners = 0;        // distinct leaf corners (octree vertices), each stored once: leaves + keyed ones
   std::size_t value_bits = 0;     // bits a quantized corner value (at most 16), or 32 (floats)
-  std::size_t key_bits = 0;       // bits of key stored a keyed corner (the rest is the bucket)
+  std::size_t key_bits = 0;       // low bits of key stored a keyed corner (the rest in unary: about 2 bits)
   double quantum = 0;             // the quantization step (0 for floats): a corner is within half of it
-  std::size_t bytes = 0;          // every array the ADF holds: tree bits, ranks, buckets, keys, values
+  std::size_t bytes = 0;          // every array the ADF holds: tree bits, ranks, keys (high and low parts, select samples), values
   std::size_t dense_bytes = 0;    // a float grid of the finest leaves' spacing over the root cube: 4 (2^depth + 1)^3
 };
 
@@ -142,7 +142,7 @@ class Adf {
 
   void save(const std::filesystem::path& path) const;
   static Adf load(const std::filesystem::path& path, Archive::Verify verify = Archive::Verify::checksums);
-  /// Throws geods::Error unless the tree bits, buckets and keys are consistent
+  /// Throws geods::Error unless the tree bits and keys are consistent
   /// (keys sorted, every leaf's corners present), values are finite (within
   /// twice the band) and the cube is finite.
   void validate() const;
@@ -200,19 +200,27 @@ class Adf {
   }
   void finish_stats();
   void make_ranks();
+  void make_selects();
+  std::uint64_t select0(std::uint64_t r) const;
+  // The keyed corner of `key` (its index among the keyed corners), or kNoIndex.
   std::size_t find_corner(std::uint64_t key) const;
+  // Checks the keyed corners' structure, calling f(i, key) for each in order.
+  template <typename F>
+  void for_each_keyed(std::size_t count, std::uint64_t last, F&& f) const;
 
   AdfOptions options_;
   Vec3d origin_ = Vec3d::Zero();
   double size_ = 1;
   std::size_t cells_ = 0, corners_ = 0, leaves_ = 0;
   int depth_ = 0;             // the finest leaves' level: keys are on the (2^depth + 1)^3 lattice
-  int shift_ = 0;             // a key's bucket is key >> shift; its low shift bits are stored
+  int shift_ = 0;             // the low shift bits of a keyed corner's key are stored, the rest in high_
   int value_bits_ = 32;       // bits a packed value, or 32: floats
   double value_lo_ = 0, quantum_ = 0;
   FlatArray<std::uint64_t> inner_;
   FlatArray<std::uint32_t> rank_;      // inner cells before each word of inner_ (computed on load)
-  FlatArray<std::uint32_t> buckets_;   // first keyed corner of each bucket, and the count at the end
+  std::uint64_t high_bits_ = 0;        // keyed + (last key >> shift) + 1
+  FlatArray<std::uint64_t> high_;      // Elias-Fano high parts: keyed corner i sets bit (key >> shift) + i
+  FlatArray<std::uint32_t> select_;    // the position of every 128th zero of high_ (computed on load)
   FlatArray<std::uint64_t> keys_;      // the low shift bits of each keyed corner's key, packed
   FlatArray<std::uint64_t> values_;    // quantized values (value_bits_ each; leaves' low corners, then keyed), packed, or empty
   FlatArray<float> values32_;          // float values when the quantum would be too coarse
