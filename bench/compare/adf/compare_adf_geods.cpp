@@ -92,7 +92,7 @@ int main(int argc, char** argv) {
   // see the kinks between the 19 points of checks = 3: a measured max error
   // close to E) from E = 0.95 x the grid's error, E then scaled by 0.95 x
   // dense / measured while the ADF's measured max error exceeds the grid's
-  // (at most 3 builds). (checks = 3 needs E = 0.77 x the grid's error: 8.7x, see docs/field.md.)
+  // (at most 3 builds). (checks = 3 at E = the grid's error misses it: max_error above.)
   double matched_error = max_error;
   geods::field::Adf matched = adf;
   double matched_e = 0.95 * options.error;
