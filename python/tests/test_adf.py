@@ -42,13 +42,20 @@ def test_distance_within_the_bound(checks, bound):
     assert np.abs(d - box_sdf(p.astype(np.float64))).max() <= bound * error
     s = adf.stats()
     assert set(s) >= {"cells", "leaves", "depth", "bytes", "dense_bytes", "unresolved", "exact_queries"}
-    # Every byte: tree bits and ranks (12 bytes per 64 cells), bucket offsets (one per 32 corners at most),
-    # bit-packed key parts and values (64-bit words, one of padding each); corners shared: fewer than 8 a leaf.
+    # Every byte: tree bits and ranks (12 bytes per 64 cells); the keys of the keyed corners (all but the
+    # leaves' low corners), Elias-Fano: key_bits = floor(log2(lattice / keyed)) low bits each, the high parts
+    # in unary (keyed + lattice / 2^key_bits bits), a 32-bit select sample per 128 zeros; the values of all.
+    # Packed fields in 64-bit words, one of padding each; corners shared: fewer than 8 a leaf.
     def words(n, bits):
         return (n * bits + 63) // 64 + 1
-    fixed = 12 * ((s["cells"] + 63) // 64) + 8 * words(s["corners"], s["key_bits"]) + 8 * words(s["corners"], s["value_bits"])
+    keyed = s["corners"] - s["leaves"]
+    lattice = (2 ** s["depth"] + 1) ** 3
+    assert keyed << s["key_bits"] <= lattice <= keyed << (s["key_bits"] + 1)
+    zeros = ((lattice - 1) >> s["key_bits"]) + 1
+    fixed = (12 * ((s["cells"] + 63) // 64) + 8 * words(keyed, s["key_bits"]) + 8 * words(s["corners"], s["value_bits"])
+             + 8 * ((keyed + zeros + 63) // 64) + 4 * ((zeros + 127) // 128))
     assert s["unresolved"] == 0 and s["value_bits"] <= 16 and error / 64 < s["quantum"] <= error / 32
-    assert fixed < s["bytes"] <= fixed + 4 * (s["corners"] // 32 + 2)
+    assert 0 < keyed and s["bytes"] == fixed
     assert s["corners"] < 8 * s["leaves"]
     assert s["dense_bytes"] == 4 * (2 ** s["depth"] + 1) ** 3
 

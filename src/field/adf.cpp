@@ -20,8 +20,10 @@ namespace geods::field {
 namespace {
 
 constexpr char kKind[] = "field.Adf";
-// 2: shared quantized corners, one bit a cell (version 1: 32-bit nodes and 8 floats a leaf).
-constexpr std::uint32_t kVersion = 2;
+// 3: a leaf's low corner stored at the leaf's rank, only the other corners
+// keyed (2: every corner keyed, read and converted; 1: 32-bit nodes and 8
+// floats a leaf, refused).
+constexpr std::uint32_t kVersion = 3;
 // The build's temporary node: the leaf bit, else the first child's index.
 constexpr std::uint32_t kLeaf = 0x80000000u;
 
@@ -49,6 +51,12 @@ std::vector<std::uint64_t> pack(const std::vector<std::uint64_t>& fields, int bi
   }
   return words;
 }
+
+// Bits of the Elias-Fano high part of m keys up to `last` whose low `shift` bits are stored apart.
+std::uint64_t high_length(std::uint64_t m, std::uint64_t last, int shift) { return m + (last >> shift) + 1; }
+
+// Every this many zeros of the high part, the position of one is sampled for select0.
+constexpr std::uint64_t kSelectStep = 128;
 
 // The key of lattice point (x, y, z) on the (n + 1)^3 lattice.
 std::uint64_t lattice_key(std::uint64_t x, std::uint64_t y, std::uint64_t z, std::uint64_t n) {
@@ -314,6 +322,8 @@ void Adf::store(const std::vector<std::uint32_t>& nodes, const std::vector<float
   std::vector<std::uint64_t> inner((cells_ + 63) / 64, 0);
   for (std::size_t i = 0; i < cells_; ++i)
     if (!(nodes[i] & kLeaf)) inner[i >> 6] |= std::uint64_t(1) << (i & 63);
+  inner_ = FlatArray<std::uint64_t>(std::move(inner));
+  make_ranks();
   // The leaves' positions, level by level.
   struct Leaf {
     int level;
@@ -355,41 +365,95 @@ void Adf::store(const std::vector<std::uint32_t>& nodes, const std::vector<float
   std::sort(corners.begin(), corners.end());
   corners.erase(std::unique(corners.begin(), corners.end(), [](const auto& a, const auto& b) { return a.first == b.first; }),
                 corners.end());
-  corners_ = corners.size();
-  if (corners_ >= kNoIndex) throw Error("adf: more than 2^32 distinct corners: a larger error or a smaller max_depth");
-  // Buckets of about 32 keys (32 bits of offset for 32 corners: the fewest
-  // bits a corner, offsets and key parts together, are at about 22).
-  const std::uint64_t last = lattice_key(n, n, n, n);
-  const std::uint64_t target = std::max<std::uint64_t>(1, corners_ / 32);
-  shift_ = 0;
-  while ((last >> shift_) + 1 > target) ++shift_;
-  const std::uint64_t mask = shift_ >= 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << shift_) - 1;
-  std::vector<std::uint32_t> buckets(std::size_t(last >> shift_) + 2, 0);
-  std::vector<std::uint64_t> fields(corners_);
-  for (std::size_t i = 0; i < corners_; ++i) {
-    ++buckets[std::size_t(corners[i].first >> shift_) + 1];
-    fields[i] = corners[i].first & mask;
-  }
-  for (std::size_t b = 1; b < buckets.size(); ++b) buckets[b] += buckets[b - 1];
-  keys_ = FlatArray<std::uint64_t>(pack(fields, shift_));
+  if (corners.size() >= kNoIndex) throw Error("adf: more than 2^32 distinct corners: a larger error or a smaller max_depth");
+  std::vector<std::uint64_t> keys(corners.size()), fields;
+  std::vector<float> floats;
+  for (std::size_t i = 0; i < corners.size(); ++i) keys[i] = corners[i].first;
   value_bits_ = value_bits;
   quantum_ = quantum;
   value_lo_ = quantum > 0 ? lo : 0;
   if (quantum > 0) {
     const long long top = (1LL << value_bits) - 1;
-    for (std::size_t i = 0; i < corners_; ++i)
+    fields.resize(corners.size());
+    for (std::size_t i = 0; i < corners.size(); ++i)
       fields[i] = std::uint64_t(std::clamp(std::llround((double(corners[i].second) - lo) / quantum), 0LL, top));
-    values_ = FlatArray<std::uint64_t>(pack(fields, value_bits));
+  } else {
+    floats.resize(corners.size());
+    for (std::size_t i = 0; i < corners.size(); ++i) floats[i] = corners[i].second;
+  }
+  lay_out(keys, fields, floats);
+}
+
+void Adf::lay_out(const std::vector<std::uint64_t>& keys, const std::vector<std::uint64_t>& fields,
+                  const std::vector<float>& floats) {
+  // Each leaf's low corner: its value goes to the leaf's rank, unkeyed.
+  const std::uint64_t n = std::uint64_t(1) << depth_;
+  std::size_t inner = 0;
+  for (const std::uint64_t w : inner_) inner += std::size_t(std::popcount(w));
+  leaves_ = cells_ - inner;
+  std::vector<std::size_t> of_leaf(leaves_, kNoIndex);
+  std::vector<char> regular(keys.size(), 0);
+  struct Cell {
+    std::size_t node;
+    std::uint64_t x, y, z;
+  };
+  std::vector<Cell> level{{0, 0, 0, 0}}, next;
+  for (int l = 0; !level.empty() && l <= depth_; ++l) {
+    next.clear();
+    for (const Cell& c : level) {
+      if (is_inner(c.node)) {
+        const std::size_t first = first_child(c.node);
+        for (std::uint64_t o = 0; o < 8; ++o)
+          next.push_back({first + o, 2 * c.x + (o & 1), 2 * c.y + ((o >> 1) & 1), 2 * c.z + ((o >> 2) & 1)});
+        continue;
+      }
+      const int s = depth_ - l;
+      const std::uint64_t key = lattice_key(c.x << s, c.y << s, c.z << s, n);
+      const auto it = std::lower_bound(keys.begin(), keys.end(), key);
+      if (it == keys.end() || *it != key)
+        throw Error(fmt::format("adf: the low corner of the level-{} leaf at ({}, {}, {}) is not stored", l, c.x, c.y, c.z));
+      const std::size_t i = std::size_t(it - keys.begin());
+      regular[i] = 1;
+      of_leaf[leaf_rank(c.node)] = i;
+    }
+    std::swap(level, next);
+  }
+  if (!level.empty()) throw Error(fmt::format("adf: the tree is deeper than its recorded depth {}", depth_));
+  std::vector<std::size_t> order(of_leaf);
+  std::vector<std::uint64_t> keyed;
+  for (std::size_t i = 0; i < keys.size(); ++i)
+    if (!regular[i]) order.push_back(i), keyed.push_back(keys[i]);
+  corners_ = order.size();
+  // The keyed corners, Elias-Fano coded: key = (high << shift) | low with
+  // shift = floor(log2(lattice / keyed)); the lows bit-packed, the highs in
+  // unary (keyed i sets bit high_i + i of `high`), found by select0.
+  const std::uint64_t last = lattice_key(n, n, n, n);
+  shift_ = 0;
+  while (shift_ < 62 && (last >> (shift_ + 1)) >= std::max<std::uint64_t>(1, keyed.size())) ++shift_;
+  const std::uint64_t mask = (std::uint64_t(1) << shift_) - 1;
+  std::vector<std::uint64_t> low(keyed.size());
+  high_bits_ = high_length(keyed.size(), last, shift_);
+  if (high_bits_ >= (std::uint64_t(1) << 32)) throw Error("adf: more than 2^32 bits of keys: a larger error or a smaller max_depth");
+  std::vector<std::uint64_t> high((high_bits_ + 63) / 64, 0);
+  for (std::size_t i = 0; i < keyed.size(); ++i) {
+    low[i] = keyed[i] & mask;
+    const std::uint64_t at = (keyed[i] >> shift_) + i;
+    high[at >> 6] |= std::uint64_t(1) << (at & 63);
+  }
+  keys_ = FlatArray<std::uint64_t>(pack(low, shift_));
+  high_ = FlatArray<std::uint64_t>(std::move(high));
+  make_selects();
+  if (value_bits_ <= 16) {
+    std::vector<std::uint64_t> v(corners_);
+    for (std::size_t i = 0; i < corners_; ++i) v[i] = fields[order[i]];
+    values_ = FlatArray<std::uint64_t>(pack(v, value_bits_));
     values32_ = {};
   } else {
     std::vector<float> v(corners_);
-    for (std::size_t i = 0; i < corners_; ++i) v[i] = corners[i].second;
+    for (std::size_t i = 0; i < corners_; ++i) v[i] = floats[order[i]];
     values32_ = FlatArray<float>(std::move(v));
     values_ = {};
   }
-  inner_ = FlatArray<std::uint64_t>(std::move(inner));
-  buckets_ = FlatArray<std::uint32_t>(std::move(buckets));
-  make_ranks();
 }
 
 void Adf::make_ranks() {
@@ -402,85 +466,207 @@ void Adf::make_ranks() {
   rank_ = FlatArray<std::uint32_t>(std::move(rank));
 }
 
-std::size_t Adf::find_corner(std::uint64_t key) const {
-  const std::uint64_t b = key >> shift_;
-  if (b + 1 >= buckets_.size()) return kNoIndex;
-  const std::uint64_t low = shift_ >= 64 ? key : key & ((std::uint64_t(1) << shift_) - 1);
-  std::size_t lo = buckets_[b], hi = buckets_[b + 1];
-  const std::uint64_t* k = keys_.data();
-  while (lo < hi) {
-    const std::size_t mid = lo + (hi - lo) / 2;
-    if (unpack(k, mid, shift_) < low) lo = mid + 1;
-    else hi = mid;
+void Adf::make_selects() {
+  // The position of every kSelectStep-th zero of `high`.
+  std::vector<std::uint32_t> select;
+  std::uint64_t zeros = 0;
+  for (std::size_t w = 0; w < high_.size(); ++w) {
+    std::uint64_t z = ~high_[w];
+    if (w + 1 == high_.size() && high_bits_ % 64) z &= (std::uint64_t(1) << (high_bits_ % 64)) - 1;
+    for (; z; z &= z - 1, ++zeros)
+      if (zeros % kSelectStep == 0) select.push_back(std::uint32_t(64 * w + std::size_t(std::countr_zero(z))));
   }
-  return lo < std::size_t(buckets_[b + 1]) && unpack(k, lo, shift_) == low ? lo : kNoIndex;
+  select_ = FlatArray<std::uint32_t>(std::move(select));
+}
+
+// The position in `high` of zero number r (from 0; r below the zeros' count).
+std::uint64_t Adf::select0(std::uint64_t r) const {
+  const std::uint64_t pos = select_[r / kSelectStep];
+  std::uint64_t left = r % kSelectStep;
+  if (!left) return pos;
+  std::size_t w = pos >> 6;
+  std::uint64_t z = ~high_[w] & (~std::uint64_t(0) << (pos & 63));
+  z &= z - 1;  // past zero number r - left
+  for (;;) {
+    const auto c = std::uint64_t(std::popcount(z));
+    if (left <= c) {
+      for (; left > 1; --left) z &= z - 1;
+      return 64 * w + std::uint64_t(std::countr_zero(z));
+    }
+    left -= c;
+    z = ~high_[++w];
+  }
+}
+
+// The index (into the keyed corners) of `key`, or kNoIndex.
+std::size_t Adf::find_corner(std::uint64_t key) const {
+  const std::uint64_t h = key >> shift_, low = key & ((std::uint64_t(1) << shift_) - 1);
+  if (h >= high_bits_ - (corners_ - leaves_)) return kNoIndex;  // beyond the zeros: no such high part
+  // The keyed corners of high part h: the ones between zero h - 1 and zero h.
+  std::uint64_t at = h == 0 ? 0 : select0(h - 1) + 1;
+  for (std::size_t i = std::size_t(at - h); (high_[at >> 6] >> (at & 63)) & 1; ++at, ++i) {
+    const std::uint64_t l = unpack(keys_.data(), i, shift_);
+    if (l >= low) return l == low ? i : kNoIndex;
+  }
+  return kNoIndex;
+}
+
+std::size_t Adf::corner_below(std::size_t node, int level, std::uint64_t x, std::uint64_t y, std::uint64_t z) const {
+  // Down to the leaf holding (x, y, z) (half-open cells): the vertex is its low corner, or keyed.
+  while (is_inner(node)) {
+    const int s = depth_ - level - 1;
+    node = first_child(node) + ((x >> s) & 1) + 2 * ((y >> s) & 1) + 4 * ((z >> s) & 1);
+    ++level;
+  }
+  const std::uint64_t below = (std::uint64_t(1) << (depth_ - level)) - 1;
+  if (((x | y | z) & below) == 0) return leaf_rank(node);
+  const std::size_t i = find_corner(lattice_key(x, y, z, std::uint64_t(1) << depth_));
+  return i == kNoIndex ? kNoIndex : leaves_ + i;
+}
+
+std::size_t Adf::corner_index(std::uint64_t x, std::uint64_t y, std::uint64_t z) const {
+  const std::uint64_t n = std::uint64_t(1) << depth_;
+  if (x > n || y > n || z > n) return kNoIndex;
+  if (x < n && y < n && z < n) return corner_below(0, 0, x, y, z);
+  const std::size_t i = find_corner(lattice_key(x, y, z, n));  // on the cube's high faces: keyed
+  return i == kNoIndex ? kNoIndex : leaves_ + i;
+}
+
+void Adf::leaf_corners(const std::size_t* path, int level, std::uint64_t x, std::uint64_t y, std::uint64_t z,
+                       float out[8]) const {
+  const int s = depth_ - level;
+  const std::uint64_t n = std::uint64_t(1) << depth_;
+  out[0] = corner_value(leaf_rank(path[level]));
+  for (int c = 1; c < 8; ++c) {
+    const std::uint64_t ox = c & 1, oy = (c >> 1) & 1, oz = (c >> 2) & 1;
+    const std::uint64_t vx = (x + ox) << s, vy = (y + oy) << s, vz = (z + oz) << s;
+    std::size_t i;
+    if (vx < n && vy < n && vz < n) {
+      // The deepest ancestor holding the corner too: above the highest bit where x and x + 1 differ.
+      const int up = int(std::max({std::bit_width((x + ox) ^ x), std::bit_width((y + oy) ^ y), std::bit_width((z + oz) ^ z)}));
+      i = corner_below(path[level - up], level - up, vx, vy, vz);
+    } else {
+      i = find_corner(lattice_key(vx, vy, vz, n));
+      if (i != kNoIndex) i += leaves_;
+    }
+    if (i == kNoIndex) throw Error(fmt::format("adf: the corner ({}, {}, {}) of a level-{} cell is not stored", vx, vy, vz, level));
+    out[c] = corner_value(i);
+  }
 }
 
 void Adf::cell_corners(int level, std::uint64_t x, std::uint64_t y, std::uint64_t z, float out[8]) const {
   if (level < 0 || level > depth_) throw Error(fmt::format("adf: no cell at level {} (depth {})", level, depth_));
   const int s = depth_ - level;
-  const std::uint64_t n = std::uint64_t(1) << depth_;
   for (int c = 0; c < 8; ++c) {
     const std::uint64_t cx = (x + (c & 1)) << s, cy = (y + ((c >> 1) & 1)) << s, cz = (z + ((c >> 2) & 1)) << s;
-    const std::size_t i = cx <= n && cy <= n && cz <= n ? find_corner(lattice_key(cx, cy, cz, n)) : kNoIndex;
+    const std::size_t i = corner_index(cx, cy, cz);
     if (i == kNoIndex) throw Error(fmt::format("adf: the corner ({}, {}, {}) of a level-{} cell is not stored", cx, cy, cz, level));
     out[c] = corner_value(i);
   }
 }
 
 void Adf::finish_stats() {
-  std::size_t inner = 0;
-  for (const std::uint64_t w : inner_) inner += std::size_t(std::popcount(w));
   stats_.cells = cells_;
-  stats_.leaves = cells_ - inner;
+  stats_.leaves = leaves_;
   stats_.depth = std::size_t(depth_);
   stats_.corners = corners_;
   stats_.value_bits = std::size_t(value_bits_);
   stats_.key_bits = std::size_t(shift_);
   stats_.quantum = quantum_;
-  stats_.bytes = 8 * inner_.size() + 4 * rank_.size() + 4 * buckets_.size() + 8 * keys_.size() + 8 * values_.size() +
+  stats_.bytes = 8 * inner_.size() + 4 * rank_.size() + 8 * high_.size() + 4 * select_.size() + 8 * keys_.size() + 8 * values_.size() +
                  4 * values32_.size();
   const double side = double(std::uint64_t(1) << depth_) + 1;
   stats_.dense_bytes = std::size_t(4 * side * side * side);
 }
 
-void Adf::validate() const {
-  check_options(options_);
-  if (!origin_.allFinite() || !std::isfinite(size_) || !(size_ > 0)) throw Error("adf: the root cube is not finite");
-  if (cells_ == 0 || cells_ >= kLeaf) throw Error("adf: no cells, or more than 2^31");
-  if (inner_.size() != (cells_ + 63) / 64 || rank_.size() != inner_.size())
-    throw Error(fmt::format("adf: {} tree words for {} cells", inner_.size(), cells_));
-  if (cells_ % 64 && inner_.back() >> (cells_ % 64)) throw Error("adf: tree bits beyond the last cell");
+// The tree's checks: word count, bits beyond the last cell, an octree, level count = depth.
+static void check_tree(std::size_t cells, const FlatArray<std::uint64_t>& inner_bits, int depth, int max_depth) {
+  if (cells == 0 || cells >= kLeaf) throw Error("adf: no cells, or more than 2^31");
+  if (inner_bits.size() != (cells + 63) / 64) throw Error(fmt::format("adf: {} tree words for {} cells", inner_bits.size(), cells));
+  if (cells % 64 && inner_bits.back() >> (cells % 64)) throw Error("adf: tree bits beyond the last cell");
   std::size_t inner = 0;
-  for (const std::uint64_t w : inner_) inner += std::size_t(std::popcount(w));
-  if (cells_ != 1 + 8 * inner) throw Error(fmt::format("adf: {} cells with {} inner ones is not an octree", cells_, inner));
+  for (const std::uint64_t w : inner_bits) inner += std::size_t(std::popcount(w));
+  if (cells != 1 + 8 * inner) throw Error(fmt::format("adf: {} cells with {} inner ones is not an octree", cells, inner));
   // The levels are consecutive cell ranges: the deepest one is the depth.
   std::size_t begin = 0, end = 1;
   int levels = 0;
   while (begin < end) {
     std::size_t level_inner = 0;
-    for (std::size_t i = begin; i < end; ++i) level_inner += is_inner(i);
+    for (std::size_t i = begin; i < end; ++i) level_inner += (inner_bits[i >> 6] >> (i & 63)) & 1;
     begin = end;
     end += 8 * level_inner;
     ++levels;
   }
-  if (levels - 1 != depth_ || depth_ > options_.max_depth)
-    throw Error(fmt::format("adf: the tree has depth {}, recorded {} (max_depth {})", levels - 1, depth_, options_.max_depth));
-  // Buckets and keys.
-  const std::uint64_t n = std::uint64_t(1) << depth_, last = lattice_key(n, n, n, n);
-  if (shift_ < 0 || shift_ > 64) throw Error(fmt::format("adf: bad key layout (shift {})", shift_));
-  if (buckets_.size() != std::size_t(shift_ >= 64 ? 0 : last >> shift_) + 2 || buckets_[0] != 0 || buckets_.back() != corners_ ||
-      keys_.size() != packed_words(corners_, shift_))
-    throw Error(fmt::format("adf: {} buckets and {} key words for {} corners do not match", buckets_.size(), keys_.size(), corners_));
-  for (std::size_t b = 0; b + 1 < buckets_.size(); ++b) {
-    if (buckets_[b] > buckets_[b + 1]) throw Error(fmt::format("adf: bucket {} starts after the next one", b));
-    for (std::size_t i = buckets_[b]; i < buckets_[b + 1]; ++i) {
-      const std::uint64_t low = unpack(keys_.data(), i, shift_);
-      const std::uint64_t key = shift_ >= 64 ? low : (std::uint64_t(b) << shift_) | low;
-      if (key > last || (i > buckets_[b] && unpack(keys_.data(), i - 1, shift_) >= low))
+  if (levels - 1 != depth || depth > max_depth)
+    throw Error(fmt::format("adf: the tree has depth {}, recorded {} (max_depth {})", levels - 1, depth, max_depth));
+}
+
+// The bucketed keys' checks (buckets, word count, keys sorted within the lattice); calls f(i, key) for each.
+template <typename F>
+static void check_keys(const FlatArray<std::uint32_t>& buckets, const FlatArray<std::uint64_t>& keys, std::size_t count,
+                       int shift, std::uint64_t last, F&& f) {
+  if (shift < 0 || shift > 64) throw Error(fmt::format("adf: bad key layout (shift {})", shift));
+  if (buckets.size() != std::size_t(shift >= 64 ? 0 : last >> shift) + 2 || buckets[0] != 0 || buckets.back() != count ||
+      keys.size() != packed_words(count, shift))
+    throw Error(fmt::format("adf: {} buckets and {} key words for {} keyed corners do not match", buckets.size(), keys.size(), count));
+  for (std::size_t b = 0; b + 1 < buckets.size(); ++b)
+    if (buckets[b] > buckets[b + 1]) throw Error(fmt::format("adf: bucket {} starts after the next one", b));
+  for (std::size_t b = 0; b + 1 < buckets.size(); ++b) {
+    for (std::size_t i = buckets[b]; i < buckets[b + 1]; ++i) {
+      const std::uint64_t low = Adf::unpack(keys.data(), i, shift);
+      const std::uint64_t key = shift >= 64 ? low : (std::uint64_t(b) << shift) | low;
+      if (key > last || (i > buckets[b] && Adf::unpack(keys.data(), i - 1, shift) >= low))
         throw Error(fmt::format("adf: corner key {} is out of order or out of range", i));
+      f(i, key);
     }
   }
+}
+
+template <typename F>
+void Adf::for_each_keyed(std::size_t count, std::uint64_t last, F&& f) const {
+  // The Elias-Fano structure's checks: its size, `count` ones, the zeros of
+  // every high part, keys increasing within the lattice; f(i, key) for each.
+  if (shift_ < 0 || shift_ > 62) throw Error(fmt::format("adf: bad key layout (shift {})", shift_));
+  if (high_bits_ != high_length(count, last, shift_) || high_.size() != (high_bits_ + 63) / 64 ||
+      keys_.size() != packed_words(count, shift_))
+    throw Error(fmt::format("adf: {} bits of high parts and {} key words for {} keyed corners do not match", high_bits_,
+                            keys_.size(), count));
+  if (high_bits_ % 64 && high_.back() >> (high_bits_ % 64)) throw Error("adf: key bits beyond the last");
+  std::size_t ones = 0;
+  for (const std::uint64_t w : high_) ones += std::size_t(std::popcount(w));
+  if (ones != count || select_.size() != (high_bits_ - count + kSelectStep - 1) / kSelectStep)
+    throw Error(fmt::format("adf: {} keyed corners in the high parts, {} recorded", ones, count));
+  std::uint64_t zeros = 0, previous = 0;
+  std::size_t i = 0;
+  for (std::uint64_t at = 0; at < high_bits_; ++at) {
+    if (!((high_[at >> 6] >> (at & 63)) & 1)) {
+      ++zeros;
+      continue;
+    }
+    const std::uint64_t key = (zeros << shift_) | unpack(keys_.data(), i, shift_);
+    if (key > last || (i > 0 && key <= previous)) throw Error(fmt::format("adf: corner key {} is out of order or out of range", i));
+    previous = key;
+    f(i++, key);
+  }
+}
+
+void Adf::validate() const {
+  check_options(options_);
+  if (!origin_.allFinite() || !std::isfinite(size_) || !(size_ > 0)) throw Error("adf: the root cube is not finite");
+  check_tree(cells_, inner_, depth_, options_.max_depth);
+  if (rank_.size() != inner_.size()) throw Error("adf: the rank table does not match the tree");
+  std::size_t inner = 0;
+  for (const std::uint64_t w : inner_) inner += std::size_t(std::popcount(w));
+  if (leaves_ != cells_ - inner || corners_ < leaves_)
+    throw Error(fmt::format("adf: {} corners for {} leaves", corners_, cells_ - inner));
+  // The keyed corners: sorted, on the lattice, none a leaf's low corner (stored unkeyed).
+  const std::uint64_t n = std::uint64_t(1) << depth_, last = lattice_key(n, n, n, n);
+  for_each_keyed(corners_ - leaves_, last, [&](std::size_t i, std::uint64_t key) {
+    const std::uint64_t x = key % (n + 1), y = key / (n + 1) % (n + 1), z = key / (n + 1) / (n + 1);
+    if (x < n && y < n && z < n && corner_below(0, 0, x, y, z) != leaves_ + i)
+      throw Error(fmt::format("adf: keyed corner {} at ({}, {}, {}) is a leaf's low corner", i, x, y, z));
+    if (find_corner(key) != i) throw Error(fmt::format("adf: keyed corner {} is not found", i));
+  });
   // Values.
   const float outer = std::isfinite(options_.band) ? float(2 * options_.band) : std::numeric_limits<float>::max();
   if (value_bits_ <= 16) {
@@ -500,14 +686,14 @@ void Adf::validate() const {
   // Every leaf finds its 8 corners (cell_corners throws otherwise).
   for_each_leaf([](int, const Vec3d&, double, const float*) {});
 }
-
 AdfSample Adf::sample(const Vec3f& p) const {
   if (!p.allFinite()) throw Error("adf: a query point is not finite");
   Vec3d u = (p.cast<double>() - origin_) / size_;
   const Vec3d inside = u.cwiseMax(0.0).cwiseMin(1.0);
   const Vec3d outside = (u - inside) * size_;  // p - (nearest point of the cube)
   u = inside;
-  std::size_t node = 0;
+  std::size_t node = 0, path[kAdfMaxDepth + 1];
+  path[0] = 0;
   std::uint64_t cx = 0, cy = 0, cz = 0;
   int level = 0;
   double side = size_;
@@ -519,10 +705,10 @@ AdfSample Adf::sample(const Vec3f& p) const {
     node = first_child(node) + child;
     cx = 2 * cx + (child & 1), cy = 2 * cy + ((child >> 1) & 1), cz = 2 * cz + ((child >> 2) & 1);
     side /= 2;
-    ++level;
+    path[++level] = node;
   }
   float c[8];
-  cell_corners(level, cx, cy, cz, c);
+  leaf_corners(path, level, cx, cy, cz, c);
   AdfSample s;
   s.distance = trilinear(c, u.x(), u.y(), u.z());
   // The derivatives of the trilinear interpolation along x, y, z.
@@ -600,7 +786,7 @@ void Adf::save(const std::filesystem::path& path) const {
   w.add_value("params", p);
   w.add_value("stats", stats_);
   w.add("inner", inner_);
-  w.add("buckets", buckets_);
+  w.add("high", high_);
   w.add("keys", keys_);
   if (values_.empty()) w.add("values", values32_);
   else w.add("values", values_);
@@ -608,7 +794,9 @@ void Adf::save(const std::filesystem::path& path) const {
 }
 
 Adf Adf::load(const std::filesystem::path& path, Archive::Verify verify) {
-  const Archive a = Archive::open(path, kKind, kVersion, verify);
+  // Version 2 (every corner keyed) is read and laid out anew; any other but 3 is refused by open.
+  const bool v2 = Archive::peek(path).version == 2;
+  const Archive a = Archive::open(path, kKind, v2 ? 2 : kVersion, verify);
   const Params p = a.value<Params>("params");
   Adf adf;
   adf.options_.error = p.error;
@@ -629,15 +817,45 @@ Adf Adf::load(const std::filesystem::path& path, Archive::Verify verify) {
   adf.value_lo_ = p.value_lo;
   adf.quantum_ = p.quantum;
   adf.inner_ = a.array<std::uint64_t>("inner");
-  adf.buckets_ = a.array<std::uint32_t>("buckets");
+  FlatArray<std::uint32_t> buckets;  // version 2
+  if (v2) buckets = a.array<std::uint32_t>("buckets");
+  else adf.high_ = a.array<std::uint64_t>("high");
   adf.keys_ = a.array<std::uint64_t>("keys");
   if (p.value_bits >= 1 && p.value_bits <= 16) adf.values_ = a.array<std::uint64_t>("values");
   else if (p.value_bits == 32) adf.values32_ = a.array<float>("values");
   else throw a.error(fmt::format("{}-bit values are not 1 to 16 or 32", p.value_bits));
   const AdfStats stored = a.value<AdfStats>("stats");
   a.check([&] {
-    if (adf.inner_.size() != (adf.cells_ + 63) / 64) throw Error("adf: the tree bits do not match the cells");
+    check_tree(adf.cells_, adf.inner_, adf.depth_, adf.options_.max_depth);
     adf.make_ranks();
+    std::size_t inner = 0;
+    for (const std::uint64_t w : adf.inner_) inner += std::size_t(std::popcount(w));
+    adf.leaves_ = adf.cells_ - inner;
+    if (v2) {
+      // Every corner keyed, in key order: decode and lay out.
+      const std::uint64_t n = std::uint64_t(1) << adf.depth_;
+      std::vector<std::uint64_t> keys(adf.corners_), fields;
+      std::vector<float> floats;
+      check_keys(buckets, adf.keys_, adf.corners_, adf.shift_, lattice_key(n, n, n, n),
+                 [&](std::size_t i, std::uint64_t key) { keys[i] = key; });
+      if (adf.value_bits_ <= 16) {
+        if (adf.values_.size() != packed_words(adf.corners_, adf.value_bits_))
+          throw Error(fmt::format("adf: {} value words for {} corners", adf.values_.size(), adf.corners_));
+        fields.resize(adf.corners_);
+        for (std::size_t i = 0; i < adf.corners_; ++i) fields[i] = unpack(adf.values_.data(), i, adf.value_bits_);
+      } else {
+        if (adf.values32_.size() != adf.corners_) throw Error(fmt::format("adf: {} values for {} corners", adf.values32_.size(), adf.corners_));
+        floats.assign(adf.values32_.begin(), adf.values32_.end());
+      }
+      adf.lay_out(keys, fields, floats);
+    } else {
+      if (adf.corners_ < adf.leaves_ || adf.shift_ < 0 || adf.shift_ > 62)
+        throw Error(fmt::format("adf: {} corners for {} leaves, key shift {}", adf.corners_, adf.leaves_, adf.shift_));
+      const std::uint64_t n = std::uint64_t(1) << adf.depth_;
+      adf.high_bits_ = high_length(adf.corners_ - adf.leaves_, lattice_key(n, n, n, n), adf.shift_);
+      if (adf.high_.size() != (adf.high_bits_ + 63) / 64) throw Error("adf: the keys' high parts do not match the corners");
+      adf.make_selects();
+    }
     adf.validate();
   });
   adf.stats_.exact_queries = stored.exact_queries;

@@ -79,16 +79,29 @@ TEST(Adf, EveryLeafIsWithinTheErrorAtItsTestPoints) {
     ASSERT_GT(s.leaves, 50u);
     ASSERT_EQ(s.cells, adf.num_cells());
     // Every byte: one bit a cell (whole 64-bit words) with a 32-bit rank a
-    // word, the bucket offsets (one per 32 corners, at most), the key parts
-    // and values bit-packed in 64-bit words with a word of padding each.
+    // word; the keys of the keyed corners (all but the leaves' low corners),
+    // Elias-Fano: key_bits = floor(log2(lattice / keyed)) low bits each, the
+    // high parts in unary (keyed + lattice / 2^key_bits bits) and a 32-bit
+    // select sample per 128 zeros; all values bit-packed. Packed fields in
+    // 64-bit words with a word of padding each.
     ASSERT_LE(s.value_bits, 16u);
     ASSERT_GT(s.quantum, 0.0);
     ASSERT_LE(s.quantum, o.error / 32);
     ASSERT_GT(s.quantum, o.error / 64);  // the fewest bits
     auto words = [](std::size_t n, std::size_t bits) { return (n * bits + 63) / 64 + 1; };
-    const std::size_t fixed = 12 * ((s.cells + 63) / 64) + 8 * words(s.corners, s.key_bits) + 8 * words(s.corners, s.value_bits);
-    ASSERT_GT(s.bytes, fixed);
-    ASSERT_LE(s.bytes, fixed + 4 * (s.corners / 32 + 2));
+    ASSERT_GT(s.corners, s.leaves);
+    const std::size_t keyed = s.corners - s.leaves;
+    const std::size_t lattice = std::size_t(std::pow((1 << s.depth) + 1, 3));
+    ASSERT_LE(keyed << s.key_bits, lattice);
+    ASSERT_GE(keyed << (s.key_bits + 1), lattice);
+    const std::size_t zeros = ((lattice - 1) >> s.key_bits) + 1;
+    const std::size_t fixed = 12 * ((s.cells + 63) / 64) + 8 * words(keyed, s.key_bits) + 8 * words(s.corners, s.value_bits) +
+                              8 * ((keyed + zeros + 63) / 64) + 4 * ((zeros + 127) / 128);
+    ASSERT_EQ(s.bytes, fixed);
+    // Leaves' low corners are distinct: the corner_value order starts with them, leaf by leaf.
+    std::size_t leaf = 0;
+    adf.for_each_leaf([&](int, const Vec3d&, double, const float* c) { ASSERT_EQ(c[0], adf.corner_value(leaf++)); });
+    ASSERT_EQ(leaf, s.leaves);
     ASSERT_LT(s.corners, 8 * s.leaves / 2);  // shared
     std::size_t points = 0;
     // The distinct corners: each leaf corner's value is the one stored for its vertex.
@@ -316,6 +329,66 @@ TEST(Adf, DeepSparseTreesAndOldFiles) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("version"), std::string::npos) << e.what();
   }
+  std::filesystem::remove_all(dir);
+}
+
+// The previous layout (version 2: every distinct corner keyed), written by
+// geods d5116bf (`geods adf data/bunny.ply --error 0.3 -o adf_bunny_v2.geodsadf`),
+// is read and gives exactly the answers of the ADF this version builds.
+TEST(Adf, SameAnswersAsThePreviousLayout) {
+  const Adf old = Adf::load(std::string(GEODS_DATA_DIR) + "/adf_bunny_v2.geodsadf");
+  EXPECT_EQ(Archive::peek(std::string(GEODS_DATA_DIR) + "/adf_bunny_v2.geodsadf").version, 2u);
+  const TriMesh b = bunny();
+  const Adf adf = Adf::build(b, old.options());
+  ASSERT_EQ(adf.num_cells(), old.num_cells());
+  ASSERT_TRUE(std::equal(adf.inner_bits().begin(), adf.inner_bits().end(), old.inner_bits().begin()));
+  ASSERT_EQ(adf.num_corners(), old.num_corners());
+  ASSERT_EQ(adf.num_corners(), 2138u);  // the count the file's writer reported
+  for (std::size_t i = 0; i < adf.num_corners(); ++i) ASSERT_EQ(adf.corner_value(i), old.corner_value(i));
+  EXPECT_LT(adf.stats().bytes, 6340u * 3 / 4);  // the writer's bytes: 6,340
+  Rng rng(17);
+  for (int i = 0; i < 3000; ++i) {
+    const Vec3f p = i % 2 ? random_in_cube(adf, rng) : near_surface(b, rng, 0.5);
+    ASSERT_EQ(adf.distance(p), old.distance(p)) << p.transpose();
+    ASSERT_EQ(adf.gradient(p), old.gradient(p)) << p.transpose();
+  }
+  // Every leaf corner: the leaf's own lookup and the generic one agree.
+  adf.for_each_leaf([&](int level, const Vec3d& lo, double, const float* c) {
+    const Vec3f centre = (lo + Vec3d::Constant(adf.size() / double(1 << level) / 2)).cast<float>();
+    const AdfSample s = adf.sample(centre);
+    ASSERT_NEAR(s.distance, interpolate(c, Vec3d::Constant(0.5)), 1e-5);
+  });
+}
+
+// Single-byte corruptions of a saved ADF, loaded without checksums: a
+// geods::Error or an ADF that answers (the structure's checks keep queries in bounds).
+TEST(Adf, CorruptFilesAreRefusedOrConsistent) {
+  const Adf adf = Adf::load(std::string(GEODS_DATA_DIR) + "/adf_bunny_v2.geodsadf");
+  const auto dir = std::filesystem::temp_directory_path() / ("geods_adf_corrupt_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  adf.save(dir / "a.geodsadf");
+  std::vector<char> bytes;
+  {
+    std::ifstream f(dir / "a.geodsadf", std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(f), {});
+  }
+  Rng rng(23);
+  int refused = 0;
+  for (int t = 0; t < 300; ++t) {
+    std::vector<char> c = bytes;
+    c[rng.below(c.size())] ^= char(1 << rng.below(8));
+    {
+      std::ofstream f(dir / "c.geodsadf", std::ios::binary);
+      f.write(c.data(), std::streamsize(c.size()));
+    }
+    try {
+      const Adf loaded = Adf::load(dir / "c.geodsadf", Archive::Verify::structure_only);
+      for (int i = 0; i < 20; ++i) (void)loaded.distance(random_in_cube(adf, rng));
+    } catch (const Error&) {
+      ++refused;
+    }
+  }
+  EXPECT_GT(refused, 0);
   std::filesystem::remove_all(dir);
 }
 

@@ -35,10 +35,16 @@
 // before each 64-bit word): the children of inner cell i are the 8 cells from
 // 1 + 8 rank(i), so no pointers and no leaf indices. The corner values are
 // stored once per distinct octree vertex (shared by the up to 8 leaves that
-// meet there), sorted by their key x + (N + 1) (y + (N + 1) z) on the lattice
-// of the finest cells (N = 2^depth): the key's high bits select a bucket (an
-// offset table, about 32 corners a bucket), its low bits are stored and found by binary
-// search, so a leaf finds its corners from its position without any index.
+// meet there). A vertex that is the low corner (x, y, z least) of a leaf --
+// every leaf has one, and it is that of no other leaf -- is stored at the
+// leaf's rank among the leaves (i - rank(i)): no key. The others (a vertex
+// in the middle of a larger leaf's low face or edge, or on the cube's high
+// faces) follow in the order of their key x + (N + 1) (y + (N + 1) z) on the
+// lattice of the finest cells (N = 2^depth), Elias-Fano coded: the low
+// floor(log2(lattice / keyed)) bits of each key bit-packed, the rest in
+// unary, with the position of every 128th zero kept for select. A leaf finds its corner c from its position:
+// the leaf holding the corner (from the deepest ancestor that holds both,
+// down) has the corner as its low corner, or the corner is keyed.
 // The values are b-bit steps of [-R, R] (R bounds |distance| over the root
 // cube) with the fewest bits b <= 16 whose step is at most E / 32, else
 // floats; the build's test uses E less one step, so the stored ADF stays
@@ -91,11 +97,11 @@ struct AdfStats {
   std::size_t unresolved = 0;     // leaves at max_depth whose test points exceed the error
   std::size_t exact_queries = 0;  // exact distances computed by the build
   std::size_t signs = 0;          // of them, signs computed (the others: a neighbour's, see adf.cpp)
-  std::size_t corners = 0;        // distinct leaf corners (octree vertices), each stored once
+  std::size_t corners = 0;        // distinct leaf corners (octree vertices), each stored once: leaves + keyed ones
   std::size_t value_bits = 0;     // bits a quantized corner value (at most 16), or 32 (floats)
-  std::size_t key_bits = 0;       // bits of key stored a corner (the rest is the bucket)
+  std::size_t key_bits = 0;       // low bits of key stored a keyed corner (the rest in unary: about 2 bits)
   double quantum = 0;             // the quantization step (0 for floats): a corner is within half of it
-  std::size_t bytes = 0;          // every array the ADF holds: tree bits, ranks, buckets, keys, values
+  std::size_t bytes = 0;          // every array the ADF holds: tree bits, ranks, keys (high and low parts, select samples), values
   std::size_t dense_bytes = 0;    // a float grid of the finest leaves' spacing over the root cube: 4 (2^depth + 1)^3
 };
 
@@ -136,7 +142,7 @@ class Adf {
 
   void save(const std::filesystem::path& path) const;
   static Adf load(const std::filesystem::path& path, Archive::Verify verify = Archive::Verify::checksums);
-  /// Throws geods::Error unless the tree bits, buckets and keys are consistent
+  /// Throws geods::Error unless the tree bits and keys are consistent
   /// (keys sorted, every leaf's corners present), values are finite (within
   /// twice the band) and the cube is finite.
   void validate() const;
@@ -155,7 +161,8 @@ class Adf {
   }
   /// The tree bits (bit i of word i / 64: cell i is inner).
   const FlatArray<std::uint64_t>& inner_bits() const { return inner_; }
-  /// The distinct corners' values in key order (decoded), and their number.
+  /// The distinct corners' values (decoded), and their number: first the
+  /// leaves' low corners in leaf order, then the keyed corners in key order.
   std::size_t num_corners() const { return corners_; }
   float corner_value(std::size_t i) const {
     return values32_.empty() ? float(value_lo_ + quantum_ * double(unpack(values_.data(), i, value_bits_))) : values32_[i];
@@ -169,28 +176,53 @@ class Adf {
   }
   /// The 8 corner values (x + 2y + 4z) of the cell at integer position (x, y, z) of `level`.
   void cell_corners(int level, std::uint64_t x, std::uint64_t y, std::uint64_t z, float out[8]) const;
+  /// The index (for corner_value) of the vertex at (x, y, z) on the finest
+  /// lattice, or kNoIndex if it is no stored vertex.
+  std::size_t corner_index(std::uint64_t x, std::uint64_t y, std::uint64_t z) const;
 
  private:
   // Takes the build's tree (per node: kLeaf | leaf, or the first child) and 8 values a leaf.
   void store(const std::vector<std::uint32_t>& nodes, const std::vector<float>& values, int value_bits, double quantum,
              double lo);
+  // Lays out the distinct corners (sorted keys with their quantized values,
+  // or float values when value_bits_ is 32) over the tree in inner_.
+  void lay_out(const std::vector<std::uint64_t>& keys, const std::vector<std::uint64_t>& fields,
+               const std::vector<float>& floats);
+  // The corners (x + 2y + 4z) of a leaf at `level` and (x, y, z), whose ancestors are path[0..level].
+  void leaf_corners(const std::size_t* path, int level, std::uint64_t x, std::uint64_t y, std::uint64_t z,
+                    float out[8]) const;
+  // The index of finest-lattice vertex (x, y, z) from `node` at `level`, a cell holding it.
+  std::size_t corner_below(std::size_t node, int level, std::uint64_t x, std::uint64_t y, std::uint64_t z) const;
+  // Cell i's rank among the leaves: i less the inner cells before it.
+  std::size_t leaf_rank(std::size_t i) const {
+    const std::uint64_t below = inner_[i >> 6] & ((std::uint64_t(1) << (i & 63)) - 1);
+    return i - std::size_t(rank_[i >> 6]) - std::size_t(std::popcount(below));
+  }
   void finish_stats();
   void make_ranks();
+  void make_selects();
+  std::uint64_t select0(std::uint64_t r) const;
+  // The keyed corner of `key` (its index among the keyed corners), or kNoIndex.
   std::size_t find_corner(std::uint64_t key) const;
+  // Checks the keyed corners' structure, calling f(i, key) for each in order.
+  template <typename F>
+  void for_each_keyed(std::size_t count, std::uint64_t last, F&& f) const;
 
   AdfOptions options_;
   Vec3d origin_ = Vec3d::Zero();
   double size_ = 1;
-  std::size_t cells_ = 0, corners_ = 0;
+  std::size_t cells_ = 0, corners_ = 0, leaves_ = 0;
   int depth_ = 0;             // the finest leaves' level: keys are on the (2^depth + 1)^3 lattice
-  int shift_ = 0;             // a key's bucket is key >> shift; its low shift bits are stored
+  int shift_ = 0;             // the low shift bits of a keyed corner's key are stored, the rest in high_
   int value_bits_ = 32;       // bits a packed value, or 32: floats
   double value_lo_ = 0, quantum_ = 0;
   FlatArray<std::uint64_t> inner_;
   FlatArray<std::uint32_t> rank_;      // inner cells before each word of inner_ (computed on load)
-  FlatArray<std::uint32_t> buckets_;   // first corner of each bucket, and the count at the end
-  FlatArray<std::uint64_t> keys_;      // the low shift bits of each corner's key, packed
-  FlatArray<std::uint64_t> values_;    // quantized values (value_bits_ each), packed, or empty
+  std::uint64_t high_bits_ = 0;        // keyed + (last key >> shift) + 1
+  FlatArray<std::uint64_t> high_;      // Elias-Fano high parts: keyed corner i sets bit (key >> shift) + i
+  FlatArray<std::uint32_t> select_;    // the position of every 128th zero of high_ (computed on load)
+  FlatArray<std::uint64_t> keys_;      // the low shift bits of each keyed corner's key, packed
+  FlatArray<std::uint64_t> values_;    // quantized values (value_bits_ each; leaves' low corners, then keyed), packed, or empty
   FlatArray<float> values32_;          // float values when the quantum would be too coarse
   AdfStats stats_;
 };
