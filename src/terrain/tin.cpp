@@ -10,6 +10,7 @@
 
 #include "geods/core/error.hpp"
 #include "geods/core/huge_page_allocator.hpp"
+#include "geods/core/simd_level.hpp"
 #include "geods/terrain/terrain.hpp"
 #include "geods/voronoi/delaunay2.hpp"
 #include "triangle_raster.hpp"
@@ -157,7 +158,11 @@ class GreedyTin {
       // Twice the area 1: by Pick's theorem no sample but the corners, whose
       // error never counts (most triangles of a fine TIN are such).
       if ((b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x) == 1) continue;
+#if defined(__x86_64__) && defined(__GNUC__)
+      const detail::Worst w = avx2_ ? detail::triangle_worst_avx2(z_, w_, a, b, c) : detail::triangle_worst(z_, w_, a, b, c);
+#else
       const detail::Worst w = detail::triangle_worst(z_, w_, a, b, c);
+#endif
       const bool corner = (w.at.x == a.x && w.at.y == a.y) || (w.at.x == b.x && w.at.y == b.y) ||
                           (w.at.x == c.x && w.at.y == c.y);
       s.x = std::int32_t(w.at.x), s.y = std::int32_t(w.at.y);
@@ -171,6 +176,7 @@ class GreedyTin {
   const float* z_;
   std::uint64_t w_;
   double limit_;
+  bool avx2_ = simd_level() >= SimdLevel::avx2;  // the rows' kernel (the same errors at every level)
   Inserter& ins_;
   std::vector<P2>& pts_;  // per point of the triangulation
   std::vector<State, HugePageAllocator<State>> state_;
@@ -253,7 +259,7 @@ TerrainMesh Terrain::tin(double max_error, std::uint32_t tiles) const {
   if (tiles < 1 || tiles > std::min(width_, height_) - 1)
     throw Error("terrain tin: tiles must be in 1.." + std::to_string(std::min(width_, height_) - 1) + ", got " +
                 std::to_string(tiles));
-  const std::vector<float> z = heights_matrix();
+  const auto z = heights_matrix();  // huge pages: the scans jump from row to row
   const std::int64_t W = std::int64_t(width_), H = std::int64_t(height_);
   float lo = z[0], hi = z[0];
   for (const float v : z) lo = std::min(lo, v), hi = std::max(hi, v);
