@@ -216,6 +216,63 @@ int red_turns(std::int64_t& dx, std::int64_t& dy) {
   return q;
 }
 
+// put(slot, x, y) for every point (x, y) of the layout's n x n grid, in
+// parallel: the interleaved slots by the level's Morton code stepped along the
+// rows of the level (no interleaved_slot() per vertex).
+template <class Put>
+void for_each_slot(const LayoutIndex& index, Put&& put) {
+  const std::uint32_t K = index.levels();
+  const std::uint64_t n = index.n();
+  const std::int64_t N = std::int64_t(n) - 1, c = N / 2;
+  if (index.layout() == Layout::matrix) {
+    parallel_for(0, n, 4, [&](std::size_t b, std::size_t e) {
+      for (std::size_t y = b; y < e; ++y)
+        for (std::size_t x = 0; x < n; ++x) put(y * n + x, std::int64_t(x), std::int64_t(y));
+    });
+  } else {
+    // Level by level; along a row of blue vertices of spacing s (step 2 s)
+    // both coordinates of the level's Morton code grow by one.
+    for (const P2 p : {P2{0, 0}, P2{N, 0}, P2{0, N}, P2{N, N}, P2{c, c}})
+      put(index.interleaved_slot(std::uint32_t(p.x), std::uint32_t(p.y)), p.x, p.y);
+    constexpr std::uint64_t kEven = 0x5555555555555555ull, kOdd = ~kEven;
+    for (std::uint32_t t = 0; t < K; ++t) {
+      const std::int64_t s = std::int64_t(1) << t;
+      const std::uint64_t base = index.level_base(t);
+      // Rows k s: blue at x = s, 3s, ... (k even) or x = 0, 2s, ... (k odd);
+      // red at x = s, 3s, ... (k odd).
+      parallel_for(0, std::size_t(N / s + 1), 4, [&](std::size_t b, std::size_t e) {
+        for (std::size_t k = b; k < e; ++k) {
+          const std::int64_t y = std::int64_t(k) * s;
+          const std::int64_t x0 = (k & 1) ? 0 : s;
+          std::uint64_t m = index.interleaved_slot(std::uint32_t(x0), std::uint32_t(y)) - base;
+          for (std::int64_t x = x0; x <= N; x += 2 * s) {
+            put(base + m, x, y);
+            m = (((m | kOdd) + 1) & kEven) | (((m | kEven) + 2) & kOdd);
+          }
+          // Red ones: within a run of the same quarter turns the ghost slot
+          // moves by a reflection of the step, both Morton coordinates by +1
+          // (an even number of turns) or -1 (odd).
+          int run = -1;
+          if (k & 1)
+            for (std::int64_t x = s; x < N; x += 2 * s) {
+              if (x == c && y == c) continue;
+              std::int64_t dx = x - c, dy = y - c;
+              const int q = red_turns(dx, dy);
+              if (q != run) {
+                m = index.interleaved_slot(std::uint32_t(x), std::uint32_t(y)) - base, run = q;
+              } else if (q & 1) {
+                m = (((m & kEven) - 1) & kEven) | (((m & kOdd) - 2) & kOdd);
+              } else {
+                m = (((m | kOdd) + 1) & kEven) | (((m | kEven) + 2) & kOdd);
+              }
+              put(base + m, x, y);
+            }
+        }
+      });
+    }
+  }
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------- layout
@@ -303,7 +360,7 @@ Terrain::Terrain(HeightField field, TerrainOptions options) {
   });
   field.heights = {};
 
-  const std::int64_t N = std::int64_t(n) - 1, c = N / 2;
+  const std::int64_t N = std::int64_t(n) - 1;
   // Own error of each vertex: the largest vertical distance between the grid and
   // the triangles it splits (its diamond); +inf where the diamond leaves the
   // field (the padding), so that those vertices are always refined and no
@@ -395,54 +452,10 @@ Terrain::Terrain(HeightField field, TerrainOptions options) {
   }
 
   std::vector<VertexRecord> records(index_.slots());  // (huge pages here stalled now and then on a loaded machine)
-  auto put = [&](std::size_t slot, std::size_t g) { records[slot] = {z[g], err[g], rad[g]}; };
-  if (index_.layout() == Layout::matrix) {
-    parallel_for(0, n * n, 4096, [&](std::size_t b, std::size_t e) {
-      for (std::size_t g = b; g < e; ++g) put(g, g);
-    });
-  } else {
-    // Level by level; along a row of blue vertices of spacing s (step 2 s)
-    // both coordinates of the level's Morton code grow by one.
-    for (const std::size_t g : {std::size_t(0), std::size_t(N), std::size_t(N) * n, std::size_t(N) * n + std::size_t(N),
-                                std::size_t(c) * n + std::size_t(c)})
-      put(index_.interleaved_slot(std::uint32_t(g % n), std::uint32_t(g / n)), g);
-    constexpr std::uint64_t kEven = 0x5555555555555555ull, kOdd = ~kEven;
-    for (std::uint32_t t = 0; t < K; ++t) {
-      const std::int64_t s = std::int64_t(1) << t;
-      const std::uint64_t base = index_.level_base(t);
-      // Rows k s: blue at x = s, 3s, ... (k even) or x = 0, 2s, ... (k odd);
-      // red at x = s, 3s, ... (k odd).
-      parallel_for(0, std::size_t(N / s + 1), 4, [&](std::size_t b, std::size_t e) {
-        for (std::size_t k = b; k < e; ++k) {
-          const std::int64_t y = std::int64_t(k) * s, row = y * std::int64_t(n);
-          const std::int64_t x0 = (k & 1) ? 0 : s;
-          std::uint64_t m = index_.interleaved_slot(std::uint32_t(x0), std::uint32_t(y)) - base;
-          for (std::int64_t x = x0; x <= N; x += 2 * s) {
-            put(base + m, std::size_t(row + x));
-            m = (((m | kOdd) + 1) & kEven) | (((m | kEven) + 2) & kOdd);
-          }
-          // Red ones: within a run of the same quarter turns the ghost slot
-          // moves by a reflection of the step, both Morton coordinates by +1
-          // (an even number of turns) or -1 (odd).
-          int run = -1;
-          if (k & 1)
-            for (std::int64_t x = s; x < N; x += 2 * s) {
-              if (x == c && y == c) continue;
-              std::int64_t dx = x - c, dy = y - c;
-              const int q = red_turns(dx, dy);
-              if (q != run) {
-                m = index_.interleaved_slot(std::uint32_t(x), std::uint32_t(y)) - base, run = q;
-              } else if (q & 1) {
-                m = (((m & kEven) - 1) & kEven) | (((m & kOdd) - 2) & kOdd);
-              } else {
-                m = (((m | kOdd) + 1) & kEven) | (((m | kEven) + 2) & kOdd);
-              }
-              put(base + m, std::size_t(row + x));
-            }
-        }
-      });
-    }
-  }
+  for_each_slot(index_, [&](std::uint64_t slot, std::int64_t x, std::int64_t y) {
+    const std::uint64_t g = std::uint64_t(y) * n + std::uint64_t(x);
+    records[slot] = {z[g], err[g], rad[g]};
+  });
   records_ = FlatArray<VertexRecord>(std::move(records));
   build_s_ = seconds_since(t0);
 }
@@ -703,11 +716,10 @@ TerrainMesh Terrain::refine_tiles(const Refinement& refinement, std::uint32_t ti
   return assemble(*this, refiner);
 }
 
-std::vector<float> Terrain::heights_matrix() const {
-  std::vector<float> z(width_ * height_);
-  parallel_for(0, height_, 16, [&](std::size_t b, std::size_t e) {
-    for (std::size_t y = b; y < e; ++y)
-      for (std::size_t x = 0; x < width_; ++x) z[y * width_ + x] = sample(std::uint32_t(x), std::uint32_t(y));
+std::vector<float, HugePageAllocator<float>> Terrain::heights_matrix() const {
+  std::vector<float, HugePageAllocator<float>> z(width_ * height_);
+  for_each_slot(index_, [&](std::uint64_t slot, std::int64_t x, std::int64_t y) {
+    if (std::uint64_t(x) < width_ && std::uint64_t(y) < height_) z[std::uint64_t(y) * width_ + std::uint64_t(x)] = records_[slot].z;
   });
   return z;
 }
@@ -717,7 +729,7 @@ double Terrain::measure_error(const TerrainMesh& mesh) const {
     for (const std::uint32_t v : tri)
       if (mesh.samples.size() <= v || mesh.samples[v][0] >= width_ || mesh.samples[v][1] >= height_)
         throw Error("terrain measure_error: a vertex without a sample of the field");
-  const std::vector<float> z = heights_matrix();
+  const auto z = heights_matrix();
   return tbb::parallel_reduce(
       tbb::blocked_range<std::size_t>(0, mesh.triangles.size(), 256), 0.0,
       [&](const tbb::blocked_range<std::size_t>& r, double worst) {

@@ -10,6 +10,7 @@
 
 #include "geods/core/error.hpp"
 #include "geods/core/huge_page_allocator.hpp"
+#include "geods/core/simd_level.hpp"
 #include "geods/terrain/terrain.hpp"
 #include "geods/voronoi/delaunay2.hpp"
 #include "triangle_raster.hpp"
@@ -55,27 +56,33 @@ struct Entry {
 
 // A 4-ary max-heap of entries by error: the four children of a node share a
 // cache line, so a pop misses half as often as in a binary heap (the queue of
-// a fine TIN holds millions of entries).
+// a fine TIN holds millions of entries). Node i is stored at i + 3, so that the
+// children 4 i + 1 .. 4 i + 4 sit at 4 (i + 1) .. 4 (i + 1) + 3: one aligned
+// 64-byte line (the allocation is page-aligned), not two.
 class MaxHeap4 {
  public:
-  bool empty() const { return heap_.empty(); }
-  const Entry& top() const { return heap_.front(); }
+  MaxHeap4() : heap_(kPad) {}
+  bool empty() const { return heap_.size() == kPad; }
+  const Entry& top() const { return heap_[kPad]; }
+  void reserve(std::size_t n) { heap_.reserve(n + kPad); }
   void push(const Entry& e) {
-    std::size_t i = heap_.size();
+    std::size_t i = heap_.size() - kPad;
     heap_.push_back(e);
+    Entry* h = heap_.data() + kPad;
     while (i > 0) {
       const std::size_t parent = (i - 1) / 4;
-      if (!(heap_[parent].error < e.error)) break;
-      heap_[i] = heap_[parent];
+      if (!(h[parent].error < e.error)) break;
+      h[i] = h[parent];
       i = parent;
     }
-    heap_[i] = e;
+    h[i] = e;
   }
   void pop() {
     const Entry last = heap_.back();
     heap_.pop_back();
-    const std::size_t n = heap_.size();
+    const std::size_t n = heap_.size() - kPad;
     if (n == 0) return;
+    Entry* h = heap_.data() + kPad;
     std::size_t i = 0;
     for (;;) {
       const std::size_t first = 4 * i + 1;
@@ -83,15 +90,16 @@ class MaxHeap4 {
       std::size_t best = first;
       const std::size_t end = std::min(first + 4, n);
       for (std::size_t c = first + 1; c < end; ++c)
-        if (heap_[best].error < heap_[c].error) best = c;
-      if (!(last.error < heap_[best].error)) break;
-      heap_[i] = heap_[best];
+        if (h[best].error < h[c].error) best = c;
+      if (!(last.error < h[best].error)) break;
+      h[i] = h[best];
       i = best;
     }
-    heap_[i] = last;
+    h[i] = last;
   }
 
  private:
+  static constexpr std::size_t kPad = 3;
   std::vector<Entry, HugePageAllocator<Entry>> heap_;
 };
 
@@ -101,6 +109,12 @@ class GreedyTin {
   GreedyTin(const float* z, std::uint64_t w, double limit, Inserter& ins, std::vector<P2>& pts)
       : z_(z), w_(w), limit_(limit), ins_(ins), pts_(pts) {}
 
+  // Room for the states and queue entries of the triangles of `points` points
+  // (address space: the pages are touched as they fill, once, not at every doubling).
+  void reserve(std::size_t points) {
+    state_.reserve(2 * points + 16);
+    queue_.reserve(2 * points + 16);
+  }
   // Inserts a sample, then rescans the triangles it changed (if `scan`).
   void insert(P2 p, std::uint32_t near = voronoi::Delaunay2::no_edge, bool scan = true) {
     const std::uint32_t i = ins_.insert(Vec2d(double(p.x), double(p.y)), near);
@@ -157,7 +171,11 @@ class GreedyTin {
       // Twice the area 1: by Pick's theorem no sample but the corners, whose
       // error never counts (most triangles of a fine TIN are such).
       if ((b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x) == 1) continue;
+#if defined(__x86_64__) && defined(__GNUC__)
+      const detail::Worst w = avx2_ ? detail::triangle_worst_avx2(z_, w_, a, b, c) : detail::triangle_worst(z_, w_, a, b, c);
+#else
       const detail::Worst w = detail::triangle_worst(z_, w_, a, b, c);
+#endif
       const bool corner = (w.at.x == a.x && w.at.y == a.y) || (w.at.x == b.x && w.at.y == b.y) ||
                           (w.at.x == c.x && w.at.y == c.y);
       s.x = std::int32_t(w.at.x), s.y = std::int32_t(w.at.y);
@@ -171,6 +189,7 @@ class GreedyTin {
   const float* z_;
   std::uint64_t w_;
   double limit_;
+  bool avx2_ = simd_level() >= SimdLevel::avx2;  // the rows' kernel (the same errors at every level)
   Inserter& ins_;
   std::vector<P2>& pts_;  // per point of the triangulation
   std::vector<State, HugePageAllocator<State>> state_;
@@ -203,8 +222,11 @@ TileTin tile_tin(const float* z, std::uint64_t w, P2 c00, P2 c11, double limit, 
   {
     voronoi::Delaunay2::Inserter ins(dt);
     // Room for every sample, up to 2^22 (a few hundred MB of address space; larger tiles grow as needed).
-    ins.reserve(std::min(std::size_t(c11.x - c00.x + 1) * std::size_t(c11.y - c00.y + 1), std::size_t(1) << 22));
+    const std::size_t room = std::min(std::size_t(c11.x - c00.x + 1) * std::size_t(c11.y - c00.y + 1), std::size_t(1) << 22);
+    ins.reserve(room);
+    tin.pts_.reserve(room);
     GreedyTin g(z, w, limit, ins, tin.pts_);
+    g.reserve(room);
     for (const P2& p : border) g.insert(p, voronoi::Delaunay2::no_edge, false);
     g.scan_all();
     g.refine();
@@ -253,7 +275,7 @@ TerrainMesh Terrain::tin(double max_error, std::uint32_t tiles) const {
   if (tiles < 1 || tiles > std::min(width_, height_) - 1)
     throw Error("terrain tin: tiles must be in 1.." + std::to_string(std::min(width_, height_) - 1) + ", got " +
                 std::to_string(tiles));
-  const std::vector<float> z = heights_matrix();
+  const auto z = heights_matrix();  // huge pages: the scans jump from row to row
   const std::int64_t W = std::int64_t(width_), H = std::int64_t(height_);
   float lo = z[0], hi = z[0];
   for (const float v : z) lo = std::min(lo, v), hi = std::max(hi, v);

@@ -70,13 +70,15 @@ struct Plane {
 
 #if defined(__x86_64__) && defined(__GNUC__)
 // row_max() four doubles at a time where the CPU has AVX2 (the same terms, the
-// same rounding: no FMA): for long rows, when simd_level() (core/simd_level.hpp)
-// is avx2 or above.
+// same rounding: no FMA), for rows of at least 4 samples (hi - lo >= 3), when
+// simd_level() (core/simd_level.hpp) is avx2 or above. The last samples are
+// taken as one more block of four ending at hi, overlapping the ones before
+// (a maximum does not mind seeing a term twice): no scalar tail.
 __attribute__((target("avx2"))) inline double row_max_avx2(const float* row, std::int64_t lo, std::int64_t hi, double base,
                                                            double gx, std::int64_t ax) {
   const __m256d vg = _mm256_set1_pd(gx), vb = _mm256_set1_pd(base), sign = _mm256_set1_pd(-0.0), eight = _mm256_set1_pd(8.0);
-  const double x = double(lo - ax);
-  __m256d x0 = _mm256_set_pd(x + 3, x + 2, x + 1, x), x1 = _mm256_set_pd(x + 7, x + 6, x + 5, x + 4);
+  const __m256d iota = _mm256_set_pd(3, 2, 1, 0);
+  __m256d x0 = _mm256_add_pd(_mm256_set1_pd(double(lo - ax)), iota), x1 = _mm256_add_pd(x0, _mm256_set1_pd(4.0));
   __m256d m0 = _mm256_setzero_pd(), m1 = _mm256_setzero_pd();
   std::int64_t i = lo;
   for (; i + 7 <= hi; i += 8) {
@@ -85,11 +87,18 @@ __attribute__((target("avx2"))) inline double row_max_avx2(const float* row, std
     m1 = _mm256_max_pd(_mm256_andnot_pd(sign, _mm256_sub_pd(z1, _mm256_add_pd(vb, _mm256_mul_pd(vg, x1)))), m1);
     x0 = _mm256_add_pd(x0, eight), x1 = _mm256_add_pd(x1, eight);
   }
+  if (i + 3 < hi) {  // 5..7 left: one block at i, the last block at hi - 3
+    const __m256d z0 = _mm256_cvtps_pd(_mm_loadu_ps(row + i));
+    m0 = _mm256_max_pd(_mm256_andnot_pd(sign, _mm256_sub_pd(z0, _mm256_add_pd(vb, _mm256_mul_pd(vg, x0)))), m0);
+  }
+  if (i <= hi) {  // the last block of four, ending at hi
+    const __m256d x = _mm256_add_pd(_mm256_set1_pd(double(hi - 3 - ax)), iota);
+    const __m256d z1 = _mm256_cvtps_pd(_mm_loadu_ps(row + hi - 3));
+    m1 = _mm256_max_pd(_mm256_andnot_pd(sign, _mm256_sub_pd(z1, _mm256_add_pd(vb, _mm256_mul_pd(vg, x)))), m1);
+  }
   const __m256d mm = _mm256_max_pd(m0, m1);
   const __m128d m2 = _mm_max_pd(_mm256_castpd256_pd128(mm), _mm256_extractf128_pd(mm, 1));
-  double m = std::max(_mm_cvtsd_f64(m2), _mm_cvtsd_f64(_mm_unpackhi_pd(m2, m2)));
-  for (; i <= hi; ++i) m = std::max(m, std::abs(double(row[i]) - (base + gx * double(i - ax))));
-  return m;
+  return std::max(_mm_cvtsd_f64(m2), _mm_cvtsd_f64(_mm_unpackhi_pd(m2, m2)));
 }
 #endif
 
@@ -132,26 +141,101 @@ struct GridTriangle : Plane {
   double base(std::int64_t y, std::int64_t ay) const { return Plane::base(y - ay); }
 };
 
-// The largest |z(sample) - plane(sample)| over the grid samples in the closed
-// triangle (a, b, c) (integer grid coordinates) of an n-wide matrix of heights,
-// and the sample where it is (the first such in row order). One scalar pass per
-// row: for the greedy TIN's triangles of every shape this measured faster than
-// SIMD row maxima followed by a search.
-inline Worst triangle_worst(const float* z, std::uint64_t n, P2 a, P2 b, P2 c) {
-  const GridTriangle t(z, n, a, b, c);
-  Worst worst;
-  for (std::int64_t y = t.y0; y <= t.y1; ++y) {
-    std::int64_t lo, hi;
-    t.row(y, lo, hi);
-    const float* row = z + y * std::int64_t(n);
-    const double base = t.base(y, a.y), gx = t.gx;
-    for (std::int64_t x = lo; x <= hi; ++x) {
-      const double d = std::abs(double(row[x]) - (base + gx * double(x - a.x)));
-      if (d > worst.error) worst = {d, {x, y}};
+// floor(B(y) / a) for B(y) = B(y0) + D (y - y0) and a > 0, stepped y -> y + 1
+// with additions only (exact; the quotient and remainder carried along).
+struct FloorWalk {
+  std::int64_t q = 0, r = 0, dq = 0, dr = 0, a = 1;
+
+  static std::int64_t floor_div(std::int64_t b, std::int64_t a) { return b / a - std::int64_t(b % a != 0 && b < 0); }
+  void start(std::int64_t b, std::int64_t d, std::int64_t divisor) {
+    a = divisor, q = floor_div(b, a), r = b - q * a, dq = floor_div(d, a), dr = d - dq * a;
+  }
+  void step() {
+    q += dq, r += dr;
+    const bool carry = r >= a;
+    q += std::int64_t(carry), r -= carry ? a : 0;
+  }
+};
+
+// The rows of a GridTriangle from y0 to y1: the same lo..hi as GridTriangle::row()
+// (the edge with A > 0 bounds hi by floor(B / A), one with A < 0 bounds lo by
+// -floor(B / |A|), a horizontal one holds on every row of the triangle), each
+// edge's quotient walked from row to row instead of divided.
+struct RowWalk {
+  FloorWalk lo_edge[2], hi_edge[2];
+  int lo_edges = 0, hi_edges = 0;
+  std::int64_t xmin, xmax;
+
+  explicit RowWalk(const GridTriangle& t) : RowWalk(t.v, t.y0) {}
+  // From the corners counter-clockwise and the first row.
+  RowWalk(const P2 (&v)[3], std::int64_t y0) : xmin(std::min({v[0].x, v[1].x, v[2].x})), xmax(std::max({v[0].x, v[1].x, v[2].x})) {
+    for (int e = 0; e < 3; ++e) {
+      const P2 p = v[e], q = v[(e + 1) % 3];
+      const std::int64_t A = q.y - p.y, D = q.x - p.x, B = D * (y0 - p.y) + A * p.x;
+      if (A > 0) hi_edge[hi_edges++].start(B, D, A);
+      if (A < 0) lo_edge[lo_edges++].start(B, D, -A);
     }
   }
-  return worst;
+  // The span of the current row; then on to the next row.
+  [[gnu::always_inline]] void span(std::int64_t& lo, std::int64_t& hi) const {
+    lo = xmin, hi = xmax;
+    for (int k = 0; k < lo_edges; ++k) lo = std::max(lo, -lo_edge[k].q);
+    for (int k = 0; k < hi_edges; ++k) hi = std::min(hi, hi_edge[k].q);
+  }
+  [[gnu::always_inline]] void next() {
+    for (int k = 0; k < lo_edges; ++k) lo_edge[k].step();
+    for (int k = 0; k < hi_edges; ++k) hi_edge[k].step();
+  }
+};
+
+// The largest |z(sample) - plane(sample)| over the grid samples in the closed
+// triangle (a, b, c) (integer grid coordinates) of an n-wide matrix of heights,
+// and the sample where it is (the first such in row order): the maximum of
+// each row (row_max_avx2() for rows of 4 or more samples when Avx2, else
+// row_max()), then the first sample of the first row holding the largest one
+// (the same terms, so the same value). Scalar loops per sample with a branch on
+// every improvement measured slower for the greedy TIN's large triangles.
+template <bool Avx2>
+[[gnu::always_inline]] inline Worst triangle_worst_rows(const float* z, std::uint64_t n, P2 a, P2 b, P2 c) {
+  const GridTriangle t(z, n, a, b, c);
+  RowWalk walk(t);
+  double worst = 0;
+  std::int64_t wy = 0, wlo = 0;
+  for (std::int64_t y = t.y0; y <= t.y1; ++y, walk.next()) {
+    std::int64_t lo, hi;
+    walk.span(lo, hi);
+    if (lo > hi) continue;
+    const float* row = z + y * std::int64_t(n);
+    const double base = t.base(y, a.y);
+    double m;
+#if defined(__x86_64__) && defined(__GNUC__)
+    if constexpr (Avx2)
+      m = hi - lo >= 3 ? row_max_avx2(row, lo, hi, base, t.gx, a.x) : row_max(row, lo, hi, base, t.gx, a.x);
+    else
+#endif
+      m = row_max(row, lo, hi, base, t.gx, a.x);
+    if (m > worst) worst = m, wy = y, wlo = lo;
+  }
+  Worst w;
+  if (!(worst > 0)) return w;
+  const float* row = z + wy * std::int64_t(n);
+  const double base = t.base(wy, a.y);
+  std::int64_t x = wlo;
+  while (std::abs(double(row[x]) - (base + t.gx * double(x - a.x))) != worst) ++x;
+  return {worst, {x, wy}};
 }
+
+// triangle_worst() for the portable build (and CPUs without AVX2).
+inline Worst triangle_worst(const float* z, std::uint64_t n, P2 a, P2 b, P2 c) {
+  return triangle_worst_rows<false>(z, n, a, b, c);
+}
+
+#if defined(__x86_64__) && defined(__GNUC__)
+// triangle_worst() with AVX2 rows: call it only when simd_level() >= avx2.
+__attribute__((target("avx2"))) inline Worst triangle_worst_avx2(const float* z, std::uint64_t n, P2 a, P2 b, P2 c) {
+  return triangle_worst_rows<true>(z, n, a, b, c);
+}
+#endif
 
 // The same largest distance alone (equal to triangle_worst().error): triangles
 // of at most 3 x 3 samples (most of the 4-8 hierarchy's) test each sample,

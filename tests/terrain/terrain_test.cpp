@@ -15,6 +15,7 @@
 #include <set>
 
 #include "geods/core/error.hpp"
+#include "geods/core/simd_level.hpp"
 #include "geods/io/npy.hpp"
 #include "geods/terrain/terrain.hpp"
 
@@ -558,6 +559,22 @@ TEST(Terrain, GreedyTinsWithinTheBoundAndTiled) {
   EXPECT_EQ(t.tin(1e9).triangles.size(), 2u);
   EXPECT_THROW(t.tin(-1), Error);
   EXPECT_THROW(t.tin(1, 0), Error);
+}
+
+// The TIN's triangle scans (AVX2 rows where the CPU has them) give the same
+// mesh at every SIMD level: the same errors, the same worst samples.
+TEST(Terrain, GreedyTinTheSameAtEverySimdLevel) {
+  const Terrain t(real_field());
+  const SimdLevel level = simd_level();
+  set_simd_level(SimdLevel::portable);
+  const TerrainMesh portable = t.tin(1.0), portable_tiles = t.tin(3.0, 2);
+  set_simd_level(level);
+  const TerrainMesh best = t.tin(1.0), best_tiles = t.tin(3.0, 2);
+  EXPECT_EQ(best.samples, portable.samples);
+  EXPECT_EQ(best.triangles, portable.triangles);
+  EXPECT_EQ(best_tiles.samples, portable_tiles.samples);
+  EXPECT_EQ(best_tiles.triangles, portable_tiles.triangles);
+  EXPECT_GT(best.triangles.size(), 1000u);
 }
 
 // Every tile of tin(e, tiles) is tin_tile() of its block of samples on its own

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "../../src/terrain/triangle_raster.hpp"
+#include "geods/core/simd_level.hpp"
 
 namespace geods::terrain::detail {
 namespace {
@@ -36,6 +37,7 @@ TEST(TriangleRaster, WorstSampleEqualsBruteForce) {
   std::vector<float> z(std::size_t(n * n));
   for (float& v : z) v = float(rng() % 40);  // integer heights: many exact ties
   int checked = 0;
+  const bool avx2 = simd_level() >= SimdLevel::avx2;
   for (int it = 0; it < 20000; ++it) {
     const std::int64_t span = it % 4 == 0 ? 3 : it % 4 == 1 ? 8 : n - 1;
     auto r = [&] { return std::int64_t(rng() % std::uint64_t(span + 1)); };
@@ -47,10 +49,45 @@ TEST(TriangleRaster, WorstSampleEqualsBruteForce) {
     ASSERT_EQ(got.error, want.error) << it;
     ASSERT_EQ(got.at.x, want.at.x) << it;
     ASSERT_EQ(got.at.y, want.at.y) << it;
+#if defined(__x86_64__) && defined(__GNUC__)
+    if (avx2) {  // AVX2 rows (blocks of four ending at each row's end): the same value and sample
+      const Worst got2 = triangle_worst_avx2(z.data(), std::uint64_t(n), a, b, c);
+      ASSERT_EQ(got2.error, want.error) << it;
+      ASSERT_EQ(got2.at.x, want.at.x) << it;
+      ASSERT_EQ(got2.at.y, want.at.y) << it;
+    }
+#endif
     ASSERT_EQ(triangle_error(z.data(), std::uint64_t(n), a, b, c), want.error) << it;
     ++checked;
   }
   EXPECT_GT(checked, 15000);
+}
+
+// The rows walked by additions (RowWalk) are the rows of GridTriangle::row()
+// (exact integer divisions), on thin, steep and long triangles too.
+TEST(TriangleRaster, RowWalkEqualsRowDivisions) {
+  std::mt19937_64 rng(5);
+  const std::vector<float> z(std::size_t(1) << 20, 0.0f);
+  const std::uint64_t n = 1024;
+  for (int it = 0; it < 20000; ++it) {
+    const std::int64_t span = it % 3 == 0 ? 4 : it % 3 == 1 ? 40 : 1000;
+    auto r = [&] { return std::int64_t(rng() % std::uint64_t(span + 1)); };
+    const P2 a{r(), r()}, b{r(), r()}, c{r(), r()};
+    if ((b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x) == 0) continue;
+    const GridTriangle t(z.data(), n, a, b, c);
+    RowWalk walk(t);
+    for (std::int64_t y = t.y0; y <= t.y1; ++y, walk.next()) {
+      std::int64_t lo, hi, wlo, whi;
+      t.row(y, lo, hi);
+      walk.span(wlo, whi);
+      if (lo > hi) {
+        ASSERT_GT(wlo, whi) << it << " " << y;
+      } else {
+        ASSERT_EQ(wlo, lo) << it << " " << y;
+        ASSERT_EQ(whi, hi) << it << " " << y;
+      }
+    }
+  }
 }
 
 }  // namespace

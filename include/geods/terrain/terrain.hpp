@@ -17,6 +17,7 @@
 
 #include "geods/core/archive.hpp"
 #include "geods/core/flat_array.hpp"
+#include "geods/core/huge_page_allocator.hpp"
 #include "geods/core/vec.hpp"
 #include "geods/ray/camera.hpp"
 #include "geods/terrain/height_field.hpp"
@@ -159,7 +160,7 @@ class Terrain {
   static Terrain load(const std::filesystem::path& path, Archive::Verify verify = Archive::Verify::checksums);
 
  private:
-  std::vector<float> heights_matrix() const;  // the field's samples (times z_scale), rows first
+  std::vector<float, HugePageAllocator<float>> heights_matrix() const;  // the field's samples (times z_scale), rows first
   std::uint64_t width_ = 0, height_ = 0;
   std::array<double, 2> spacing_{1, 1}, origin_{0, 0};
   double z_scale_ = 1;
