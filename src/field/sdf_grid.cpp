@@ -460,9 +460,16 @@ struct Search {
     at_lane = _mm512_mask_blend_epi32(closer, at_lane, _mm512_add_epi32(lanes, _mm512_set1_epi32(std::int32_t(i))));
     reach2 = std::min(reach2, _mm512_reduce_min_ps(r));
   }
+  const float* row = nullptr;  // optional: row_bounds() of p's row
   // Whether every entry's bound in pair c (as lower() of nearest()) exceeds reach2.
   GEODS_AVX512_INLINE bool beyond(std::size_t c, float spread, float slack) const {
     const std::size_t i = 16 * c;
+    if (row) {
+      const __m512 z = lerp(_mm512_loadu_ps(row + 2 * i), _mm512_loadu_ps(row + 2 * i + 16), wx);
+      const __m512 lb = _mm512_sub_ps(_mm512_sub_ps(_mm512_mul_ps(z, _mm512_set1_ps(1 - 1e-4f)), _mm512_set1_ps(spread)),
+                                      _mm512_set1_ps(slack));
+      return _mm512_cmp_ps_mask(lb, _mm512_set1_ps(reach2 * (1 + 1e-4f)), _CMP_GT_OQ) == __mmask16(0xffff);
+    }
     const int k0 = Packed::k0;
     const __m512 x0 = lerp(at(t.f, k0, i), at(t.f, k0 + 1, i), wx), x1 = lerp(at(t.f, k0 + 2, i), at(t.f, k0 + 3, i), wx);
     const __m512 x2 = lerp(at(t.f, k0 + 4, i), at(t.f, k0 + 5, i), wx), x3 = lerp(at(t.f, k0 + 6, i), at(t.f, k0 + 7, i), wx);
@@ -473,9 +480,27 @@ struct Search {
   }
 };
 
+// For the samples of one row along x of a block (weights wy, wz): each
+// entry's corner distances interpolated along y and z at the block's two
+// x-ends, so that a sample's bound is one interpolation along x (the same
+// trilinear bound in another order: its rounding is covered as that of lower()).
+// row[32 c + l] and row[32 c + 16 + l]: the ends of entry 16 c + l.
+GEODS_AVX512_FN void row_bounds(const Packed& t, float wy, float wz, float* row) {
+  const __m512 y = _mm512_set1_ps(wy), z = _mm512_set1_ps(wz);
+  const int k0 = Packed::k0;
+  for (std::size_t i = 0; i < t.size; i += 16) {
+    const __m512 lo = lerp(lerp(at(t.f, k0, i), at(t.f, k0 + 2, i), y), lerp(at(t.f, k0 + 4, i), at(t.f, k0 + 6, i), y), z);
+    const __m512 hi =
+        lerp(lerp(at(t.f, k0 + 1, i), at(t.f, k0 + 3, i), y), lerp(at(t.f, k0 + 5, i), at(t.f, k0 + 7, i), y), z);
+    _mm512_storeu_ps(row + 2 * i, lo);
+    _mm512_storeu_ps(row + 2 * i + 16, hi);
+  }
+}
+
 // As nearest() above; groups of 8 are searched and bounded two at a time.
+// With `row` (row_bounds() of p's row), the bounds come from there.
 GEODS_AVX512_FN std::size_t nearest(const Packed& t, const Vec3f& p, const InBlock* in_block, float slack,
-                                    std::size_t seed, float& d2) {
+                                    std::size_t seed, float& d2, const float* row = nullptr) {
   const float* floor = in_block && !t.floor.empty() ? t.floor.data() : nullptr;
   const InBlock at_p = in_block ? *in_block : InBlock{};
   Search s{t,
@@ -485,6 +510,7 @@ GEODS_AVX512_FN std::size_t nearest(const Packed& t, const Vec3f& p, const InBlo
            _mm512_set1_ps(at_p.wx),
            _mm512_set1_ps(at_p.wy),
            _mm512_set1_ps(at_p.wz)};
+  s.row = in_block ? row : nullptr;
   const std::size_t groups = (t.size + 7) / 8, pairs = (groups + 1) / 2;
   seed /= 2;  // the pair of group `seed`
   if (seed >= pairs) seed = 0;
@@ -515,6 +541,7 @@ struct Scratch {
   std::vector<Kept> kept;
   std::vector<std::uint32_t> found;
   std::array<std::vector<std::uint32_t>, kBlocks> survivors;
+  std::vector<float> row;  // avx512::row_bounds
 };
 
 class GridSolver {
@@ -564,7 +591,7 @@ class GridSolver {
     if (!(centre.distance - box.radius > band_ + margin_)) {
       // Scratch lists of this thread, kept from tile to tile: no allocation or zeroing per tile.
       thread_local Scratch scratch;
-      auto& [tile_list, block_list, near, kept, found, survivors] = scratch;
+      auto& [tile_list, block_list, near, kept, found, survivors, row] = scratch;
       gather(box, centre.closest, tile_list, near, found, kept);
       // Surface points: the closest points of the tile's centre and of the
       // blocks' centres. A face that can be nearest to a sample p of a block is
@@ -637,9 +664,12 @@ class GridSolver {
         if (std::sqrt(c.d2) - block.radius > band_ + margin_) continue;
         select(tile_list, survivors[b], near, Packed::k0);
         filter(near, block, c.point, block_list, kept, true, std::span(anchors.data(), num_anchors));
+        const BlockWeights weights = block_weights(block);  // in_box of each sample
         std::size_t seed = 0;  // the group of the previous sample's nearest face
+        if (wide_ && row.size() < 2 * block_list.f[0].size()) row.resize(2 * block_list.f[0].size());
         for (std::size_t k = block.lo[2]; k < block.hi[2]; ++k)
-          for (std::size_t j = block.lo[1]; j < block.hi[1]; ++j)
+          for (std::size_t j = block.lo[1]; j < block.hi[1]; ++j) {
+            bool row_ready = false;
             for (std::size_t i = block.lo[0]; i < block.hi[0]; ++i) {
               const Vec3f p = grid_.position(i, j, k);
               // The block's corner samples have their distances from every face
@@ -651,8 +681,11 @@ class GridSolver {
               if (cx >= 0 && cy >= 0 && cz >= 0) {
                 s = closest_at_corner(block_list, p, cx + cy + cz);
               } else {
-                const InBlock at_p = in_box(block, p);
-                s = closest_in(block_list, p, &at_p, seed);
+                const InBlock at_p = in_box(weights, i - block.lo[0], j - block.lo[1], k - block.lo[2]);
+#ifdef GEODS_SDF_AVX512
+                if (wide_ && !row_ready) avx512::row_bounds(block_list, at_p.wy, at_p.wz, row.data()), row_ready = true;
+#endif
+                s = closest_in(block_list, p, &at_p, seed, wide_ ? row.data() : nullptr);
               }
               seed = s.slot / 8;
               const float d = std::sqrt(s.d2);
@@ -662,6 +695,7 @@ class GridSolver {
               best[local(i, j, k)] = s;
               ++stats.in_band;
             }
+          }
       }
     } else {
       ++stats.tiles_outside;
@@ -710,10 +744,36 @@ class GridSolver {
     const Vec3f extent = box.corners[7] - box.corners[0];
     float w[3], spread = 0;
     for (int a = 0; a < 3; ++a) {
-      w[a] = extent[a] > 0 ? std::clamp((p[a] - box.corners[0][a]) / extent[a], 0.0f, 1.0f) : 0.0f;
-      spread += extent[a] * extent[a] * w[a] * (1 - w[a]);
+      float part;
+      w[a] = on_axis(box, extent, a, p[a], part);
+      spread += part;
     }
     return {w[0], w[1], w[2], spread * (1 + 1e-4f) + margin_ * margin_};
+  }
+  // in_box's weight along axis a of a point at coordinate x, and its term of the spread.
+  static float on_axis(const SampleBox& box, const Vec3f& extent, int a, float x, float& part) {
+    const float w = extent[a] > 0 ? std::clamp((x - box.corners[0][a]) / extent[a], 0.0f, 1.0f) : 0.0f;
+    part = extent[a] * extent[a] * w * (1 - w);
+    return w;
+  }
+  // in_box for every sample of a block (of at most kBlock samples a side), axis by axis.
+  struct BlockWeights {
+    std::array<std::array<float, kBlock>, 3> w, part;
+  };
+  BlockWeights block_weights(const SampleBox& box) const {
+    BlockWeights bw;
+    const Vec3f extent = box.corners[7] - box.corners[0];
+    for (int a = 0; a < 3; ++a)
+      for (std::size_t m = 0; m < box.hi[a] - box.lo[a]; ++m)
+        bw.w[a][m] = on_axis(box, extent, a, grid_.origin[a] + float(box.lo[a] + m) * grid_.spacing[a], bw.part[a][m]);
+    return bw;
+  }
+  InBlock in_box(const BlockWeights& bw, std::size_t i, std::size_t j, std::size_t k) const {
+    float spread = 0;  // summed in in_box's order
+    spread += bw.part[0][i];
+    spread += bw.part[1][j];
+    spread += bw.part[2][k];
+    return {bw.w[0][i], bw.w[1][j], bw.w[2][k], spread * (1 + 1e-4f) + margin_ * margin_};
   }
 
   // Squared distance bounds at a box's corners from a surface point q.
@@ -814,12 +874,13 @@ class GridSolver {
   // The closest entry of `list` to p (ties: the smallest face index), with
   // its exact closest point and region.
   // With `at_p`, the list is a block's (with corner distances) and p is in the block.
-  Closest closest_in(const Packed& list, const Vec3f& p, const InBlock* at_p = nullptr, std::size_t seed = 0) const {
+  Closest closest_in(const Packed& list, const Vec3f& p, const InBlock* at_p = nullptr, std::size_t seed = 0,
+                     const float* row = nullptr) const {
     Closest best;
     if (list.size == 0) return best;
     float nearest_d2;
 #ifdef GEODS_SDF_AVX512
-    const std::size_t i = wide_ ? avx512::nearest(list, p, at_p, slack_, seed, nearest_d2)
+    const std::size_t i = wide_ ? avx512::nearest(list, p, at_p, slack_, seed, nearest_d2, row)
                                 : nearest(list, p, at_p, slack_, seed, nearest_d2);
 #else
     const std::size_t i = nearest(list, p, at_p, slack_, seed, nearest_d2);
