@@ -249,6 +249,18 @@ struct InBlock {
   float wx, wy, wz, spread;
 };
 
+// Of the search's lanes (each lane's best squared distance, face and entry),
+// the entry of the smallest distance, ties to the smallest face; d2 = its distance.
+inline std::size_t best_lane(const float* best, const std::int32_t* face_of, const std::int32_t* entry, int lanes,
+                             float& d2) {
+  std::size_t index = 0;
+  d2 = kInf;
+  std::int32_t face = std::numeric_limits<std::int32_t>::max();
+  for (int l = 0; l < lanes; ++l)
+    if (best[l] < d2 || (best[l] == d2 && face_of[l] < face)) d2 = best[l], face = face_of[l], index = std::size_t(entry[l]);
+  return index;
+}
+
 // The entry of t nearest to p and its squared distance; of equally near
 // ones, the one of the smallest face index. t is a block's list with the
 // squared distances from the block's corners (k0..k7): by concavity,
@@ -301,12 +313,12 @@ __attribute__((target_clones("avx2", "default"))) std::size_t nearest(const Pack
     if (c == seed || (in_block && lower(c) > reach2 * (1 + 1e-4f))) continue;
     group(c);
   }
-  std::size_t index = 0;
-  d2 = kInf;
-  std::int32_t face = std::numeric_limits<std::int32_t>::max();
-  for (int l = 0; l < 8; ++l)
-    if (best[l] < d2 || (best[l] == d2 && best_face[l] < face)) d2 = best[l], face = best_face[l], index = std::size_t(at[l]);
-  return index;
+  float bd[8];
+  std::int32_t bf[8], ba[8];
+  std::memcpy(bd, &best, sizeof bd);
+  std::memcpy(bf, &best_face, sizeof bf);
+  std::memcpy(ba, &at, sizeof ba);
+  return best_lane(bd, bf, ba, 8, d2);
 }
 
 // The same kernels sixteen entries at a time with AVX-512 (chosen at run time
@@ -525,12 +537,7 @@ GEODS_AVX512_FN std::size_t nearest(const Packed& t, const Vec3f& p, const InBlo
   _mm512_store_ps(bd, s.best);
   _mm512_store_si512(bf, s.best_face);
   _mm512_store_si512(ba, s.at_lane);
-  std::size_t index = 0;
-  d2 = kInf;
-  std::int32_t face = std::numeric_limits<std::int32_t>::max();
-  for (int l = 0; l < 16; ++l)
-    if (bd[l] < d2 || (bd[l] == d2 && bf[l] < face)) d2 = bd[l], face = bf[l], index = std::size_t(ba[l]);
-  return index;
+  return best_lane(bd, bf, ba, 16, d2);
 }
 
 }  // namespace avx512
