@@ -854,28 +854,39 @@ class GridSolver {
     else
 #endif
       corner_test(in, box.corners, sets.data(), num_sets, kept);
-    if (sorted)
-      std::sort(kept.begin(), kept.end(),
-                [](const Kept& a, const Kept& b) { return a.key < b.key || (a.key == b.key && a.index < b.index); });
+    // The order of the entries: by key, ties by index (kept is in index order),
+    // sorted as 64-bit words (key bits, position): non-negative floats order as their bits.
     const std::size_t n = kept.size();
+    thread_local std::vector<std::uint64_t> order;
+    order.resize(n);
+    for (std::size_t j = 0; j < n; ++j) {
+      std::uint32_t bits = 0;
+      if (sorted) {
+        const float key = kept[j].key + 0.0f;  // no -0
+        std::memcpy(&bits, &key, sizeof bits);
+      }
+      order[j] = std::uint64_t(bits) << 32 | j;
+    }
+    if (sorted) std::sort(order.begin(), order.end());
+    const auto at = [&](std::size_t j) -> const Kept& { return kept[std::uint32_t(order[j])]; };
     out.clear();
     out.reserve(n);
     for (int k = 0; k < Packed::k0; ++k) {
       const float* src = in.f[k].data();
       float* o = out.f[k].data();
-      for (std::size_t j = 0; j < n; ++j) o[j] = src[kept[j].index];
+      for (std::size_t j = 0; j < n; ++j) o[j] = src[at(j).index];
     }
     for (int k = 0; k < 8; ++k) {
       float* o = out.f[Packed::k0 + k].data();
-      for (std::size_t j = 0; j < n; ++j) o[j] = kept[j].k[k];
+      for (std::size_t j = 0; j < n; ++j) o[j] = at(j).k[k];
     }
-    for (std::size_t j = 0; j < n; ++j) out.face[j] = in.face[kept[j].index], out.leaf.push_back(in.leaf[kept[j].index]);
+    for (std::size_t j = 0; j < n; ++j) out.face[j] = in.face[at(j).index], out.leaf.push_back(in.leaf[at(j).index]);
     out.size = n;
     out.floor.clear();
     if (!sorted) return;
     const Vec3f extent = box.corners[7] - box.corners[0];
     const float spread = 0.25f * extent.squaredNorm() * (1 + 1e-4f) + margin_ * margin_;
-    for (std::size_t j = 0; j < n; j += 8) out.floor.push_back(kept[j].key * (1 - 1e-4f) - spread - slack_);
+    for (std::size_t j = 0; j < n; j += 8) out.floor.push_back(at(j).key * (1 - 1e-4f) - spread - slack_);
   }
 
   // The closest entry of `list` to p (ties: the smallest face index), with
