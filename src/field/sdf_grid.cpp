@@ -331,6 +331,13 @@ __attribute__((target_clones("avx2", "default"))) std::size_t nearest(const Pack
 #define GEODS_SDF_AVX512 1
 #define GEODS_AVX512_FN __attribute__((target("avx512f,avx512vl,avx512bw,avx512dq,avx2,bmi,bmi2,popcnt")))
 #define GEODS_AVX512_INLINE __attribute__((target("avx512f,avx512vl,avx512bw,avx512dq,avx2,bmi,bmi2,popcnt"), always_inline)) inline
+// GCC 12 warns about the undefined pass-through operand inside its own
+// intrinsics (_mm512_min_ps, _mm512_max_ps, _mm512_reduce_min_ps) once they are inlined.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wuninitialized"
+#if !defined(__clang__)
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 namespace avx512 {
 
 GEODS_AVX512_INLINE __m512 at(const Packed::Arrays& f, int k, std::size_t i) { return _mm512_loadu_ps(f[k].data() + i); }
@@ -541,6 +548,7 @@ GEODS_AVX512_FN std::size_t nearest(const Packed& t, const Vec3f& p, const InBlo
 }
 
 }  // namespace avx512
+#pragma GCC diagnostic pop
 #endif
 
 struct Scratch {
@@ -894,8 +902,7 @@ class GridSolver {
   // With `at_p`, the list is a block's (with corner distances) and p is in the block.
   Closest closest_in(const Packed& list, const Vec3f& p, const InBlock* at_p = nullptr, std::size_t seed = 0,
                      const float* row = nullptr) const {
-    Closest best;
-    if (list.size == 0) return best;
+    if (list.size == 0) return Closest{};
     float nearest_d2;
 #ifdef GEODS_SDF_AVX512
     const std::size_t i = wide_ ? avx512::nearest(list, p, at_p, slack_, seed, nearest_d2, row)
@@ -903,6 +910,12 @@ class GridSolver {
 #else
     const std::size_t i = nearest(list, p, at_p, slack_, seed, nearest_d2);
 #endif
+    return entry(list, p, i);
+  }
+
+  // Entry i of the list as p's closest: its exact closest point and region.
+  Closest entry(const Packed& list, const Vec3f& p, std::size_t i) const {
+    Closest best;
     const BvhTriangle& tri = tris_[list.leaf[i]];
     best.leaf = list.leaf[i];
     best.slot = i;
@@ -915,8 +928,7 @@ class GridSolver {
   // list's distances k<c>): the same face, of the same squared distance as
   // the search computes, with the same ties.
   Closest closest_at_corner(const Packed& list, const Vec3f& p, int c) const {
-    Closest best;
-    if (list.size == 0) return best;
+    if (list.size == 0) return Closest{};
     const float* k = list.f[Packed::k0 + c].data();
     const std::int32_t* face = list.face.data();
     std::size_t i = 0;
@@ -924,12 +936,7 @@ class GridSolver {
     std::int32_t f = std::numeric_limits<std::int32_t>::max();
     for (std::size_t j = 0; j < list.size; ++j)
       if (k[j] < d2 || (k[j] == d2 && face[j] < f)) d2 = k[j], f = face[j], i = j;
-    const BvhTriangle& tri = tris_[list.leaf[i]];
-    best.leaf = list.leaf[i];
-    best.slot = i;
-    best.point = closest_point_on_triangle(p, tri.a, tri.b, tri.c, best.region);
-    best.d2 = (best.point - p).squaredNorm();
-    return best;
+    return entry(list, p, i);
   }
 
   const MeshDistance& mesh_;
