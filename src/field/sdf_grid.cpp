@@ -2,6 +2,10 @@
 
 #include <unistd.h>
 
+#if defined(__x86_64__)
+#include <immintrin.h>
+#endif
+
 #include <algorithm>
 #include <array>
 #include <atomic>
@@ -15,6 +19,7 @@
 #include "geods/bvh/traversal.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"
+#include "geods/core/simd_level.hpp"
 
 namespace geods::field {
 namespace {
@@ -244,6 +249,18 @@ struct InBlock {
   float wx, wy, wz, spread;
 };
 
+// Of the search's lanes (each lane's best squared distance, face and entry),
+// the entry of the smallest distance, ties to the smallest face; d2 = its distance.
+inline std::size_t best_lane(const float* best, const std::int32_t* face_of, const std::int32_t* entry, int lanes,
+                             float& d2) {
+  std::size_t index = 0;
+  d2 = kInf;
+  std::int32_t face = std::numeric_limits<std::int32_t>::max();
+  for (int l = 0; l < lanes; ++l)
+    if (best[l] < d2 || (best[l] == d2 && face_of[l] < face)) d2 = best[l], face = face_of[l], index = std::size_t(entry[l]);
+  return index;
+}
+
 // The entry of t nearest to p and its squared distance; of equally near
 // ones, the one of the smallest face index. t is a block's list with the
 // squared distances from the block's corners (k0..k7): by concavity,
@@ -296,19 +313,250 @@ __attribute__((target_clones("avx2", "default"))) std::size_t nearest(const Pack
     if (c == seed || (in_block && lower(c) > reach2 * (1 + 1e-4f))) continue;
     group(c);
   }
-  std::size_t index = 0;
-  d2 = kInf;
-  std::int32_t face = std::numeric_limits<std::int32_t>::max();
-  for (int l = 0; l < 8; ++l)
-    if (best[l] < d2 || (best[l] == d2 && best_face[l] < face)) d2 = best[l], face = best_face[l], index = std::size_t(at[l]);
-  return index;
+  float bd[8];
+  std::int32_t bf[8], ba[8];
+  std::memcpy(bd, &best, sizeof bd);
+  std::memcpy(bf, &best_face, sizeof bf);
+  std::memcpy(ba, &at, sizeof ba);
+  return best_lane(bd, bf, ba, 8, d2);
 }
+
+// The same kernels sixteen entries at a time with AVX-512 (chosen at run time
+// by core/simd_level.hpp). They perform the same IEEE operations in the same
+// order as the eight-wide ones above (this file is compiled with
+// -ffp-contract=off, so no FMA contraction), hence the same distances; the
+// search prunes pairs of groups instead of groups, which drops only entries
+// that cannot be nearest, so the results are identical.
+#if defined(__x86_64__) && defined(__GNUC__)
+#define GEODS_SDF_AVX512 1
+#define GEODS_AVX512_FN __attribute__((target("avx512f,avx512vl,avx512bw,avx512dq,avx2,bmi,bmi2,popcnt")))
+#define GEODS_AVX512_INLINE __attribute__((target("avx512f,avx512vl,avx512bw,avx512dq,avx2,bmi,bmi2,popcnt"), always_inline)) inline
+// GCC 12 warns about the undefined pass-through operand inside its own
+// intrinsics (_mm512_min_ps, _mm512_max_ps, _mm512_reduce_min_ps) once they are inlined.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wuninitialized"
+#if !defined(__clang__)
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
+namespace avx512 {
+
+GEODS_AVX512_INLINE __m512 at(const Packed::Arrays& f, int k, std::size_t i) { return _mm512_loadu_ps(f[k].data() + i); }
+
+GEODS_AVX512_INLINE __m512 clamp01(__m512 t) {  // 1 < max(0, t) ? 1 : ..., as the eight-wide selects
+  return _mm512_min_ps(_mm512_set1_ps(1.0f), _mm512_max_ps(_mm512_setzero_ps(), t));
+}
+GEODS_AVX512_INLINE __m512 dot(__m512 a, __m512 b, __m512 c, __m512 x, __m512 y, __m512 z) {
+  return _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(a, x), _mm512_mul_ps(b, y)), _mm512_mul_ps(c, z));
+}
+GEODS_AVX512_INLINE __m512 sq(__m512 x, __m512 y, __m512 z) { return dot(x, y, z, x, y, z); }
+GEODS_AVX512_INLINE __m512 lerp(__m512 a, __m512 b, __m512 w) {
+  return _mm512_add_ps(a, _mm512_mul_ps(w, _mm512_sub_ps(b, a)));
+}
+
+// Squared distances from p to entries [i, i + 16) of f (as distance8).
+GEODS_AVX512_INLINE __m512 distance16(const Packed::Arrays& f, std::size_t i, __m512 px, __m512 py, __m512 pz) {
+  const __m512 zero = _mm512_setzero_ps(), one = _mm512_set1_ps(1.0f);
+  const __m512 bx = at(f, Packed::bx, i), by = at(f, Packed::by, i), bz = at(f, Packed::bz, i);
+  const __m512 cx = at(f, Packed::cx, i), cy = at(f, Packed::cy, i), cz = at(f, Packed::cz, i);
+  const __m512 qx = _mm512_sub_ps(px, at(f, Packed::ax, i)), qy = _mm512_sub_ps(py, at(f, Packed::ay, i)),
+               qz = _mm512_sub_ps(pz, at(f, Packed::az, i));
+  const __m512 e1 = dot(bx, by, bz, qx, qy, qz);
+  const __m512 e2 = dot(cx, cy, cz, qx, qy, qz);
+  const __m512 d01 = at(f, Packed::d01, i), inv_den = at(f, Packed::inv_den, i), inv_nn = at(f, Packed::inv_nn, i);
+  const __m512 v = _mm512_mul_ps(_mm512_sub_ps(_mm512_mul_ps(at(f, Packed::d11, i), e1), _mm512_mul_ps(d01, e2)), inv_den);
+  const __m512 w = _mm512_mul_ps(_mm512_sub_ps(_mm512_mul_ps(at(f, Packed::d00, i), e2), _mm512_mul_ps(d01, e1)), inv_den);
+  const __m512 h = dot(at(f, Packed::nx, i), at(f, Packed::ny, i), at(f, Packed::nz, i), qx, qy, qz);
+  const __m512 face = _mm512_mul_ps(_mm512_mul_ps(h, h), inv_nn);
+  const __mmask16 inside = _mm512_cmp_ps_mask(v, zero, _CMP_GE_OQ) & _mm512_cmp_ps_mask(w, zero, _CMP_GE_OQ) &
+                           _mm512_cmp_ps_mask(_mm512_add_ps(v, w), one, _CMP_LE_OQ) &
+                           _mm512_cmp_ps_mask(inv_nn, zero, _CMP_GT_OQ);
+  __m512 s = clamp01(_mm512_mul_ps(e1, at(f, Packed::inv_ab, i)));
+  const __m512 dab = sq(_mm512_sub_ps(qx, _mm512_mul_ps(s, bx)), _mm512_sub_ps(qy, _mm512_mul_ps(s, by)),
+                        _mm512_sub_ps(qz, _mm512_mul_ps(s, bz)));
+  s = clamp01(_mm512_mul_ps(e2, at(f, Packed::inv_ac, i)));
+  const __m512 dac = sq(_mm512_sub_ps(qx, _mm512_mul_ps(s, cx)), _mm512_sub_ps(qy, _mm512_mul_ps(s, cy)),
+                        _mm512_sub_ps(qz, _mm512_mul_ps(s, cz)));
+  const __m512 ux = _mm512_sub_ps(qx, bx), uy = _mm512_sub_ps(qy, by), uz = _mm512_sub_ps(qz, bz);
+  const __m512 wx = _mm512_sub_ps(cx, bx), wy = _mm512_sub_ps(cy, by), wz = _mm512_sub_ps(cz, bz);
+  s = clamp01(_mm512_mul_ps(dot(ux, uy, uz, wx, wy, wz), at(f, Packed::inv_bc, i)));
+  const __m512 dbc = sq(_mm512_sub_ps(ux, _mm512_mul_ps(s, wx)), _mm512_sub_ps(uy, _mm512_mul_ps(s, wy)),
+                        _mm512_sub_ps(uz, _mm512_mul_ps(s, wz)));
+  // dab < dac ? dab : dac, then dbc < edge ? dbc : edge.
+  const __m512 edge = _mm512_min_ps(dbc, _mm512_min_ps(dab, dac));
+  return _mm512_mask_blend_ps(inside, edge, face);
+}
+
+GEODS_AVX512_INLINE __mmask16 valid(std::size_t i, std::size_t size) {
+  return i + 16 <= size ? __mmask16(0xffff) : i >= size ? __mmask16(0) : __mmask16((1u << (size - i)) - 1);
+}
+
+GEODS_AVX512_FN void corner_test(const Packed& t, const std::array<Vec3f, 8>& corners, const std::array<float, 8>* bound2,
+                                 int sets, std::vector<Kept>& kept) {
+  alignas(64) float d[8][16];
+  for (std::size_t i = 0; i < t.size; i += 16) {
+    __m512 dv[8];
+    __mmask16 pass = 0;
+    for (int k = 0; k < 8; ++k) {
+      dv[k] = distance16(t.f, i, _mm512_set1_ps(corners[k].x()), _mm512_set1_ps(corners[k].y()),
+                         _mm512_set1_ps(corners[k].z()));
+      pass |= _mm512_cmp_ps_mask(dv[k], _mm512_set1_ps(bound2[0][k]), _CMP_LE_OQ);
+    }
+    for (int j = 1; j < sets; ++j) {
+      __mmask16 also = 0;
+      for (int k = 0; k < 8; ++k) also |= _mm512_cmp_ps_mask(dv[k], _mm512_set1_ps(bound2[j][k]), _CMP_LE_OQ);
+      pass &= also;
+    }
+    pass &= valid(i, t.size);
+    if (!pass) continue;
+    for (int k = 0; k < 8; ++k) _mm512_store_ps(d[k], dv[k]);
+    for (unsigned m = pass; m; m &= m - 1) {
+      const int l = __builtin_ctz(m);
+      Kept& e = kept.emplace_back();
+      e.index = std::uint32_t(i + std::size_t(l));
+      e.key = d[0][l];
+      for (int k = 0; k < 8; ++k) e.k[k] = d[k][l], e.key = std::min(e.key, d[k][l]);
+    }
+  }
+}
+
+GEODS_AVX512_FN void lattice_filter(const Packed& t, const Lattice& lat,
+                                    std::array<std::vector<std::uint32_t>, kBlocks>& out) {
+  const int nx = lat.n[0], ny = lat.n[1], nz = lat.n[2];
+  for (std::size_t b = 0; b < lat.blocks; ++b) out[b].clear();
+  const __m512 shrink = _mm512_set1_ps(1 - 1e-4f);
+  for (std::size_t i = 0; i < t.size; i += 16) {
+    __m512 x[4][4], y[2][4][4], lb[64];
+    for (int e = 0; e < 4; ++e) {
+      const __m512 lo = at(t.f, Packed::k0 + 2 * e, i), hi = at(t.f, Packed::k0 + 2 * e + 1, i);
+      const __m512 dif = _mm512_sub_ps(hi, lo);
+      for (int a = 0; a < nx; ++a) x[e][a] = _mm512_add_ps(lo, _mm512_mul_ps(_mm512_set1_ps(lat.w[0][a]), dif));
+    }
+    for (int z = 0; z < 2; ++z)
+      for (int b = 0; b < ny; ++b)
+        for (int a = 0; a < nx; ++a)
+          y[z][b][a] = _mm512_add_ps(x[2 * z][a], _mm512_mul_ps(_mm512_set1_ps(lat.w[1][b]),
+                                                                _mm512_sub_ps(x[2 * z + 1][a], x[2 * z][a])));
+    for (int c = 0; c < nz; ++c)
+      for (int b = 0; b < ny; ++b)
+        for (int a = 0; a < nx; ++a) {
+          const int l = a + 4 * (b + 4 * c);
+          lb[l] = _mm512_sub_ps(
+              _mm512_mul_ps(_mm512_add_ps(y[0][b][a], _mm512_mul_ps(_mm512_set1_ps(lat.w[2][c]),
+                                                                    _mm512_sub_ps(y[1][b][a], y[0][b][a]))),
+                            shrink),
+              _mm512_set1_ps(lat.spread[l]));
+        }
+    const __mmask16 ok = valid(i, t.size);
+    for (std::size_t b = 0; b < lat.blocks; ++b) {
+      __mmask16 pass = 0;
+      for (int k = 0; k < 8; ++k)
+        pass |= _mm512_cmp_ps_mask(lb[lat.corner[b][k]], _mm512_set1_ps(lat.bound2[b][k]), _CMP_LE_OQ);
+      pass &= ok;
+      for (unsigned m = pass; m; m &= m - 1) out[b].push_back(std::uint32_t(i + std::size_t(__builtin_ctz(m))));
+    }
+  }
+}
+
+// The search state of nearest() below.
+struct Search {
+  const Packed& t;
+  __m512 px, py, pz, wx, wy, wz;
+  __m512 best = _mm512_set1_ps(kInf);
+  __m512i at_lane = _mm512_setzero_si512(), best_face = _mm512_set1_epi32(std::numeric_limits<std::int32_t>::max());
+  float reach2 = kInf;  // the best squared distance so far
+
+  // Entries [16 c, 16 c + 16).
+  GEODS_AVX512_INLINE void pair(std::size_t c) {
+    const std::size_t i = 16 * c;
+    __m512 r = distance16(t.f, i, px, py, pz);
+    r = _mm512_mask_blend_ps(valid(i, t.size), _mm512_set1_ps(kInf), r);  // the padding
+    const __m512i face = _mm512_loadu_si512(t.face.data() + i);
+    const __mmask16 closer = _mm512_cmp_ps_mask(r, best, _CMP_LT_OQ) |
+                             (_mm512_cmp_ps_mask(r, best, _CMP_EQ_OQ) & _mm512_cmplt_epi32_mask(face, best_face));
+    const __m512i lanes = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+    best = _mm512_mask_blend_ps(closer, best, r);
+    best_face = _mm512_mask_blend_epi32(closer, best_face, face);
+    at_lane = _mm512_mask_blend_epi32(closer, at_lane, _mm512_add_epi32(lanes, _mm512_set1_epi32(std::int32_t(i))));
+    reach2 = std::min(reach2, _mm512_reduce_min_ps(r));
+  }
+  const float* row = nullptr;  // optional: row_bounds() of p's row
+  // Whether every entry's bound in pair c (as lower() of nearest()) exceeds reach2.
+  GEODS_AVX512_INLINE bool beyond(std::size_t c, float spread, float slack) const {
+    const std::size_t i = 16 * c;
+    if (row) {
+      const __m512 z = lerp(_mm512_loadu_ps(row + 2 * i), _mm512_loadu_ps(row + 2 * i + 16), wx);
+      const __m512 lb = _mm512_sub_ps(_mm512_sub_ps(_mm512_mul_ps(z, _mm512_set1_ps(1 - 1e-4f)), _mm512_set1_ps(spread)),
+                                      _mm512_set1_ps(slack));
+      return _mm512_cmp_ps_mask(lb, _mm512_set1_ps(reach2 * (1 + 1e-4f)), _CMP_GT_OQ) == __mmask16(0xffff);
+    }
+    const int k0 = Packed::k0;
+    const __m512 x0 = lerp(at(t.f, k0, i), at(t.f, k0 + 1, i), wx), x1 = lerp(at(t.f, k0 + 2, i), at(t.f, k0 + 3, i), wx);
+    const __m512 x2 = lerp(at(t.f, k0 + 4, i), at(t.f, k0 + 5, i), wx), x3 = lerp(at(t.f, k0 + 6, i), at(t.f, k0 + 7, i), wx);
+    const __m512 z = lerp(lerp(x0, x1, wy), lerp(x2, x3, wy), wz);
+    const __m512 lb = _mm512_sub_ps(_mm512_sub_ps(_mm512_mul_ps(z, _mm512_set1_ps(1 - 1e-4f)), _mm512_set1_ps(spread)),
+                                    _mm512_set1_ps(slack));
+    return _mm512_cmp_ps_mask(lb, _mm512_set1_ps(reach2 * (1 + 1e-4f)), _CMP_GT_OQ) == __mmask16(0xffff);
+  }
+};
+
+// For the samples of one row along x of a block (weights wy, wz): each
+// entry's corner distances interpolated along y and z at the block's two
+// x-ends, so that a sample's bound is one interpolation along x (the same
+// trilinear bound in another order: its rounding is covered as that of lower()).
+// row[32 c + l] and row[32 c + 16 + l]: the ends of entry 16 c + l.
+GEODS_AVX512_FN void row_bounds(const Packed& t, float wy, float wz, float* row) {
+  const __m512 y = _mm512_set1_ps(wy), z = _mm512_set1_ps(wz);
+  const int k0 = Packed::k0;
+  for (std::size_t i = 0; i < t.size; i += 16) {
+    const __m512 lo = lerp(lerp(at(t.f, k0, i), at(t.f, k0 + 2, i), y), lerp(at(t.f, k0 + 4, i), at(t.f, k0 + 6, i), y), z);
+    const __m512 hi =
+        lerp(lerp(at(t.f, k0 + 1, i), at(t.f, k0 + 3, i), y), lerp(at(t.f, k0 + 5, i), at(t.f, k0 + 7, i), y), z);
+    _mm512_storeu_ps(row + 2 * i, lo);
+    _mm512_storeu_ps(row + 2 * i + 16, hi);
+  }
+}
+
+// As nearest() above; groups of 8 are searched and bounded two at a time.
+// With `row` (row_bounds() of p's row), the bounds come from there.
+GEODS_AVX512_FN std::size_t nearest(const Packed& t, const Vec3f& p, const InBlock* in_block, float slack,
+                                    std::size_t seed, float& d2, const float* row = nullptr) {
+  const float* floor = in_block && !t.floor.empty() ? t.floor.data() : nullptr;
+  const InBlock at_p = in_block ? *in_block : InBlock{};
+  Search s{t,
+           _mm512_set1_ps(p.x()),
+           _mm512_set1_ps(p.y()),
+           _mm512_set1_ps(p.z()),
+           _mm512_set1_ps(at_p.wx),
+           _mm512_set1_ps(at_p.wy),
+           _mm512_set1_ps(at_p.wz)};
+  s.row = in_block ? row : nullptr;
+  const std::size_t groups = (t.size + 7) / 8, pairs = (groups + 1) / 2;
+  seed /= 2;  // the pair of group `seed`
+  if (seed >= pairs) seed = 0;
+  s.pair(seed);
+  for (std::size_t c = 0; c < pairs; ++c) {
+    if (floor && floor[2 * c] > s.reach2 * (1 + 1e-4f)) break;  // the groups are sorted by their floors
+    if (c == seed || (in_block && s.beyond(c, at_p.spread, slack))) continue;
+    s.pair(c);
+  }
+  alignas(64) float bd[16];
+  alignas(64) std::int32_t bf[16], ba[16];
+  _mm512_store_ps(bd, s.best);
+  _mm512_store_si512(bf, s.best_face);
+  _mm512_store_si512(ba, s.at_lane);
+  return best_lane(bd, bf, ba, 16, d2);
+}
+
+}  // namespace avx512
+#pragma GCC diagnostic pop
+#endif
 
 struct Scratch {
   Packed tile_list, block_list, near;
   std::vector<Kept> kept;
   std::vector<std::uint32_t> found;
   std::array<std::vector<std::uint32_t>, kBlocks> survivors;
+  std::vector<float> row;  // avx512::row_bounds
 };
 
 class GridSolver {
@@ -358,7 +606,7 @@ class GridSolver {
     if (!(centre.distance - box.radius > band_ + margin_)) {
       // Scratch lists of this thread, kept from tile to tile: no allocation or zeroing per tile.
       thread_local Scratch scratch;
-      auto& [tile_list, block_list, near, kept, found, survivors] = scratch;
+      auto& [tile_list, block_list, near, kept, found, survivors, row] = scratch;
       gather(box, centre.closest, tile_list, near, found, kept);
       // Surface points: the closest points of the tile's centre and of the
       // blocks' centres. A face that can be nearest to a sample p of a block is
@@ -419,20 +667,41 @@ class GridSolver {
           }
         }
       }
-      lattice_filter(tile_list, lat, survivors);
+#ifdef GEODS_SDF_AVX512
+      if (wide_)
+        avx512::lattice_filter(tile_list, lat, survivors);
+      else
+#endif
+        lattice_filter(tile_list, lat, survivors);
       for (std::size_t b = 0; b < num_blocks; ++b) {
         const SampleBox block = block_box(b);
         const Closest& c = block_closest[b];
         if (std::sqrt(c.d2) - block.radius > band_ + margin_) continue;
         select(tile_list, survivors[b], near, Packed::k0);
         filter(near, block, c.point, block_list, kept, true, std::span(anchors.data(), num_anchors));
+        const BlockWeights weights = block_weights(block);  // in_box of each sample
         std::size_t seed = 0;  // the group of the previous sample's nearest face
+        if (wide_ && row.size() < 2 * block_list.f[0].size()) row.resize(2 * block_list.f[0].size());
         for (std::size_t k = block.lo[2]; k < block.hi[2]; ++k)
-          for (std::size_t j = block.lo[1]; j < block.hi[1]; ++j)
+          for (std::size_t j = block.lo[1]; j < block.hi[1]; ++j) {
+            bool row_ready = false;
             for (std::size_t i = block.lo[0]; i < block.hi[0]; ++i) {
               const Vec3f p = grid_.position(i, j, k);
-              const InBlock at_p = in_box(block, p);
-              const Closest s = closest_in(block_list, p, &at_p, seed);
+              // The block's corner samples have their distances from every face
+              // of the list already (k0..k7): the nearest is the smallest of them.
+              const int cx = i == block.lo[0] ? 0 : i + 1 == block.hi[0] ? 1 : -1;
+              const int cy = j == block.lo[1] ? 0 : j + 1 == block.hi[1] ? 2 : -1;
+              const int cz = k == block.lo[2] ? 0 : k + 1 == block.hi[2] ? 4 : -1;
+              Closest s;
+              if (cx >= 0 && cy >= 0 && cz >= 0) {
+                s = closest_at_corner(block_list, p, cx + cy + cz);
+              } else {
+                const InBlock at_p = in_box(weights, i - block.lo[0], j - block.lo[1], k - block.lo[2]);
+#ifdef GEODS_SDF_AVX512
+                if (wide_ && !row_ready) avx512::row_bounds(block_list, at_p.wy, at_p.wz, row.data()), row_ready = true;
+#endif
+                s = closest_in(block_list, p, &at_p, seed, wide_ ? row.data() : nullptr);
+              }
               seed = s.slot / 8;
               const float d = std::sqrt(s.d2);
               if (d > band_) continue;
@@ -441,6 +710,7 @@ class GridSolver {
               best[local(i, j, k)] = s;
               ++stats.in_band;
             }
+          }
       }
     } else {
       ++stats.tiles_outside;
@@ -489,10 +759,36 @@ class GridSolver {
     const Vec3f extent = box.corners[7] - box.corners[0];
     float w[3], spread = 0;
     for (int a = 0; a < 3; ++a) {
-      w[a] = extent[a] > 0 ? std::clamp((p[a] - box.corners[0][a]) / extent[a], 0.0f, 1.0f) : 0.0f;
-      spread += extent[a] * extent[a] * w[a] * (1 - w[a]);
+      float part;
+      w[a] = on_axis(box, extent, a, p[a], part);
+      spread += part;
     }
     return {w[0], w[1], w[2], spread * (1 + 1e-4f) + margin_ * margin_};
+  }
+  // in_box's weight along axis a of a point at coordinate x, and its term of the spread.
+  static float on_axis(const SampleBox& box, const Vec3f& extent, int a, float x, float& part) {
+    const float w = extent[a] > 0 ? std::clamp((x - box.corners[0][a]) / extent[a], 0.0f, 1.0f) : 0.0f;
+    part = extent[a] * extent[a] * w * (1 - w);
+    return w;
+  }
+  // in_box for every sample of a block (of at most kBlock samples a side), axis by axis.
+  struct BlockWeights {
+    std::array<std::array<float, kBlock>, 3> w, part;
+  };
+  BlockWeights block_weights(const SampleBox& box) const {
+    BlockWeights bw;
+    const Vec3f extent = box.corners[7] - box.corners[0];
+    for (int a = 0; a < 3; ++a)
+      for (std::size_t m = 0; m < box.hi[a] - box.lo[a]; ++m)
+        bw.w[a][m] = on_axis(box, extent, a, grid_.origin[a] + float(box.lo[a] + m) * grid_.spacing[a], bw.part[a][m]);
+    return bw;
+  }
+  InBlock in_box(const BlockWeights& bw, std::size_t i, std::size_t j, std::size_t k) const {
+    float spread = 0;  // summed in in_box's order
+    spread += bw.part[0][i];
+    spread += bw.part[1][j];
+    spread += bw.part[2][k];
+    return {bw.w[0][i], bw.w[1][j], bw.w[2][k], spread * (1 + 1e-4f) + margin_ * margin_};
   }
 
   // Squared distance bounds at a box's corners from a surface point q.
@@ -560,45 +856,87 @@ class GridSolver {
     const int num_sets = 1 + int(std::min<std::size_t>(more.size(), sets.size() - 1));
     sets[0] = bounds_from(box, q);
     for (int j = 1; j < num_sets; ++j) sets[j] = bounds_from(box, more[j - 1]);
-    corner_test(in, box.corners, sets.data(), num_sets, kept);
-    if (sorted)
-      std::sort(kept.begin(), kept.end(),
-                [](const Kept& a, const Kept& b) { return a.key < b.key || (a.key == b.key && a.index < b.index); });
+#ifdef GEODS_SDF_AVX512
+    if (wide_)
+      avx512::corner_test(in, box.corners, sets.data(), num_sets, kept);
+    else
+#endif
+      corner_test(in, box.corners, sets.data(), num_sets, kept);
+    // The order of the entries: by key, ties by index (kept is in index order),
+    // sorted as 64-bit words (key bits, position): non-negative floats order as their bits.
     const std::size_t n = kept.size();
+    thread_local std::vector<std::uint64_t> order;
+    order.resize(n);
+    for (std::size_t j = 0; j < n; ++j) {
+      std::uint32_t bits = 0;
+      if (sorted) {
+        const float key = kept[j].key + 0.0f;  // no -0
+        std::memcpy(&bits, &key, sizeof bits);
+      }
+      order[j] = std::uint64_t(bits) << 32 | j;
+    }
+    if (sorted) std::sort(order.begin(), order.end());
+    const auto at = [&](std::size_t j) -> const Kept& { return kept[std::uint32_t(order[j])]; };
     out.clear();
     out.reserve(n);
     for (int k = 0; k < Packed::k0; ++k) {
       const float* src = in.f[k].data();
       float* o = out.f[k].data();
-      for (std::size_t j = 0; j < n; ++j) o[j] = src[kept[j].index];
+      for (std::size_t j = 0; j < n; ++j) o[j] = src[at(j).index];
     }
     for (int k = 0; k < 8; ++k) {
       float* o = out.f[Packed::k0 + k].data();
-      for (std::size_t j = 0; j < n; ++j) o[j] = kept[j].k[k];
+      for (std::size_t j = 0; j < n; ++j) o[j] = at(j).k[k];
     }
-    for (std::size_t j = 0; j < n; ++j) out.face[j] = in.face[kept[j].index], out.leaf.push_back(in.leaf[kept[j].index]);
+    for (std::size_t j = 0; j < n; ++j) out.face[j] = in.face[at(j).index], out.leaf.push_back(in.leaf[at(j).index]);
     out.size = n;
     out.floor.clear();
     if (!sorted) return;
     const Vec3f extent = box.corners[7] - box.corners[0];
     const float spread = 0.25f * extent.squaredNorm() * (1 + 1e-4f) + margin_ * margin_;
-    for (std::size_t j = 0; j < n; j += 8) out.floor.push_back(kept[j].key * (1 - 1e-4f) - spread - slack_);
+    for (std::size_t j = 0; j < n; j += 8) out.floor.push_back(at(j).key * (1 - 1e-4f) - spread - slack_);
   }
 
   // The closest entry of `list` to p (ties: the smallest face index), with
   // its exact closest point and region.
   // With `at_p`, the list is a block's (with corner distances) and p is in the block.
-  Closest closest_in(const Packed& list, const Vec3f& p, const InBlock* at_p = nullptr, std::size_t seed = 0) const {
-    Closest best;
-    if (list.size == 0) return best;
+  Closest closest_in(const Packed& list, const Vec3f& p, const InBlock* at_p = nullptr, std::size_t seed = 0,
+                     const float* row = nullptr) const {
+    if (list.size == 0) return Closest{};
     float nearest_d2;
+#ifdef GEODS_SDF_AVX512
+    const std::size_t i = wide_ ? avx512::nearest(list, p, at_p, slack_, seed, nearest_d2, row)
+                                : nearest(list, p, at_p, slack_, seed, nearest_d2);
+#else
     const std::size_t i = nearest(list, p, at_p, slack_, seed, nearest_d2);
+#endif
+    return entry(list, p, i);
+  }
+
+  // Entry i of the list as p's closest: its exact closest point and region.
+  Closest entry(const Packed& list, const Vec3f& p, std::size_t i) const {
+    Closest best;
     const BvhTriangle& tri = tris_[list.leaf[i]];
     best.leaf = list.leaf[i];
     best.slot = i;
     best.point = closest_point_on_triangle(p, tri.a, tri.b, tri.c, best.region);
     best.d2 = (best.point - p).squaredNorm();
     return best;
+  }
+
+  // As closest_in for a block's corner sample p (corner c of the block, the
+  // list's distances k<c>): the same face, of the same squared distance as
+  // the search computes, with the same ties.
+  Closest closest_at_corner(const Packed& list, const Vec3f& p, int c) const {
+    if (list.size == 0) return Closest{};
+    const float* k = list.f[Packed::k0 + c].data();
+    const std::int32_t* face = list.face.data();
+    std::size_t i = 0;
+    float d2 = kInf;
+    std::int32_t f = std::numeric_limits<std::int32_t>::max();
+    for (std::size_t j = 0; j < list.size; ++j)
+      if (k[j] < d2 || (k[j] == d2 && face[j] < f)) d2 = k[j], f = face[j], i = j;
+    return entry(list, p, i);
   }
 
   const MeshDistance& mesh_;
@@ -610,6 +948,7 @@ class GridSolver {
   float margin_ = 0;
   float slack_ = 0;
   float band_ = kInf;
+  bool wide_ = simd_level() == SimdLevel::avx512;  // the AVX-512 kernels
 };
 
 }  // namespace

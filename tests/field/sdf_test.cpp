@@ -12,6 +12,7 @@
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"
 #include "geods/core/rng.hpp"
+#include "geods/core/simd_level.hpp"
 #include "geods/field/sdf_grid.hpp"
 #include "geods/io/mesh_io.hpp"
 #include "mesh_oracle.hpp"
@@ -154,6 +155,32 @@ TEST(SdfGrid, SameBitsForAnyThreadCount) {
   const SdfGrid all = sdf_grid(bunny, grid, options);
   EXPECT_EQ(one.distance.data, all.distance.data);
   EXPECT_EQ(one.faces, all.faces);
+}
+
+// The AVX-512 kernels (chosen at run time) against the portable ones: the
+// same bits and faces, whole grid and band (portable alone where the CPU has
+// no AVX-512; ctest field_portable_simd runs the brute-force tests there too).
+TEST(SdfGrid, SameBitsAtEverySimdLevel) {
+  const TriMesh bunny = data_mesh("bunny.ply");
+  const MeshDistance md = MeshDistance::build(bunny);
+  const Grid3Geometry grid = sdf_grid_geometry(bunny.bounds(), 40, 0, 3);
+  const SimdLevel saved = simd_level();
+  for (const double band : {std::numeric_limits<double>::infinity(), 2.0}) {
+    SdfGridOptions options;
+    options.faces = true;
+    options.band = band;
+    set_simd_level(SimdLevel::portable);
+    const SdfGrid portable = sdf_grid(md, grid, options);
+    for (const SimdLevel level : {SimdLevel::avx2, SimdLevel::avx512}) {
+      if (level > best_simd_level()) continue;
+      set_simd_level(level);
+      const SdfGrid r = sdf_grid(md, grid, options);
+      EXPECT_EQ(r.distance.data, portable.distance.data) << simd_level_name(level);
+      EXPECT_EQ(r.faces, portable.faces) << simd_level_name(level);
+      EXPECT_EQ(r.stats.in_band, portable.stats.in_band);
+    }
+  }
+  set_simd_level(saved);
 }
 
 TEST(SdfGrid, NarrowBandEqualsTheWholeGridInside) {

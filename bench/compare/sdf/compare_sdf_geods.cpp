@@ -1,6 +1,9 @@
 // geods::field::sdf_grid on the sdf workload (see sdf_driver.hpp): MeshDistance built once
 // (build_s: the hierarchy, pseudonormals, winding-number moments), then the grid, exact on
 // every sample ("whole") or in a band of 3 voxels, signed by winding numbers.
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <optional>
 
 #include "geods/field/sdf_grid.hpp"
@@ -28,6 +31,15 @@ int main(int argc, char** argv) {
         geods::field::SdfGridOptions options;
         options.band = v.band;
         field = geods::field::sdf_grid(*md, grid, options);
+        if (std::getenv("GEODS_SDF_HASH")) {  // the grid's bits (FNV-1a), to check that a change keeps them
+          std::uint64_t h = 1469598103934665603ull;
+          for (const float d : field.distance.data) {
+            std::uint32_t b;
+            std::memcpy(&b, &d, 4);
+            h = (h ^ b) * 1099511628211ull;
+          }
+          std::fprintf(stderr, "%s grid hash %016llx\n", v.name.c_str(), (unsigned long long)h);
+        }
       },
       [&](std::size_t i, std::size_t j, std::size_t k) { return field.distance(i, j, k); });
 }
