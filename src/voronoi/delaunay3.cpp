@@ -305,6 +305,7 @@ void Delaunay3::build(Options options, bool may_split) {
     canonicalize();
     return;
   }
+  tets_.clear();  // (a parallel build that gave up may have left slots)
   const std::vector<std::uint32_t> order = brio_order(std::span<const Vec3d>(points_), active, options.seed);
 
   // The first tetrahedron: the earliest four affinely independent points in the order.
@@ -647,12 +648,24 @@ void Delaunay3::canonicalize() {
           std::sort(sorted.begin() + std::ptrdiff_t(from), sorted.begin() + std::ptrdiff_t(count[i]),
                     [](const Key& a, const Key& b) { return std::lexicographical_compare(a.v + 1, a.v + 4, b.v + 1, b.v + 4); });
         }
-        for (std::size_t t = 0; t < sorted.size(); ++t) new_of[sorted[t].slot] = std::uint32_t(begin + t);
+        // (random stores: ask for each line some stores ahead, so that the misses overlap)
+        constexpr std::size_t kAhead = 16;
+        for (std::size_t t = 0; t < std::min(kAhead, sorted.size()); ++t) __builtin_prefetch(&new_of[sorted[t].slot], 1);
+        for (std::size_t t = 0; t < sorted.size(); ++t) {
+          if (t + kAhead < sorted.size()) __builtin_prefetch(&new_of[sorted[t + kAhead].slot], 1);
+          new_of[sorted[t].slot] = std::uint32_t(begin + t);
+        }
       },
       1);
   std::vector<std::uint32_t> out(8 * live);
   parallel_for(0, slots, 1 << 14, [&](std::size_t begin, std::size_t end) {
+    // The stores go to random places: each slot's destination line is asked
+    // for (with intent to write) some slots ahead, so that the misses overlap.
+    constexpr std::size_t kAhead = 12;
+    for (std::size_t s = begin; s < std::min(end, begin + kAhead); ++s)
+      if (new_of[s] != kNone) __builtin_prefetch(&out[8 * std::size_t(new_of[s])], 1);
     for (std::size_t s = begin; s < end; ++s) {
+      if (s + kAhead < end && new_of[s + kAhead] != kNone) __builtin_prefetch(&out[8 * std::size_t(new_of[s + kAhead])], 1);
       const std::size_t t = new_of[s];
       if (t == kNone) continue;
       for (int j = 0; j < 4; ++j) {
