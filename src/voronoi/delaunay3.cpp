@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <numeric>
 #include <optional>
 #include <string>
@@ -567,7 +568,9 @@ inline void canonical_positions(const std::uint32_t* v, std::uint8_t position[4]
 void Delaunay3::canonicalize() {
   const std::size_t slots = tets_.size() / 8;
   const std::size_t n = points_.size();
-  std::vector<std::array<std::uint8_t, 4>> place(slots);  // where entry j of slot s goes
+  // Where entry j of slot s goes (set for every live slot; the only ones read).
+  // Here and for the keys: left uninitialized, as every entry read is written first.
+  const std::unique_ptr<std::array<std::uint8_t, 4>[]> place(new std::array<std::uint8_t, 4>[slots]);
   struct Key {  // a slot's canonical vertices
     std::uint32_t v[4];
     std::uint32_t slot;
@@ -611,7 +614,7 @@ void Delaunay3::canonicalize() {
     offset[blocks * parts] = total;
   }
   const std::size_t live = offset[blocks * parts];
-  std::vector<Key> keys(live);
+  const std::unique_ptr<Key[]> keys(new Key[live]);
   parallel_for_each_index(
       0, blocks,
       [&](std::size_t block) {
