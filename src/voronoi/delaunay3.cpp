@@ -662,13 +662,7 @@ void Delaunay3::canonicalize() {
       1);
   std::vector<std::uint32_t> out(8 * live);
   parallel_for(0, slots, 1 << 14, [&](std::size_t begin, std::size_t end) {
-    // The stores go to random places: each slot's destination line is asked
-    // for (with intent to write) some slots ahead, so that the misses overlap.
-    constexpr std::size_t kAhead = 12;
-    for (std::size_t s = begin; s < std::min(end, begin + kAhead); ++s)
-      if (new_of[s] != kNone) __builtin_prefetch(&out[8 * std::size_t(new_of[s])], 1);
     for (std::size_t s = begin; s < end; ++s) {
-      if (s + kAhead < end && new_of[s + kAhead] != kNone) __builtin_prefetch(&out[8 * std::size_t(new_of[s + kAhead])], 1);
       const std::size_t t = new_of[s];
       if (t == kNone) continue;
       for (int j = 0; j < 4; ++j) {
