@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <numeric>
 #include <optional>
 #include <string>
@@ -305,6 +306,7 @@ void Delaunay3::build(Options options, bool may_split) {
     canonicalize();
     return;
   }
+  tets_.clear();  // (a parallel build that gave up may have left slots)
   const std::vector<std::uint32_t> order = brio_order(std::span<const Vec3d>(points_), active, options.seed);
 
   // The first tetrahedron: the earliest four affinely independent points in the order.
@@ -566,7 +568,9 @@ inline void canonical_positions(const std::uint32_t* v, std::uint8_t position[4]
 void Delaunay3::canonicalize() {
   const std::size_t slots = tets_.size() / 8;
   const std::size_t n = points_.size();
-  std::vector<std::array<std::uint8_t, 4>> place(slots);  // where entry j of slot s goes
+  // Where entry j of slot s goes (set for every live slot; the only ones read).
+  // Here and for the keys: left uninitialized, as every entry read is written first.
+  const std::unique_ptr<std::array<std::uint8_t, 4>[]> place(new std::array<std::uint8_t, 4>[slots]);
   struct Key {  // a slot's canonical vertices
     std::uint32_t v[4];
     std::uint32_t slot;
@@ -610,7 +614,7 @@ void Delaunay3::canonicalize() {
     offset[blocks * parts] = total;
   }
   const std::size_t live = offset[blocks * parts];
-  std::vector<Key> keys(live);
+  const std::unique_ptr<Key[]> keys(new Key[live]);
   parallel_for_each_index(
       0, blocks,
       [&](std::size_t block) {
@@ -647,7 +651,13 @@ void Delaunay3::canonicalize() {
           std::sort(sorted.begin() + std::ptrdiff_t(from), sorted.begin() + std::ptrdiff_t(count[i]),
                     [](const Key& a, const Key& b) { return std::lexicographical_compare(a.v + 1, a.v + 4, b.v + 1, b.v + 4); });
         }
-        for (std::size_t t = 0; t < sorted.size(); ++t) new_of[sorted[t].slot] = std::uint32_t(begin + t);
+        // (random stores: ask for each line some stores ahead, so that the misses overlap)
+        constexpr std::size_t kAhead = 16;
+        for (std::size_t t = 0; t < std::min(kAhead, sorted.size()); ++t) __builtin_prefetch(&new_of[sorted[t].slot], 1);
+        for (std::size_t t = 0; t < sorted.size(); ++t) {
+          if (t + kAhead < sorted.size()) __builtin_prefetch(&new_of[sorted[t + kAhead].slot], 1);
+          new_of[sorted[t].slot] = std::uint32_t(begin + t);
+        }
       },
       1);
   std::vector<std::uint32_t> out(8 * live);

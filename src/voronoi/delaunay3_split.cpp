@@ -81,19 +81,6 @@ bool Delaunay3::build_split(const std::vector<std::uint32_t>& active) {
   std::array<std::vector<std::uint32_t>, 2> global;  // per half, its points' indices here
   for (const std::uint32_t i : active) global[points_[i][0] < split ? 0 : 1].push_back(i);
   if (global[0].size() < 8 || global[1].size() < 8) return false;
-  std::array<Delaunay3, 2> half;
-  parallel_for_each_index(
-      0, 2,
-      [&](std::size_t h) {
-        half[h].options_ = options_;
-        half[h].points_.resize(global[h].size());
-        for (std::size_t k = 0; k < global[h].size(); ++k) half[h].points_[k] = points_[global[h][k]];
-        half[h].build(options_, false);
-        half[h].index_vertices();  // for nearest_vertex
-      },
-      1);
-  if (half[0].dimension_ < 3 || half[1].dimension_ < 3) return false;
-
   const double tolerance = 1e-9 * scale;
   // A finite slot's circumsphere: its centre and a radius that covers the
   // rounding; none for slivers, whose centres' rounding the margins do not
@@ -107,7 +94,8 @@ bool Delaunay3::build_split(const std::vector<std::uint32_t>& active) {
     const Vec3d* C = d.points_.data();
     const Vec3d ab = C[v[1]] - C[v[0]], ac = C[v[2]] - C[v[0]], ad = C[v[3]] - C[v[0]];
     const double det = 2 * ab.dot(ac.cross(ad));
-    const double edge = std::max({ab.norm(), ac.norm(), ad.norm()});
+    // (one square root: sqrt is monotone and correctly rounded, so this is the largest edge's norm exactly)
+    const double edge = std::sqrt(std::max({ab.squaredNorm(), ac.squaredNorm(), ad.squaredNorm()}));
     if (!(std::abs(det) >= 2e-6 * edge * edge * edge)) return {};
     const Vec3d offset =
         (ab.squaredNorm() * ac.cross(ad) + ac.squaredNorm() * ad.cross(ab) + ad.squaredNorm() * ab.cross(ac)) / det;
@@ -115,58 +103,81 @@ bool Delaunay3::build_split(const std::vector<std::uint32_t>& active) {
     if (!std::isfinite(radius)) return {};
     return Sphere{C[v[0]] + offset, radius * (1 + 1e-6) + tolerance};
   };
-  // Per half, its hull's vertex adjacency (for the extreme points the other half's hull faces ask for).
-  std::array<std::vector<std::vector<std::uint32_t>>, 2> hull_adjacent;
-  std::array<std::uint32_t, 2> hull_start{};
-  for (int h = 0; h < 2; ++h) {
-    hull_adjacent[h].resize(half[h].points_.size());
-    for (const auto& t : half[h].hull())
-      for (int k = 0; k < 3; ++k) {
-        hull_adjacent[h][t[k]].push_back(t[(k + 1) % 3]);
-        hull_start[h] = t[0];
-      }
-  }
   // state[h][s] of slot s of half h: kept (certainly a (ghost) tetrahedron of
-  // the whole set), to the seam, or pending (its sphere crosses the split).
-  constexpr std::uint8_t seam_slot = 0, kept = 1, pending = 2;
+  // the whole set), to the seam, or pending (its sphere crosses the split);
+  // hull_face until both halves are built (it needs the other half's hull).
+  constexpr std::uint8_t seam_slot = 0, kept = 1, pending = 2, hull_face = 3;
   const double far = 16 * extent / std::cbrt(double(active.size()));  // 16 mean spacings
   std::array<std::vector<std::uint8_t>, 2> valid;
   std::array<std::atomic<double>, 2> beyond{};  // per half: how far its pending spheres reach past the split
+  // Per half, its hull's vertex adjacency (for the extreme points the other half's hull faces ask for).
+  std::array<std::vector<std::vector<std::uint32_t>>, 2> hull_adjacent;
+  std::array<std::uint32_t, 2> hull_start{};
+  // Each half, once built, indexes its hull and classifies its finite slots
+  // (which need nothing of the other half) at once: the half built first
+  // does not wait for the other, and its thread helps with the other's pass.
+  std::array<Delaunay3, 2> half;
+  for (int h = 0; h < 2; ++h) hull_adjacent[h].resize(global[h].size());  // (allocated here, by the calling thread)
+  parallel_for_each_index(
+      0, 2,
+      [&](std::size_t h) {
+        Delaunay3& self = half[h];
+        self.options_ = options_;
+        self.points_.resize(global[h].size());
+        for (std::size_t k = 0; k < global[h].size(); ++k) self.points_[k] = points_[global[h][k]];
+        self.build(options_, false);
+        if (self.dimension_ < 3) return;
+        for (const auto& t : self.hull())
+          for (int k = 0; k < 3; ++k) {
+            hull_adjacent[h][t[k]].push_back(t[(k + 1) % 3]);
+            hull_start[h] = t[0];
+          }
+        const std::size_t slots = self.tets_.size() / 8;
+        valid[h].assign(slots, seam_slot);
+        parallel_for(0, slots, 1 << 12, [&](std::size_t begin, std::size_t end) {
+          double deepest = 0;
+          for (std::size_t s = begin; s < end; ++s) {
+            const std::uint32_t* v = &self.tets_[8 * s];
+            if (v[0] == kNone) continue;
+            if (std::find(v, v + 4, kGhost) != v + 4) {
+              valid[h][s] = hull_face;
+              continue;
+            }
+            const auto b = sphere(self, v);
+            if (!b) continue;
+            const double past = h == 0 ? b->centre[0] + b->reach - split : split - (b->centre[0] - b->reach);
+            if (past < 0) {
+              valid[h][s] = kept;  // the sphere does not reach the other half's side
+            } else if (past <= far) {  // (larger spheres, flat ones by the hull, go to the seam: the slab stays thin)
+              valid[h][s] = pending;
+              deepest = std::max(deepest, past);
+            }
+          }
+          for (double seen = beyond[h].load(); deepest > seen && !beyond[h].compare_exchange_weak(seen, deepest);) {
+          }
+        });
+      },
+      1);
+  if (half[0].dimension_ < 3 || half[1].dimension_ < 3) return false;
+  // The hull faces: kept if the other half lies strictly inside the face's plane, by a margin.
   for (int h = 0; h < 2; ++h) {
     const Delaunay3& self = half[h];
     const Delaunay3& other = half[1 - h];
-    const std::size_t slots = self.tets_.size() / 8;
-    valid[h].assign(slots, seam_slot);
     const Vec3d* C = self.points_.data();
-    parallel_for(0, slots, 1 << 12, [&](std::size_t begin, std::size_t end) {
+    parallel_for(0, valid[h].size(), 1 << 12, [&](std::size_t begin, std::size_t end) {
       std::uint32_t climb = hull_start[1 - h];
-      double deepest = 0;
       for (std::size_t s = begin; s < end; ++s) {
+        if (valid[h][s] != hull_face) continue;
+        valid[h][s] = seam_slot;
         const std::uint32_t* v = &self.tets_[8 * s];
-        if (v[0] == kNone) continue;
         const int g = int(std::find(v, v + 4, kGhost) - v);
-        if (g < 4) {
-          // A hull face: kept if the other half lies strictly inside its plane, by a margin.
-          const std::array<int, 3> f = Tet3Mesh::face_towards(g);
-          const Vec3d &a = C[v[f[0]]], &b = C[v[f[1]]], &c = C[v[f[2]]];
-          const Vec3d normal = (b - a).cross(c - a);  // outwards: the face is counter-clockwise seen from the ghost's side
-          const double length = normal.norm();
-          if (!(length > 0)) continue;
-          climb = extreme_vertex(hull_adjacent[1 - h], other.points_, normal, climb);
-          valid[h][s] = normal.dot(other.points_[climb] - a) / length < -tolerance ? kept : seam_slot;
-          continue;
-        }
-        const auto b = sphere(self, v);
-        if (!b) continue;
-        const double past = h == 0 ? b->centre[0] + b->reach - split : split - (b->centre[0] - b->reach);
-        if (past < 0) {
-          valid[h][s] = kept;  // the sphere does not reach the other half's side
-        } else if (past <= far) {  // (larger spheres, flat ones by the hull, go to the seam: the slab stays thin)
-          valid[h][s] = pending;
-          deepest = std::max(deepest, past);
-        }
-      }
-      for (double seen = beyond[h].load(); deepest > seen && !beyond[h].compare_exchange_weak(seen, deepest);) {
+        const std::array<int, 3> f = Tet3Mesh::face_towards(g);
+        const Vec3d &a = C[v[f[0]]], &b = C[v[f[1]]], &c = C[v[f[2]]];
+        const Vec3d normal = (b - a).cross(c - a);  // outwards: the face is counter-clockwise seen from the ghost's side
+        const double length = normal.norm();
+        if (!(length > 0)) continue;
+        climb = extreme_vertex(hull_adjacent[1 - h], other.points_, normal, climb);
+        valid[h][s] = normal.dot(other.points_[climb] - a) / length < -tolerance ? kept : seam_slot;
       }
     });
   }
@@ -259,10 +270,14 @@ bool Delaunay3::build_split(const std::vector<std::uint32_t>& active) {
   parallel_for_each_index(
       0, 2,
       [&](std::size_t task) {
-        if (task == 0)
+        if (task == 0) {
           filler.build(options_, false);
-        else
+          // The assembled slots' array, zeroed here (the other task is the longer):
+          // at most every slot of both halves and of the filler.
+          tets_.assign(8 * (half[0].tets_.size() / 8 + half[1].tets_.size() / 8 + filler.tets_.size() / 8), 0);
+        } else {
           number_kept();
+        }
       },
       1);
   if (filler.dimension_ < 3) return false;
@@ -272,7 +287,7 @@ bool Delaunay3::build_split(const std::vector<std::uint32_t>& active) {
   for (const std::uint32_t s : seam_fill.fill) seam_fill.slot[s] = next++;
 
   // Assemble: kept slots with their adjacencies renumbered (towards the seam: the fill's), then the fill.
-  tets_.assign(8 * std::size_t(next), 0);
+  tets_.resize(8 * std::size_t(next));  // (a shrink: zeroed above)
   for (int h = 0; h < 2; ++h)
     parallel_for(0, valid[h].size(), 1 << 14, [&](std::size_t begin, std::size_t end) {
       for (std::size_t s = begin; s < end; ++s) {
