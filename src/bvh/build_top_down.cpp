@@ -414,7 +414,7 @@ class TopDown {
 
   const BuildOptions& options_;
   // The primitives move with the partitions, so every scan reads them in order.
-  std::vector<PrimRef> refs_;
+  std::vector<PrimRef, HugePageAllocator<PrimRef>> refs_;
   BinaryTree tree_;
   std::atomic<std::uint32_t> next_{0};
 };
