@@ -145,23 +145,30 @@ class TopDown {
     std::uint32_t mid = begin;
     bool leaf = options_.builder != Builder::sah && count <= std::uint32_t(options_.leaf_size);
     if (leaf) return make_leaf(id, begin, end);
+    // The SAH split computes the bounds of both sides while it partitions.
+    RangeBounds side[2];
+    bool have_sides = false;
     switch (options_.builder) {
-      case Builder::sah: mid = split_sah(begin, end, rb, leaf); break;
+      case Builder::sah: mid = split_sah(begin, end, rb, leaf, side, have_sides); break;
       case Builder::pca: mid = split_pca(begin, end); break;
       case Builder::boxtree: mid = depth < 48 ? split_boxtree(begin, end, rb.box) : begin; break;
       default: break;
     }
     if (leaf) return make_leaf(id, begin, end);
-    if (mid <= begin || mid >= end) mid = split_median(begin, end, rb.centroid);
+    if (mid <= begin || mid >= end) {
+      mid = split_median(begin, end, rb.centroid);
+      have_sides = false;
+    }
     std::uint32_t left = 0, right = 0;
     if (count >= kParallelThreshold && num_threads() > 1) {
-      RangeBounds lb, rbb;
-      tbb::parallel_invoke([&] { lb = bounds(begin, mid); }, [&] { rbb = bounds(mid, end); });
-      tbb::parallel_invoke([&] { left = build(begin, mid, lb, depth + 1); },
-                           [&] { right = build(mid, end, rbb, depth + 1); });
+      if (!have_sides)
+        tbb::parallel_invoke([&] { side[0] = bounds(begin, mid); }, [&] { side[1] = bounds(mid, end); });
+      tbb::parallel_invoke([&] { left = build(begin, mid, side[0], depth + 1); },
+                           [&] { right = build(mid, end, side[1], depth + 1); });
     } else {
-      left = build(begin, mid, bounds(begin, mid), depth + 1);
-      right = build(mid, end, bounds(mid, end), depth + 1);
+      if (!have_sides) side[0] = bounds(begin, mid), side[1] = bounds(mid, end);
+      left = build(begin, mid, side[0], depth + 1);
+      right = build(mid, end, side[1], depth + 1);
     }
     tree_.nodes[id].left = left;
     tree_.nodes[id].right = right;
@@ -182,7 +189,8 @@ class TopDown {
 
   // Binned SAH: bins on all three axes, the sweep of §4.1.4 over bin
   // boundaries, cost (7) with unit traversal and intersection costs.
-  std::uint32_t split_sah(std::uint32_t begin, std::uint32_t end, const RangeBounds& rb, bool& leaf) {
+  std::uint32_t split_sah(std::uint32_t begin, std::uint32_t end, const RangeBounds& rb, bool& leaf,
+                          RangeBounds side[2], bool& have_sides) {
     const std::uint32_t count = end - begin;
     // Fewer bins than primitives would leave most of them empty.
     const int nbins = std::clamp<int>(int(count), 2, std::min<int>(options_.sah_bins, kMaxBins));
@@ -260,10 +268,52 @@ class TopDown {
       return begin;
     }
     if (best_axis < 0) return begin;  // all centroids equal: median split by id
-    auto* p = refs_.data();
-    return std::uint32_t(std::partition(p + begin, p + end, [&](const PrimRef& r) {
-                           return bins_of(r)[best_axis] <= best_bin;
-                         }) - p);
+    // std::partition's algorithm (libstdc++'s bidirectional one: the same
+    // order, so the same tree as before), with the boxes and centroid boxes of
+    // both sides gathered on the way instead of in two more passes.
+    const float inf = std::numeric_limits<float>::infinity();
+    Float4 lo[2], hi[2], clo[2], chi[2];
+    for (int s = 0; s < 2; ++s) {
+      lo[s] = clo[s] = Float4{inf, inf, inf, inf};
+      hi[s] = chi[s] = -lo[s];
+    }
+    auto add = [&](int s, const PrimRef& r) {
+      lo[s] = min4(lo[s], load4(r.box.lo.data()));
+      hi[s] = max4(hi[s], load4(r.box.hi.data()));
+      const Float4 c = load4(r.center.data());
+      clo[s] = min4(clo[s], c);
+      chi[s] = max4(chi[s], c);
+    };
+    auto is_left = [&](const PrimRef& r) { return bins_of(r)[best_axis] <= best_bin; };
+    PrimRef* front = refs_.data() + begin;
+    PrimRef* back = refs_.data() + end;
+    for (;;) {
+      for (;;) {
+        if (front == back) goto done;
+        if (!is_left(*front)) break;
+        add(0, *front);
+        ++front;
+      }
+      add(1, *front);  // goes right: stays at the split or is swapped to back
+      --back;
+      for (;;) {
+        if (front == back) goto done;
+        if (is_left(*back)) break;
+        add(1, *back);
+        --back;
+      }
+      add(0, *back);
+      std::iter_swap(front, back);
+      ++front;
+    }
+  done:
+    for (int s = 0; s < 2; ++s)
+      for (int a = 0; a < 3; ++a) {
+        side[s].box.lo[a] = lo[s][a], side[s].box.hi[a] = hi[s][a];
+        side[s].centroid.lo[a] = clo[s][a], side[s].centroid.hi[a] = chi[s][a];
+      }
+    have_sides = true;
+    return std::uint32_t(front - refs_.data());
   }
 
   // Plane through the barycenter of the centroids, orthogonal to their
@@ -364,7 +414,7 @@ class TopDown {
 
   const BuildOptions& options_;
   // The primitives move with the partitions, so every scan reads them in order.
-  std::vector<PrimRef> refs_;
+  std::vector<PrimRef, HugePageAllocator<PrimRef>> refs_;
   BinaryTree tree_;
   std::atomic<std::uint32_t> next_{0};
 };
