@@ -126,11 +126,22 @@ bool Accelerator::occluded(const Ray3f& ray, RayCache& cache) const {
   return true;
 }
 
-bvh::HitPacket Accelerator::intersect(const bvh::RayPacket& packet, RayCache& cache) const {
+namespace {
+
+// The packet with only its active rays that can hit anything (Accelerator::shootable).
+template <typename Shootable>
+bvh::RayPacket shootable_lanes(const bvh::RayPacket& packet, Shootable&& shootable) {
   bvh::RayPacket shot = packet;
   shot.active &= (1u << bvh::kPacketSize) - 1;
   for (int i = 0; i < bvh::kPacketSize; ++i)
     if (!shootable(packet.rays[i])) shot.active &= ~(1u << i);
+  return shot;
+}
+
+}  // namespace
+
+bvh::HitPacket Accelerator::intersect(const bvh::RayPacket& packet, RayCache& cache) const {
+  const bvh::RayPacket shot = shootable_lanes(packet, shootable);
   if (shot.active == 0 || corners_.empty()) return {};
   if (cache.owner != id_) cache = RayCache{id_};
   bvh::HitPacket out = closest_hits(shot, cache);
@@ -140,10 +151,7 @@ bvh::HitPacket Accelerator::intersect(const bvh::RayPacket& packet, RayCache& ca
 }
 
 std::uint32_t Accelerator::occluded(const bvh::RayPacket& packet, RayCache& cache) const {
-  bvh::RayPacket shot = packet;
-  shot.active &= (1u << bvh::kPacketSize) - 1;
-  for (int i = 0; i < bvh::kPacketSize; ++i)
-    if (!shootable(packet.rays[i])) shot.active &= ~(1u << i);
+  const bvh::RayPacket shot = shootable_lanes(packet, shootable);
   if (shot.active == 0 || corners_.empty()) return 0;
   if (cache.owner != id_) cache = RayCache{id_};
   return any_hits(shot, cache) & shot.active;

@@ -175,16 +175,8 @@ TEST(RayPacket, DegenerateSoupsAndDegenerateRays) {
 TEST(RayPacket, TiesAtSharedEdgesKeepTheSingleRayTriangle) {
   // A flat grid hit exactly through its vertices and edges: several triangles
   // at the same t, where the single ray's visiting order picks one.
-  TriMesh grid;
   const int n = 12;
-  for (int y = 0; y <= n; ++y)
-    for (int x = 0; x <= n; ++x) grid.vertices.push_back({float(x), float(y), 0.0f});
-  for (int y = 0; y < n; ++y)
-    for (int x = 0; x < n; ++x) {
-      const std::uint32_t a = y * (n + 1) + x, b = a + 1, c = a + n + 1, d = c + 1;
-      grid.triangles.push_back({a, b, d});
-      grid.triangles.push_back({a, d, c});
-    }
+  const TriMesh grid = test::flat_grid(n);
   std::vector<Ray3f> rays;
   for (int y = 0; y <= 2 * n; ++y)
     for (int x = 0; x <= 2 * n; ++x) {
