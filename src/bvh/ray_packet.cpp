@@ -146,22 +146,6 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
     same_sign[a] = negatives == 0 || negatives == __builtin_popcount(active);
   }
   for (std::uint32_t b = active; b != 0; b &= b - 1) tmin_lo = std::min(tmin_lo, tmin[__builtin_ctz(b)]);
-  // The per-lane setup of the scalar watertight test, and whether every lane
-  // shears along the same axes (then leaves test one triangle against all lanes).
-  alignas(64) unsigned char scalar_storage[P][sizeof(RayTriangleTest<float>)];
-  RayTriangleTest<float>* scalar = reinterpret_cast<RayTriangleTest<float>*>(scalar_storage);
-  const int first_lane = __builtin_ctz(active);
-  bool same_axes = true;
-  vf sh_x, sh_y, sh_z;
-  for (int i = 0; i < P; ++i) {
-    const int lane = (active >> i & 1) ? i : first_lane;
-    new (&scalar[i]) RayTriangleTest<float>(packet.rays[lane]);
-    sh_x[i] = scalar[i].shear_x(), sh_y[i] = scalar[i].shear_y(), sh_z[i] = scalar[i].shear_z();
-  }
-  const int kx = scalar[first_lane].axis_x(), ky = scalar[first_lane].axis_y(), kz = scalar[first_lane].axis_z();
-  for (int i = 0; i < P; ++i)
-    same_axes &= scalar[i].axis_x() == kx && scalar[i].axis_y() == ky && scalar[i].axis_z() == kz;
-  const vf ox = org[kx], oy = org[ky], oz = org[kz];
   TraversalStack<PacketEntry> stack(traversal_stack_size(depth, W));
   const float widen = 1.0f + 4e-7f;
   // The lanes of entry e that may still hit something in it: its box was
@@ -258,74 +242,7 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
     }
     return r;
   };
-  // A hit of lane i at t (tmax[i] or before): the closest so far; a second
-  // triangle at the same t makes the lane ambiguous (shot again alone).
-  auto record = [&](int i, float t, std::uint32_t prim, float u, float v) GEODS_BVH_INLINE_LAMBDA {
-    RayHit& hit = out.hits[i];
-    if (hit.hit()) {
-      if (t < hit.t) {
-        ambiguous &= ~(1u << i);
-      } else if (hit.prim != prim) {
-        ambiguous |= 1u << i;
-      }
-    }
-    tmax[i] = t;
-    hit = {t, prim, u, v};
-    if (any) done |= 1u << i;
-  };
-  // Coherent packets (every lane sheared along the same axes): one triangle
-  // against all lanes at once, each lane doing the scalar test's operations.
-  auto leaf_rays = [&](const PacketEntry& e) GEODS_BVH_INLINE_LAMBDA {
-    std::uint32_t lanes = live(e);
-    const vf tmin_vec = tmin_v;
-    for (std::uint32_t g = e.child; g < e.child + e.count && lanes != 0; ++g) {
-      const TriangleGroup& group = groups[g];
-      for (int k = 0; k < 4 && lanes != 0; ++k) {
-        if (k > 0 && group.index[k] == group.index[k - 1]) break;  // unused lanes repeat the last triangle
-        vf px[3], py[3], pz[3];
-        for (int c = 0; c < 3; ++c) {
-          pz[c] = splat(group.corner[c][kz][k]) - oz;
-          px[c] = (splat(group.corner[c][kx][k]) - ox) - sh_x * pz[c];
-          py[c] = (splat(group.corner[c][ky][k]) - oy) - sh_y * pz[c];
-        }
-        const vf eu = px[2] * py[1] - py[2] * px[1];
-        const vf ev = px[0] * py[2] - py[0] * px[2];
-        const vf ew = px[1] * py[0] - py[1] * px[0];
-        const vf zero = splat(0.0f);
-        const vi on_edge = (eu == zero) | (ev == zero) | (ew == zero);
-        const vi mixed = ((eu < zero) | (ev < zero) | (ew < zero)) & ((eu > zero) | (ev > zero) | (ew > zero));
-        const vf det = eu + ev + ew;
-        const vi inside = ~mixed & ~on_edge & (det != zero) & (det - det == zero);
-        const std::uint32_t edge = lane_bits(on_edge) & lanes;
-        if ((lane_bits(inside) & lanes) == 0 && edge == 0) continue;
-        const vf scaled_t = eu * (sh_z * pz[0]) + ev * (sh_z * pz[1]) + ew * (sh_z * pz[2]);
-        const vf inv_det = splat(1.0f) / det;
-        vf t = scaled_t * inv_det, u = ev * inv_det, v = ew * inv_det;
-        vf tm;
-        std::memcpy(&tm, tmax, sizeof tm);
-        std::uint32_t hits = lane_bits(inside & (t >= tmin_vec) & (t <= tm)) & lanes;
-        for (std::uint32_t b = edge; b != 0; b &= b - 1) {  // the scalar test's double-precision path
-          const int i = __builtin_ctz(b);
-          const Vec3f a(group.corner[0][0][k], group.corner[0][1][k], group.corner[0][2][k]);
-          const Vec3f bb(group.corner[1][0][k], group.corner[1][1][k], group.corner[1][2][k]);
-          const Vec3f cc(group.corner[2][0][k], group.corner[2][1][k], group.corner[2][2][k]);
-          float ht, hu, hv;
-          if (scalar[i].intersect(a, bb, cc, tmin[i], tmax[i], ht, hu, hv)) {
-            t[i] = ht, u[i] = hu, v[i] = hv;
-            hits |= 1u << i;
-          }
-        }
-        for (std::uint32_t b = hits; b != 0; b &= b - 1) {
-          const int i = __builtin_ctz(b);
-          record(i, t[i], group.index[k], u[i], v[i]);
-        }
-        lanes &= ~done;
-      }
-    }
-    return (active & ~done) != 0;
-  };
   auto leaf = [&](const PacketEntry& e) GEODS_BVH_INLINE_LAMBDA {
-    if (same_axes) return leaf_rays(e);
     std::uint32_t lanes = live(e);
     for (std::uint32_t g = e.child; g < e.child + e.count && lanes != 0; ++g) {
       const TriangleGroup& group = groups[g];
