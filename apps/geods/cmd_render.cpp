@@ -7,6 +7,7 @@
 
 #include "command.hpp"
 #include "geods/core/error.hpp"
+#include "geods/core/simd_level.hpp"
 #include "geods/io/image_io.hpp"
 #include "geods/io/mesh_io.hpp"
 #include "geods/ray/render.hpp"
@@ -54,6 +55,8 @@ class RenderCommand : public Command {
     app.add_option("--height", height_, "Image height in pixels")->default_val(height_);
     app.add_option("--camera", camera_, "ex,ey,ez,tx,ty,tz,ux,uy,uz,fov (default: a three-quarter view of the mesh)");
     app.add_flag("--shadows", shadows_, "Hard shadows (any-hit rays towards the light)");
+    app.add_flag("--packets,!--no-packets", packets_,
+                 "Shoot primary and shadow rays in packets of 4 x 2 pixels (default; the same picture)");
   }
 
   void run(const RunContext& context, Report& report) override {
@@ -62,6 +65,7 @@ class RenderCommand : public Command {
     options.width = width_;
     options.height = height_;
     options.shadows = shadows_;
+    options.packets = packets_;
     if (!camera_.empty()) options.camera = parse_camera(camera_);
     options.progress = context.progress;
     const TriMesh mesh = io::read_mesh(mesh_);
@@ -91,6 +95,8 @@ class RenderCommand : public Command {
     j["width"] = width_;
     j["height"] = height_;
     j["shadows"] = shadows_;
+    j["packets"] = packets_;
+    j["simd_level"] = simd_level_name(simd_level());
     j["rays"] = result.rays;
     j["primary_hits"] = result.hits;
     j["occluder_cache_hits"] = result.occluder_hits;
@@ -116,6 +122,7 @@ class RenderCommand : public Command {
   CLI::Option* accel_option_ = nullptr;
   int width_ = 512, height_ = 512;
   bool shadows_ = false;
+  bool packets_ = true;
 };
 
 const bool registered = register_command<RenderCommand>();

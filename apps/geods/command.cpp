@@ -1,5 +1,6 @@
 #include "command.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cstdio>
 #include <cstdlib>
@@ -10,6 +11,7 @@
 
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"
+#include "geods/core/simd_level.hpp"
 #include "progress_bar.hpp"
 
 namespace geods::cli {
@@ -109,6 +111,10 @@ int run_cli(int argc, char** argv) {
     sub->add_flag("--json", context.json, "Print one JSON object instead of the summary");
     sub->add_option("--threads", context.threads, "Worker threads (default: all cores; 1: single-threaded)")
         ->check(at_least(0));
+    sub->add_option("--simd", context.simd,
+                    "Cap the SIMD level of the kernels: portable, avx, avx2 or avx512 (default: the best the CPU "
+                    "runs, capped by GEODS_SIMD); every level gives the same results")
+        ->check(CLI::IsMember({"portable", "avx", "avx2", "avx512"}));
     command->add_options(*sub);
     entries.push_back({command.get(), sub});
   }
@@ -135,6 +141,8 @@ int run_cli(int argc, char** argv) {
     Report report;
     int status = 0;
     try {
+      // A cap, like GEODS_SIMD: a level above the CPU's best runs the best.
+      if (!context.simd.empty()) set_simd_level(std::min(parse_simd_level(context.simd), best_simd_level()));
       entry.command->run(context, report);
       status = report.json.value("failed_steps", 0) > 0 ? 1 : 0;
     } catch (const Error& e) {

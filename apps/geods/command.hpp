@@ -26,6 +26,7 @@ struct Report {
 struct RunContext {
   bool json = false;
   int threads = 0;            // 0: all cores
+  std::string simd;           // --simd: cap of simd_level() (core/simd_level.hpp); empty: unchanged
   ProgressCallback progress;  // a progress bar on a terminal, else empty
 };
 

@@ -144,12 +144,18 @@ class Bvh:
     def intersect(self, origins: ArrayLike, directions: ArrayLike, tmax: ArrayLike = ...) -> tuple[Any, ...]:
         """Closest hits of rays origins, directions float32 (n, 3): (t float32 (n,), prim int64 (n,), u, v float32 (n,)); t = inf and prim = -1 on a miss. Rays in parallel.
         """
+    def intersect_packets(self, origins: ArrayLike, directions: ArrayLike, tmax: ArrayLike = ...) -> tuple[Any, ...]:
+        """intersect() with the rays in packets of 8 consecutive rays traversed together (give coherent rays, e.g. the pixels of 4 x 2 tiles, next to each other): the same hits, bit for bit. origins, directions float32 (n, 3) -> (t float32 (n,), prim int64 (n,), u, v float32 (n,)).
+        """
     @staticmethod
     def load(path: str | os.PathLike[str]) -> TriangleBvh:
         """Maps a file written by save() (read in place; the mesh is not needed).
         """
     def occluded(self, origins: ArrayLike, directions: ArrayLike, tmax: ArrayLike = ...) -> NDArray[numpy.bool_]:
         """Whether each ray (origins, directions float32 (n, 3)) hits anything with t in [0, tmax]: bool (n,).
+        """
+    def occluded_packets(self, origins: ArrayLike, directions: ArrayLike, tmax: ArrayLike = ...) -> NDArray[numpy.bool_]:
+        """occluded() with the rays in packets of 8 consecutive rays: origins, directions float32 (n, 3) -> bool (n,).
         """
     def save(self, path: str | os.PathLike[str]) -> None:
         """Writes the hierarchy with its triangles to a binary file.
@@ -979,12 +985,18 @@ class TriangleBvh:
     def intersect(self, origins: ArrayLike, directions: ArrayLike, tmax: ArrayLike = ...) -> tuple[Any, ...]:
         """Closest hits of rays origins, directions float32 (n, 3): (t float32 (n,), prim int64 (n,), u, v float32 (n,)); t = inf and prim = -1 on a miss. Rays in parallel.
         """
+    def intersect_packets(self, origins: ArrayLike, directions: ArrayLike, tmax: ArrayLike = ...) -> tuple[Any, ...]:
+        """intersect() with the rays in packets of 8 consecutive rays traversed together (give coherent rays, e.g. the pixels of 4 x 2 tiles, next to each other): the same hits, bit for bit. origins, directions float32 (n, 3) -> (t float32 (n,), prim int64 (n,), u, v float32 (n,)).
+        """
     @staticmethod
     def load(path: str | os.PathLike[str]) -> TriangleBvh:
         """Maps a file written by save() (read in place; the mesh is not needed).
         """
     def occluded(self, origins: ArrayLike, directions: ArrayLike, tmax: ArrayLike = ...) -> NDArray[numpy.bool_]:
         """Whether each ray (origins, directions float32 (n, 3)) hits anything with t in [0, tmax]: bool (n,).
+        """
+    def occluded_packets(self, origins: ArrayLike, directions: ArrayLike, tmax: ArrayLike = ...) -> NDArray[numpy.bool_]:
+        """occluded() with the rays in packets of 8 consecutive rays: origins, directions float32 (n, 3) -> bool (n,).
         """
     def save(self, path: str | os.PathLike[str]) -> None:
         """Writes the hierarchy with its triangles to a binary file.
@@ -1065,6 +1077,10 @@ class WalkLocator:
 
 def all_nearest_neighbors(points: Any) -> NDArray[numpy.int64]:
     """For each of (n, 2) or (n, 3) points the index of its nearest other point: int64 (n,).
+    """
+
+def best_simd_level() -> str:
+    """The highest SIMD level this CPU (and the build) runs: 'portable', 'avx', 'avx2' or 'avx512'.
     """
 
 def blend(a: Any, b: Any, radius: float, op: str = ...) -> NDArray[numpy.float32]:
@@ -1332,8 +1348,8 @@ def read_volume(path: str | os.PathLike[str], with_meta: bool = ...) -> Any:
     (x, y, z) tuples.
     """
 
-def render(V: ArrayLike, F: ArrayLike, width: int = ..., height: int = ..., camera: Sequence[float] | None = ..., accel: str = ..., shadows: bool = ...) -> NDArray[numpy.uint8]:
-    """Ray-traces the mesh (Lambert shading, optional hard shadows) into an (height, width, 3) uint8 image. camera: (ex, ey, ez, tx, ty, tz, ux, uy, uz[, fov]); default a three-quarter view.
+def render(V: ArrayLike, F: ArrayLike, width: int = ..., height: int = ..., camera: Sequence[float] | None = ..., accel: str = ..., shadows: bool = ..., packets: bool = ...) -> NDArray[numpy.uint8]:
+    """Ray-traces the mesh (Lambert shading, optional hard shadows) into an (height, width, 3) uint8 image. camera: (ex, ey, ez, tx, ty, tz, ux, uy, uz[, fov]); default a three-quarter view. packets: rays in packets of 4 x 2 pixels (the same image as packets=False, one ray at a time).
     """
 
 def sdf_grid(V: ArrayLike, F: ArrayLike, res: Any = ..., spacing: Any = ..., padding: float = ..., band: Any = ..., sign: str = ..., origin: Any = ..., dims: Any = ..., return_faces: bool = ..., method: str = ...) -> tuple[Any, ...]:
@@ -1351,6 +1367,10 @@ def set_num_threads(n: int) -> None:
     """Limits the worker threads of every later parallel call; n <= 0 restores all cores.
     """
 
+def set_simd_level(level: str) -> None:
+    """Sets the SIMD level of later kernel calls (every thread): 'portable', 'avx', 'avx2' or 'avx512'. Raises ValueError for an unknown name or a level the CPU does not run. Every level gives the same results.
+    """
+
 def shape_distribution(V: ArrayLike, F: ArrayLike, kind: str = ..., samples: int = ..., bins: int = ..., seed: int = ..., normalization: str = ..., max_value: float = ...) -> NDArray[numpy.float32]:
     """The shape distribution of a mesh (seed §5.6, Osada et al.): `samples` evaluations of the shape function `kind` (d1, d2, a3, d3, d4) on uniform random surface points, binned into a float32 histogram of `bins` values summing to 1. normalization: 'mean' or 'median' divides lengths by that statistic (range [0, 3) or [0, 4), or max_value), 'none' bins raw values over [0, max_value). Deterministic per seed.
     """
@@ -1361,6 +1381,10 @@ def signed_distance(V: ArrayLike, F: ArrayLike, points: Any, sign: str = ..., re
     the feature of the face holding the closest point (int8: 0 vertex, 1 edge, 2 face).
     sign: 'winding' (generalized winding number > 1/2: any mesh, open ones too), 'pseudonormal'
     (angle-weighted pseudonormals: closed meshes) or 'none'. Parallel over the points.
+    """
+
+def simd_level() -> str:
+    """The SIMD level of the multi-versioned kernels (the BVH's ray and packet traversals, terrain's error rows): 'portable', 'avx', 'avx2' or 'avx512'; the best the CPU runs, capped by the environment variable GEODS_SIMD.
     """
 
 def smallest_color_spanning_circle(points: Any, colors: Any) -> tuple[Any, ...]:

@@ -17,6 +17,7 @@
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"
 #include "geods/core/predicates.hpp"
+#include "geods/core/simd_level.hpp"
 
 namespace py = pybind11;
 
@@ -179,6 +180,14 @@ for NaN or infinite coordinates.)doc");
   m.def("set_num_threads", &set_num_threads, py::arg("n"),
         "Limits the worker threads of every later parallel call; n <= 0 restores all cores.");
   m.def("num_threads", &num_threads, "The current limit on worker threads (all cores unless set_num_threads was called).");
+  m.def("simd_level", [] { return simd_level_name(simd_level()); },
+        "The SIMD level of the multi-versioned kernels (the BVH's ray and packet traversals, terrain's error rows): "
+        "'portable', 'avx', 'avx2' or 'avx512'; the best the CPU runs, capped by the environment variable GEODS_SIMD.");
+  m.def("best_simd_level", [] { return simd_level_name(best_simd_level()); },
+        "The highest SIMD level this CPU (and the build) runs: 'portable', 'avx', 'avx2' or 'avx512'.");
+  m.def("set_simd_level", [](const std::string& level) { set_simd_level(parse_simd_level(level)); }, py::arg("level"),
+        "Sets the SIMD level of later kernel calls (every thread): 'portable', 'avx', 'avx2' or 'avx512'. "
+        "Raises ValueError for an unknown name or a level the CPU does not run. Every level gives the same results.");
 }
 
 }  // namespace geods::python

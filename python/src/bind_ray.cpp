@@ -93,12 +93,13 @@ ray::Camera camera_from_sequence(const std::vector<float>& values) {
 
 py::array_t<std::uint8_t> render_py(const Rows<float>& v, const Rows<std::int64_t>& f, int width, int height,
                                     const std::optional<std::vector<float>>& camera, const std::string& accel,
-                                    bool shadows) {
+                                    bool shadows, bool packets) {
   const TriMesh mesh = mesh_from_arrays(v, f, "render");
   ray::RenderOptions options;
   options.width = width;
   options.height = height;
   options.shadows = shadows;
+  options.packets = packets;
   options.accel = ray::parse_accelerator_kind(accel);
   if (camera) options.camera = camera_from_sequence(*camera);
   const ray::RenderResult result = without_gil([&] { return ray::render(mesh, options); });
@@ -132,8 +133,10 @@ void bind_ray(py::module_& m) {
   m.attr("RayAccelerator") = m.attr("Accelerator");  // deprecated: the name before Python took the C++ names
   m.def("render", &render_py, py::arg("V"), py::arg("F"), py::arg("width") = 512, py::arg("height") = 512,
         py::arg("camera") = py::none(), py::arg("accel") = "bvh", py::arg("shadows") = false,
+        py::arg("packets") = true,
         "Ray-traces the mesh (Lambert shading, optional hard shadows) into an (height, width, 3) uint8 image. "
-        "camera: (ex, ey, ez, tx, ty, tz, ux, uy, uz[, fov]); default a three-quarter view.");
+        "camera: (ex, ey, ez, tx, ty, tz, ux, uy, uz[, fov]); default a three-quarter view. packets: rays in "
+        "packets of 4 x 2 pixels (the same image as packets=False, one ray at a time).");
 }
 
 }  // namespace geods::python

@@ -249,3 +249,92 @@ def test_load_refuses_bad_files(bunny, tmp_path):
         geods.Bvh.load(tmp_path / "grid.geods")
     with pytest.raises(geods.Error):
         geods.Bvh.load(tmp_path / "missing.bvh")
+
+
+def camera_rays(V, width, height):
+    """Pinhole camera rays in 4 x 2 pixel tiles (coherent packets), float32."""
+    lo, hi = V.min(0), V.max(0)
+    eye = (lo + hi) / 2 + 1.5 * (hi - lo)
+    forward = (lo + hi) / 2 - eye
+    forward /= np.linalg.norm(forward)
+    right = np.cross(forward, [0, 1, 0])
+    right /= np.linalg.norm(right)
+    up = np.cross(right, forward)
+    dirs = []
+    for ty in range(0, height, 2):
+        for tx in range(0, width, 4):
+            for y in range(ty, ty + 2):
+                for x in range(tx, tx + 4):
+                    dirs.append(forward + (x / width - 0.5) * 0.8 * right - (y / height - 0.5) * 0.8 * up)
+    d = np.array(dirs)
+    d /= np.linalg.norm(d, axis=1)[:, None]
+    return np.tile(eye, (len(d), 1)).astype(np.float32), d.astype(np.float32)
+
+
+@pytest.mark.parametrize("arity", [4, 8])
+def test_packets_give_the_single_ray_hits_bit_for_bit(bunny, arity):
+    V, F = bunny
+    bvh = geods.TriangleBvh(V, F, arity=arity)
+    o1, d1 = camera_rays(V, 32, 16)
+    o2, d2 = rays_at(V, 101, 9)  # incoherent, and not a multiple of 8
+    d2[::7] = [1, 0, 0]          # axis-parallel rays among them
+    o3 = np.tile((V.min(0) + V.max(0)) / 2, (40, 1)).astype(np.float32)  # from inside the boxes
+    d3 = np.random.default_rng(3).standard_normal((40, 3)).astype(np.float32)
+    origins, directions = np.vstack([o1, o2, o3]), np.vstack([d1, d2, d3])
+    for tmax in (np.inf, np.float32(0.3)):
+        single = bvh.intersect(origins, directions, tmax)
+        packets = bvh.intersect_packets(origins, directions, tmax)
+        for a, b in zip(single, packets):  # t, prim, u, v: the same bits
+            assert a.dtype == b.dtype and a.tobytes() == b.tobytes()
+        blocked = bvh.occluded_packets(origins, directions, tmax)
+        assert blocked.dtype == np.bool_ and np.array_equal(blocked, bvh.occluded(origins, directions, tmax))
+    t = bvh.intersect_packets(o1, d1)[0]
+    expected = brute_intersect(V, F, o1[::3], d1[::3])
+    hit = np.isfinite(expected)
+    assert hit.sum() > 10
+    assert np.array_equal(np.isfinite(t[::3]), hit)
+    assert np.allclose(t[::3][hit], expected[hit], rtol=1e-5, atol=1e-6)
+    with pytest.raises(geods.Error):
+        bvh.intersect_packets(np.zeros((2, 3)), np.zeros((3, 3)))
+
+
+def test_simd_level_names_and_cap(bunny):
+    V, F = bunny
+    names = ["portable", "avx", "avx2", "avx512"]
+    best, before = geods.best_simd_level(), geods.simd_level()
+    assert best in names and before in names and names.index(before) <= names.index(best)
+    bvh = geods.TriangleBvh(V, F, arity=8)
+    origins, directions = camera_rays(V, 16, 8)
+    reference = bvh.intersect_packets(origins, directions)
+    try:
+        for level in names[: names.index(best) + 1]:
+            geods.set_simd_level(level)
+            assert geods.simd_level() == level
+            for a, b in zip(bvh.intersect_packets(origins, directions), reference):
+                assert a.tobytes() == b.tobytes()
+        if best != "avx512":
+            with pytest.raises(ValueError):
+                geods.set_simd_level("avx512")
+        with pytest.raises(ValueError):
+            geods.set_simd_level("sse9")
+    finally:
+        geods.set_simd_level(before)
+    assert geods.simd_level() == before
+
+
+def test_cli_packets_and_simd(cli, data_dir, workdir):
+    V, F = geods.read_mesh(str(data_dir / "bunny.ply"))
+    origins, directions = camera_rays(V, 16, 8)
+    np.save(workdir / "prays.npy", np.hstack([origins, directions]).astype(np.float64))
+    out = subprocess.run([cli, "bvh", data_dir / "bunny.ply", "--arity", "8", "--rays", "prays.npy", "-o", "phits.npy",
+                          "--packets", "--simd", "portable", "--json"], cwd=workdir, check=True, capture_output=True, text=True)
+    report = json.loads(out.stdout)
+    assert report["packets"] is True and report["simd_level"] == "portable"
+    hits = np.load(workdir / "phits.npy")
+    t, prim, _, _ = geods.TriangleBvh(V, F, arity=8).intersect(origins, directions)
+    assert np.array_equal(hits[:, 1], prim) and np.array_equal(hits[:, 0][prim >= 0], t[prim >= 0].astype(np.float64))
+    # --simd caps like GEODS_SIMD: a level above the CPU's runs the CPU's best.
+    out = subprocess.run([cli, "bvh", data_dir / "bunny.ply", "--simd", "avx512", "--json"], capture_output=True, text=True, check=True)
+    assert json.loads(out.stdout)["build_s"] >= 0
+    bad = subprocess.run([cli, "bvh", data_dir / "bunny.ply", "--simd", "sse9"], capture_output=True, text=True)
+    assert bad.returncode == 2 and bad.stderr.count("\n") == 1

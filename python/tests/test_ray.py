@@ -143,6 +143,24 @@ def test_render_same_image_with_every_accelerator(bunny):
     assert not surface[0].any() and not surface[-1].any()
 
 
+def test_render_packets_give_the_same_image(bunny, cli, data_dir, tmp_path):
+    V, F = bunny
+    for kind in ["bvh", "grid"]:
+        packets = geods.render(V, F, width=45, height=27, accel=kind, shadows=True)
+        single = geods.render(V, F, width=45, height=27, accel=kind, shadows=True, packets=False)
+        np.testing.assert_array_equal(packets, single)
+    reports = []
+    for flag in ["--packets", "--no-packets"]:
+        proc = subprocess.run([str(cli), "render", str(data_dir / "bunny.ply"), "-o", str(tmp_path / f"b{flag}.png"),
+                               "--width", "40", "--height", "24", "--shadows", flag, "--json"],
+                              capture_output=True, text=True, check=True)
+        reports.append(json.loads(proc.stdout))
+    assert reports[0]["packets"] is True and reports[1]["packets"] is False
+    assert reports[0]["rays"] == reports[1]["rays"] and reports[0]["simd_level"] == geods.simd_level()
+    assert np.array_equal(geods.read_image(str(tmp_path / "b--packets.png")),
+                          geods.read_image(str(tmp_path / "b--no-packets.png")))
+
+
 def test_render_camera(bunny):
     V, F = bunny
     c = (V.min(0) + V.max(0)) / 2

@@ -126,6 +126,51 @@ bool Accelerator::occluded(const Ray3f& ray, RayCache& cache) const {
   return true;
 }
 
+namespace {
+
+// The packet with only its active rays that can hit anything (Accelerator::shootable).
+template <typename Shootable>
+bvh::RayPacket shootable_lanes(const bvh::RayPacket& packet, Shootable&& shootable) {
+  bvh::RayPacket shot = packet;
+  shot.active &= (1u << bvh::kPacketSize) - 1;
+  for (int i = 0; i < bvh::kPacketSize; ++i)
+    if (!shootable(packet.rays[i])) shot.active &= ~(1u << i);
+  return shot;
+}
+
+}  // namespace
+
+bvh::HitPacket Accelerator::intersect(const bvh::RayPacket& packet, RayCache& cache) const {
+  const bvh::RayPacket shot = shootable_lanes(packet, shootable);
+  if (shot.active == 0 || corners_.empty()) return {};
+  if (cache.owner != id_) cache = RayCache{id_};
+  bvh::HitPacket out = closest_hits(shot, cache);
+  for (int i = 0; i < bvh::kPacketSize; ++i)
+    if (!(shot.active >> i & 1) || !out.hits[i].hit()) out.hits[i] = RayHit{};
+  return out;
+}
+
+std::uint32_t Accelerator::occluded(const bvh::RayPacket& packet, RayCache& cache) const {
+  const bvh::RayPacket shot = shootable_lanes(packet, shootable);
+  if (shot.active == 0 || corners_.empty()) return 0;
+  if (cache.owner != id_) cache = RayCache{id_};
+  return any_hits(shot, cache) & shot.active;
+}
+
+bvh::HitPacket Accelerator::closest_hits(const bvh::RayPacket& packet, RayCache& cache) const {
+  bvh::HitPacket out;
+  for (int i = 0; i < bvh::kPacketSize; ++i)
+    if (packet.active >> i & 1) out.hits[i] = intersect(packet.rays[i], cache);
+  return out;
+}
+
+std::uint32_t Accelerator::any_hits(const bvh::RayPacket& packet, RayCache& cache) const {
+  std::uint32_t mask = 0;
+  for (int i = 0; i < bvh::kPacketSize; ++i)
+    if ((packet.active >> i & 1) && occluded(packet.rays[i], cache)) mask |= 1u << i;
+  return mask;
+}
+
 std::unique_ptr<Accelerator> make_accelerator(const TriMesh& mesh, AcceleratorKind kind,
                                               const AcceleratorOptions& options) {
   switch (kind) {

@@ -34,6 +34,14 @@ std::uint32_t BvhAccelerator::any_hit(const Ray3f& ray, RayCache&) const {
   return bvh_.intersect(ray).prim;
 }
 
+bvh::HitPacket BvhAccelerator::closest_hits(const bvh::RayPacket& packet, RayCache&) const {
+  return bvh_.intersect(packet);
+}
+
+std::uint32_t BvhAccelerator::any_hits(const bvh::RayPacket& packet, RayCache&) const {
+  return bvh_.occluded(packet);
+}
+
 AcceleratorStats BvhAccelerator::stats() const {
   const bvh::BvhStats b = bvh_.stats();
   AcceleratorStats s;

@@ -14,7 +14,9 @@ namespace geods::ray {
 
 namespace {
 
-constexpr int kTile = 16;
+constexpr int kTile = 16;  // a multiple of the 4 x 2 pixel blocks of a packet
+constexpr int kBlockX = 4, kBlockY = 2;
+static_assert(kBlockX * kBlockY == bvh::kPacketSize);
 
 // Area-weighted vertex normals for smooth shading when the mesh has none.
 std::vector<Vec3f> vertex_normals(const TriMesh& mesh) {
@@ -101,16 +103,39 @@ RenderResult render(const TriMesh& mesh, const Accelerator& accel, const RenderO
     RayCache primary_cache, shadow_cache;
     std::uint64_t tile_rays = 0, tile_hits = 0;
     const int x0 = int(tile % std::size_t(tiles_x)) * kTile, y0 = int(tile / std::size_t(tiles_x)) * kTile;
-    for (int y = y0; y < std::min(y0 + kTile, height); ++y)
-      for (int x = x0; x < std::min(x0 + kTile, width); ++x) {
-        const Ray3f ray = frame.ray(float(x) + 0.5f, float(y) + 0.5f);
-        ++tile_rays;
-        const RayHit hit = accel.intersect(ray, primary_cache);
-        Vec3f color;
-        if (!hit.hit()) {
-          const float s = float(y) / float(height);
-          color = (1 - s) * Vec3f(0.93f, 0.95f, 0.98f) + s * Vec3f(0.70f, 0.76f, 0.84f);
+    // Blocks of 4 x 2 pixels: one packet of primary rays, then one of the
+    // shadow rays of the lit pixels (ray by ray without options.packets).
+    for (int by = y0; by < std::min(y0 + kTile, height); by += kBlockY)
+      for (int bx = x0; bx < std::min(x0 + kTile, width); bx += kBlockX) {
+        bvh::RayPacket primary;
+        primary.active = 0;
+        for (int i = 0; i < bvh::kPacketSize; ++i) {
+          const int x = bx + i % kBlockX, y = by + i / kBlockX;
+          if (x >= width || y >= height) continue;
+          primary.rays[i] = frame.ray(float(x) + 0.5f, float(y) + 0.5f);
+          primary.active |= 1u << i;
+          ++tile_rays;
+        }
+        bvh::HitPacket primary_hits;
+        if (options.packets) {
+          primary_hits = accel.intersect(primary, primary_cache);
         } else {
+          for (int i = 0; i < bvh::kPacketSize; ++i)
+            if (primary.active >> i & 1) primary_hits.hits[i] = accel.intersect(primary.rays[i], primary_cache);
+        }
+        Vec3f colors[bvh::kPacketSize];
+        float keys[bvh::kPacketSize], fills[bvh::kPacketSize];
+        bvh::RayPacket shadow;
+        shadow.active = 0;
+        for (int i = 0; i < bvh::kPacketSize; ++i) {
+          if (!(primary.active >> i & 1)) continue;
+          const Ray3f& ray = primary.rays[i];
+          const RayHit& hit = primary_hits.hits[i];
+          if (!hit.hit()) {
+            const float s = float(by + i / kBlockX) / float(height);
+            colors[i] = (1 - s) * Vec3f(0.93f, 0.95f, 0.98f) + s * Vec3f(0.70f, 0.76f, 0.84f);
+            continue;
+          }
           ++tile_hits;
           const auto& tri = mesh.triangles[hit.prim];
           const Vec3f &a = mesh.vertices[tri[0]], &b = mesh.vertices[tri[1]], &c = mesh.vertices[tri[2]];
@@ -121,18 +146,35 @@ RenderResult render(const TriMesh& mesh, const Accelerator& accel, const RenderO
           Vec3f n = (1 - hit.u - hit.v) * normals[tri[0]] + hit.u * normals[tri[1]] + hit.v * normals[tri[2]];
           n = n.squaredNorm() > 0 ? Vec3f(facing * n.normalized()) : geometric;
           if (n.dot(ray.direction) > 0) n = geometric;
-          float key = std::max(0.0f, n.dot(light));
-          if (options.shadows && key > 0 && geometric.dot(light) > 0) {
-            Ray3f shadow;
-            shadow.origin = ray.at(hit.t) + offset * geometric;
-            shadow.direction = light;
+          keys[i] = std::max(0.0f, n.dot(light));
+          fills[i] = std::abs(n.dot(ray.direction));
+          if (options.shadows && keys[i] > 0 && geometric.dot(light) > 0) {
+            Ray3f& s = shadow.rays[i];
+            s.origin = ray.at(hit.t) + offset * geometric;
+            s.direction = light;
+            shadow.active |= 1u << i;
             ++tile_rays;
-            if (accel.occluded(shadow, shadow_cache)) key = 0;
           }
-          const float fill = std::abs(n.dot(ray.direction));
-          color = albedo * (0.10f + 0.75f * key + 0.20f * fill);
         }
-        for (int ch = 0; ch < 3; ++ch) result.image(std::size_t(x), std::size_t(y), std::size_t(ch)) = to_byte(color[ch]);
+        std::uint32_t blocked = 0;
+        if (shadow.active != 0) {
+          if (options.packets) {
+            blocked = accel.occluded(shadow, shadow_cache);
+          } else {
+            for (int i = 0; i < bvh::kPacketSize; ++i)
+              if ((shadow.active >> i & 1) && accel.occluded(shadow.rays[i], shadow_cache)) blocked |= 1u << i;
+          }
+        }
+        for (int i = 0; i < bvh::kPacketSize; ++i) {
+          if (!(primary.active >> i & 1)) continue;
+          if (primary_hits.hits[i].hit()) {
+            const float key = (blocked >> i & 1) ? 0.0f : keys[i];
+            colors[i] = albedo * (0.10f + 0.75f * key + 0.20f * fills[i]);
+          }
+          const int x = bx + i % kBlockX, y = by + i / kBlockX;
+          for (int ch = 0; ch < 3; ++ch)
+            result.image(std::size_t(x), std::size_t(y), std::size_t(ch)) = to_byte(colors[i][ch]);
+        }
       }
     rays.fetch_add(tile_rays, std::memory_order_relaxed);
     hits.fetch_add(tile_hits, std::memory_order_relaxed);

@@ -68,6 +68,21 @@ inline TriMesh random_soup(std::size_t n, std::uint64_t seed) {
   return mesh;
 }
 
+/// A flat n x n grid of unit squares split into right triangles (z = 0), for
+/// rays exactly through shared edges and vertices.
+inline TriMesh flat_grid(int n) {
+  TriMesh grid;
+  for (int y = 0; y <= n; ++y)
+    for (int x = 0; x <= n; ++x) grid.vertices.push_back({float(x), float(y), 0.0f});
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x) {
+      const std::uint32_t a = std::uint32_t(y * (n + 1) + x), b = a + 1, c = a + std::uint32_t(n) + 1, d = c + 1;
+      grid.triangles.push_back({a, b, d});
+      grid.triangles.push_back({a, d, c});
+    }
+  return grid;
+}
+
 inline Vec3f corner(const TriMesh& mesh, std::size_t tri, int k) { return mesh.vertices[mesh.triangles[tri][k]]; }
 
 /// Brute force closest hit, same watertight test.

@@ -103,7 +103,39 @@ TEST(Render, ShadowsDarkenAndUseTheOccluderCache) {
   }
   EXPECT_GT(darker, 0);
   EXPECT_EQ(brighter, 0);
-  EXPECT_GT(shadowed.occluder_hits, 0u);
+  // The BVH's shadow packets do not use the occluder cache; ray by ray they do.
+  options.packets = false;
+  const RenderResult cached = render(mesh, options);
+  EXPECT_EQ(cached.image.data, shadowed.image.data);
+  EXPECT_GT(cached.occluder_hits, 0u);
+  options.accel = AcceleratorKind::grid;
+  options.packets = true;
+  EXPECT_GT(render(mesh, options).occluder_hits, 0u);
+}
+
+TEST(Render, PacketsGiveTheSamePictureAsSingleRays) {
+  // Sizes that are not multiples of the 4 x 2 pixel packets; 4 and 8 wide
+  // BVHs (packet traversal) and the octree (ray by ray behind the interface).
+  const TriMesh mesh = bunny();
+  RenderOptions options;
+  options.width = 75;
+  options.height = 41;
+  options.shadows = true;
+  for (int arity : {4, 8}) {
+    options.accel = AcceleratorKind::bvh;
+    options.accel_options.bvh.arity = arity;
+    options.packets = false;
+    const RenderResult single = render(mesh, options);
+    options.packets = true;
+    const RenderResult packets = render(mesh, options);
+    EXPECT_EQ(packets.image.data, single.image.data) << "arity " << arity;
+    EXPECT_EQ(packets.rays, single.rays);
+    EXPECT_EQ(packets.hits, single.hits);
+    EXPECT_GT(single.hits, 75u * 41u / 10);
+    EXPECT_GT(single.rays, 75u * 41u);  // shadow rays were shot too
+    options.accel = AcceleratorKind::octree;
+    EXPECT_EQ(render(mesh, options).image.data, single.image.data);
+  }
 }
 
 TEST(Render, BadOptionsRaise) {

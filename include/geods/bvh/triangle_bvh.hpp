@@ -24,6 +24,7 @@
 #include "geods/core/huge_page_allocator.hpp"
 #include "geods/bvh/kdop.hpp"
 #include "geods/bvh/obb.hpp"
+#include "geods/bvh/ray_packet.hpp"
 #include "geods/bvh/ray_triangle4.hpp"
 #include "geods/bvh/rss.hpp"
 #include "geods/bvh/sphere.hpp"
@@ -108,6 +109,17 @@ class TriangleBvh {
   RayHit intersect(const Ray3f& ray) const;
   /// Whether any triangle is hit with t in [ray.tmin, ray.tmax].
   bool occluded(const Ray3f& ray) const;
+  /// Packets of up to kPacketSize rays traversed together (ray_packet.hpp;
+  /// src/bvh/ray_packet.cpp): hits[i] (bit i of occluded's mask) is exactly
+  /// what intersect(rays[i]) (occluded(rays[i])) answers, for every active i.
+  /// With AABBs and arity 4 or 8 (the wide layout), else one ray at a time.
+  HitPacket intersect(const RayPacket& packet) const;
+  std::uint32_t occluded(const RayPacket& packet) const;
+  /// Every ray, in packets of kPacketSize consecutive rays (give coherent
+  /// rays in neighbouring order: pixels of small tiles); hits.size() and
+  /// occluded.size() must be rays.size() (geods::Error otherwise).
+  void intersect_packets(std::span<const Ray3f> rays, std::span<RayHit> hits) const;
+  void occluded_packets(std::span<const Ray3f> rays, std::span<std::uint8_t> occluded) const;
   /// Closest point of the mesh to p, if closer than max_distance.
   ClosestPoint closest_point(const Vec3f& p, float max_distance = std::numeric_limits<float>::infinity()) const;
   /// Whether p is inside the mesh, which should be closed. Parity of the
@@ -136,6 +148,13 @@ class TriangleBvh {
   const FlatArray<Triangle>& triangles() const { return triangles_; }
   const FlatArray<std::uint32_t>& triangle_ids() const { return topology_.prim_order; }
   std::size_t num_triangles() const { return triangles_.size(); }
+  /// The wide layout read by the packet traversal (ray_packet.cpp): the
+  /// 4- or 8-wide nodes (empty unless AABB and that arity), the triangle
+  /// groups of their leaves, and the depth that sizes traversal stacks.
+  const FlatArray<WideNode<4>>& wide4_nodes() const { return wide4_; }
+  const FlatArray<WideNode<8>>& wide8_nodes() const { return wide8_; }
+  const FlatArray<TriangleGroup>& triangle_groups() const { return groups_; }
+  int depth() const { return depth_; }
 
  private:
   template <typename BV>

@@ -26,6 +26,7 @@
 #include "geods/core/ray_triangle.hpp"
 #include "geods/core/tri_mesh.hpp"
 #include "geods/bvh/build_options.hpp"
+#include "geods/bvh/ray_packet.hpp"
 
 namespace geods::ray {
 
@@ -106,6 +107,13 @@ class Accelerator {
   /// triangle that blocked the previous ray is tried first (the occluder cache).
   bool occluded(const Ray3f& ray) const;
   bool occluded(const Ray3f& ray, RayCache& cache) const;
+  /// Up to 8 rays at once (bvh::RayPacket, bit i of `active`: rays[i] is
+  /// shot): hits[i] is what intersect(rays[i], cache) answers (no hit for the
+  /// inactive rays), bit i of the mask what occluded(rays[i], cache) answers.
+  /// The BVH traverses the packet's rays together (bvh/ray_packet.hpp); the
+  /// other kinds shoot them one by one in lane order.
+  bvh::HitPacket intersect(const bvh::RayPacket& packet, RayCache& cache) const;
+  std::uint32_t occluded(const bvh::RayPacket& packet, RayCache& cache) const;
 
   /// Writes the accelerator to `path` (an archive of kind "ray.<Class>");
   /// throws geods::Error naming the file if it cannot be written.
@@ -135,6 +143,9 @@ class Accelerator {
   virtual RayHit closest_hit(const Ray3f& ray, RayCache& cache) const = 0;
   /// The index of some triangle hit in [ray.tmin, ray.tmax], or RayHit::no_hit.
   virtual std::uint32_t any_hit(const Ray3f& ray, RayCache& cache) const = 0;
+  /// The packet queries on shootable rays (default: ray by ray with the cache).
+  virtual bvh::HitPacket closest_hits(const bvh::RayPacket& packet, RayCache& cache) const;
+  virtual std::uint32_t any_hits(const bvh::RayPacket& packet, RayCache& cache) const;
 
   /// Tests triangle `prim` and keeps it in `best` if it is closer (ties: smaller index).
   bool test_closest(const RayTriangleTest<float>& test, std::uint32_t prim, float tmin, RayHit& best) const {

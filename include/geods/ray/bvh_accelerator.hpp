@@ -29,6 +29,10 @@ class BvhAccelerator final : public Accelerator {
   /// TriangleBvh::occluded does not say which triangle blocks the ray, so a
   /// blocked ray is shot again for its closest hit to refresh the occluder cache.
   std::uint32_t any_hit(const Ray3f& ray, RayCache& cache) const override;
+  /// The packet traversal of bvh::TriangleBvh (no occluder cache: the packet
+  /// does not say which triangle blocks a ray).
+  bvh::HitPacket closest_hits(const bvh::RayPacket& packet, RayCache& cache) const override;
+  std::uint32_t any_hits(const bvh::RayPacket& packet, RayCache& cache) const override;
 
  private:
   explicit BvhAccelerator(const TriMesh& mesh) : Accelerator(mesh) {}

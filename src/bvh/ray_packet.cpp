@@ -1,0 +1,426 @@
+// The packet traversal of TriangleBvh (ray_packet.hpp): up to 8 rays through
+// the wide AABB layout together, on the one depth-first loop of traversal.hpp.
+// Compiled once more for AVX, AVX2 and AVX-512 and chosen at run time by
+// simd_level() (core/simd_level.hpp), like the single-ray traversal; this
+// file is compiled with -ffp-contract=off, so every level does the same IEEE
+// operations as the portable code and as the single-ray traversal.
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <new>
+
+#include "geods/bvh/traversal.hpp"
+#include "geods/bvh/triangle_bvh.hpp"
+#include "geods/core/error.hpp"
+#include "geods/core/simd_level.hpp"
+
+#if defined(__SSE__)
+#include <xmmintrin.h>
+#endif
+
+// 8-lane vectors are passed between inlined helpers only.
+#pragma GCC diagnostic ignored "-Wpsabi"
+
+namespace geods::bvh {
+
+namespace {
+
+constexpr int P = kPacketSize;
+typedef float vf __attribute__((vector_size(4 * P)));
+typedef std::int32_t vi __attribute__((vector_size(4 * P)));
+
+// Bit i set where lane i of a comparison result is true.
+GEODS_BVH_INLINE unsigned lane_bits(vi m) {
+#if defined(__SSE__)
+  __m128 half[2];
+  std::memcpy(half, &m, sizeof half);
+  return unsigned(_mm_movemask_ps(half[0])) | unsigned(_mm_movemask_ps(half[1])) << 4;
+#else
+  unsigned bits = 0;
+  for (int i = 0; i < P; ++i) bits |= unsigned(m[i] & 1) << i;
+  return bits;
+#endif
+}
+
+GEODS_BVH_INLINE vf splat(float x) {
+  vf r;
+  for (int i = 0; i < P; ++i) r[i] = x;
+  return r;
+}
+
+// W-wide vectors over the children of a node.
+template <int W>
+struct WideVector {
+  typedef float vf __attribute__((vector_size(4 * W)));
+  typedef std::int32_t vi __attribute__((vector_size(4 * W)));
+};
+template <int W>
+GEODS_BVH_INLINE typename WideVector<W>::vf wide_splat(float x) {
+  typename WideVector<W>::vf r;
+  for (int i = 0; i < W; ++i) r[i] = x;
+  return r;
+}
+template <typename V>
+GEODS_BVH_INLINE V nan_min(V a, V b) {  // a NaN in either gives NaN
+  return (a < b) | (a != a) ? a : b;
+}
+template <typename V>
+GEODS_BVH_INLINE V nan_max(V a, V b) {
+  return (a > b) | (a != a) ? a : b;
+}
+template <typename M>
+GEODS_BVH_INLINE unsigned wide_bits(M m) {
+  unsigned bits = 0;
+  if constexpr (sizeof(M) == 32) {
+    return lane_bits(m);
+  } else {
+#if defined(__SSE__)
+    bits = unsigned(_mm_movemask_ps(reinterpret_cast<__m128>(m)));
+#else
+    for (int i = 0; i < int(sizeof(M) / 4); ++i) bits |= unsigned(m[i] & 1) << i;
+#endif
+  }
+  return bits;
+}
+
+// A child waiting to be visited (an inner WideNode, count 0, or a leaf's
+// groups), with the lanes that entered its box, where they entered it, and
+// the nearest of those entries as the key the children are ordered by.
+struct PacketEntry {
+  std::uint32_t child, count;
+  float key;
+  std::uint32_t mask;
+  float t_near[P];
+};
+
+// Rays that the packet does not take: they go through the single-ray query.
+bool alone(const Ray3f& r) {
+  return !r.origin.allFinite() || !r.direction.allFinite() || r.direction.isZero(0) || std::isnan(r.tmin) ||
+         std::isnan(r.tmax);
+}
+
+// The traversal of the active lanes of `packet`; `any`: occlusion (a lane
+// stops at its first hit). Lanes in `ambiguous` found two different
+// triangles at their closest t: the caller shoots them alone.
+template <int W>
+GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const FlatArray<TriangleGroup>& groups,
+                                      int depth, const RayPacket& packet, std::uint32_t active, bool any,
+                                      HitPacket& out, std::uint32_t& done, std::uint32_t& ambiguous) {
+  vf org[3], inv[3];
+  vi neg[3];
+  vf tmin_v, tmax_v;
+  alignas(64) unsigned char test_storage[P][sizeof(RayTriangle4Test)];
+  RayTriangle4Test* tests = reinterpret_cast<RayTriangle4Test*>(test_storage);
+  for (int i = 0; i < P; ++i) {
+    const Ray3f& r = packet.rays[(active >> i & 1) ? i : __builtin_ctz(active)];
+    for (int a = 0; a < 3; ++a) {
+      const float inv_a = 1.0f / r.direction[a];
+      org[a][i] = r.origin[a];
+      inv[a][i] = inv_a;
+      neg[a][i] = inv_a < 0 ? -1 : 0;
+    }
+    tmin_v[i] = r.tmin;
+    tmax_v[i] = r.tmax;
+    if (active >> i & 1) new (&tests[i]) RayTriangle4Test(r);
+  }
+  float tmin[P], tmax[P];
+  std::memcpy(tmin, &tmin_v, sizeof tmin);
+  std::memcpy(tmax, &tmax_v, sizeof tmax);
+  // The packet's bounds for the frustum test (interval arithmetic over the
+  // lanes): per axis the range of the origins and of the inverse directions,
+  // used where every lane's inverse direction has the same sign.
+  float o_lo[3], o_hi[3], i_lo[3], i_hi[3];
+  bool same_sign[3];
+  float tmin_lo = std::numeric_limits<float>::infinity();
+  for (int a = 0; a < 3; ++a) {
+    o_lo[a] = i_lo[a] = std::numeric_limits<float>::infinity();
+    o_hi[a] = i_hi[a] = -std::numeric_limits<float>::infinity();
+    int negatives = 0;
+    for (std::uint32_t b = active; b != 0; b &= b - 1) {
+      const int i = __builtin_ctz(b);
+      o_lo[a] = std::min(o_lo[a], org[a][i]), o_hi[a] = std::max(o_hi[a], org[a][i]);
+      i_lo[a] = std::min(i_lo[a], inv[a][i]), i_hi[a] = std::max(i_hi[a], inv[a][i]);
+      negatives += neg[a][i] != 0;
+    }
+    same_sign[a] = negatives == 0 || negatives == __builtin_popcount(active);
+  }
+  for (std::uint32_t b = active; b != 0; b &= b - 1) tmin_lo = std::min(tmin_lo, tmin[__builtin_ctz(b)]);
+  TraversalStack<PacketEntry> stack(traversal_stack_size(depth, W));
+  const float widen = 1.0f + 4e-7f;
+  // The lanes of entry e that may still hit something in it: its box was
+  // entered no later than their tmax allows (may_hit_before of the single ray).
+  auto live = [&](const PacketEntry& e) GEODS_BVH_INLINE_LAMBDA {
+    vf tn, tm;
+    std::memcpy(&tn, e.t_near, sizeof tn);
+    std::memcpy(&tm, tmax, sizeof tm);
+    const vf slack = (tm < splat(0.0f) ? -tm : tm) * splat(4e-7f);
+    return e.mask & ~done & lane_bits(tn <= tm + slack);
+  };
+  // The children that some lane may enter, all W at once: a lane's entry
+  // and exit distances along an axis are products of (bound - origin) and the
+  // inverse direction, and rounding is monotone, so the extreme products of
+  // the packet's ranges bound every lane's (a NaN from 0 * inf drops the
+  // axis, as it does for the lane). A child this rejects, every lane's own
+  // slab test rejects too.
+  auto frustum = [&](const WideNode<W>& node, std::uint32_t lanes) GEODS_BVH_INLINE_LAMBDA {
+    using vw = typename WideVector<W>::vf;
+    float tmax_hi = -std::numeric_limits<float>::infinity();
+    for (std::uint32_t b = lanes; b != 0; b &= b - 1) tmax_hi = std::max(tmax_hi, tmax[__builtin_ctz(b)]);
+    vw tn = wide_splat<W>(tmin_lo), tf = wide_splat<W>(tmax_hi);
+    for (int a = 0; a < 3; ++a) {
+      if (!same_sign[a]) continue;
+      vw lo, hi;
+      std::memcpy(&lo, node.bounds[2 * a], sizeof lo);
+      std::memcpy(&hi, node.bounds[2 * a + 1], sizeof hi);
+      const vw i0 = wide_splat<W>(i_lo[a]), i1 = wide_splat<W>(i_hi[a]);
+      vw near, far;
+      if (i_lo[a] >= 0) {  // entering at lo - origin: least at the largest origin
+        const vw lo_min = lo - wide_splat<W>(o_hi[a]), hi_max = hi - wide_splat<W>(o_lo[a]);
+        near = nan_min(lo_min * i0, lo_min * i1);
+        far = nan_max(hi_max * i0, hi_max * i1);
+      } else {  // negative inverse: entering at hi, exiting at lo
+        const vw hi_max = hi - wide_splat<W>(o_lo[a]), lo_min = lo - wide_splat<W>(o_hi[a]);
+        near = nan_min(hi_max * i0, hi_max * i1);
+        far = nan_max(lo_min * i0, lo_min * i1);
+      }
+      tn = near > tn ? near : tn;
+      tf = far < tf ? far : tf;
+    }
+    return wide_bits(tn <= tf * wide_splat<W>(widen));
+  };
+  // Per child of the node being opened: the lanes that enter it and where.
+  std::uint32_t child_mask[W];
+  vf child_near[W];
+  auto children = [&](const PacketEntry& e, float* keys) GEODS_BVH_INLINE_LAMBDA {
+    const std::uint32_t lanes = e.mask & ~done;
+    const WideNode<W>& node = nodes[e.child];
+    vf tm;
+    std::memcpy(&tm, tmax, sizeof tm);
+    const vf tf0 = tm;
+    unsigned candidates = frustum(node, lanes);
+    unsigned bits = 0;
+    for (; candidates != 0; candidates &= candidates - 1) {
+      const int c = __builtin_ctz(candidates);
+      if (node.count[c] == 0 && node.child[c] == WideNode<W>::kEmpty) continue;
+      vf tn = tmin_v, tf = tf0;
+      for (int a = 0; a < 3; ++a) {
+        // The single ray's slab test, lane by lane: the near bound by the
+        // sign of the inverse direction, NaNs (0 * inf) leave the interval.
+        const vf t_lo = (splat(node.bounds[2 * a][c]) - org[a]) * inv[a];
+        const vf t_hi = (splat(node.bounds[2 * a + 1][c]) - org[a]) * inv[a];
+        const vf near = neg[a] ? t_hi : t_lo;
+        const vf far = neg[a] ? t_lo : t_hi;
+        tn = near > tn ? near : tn;
+        tf = far < tf ? far : tf;
+      }
+      const std::uint32_t m = lanes & lane_bits(tn <= tf * splat(widen));
+      if (m == 0) continue;
+      child_mask[c] = m;
+      child_near[c] = tn;
+      float key = std::numeric_limits<float>::infinity();
+      for (std::uint32_t b = m; b != 0; b &= b - 1) key = std::min(key, tn[__builtin_ctz(b)]);
+      keys[c] = key;
+      bits |= 1u << c;
+    }
+    return bits;
+  };
+  auto child = [&](const PacketEntry& e, int c, float key) GEODS_BVH_INLINE_LAMBDA {
+    const WideNode<W>& node = nodes[e.child];
+    PacketEntry r;
+    r.child = node.child[c];
+    r.count = node.count[c];
+    r.key = key;
+    r.mask = child_mask[c];
+    std::memcpy(r.t_near, &child_near[c], sizeof r.t_near);
+    if (r.count == 0) {
+      const char* p = reinterpret_cast<const char*>(&nodes[r.child]);
+      for (std::size_t k = 0; k < sizeof(WideNode<W>); k += 64) __builtin_prefetch(p + k);
+    } else {
+      const char* p = reinterpret_cast<const char*>(&groups[r.child]);
+      for (std::size_t k = 0; k < sizeof(TriangleGroup) * r.count; k += 64) __builtin_prefetch(p + k);
+    }
+    return r;
+  };
+  auto leaf = [&](const PacketEntry& e) GEODS_BVH_INLINE_LAMBDA {
+    std::uint32_t lanes = live(e);
+    for (std::uint32_t g = e.child; g < e.child + e.count && lanes != 0; ++g) {
+      const TriangleGroup& group = groups[g];
+      for (std::uint32_t b = lanes; b != 0; b &= b - 1) {
+        const int i = __builtin_ctz(b);
+        RayTriangle4Test::vf t, u, v;
+        const int mask = tests[i].intersect(group, tmin[i], tmax[i], t, u, v);
+        if (mask == 0) continue;
+        // The nearest lane, ties to the last one, as the single ray keeps it.
+        int best = -1;
+        for (int k = 0; k < 4; ++k)
+          if ((mask >> k & 1) && (best < 0 || t[k] <= t[best])) best = k;
+        RayHit& hit = out.hits[i];
+        const std::uint32_t prim = group.index[best];
+        bool tie = false;
+        for (int k = 0; k < 4; ++k)
+          if ((mask >> k & 1) && t[k] == t[best] && group.index[k] != prim) tie = true;
+        if (hit.hit() && t[best] == hit.t && hit.prim != prim) tie = true;
+        if (hit.hit() && t[best] < hit.t) ambiguous &= ~(1u << i);
+        if (tie) ambiguous |= 1u << i;
+        tmax[i] = t[best];
+        hit = {t[best], prim, u[best], v[best]};
+        if (any) {
+          done |= 1u << i;
+          lanes &= ~(1u << i);
+        }
+      }
+    }
+    return (active & ~done) != 0;
+  };
+  const auto is_leaf = [](const PacketEntry& e) GEODS_BVH_INLINE_LAMBDA { return e.count != 0; };
+  const auto still_needed = [&](const PacketEntry& e) GEODS_BVH_INLINE_LAMBDA { return live(e) != 0; };
+  PacketEntry root{0, 0, 0.0f, active, {}};
+  std::memcpy(root.t_near, tmin, sizeof root.t_near);
+  if (any) {
+    traverse<W, false>(root, stack, is_leaf, children, child, leaf, still_needed);
+  } else {
+    traverse<W, true>(root, stack, is_leaf, children, child, leaf, still_needed);
+  }
+}
+
+template <int W>
+void packet_portable(const FlatArray<WideNode<W>>& nodes, const FlatArray<TriangleGroup>& groups, int depth,
+                     const RayPacket& packet, std::uint32_t active, bool any, HitPacket& out, std::uint32_t& done,
+                     std::uint32_t& ambiguous) {
+  packet_traverse<W>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
+}
+
+#if defined(__x86_64__) && defined(__GNUC__)
+#define GEODS_PACKET_SIMD_DISPATCH 1
+template <int W>
+__attribute__((target("avx"), flatten)) void packet_avx(const FlatArray<WideNode<W>>& nodes,
+                                                         const FlatArray<TriangleGroup>& groups, int depth,
+                                                         const RayPacket& packet, std::uint32_t active, bool any,
+                                                         HitPacket& out, std::uint32_t& done,
+                                                         std::uint32_t& ambiguous) {
+  packet_traverse<W>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
+}
+template <int W>
+__attribute__((target("avx2,bmi,bmi2,lzcnt,popcnt"), flatten)) void packet_avx2(
+    const FlatArray<WideNode<W>>& nodes, const FlatArray<TriangleGroup>& groups, int depth, const RayPacket& packet,
+    std::uint32_t active, bool any, HitPacket& out, std::uint32_t& done, std::uint32_t& ambiguous) {
+  packet_traverse<W>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
+}
+template <int W>
+__attribute__((target("avx512f,avx512vl,avx512bw,avx512dq,avx2,bmi,bmi2,lzcnt,popcnt"), flatten)) void packet_avx512(
+    const FlatArray<WideNode<W>>& nodes, const FlatArray<TriangleGroup>& groups, int depth, const RayPacket& packet,
+    std::uint32_t active, bool any, HitPacket& out, std::uint32_t& done, std::uint32_t& ambiguous) {
+  packet_traverse<W>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
+}
+#endif
+
+template <int W>
+void packet_best(const FlatArray<WideNode<W>>& nodes, const FlatArray<TriangleGroup>& groups, int depth,
+                 const RayPacket& packet, std::uint32_t active, bool any, HitPacket& out, std::uint32_t& done,
+                 std::uint32_t& ambiguous) {
+#if defined(GEODS_PACKET_SIMD_DISPATCH)
+  switch (simd_level()) {
+    case SimdLevel::avx512: return packet_avx512<W>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
+    case SimdLevel::avx2: return packet_avx2<W>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
+    case SimdLevel::avx: return packet_avx<W>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
+    case SimdLevel::portable: break;
+  }
+#endif
+  packet_portable<W>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
+}
+
+}  // namespace
+
+namespace {
+
+// The lanes the packet traversal takes, and the others shot alone into `out`.
+std::uint32_t split_lanes(const TriangleBvh& bvh, const RayPacket& packet, bool any, HitPacket& out,
+                          std::uint32_t& occluded) {
+  const std::uint32_t active = packet.active & ((1u << P) - 1);
+  const bool wide = !bvh.wide4_nodes().empty() || !bvh.wide8_nodes().empty();
+  std::uint32_t lanes = 0;
+  for (int i = 0; i < P; ++i) {
+    if (!(active >> i & 1)) continue;
+    if (wide && !alone(packet.rays[i])) {
+      lanes |= 1u << i;
+    } else if (any) {
+      if (bvh.occluded(packet.rays[i])) occluded |= 1u << i;
+    } else {
+      out.hits[i] = bvh.intersect(packet.rays[i]);
+    }
+  }
+  // One ray is cheaper alone.
+  if (__builtin_popcount(lanes) == 1) {
+    const int i = __builtin_ctz(lanes);
+    if (any) {
+      if (bvh.occluded(packet.rays[i])) occluded |= 1u << i;
+    } else {
+      out.hits[i] = bvh.intersect(packet.rays[i]);
+    }
+    lanes = 0;
+  }
+  return lanes;
+}
+
+void run_packet(const TriangleBvh& bvh, const RayPacket& packet, std::uint32_t lanes, bool any, HitPacket& out,
+                std::uint32_t& done, std::uint32_t& ambiguous) {
+  if (!bvh.wide8_nodes().empty()) {
+    packet_best<8>(bvh.wide8_nodes(), bvh.triangle_groups(), bvh.depth(), packet, lanes, any, out, done, ambiguous);
+  } else {
+    packet_best<4>(bvh.wide4_nodes(), bvh.triangle_groups(), bvh.depth(), packet, lanes, any, out, done, ambiguous);
+  }
+}
+
+}  // namespace
+
+HitPacket TriangleBvh::intersect(const RayPacket& packet) const {
+  HitPacket out;
+  std::uint32_t unused = 0;
+  const std::uint32_t lanes = split_lanes(*this, packet, false, out, unused);
+  if (lanes == 0) return out;
+  std::uint32_t done = 0, ambiguous = 0;
+  run_packet(*this, packet, lanes, false, out, done, ambiguous);
+  // Two triangles at a ray's closest t: the single ray's order decides.
+  for (std::uint32_t b = ambiguous & lanes; b != 0; b &= b - 1) {
+    const int i = __builtin_ctz(b);
+    out.hits[i] = intersect(packet.rays[i]);
+  }
+  return out;
+}
+
+std::uint32_t TriangleBvh::occluded(const RayPacket& packet) const {
+  HitPacket out;
+  std::uint32_t occluded = 0;
+  const std::uint32_t lanes = split_lanes(*this, packet, true, out, occluded);
+  if (lanes == 0) return occluded;
+  std::uint32_t done = 0, ambiguous = 0;
+  run_packet(*this, packet, lanes, true, out, done, ambiguous);
+  return occluded | (done & lanes);
+}
+
+void TriangleBvh::intersect_packets(std::span<const Ray3f> rays, std::span<RayHit> hits) const {
+  if (hits.size() != rays.size()) throw Error("TriangleBvh::intersect_packets: one hit per ray expected");
+  for (std::size_t first = 0; first < rays.size(); first += P) {
+    RayPacket packet;
+    const std::size_t n = std::min<std::size_t>(P, rays.size() - first);
+    for (std::size_t i = 0; i < n; ++i) packet.rays[i] = rays[first + i];
+    packet.active = (1u << n) - 1;
+    const HitPacket out = intersect(packet);
+    for (std::size_t i = 0; i < n; ++i) hits[first + i] = out.hits[i];
+  }
+}
+
+void TriangleBvh::occluded_packets(std::span<const Ray3f> rays, std::span<std::uint8_t> occluded_out) const {
+  if (occluded_out.size() != rays.size()) throw Error("TriangleBvh::occluded_packets: one answer per ray expected");
+  for (std::size_t first = 0; first < rays.size(); first += P) {
+    RayPacket packet;
+    const std::size_t n = std::min<std::size_t>(P, rays.size() - first);
+    for (std::size_t i = 0; i < n; ++i) packet.rays[i] = rays[first + i];
+    packet.active = (1u << n) - 1;
+    const std::uint32_t mask = occluded(packet);
+    for (std::size_t i = 0; i < n; ++i) occluded_out[first + i] = std::uint8_t(mask >> i & 1);
+  }
+}
+
+}  // namespace geods::bvh

@@ -1,0 +1,241 @@
+// Packets of rays (ray_packet.hpp) against the single-ray queries on the same
+// rays: bit-identical closest hits (t, u, v, triangle) and occlusion for every
+// ray, on incoherent, coherent (pinhole camera tiles) and degenerate rays,
+// rays from inside boxes and axis-parallel rays, 4 and 8 wide, the fallback
+// layouts, partial masks and every SIMD level; brute force checks the t.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <limits>
+
+#include "bvh/bvh_test_util.hpp"
+#include "geods/core/error.hpp"
+#include "geods/core/simd_level.hpp"
+
+namespace geods::bvh {
+namespace {
+
+bool same_bits(const RayHit& a, const RayHit& b) {
+  return std::memcmp(&a.t, &b.t, sizeof(float)) == 0 && std::memcmp(&a.u, &b.u, sizeof(float)) == 0 &&
+         std::memcmp(&a.v, &b.v, sizeof(float)) == 0 && a.prim == b.prim;
+}
+
+struct LevelGuard {
+  SimdLevel saved = simd_level();
+  ~LevelGuard() { set_simd_level(saved); }
+};
+
+// Packets of consecutive rays with the given active masks (cycled) against
+// one ray at a time; returns the number of hits.
+std::size_t expect_packets_match(const TriangleBvh& bvh, const std::vector<Ray3f>& rays, const std::string& what,
+                                 const std::vector<std::uint32_t>& masks = {0xff}) {
+  std::size_t hits = 0, k = 0;
+  for (std::size_t first = 0; first < rays.size(); first += kPacketSize, ++k) {
+    RayPacket packet;
+    const std::size_t n = std::min<std::size_t>(kPacketSize, rays.size() - first);
+    for (std::size_t i = 0; i < n; ++i) packet.rays[i] = rays[first + i];
+    packet.active = masks[k % masks.size()] & ((1u << n) - 1);
+    const HitPacket out = bvh.intersect(packet);
+    const std::uint32_t blocked = bvh.occluded(packet);
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!(packet.active >> i & 1)) {
+        EXPECT_FALSE(out.hits[i].hit()) << what << ": inactive ray " << first + i;
+        EXPECT_FALSE(blocked >> i & 1) << what << ": inactive ray " << first + i;
+        continue;
+      }
+      const RayHit single = bvh.intersect(rays[first + i]);
+      EXPECT_TRUE(same_bits(out.hits[i], single))
+          << what << " ray " << first + i << ": packet t " << out.hits[i].t << " prim " << out.hits[i].prim
+          << ", single t " << single.t << " prim " << single.prim;
+      EXPECT_EQ(bool(blocked >> i & 1), bvh.occluded(rays[first + i])) << what << " ray " << first + i;
+      hits += single.hit();
+    }
+  }
+  return hits;
+}
+
+// Every layout the packet reads (4 and 8 wide) and one it does not (OBBs: ray by ray).
+void expect_layouts_match(const TriMesh& mesh, const std::vector<Ray3f>& rays, const std::string& what) {
+  for (int arity : {4, 8}) {
+    BuildOptions options;
+    options.arity = arity;
+    const TriangleBvh bvh = TriangleBvh::build(mesh, options);
+    const std::size_t hits = expect_packets_match(bvh, rays, what + " arity " + std::to_string(arity),
+                                                  {0xff, 0x5a, 0x81, 0x01, 0xfe, 0x00});
+    EXPECT_GT(hits, rays.size() / 20) << what << ": the rays must hit something to compare";
+  }
+  BuildOptions obb;
+  obb.bv = BoundingVolume::obb;
+  expect_packets_match(TriangleBvh::build(mesh, obb), std::vector<Ray3f>(rays.begin(), rays.begin() + std::min<std::size_t>(rays.size(), 400)),
+                       what + " obb");
+}
+
+// Primary rays of a pinhole camera in 4 x 2 pixel tiles (coherent packets).
+std::vector<Ray3f> camera_rays(const AABB3f& box, Vec3f eye, int width, int height) {
+  const Vec3f target = box.center();
+  const Vec3f forward = (target - eye).normalized();
+  const Vec3f right = forward.cross(Vec3f::UnitY()).normalized();
+  const Vec3f up = right.cross(forward);
+  std::vector<Ray3f> rays;
+  for (int ty = 0; ty < height; ty += 2)
+    for (int tx = 0; tx < width; tx += 4)
+      for (int y = ty; y < ty + 2; ++y)
+        for (int x = tx; x < tx + 4; ++x) {
+          Ray3f r;
+          r.origin = eye;
+          r.direction = (forward + (float(x) / float(width) - 0.5f) * 0.8f * right -
+                         (float(y) / float(height) - 0.5f) * 0.8f * up)
+                            .normalized();
+          rays.push_back(r);
+        }
+  return rays;
+}
+
+TEST(RayPacket, IncoherentAndHardRaysMatchTheSingleRayOnTheBunny) {
+  const TriMesh bunny = test::data_mesh("bunny.ply");
+  expect_layouts_match(bunny, test::test_rays(bunny, 1600, 21), "bunny hard rays");
+}
+
+TEST(RayPacket, CoherentCameraRaysMatchTheSingleRayAndBruteForce) {
+  const TriMesh bunny = test::data_mesh("bunny.ply");
+  const AABB3f box = bunny.bounds();
+  const std::vector<Ray3f> rays = camera_rays(box, box.center() + 1.5f * box.extent(), 48, 32);
+  expect_layouts_match(bunny, rays, "bunny camera");
+  BuildOptions options;
+  options.arity = 8;
+  const TriangleBvh bvh = TriangleBvh::build(bunny, options);
+  std::vector<RayHit> hits(rays.size());
+  bvh.intersect_packets(rays, hits);
+  std::vector<std::uint8_t> blocked(rays.size());
+  bvh.occluded_packets(rays, blocked);
+  for (std::size_t i = 0; i < rays.size(); i += 7) {
+    const RayHit brute = test::brute_intersect(bunny, rays[i]);
+    EXPECT_EQ(hits[i].t, brute.t) << "ray " << i;
+    EXPECT_EQ(bool(blocked[i]), brute.hit()) << "ray " << i;
+  }
+  // Shadow rays from the hits towards a light (any hit), a short tmax too.
+  std::vector<Ray3f> shadows;
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    if (!hits[i].hit()) continue;
+    Ray3f s;
+    s.origin = rays[i].at(hits[i].t) + 1e-4f * Vec3f(0.3f, 1.0f, 0.2f);
+    s.direction = Vec3f(0.3f, 1.0f, 0.2f).normalized();
+    s.tmax = i % 3 == 0 ? 0.01f : std::numeric_limits<float>::infinity();
+    shadows.push_back(s);
+  }
+  ASSERT_GT(shadows.size(), rays.size() / 10);
+  expect_packets_match(bvh, shadows, "shadow rays");
+}
+
+TEST(RayPacket, RaysFromInsideBoxesAndAxisParallelRays) {
+  const TriMesh bunny = test::data_mesh("bunny.ply");
+  const AABB3f box = bunny.bounds();
+  Rng rng(5);
+  std::vector<Ray3f> rays;
+  // From the centre and from points inside the box, in all directions.
+  for (int i = 0; i < 400; ++i) {
+    Ray3f r;
+    r.origin = i < 200 ? box.center() : Vec3f(box.center() + 0.45f * box.extent().cwiseProduct(test::random_point(rng, -1, 1)));
+    r.direction = test::random_direction(rng);
+    rays.push_back(r);
+  }
+  // Packets of parallel axis-aligned rays (+-x, +-y, +-z), from inside and outside.
+  for (int axis = 0; axis < 3; ++axis)
+    for (int sign : {-1, 1})
+      for (int i = 0; i < 64; ++i) {
+        Ray3f r;
+        r.origin = box.center() + 0.4f * box.extent().cwiseProduct(Vec3f(float(i % 8) / 8 - 0.5f, float(i / 8) / 8 - 0.5f, 0.1f));
+        if (i >= 32) r.origin[axis] = sign > 0 ? box.lo[axis] - 0.1f : box.hi[axis] + 0.1f;
+        r.direction = Vec3f::Zero();
+        r.direction[axis] = float(sign);
+        rays.push_back(r);
+      }
+  expect_layouts_match(bunny, rays, "inside and axis-parallel");
+}
+
+TEST(RayPacket, DegenerateSoupsAndDegenerateRays) {
+  const TriMesh soup = test::random_soup(500, 31);
+  std::vector<Ray3f> rays = test::test_rays(soup, 1200, 32);
+  // Rays the packet hands to the single ray, mixed into packets of good rays.
+  const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
+  for (std::size_t i = 3; i < rays.size(); i += 29) {
+    Ray3f& r = rays[i];
+    switch (i % 6) {
+      case 0: r.direction = Vec3f::Zero(); break;
+      case 1: r.origin[1] = nan; break;
+      case 2: r.direction[2] = inf; break;
+      case 3: r.tmin = r.tmax = 0.5f; break;
+      case 4: r.tmin = 2.0f, r.tmax = 1.0f; break;
+      default: r.tmax = nan; break;
+    }
+  }
+  expect_layouts_match(soup, rays, "soup");
+}
+
+TEST(RayPacket, TiesAtSharedEdgesKeepTheSingleRayTriangle) {
+  // A flat grid hit exactly through its vertices and edges: several triangles
+  // at the same t, where the single ray's visiting order picks one.
+  const int n = 12;
+  const TriMesh grid = test::flat_grid(n);
+  std::vector<Ray3f> rays;
+  for (int y = 0; y <= 2 * n; ++y)
+    for (int x = 0; x <= 2 * n; ++x) {
+      Ray3f r;
+      r.origin = {0.5f * float(x), 0.5f * float(y), 1.0f};
+      r.direction = {0.0f, 0.0f, -1.0f};
+      rays.push_back(r);
+    }
+  for (int y = 0; y <= 2 * n; ++y)
+    for (int x = 0; x <= 2 * n; ++x) {
+      Ray3f r;
+      r.direction = Vec3f(0.25f, -0.5f, -1.0f);
+      r.origin = Vec3f(0.5f * float(x), 0.5f * float(y), 0.0f) - r.direction;
+      rays.push_back(r);
+    }
+  expect_layouts_match(grid, rays, "grid");
+}
+
+TEST(RayPacket, EveryLevelGivesThePortableSingleRayHits) {
+  const LevelGuard guard;
+  const TriMesh bunny = test::data_mesh("bunny.ply");
+  const AABB3f box = bunny.bounds();
+  std::vector<Ray3f> rays = camera_rays(box, box.center() + 1.5f * box.extent(), 32, 16);
+  const std::vector<Ray3f> hard = test::test_rays(bunny, 512, 41);
+  rays.insert(rays.end(), hard.begin(), hard.end());
+  BuildOptions options;
+  options.arity = 8;
+  const TriangleBvh bvh = TriangleBvh::build(bunny, options);
+  set_simd_level(SimdLevel::portable);
+  std::vector<RayHit> expected(rays.size());
+  std::vector<std::uint8_t> blocked(rays.size());
+  for (std::size_t i = 0; i < rays.size(); ++i) expected[i] = bvh.intersect(rays[i]), blocked[i] = bvh.occluded(rays[i]);
+  for (SimdLevel level : {SimdLevel::portable, SimdLevel::avx, SimdLevel::avx2, SimdLevel::avx512}) {
+    if (level > best_simd_level()) continue;
+    set_simd_level(level);
+    std::vector<RayHit> hits(rays.size());
+    std::vector<std::uint8_t> occ(rays.size());
+    bvh.intersect_packets(rays, hits);
+    bvh.occluded_packets(rays, occ);
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+      ASSERT_TRUE(same_bits(hits[i], expected[i])) << simd_level_name(level) << " ray " << i;
+      ASSERT_EQ(occ[i], blocked[i]) << simd_level_name(level) << " ray " << i;
+    }
+  }
+}
+
+TEST(RayPacket, EmptyHierarchyAndSizeMismatch) {
+  const TriangleBvh empty;
+  RayPacket packet;
+  for (Ray3f& r : packet.rays) r.direction = Vec3f(0, 0, 1);
+  const HitPacket out = empty.intersect(packet);
+  for (const RayHit& h : out.hits) EXPECT_FALSE(h.hit());
+  EXPECT_EQ(empty.occluded(packet), 0u);
+  std::vector<Ray3f> rays(10);
+  std::vector<RayHit> hits(9);
+  std::vector<std::uint8_t> occ(11);
+  EXPECT_THROW(empty.intersect_packets(rays, hits), Error);
+  EXPECT_THROW(empty.occluded_packets(rays, occ), Error);
+}
+
+}  // namespace
+}  // namespace geods::bvh
