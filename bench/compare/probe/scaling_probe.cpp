@@ -8,7 +8,7 @@
 //   copy_fresh  copies MB megabytes into newly allocated memory (page faults, as a structure that
 //               copies its input does);
 //   copy_warm   the same copy into memory already touched (memory bandwidth);
-//   scan        the maximum of the MB megabytes of floats (a read-only pass).
+//   scan        counts the floats above 0.5 in the MB megabytes (a read-only pass: memory bandwidth).
 // On a loaded machine wall / cpu shows how much of a core the process got.
 #include <tbb/blocked_range.h>
 #include <tbb/global_control.h>
@@ -97,13 +97,13 @@ int main(int argc, char** argv) {
     sink = sink + dst[n / 3];
   });
   measure("scan", threads, reps, [&] {
-    sink = sink + tbb::parallel_reduce(
-        tbb::blocked_range<std::size_t>(0, n, grain), 0.0f,
-        [&](const tbb::blocked_range<std::size_t>& r, float hi) {
-          for (std::size_t i = r.begin(); i < r.end(); ++i) hi = std::max(hi, src[i]);
-          return hi;
+    sink = sink + double(tbb::parallel_reduce(
+        tbb::blocked_range<std::size_t>(0, n, grain), std::size_t(0),
+        [&](const tbb::blocked_range<std::size_t>& r, std::size_t count) {
+          for (std::size_t i = r.begin(); i < r.end(); ++i) count += src[i] > 0.5f;  // vectorized
+          return count;
         },
-        [](float a, float b) { return std::max(a, b); });
+        [](std::size_t a, std::size_t b) { return a + b; }));
   });
   return 0;
 }
