@@ -194,8 +194,10 @@ def run_comparison(c, bin_dir, data_dir, threads_list, rounds, reps, scale, stat
     records, raw, problems = [], [], []
     tl = threads_list if c["threads"] == "all" else [1]
     env = dict(os.environ, ANCHORS_REPS=str(reps), ANCHORS_DATA=data_dir)
-    for threads in tl:
-        for rnd in range(rounds):
+    # Each round runs every program on 1 thread, then on the other counts: the speed-ups of the
+    # All-cores table compare runs minutes apart, not the first and last parts of the comparison.
+    for rnd in range(rounds):
+        for threads in tl:
             for p in c["programs"]:
                 if "command" in p:
                     cmd = [a.format(python=PY, dir=c["dir"], bin=bin_dir) for a in p["command"]]
