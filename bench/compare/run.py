@@ -50,6 +50,10 @@ declares them with geods_compare_program(), and a compare.json read here:
               own "args", e.g. ["--reps", "1"] for a peer that takes minutes)
   rounds      optional number of interleaved rounds when --rounds is not given (default 1)
   timeout_s   optional per-program time limit (default 1800)
+  scaling     optional [{"anchor": "geods", "variant": "iso 1.8", "metric": "build_s", "note": "..."}]:
+              the measured reason for a geods program's speed-up on all cores (variant and metric: a
+              name or a list of names, left out to match all), shown in the "why" column of the
+              All-cores table
 
 Every program takes --data DIR --threads N --reps N [--scale X] and prints one JSON line per
 measurement: {"workload","anchor","variant","threads","build_s","query_s","count","median_of",...,"ok"}.
@@ -190,8 +194,10 @@ def run_comparison(c, bin_dir, data_dir, threads_list, rounds, reps, scale, stat
     records, raw, problems = [], [], []
     tl = threads_list if c["threads"] == "all" else [1]
     env = dict(os.environ, ANCHORS_REPS=str(reps), ANCHORS_DATA=data_dir)
-    for threads in tl:
-        for rnd in range(rounds):
+    # Each round runs every program on 1 thread, then on the other counts: the speed-ups of the
+    # All-cores table compare runs minutes apart, not the first and last parts of the comparison.
+    for rnd in range(rounds):
+        for threads in tl:
             for p in c["programs"]:
                 if "command" in p:
                     cmd = [a.format(python=PY, dir=c["dir"], bin=bin_dir) for a in p["command"]]
@@ -410,6 +416,10 @@ def tabulate(c, records):
     return "\n".join(lines), summary, labels
 
 
+def as_list(x):
+    return x if isinstance(x, list) else [x]
+
+
 def speedup_rows(c, records, labels, run):
     """Rows of the all-cores table: every geods program's time on one thread / on the most threads
     measured in the same run, per variant and timing metric, beside the peers' same ratio."""
@@ -440,8 +450,10 @@ def speedup_rows(c, records, labels, run):
         peers = [f"{labels.get(b, b)} {ps:.2f}" for b in labels if not b.startswith("geods")
                  for ps, _ in [speedup((b, v, m))] if ps]
         mark = f"**{s:.2f}**" if s >= 1.6 else f"{s:.2f} (< 1.6)"
+        why = next((n["note"] for n in c.get("scaling", []) if n.get("anchor") == a
+                    and v in as_list(n.get("variant", v)) and m in as_list(n.get("metric", m))), "")
         rows.append(f"| {c['workload']} | {md_escape(labels.get(a, a))} | `{v}` | {m} | {most} | {mark} | "
-                    f"{md_escape(', '.join(peers)) or '–'} | {load} |")
+                    f"{md_escape(', '.join(peers)) or '–'} | {load} | {md_escape(why) or '–'} |")
     return rows
 
 
@@ -607,9 +619,10 @@ def write_report(out, jsonl, cmdline, info, versions, verify, comps, results, st
     L.append("Speed-up of every geods program measured on one thread and on all threads in the same run: "
              "time on 1 thread / time on N threads (N = the machine's cores), with the peers' speed-up on the "
              "same variant for comparison and the load average of that run (a loaded machine cannot show a "
-             "speed-up: compare with the peers' column).\n")
-    L.append("| workload | program | variant | metric | threads | speed-up | peers' speed-up | load |")
-    L.append("|---|---|---|---|---|---|---|---|")
+             "speed-up: compare with the peers' column). \"why\": the measured reason, from the comparison's "
+             "compare.json (`scaling`), where the speed-up is below 1.6 or the program is sequential by design.\n")
+    L.append("| workload | program | variant | metric | threads | speed-up | peers' speed-up | load | why |")
+    L.append("|---|---|---|---|---|---|---|---|---|")
     L += all_cores
     L.append("")
     if problems_all:

@@ -4,6 +4,7 @@
 #include <Eigen/Dense>
 
 #include <array>
+#include <atomic>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -14,6 +15,7 @@
 
 #include "geods/core/error.hpp"
 #include "geods/core/grid3.hpp"
+#include "geods/core/parallel.hpp"
 #include "geods/iso/case_table.hpp"
 
 namespace geods::iso::detail {
@@ -253,10 +255,15 @@ bool mirrored(const Grid3View<T>& volume, std::span<const Vec3f> positions) {
 template <typename T>
 void check_samples(const Grid3View<T>& volume) {
   if constexpr (std::is_floating_point_v<T>) {
-    bool bad = false;
-    for (const T v : volume.data) bad |= (v - v != 0);
-    if (bad) {
-      for (std::size_t i = 0; i < volume.size(); ++i)
+    // One pass over the samples in parallel blocks; the rare failure is then located in order.
+    std::atomic<bool> bad{false};
+    parallel_for(0, volume.data.size(), std::size_t(1) << 16, [&](std::size_t b, std::size_t e) {
+      bool block = false;
+      for (std::size_t i = b; i < e; ++i) block |= (volume.data[i] - volume.data[i] != 0);
+      if (block) bad.store(true, std::memory_order_relaxed);
+    });
+    if (bad.load()) {
+      for (std::size_t i = 0; i < volume.data.size(); ++i)
         if (!std::isfinite(volume.data[i]))
           throw Error("isosurface: sample " + std::to_string(i) + " of the volume is " +
                       (volume.data[i] != volume.data[i] ? "NaN" : "infinite"));

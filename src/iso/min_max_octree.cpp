@@ -246,19 +246,27 @@ MinMaxOctree<T>::MinMaxOctree(Grid3<T> volume, std::size_t leaf_cells)
   if (leaf_cells_ == 0 || leaf_cells_ > kMaxLeafCells)
     throw Error("MinMaxOctree: leaf_cells must be in [1, " + std::to_string(kMaxLeafCells) + "], not " +
                 std::to_string(leaf_cells_));
-  detail::check_samples(this->volume());
   const std::size_t total = make_levels();
-  if (total == 0) return;
+  if (total == 0) {
+    detail::check_samples(this->volume());
+    return;
+  }
   std::vector<T> min(total), max(total);
   const auto& leaves = levels_[0].dims;
+  // The leaves cover every sample, so their pass also checks that all are finite (one pass over
+  // the volume instead of two; check_samples then names the first bad sample).
+  std::vector<char> non_finite(leaves[2], 0);
   parallel_for_each_index(0, leaves[2], [&](std::size_t z) {
+    bool bad = false;
     for (std::size_t y = 0; y < leaves[1]; ++y)
       for (std::size_t x = 0; x < leaves[0]; ++x) {
-        const std::array<T, 2> r = leaf_range(x, y, z);
+        const std::array<T, 2> r = leaf_range(x, y, z, &bad);
         min[node_index(0, x, y, z)] = r[0];
         max[node_index(0, x, y, z)] = r[1];
       }
+    non_finite[z] = bad;
   }, 1);
+  if (std::find(non_finite.begin(), non_finite.end(), 1) != non_finite.end()) detail::check_samples(this->volume());
   for (std::size_t level = 1; level < levels_.size(); ++level) {
     const auto& d = levels_[level].dims;
     const auto& cd = levels_[level - 1].dims;
@@ -284,17 +292,22 @@ MinMaxOctree<T>::MinMaxOctree(Grid3<T> volume, std::size_t leaf_cells)
 }
 
 template <typename T>
-std::array<T, 2> MinMaxOctree<T>::leaf_range(std::size_t x, std::size_t y, std::size_t z) const {
+std::array<T, 2> MinMaxOctree<T>::leaf_range(std::size_t x, std::size_t y, std::size_t z, bool* non_finite) const {
   const std::size_t L = leaf_cells_;
   const std::size_t x0 = x * L, y0 = y * L, z0 = z * L;
   const std::size_t x1 = std::min(x0 + L, cells_[0]), y1 = std::min(y0 + L, cells_[1]),
                     z1 = std::min(z0 + L, cells_[2]);
   T lo = samples_[grid_.index(x0, y0, z0)], hi = lo;
+  bool bad = false;
   for (std::size_t k = z0; k <= z1; ++k)
     for (std::size_t j = y0; j <= y1; ++j) {
       const T* row = samples_.data() + grid_.index(0, j, k);
       for (std::size_t i = x0; i <= x1; ++i) lo = std::min(lo, row[i]), hi = std::max(hi, row[i]);
+      if constexpr (std::is_floating_point_v<T>)
+        if (non_finite)
+          for (std::size_t i = x0; i <= x1; ++i) bad |= (row[i] - row[i] != 0);  // NaN or infinite
     }
+  if (non_finite) *non_finite |= bad;
   return {lo, hi};
 }
 

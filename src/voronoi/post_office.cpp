@@ -2,9 +2,11 @@
 #include "geods/voronoi/post_office.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <string>
+#include <utility>
 
 #include "exact_compare.hpp"
 #include "geods/core/coordinate_range.hpp"
@@ -100,27 +102,52 @@ SlabLocator::SlabLocator(const Voronoi2& diagram) : diagram_(&diagram) {
   const auto last_slab = [&](double x1) {
     return x1 == kInf ? xs_.size() : std::size_t(std::lower_bound(xs_.begin(), xs_.end(), x1) - xs_.begin());
   };
-  std::vector<std::size_t> count(slabs + 1, 0);
-  for (const Span& s : spans) {
-    ++count[first_slab(s.x0)];
-    --count[last_slab(s.x1) + 1];
-  }
-  std::size_t total = 0, running = 0;
+  // The spans in consecutive blocks, counted and filled block by block in parallel: each slab
+  // gets its edges in the order of the spans whatever the number of blocks (the sort below
+  // then sees the same input on any number of threads).
+  std::vector<std::array<std::uint32_t, 2>> span_slabs(spans.size());  // first and last slab
+  parallel_for(0, spans.size(), 4096, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i)
+      span_slabs[i] = {std::uint32_t(first_slab(spans[i].x0)), std::uint32_t(last_slab(spans[i].x1))};
+  });
+  const std::size_t threads = std::size_t(num_threads());
+  const std::size_t blocks =
+      threads == 1 ? 1 : std::max<std::size_t>(1, std::min<std::size_t>(2 * threads, spans.size() / 4096));
+  const auto block_begin = [&](std::size_t b) { return b * spans.size() / blocks; };
+  // Per block and slab: how many of the block's spans cross the slab (from a difference
+  // array; unsigned wrap-around is exact since every count fits), later where they go.
+  std::vector<std::vector<std::uint32_t>> place(blocks);
+  parallel_for_each_index(0, blocks, [&](std::size_t b) {
+    std::vector<std::uint32_t>& c = place[b];
+    c.assign(slabs + 1, 0);
+    for (std::size_t i = block_begin(b); i < block_begin(b + 1); ++i) {
+      ++c[span_slabs[i][0]];
+      --c[span_slabs[i][1] + 1];
+    }
+    std::uint32_t running = 0;
+    for (std::size_t s = 0; s < slabs; ++s) c[s] = running += c[s];
+  }, 1);
+  std::size_t total = 0;
   offsets_.assign(slabs + 1, 0);
   for (std::size_t s = 0; s < slabs; ++s) {
-    running += count[s];
-    total += running;
+    for (std::size_t b = 0; b < blocks; ++b) total += place[b][s];
     if (total >= std::numeric_limits<std::uint32_t>::max())
       throw Error("SlabLocator: more than 2^32 edge-slab crossings (" + std::to_string(diagram.stats().distinct) +
                   " sites); use WalkLocator for this many sites");
     offsets_[s + 1] = std::uint32_t(total);
   }
+  parallel_for(0, slabs, 1024, [&](std::size_t first, std::size_t last) {
+    for (std::size_t s = first; s < last; ++s)
+      for (std::uint32_t b = 0, at = offsets_[s]; b < blocks; ++b) at += std::exchange(place[b][s], at);
+  });
   edge_.resize(total);
   below_.resize(total);
-  std::vector<std::uint32_t> fill(offsets_.begin(), offsets_.end() - 1);
-  for (const Span& s : spans)
-    for (std::size_t slab = first_slab(s.x0), last = last_slab(s.x1); slab <= last; ++slab)
-      edge_[fill[slab]++] = s.edge;
+  parallel_for_each_index(0, blocks, [&](std::size_t b) {
+    std::vector<std::uint32_t>& fill = place[b];
+    for (std::size_t i = block_begin(b); i < block_begin(b + 1); ++i)
+      for (std::size_t slab = span_slabs[i][0], last = span_slabs[i][1]; slab <= last; ++slab)
+        edge_[fill[slab]++] = spans[i].edge;
+  }, 1);
 
   // Sort each slab bottom to top at its middle; edges do not cross inside a slab.
   top_.assign(slabs, 0);

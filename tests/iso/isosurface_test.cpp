@@ -306,6 +306,44 @@ TEST(Isosurface, CurvilinearGridPlacesVerticesInPhysicalSpace) {
   }
 }
 
+// The octree checks the samples in its leaf pass (leaves share their boundary samples): on
+// any number of threads it names the first non-finite sample, as the check of the whole volume does.
+TEST(MinMaxOctree, NamesTheFirstNonFiniteSample) {
+  ThreadGuard guard;
+  const auto message = [](const Grid3<float>& g, std::size_t leaf_cells) {
+    try {
+      MinMaxOctree<float> tree(g, leaf_cells);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  Rng rng(19);
+  for (int threads : {1, 2, 3}) {
+    set_num_threads(threads);
+    for (const std::array<std::size_t, 3> dims : {std::array<std::size_t, 3>{9, 13, 17}, {2, 2, 2}, {33, 5, 8}}) {
+      const std::size_t n = dims[0] * dims[1] * dims[2];
+      // The first, the last, a leaf boundary (x = 4 with 4 cells a leaf) and random samples,
+      // alone or with a later bad one.
+      std::vector<std::size_t> where = {0, n - 1, std::min<std::size_t>(4, dims[0] - 1)};
+      for (int k = 0; k < 4; ++k) where.push_back(std::size_t(rng.below(n)));
+      for (std::size_t i : where)
+        for (float bad : {std::nanf(""), INFINITY, -INFINITY}) {
+          Grid3<float> g(dims[0], dims[1], dims[2], 0.5f);
+          g.data[i] = bad;
+          if (i + 1 < n) g.data[n - 1] = std::nanf("");  // a later one must not be named
+          const std::string want = "isosurface: sample " + std::to_string(i) + " of the volume is " +
+                                   (bad != bad ? "NaN" : "infinite");
+          EXPECT_EQ(message(g, 4), want) << threads << " threads, sample " << i;
+          EXPECT_EQ(message(g, 1), want) << threads << " threads, sample " << i << ", leaf_cells 1";
+        }
+    }
+  }
+  Grid3<float> flat(5, 5, 1, 0.0f);  // no cells: still checked
+  flat(3, 2, 0) = std::nanf("");
+  EXPECT_EQ(message(flat, 4), "isosurface: sample 13 of the volume is NaN");
+}
+
 TEST(Isosurface, BadInputThrows) {
   Grid3<float> g(4, 4, 4, 0.0f);
   EXPECT_THROW(isosurface(g, std::nan("")), Error);

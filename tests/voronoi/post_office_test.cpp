@@ -4,6 +4,7 @@
 
 #include "brute_delaunay.hpp"
 #include "geods/core/error.hpp"
+#include "geods/core/parallel.hpp"
 #include "geods/voronoi/post_office.hpp"
 
 namespace geods::voronoi {
@@ -101,6 +102,36 @@ TEST(PostOffice, CollinearAndDuplicatedSites) {
   std::vector<Vec2d> p = uniform_points(30, 10);
   p.insert(p.end(), {p[0], p[5], p[5]});
   check_locators(brute_delaunay(p).voronoi(), 11);
+}
+
+// The slabs are filled block by block in parallel (a block per 4096 edges at most): the same
+// structure, so the same answers, on any number of threads.
+TEST(PostOffice, SlabsTheSameOnAnyNumberOfThreads) {
+  std::vector<Vec2d> p = uniform_points(6000, 21);
+  for (int i = 0; i < 2000; ++i) p.push_back(p[std::size_t(i)] * 1e-3 + Vec2d(0.5, 0.5));  // a dense cluster
+  const Voronoi2 v(p);
+  Rng rng(22);
+  std::vector<Vec2d> queries;
+  for (int i = 0; i < 20000; ++i) queries.push_back({rng.uniform(-0.2, 1.2), rng.uniform(-0.2, 1.2)});
+  for (int i = 0; i < 2000; ++i) queries.push_back(Vec2d(0.5, 0.5) + 1e-3 * Vec2d(rng.uniform(), rng.uniform()));
+  for (const Vec2d& c : v.vertices()) queries.push_back(c);
+  set_num_threads(1);
+  const SlabLocator one(v);
+  one.validate();
+  std::vector<std::uint32_t> want;
+  for (const Vec2d& q : queries) want.push_back(one.locate(q));
+  for (int threads : {2, 3, 5}) {
+    set_num_threads(threads);
+    const SlabLocator many(v);
+    many.validate();
+    EXPECT_EQ(many.stats().slabs, one.stats().slabs);
+    EXPECT_EQ(many.stats().crossings, one.stats().crossings);
+    std::size_t differ = 0;
+    for (std::size_t i = 0; i < queries.size(); ++i) differ += many.locate(queries[i]) != want[i];
+    EXPECT_EQ(differ, 0u) << threads << " threads";
+  }
+  set_num_threads(0);
+  for (std::size_t i = 0; i < queries.size(); i += 97) expect_nearest(v, queries[i], one.nearest(queries[i]));
 }
 
 TEST(PostOffice, BadQueries) {

@@ -147,7 +147,9 @@ class MinMaxOctree {
     const Level& l = levels_[level];
     return l.offset + x + l.dims[0] * (y + l.dims[1] * z);
   }
-  std::array<T, 2> leaf_range(std::size_t x, std::size_t y, std::size_t z) const;
+  // The least and greatest sample of a leaf; with non_finite, also sets *non_finite when one of
+  // them is NaN or infinite (the constructor's check, in the same pass over the samples).
+  std::array<T, 2> leaf_range(std::size_t x, std::size_t y, std::size_t z, bool* non_finite = nullptr) const;
   // validate(); without leaves_against_samples the leaves are only checked
   // min <= max (no pass over the volume), the levels above against their children.
   void check_nodes(bool leaves_against_samples) const;

@@ -20,7 +20,10 @@
 // so the answer is always a nearest site: the representative of a point at the
 // smallest distance; among sites at exactly equal distance, any one of them.
 #include <cstdint>
+#include <memory>
+#include <new>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "geods/core/vec.hpp"
@@ -67,13 +70,34 @@ class SlabLocator {
     return l.y0 + (x - l.x0) * l.slope;
   }
   double slab_middle(std::size_t s) const;  // an x inside slab s
+  // The entries are all written by the parallel fill and sorts: resize() leaves them
+  // uninitialized (no sequential zero-fill of n^1.5 entries; their pages are first touched in parallel).
+  template <typename T>
+  struct Uninitialized : std::allocator<T> {
+    template <typename U>
+    struct rebind {
+      using other = Uninitialized<U>;
+    };
+    Uninitialized() = default;
+    template <typename U>
+    Uninitialized(const Uninitialized<U>&) noexcept {}
+    template <typename U>
+    void construct(U* p) noexcept {
+      ::new (static_cast<void*>(p)) U;
+    }
+    template <typename U, typename... Args>
+    void construct(U* p, Args&&... args) {
+      ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+    }
+  };
+  using Entries = std::vector<std::uint32_t, Uninitialized<std::uint32_t>>;
 
   const Voronoi2* diagram_;
   std::vector<Line> lines_;                  // per half-edge of the diagram (only stored ones are set)
   std::vector<double> xs_;                   // slab boundaries, increasing; slab s spans (xs_[s-1], xs_[s])
   std::vector<std::uint32_t> offsets_;       // slab s holds entries [offsets_[s], offsets_[s+1])
-  std::vector<std::uint32_t> edge_;          // per entry: a half-edge of the edge, with its site above it
-  std::vector<std::uint32_t> below_;         // per entry: the site below the edge
+  Entries edge_;                             // per entry: a half-edge of the edge, with its site above it
+  Entries below_;                            // per entry: the site below the edge
   std::vector<std::uint32_t> top_;           // per slab: the site above its highest edge
 };
 
