@@ -1,6 +1,7 @@
 // Embree 3 (RTC_BUILD_QUALITY_MEDIUM, rtcIntersect1 one ray at a time) on the ray comparison.
 #include <embree3/rtcore.h>
 
+#include "embree_scene.hpp"
 #include "ray_driver.hpp"
 
 namespace {
@@ -20,20 +21,7 @@ struct Embree {
     auto index = std::make_unique<Index>();
     const std::string config = "threads=" + std::to_string(threads);
     index->device = rtcNewDevice(config.c_str());
-    index->scene = rtcNewScene(index->device);
-    rtcSetSceneBuildQuality(index->scene, RTC_BUILD_QUALITY_MEDIUM);
-    RTCGeometry geom = rtcNewGeometry(index->device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    auto* v = static_cast<float*>(
-        rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), mesh.vertices()));
-    std::copy(mesh.xyz.begin(), mesh.xyz.end(), v);
-    auto* f = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                             3 * sizeof(unsigned), mesh.triangles()));
-    std::copy(mesh.tris.begin(), mesh.tris.end(), f);
-    rtcSetGeometryBuildQuality(geom, RTC_BUILD_QUALITY_MEDIUM);
-    rtcCommitGeometry(geom);
-    rtcAttachGeometry(index->scene, geom);
-    rtcReleaseGeometry(geom);
-    rtcCommitScene(index->scene);
+    index->scene = embree_mesh_scene(index->device, mesh);
     return index;
   }
   static compare::ray::Hit intersect(const Index& index, const float* r) {

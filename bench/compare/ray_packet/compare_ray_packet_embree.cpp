@@ -5,6 +5,7 @@
 // (RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED; else 8 and 4 x 2 tiles).
 #include <embree3/rtcore.h>
 
+#include "embree_scene.hpp"
 #include "ray_packet_driver.hpp"
 
 #ifndef GEODS_EMBREE_PACKET
@@ -52,20 +53,7 @@ struct Embree {
     const int property = N == 16 ? RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED : RTC_DEVICE_PROPERTY_NATIVE_RAY8_SUPPORTED;
     if (!rtcGetDeviceProperty(index->device, RTCDeviceProperty(property)))
       throw std::runtime_error("Embree: this CPU or build does not support packets of " + std::to_string(N));
-    index->scene = rtcNewScene(index->device);
-    rtcSetSceneBuildQuality(index->scene, RTC_BUILD_QUALITY_MEDIUM);
-    RTCGeometry geom = rtcNewGeometry(index->device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    auto* v = static_cast<float*>(
-        rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), mesh.vertices()));
-    std::copy(mesh.xyz.begin(), mesh.xyz.end(), v);
-    auto* f = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                             3 * sizeof(unsigned), mesh.triangles()));
-    std::copy(mesh.tris.begin(), mesh.tris.end(), f);
-    rtcSetGeometryBuildQuality(geom, RTC_BUILD_QUALITY_MEDIUM);
-    rtcCommitGeometry(geom);
-    rtcAttachGeometry(index->scene, geom);
-    rtcReleaseGeometry(geom);
-    rtcCommitScene(index->scene);
+    index->scene = embree_mesh_scene(index->device, mesh);
     return index;
   }
   template <class RayN>
