@@ -8,6 +8,7 @@
 #include <map>
 #include <string>
 
+#include "geods/core/archive.hpp"
 #include "geods/core/error.hpp"
 #include "geods/io/image_io.hpp"
 #include "geods/io/mesh_io.hpp"
@@ -257,6 +258,16 @@ void describe_collection(const fs::path& path, Report& report) {
   for (const std::string& w : c.warnings()) report.lines.push_back("  problem: " + w);
 }
 
+// A geods archive (what save() writes: .geodsadf, .geodsterrain, ...): its structure and layout version.
+void describe_archive(const fs::path& path, Report& report) {
+  const Archive::Kind kind = Archive::peek(path);
+  report.json["kind"] = "archive";
+  report.json["structure"] = kind.kind;
+  report.json["version"] = kind.version;
+  report.lines.push_back(fmt::format("{}: geods archive of a {} (layout version {}), {} bytes",
+                                     path.filename().string(), kind.kind, kind.version, fs::file_size(path)));
+}
+
 }  // namespace
 
 Report describe_file(const fs::path& path, const std::optional<RawVolumeSpec>& raw) {
@@ -293,6 +304,8 @@ Report describe_file(const fs::path& path, const std::optional<RawVolumeSpec>& r
     describe_map(path, report);
   } else if (ext == ".tif" || ext == ".tiff" || ext == ".ter" || ext == ".asc" || ext == ".hgt") {
     describe_raster(path, report);
+  } else if (!standard_input && ext.starts_with(".geods")) {
+    describe_archive(path, report);
   } else if (ext == ".raw") {
     throw Error(path.string() + ": a raw volume needs --dims X,Y,Z and --dtype");
   } else {
@@ -300,6 +313,7 @@ Report describe_file(const fs::path& path, const std::optional<RawVolumeSpec>& r
                 "' (meshes .ply .obj .stl .off .gltf .glb, also .gz; volumes .nii .nii.gz .nrrd .npy .raw; images .png "
                 ".jpg .bmp; points .xyz .csv .txt .ply .npy; segments .edg .cin .npy; shape collections .sh3f .zip; maps .shp "
                 ".wkt .geojson .gpkg .kml .svg; height fields .tif .ter .asc .hgt; "
+                "geods archives .geods*; "
                 "- for standard input)");
   }
   report.json["compute_s"] = watch.seconds();

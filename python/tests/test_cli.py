@@ -36,7 +36,7 @@ def test_bad_arguments_exit_2_with_one_line(cli):
 @pytest.mark.parametrize("name,kind", [
     ("bunny.ply", "mesh"), ("teapot.obj", "mesh"), ("brick.png", "image"), ("t1_head.nii.gz", "volume"),
     ("jacksboro_dem.npy", "array"), ("land_points.npy", "points"), ("land_segments.npy", "segments"),
-    ("furniture.sh3f", "collection"),
+    ("furniture.sh3f", "collection"), ("adf_bunny_v2.geodsadf", "archive"),
 ])
 def test_info_json_on_every_data_file(cli, data_dir, name, kind):
     r = run(cli, "info", data_dir / name, "--json")
@@ -47,6 +47,8 @@ def test_info_json_on_every_data_file(cli, data_dir, name, kind):
     assert report["compute_s"] >= 0
     if kind == "mesh":
         assert report["triangles"] > 0 and len(report["bounds"]["min"]) == 3
+    if kind == "archive":
+        assert report["structure"] == "field.Adf" and report["version"] == 2
     # The human form names the file too.
     r = run(cli, "info", data_dir / name)
     assert r.returncode == 0 and name in r.stdout
