@@ -261,6 +261,36 @@ inline std::size_t best_lane(const float* best, const std::int32_t* face_of, con
   return index;
 }
 
+// For each corner c of a block's list (k<c>: the squared distances from the
+// block's corner c), the entry of the smallest distance, ties to the smallest
+// face (the lexicographic minimum of (distance, face): one entry whatever the
+// order of the search, so the same at every SIMD level).
+__attribute__((target_clones("avx2", "default"))) void corner_nearest(const Packed& t, std::array<std::size_t, 8>& index) {
+  const I8 size = I8{} + std::int32_t(t.size), lanes = I8{0, 1, 2, 3, 4, 5, 6, 7};
+  for (int c = 0; c < 8; ++c) {
+    V8 best = V8{} + kInf;
+    I8 at = I8{}, best_face = I8{} + std::numeric_limits<std::int32_t>::max();
+    const float* k = t.f[Packed::k0 + c].data();
+    for (std::size_t i = 0; i < t.size; i += 8) {
+      const I8 lane = lanes + std::int32_t(i);
+      V8 r = load8(k + i);
+      r = lane < size ? r : V8{} + kInf;
+      I8 face;
+      std::memcpy(&face, t.face.data() + i, sizeof face);
+      const auto closer = (r < best) | ((r == best) & (face < best_face));
+      best = closer ? r : best;
+      best_face = closer ? face : best_face;
+      at = closer ? lane : at;
+    }
+    float bd[8], d2;
+    std::int32_t bf[8], ba[8];
+    std::memcpy(bd, &best, sizeof bd);
+    std::memcpy(bf, &best_face, sizeof bf);
+    std::memcpy(ba, &at, sizeof ba);
+    index[c] = best_lane(bd, bf, ba, 8, d2);
+  }
+}
+
 // The entry of t nearest to p and its squared distance; of equally near
 // ones, the one of the smallest face index. t is a block's list with the
 // squared distances from the block's corners (k0..k7): by concavity,
@@ -454,6 +484,32 @@ GEODS_AVX512_FN void lattice_filter(const Packed& t, const Lattice& lat,
       pass &= ok;
       for (unsigned m = pass; m; m &= m - 1) out[b].push_back(std::uint32_t(i + std::size_t(__builtin_ctz(m))));
     }
+  }
+}
+
+// As corner_nearest() above, sixteen entries at a time.
+GEODS_AVX512_FN void corner_nearest(const Packed& t, std::array<std::size_t, 8>& index) {
+  const __m512i lanes = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+  for (int c = 0; c < 8; ++c) {
+    __m512 best = _mm512_set1_ps(kInf);
+    __m512i at = _mm512_setzero_si512(), best_face = _mm512_set1_epi32(std::numeric_limits<std::int32_t>::max());
+    const float* k = t.f[Packed::k0 + c].data();
+    for (std::size_t i = 0; i < t.size; i += 16) {
+      const __m512 r = _mm512_mask_blend_ps(valid(i, t.size), _mm512_set1_ps(kInf), _mm512_loadu_ps(k + i));
+      const __m512i face = _mm512_loadu_si512(t.face.data() + i);
+      const __mmask16 closer = _mm512_cmp_ps_mask(r, best, _CMP_LT_OQ) |
+                               (_mm512_cmp_ps_mask(r, best, _CMP_EQ_OQ) & _mm512_cmplt_epi32_mask(face, best_face));
+      best = _mm512_mask_blend_ps(closer, best, r);
+      best_face = _mm512_mask_blend_epi32(closer, best_face, face);
+      at = _mm512_mask_blend_epi32(closer, at, _mm512_add_epi32(lanes, _mm512_set1_epi32(std::int32_t(i))));
+    }
+    alignas(64) float bd[16];
+    alignas(64) std::int32_t bf[16], ba[16];
+    float d2;
+    _mm512_store_ps(bd, best);
+    _mm512_store_si512(bf, best_face);
+    _mm512_store_si512(ba, at);
+    index[c] = best_lane(bd, bf, ba, 16, d2);
   }
 }
 
@@ -681,6 +737,17 @@ class GridSolver {
         filter(near, block, c.point, block_list, kept, true, std::span(anchors.data(), num_anchors));
         const BlockWeights weights = block_weights(block);  // in_box of each sample
         std::size_t seed = 0;  // the group of the previous sample's nearest face
+        // The block's corner samples have their distances from every face of
+        // the list already (k0..k7): their nearest entries in one pass.
+        std::array<std::size_t, 8> corner{};
+        if (block_list.size) {
+#ifdef GEODS_SDF_AVX512
+          if (wide_)
+            avx512::corner_nearest(block_list, corner);
+          else
+#endif
+            corner_nearest(block_list, corner);
+        }
         if (wide_ && row.size() < 2 * block_list.f[0].size()) row.resize(2 * block_list.f[0].size());
         for (std::size_t k = block.lo[2]; k < block.hi[2]; ++k)
           for (std::size_t j = block.lo[1]; j < block.hi[1]; ++j) {
@@ -694,7 +761,7 @@ class GridSolver {
               const int cz = k == block.lo[2] ? 0 : k + 1 == block.hi[2] ? 4 : -1;
               Closest s;
               if (cx >= 0 && cy >= 0 && cz >= 0) {
-                s = closest_at_corner(block_list, p, cx + cy + cz);
+                if (block_list.size) s = entry(block_list, p, corner[cx + cy + cz]);
               } else {
                 const InBlock at_p = in_box(weights, i - block.lo[0], j - block.lo[1], k - block.lo[2]);
 #ifdef GEODS_SDF_AVX512
@@ -922,21 +989,6 @@ class GridSolver {
     best.point = closest_point_on_triangle(p, tri.a, tri.b, tri.c, best.region);
     best.d2 = (best.point - p).squaredNorm();
     return best;
-  }
-
-  // As closest_in for a block's corner sample p (corner c of the block, the
-  // list's distances k<c>): the same face, of the same squared distance as
-  // the search computes, with the same ties.
-  Closest closest_at_corner(const Packed& list, const Vec3f& p, int c) const {
-    if (list.size == 0) return Closest{};
-    const float* k = list.f[Packed::k0 + c].data();
-    const std::int32_t* face = list.face.data();
-    std::size_t i = 0;
-    float d2 = kInf;
-    std::int32_t f = std::numeric_limits<std::int32_t>::max();
-    for (std::size_t j = 0; j < list.size; ++j)
-      if (k[j] < d2 || (k[j] == d2 && face[j] < f)) d2 = k[j], f = face[j], i = j;
-    return entry(list, p, i);
   }
 
   const MeshDistance& mesh_;
