@@ -265,7 +265,7 @@ inline std::size_t best_lane(const float* best, const std::int32_t* face_of, con
 // block's corner c), the entry of the smallest distance, ties to the smallest
 // face (the lexicographic minimum of (distance, face): one entry whatever the
 // order of the search, so the same at every SIMD level).
-__attribute__((target_clones("avx2", "default"))) void corner_nearest(const Packed& t, std::array<std::size_t, 8>& index) {
+__attribute__((target_clones("avx2", "default"))) void corner_nearest(const Packed& t, std::array<std::size_t, 8>& index, std::array<float, 8>& dist2) {
   const I8 size = I8{} + std::int32_t(t.size), lanes = I8{0, 1, 2, 3, 4, 5, 6, 7};
   for (int c = 0; c < 8; ++c) {
     V8 best = V8{} + kInf;
@@ -288,6 +288,7 @@ __attribute__((target_clones("avx2", "default"))) void corner_nearest(const Pack
     std::memcpy(bf, &best_face, sizeof bf);
     std::memcpy(ba, &at, sizeof ba);
     index[c] = best_lane(bd, bf, ba, 8, d2);
+    dist2[c] = d2;
   }
 }
 
@@ -488,7 +489,7 @@ GEODS_AVX512_FN void lattice_filter(const Packed& t, const Lattice& lat,
 }
 
 // As corner_nearest() above, sixteen entries at a time.
-GEODS_AVX512_FN void corner_nearest(const Packed& t, std::array<std::size_t, 8>& index) {
+GEODS_AVX512_FN void corner_nearest(const Packed& t, std::array<std::size_t, 8>& index, std::array<float, 8>& dist2) {
   const __m512i lanes = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
   for (int c = 0; c < 8; ++c) {
     __m512 best = _mm512_set1_ps(kInf);
@@ -510,6 +511,7 @@ GEODS_AVX512_FN void corner_nearest(const Packed& t, std::array<std::size_t, 8>&
     _mm512_store_si512(bf, best_face);
     _mm512_store_si512(ba, at);
     index[c] = best_lane(bd, bf, ba, 16, d2);
+    dist2[c] = d2;
   }
 }
 
@@ -740,13 +742,14 @@ class GridSolver {
         // The block's corner samples have their distances from every face of
         // the list already (k0..k7): their nearest entries in one pass.
         std::array<std::size_t, 8> corner{};
+        std::array<float, 8> corner_d2{};
         if (block_list.size) {
 #ifdef GEODS_SDF_AVX512
           if (wide_)
-            avx512::corner_nearest(block_list, corner);
+            avx512::corner_nearest(block_list, corner, corner_d2);
           else
 #endif
-            corner_nearest(block_list, corner);
+            corner_nearest(block_list, corner, corner_d2);
         }
         if (wide_ && row.size() < 2 * block_list.f[0].size()) row.resize(2 * block_list.f[0].size());
         for (std::size_t k = block.lo[2]; k < block.hi[2]; ++k)
@@ -761,13 +764,13 @@ class GridSolver {
               const int cz = k == block.lo[2] ? 0 : k + 1 == block.hi[2] ? 4 : -1;
               Closest s;
               if (cx >= 0 && cy >= 0 && cz >= 0) {
-                if (block_list.size) s = entry(block_list, p, corner[cx + cy + cz]);
+                if (block_list.size) s = as_nearest(block_list, corner[cx + cy + cz], corner_d2[cx + cy + cz]);
               } else {
                 const InBlock at_p = in_box(weights, i - block.lo[0], j - block.lo[1], k - block.lo[2]);
 #ifdef GEODS_SDF_AVX512
                 if (wide_ && !row_ready) avx512::row_bounds(block_list, at_p.wy, at_p.wz, row.data()), row_ready = true;
 #endif
-                s = closest_in(block_list, p, &at_p, seed, wide_ ? row.data() : nullptr);
+                s = closest_in(block_list, p, &at_p, seed, wide_ ? row.data() : nullptr, false);
               }
               seed = s.slot / 8;
               const float d = std::sqrt(s.d2);
@@ -797,8 +800,13 @@ class GridSolver {
           const auto apart = [&](std::size_t n, float h) { return d + ud[n] > h * (1 + 1e-5f) + 2 * margin_; };
           if (options_.sign == SignMethod::none) {
           } else if (options_.sign == SignMethod::pseudonormal && d < kInf) {
+            // The side of the closest point's feature (the samples keep only their face).
             const std::uint32_t face = ids_[c.leaf];
-            in = (grid_.position(i, j, k) - c.point).dot(mesh_.pseudonormal(face, c.region)) < 0;
+            const BvhTriangle& tri = tris_[c.leaf];
+            const Vec3f p = grid_.position(i, j, k);
+            TriangleRegion region;
+            const Vec3f q = closest_point_on_triangle(p, tri.a, tri.b, tri.c, region);
+            in = (p - q).dot(mesh_.pseudonormal(face, region)) < 0;
           } else if (propagate && i > box.lo[0] && apart(l - 1, hx)) {
             in = inside[l - 1];
           } else if (propagate && j > box.lo[1] && apart(l - nx, hy)) {
@@ -965,10 +973,11 @@ class GridSolver {
   }
 
   // The closest entry of `list` to p (ties: the smallest face index), with
-  // its exact closest point and region.
+  // its exact closest point and region (`point`), else only its face and the
+  // search's squared distance.
   // With `at_p`, the list is a block's (with corner distances) and p is in the block.
   Closest closest_in(const Packed& list, const Vec3f& p, const InBlock* at_p = nullptr, std::size_t seed = 0,
-                     const float* row = nullptr) const {
+                     const float* row = nullptr, bool point = true) const {
     if (list.size == 0) return Closest{};
     float nearest_d2;
 #ifdef GEODS_SDF_AVX512
@@ -977,7 +986,18 @@ class GridSolver {
 #else
     const std::size_t i = nearest(list, p, at_p, slack_, seed, nearest_d2);
 #endif
-    return entry(list, p, i);
+    return point ? entry(list, p, i) : as_nearest(list, i, nearest_d2);
+  }
+
+  // Entry i of the list as a sample's closest, at the search's squared
+  // distance d2 (the same IEEE operations at every SIMD level), without its
+  // closest point.
+  static Closest as_nearest(const Packed& list, std::size_t i, float d2) {
+    Closest best;
+    best.leaf = list.leaf[i];
+    best.slot = i;
+    best.d2 = d2;
+    return best;
   }
 
   // Entry i of the list as p's closest: its exact closest point and region.
