@@ -937,39 +937,60 @@ class GridSolver {
     else
 #endif
       corner_test(in, box.corners, sets.data(), num_sets, kept);
-    // The order of the entries: by key, ties by index (kept is in index order),
-    // sorted as 64-bit words (key bits, position): non-negative floats order as their bits.
+    // The order of the entries: `sorted`, nearly by key, by a counting sort
+    // into buckets of equal key ranges (in index order within a bucket: kept
+    // is in index order); the order changes only how soon a search may stop,
+    // never its result (the nearest entry, ties to the smallest face).
     const std::size_t n = kept.size();
-    thread_local std::vector<std::uint64_t> order;
+    thread_local std::vector<std::uint32_t> order, from;
+    thread_local std::vector<std::uint8_t> bucket;
     order.resize(n);
-    for (std::size_t j = 0; j < n; ++j) {
-      std::uint32_t bits = 0;
-      if (sorted) {
-        const float key = kept[j].key + 0.0f;  // no -0
-        std::memcpy(&bits, &key, sizeof bits);
+    from.resize(n);
+    if (sorted && n > 8) {
+      constexpr int kBuckets = 64;
+      float lo = kInf, hi = 0;
+      for (std::size_t j = 0; j < n; ++j) lo = std::min(lo, kept[j].key), hi = std::max(hi, kept[j].key);
+      const float scale = hi > lo ? float(kBuckets) / (hi - lo) : 0.0f;
+      std::array<std::uint32_t, kBuckets + 1> start{};
+      bucket.resize(n);
+      for (std::size_t j = 0; j < n; ++j) {
+        const float x = (kept[j].key - lo) * scale;  // NaN (0 * inf) or below 1: the first bucket
+        const int b = x >= 1 ? int(std::min(x, float(kBuckets - 1))) : 0;
+        bucket[j] = std::uint8_t(b);
+        ++start[std::size_t(b) + 1];
       }
-      order[j] = std::uint64_t(bits) << 32 | j;
+      for (int b = 0; b < kBuckets; ++b) start[std::size_t(b) + 1] += start[std::size_t(b)];
+      for (std::size_t j = 0; j < n; ++j) order[start[bucket[j]]++] = std::uint32_t(j);
+    } else {
+      for (std::size_t j = 0; j < n; ++j) order[j] = std::uint32_t(j);
     }
-    if (sorted) std::sort(order.begin(), order.end());
-    const auto at = [&](std::size_t j) -> const Kept& { return kept[std::uint32_t(order[j])]; };
+    for (std::size_t j = 0; j < n; ++j) from[j] = kept[order[j]].index;
     out.clear();
     out.reserve(n);
     for (int k = 0; k < Packed::k0; ++k) {
       const float* src = in.f[k].data();
       float* o = out.f[k].data();
-      for (std::size_t j = 0; j < n; ++j) o[j] = src[at(j).index];
+      for (std::size_t j = 0; j < n; ++j) o[j] = src[from[j]];
     }
     for (int k = 0; k < 8; ++k) {
       float* o = out.f[Packed::k0 + k].data();
-      for (std::size_t j = 0; j < n; ++j) o[j] = at(j).k[k];
+      for (std::size_t j = 0; j < n; ++j) o[j] = kept[order[j]].k[k];
     }
-    for (std::size_t j = 0; j < n; ++j) out.face[j] = in.face[at(j).index], out.leaf.push_back(in.leaf[at(j).index]);
+    for (std::size_t j = 0; j < n; ++j) out.face[j] = in.face[from[j]], out.leaf.push_back(in.leaf[from[j]]);
     out.size = n;
     out.floor.clear();
     if (!sorted) return;
+    // Each group's floor: below the keys of its entries and of all later
+    // ones (nondecreasing, so a search stops at the first that exceeds its best).
     const Vec3f extent = box.corners[7] - box.corners[0];
     const float spread = 0.25f * extent.squaredNorm() * (1 + 1e-4f) + margin_ * margin_;
-    for (std::size_t j = 0; j < n; j += 8) out.floor.push_back(at(j).key * (1 - 1e-4f) - spread - slack_);
+    const std::size_t groups = (n + 7) / 8;
+    out.floor.resize(groups);
+    float least = kInf;
+    for (std::size_t c = groups; c-- > 0;) {
+      for (std::size_t j = 8 * c; j < std::min(n, 8 * c + 8); ++j) least = std::min(least, kept[order[j]].key);
+      out.floor[c] = least * (1 - 1e-4f) - spread - slack_;
+    }
   }
 
   // The closest entry of `list` to p (ties: the smallest face index), with
