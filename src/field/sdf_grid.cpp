@@ -138,11 +138,21 @@ __attribute__((always_inline)) inline void distance8(const Packed::Arrays& f, st
 
 using I8 = std::int32_t __attribute__((vector_size(32)));
 
-// An entry that passes a box's corner test, with its squared distances from the 8 corners.
+// The entries that pass a box's corner test (structure of arrays): their
+// positions in the tested list, their squared distances from the 8 corners
+// and the smallest of those (key).
 struct Kept {
-  float key;  // the smallest of k
-  std::uint32_t index;
-  std::array<float, 8> k;
+  std::vector<std::uint32_t> index;
+  std::vector<float> key;
+  std::array<std::vector<float>, 8> k;
+  std::size_t size = 0;
+  // Empty, with room for n entries and a vector's overhang.
+  void reset(std::size_t n) {
+    size = 0;
+    if (index.size() >= n + 16) return;
+    index.resize(n + 16), key.resize(n + 16);
+    for (auto& a : k) a.resize(n + 16);
+  }
 };
 
 // The entries of t within bound2[0][k] of some corner k, appended to `kept`,
@@ -150,8 +160,9 @@ struct Kept {
 // bound2[j][k] of some corner k for every j < sets.
 __attribute__((target_clones("avx2", "default"))) void corner_test(const Packed& t, const std::array<Vec3f, 8>& corners,
                                                                   const std::array<float, 8>* bound2, int sets,
-                                                                  std::vector<Kept>& kept) {
+                                                                  Kept& kept) {
   const I8 size = I8{} + std::int32_t(t.size), lanes = I8{0, 1, 2, 3, 4, 5, 6, 7};
+  kept.reset(t.size);
   for (std::size_t i = 0; i < t.size; i += 8) {
     V8 d[8];
     I8 pass = I8{};
@@ -167,10 +178,11 @@ __attribute__((target_clones("avx2", "default"))) void corner_test(const Packed&
     pass &= (lanes + std::int32_t(i)) < size;
     for (int l = 0; l < 8; ++l) {
       if (!pass[l]) continue;
-      Kept& e = kept.emplace_back();
-      e.index = std::uint32_t(i + std::size_t(l));
-      e.key = d[0][l];
-      for (int k = 0; k < 8; ++k) e.k[k] = d[k][l], e.key = std::min(e.key, d[k][l]);
+      const std::size_t e = kept.size++;
+      kept.index[e] = std::uint32_t(i + std::size_t(l));
+      float key = d[0][l];
+      for (int k = 0; k < 8; ++k) kept.k[k][e] = d[k][l], key = std::min(key, d[k][l]);
+      kept.key[e] = key;
     }
   }
 }
@@ -422,8 +434,9 @@ GEODS_AVX512_INLINE __mmask16 valid(std::size_t i, std::size_t size) {
 }
 
 GEODS_AVX512_FN void corner_test(const Packed& t, const std::array<Vec3f, 8>& corners, const std::array<float, 8>* bound2,
-                                 int sets, std::vector<Kept>& kept) {
-  alignas(64) float d[8][16];
+                                 int sets, Kept& kept) {
+  kept.reset(t.size);
+  const __m512i lanes = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
   for (std::size_t i = 0; i < t.size; i += 16) {
     __m512 dv[8];
     __mmask16 pass = 0;
@@ -439,14 +452,18 @@ GEODS_AVX512_FN void corner_test(const Packed& t, const std::array<Vec3f, 8>& co
     }
     pass &= valid(i, t.size);
     if (!pass) continue;
-    for (int k = 0; k < 8; ++k) _mm512_store_ps(d[k], dv[k]);
-    for (unsigned m = pass; m; m &= m - 1) {
-      const int l = __builtin_ctz(m);
-      Kept& e = kept.emplace_back();
-      e.index = std::uint32_t(i + std::size_t(l));
-      e.key = d[0][l];
-      for (int k = 0; k < 8; ++k) e.k[k] = d[k][l], e.key = std::min(e.key, d[k][l]);
+    // The passing lanes packed to the end of kept's arrays; key = the
+    // smallest of the 8 distances (as min(key, d) in the eight-wide loop).
+    const std::size_t e = kept.size;
+    __m512 key = dv[0];
+    for (int k = 0; k < 8; ++k) {
+      _mm512_mask_compressstoreu_ps(kept.k[k].data() + e, pass, dv[k]);
+      key = _mm512_mask_blend_ps(_mm512_cmp_ps_mask(dv[k], key, _CMP_LT_OQ), key, dv[k]);
     }
+    _mm512_mask_compressstoreu_ps(kept.key.data() + e, pass, key);
+    _mm512_mask_compressstoreu_epi32(kept.index.data() + e, pass,
+                                     _mm512_add_epi32(lanes, _mm512_set1_epi32(std::int32_t(i))));
+    kept.size += std::size_t(__builtin_popcount(pass));
   }
 }
 
@@ -611,7 +628,7 @@ GEODS_AVX512_FN std::size_t nearest(const Packed& t, const Vec3f& p, const InBlo
 
 struct Scratch {
   Packed tile_list, block_list, near;
-  std::vector<Kept> kept;
+  Kept kept;
   std::vector<std::uint32_t> found;
   std::array<std::vector<std::uint32_t>, kBlocks> survivors;
   std::vector<float> row;  // avx512::row_bounds
@@ -881,7 +898,7 @@ class GridSolver {
   // of the box's corners, then their triangles the same test (filter), in
   // leaf order.
   void gather(const SampleBox& box, const Vec3f& q, Packed& out, Packed& near, std::vector<std::uint32_t>& found,
-              std::vector<Kept>& kept) const {
+              Kept& kept) const {
     const std::array<float, 8> bound2 = bounds_from(box, q);
     const bvh::Topology& topo = mesh_.bvh().topology();
     found.clear();
@@ -924,9 +941,8 @@ class GridSolver {
   // bound below the squared distance from any point of the box to any of
   // the group's faces (by the concavity above: at least the smallest corner
   // distance less the largest spread).
-  void filter(const Packed& in, const SampleBox& box, const Vec3f& q, Packed& out, std::vector<Kept>& kept,
+  void filter(const Packed& in, const SampleBox& box, const Vec3f& q, Packed& out, Kept& kept,
               bool sorted, std::span<const Vec3f> more = {}) const {
-    kept.clear();
     std::array<std::array<float, 8>, 2 + kBlocks> sets;
     const int num_sets = 1 + int(std::min<std::size_t>(more.size(), sets.size() - 1));
     sets[0] = bounds_from(box, q);
@@ -941,7 +957,7 @@ class GridSolver {
     // into buckets of equal key ranges (in index order within a bucket: kept
     // is in index order); the order changes only how soon a search may stop,
     // never its result (the nearest entry, ties to the smallest face).
-    const std::size_t n = kept.size();
+    const std::size_t n = kept.size;
     thread_local std::vector<std::uint32_t> order, from;
     thread_local std::vector<std::uint8_t> bucket;
     order.resize(n);
@@ -949,12 +965,12 @@ class GridSolver {
     if (sorted && n > 8) {
       constexpr int kBuckets = 64;
       float lo = kInf, hi = 0;
-      for (std::size_t j = 0; j < n; ++j) lo = std::min(lo, kept[j].key), hi = std::max(hi, kept[j].key);
+      for (std::size_t j = 0; j < n; ++j) lo = std::min(lo, kept.key[j]), hi = std::max(hi, kept.key[j]);
       const float scale = hi > lo ? float(kBuckets) / (hi - lo) : 0.0f;
       std::array<std::uint32_t, kBuckets + 1> start{};
       bucket.resize(n);
       for (std::size_t j = 0; j < n; ++j) {
-        const float x = (kept[j].key - lo) * scale;  // NaN (0 * inf) or below 1: the first bucket
+        const float x = (kept.key[j] - lo) * scale;  // NaN (0 * inf) or below 1: the first bucket
         const int b = x >= 1 ? int(std::min(x, float(kBuckets - 1))) : 0;
         bucket[j] = std::uint8_t(b);
         ++start[std::size_t(b) + 1];
@@ -964,7 +980,7 @@ class GridSolver {
     } else {
       for (std::size_t j = 0; j < n; ++j) order[j] = std::uint32_t(j);
     }
-    for (std::size_t j = 0; j < n; ++j) from[j] = kept[order[j]].index;
+    for (std::size_t j = 0; j < n; ++j) from[j] = kept.index[order[j]];
     out.clear();
     out.reserve(n);
     for (int k = 0; k < Packed::k0; ++k) {
@@ -973,8 +989,9 @@ class GridSolver {
       for (std::size_t j = 0; j < n; ++j) o[j] = src[from[j]];
     }
     for (int k = 0; k < 8; ++k) {
+      const float* src = kept.k[k].data();
       float* o = out.f[Packed::k0 + k].data();
-      for (std::size_t j = 0; j < n; ++j) o[j] = kept[order[j]].k[k];
+      for (std::size_t j = 0; j < n; ++j) o[j] = src[order[j]];
     }
     for (std::size_t j = 0; j < n; ++j) out.face[j] = in.face[from[j]], out.leaf.push_back(in.leaf[from[j]]);
     out.size = n;
@@ -988,7 +1005,7 @@ class GridSolver {
     out.floor.resize(groups);
     float least = kInf;
     for (std::size_t c = groups; c-- > 0;) {
-      for (std::size_t j = 8 * c; j < std::min(n, 8 * c + 8); ++j) least = std::min(least, kept[order[j]].key);
+      for (std::size_t j = 8 * c; j < std::min(n, 8 * c + 8); ++j) least = std::min(least, kept.key[order[j]]);
       out.floor[c] = least * (1 - 1e-4f) - spread - slack_;
     }
   }
