@@ -187,6 +187,21 @@ __attribute__((target_clones("avx2", "default"))) void corner_test(const Packed&
   }
 }
 
+// The positions in a tile's list of each block's candidates (the first
+// count[b] of list[b]).
+struct Survivors {
+  std::array<std::vector<std::uint32_t>, kBlocks> list;
+  std::array<std::size_t, kBlocks> count{};
+  // Empty, with room for n each and a vector's overhang.
+  void reset(std::size_t blocks, std::size_t n) {
+    for (std::size_t b = 0; b < blocks; ++b) {
+      count[b] = 0;
+      if (list[b].size() < n + 16) list[b].resize(n + 16);
+    }
+  }
+  std::span<const std::uint32_t> operator[](std::size_t b) const { return {list[b].data(), count[b]}; }
+};
+
 // The corners of a tile's blocks as a lattice of the tile's box: along
 // each axis two positions per block (its first and last samples), their
 // trilinear weights in the tile, and at each lattice point the spread of
@@ -210,10 +225,10 @@ struct Lattice {
 // t serves all the blocks (the interpolation is shared along the lattice's
 // rows); out[b] receives the indices of block b's survivors, in order.
 __attribute__((target_clones("avx2", "default"))) void lattice_filter(const Packed& t, const Lattice& lat,
-                                                                     std::array<std::vector<std::uint32_t>, kBlocks>& out) {
+                                                                     Survivors& out) {
   const I8 size = I8{} + std::int32_t(t.size), lanes = I8{0, 1, 2, 3, 4, 5, 6, 7};
   const int nx = lat.n[0], ny = lat.n[1], nz = lat.n[2];
-  for (std::size_t b = 0; b < lat.blocks; ++b) out[b].clear();
+  out.reset(lat.blocks, t.size);
   for (std::size_t i = 0; i < t.size; i += 8) {
     V8 x[4][4], y[2][4][4], lb[64];
     for (int e = 0; e < 4; ++e) {
@@ -235,7 +250,7 @@ __attribute__((target_clones("avx2", "default"))) void lattice_filter(const Pack
       for (int k = 0; k < 8; ++k) pass |= lb[lat.corner[b][k]] <= lat.bound2[b][k];
       pass &= valid;
       for (int l = 0; l < 8; ++l)
-        if (pass[l]) out[b].push_back(std::uint32_t(i + std::size_t(l)));
+        if (pass[l]) out.list[b][out.count[b]++] = std::uint32_t(i + std::size_t(l));
     }
   }
 }
@@ -468,9 +483,9 @@ GEODS_AVX512_FN void corner_test(const Packed& t, const std::array<Vec3f, 8>& co
 }
 
 GEODS_AVX512_FN void lattice_filter(const Packed& t, const Lattice& lat,
-                                    std::array<std::vector<std::uint32_t>, kBlocks>& out) {
+                                    Survivors& out) {
   const int nx = lat.n[0], ny = lat.n[1], nz = lat.n[2];
-  for (std::size_t b = 0; b < lat.blocks; ++b) out[b].clear();
+  out.reset(lat.blocks, t.size);
   const __m512 shrink = _mm512_set1_ps(1 - 1e-4f);
   for (std::size_t i = 0; i < t.size; i += 16) {
     __m512 x[4][4], y[2][4][4], lb[64];
@@ -495,12 +510,15 @@ GEODS_AVX512_FN void lattice_filter(const Packed& t, const Lattice& lat,
               _mm512_set1_ps(lat.spread[l]));
         }
     const __mmask16 ok = valid(i, t.size);
+    const __m512i index = _mm512_add_epi32(_mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15),
+                                           _mm512_set1_epi32(std::int32_t(i)));
     for (std::size_t b = 0; b < lat.blocks; ++b) {
       __mmask16 pass = 0;
       for (int k = 0; k < 8; ++k)
         pass |= _mm512_cmp_ps_mask(lb[lat.corner[b][k]], _mm512_set1_ps(lat.bound2[b][k]), _CMP_LE_OQ);
       pass &= ok;
-      for (unsigned m = pass; m; m &= m - 1) out[b].push_back(std::uint32_t(i + std::size_t(__builtin_ctz(m))));
+      _mm512_mask_compressstoreu_epi32(out.list[b].data() + out.count[b], pass, index);
+      out.count[b] += std::size_t(__builtin_popcount(pass));
     }
   }
 }
@@ -630,7 +648,7 @@ struct Scratch {
   Packed tile_list, block_list, near;
   Kept kept;
   std::vector<std::uint32_t> found;
-  std::array<std::vector<std::uint32_t>, kBlocks> survivors;
+  Survivors survivors;
   std::vector<float> row;  // avx512::row_bounds
 };
 
