@@ -72,13 +72,14 @@ struct Packed {
   std::vector<float> floor;         // a block's list: per group of 8, a bound below every distance in the block
   std::size_t size = 0;
 
-  void clear() { size = 0, leaf.clear(); }
+  void clear() { size = 0; }
   // Room for n entries, rounded up to whole vectors (the tail is never read as a result).
   void reserve(std::size_t n) {
     const std::size_t padded = (n + 15) & ~std::size_t(15);
     if (f[0].size() < padded) {
       for (auto& a : f) a.resize(padded, 0.0f);
       face.resize(padded, 0);
+      leaf.resize(padded, 0);
     }
   }
 };
@@ -550,6 +551,15 @@ GEODS_AVX512_FN void corner_nearest(const Packed& t, std::array<std::size_t, 8>&
   }
 }
 
+// out[j] = src[index[j]] for j < n (32-bit values, moved as bits).
+GEODS_AVX512_FN void gather(const std::uint32_t* src, const std::uint32_t* index, std::size_t n, std::uint32_t* out) {
+  for (std::size_t j = 0; j < n; j += 16) {
+    const __mmask16 m = valid(j, n);
+    const __m512i at = _mm512_maskz_loadu_epi32(m, index + j);
+    _mm512_mask_storeu_epi32(out + j, m, _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), m, at, src, 4));
+  }
+}
+
 // The search state of nearest() below.
 struct Search {
   const Packed& t;
@@ -660,7 +670,6 @@ class GridSolver {
     const std::size_t n = mesh.triangles().size();
     all_.reserve(n);
     all_.size = n;
-    all_.leaf.resize(n);
     if (n >= std::size_t(std::numeric_limits<std::int32_t>::max())) throw Error("sdf grid: too many faces");
     parallel_for_each_index(0, n, [&](std::size_t i) {
       const BvhTriangle& t = tris_[i];
@@ -941,16 +950,24 @@ class GridSolver {
   }
 
   // out = the entries `index` of `in` (the first `fields` quantities, faces and leaves).
-  static void select(const Packed& in, std::span<const std::uint32_t> index, Packed& out, int fields) {
+  void select(const Packed& in, std::span<const std::uint32_t> index, Packed& out, int fields) const {
     out.clear();
     out.reserve(index.size());
-    for (int k = 0; k < fields; ++k) {
-      const float* src = in.f[k].data();
-      float* o = out.f[k].data();
-      for (std::size_t j = 0; j < index.size(); ++j) o[j] = src[index[j]];
-    }
-    for (std::size_t j = 0; j < index.size(); ++j) out.face[j] = in.face[index[j]], out.leaf.push_back(in.leaf[index[j]]);
+    for (int k = 0; k < fields; ++k) copy_at(in.f[k].data(), index.data(), index.size(), out.f[k].data());
+    copy_at(in.face.data(), index.data(), index.size(), out.face.data());
+    copy_at(in.leaf.data(), index.data(), index.size(), out.leaf.data());
     out.size = index.size();
+  }
+
+  // out[j] = src[index[j]] for j < n.
+  template <class T>
+  void copy_at(const T* src, const std::uint32_t* index, std::size_t n, T* out) const {
+    static_assert(sizeof(T) == 4);
+#ifdef GEODS_SDF_AVX512
+    if (wide_)
+      return avx512::gather(reinterpret_cast<const std::uint32_t*>(src), index, n, reinterpret_cast<std::uint32_t*>(out));
+#endif
+    for (std::size_t j = 0; j < n; ++j) out[j] = src[index[j]];
   }
 
   // The entries of `in` that pass the corner test of `box` with the surface
@@ -1001,17 +1018,10 @@ class GridSolver {
     for (std::size_t j = 0; j < n; ++j) from[j] = kept.index[order[j]];
     out.clear();
     out.reserve(n);
-    for (int k = 0; k < Packed::k0; ++k) {
-      const float* src = in.f[k].data();
-      float* o = out.f[k].data();
-      for (std::size_t j = 0; j < n; ++j) o[j] = src[from[j]];
-    }
-    for (int k = 0; k < 8; ++k) {
-      const float* src = kept.k[k].data();
-      float* o = out.f[Packed::k0 + k].data();
-      for (std::size_t j = 0; j < n; ++j) o[j] = src[order[j]];
-    }
-    for (std::size_t j = 0; j < n; ++j) out.face[j] = in.face[from[j]], out.leaf.push_back(in.leaf[from[j]]);
+    for (int k = 0; k < Packed::k0; ++k) copy_at(in.f[k].data(), from.data(), n, out.f[k].data());
+    for (int k = 0; k < 8; ++k) copy_at(kept.k[k].data(), order.data(), n, out.f[Packed::k0 + k].data());
+    copy_at(in.face.data(), from.data(), n, out.face.data());
+    copy_at(in.leaf.data(), from.data(), n, out.leaf.data());
     out.size = n;
     out.floor.clear();
     if (!sorted) return;
