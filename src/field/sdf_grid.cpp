@@ -289,6 +289,31 @@ inline std::size_t best_lane(const float* best, const std::int32_t* face_of, con
   return index;
 }
 
+// Per lane, the nearest of the entries seen so far (ties to the smallest face):
+// its squared distance, face and entry.
+struct Best8 {
+  V8 d2 = V8{} + kInf;
+  I8 face = I8{} + std::numeric_limits<std::int32_t>::max(), at = I8{};
+  // Entries `lane` at squared distances r (inf for the padding), from t.face.
+  __attribute__((always_inline)) void update(const V8& r, const I8& lane, const std::int32_t* faces) {
+    I8 f;
+    std::memcpy(&f, faces, sizeof f);
+    const auto closer = (r < d2) | ((r == d2) & (f < face));
+    d2 = closer ? r : d2;
+    face = closer ? f : face;
+    at = closer ? lane : at;
+  }
+  // The nearest entry of all lanes; `nearest_d2` = its squared distance.
+  __attribute__((always_inline)) std::size_t result(float& nearest_d2) const {
+    float bd[8];
+    std::int32_t bf[8], ba[8];
+    std::memcpy(bd, &d2, sizeof bd);
+    std::memcpy(bf, &face, sizeof bf);
+    std::memcpy(ba, &at, sizeof ba);
+    return best_lane(bd, bf, ba, 8, nearest_d2);
+  }
+};
+
 // For each corner c of a block's list (k<c>: the squared distances from the
 // block's corner c), the entry of the smallest distance, ties to the smallest
 // face (the lexicographic minimum of (distance, face): one entry whatever the
@@ -296,27 +321,14 @@ inline std::size_t best_lane(const float* best, const std::int32_t* face_of, con
 __attribute__((target_clones("avx2", "default"))) void corner_nearest(const Packed& t, std::array<std::size_t, 8>& index, std::array<float, 8>& dist2) {
   const I8 size = I8{} + std::int32_t(t.size), lanes = I8{0, 1, 2, 3, 4, 5, 6, 7};
   for (int c = 0; c < 8; ++c) {
-    V8 best = V8{} + kInf;
-    I8 at = I8{}, best_face = I8{} + std::numeric_limits<std::int32_t>::max();
+    Best8 best;
     const float* k = t.f[Packed::k0 + c].data();
     for (std::size_t i = 0; i < t.size; i += 8) {
       const I8 lane = lanes + std::int32_t(i);
-      V8 r = load8(k + i);
-      r = lane < size ? r : V8{} + kInf;
-      I8 face;
-      std::memcpy(&face, t.face.data() + i, sizeof face);
-      const auto closer = (r < best) | ((r == best) & (face < best_face));
-      best = closer ? r : best;
-      best_face = closer ? face : best_face;
-      at = closer ? lane : at;
+      const V8 r = load8(k + i);
+      best.update(lane < size ? r : V8{} + kInf, lane, t.face.data() + i);
     }
-    float bd[8], d2;
-    std::int32_t bf[8], ba[8];
-    std::memcpy(bd, &best, sizeof bd);
-    std::memcpy(bf, &best_face, sizeof bf);
-    std::memcpy(ba, &at, sizeof ba);
-    index[c] = best_lane(bd, bf, ba, 8, d2);
-    dist2[c] = d2;
+    index[c] = best.result(dist2[c]);
   }
 }
 
@@ -337,8 +349,7 @@ __attribute__((target_clones("avx2", "default"))) std::size_t nearest(const Pack
   const InBlock at_p = in_block ? *in_block : InBlock{};
   const V8 px = V8{} + p.x(), py = V8{} + p.y(), pz = V8{} + p.z();
   const V8 wx = V8{} + at_p.wx, wy = V8{} + at_p.wy, wz = V8{} + at_p.wz;
-  V8 best = V8{} + kInf;
-  I8 at = I8{}, best_face = I8{} + std::numeric_limits<std::int32_t>::max();
+  Best8 best;
   const I8 size = I8{} + std::int32_t(t.size), lanes = I8{0, 1, 2, 3, 4, 5, 6, 7};
   float reach2 = kInf;  // the best squared distance so far
   const auto group = [&](std::size_t c) __attribute__((always_inline)) {  // inlined: compiled for the clone's target
@@ -347,12 +358,7 @@ __attribute__((target_clones("avx2", "default"))) std::size_t nearest(const Pack
     V8 r;
     distance8(t.f, i, px, py, pz, r);
     r = lane < size ? r : V8{} + kInf;  // the padding
-    I8 face;
-    std::memcpy(&face, t.face.data() + i, sizeof face);
-    const auto closer = (r < best) | ((r == best) & (face < best_face));
-    best = closer ? r : best;
-    best_face = closer ? face : best_face;
-    at = closer ? lane : at;
+    best.update(r, lane, t.face.data() + i);
     reach2 = std::min(reach2, min8(r));
   };
   const auto lower = [&](std::size_t c) __attribute__((always_inline)) {  // the smallest bound of group c
@@ -372,12 +378,7 @@ __attribute__((target_clones("avx2", "default"))) std::size_t nearest(const Pack
     if (c == seed || (in_block && lower(c) > reach2 * (1 + 1e-4f))) continue;
     group(c);
   }
-  float bd[8];
-  std::int32_t bf[8], ba[8];
-  std::memcpy(bd, &best, sizeof bd);
-  std::memcpy(bf, &best_face, sizeof bf);
-  std::memcpy(ba, &at, sizeof ba);
-  return best_lane(bd, bf, ba, 8, d2);
+  return best.result(d2);
 }
 
 // The same kernels sixteen entries at a time with AVX-512 (chosen at run time
