@@ -1384,7 +1384,7 @@ def signed_distance(V: ArrayLike, F: ArrayLike, points: Any, sign: str = ..., re
     """
 
 def simd_level() -> str:
-    """The SIMD level of the multi-versioned kernels (the BVH's ray and packet traversals, terrain's error rows): 'portable', 'avx', 'avx2' or 'avx512'; the best the CPU runs, capped by the environment variable GEODS_SIMD.
+    """The SIMD level of the multi-versioned kernels (the BVH's ray and packet traversals, terrain's error rows, the signed distance grid's candidate search): 'portable', 'avx', 'avx2' or 'avx512'; the best the CPU runs, capped by the environment variable GEODS_SIMD.
     """
 
 def smallest_color_spanning_circle(points: Any, colors: Any) -> tuple[Any, ...]:

@@ -181,7 +181,7 @@ for NaN or infinite coordinates.)doc");
         "Limits the worker threads of every later parallel call; n <= 0 restores all cores.");
   m.def("num_threads", &num_threads, "The current limit on worker threads (all cores unless set_num_threads was called).");
   m.def("simd_level", [] { return simd_level_name(simd_level()); },
-        "The SIMD level of the multi-versioned kernels (the BVH's ray and packet traversals, terrain's error rows): "
+        "The SIMD level of the multi-versioned kernels (the BVH's ray and packet traversals, terrain's error rows, the signed distance grid's candidate search): "
         "'portable', 'avx', 'avx2' or 'avx512'; the best the CPU runs, capped by the environment variable GEODS_SIMD.");
   m.def("best_simd_level", [] { return simd_level_name(best_simd_level()); },
         "The highest SIMD level this CPU (and the build) runs: 'portable', 'avx', 'avx2' or 'avx512'.");

@@ -84,6 +84,13 @@ int main(int argc, char** argv) {
   geods::field::Adf adf;
   const double s = compare::median_time_s(1, [&] { adf = geods::field::Adf::build(mesh, md, options); });
   const double max_error = adf_error(adf);
+  // Queries: the distance at the 20,000 error points, one at a time.
+  std::vector<float> answers(points.size());
+  const double query_s = compare::median_time_s(3, [&] {
+    for (std::size_t i = 0; i < points.size(); ++i) answers[i] = adf.distance(points[i]);
+  });
+  double answers_error = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) answers_error = std::max(answers_error, std::abs(double(answers[i]) - exact[i]));
   // measure_adf_error's own points (near-surface ones within 8 finest leaf sides), for reference.
   const geods::field::AdfError e = geods::field::measure_adf_error(adf, mesh, md, 20000);
   const geods::field::AdfStats st = adf.stats();
@@ -107,7 +114,8 @@ int main(int argc, char** argv) {
   // The old layout (32-bit nodes, 8 floats a leaf) for reference.
   const double float_leaf_bytes = 4.0 * double(st.cells) + 32.0 * double(st.leaves);
   compare::Record("adf", "geods", "mesh_100k", args.threads)
-      .timing(0, s, st.leaves, 1)
+      .timing(s, query_s, st.leaves, 1)
+      .set("queries", points.size())
       .set("error", dense_error)
       .set("cells", st.cells)
       .set("bytes", st.bytes)
@@ -128,6 +136,6 @@ int main(int argc, char** argv) {
       .set("matched_max_error", matched_error)
       .set("matched_bytes", matched.stats().bytes)
       .set("matched_ratio", double(dense_bytes) / double(matched.stats().bytes))
-      .print(max_error <= 1.5 * dense_error && matched_error <= dense_error);
+      .print(answers_error == max_error && max_error <= 1.5 * dense_error && matched_error <= dense_error);
   return 0;
 }
