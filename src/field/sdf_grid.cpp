@@ -97,6 +97,9 @@ __attribute__((always_inline)) inline V8 load8(const float* p) {
   std::memcpy(&v, p, sizeof v);
   return v;
 }
+// The same into v: for the target_clones functions' own loops, where clang
+// refuses a vector returned by value in the default (no AVX) clone.
+__attribute__((always_inline)) inline void load8(const float* p, V8& v) { std::memcpy(&v, p, sizeof v); }
 
 // Entries [i, i + 8) of t.
 // Vectors by reference in and out: passed or returned by value in the default
@@ -233,7 +236,9 @@ __attribute__((target_clones("avx2", "default"))) void lattice_filter(const Pack
   for (std::size_t i = 0; i < t.size; i += 8) {
     V8 x[4][4], y[2][4][4], lb[64];
     for (int e = 0; e < 4; ++e) {
-      const V8 lo = load8(t.f[Packed::k0 + 2 * e].data() + i), hi = load8(t.f[Packed::k0 + 2 * e + 1].data() + i);
+      V8 lo, hi;
+      load8(t.f[Packed::k0 + 2 * e].data() + i, lo);
+      load8(t.f[Packed::k0 + 2 * e + 1].data() + i, hi);
       for (int a = 0; a < nx; ++a) x[e][a] = lo + lat.w[0][a] * (hi - lo);
     }
     for (int z = 0; z < 2; ++z)
@@ -325,7 +330,8 @@ __attribute__((target_clones("avx2", "default"))) void corner_nearest(const Pack
     const float* k = t.f[Packed::k0 + c].data();
     for (std::size_t i = 0; i < t.size; i += 8) {
       const I8 lane = lanes + std::int32_t(i);
-      const V8 r = load8(k + i);
+      V8 r;
+      load8(k + i, r);
       best.update(lane < size ? r : V8{} + kInf, lane, t.face.data() + i);
     }
     index[c] = best.result(dist2[c]);
