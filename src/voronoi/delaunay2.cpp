@@ -635,6 +635,18 @@ void Delaunay2::Inserter::prefetch(std::uint32_t h) const {
     if (core.vert[e] < core.coords.size()) __builtin_prefetch(&core.coords[core.vert[e]]);
 }
 
+void Delaunay2::Inserter::prefetch_neighbors(std::uint32_t h) const {
+  const DelaunayCore& core = editor_->core;
+  if (h >= core.vert.size() / 3) return;
+  for (std::uint32_t e = 3 * h; e < 3 * h + 3; ++e) {
+    const std::uint32_t t = core.twin[e] / 3;
+    if (3 * std::size_t(t) + 2 >= core.vert.size()) continue;
+    // A triangle's three entries may straddle two lines.
+    __builtin_prefetch(&core.vert[3 * t]), __builtin_prefetch(&core.vert[3 * t + 2]);
+    __builtin_prefetch(&core.twin[3 * t], 1), __builtin_prefetch(&core.twin[3 * t + 2], 1);
+  }
+}
+
 std::uint32_t Delaunay2::Inserter::handle_count() const { return std::uint32_t(editor_->core.vert.size() / 3); }
 
 bool Delaunay2::Inserter::is_triangle(std::uint32_t h) const {
