@@ -87,6 +87,10 @@ class MaxHeap4 {
     for (;;) {
       const std::size_t first = 4 * i + 1;
       if (first >= n) break;
+      // The grandchildren: four lines, one of which the next level reads;
+      // asked for now, they arrive while this level compares (deep levels miss).
+      if (4 * first + 1 < n)
+        for (std::size_t c = 0; c < 4; ++c) __builtin_prefetch(h + 4 * (first + c) + 1);
       std::size_t best = first;
       const std::size_t end = std::min(first + 4, n);
       for (std::size_t c = first + 1; c < end; ++c)
@@ -122,8 +126,11 @@ class GreedyTin {
     pts_.push_back(p);
     if (!scan) return;
     // The next insertion likely starts at the queue's top: fetch its triangle while this one is rescanned.
-    if (!queue_.empty()) ins_.prefetch(queue_.top().triangle);
+    const std::uint32_t next = queue_.empty() ? voronoi::Delaunay2::no_edge : queue_.top().triangle;
+    if (next != voronoi::Delaunay2::no_edge) ins_.prefetch(next);
     rescan(ins_.changed());
+    // Then its neighbours (the rescan's pushes rarely change the top).
+    if (next != voronoi::Delaunay2::no_edge) ins_.prefetch_neighbors(next);
   }
   // Scans every triangle.
   void scan_all() {
@@ -196,10 +203,11 @@ class GreedyTin {
   MaxHeap4 queue_;
 };
 
-// A tile's TIN: its samples and triangles (indices into them, counter-clockwise).
+// A tile's TIN: its samples and their triangulation (dt.triangles(): indices
+// into pts_, counter-clockwise; read in place, not copied).
 struct TileTin {
   std::vector<P2> pts_;
-  std::vector<std::uint32_t> tri_;
+  voronoi::Delaunay2 dt;
 };
 
 // The greedy TIN of the tile [c00, c11] of the row-major samples z (row length w):
@@ -218,9 +226,9 @@ TileTin tile_tin(const float* z, std::uint64_t w, P2 c00, P2 c11, double limit, 
   tin.pts_ = {c00, c10, c11, c01};
   std::vector<Vec2d> corners;
   for (const P2& p : tin.pts_) corners.emplace_back(double(p.x), double(p.y));
-  voronoi::Delaunay2 dt(corners);
+  tin.dt = voronoi::Delaunay2(corners);
   {
-    voronoi::Delaunay2::Inserter ins(dt);
+    voronoi::Delaunay2::Inserter ins(tin.dt);
     // Room for every sample, up to 2^22 (a few hundred MB of address space; larger tiles grow as needed).
     const std::size_t room = std::min(std::size_t(c11.x - c00.x + 1) * std::size_t(c11.y - c00.y + 1), std::size_t(1) << 22);
     ins.reserve(room);
@@ -231,7 +239,6 @@ TileTin tile_tin(const float* z, std::uint64_t w, P2 c00, P2 c11, double limit, 
     g.scan_all();
     g.refine();
   }
-  tin.tri_.assign(dt.triangles().begin(), dt.triangles().end());
   return tin;
 }
 
@@ -262,11 +269,15 @@ TerrainMesh tin_tile(std::span<const float> z, std::size_t width, std::size_t he
   const TileTin g = tile_tin(z.data(), width, P2{0, 0}, P2{std::int64_t(width) - 1, std::int64_t(height) - 1},
                                max_error, border_limit);
   TerrainMesh mesh;
+  const auto& tri = g.dt.triangles();
+  mesh.samples.reserve(g.pts_.size());
+  mesh.vertices.reserve(g.pts_.size());
+  mesh.triangles.reserve(tri.size() / 3);
   for (const P2& p : g.pts_) {
     mesh.samples.push_back({std::uint32_t(p.x), std::uint32_t(p.y)});
     mesh.vertices.push_back(Vec3f(float(p.x), float(p.y), z[std::size_t(p.y) * width + std::size_t(p.x)]));
   }
-  for (std::size_t k = 0; k + 2 < g.tri_.size(); k += 3) mesh.triangles.push_back({g.tri_[k], g.tri_[k + 1], g.tri_[k + 2]});
+  for (std::size_t k = 0; k + 2 < tri.size(); k += 3) mesh.triangles.push_back({tri[k], tri[k + 1], tri[k + 2]});
   return mesh;
 }
 
@@ -299,6 +310,12 @@ TerrainMesh Terrain::tin(double max_error, std::uint32_t tiles) const {
   for (std::uint32_t ty = 0; ty < tiles; ++ty)
     for (std::uint32_t tx = 0; tx < tiles; ++tx) {
       const TileTin g = tile_tin(z.data(), width_, P2{xs[tx], ys[ty]}, P2{xs[tx + 1], ys[ty + 1]}, limit, border_limit);
+      const auto& tri = g.dt.triangles();
+      if (tiles == 1) {  // the sizes are known: no copies as the arrays grow
+        mesh.samples.reserve(g.pts_.size());
+        mesh.vertices.reserve(g.pts_.size());
+        mesh.triangles.reserve(tri.size() / 3);
+      }
       vertex_of.resize(g.pts_.size());
       for (std::size_t i = 0; i < g.pts_.size(); ++i) {
         const P2 p = g.pts_[i];
@@ -310,8 +327,8 @@ TerrainMesh Terrain::tin(double max_error, std::uint32_t tiles) const {
         const auto it = border_vertex.find(id);
         vertex_of[i] = it != border_vertex.end() ? it->second : (border_vertex[id] = add_vertex(p));
       }
-      for (std::size_t k = 0; k + 2 < g.tri_.size(); k += 3)
-        mesh.triangles.push_back({vertex_of[g.tri_[k]], vertex_of[g.tri_[k + 1]], vertex_of[g.tri_[k + 2]]});
+      for (std::size_t k = 0; k + 2 < tri.size(); k += 3)
+        mesh.triangles.push_back({vertex_of[tri[k]], vertex_of[tri[k + 1]], vertex_of[tri[k + 2]]});
     }
   return mesh;
 }

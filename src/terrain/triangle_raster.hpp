@@ -194,10 +194,42 @@ struct RowWalk {
 // each row (row_max_avx2() for rows of 4 or more samples when Avx2, else
 // row_max()), then the first sample of the first row holding the largest one
 // (the same terms, so the same value). Scalar loops per sample with a branch on
-// every improvement measured slower for the greedy TIN's large triangles.
+// every improvement measured slower for the greedy TIN's large triangles; small
+// ones (a bounding box of at most 4 x 4 samples) take triangle_worst_small().
+// Triangles whose bounding box is at most kSmallSpan + 1 samples wide and
+// high (most of a fine TIN's) are scanned sample by sample instead:
+// triangle_worst_small().
+inline constexpr std::int64_t kSmallSpan = 3;
+
+// triangle_worst() of a small triangle: every sample of the bounding box,
+// tested by the three edge functions stepped by additions (no division, no
+// row set-up), the same plane terms as the rows.
+[[gnu::always_inline]] inline Worst triangle_worst_small(const float* z, std::uint64_t n, const GridTriangle& t, P2 a) {
+  std::int64_t edge[3], step[3];  // at (xmin, y); the change per sample to the right
+  for (int e = 0; e < 3; ++e) {
+    const P2 p = t.v[e], q = t.v[(e + 1) % 3];
+    edge[e] = (q.x - p.x) * (t.y0 - p.y) - (q.y - p.y) * (t.xmin - p.x);
+    step[e] = q.y - p.y;
+  }
+  Worst w;
+  for (std::int64_t y = t.y0; y <= t.y1; ++y) {
+    const float* row = z + y * std::int64_t(n);
+    const double base = t.base(y, a.y);
+    std::int64_t e0 = edge[0], e1 = edge[1], e2 = edge[2];
+    for (std::int64_t x = t.xmin; x <= t.xmax; ++x, e0 -= step[0], e1 -= step[1], e2 -= step[2]) {
+      if ((e0 | e1 | e2) < 0) continue;  // outside: some edge function is negative
+      const double d = std::abs(double(row[x]) - (base + t.gx * double(x - a.x)));
+      if (d > w.error) w = {d, {x, y}};
+    }
+    for (int e = 0; e < 3; ++e) edge[e] += t.v[(e + 1) % 3].x - t.v[e].x;
+  }
+  return w;
+}
+
 template <bool Avx2>
 [[gnu::always_inline]] inline Worst triangle_worst_rows(const float* z, std::uint64_t n, P2 a, P2 b, P2 c) {
   const GridTriangle t(z, n, a, b, c);
+  if (t.xmax - t.xmin <= kSmallSpan && t.y1 - t.y0 <= kSmallSpan) return triangle_worst_small(z, n, t, a);
   RowWalk walk(t);
   double worst = 0;
   std::int64_t wy = 0, wlo = 0;

@@ -356,6 +356,7 @@ void Delaunay2::Editor::publish() {
   const std::uint32_t internal = std::uint32_t(core.vert.size() / 3);
   public_triangle.assign(internal, kNone);
   internal_triangle.clear();
+  internal_triangle.reserve(internal);
   for (std::uint32_t t = 0; t < internal; ++t) {
     if (core.vert[3 * t] == kNone || core.is_ghost_triangle(t)) continue;
     public_triangle[t] = std::uint32_t(internal_triangle.size());
@@ -364,8 +365,14 @@ void Delaunay2::Editor::publish() {
   const std::size_t m = internal_triangle.size();
   triangles.resize(3 * m);
   halfedges.resize(3 * m);
+  constexpr std::size_t kAhead = 16;  // the neighbours' numbers and the points are read at random: ask ahead
   for (std::size_t k = 0; k < m; ++k) {
     const std::uint32_t t = internal_triangle[k];
+    if (k + kAhead < m)
+      for (std::uint32_t s = 0, u = internal_triangle[k + kAhead]; s < 3; ++s) {
+        __builtin_prefetch(&public_triangle[core.twin[3 * u + s] / 3]);
+        __builtin_prefetch(&original_of[core.vert[3 * u + s]]);
+      }
     for (std::uint32_t s = 0; s < 3; ++s) {
       triangles[3 * k + s] = original_of[core.vert[3 * t + s]];
       const std::uint32_t f = core.twin[3 * t + s], other = public_triangle[f / 3];
@@ -633,6 +640,18 @@ void Delaunay2::Inserter::prefetch(std::uint32_t h) const {
   __builtin_prefetch(&core.twin[3 * h]);
   for (std::uint32_t e = 3 * h; e < 3 * h + 3; ++e)
     if (core.vert[e] < core.coords.size()) __builtin_prefetch(&core.coords[core.vert[e]]);
+}
+
+void Delaunay2::Inserter::prefetch_neighbors(std::uint32_t h) const {
+  const DelaunayCore& core = editor_->core;
+  if (h >= core.vert.size() / 3) return;
+  for (std::uint32_t e = 3 * h; e < 3 * h + 3; ++e) {
+    const std::uint32_t t = core.twin[e] / 3;
+    if (3 * std::size_t(t) + 2 >= core.vert.size()) continue;
+    // A triangle's three entries may straddle two lines.
+    __builtin_prefetch(&core.vert[3 * t]), __builtin_prefetch(&core.vert[3 * t + 2]);
+    __builtin_prefetch(&core.twin[3 * t], 1), __builtin_prefetch(&core.twin[3 * t + 2], 1);
+  }
 }
 
 std::uint32_t Delaunay2::Inserter::handle_count() const { return std::uint32_t(editor_->core.vert.size() / 3); }

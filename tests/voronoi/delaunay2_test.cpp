@@ -458,9 +458,13 @@ TEST(Delaunay2, InserterAtKnownTriangles) {
           holder = h;
       }
       ASSERT_NE(holder, kNone);
+      ins.prefetch(holder);  // hints: no effect on the result (and no reads outside the arrays, under asan)
+      ins.prefetch_neighbors(holder);
       ins.insert(q, holder);
       p.push_back(q);
     }
+    ins.prefetch(ins.handle_count());  // out of range: ignored
+    ins.prefetch_neighbors(ins.handle_count());
     EXPECT_THROW(ins.insert({0.5, 0.5}, ins.handle_count()), Error);
     EXPECT_THROW(ins.insert({std::nan(""), 0.5}), Error);
     EXPECT_THROW(ins.triangle(ins.handle_count()), Error);

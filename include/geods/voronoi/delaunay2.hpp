@@ -274,6 +274,10 @@ class Delaunay2::Inserter {
   /// A hint that a coming insert() starts at triangle h: its arrays and
   /// corners are fetched into the cache meanwhile (they lie anywhere in memory).
   void prefetch(std::uint32_t h) const;
+  /// The next step of that hint, some time after prefetch(h): the arrays of
+  /// h's neighbours across its edges (which the split relinks and the flips
+  /// test), found through h's twins, which prefetch(h) fetched.
+  void prefetch_neighbors(std::uint32_t h) const;
   /// One more than the largest handle.
   std::uint32_t handle_count() const;
   /// Whether handle h names a finite triangle now.
