@@ -565,9 +565,12 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray, 
       if (mask == 0) continue;
       // The nearest lane, ties to the last one: what testing the triangles
       // one after the other, each against the shrinking tmax, would keep.
-      int best = -1;
-      for (int i = 0; i < 4; ++i)
-        if ((mask >> i & 1) && (best < 0 || t[i] <= t[best])) best = i;
+      // Usually a single lane: no data-dependent branch per lane then.
+      int best = __builtin_ctz(unsigned(mask));
+      if (mask & (mask - 1)) {
+        for (int i = best + 1; i < 4; ++i)
+          if ((mask >> i & 1) && t[i] <= t[best]) best = i;
+      }
       tmax = t[best];
       hit = {t[best], groups_[g].index[best], u[best], v[best]};
       if (any) return false;
