@@ -3,7 +3,8 @@
 //
 // Every program follows the timing rules of anchors/WORKLOADS.md:
 //   * inputs are loaded and converted before timing,
-//   * std::chrono::steady_clock around the operation only,
+//   * std::chrono::steady_clock around the operation only (ANCHORS_CPU_TIME=1: the process's CPU
+//     time instead, for A/B runs on a loaded machine; not for recorded runs),
 //   * each measurement is repeated `reps` times (ANCHORS_REPS, default 3), the median is reported,
 //   * one JSON line per measurement on stdout:
 //     {"workload","anchor","variant","threads","build_s","query_s","count","median_of",...,"ok"}
