@@ -3,7 +3,8 @@
 //
 // Every program follows the timing rules of anchors/WORKLOADS.md:
 //   * inputs are loaded and converted before timing,
-//   * std::chrono::steady_clock around the operation only,
+//   * std::chrono::steady_clock around the operation only (ANCHORS_CPU_TIME=1: the process's CPU
+//     time instead, for A/B runs on a loaded machine; not for recorded runs),
 //   * each measurement is repeated `reps` times (ANCHORS_REPS, default 3), the median is reported,
 //   * one JSON line per measurement on stdout:
 //     {"workload","anchor","variant","threads","build_s","query_s","count","median_of",...,"ok"}
@@ -24,6 +25,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
 #include <fstream>
 #include <functional>
 #include <initializer_list>
@@ -116,8 +118,24 @@ int run_variants(int argc, char** argv, std::initializer_list<const char*> varia
 using Clock = std::chrono::steady_clock;
 
 /// Seconds taken by fn().
+/// With the environment variable ANCHORS_CPU_TIME=1: CPU seconds of the
+/// process (all its threads) instead, for A/B runs on a loaded machine.
 template <class F>
 double time_s(F&& fn) {
+  static const bool cpu = [] {
+    const char* e = std::getenv("ANCHORS_CPU_TIME");
+    return e && *e && std::string_view(e) != "0";
+  }();
+  if (cpu) {
+    auto now = [] {
+      timespec ts;
+      clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+      return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+    };
+    const double t0 = now();
+    fn();
+    return now() - t0;
+  }
   auto t0 = Clock::now();
   fn();
   return std::chrono::duration<double>(Clock::now() - t0).count();

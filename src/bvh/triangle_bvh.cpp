@@ -8,6 +8,7 @@
 #include <cstring>
 #include <string>
 #include <type_traits>
+#include <utility>
 
 #if defined(__SSE__)
 #include <immintrin.h>
@@ -370,6 +371,22 @@ struct SimdTypes<8> {
   typedef float vf __attribute__((vector_size(32)));
 };
 
+// Every lane x (one broadcast; filling the lanes one by one in a loop made
+// GCC assemble the vectors lane by lane through the stack).
+// (Written through a reference: a 32-byte vector passed by value has another
+// ABI with AVX than without.)
+template <typename V>
+GEODS_BVH_INLINE void splat(V& v, float x) {
+  typedef float v4 __attribute__((vector_size(16)));
+  const v4 s = {x, x, x, x};
+  if constexpr (sizeof(V) == 16) {
+    v = s;
+  } else {
+    static_assert(sizeof(V) == 32);
+    v = __builtin_shufflevector(s, s, 0, 1, 2, 3, 0, 1, 2, 3);
+  }
+}
+
 // Bit i set where lane i of a comparison result is true.
 template <typename Mask>
 inline unsigned lane_bits(Mask m) {
@@ -391,6 +408,18 @@ inline unsigned lane_bits(Mask m) {
   return bits;
 }
 
+#if defined(__x86_64__) && defined(__GNUC__)
+// lane_bits of an 8-wide mask in one instruction, for code compiled for AVX
+// or later (inlined there; intersect_wide<W, true> is only called from such code).
+template <typename Mask>
+__attribute__((target("avx"))) inline unsigned lane_bits_avx(const Mask& m) {
+  static_assert(sizeof(Mask) == 32);
+  __m256 v;
+  std::memcpy(&v, &m, sizeof v);
+  return unsigned(_mm256_movemask_ps(v));
+}
+#endif
+
 }  // namespace
 
 // The traversal compiled once more per instruction set (simd_level.hpp), the
@@ -403,17 +432,17 @@ inline unsigned lane_bits(Mask m) {
 template <int W>
 __attribute__((target("avx"), flatten)) RayHit TriangleBvh::intersect_wide_avx(const WideNodes<W>& nodes,
                                                                                const Ray3f& ray, bool any) const {
-  return intersect_wide(nodes, ray, any);
+  return intersect_wide<W, true>(nodes, ray, any);
 }
 template <int W>
 __attribute__((target("avx2,bmi,bmi2,lzcnt,popcnt"), flatten)) RayHit TriangleBvh::intersect_wide_avx2(
     const WideNodes<W>& nodes, const Ray3f& ray, bool any) const {
-  return intersect_wide(nodes, ray, any);
+  return intersect_wide<W, true>(nodes, ray, any);
 }
 template <int W>
 __attribute__((target("avx512f,avx512vl,avx512bw,avx512dq,avx2,bmi,bmi2,lzcnt,popcnt"), flatten)) RayHit
 TriangleBvh::intersect_wide_avx512(const WideNodes<W>& nodes, const Ray3f& ray, bool any) const {
-  return intersect_wide(nodes, ray, any);
+  return intersect_wide<W, true>(nodes, ray, any);
 }
 #endif
 
@@ -430,7 +459,7 @@ RayHit TriangleBvh::intersect_wide_best(const WideNodes<W>& nodes, const Ray3f& 
   return intersect_wide(nodes, ray, any);
 }
 
-template <int W>
+template <int W, bool Avx>
 RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray, bool any) const {
   using vf = typename SimdTypes<W>::vf;
   RayHit hit;
@@ -445,12 +474,13 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray, 
   for (int a = 0; a < 3; ++a) {
     const float inv_a = 1.0f / ray.direction[a];
     near_row[a] = 2 * a + (inv_a < 0 ? 1 : 0);
-    for (int i = 0; i < W; ++i) org[a][i] = ray.origin[a], inv[a][i] = inv_a;
+    splat(org[a], ray.origin[a]);
+    splat(inv[a], inv_a);
   }
   float tmax = ray.tmax;
   const float tmin = ray.tmin;
   vf tmin_v;
-  for (int i = 0; i < W; ++i) tmin_v[i] = tmin;
+  splat(tmin_v, tmin);
   TraversalStack<WideEntry> stack(traversal_stack_size(depth_, W));
   // Start fetching what a child needs, every cache line of it (a node: 2 or
   // 4 lines; a leaf: its groups of 160 bytes, which straddle lines); the cache
@@ -465,24 +495,63 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray, 
     const std::uintptr_t last = reinterpret_cast<std::uintptr_t>(&groups_[e.child] + e.count) - 1;
     for (std::uintptr_t p = first; p <= last; p += 64) __builtin_prefetch(reinterpret_cast<const void*>(p));
   };
+  // Without a NaN among the slab distances (a finite origin, finite nonzero
+  // inverse directions, tmin and tmax not NaN) the four-way max and min are
+  // taken as two levels of a tree instead of a chain, with the far bound
+  // widened per axis (x -> x (1 + 4e-7) rounds monotonically, so the minimum
+  // of the widened values is the widened minimum): the same values and mask
+  // as the chain, a shorter dependency chain from a node's bounds to its mask.
+  bool no_nan = !std::isnan(tmin) && !std::isnan(tmax);
+  for (int a = 0; a < 3; ++a) no_nan = no_nan && std::isfinite(ray.origin[a]) && std::isfinite(inv[a][0]) && inv[a][0] != 0.0f;
+  constexpr float kWiden = 1.0f + 4e-7f;
+  auto mask_bits = [&](const auto& m) GEODS_BVH_INLINE_LAMBDA {
+#if defined(GEODS_BVH_SIMD_DISPATCH)
+    if constexpr (Avx && W == 8) return lane_bits_avx(m);
+#endif
+    return lane_bits(m);
+  };
   // The children whose boxes the ray enters before tmax, all W at once.
+  // The entry and exit distances of the ray at the slabs of axis a of the W children.
+  auto slab = [&](const WideNode<W>& node, int a, vf& t0, vf& t1) GEODS_BVH_INLINE_LAMBDA {
+    vf lo, hi;
+    std::memcpy(&lo, node.bounds[near_row[a]], sizeof(vf));
+    std::memcpy(&hi, node.bounds[near_row[a] ^ 1], sizeof(vf));
+    t0 = (lo - org[a]) * inv[a];
+    t1 = (hi - org[a]) * inv[a];
+  };
   auto children = [&](const WideEntry& e, float* keys) GEODS_BVH_INLINE_LAMBDA {
     const WideNode<W>& node = nodes[e.child];
-    vf tn = tmin_v, tf;
-    for (int i = 0; i < W; ++i) tf[i] = tmax;
+    vf tmax_v;
+    splat(tmax_v, tmax);
+    if (no_nan) [[likely]] {
+      vf t0x, t1x, t0y, t1y, t0z, t1z;
+      slab(node, 0, t0x, t1x);
+      slab(node, 1, t0y, t1y);
+      slab(node, 2, t0z, t1z);
+      t1x *= kWiden;
+      t1y *= kWiden;
+      t1z *= kWiden;
+      const vf n01 = t0x > t0y ? t0x : t0y;
+      const vf n2 = t0z > tmin_v ? t0z : tmin_v;
+      const vf tn = n01 > n2 ? n01 : n2;
+      const vf f01 = t1x < t1y ? t1x : t1y;
+      const vf tmw = tmax_v * kWiden;
+      const vf f2 = t1z < tmw ? t1z : tmw;
+      const vf tf = f01 < f2 ? f01 : f2;
+      std::memcpy(keys, &tn, sizeof tn);
+      return mask_bits(tn <= tf);
+    }
+    vf tn = tmin_v, tf = tmax_v;
     for (int a = 0; a < 3; ++a) {
-      vf lo, hi;
-      std::memcpy(&lo, node.bounds[near_row[a]], sizeof(vf));
-      std::memcpy(&hi, node.bounds[near_row[a] ^ 1], sizeof(vf));
-      const vf t0 = (lo - org[a]) * inv[a];
-      const vf t1 = (hi - org[a]) * inv[a];
+      vf t0, t1;
+      slab(node, a, t0, t1);
       // Written so that a NaN t0 or t1 leaves the interval unchanged.
       tn = t0 > tn ? t0 : tn;
       tf = t1 < tf ? t1 : tf;
     }
     std::memcpy(keys, &tn, sizeof tn);
     // Widened far bound: a box hit that rounding would lose is kept (Ize 2013).
-    return lane_bits(tn <= tf * (1.0f + 4e-7f));
+    return mask_bits(tn <= tf * kWiden);
   };
   auto child = [&](const WideEntry& e, int i, float t) GEODS_BVH_INLINE_LAMBDA {
     const WideEntry c{nodes[e.child].child[i], nodes[e.child].count[i], t};
@@ -496,9 +565,12 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray, 
       if (mask == 0) continue;
       // The nearest lane, ties to the last one: what testing the triangles
       // one after the other, each against the shrinking tmax, would keep.
-      int best = -1;
-      for (int i = 0; i < 4; ++i)
-        if ((mask >> i & 1) && (best < 0 || t[i] <= t[best])) best = i;
+      // Usually a single lane: no data-dependent branch per lane then.
+      int best = __builtin_ctz(unsigned(mask));
+      if (mask & (mask - 1)) {
+        for (int i = best + 1; i < 4; ++i)
+          if ((mask >> i & 1) && t[i] <= t[best]) best = i;
+      }
       tmax = t[best];
       hit = {t[best], groups_[g].index[best], u[best], v[best]};
       if (any) return false;

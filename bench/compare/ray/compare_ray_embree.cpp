@@ -41,6 +41,20 @@ struct Embree {
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return {};
     return {rh.ray.tfar, rh.hit.primID};
   }
+  static bool occluded(const Index& index, const float* r) {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    RTCRay ray;
+    ray.org_x = r[0], ray.org_y = r[1], ray.org_z = r[2];
+    ray.dir_x = r[3], ray.dir_y = r[4], ray.dir_z = r[5];
+    ray.tnear = 0.0f;
+    ray.tfar = std::numeric_limits<float>::infinity();
+    ray.mask = ~0u;
+    ray.flags = 0;
+    ray.time = 0.0f;
+    rtcOccluded1(index.scene, &context, &ray);
+    return ray.tfar < 0.0f;  // Embree sets tfar to -inf on a hit
+  }
 };
 
 }  // namespace

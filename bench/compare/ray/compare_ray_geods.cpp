@@ -22,6 +22,12 @@ struct Geods {
     const geods::RayHit hit = bvh.intersect(ray);
     return {hit.t, hit.prim};
   }
+  static bool occluded(const Index& bvh, const float* r) {
+    geods::Ray3f ray;
+    ray.origin = {r[0], r[1], r[2]};
+    ray.direction = {r[3], r[4], r[5]};
+    return bvh.occluded(ray);
+  }
 };
 
 }  // namespace

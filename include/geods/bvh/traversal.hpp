@@ -100,6 +100,20 @@ GEODS_BVH_INLINE bool traverse(Entry root, TraversalStack<Entry>& stack, IsLeaf&
           cur = child(cur, first, keys[first]);
           continue;
         }
+        if ((bits & (bits - 1)) == 0) {  // two children, the usual case after one: no sort
+          const int second = __builtin_ctz(bits);
+          const Entry a = child(cur, first, keys[first]);
+          const Entry b = child(cur, second, keys[second]);
+          // As the general case below: farthest first, equal keys the later child first.
+          if (Ordered && a.key < b.key) {
+            stack.push(b);
+            cur = a;
+          } else {
+            stack.push(a);
+            cur = b;
+          }
+          continue;
+        }
         Entry visit[MaxChildren];  // farthest first: the last one is visited next
         visit[0] = child(cur, first, keys[first]);
         int n = 1;

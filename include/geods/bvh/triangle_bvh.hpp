@@ -161,7 +161,8 @@ class TriangleBvh {
   RayHit intersect_generic(const FlatArray<BV>& volumes, const Ray3f& ray, bool any) const;
   template <int W>
   using WideNodes = FlatArray<WideNode<W>>;  // built in huge pages (HugePageAllocator)
-  template <int W>
+  // Avx: compiled into an AVX (or later) function, 8-wide masks in one movemask.
+  template <int W, bool Avx = false>
   RayHit intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray, bool any) const;
   // The same compiled for AVX, AVX2 and AVX-512, and the choice between them
   // by simd_level() (simd_level.hpp).
