@@ -32,6 +32,23 @@ bool collinear(const Vec3d& a, const Vec3d& b, const Vec3d& c) {
   return true;
 }
 
+// kFaceEdge[f][j]: for a tetrahedron whose vertex f is the new point p, the
+// other two vertices of its face opposite j (j != f), in the order that makes
+// (p, x, y) counter-clockwise seen from vertex j's side: the tetrahedron on
+// the other side of that face sees the edge as (y, x).
+constexpr std::array<std::array<std::array<std::uint8_t, 2>, 4>, 4> kFaceEdge = [] {
+  std::array<std::array<std::array<std::uint8_t, 2>, 4>, 4> e{};
+  for (int f = 0; f < 4; ++f)
+    for (int j = 0; j < 4; ++j) {
+      if (j == f) continue;
+      const std::array<int, 3> t = j % 2 == 0 ? std::array<int, 3>{(j + 1) % 4, (j + 3) % 4, (j + 2) % 4}
+                                              : std::array<int, 3>{(j + 1) % 4, (j + 2) % 4, (j + 3) % 4};
+      const int at = t[0] == f ? 0 : t[1] == f ? 1 : 2;
+      e[f][j] = {std::uint8_t(t[(at + 1) % 3]), std::uint8_t(t[(at + 2) % 3])};
+    }
+  return e;
+}();
+
 std::string tet_name(std::uint32_t t) { return "tetrahedron slot " + std::to_string(t); }
 
 }  // namespace
@@ -212,7 +229,6 @@ std::uint32_t Tet3Mesh::insert(std::uint32_t pv) {
       b.face = f;
       b.outer = a;
       b.cell = c;
-      std::fill_n(b.adjacent, 4, kNone);
       faces |= std::uint8_t(1u << f);
     }
     M[c] = in | faces;
@@ -225,44 +241,61 @@ std::uint32_t Tet3Mesh::insert(std::uint32_t pv) {
     T = tets.data();
     M = mark.data();
   }
-  // New tetrahedron i (cavity slot c with p for its vertex f) has three faces
-  // through p, each with an edge of c's; its neighbour across the one opposite
-  // j is found by turning about that edge from c's face j through the cavity
-  // until a boundary face: the new tetrahedron made from that face. The cavity
-  // slots' boundary faces point to their new tetrahedra meanwhile (no hashing:
-  // the old tetrahedra are the map), and each pair is linked from both sides at once.
-  for (std::size_t i = 0; i < boundary.size(); ++i) {
-    const Boundary& b = boundary[i];
-    T[8 * std::size_t(b.cell) + 4 + b.face] = std::uint32_t(i);
-  }
-  for (std::size_t i = 0; i < boundary.size(); ++i) {
-    Boundary& b = boundary[i];
-    for (std::uint32_t j = 0; j < 4; ++j) {
-      if (j == b.face || b.adjacent[j] != kNone) continue;
-      std::uint32_t cell = b.cell, from = b.face, across = j;  // the faces of `cell` about the edge
-      while (!(M[cell] >> across & 1)) {
-        const std::uint32_t a = T[8 * std::size_t(cell) + 4 + across];
-        const std::uint32_t x = T[8 * std::size_t(cell) + from];  // on the face crossed, off the edge
-        cell = a >> 2;
-        from = a & 3;
-        const std::uint32_t* w = &T[8 * std::size_t(cell)];
-        across = std::uint32_t(w[1] == x) | std::uint32_t(w[2] == x) << 1 | std::uint32_t(w[3] == x) * 3;
-      }
-      const std::uint32_t k = T[8 * std::size_t(cell) + 4 + across];
-      b.adjacent[j] = 4 * cavity[k] + from;
-      boundary[k].adjacent[from] = 4 * cavity[i] + j;
-    }
-  }
+  // The new tetrahedra, then their links to each other: new tetrahedron i
+  // (cavity slot c with p for its vertex f) has three faces through p, each
+  // with an edge of its boundary face, which one other boundary face shares,
+  // the other way round. A small hash table of those directed edges (valid
+  // for this insertion by its stamp, so never cleared) finds the pairs: all
+  // edges in, then each looks its reverse up (straight-line loops, no
+  // unpredictable walk about the edge through the cavity).
   std::uint32_t newest = kNone;
   for (std::size_t i = 0; i < boundary.size(); ++i) {
     const Boundary& b = boundary[i];
     const std::uint32_t s = cavity[i];
     std::uint32_t* w = &T[8 * std::size_t(s)];
     std::copy_n(b.v, 4, w);
-    std::copy_n(b.adjacent, 4, w + 4);
     w[4 + b.face] = b.outer;
     T[entry(b.outer)] = 4 * s + b.face;
     if (newest == kNone || ((b.v[0] | b.v[1] | b.v[2] | b.v[3]) & kGhostBit) == 0) newest = s;
+  }
+  const std::size_t edges = 3 * boundary.size();
+  std::size_t size = 64;
+  while (size < 4 * edges) size *= 2;
+  if (edge_table.size() < size) {
+    edge_table.assign(size, EdgeEntry{});
+    edge_stamp = 0;
+  }
+  if (++edge_stamp == 0) {  // wrapped: old stamps could match again
+    std::fill(edge_table.begin(), edge_table.end(), EdgeEntry{});
+    edge_stamp = 1;
+  }
+  EdgeEntry* table = edge_table.data();
+  const std::uint32_t stamp = edge_stamp, mask = std::uint32_t(size - 1);
+  const auto hash = [mask](std::uint32_t a, std::uint32_t b) {
+    const std::uint32_t h = a * 0x9E3779B1u + b * 0x85EBCA77u;
+    return (h ^ (h >> 15)) & mask;
+  };
+  for (std::size_t i = 0; i < boundary.size(); ++i) {
+    const Boundary& b = boundary[i];
+    const std::uint32_t s = cavity[i];
+    for (std::uint32_t j = 0; j < 4; ++j) {
+      if (j == b.face) continue;
+      const std::uint32_t x = b.v[kFaceEdge[b.face][j][0]], y = b.v[kFaceEdge[b.face][j][1]];
+      std::uint32_t h = hash(x, y);
+      while (table[h].stamp == stamp) h = (h + 1) & mask;
+      table[h] = {x, y, 4 * s + j, stamp};
+    }
+  }
+  for (std::size_t i = 0; i < boundary.size(); ++i) {
+    const Boundary& b = boundary[i];
+    std::uint32_t* w = &T[8 * std::size_t(cavity[i])];
+    for (std::uint32_t j = 0; j < 4; ++j) {
+      if (j == b.face) continue;
+      const std::uint32_t x = b.v[kFaceEdge[b.face][j][0]], y = b.v[kFaceEdge[b.face][j][1]];
+      std::uint32_t h = hash(y, x);
+      while (table[h].a != y || table[h].b != x || table[h].stamp != stamp) h = (h + 1) & mask;
+      w[4 + j] = table[h].adjacency;
+    }
   }
   // Marks back to untested: the cavity's slots and the tetrahedra tested around it.
   for (const std::uint32_t c : cavity) M[c] = 0;
