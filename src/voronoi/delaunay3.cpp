@@ -4,6 +4,7 @@
 #include "geods/voronoi/delaunay3.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <memory>
 #include <numeric>
@@ -619,6 +620,7 @@ void Delaunay3::canonicalize() {
     return;
   }
   std::vector<std::uint32_t> offset(blocks * parts + 1, 0);  // per (partition, block): where its keys start
+  std::vector<std::uint32_t> ghosts_in(parts, 0);  // ghost slots per partition
   // The canonical order of each slot's entries, and the keys per partition per block.
   parallel_for_each_index(
       0, blocks,
@@ -631,6 +633,8 @@ void Delaunay3::canonicalize() {
           canonical_positions(v, position);
           for (int i = 0; i < 4; ++i) place[s][position[i]] = std::uint8_t(i);
           ++count[v[position[0]] >> shift];
+          if (((v[0] | v[1] | v[2] | v[3]) & Tet3Mesh::kGhostBit) != 0)  // (few: the hull's)
+            std::atomic_ref<std::uint32_t>(ghosts_in[v[position[0]] >> shift]).fetch_add(1, std::memory_order_relaxed);
         }
       },
       1);
@@ -666,6 +670,19 @@ void Delaunay3::canonicalize() {
   const auto part_begin = [&](std::size_t p) -> std::size_t {
     return p == 0 ? 0 : offset[(blocks - 1) * parts + p - 1];
   };
+  // The public arrays (the finite slots in the new order) are written with
+  // the sort, from the sorted keys: partition p's first public tetrahedron is
+  // its first slot less the ghosts before it.
+  std::vector<std::uint32_t> public_first(parts);
+  {
+    std::uint32_t ghosts = 0;
+    for (std::size_t p = 0; p < parts; ++p) {
+      public_first[p] = std::uint32_t(part_begin(p)) - ghosts;
+      ghosts += ghosts_in[p];
+    }
+    tetrahedra_.resize(4 * (live - ghosts));
+    public_of_.resize(live);
+  }
   std::vector<std::uint32_t> new_of(slots, kNone);
   parallel_for_each_index(
       0, parts,
@@ -691,6 +708,16 @@ void Delaunay3::canonicalize() {
           if (t + kAhead < sorted.size()) __builtin_prefetch(&new_of[sorted[t + kAhead].slot], 1);
           new_of[sorted[t].slot] = std::uint32_t(begin + t);
         }
+        std::uint32_t next = public_first[p];
+        for (std::size_t t = 0; t < sorted.size(); ++t) {
+          const std::uint32_t* v = sorted[t].v;
+          if (((v[2] | v[3]) & Tet3Mesh::kGhostBit) == 0) {  // (the ghost, the largest vertex, is never first or second)
+            std::copy_n(v, 4, &tetrahedra_[4 * std::size_t(next)]);
+            public_of_[begin + t] = next++;
+          } else {
+            public_of_[begin + t] = kNone;
+          }
+        }
       },
       1);
   std::vector<std::uint32_t> out(8 * live);
@@ -708,11 +735,17 @@ void Delaunay3::canonicalize() {
   tets_.swap(out);
   free_slots_.clear();
   last_ = last_ < slots && new_of[last_] != kNone ? new_of[last_] : 0;
+  published_ = true;
 }
 
 // The public arrays: the finite slots in slot order (canonical after a build;
 // insert and remove reuse and append slots).
 void Delaunay3::publish() {
+  if (published_) {
+    published_ = false;
+    index_vertices();
+    return;
+  }
   const std::size_t slots = tets_.size() / 8;
   public_of_.assign(slots, kNone);
   std::size_t count = 0;
@@ -741,12 +774,28 @@ std::vector<std::uint32_t> Delaunay3::neighbors() const {
 }
 
 void Delaunay3::index_vertices() {
-  vertex_slot_.assign(points_.size(), kNone);
-  for (std::size_t s = 0; s < tets_.size() / 8; ++s)
-    for (int k = 0; k < 4; ++k) {
-      const std::uint32_t v = tets_[8 * s + k];
-      if ((v & Tet3Mesh::kGhostBit) == 0) vertex_slot_[v] = std::uint32_t(s);
-    }
+  // Per vertex the last slot holding it; on several threads, the two halves
+  // of the slots at once, the upper one's answer first.
+  const std::size_t slots = tets_.size() / 8;
+  const auto scan = [&](std::size_t begin, std::size_t end, std::vector<std::uint32_t>& into) {
+    into.assign(points_.size(), kNone);
+    for (std::size_t s = begin; s < end; ++s)
+      for (int k = 0; k < 4; ++k) {
+        const std::uint32_t v = tets_[8 * s + k];
+        if ((v & Tet3Mesh::kGhostBit) == 0) into[v] = std::uint32_t(s);
+      }
+  };
+  if (num_threads() == 1 || slots < (1 << 16)) {
+    scan(0, slots, vertex_slot_);
+    return;
+  }
+  std::vector<std::uint32_t> upper;
+  parallel_for_each_index(
+      0, 2, [&](std::size_t h) { h == 0 ? scan(0, slots / 2, vertex_slot_) : scan(slots / 2, slots, upper); }, 1);
+  parallel_for(0, upper.size(), 1 << 16, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t v = begin; v < end; ++v)
+      if (upper[v] != kNone) vertex_slot_[v] = upper[v];
+  });
 }
 
 std::vector<Delaunay3::Triangle> Delaunay3::hull() const {
