@@ -651,10 +651,30 @@ void Delaunay3::canonicalize() {
     offset[blocks * parts] = total;
   }
   const std::size_t live = offset[blocks * parts];
+  // The public arrays (the finite slots in the new order) are written with
+  // the sort, from the sorted keys: partition p's first public tetrahedron is
+  // its first slot (block 0's start of it) less the ghosts before it.
+  std::vector<std::uint32_t> public_first(parts);
+  std::size_t ghosts = 0;
+  for (std::size_t p = 0; p < parts; ++p) {
+    public_first[p] = offset[p] - std::uint32_t(ghosts);
+    ghosts += ghosts_in[p];
+  }
+  // The keys per partition; meanwhile (task 0, the first one a thread
+  // starts) the arrays the sort fills are allocated: zeroing them is one
+  // thread's work, which the others' keys overlap.
   const std::unique_ptr<Key[]> keys(new Key[live]);
+  std::vector<std::uint32_t> new_of;
   parallel_for_each_index(
-      0, blocks,
-      [&](std::size_t block) {
+      0, blocks + 1,
+      [&](std::size_t task) {
+        if (task == 0) {
+          tetrahedra_.resize(4 * (live - ghosts));
+          public_of_.resize(live);
+          new_of.assign(slots, kNone);
+          return;
+        }
+        const std::size_t block = task - 1;
         std::uint32_t* next = &offset[block * parts];
         for (std::size_t s = block * kBlock; s < std::min(slots, (block + 1) * kBlock); ++s) {
           const std::uint32_t* v = &tets_[8 * s];
@@ -670,23 +690,16 @@ void Delaunay3::canonicalize() {
   const auto part_begin = [&](std::size_t p) -> std::size_t {
     return p == 0 ? 0 : offset[(blocks - 1) * parts + p - 1];
   };
-  // The public arrays (the finite slots in the new order) are written with
-  // the sort, from the sorted keys: partition p's first public tetrahedron is
-  // its first slot less the ghosts before it.
-  std::vector<std::uint32_t> public_first(parts);
-  {
-    std::uint32_t ghosts = 0;
-    for (std::size_t p = 0; p < parts; ++p) {
-      public_first[p] = std::uint32_t(part_begin(p)) - ghosts;
-      ghosts += ghosts_in[p];
-    }
-    tetrahedra_.resize(4 * (live - ghosts));
-    public_of_.resize(live);
-  }
-  std::vector<std::uint32_t> new_of(slots, kNone);
+  // The sort (and, as task 0, the new slots' array allocated).
+  std::vector<std::uint32_t> out;
   parallel_for_each_index(
-      0, parts,
-      [&](std::size_t p) {
+      0, parts + 1,
+      [&](std::size_t task) {
+        if (task == 0) {
+          out.resize(8 * live);
+          return;
+        }
+        const std::size_t p = task - 1;
         const std::size_t begin = part_begin(p), end = offset[(blocks - 1) * parts + p];
         if (begin == end) return;
         // A counting sort on the first vertex, then each bucket by the other three.
@@ -720,7 +733,6 @@ void Delaunay3::canonicalize() {
         }
       },
       1);
-  std::vector<std::uint32_t> out(8 * live);
   parallel_for(0, slots, 1 << 14, [&](std::size_t begin, std::size_t end) {
     for (std::size_t s = begin; s < end; ++s) {
       const std::size_t t = new_of[s];
