@@ -8,9 +8,7 @@
 // adjacencies, side by side in one cache line: adjacency 4u + g means
 // neighbour u, where this face is u's face g (opposite u's vertex g). Tetrahedra are positively oriented (orient() > 0); a ghost tetrahedron
 // is oriented as if its ghost were a point beyond its hull face.
-#include <algorithm>
 #include <array>
-#include <cmath>
 #include <cstdint>
 #include <span>
 #include <utility>
@@ -38,55 +36,11 @@ struct Tet3Mesh {
   std::size_t walk_steps = 0, conflicts = 0;
 
   /// det(b - a, c - a, d - a): > 0 for a positively oriented tetrahedron (exact sign).
-  [[gnu::always_inline]] static double orient(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& d) {
-    // A semi-static filter first (as CGAL's Epick): the determinant of
-    // orient3d, with a bound from the largest |difference| per axis instead of
-    // its permanent (fewer operations). Shewchuk's bound is (7 + 56 eps) eps
-    // times the permanent, which is at most 6 mx my mz; with the axes' maxima
-    // above 1e-97 no term underflows enough to matter, and below 1e102 none
-    // overflows. Otherwise: the exact predicate (the same sign either way).
-    const double adx = a[0] - d[0], ady = a[1] - d[1], adz = a[2] - d[2];
-    const double bdx = b[0] - d[0], bdy = b[1] - d[1], bdz = b[2] - d[2];
-    const double cdx = c[0] - d[0], cdy = c[1] - d[1], cdz = c[2] - d[2];
-    const double det = adz * (bdx * cdy - cdx * bdy) + bdz * (cdx * ady - adx * cdy) + cdz * (adx * bdy - bdx * ady);
-    const double mx = std::max(std::max(std::abs(adx), std::abs(bdx)), std::abs(cdx));
-    const double my = std::max(std::max(std::abs(ady), std::abs(bdy)), std::abs(cdy));
-    const double mz = std::max(std::max(std::abs(adz), std::abs(bdz)), std::abs(cdz));
-    const double low = std::min(std::min(mx, my), mz), high = std::max(std::max(mx, my), mz);
-    if (low > 1e-97 && high < 1e102) [[likely]] {
-      if (std::abs(det) > 9.5e-15 * (mx * my * mz)) [[likely]]
-        return -det;
-    }
+  static double orient(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& d) {
     return -orient3d(a.data(), b.data(), c.data(), d.data());
   }
   /// For a positive (a, b, c, d): > 0 if e is inside their sphere, < 0 outside, 0 on it (exact sign).
-  [[gnu::always_inline]] static double in_sphere(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& d, const Vec3d& e) {
-    // The same kind of filter for insphere: Shewchuk's bound (16 + 224 eps) eps
-    // times the permanent, which is at most 72 mx my mz M^2 (M the largest of
-    // the three); maxima in [1e-58, 1e61] keep underflow and overflow away.
-    const double aex = a[0] - e[0], aey = a[1] - e[1], aez = a[2] - e[2];
-    const double bex = b[0] - e[0], bey = b[1] - e[1], bez = b[2] - e[2];
-    const double cex = c[0] - e[0], cey = c[1] - e[1], cez = c[2] - e[2];
-    const double dex = d[0] - e[0], dey = d[1] - e[1], dez = d[2] - e[2];
-    const double ab = aex * bey - bex * aey, bc = bex * cey - cex * bey, cd = cex * dey - dex * cey;
-    const double da = dex * aey - aex * dey, ac = aex * cey - cex * aey, bd = bex * dey - dex * bey;
-    const double abc = aez * bc - bez * ac + cez * ab;
-    const double bcd = bez * cd - cez * bd + dez * bc;
-    const double cda = cez * da + dez * ac + aez * cd;
-    const double dab = dez * ab + aez * bd + bez * da;
-    const double alift = aex * aex + aey * aey + aez * aez;
-    const double blift = bex * bex + bey * bey + bez * bez;
-    const double clift = cex * cex + cey * cey + cez * cez;
-    const double dlift = dex * dex + dey * dey + dez * dez;
-    const double det = (dlift * abc - clift * dab) + (blift * cda - alift * bcd);
-    const double mx = std::max(std::max(std::abs(aex), std::abs(bex)), std::max(std::abs(cex), std::abs(dex)));
-    const double my = std::max(std::max(std::abs(aey), std::abs(bey)), std::max(std::abs(cey), std::abs(dey)));
-    const double mz = std::max(std::max(std::abs(aez), std::abs(bez)), std::max(std::abs(cez), std::abs(dez)));
-    const double low = std::min(std::min(mx, my), mz), high = std::max(std::max(mx, my), mz);
-    if (low > 1e-58 && high < 1e61) [[likely]] {
-      if (std::abs(det) > 2.6e-13 * (mx * my * mz) * (high * high)) [[likely]]
-        return -det;
-    }
+  static double in_sphere(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& d, const Vec3d& e) {
     return -insphere(a.data(), b.data(), c.data(), d.data(), e.data());
   }
   static bool lex_less(const Vec3d& a, const Vec3d& b) {
