@@ -4,6 +4,7 @@
 #include "geods/voronoi/delaunay3.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <memory>
 #include <numeric>
@@ -31,6 +32,23 @@ bool collinear(const Vec3d& a, const Vec3d& b, const Vec3d& c) {
   }
   return true;
 }
+
+// kFaceEdge[f][j]: for a tetrahedron whose vertex f is the new point p, the
+// other two vertices of its face opposite j (j != f), in the order that makes
+// (p, x, y) counter-clockwise seen from vertex j's side: the tetrahedron on
+// the other side of that face sees the edge as (y, x).
+constexpr std::array<std::array<std::array<std::uint8_t, 2>, 4>, 4> kFaceEdge = [] {
+  std::array<std::array<std::array<std::uint8_t, 2>, 4>, 4> e{};
+  for (int f = 0; f < 4; ++f)
+    for (int j = 0; j < 4; ++j) {
+      if (j == f) continue;
+      const std::array<int, 3> t = j % 2 == 0 ? std::array<int, 3>{(j + 1) % 4, (j + 3) % 4, (j + 2) % 4}
+                                              : std::array<int, 3>{(j + 1) % 4, (j + 2) % 4, (j + 3) % 4};
+      const int at = t[0] == f ? 0 : t[1] == f ? 1 : 2;
+      e[f][j] = {std::uint8_t(t[(at + 1) % 3]), std::uint8_t(t[(at + 2) % 3])};
+    }
+  return e;
+}();
 
 std::string tet_name(std::uint32_t t) { return "tetrahedron slot " + std::to_string(t); }
 
@@ -212,7 +230,6 @@ std::uint32_t Tet3Mesh::insert(std::uint32_t pv) {
       b.face = f;
       b.outer = a;
       b.cell = c;
-      std::fill_n(b.adjacent, 4, kNone);
       faces |= std::uint8_t(1u << f);
     }
     M[c] = in | faces;
@@ -225,44 +242,61 @@ std::uint32_t Tet3Mesh::insert(std::uint32_t pv) {
     T = tets.data();
     M = mark.data();
   }
-  // New tetrahedron i (cavity slot c with p for its vertex f) has three faces
-  // through p, each with an edge of c's; its neighbour across the one opposite
-  // j is found by turning about that edge from c's face j through the cavity
-  // until a boundary face: the new tetrahedron made from that face. The cavity
-  // slots' boundary faces point to their new tetrahedra meanwhile (no hashing:
-  // the old tetrahedra are the map), and each pair is linked from both sides at once.
-  for (std::size_t i = 0; i < boundary.size(); ++i) {
-    const Boundary& b = boundary[i];
-    T[8 * std::size_t(b.cell) + 4 + b.face] = std::uint32_t(i);
-  }
-  for (std::size_t i = 0; i < boundary.size(); ++i) {
-    Boundary& b = boundary[i];
-    for (std::uint32_t j = 0; j < 4; ++j) {
-      if (j == b.face || b.adjacent[j] != kNone) continue;
-      std::uint32_t cell = b.cell, from = b.face, across = j;  // the faces of `cell` about the edge
-      while (!(M[cell] >> across & 1)) {
-        const std::uint32_t a = T[8 * std::size_t(cell) + 4 + across];
-        const std::uint32_t x = T[8 * std::size_t(cell) + from];  // on the face crossed, off the edge
-        cell = a >> 2;
-        from = a & 3;
-        const std::uint32_t* w = &T[8 * std::size_t(cell)];
-        across = std::uint32_t(w[1] == x) | std::uint32_t(w[2] == x) << 1 | std::uint32_t(w[3] == x) * 3;
-      }
-      const std::uint32_t k = T[8 * std::size_t(cell) + 4 + across];
-      b.adjacent[j] = 4 * cavity[k] + from;
-      boundary[k].adjacent[from] = 4 * cavity[i] + j;
-    }
-  }
+  // The new tetrahedra, then their links to each other: new tetrahedron i
+  // (cavity slot c with p for its vertex f) has three faces through p, each
+  // with an edge of its boundary face, which one other boundary face shares,
+  // the other way round. A small hash table of those directed edges (valid
+  // for this insertion by its stamp, so never cleared) finds the pairs: all
+  // edges in, then each looks its reverse up (straight-line loops, no
+  // unpredictable walk about the edge through the cavity).
   std::uint32_t newest = kNone;
   for (std::size_t i = 0; i < boundary.size(); ++i) {
     const Boundary& b = boundary[i];
     const std::uint32_t s = cavity[i];
     std::uint32_t* w = &T[8 * std::size_t(s)];
     std::copy_n(b.v, 4, w);
-    std::copy_n(b.adjacent, 4, w + 4);
     w[4 + b.face] = b.outer;
     T[entry(b.outer)] = 4 * s + b.face;
     if (newest == kNone || ((b.v[0] | b.v[1] | b.v[2] | b.v[3]) & kGhostBit) == 0) newest = s;
+  }
+  const std::size_t edges = 3 * boundary.size();
+  std::size_t size = 64;
+  while (size < 4 * edges) size *= 2;
+  if (edge_table.size() < size) {
+    edge_table.assign(size, EdgeEntry{});
+    edge_stamp = 0;
+  }
+  if (++edge_stamp == 0) {  // wrapped: old stamps could match again
+    std::fill(edge_table.begin(), edge_table.end(), EdgeEntry{});
+    edge_stamp = 1;
+  }
+  EdgeEntry* table = edge_table.data();
+  const std::uint32_t stamp = edge_stamp, mask = std::uint32_t(size - 1);
+  const auto hash = [mask](std::uint32_t a, std::uint32_t b) {
+    const std::uint32_t h = a * 0x9E3779B1u + b * 0x85EBCA77u;
+    return (h ^ (h >> 15)) & mask;
+  };
+  for (std::size_t i = 0; i < boundary.size(); ++i) {
+    const Boundary& b = boundary[i];
+    const std::uint32_t s = cavity[i];
+    for (std::uint32_t j = 0; j < 4; ++j) {
+      if (j == b.face) continue;
+      const std::uint32_t x = b.v[kFaceEdge[b.face][j][0]], y = b.v[kFaceEdge[b.face][j][1]];
+      std::uint32_t h = hash(x, y);
+      while (table[h].stamp == stamp) h = (h + 1) & mask;
+      table[h] = {x, y, 4 * s + j, stamp};
+    }
+  }
+  for (std::size_t i = 0; i < boundary.size(); ++i) {
+    const Boundary& b = boundary[i];
+    std::uint32_t* w = &T[8 * std::size_t(cavity[i])];
+    for (std::uint32_t j = 0; j < 4; ++j) {
+      if (j == b.face) continue;
+      const std::uint32_t x = b.v[kFaceEdge[b.face][j][0]], y = b.v[kFaceEdge[b.face][j][1]];
+      std::uint32_t h = hash(y, x);
+      while (table[h].a != y || table[h].b != x || table[h].stamp != stamp) h = (h + 1) & mask;
+      w[4 + j] = table[h].adjacency;
+    }
   }
   // Marks back to untested: the cavity's slots and the tetrahedra tested around it.
   for (const std::uint32_t c : cavity) M[c] = 0;
@@ -586,6 +620,7 @@ void Delaunay3::canonicalize() {
     return;
   }
   std::vector<std::uint32_t> offset(blocks * parts + 1, 0);  // per (partition, block): where its keys start
+  std::vector<std::uint32_t> ghosts_in(parts, 0);  // ghost slots per partition
   // The canonical order of each slot's entries, and the keys per partition per block.
   parallel_for_each_index(
       0, blocks,
@@ -598,6 +633,8 @@ void Delaunay3::canonicalize() {
           canonical_positions(v, position);
           for (int i = 0; i < 4; ++i) place[s][position[i]] = std::uint8_t(i);
           ++count[v[position[0]] >> shift];
+          if (((v[0] | v[1] | v[2] | v[3]) & Tet3Mesh::kGhostBit) != 0)  // (few: the hull's)
+            std::atomic_ref<std::uint32_t>(ghosts_in[v[position[0]] >> shift]).fetch_add(1, std::memory_order_relaxed);
         }
       },
       1);
@@ -614,10 +651,30 @@ void Delaunay3::canonicalize() {
     offset[blocks * parts] = total;
   }
   const std::size_t live = offset[blocks * parts];
+  // The public arrays (the finite slots in the new order) are written with
+  // the sort, from the sorted keys: partition p's first public tetrahedron is
+  // its first slot (block 0's start of it) less the ghosts before it.
+  std::vector<std::uint32_t> public_first(parts);
+  std::size_t ghosts = 0;
+  for (std::size_t p = 0; p < parts; ++p) {
+    public_first[p] = offset[p] - std::uint32_t(ghosts);
+    ghosts += ghosts_in[p];
+  }
+  // The keys per partition; meanwhile (task 0, the first one a thread
+  // starts) the arrays the sort fills are allocated: zeroing them is one
+  // thread's work, which the others' keys overlap.
   const std::unique_ptr<Key[]> keys(new Key[live]);
+  std::vector<std::uint32_t> new_of;
   parallel_for_each_index(
-      0, blocks,
-      [&](std::size_t block) {
+      0, blocks + 1,
+      [&](std::size_t task) {
+        if (task == 0) {
+          tetrahedra_.resize(4 * (live - ghosts));
+          public_of_.resize(live);
+          new_of.assign(slots, kNone);
+          return;
+        }
+        const std::size_t block = task - 1;
         std::uint32_t* next = &offset[block * parts];
         for (std::size_t s = block * kBlock; s < std::min(slots, (block + 1) * kBlock); ++s) {
           const std::uint32_t* v = &tets_[8 * s];
@@ -633,10 +690,16 @@ void Delaunay3::canonicalize() {
   const auto part_begin = [&](std::size_t p) -> std::size_t {
     return p == 0 ? 0 : offset[(blocks - 1) * parts + p - 1];
   };
-  std::vector<std::uint32_t> new_of(slots, kNone);
+  // The sort (and, as task 0, the new slots' array allocated).
+  std::vector<std::uint32_t> out;
   parallel_for_each_index(
-      0, parts,
-      [&](std::size_t p) {
+      0, parts + 1,
+      [&](std::size_t task) {
+        if (task == 0) {
+          out.resize(8 * live);
+          return;
+        }
+        const std::size_t p = task - 1;
         const std::size_t begin = part_begin(p), end = offset[(blocks - 1) * parts + p];
         if (begin == end) return;
         // A counting sort on the first vertex, then each bucket by the other three.
@@ -658,9 +721,18 @@ void Delaunay3::canonicalize() {
           if (t + kAhead < sorted.size()) __builtin_prefetch(&new_of[sorted[t + kAhead].slot], 1);
           new_of[sorted[t].slot] = std::uint32_t(begin + t);
         }
+        std::uint32_t next = public_first[p];
+        for (std::size_t t = 0; t < sorted.size(); ++t) {
+          const std::uint32_t* v = sorted[t].v;
+          if (((v[2] | v[3]) & Tet3Mesh::kGhostBit) == 0) {  // (the ghost, the largest vertex, is never first or second)
+            std::copy_n(v, 4, &tetrahedra_[4 * std::size_t(next)]);
+            public_of_[begin + t] = next++;
+          } else {
+            public_of_[begin + t] = kNone;
+          }
+        }
       },
       1);
-  std::vector<std::uint32_t> out(8 * live);
   parallel_for(0, slots, 1 << 14, [&](std::size_t begin, std::size_t end) {
     for (std::size_t s = begin; s < end; ++s) {
       const std::size_t t = new_of[s];
@@ -675,11 +747,17 @@ void Delaunay3::canonicalize() {
   tets_.swap(out);
   free_slots_.clear();
   last_ = last_ < slots && new_of[last_] != kNone ? new_of[last_] : 0;
+  published_ = true;
 }
 
 // The public arrays: the finite slots in slot order (canonical after a build;
 // insert and remove reuse and append slots).
 void Delaunay3::publish() {
+  if (published_) {
+    published_ = false;
+    index_vertices();
+    return;
+  }
   const std::size_t slots = tets_.size() / 8;
   public_of_.assign(slots, kNone);
   std::size_t count = 0;
@@ -708,12 +786,28 @@ std::vector<std::uint32_t> Delaunay3::neighbors() const {
 }
 
 void Delaunay3::index_vertices() {
-  vertex_slot_.assign(points_.size(), kNone);
-  for (std::size_t s = 0; s < tets_.size() / 8; ++s)
-    for (int k = 0; k < 4; ++k) {
-      const std::uint32_t v = tets_[8 * s + k];
-      if ((v & Tet3Mesh::kGhostBit) == 0) vertex_slot_[v] = std::uint32_t(s);
-    }
+  // Per vertex the last slot holding it; on several threads, the two halves
+  // of the slots at once, the upper one's answer first.
+  const std::size_t slots = tets_.size() / 8;
+  const auto scan = [&](std::size_t begin, std::size_t end, std::vector<std::uint32_t>& into) {
+    into.assign(points_.size(), kNone);
+    for (std::size_t s = begin; s < end; ++s)
+      for (int k = 0; k < 4; ++k) {
+        const std::uint32_t v = tets_[8 * s + k];
+        if ((v & Tet3Mesh::kGhostBit) == 0) into[v] = std::uint32_t(s);
+      }
+  };
+  if (num_threads() == 1 || slots < (1 << 16)) {
+    scan(0, slots, vertex_slot_);
+    return;
+  }
+  std::vector<std::uint32_t> upper;
+  parallel_for_each_index(
+      0, 2, [&](std::size_t h) { h == 0 ? scan(0, slots / 2, vertex_slot_) : scan(slots / 2, slots, upper); }, 1);
+  parallel_for(0, upper.size(), 1 << 16, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t v = begin; v < end; ++v)
+      if (upper[v] != kNone) vertex_slot_[v] = upper[v];
+  });
 }
 
 std::vector<Delaunay3::Triangle> Delaunay3::hull() const {

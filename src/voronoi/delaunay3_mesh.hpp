@@ -102,13 +102,17 @@ struct Tet3Mesh {
 
   struct Boundary {
     std::uint32_t v[4];  // the new tetrahedron: the cavity one with p in place of the vertex facing out
-    std::uint32_t adjacent[4];  // its adjacencies (kNone until linked)
     std::uint32_t face;  // its face on the cavity's boundary
     std::uint32_t outer;  // the adjacency across it
     std::uint32_t cell;  // the cavity slot it is made from
   };
   std::vector<std::uint32_t> stack, cavity;
   std::vector<Boundary> boundary;
+  struct EdgeEntry {  // a new tetrahedron's face through p, by its directed edge (a, b)
+    std::uint32_t a = 0, b = 0, adjacency = 0, stamp = 0;
+  };
+  std::vector<EdgeEntry> edge_table;  // open addressing; an entry is used if its stamp is edge_stamp
+  std::uint32_t edge_stamp = 0;
 
   // Flip-based insertion (delaunay3_flip.cpp): insert() defers to
   // insert_by_flips() when `flips` is set; same answer, same tetrahedralization.

@@ -201,8 +201,8 @@ class Delaunay3 {
   void build(Options options, bool may_split = true);
   bool build_split(const std::vector<std::uint32_t>& active);  // false: the halves cannot be stitched, build sequentially
   bool remove_locally(std::uint32_t v);  // false: the link is flat, rebuild instead
-  void canonicalize();  // slots in an order that depends only on the points
-  void publish();
+  void canonicalize();  // slots in an order that depends only on the points; publishes them too
+  void publish();  // (only vertex_slot_ left to do right after canonicalize: `published_`)
   void index_vertices();  // vertex_slot_ from the slots
   std::uint32_t start_slot(std::uint32_t hint) const;  // a live slot to walk from
   // nearest_vertex(q) walking from `slot` (dimension 3), which becomes the slot q lies in (or a ghost beyond it).
@@ -222,6 +222,7 @@ class Delaunay3 {
 
   std::vector<std::uint32_t> tetrahedra_;  // public, finite only
   std::vector<std::uint32_t> public_of_;               // internal slot -> public tetrahedron (no_index: ghost or free)
+  bool published_ = false;  // tetrahedra_ and public_of_ are already those of tets_ (set by canonicalize)
 };
 
 }  // namespace geods::voronoi
