@@ -13,6 +13,7 @@
 #include <cstring>
 #include <span>
 #include <string>
+#include <type_traits>
 
 #include <fmt/format.h>
 
@@ -962,9 +963,26 @@ class GridSolver {
           bvh::traverse_topology<false>(
               topo, 0, stack,
               [&](std::uint32_t node, float&) {
-                for (int k = 0; k < 8; ++k)
-                  if (bvh::squared_distance(volumes[node], box.corners[k]) <= bound2[k]) return true;
-                return false;
+                if constexpr (std::is_same_v<std::decay_t<decltype(volumes[node])>, AABB3f>) {
+                  // The corners take two coordinates per axis: six squared
+                  // gaps instead of 8 box distances (most nodes tested fail all 8).
+                  const AABB3f& v = volumes[node];
+                  std::array<std::array<float, 2>, 3> gap;
+                  for (int a = 0; a < 3; ++a)
+                    for (int e = 0; e < 2; ++e) {
+                      const float c = box.corners[e ? 7 : 0][a];
+                      const float g = std::max({v.lo[a] - c, c - v.hi[a], 0.0f});
+                      gap[a][e] = g * g;
+                    }
+                  bool near = false;
+                  for (int k = 0; k < 8; ++k)
+                    near |= gap[0][k & 1] + gap[1][k >> 1 & 1] + gap[2][k >> 2 & 1] <= bound2[k];
+                  return near;
+                } else {
+                  for (int k = 0; k < 8; ++k)
+                    if (bvh::squared_distance(volumes[node], box.corners[k]) <= bound2[k]) return true;
+                  return false;
+                }
               },
               [&](const bvh::TopoNode& node) {
                 for (std::uint32_t i = node.prim_first; i < node.prim_first + node.prim_count; ++i) found.push_back(i);
