@@ -13,6 +13,7 @@
 #include <cstring>
 #include <span>
 #include <string>
+#include <type_traits>
 
 #include <fmt/format.h>
 
@@ -531,6 +532,21 @@ GEODS_AVX512_FN void lattice_filter(const Packed& t, const Lattice& lat,
   }
 }
 
+// best_lane() of sixteen lanes by vector reductions (the scalar loop's
+// data-dependent branches cost a quarter of a search): the smallest distance,
+// of its lanes the smallest face, of those the first lane. The lanes hold no
+// NaN (they change only on ordered comparisons), so some lane is chosen.
+GEODS_AVX512_INLINE std::size_t best_lane16(__m512 best, __m512i face, __m512i entry, float& d2) {
+  const float least = _mm512_reduce_min_ps(best);
+  const __mmask16 at_least = _mm512_cmp_ps_mask(best, _mm512_set1_ps(least), _CMP_EQ_OQ);
+  const std::int32_t first_face = _mm512_mask_reduce_min_epi32(at_least, face);
+  const __mmask16 chosen = at_least & _mm512_cmpeq_epi32_mask(face, _mm512_set1_epi32(first_face));
+  d2 = least;
+  alignas(64) std::int32_t ba[16];
+  _mm512_store_si512(ba, entry);
+  return std::size_t(ba[__builtin_ctz(chosen)]);
+}
+
 // As corner_nearest() above, sixteen entries at a time.
 GEODS_AVX512_FN void corner_nearest(const Packed& t, std::array<std::size_t, 8>& index, std::array<float, 8>& dist2) {
   const __m512i lanes = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
@@ -547,13 +563,8 @@ GEODS_AVX512_FN void corner_nearest(const Packed& t, std::array<std::size_t, 8>&
       best_face = _mm512_mask_blend_epi32(closer, best_face, face);
       at = _mm512_mask_blend_epi32(closer, at, _mm512_add_epi32(lanes, _mm512_set1_epi32(std::int32_t(i))));
     }
-    alignas(64) float bd[16];
-    alignas(64) std::int32_t bf[16], ba[16];
     float d2;
-    _mm512_store_ps(bd, best);
-    _mm512_store_si512(bf, best_face);
-    _mm512_store_si512(ba, at);
-    index[c] = best_lane(bd, bf, ba, 16, d2);
+    index[c] = best_lane16(best, best_face, at, d2);
     dist2[c] = d2;
   }
 }
@@ -661,12 +672,7 @@ GEODS_AVX512_FN std::size_t nearest(const Packed& t, const Vec3f& p, const InBlo
     if (c == seed || (in_block && s.beyond(c, at_p.spread, slack))) continue;
     s.pair(c);
   }
-  alignas(64) float bd[16];
-  alignas(64) std::int32_t bf[16], ba[16];
-  _mm512_store_ps(bd, s.best);
-  _mm512_store_si512(bf, s.best_face);
-  _mm512_store_si512(ba, s.at_lane);
-  return best_lane(bd, bf, ba, 16, d2);
+  return best_lane16(s.best, s.best_face, s.at_lane, d2);
 }
 
 }  // namespace avx512
@@ -957,9 +963,26 @@ class GridSolver {
           bvh::traverse_topology<false>(
               topo, 0, stack,
               [&](std::uint32_t node, float&) {
-                for (int k = 0; k < 8; ++k)
-                  if (bvh::squared_distance(volumes[node], box.corners[k]) <= bound2[k]) return true;
-                return false;
+                if constexpr (std::is_same_v<std::decay_t<decltype(volumes[node])>, AABB3f>) {
+                  // The corners take two coordinates per axis: six squared
+                  // gaps instead of 8 box distances (most nodes tested fail all 8).
+                  const AABB3f& v = volumes[node];
+                  std::array<std::array<float, 2>, 3> gap;
+                  for (int a = 0; a < 3; ++a)
+                    for (int e = 0; e < 2; ++e) {
+                      const float c = box.corners[e ? 7 : 0][a];
+                      const float g = std::max({v.lo[a] - c, c - v.hi[a], 0.0f});
+                      gap[a][e] = g * g;
+                    }
+                  bool near = false;
+                  for (int k = 0; k < 8; ++k)
+                    near |= gap[0][k & 1] + gap[1][k >> 1 & 1] + gap[2][k >> 2 & 1] <= bound2[k];
+                  return near;
+                } else {
+                  for (int k = 0; k < 8; ++k)
+                    if (bvh::squared_distance(volumes[node], box.corners[k]) <= bound2[k]) return true;
+                  return false;
+                }
               },
               [&](const bvh::TopoNode& node) {
                 for (std::uint32_t i = node.prim_first; i < node.prim_first + node.prim_count; ++i) found.push_back(i);
@@ -1051,7 +1074,9 @@ class GridSolver {
     out.clear();
     out.reserve(n);
     for (int k = 0; k < Packed::k0; ++k) copy_at(in.f[k].data(), from.data(), n, out.f[k].data());
-    for (int k = 0; k < 8; ++k) copy_at(kept.k[k].data(), order.data(), n, out.f[Packed::k0 + k].data());
+    for (int k = 0; k < 8; ++k)  // unsorted: kept's own order, a plain copy
+      sorted ? copy_at(kept.k[k].data(), order.data(), n, out.f[Packed::k0 + k].data())
+             : void(std::copy_n(kept.k[k].data(), n, out.f[Packed::k0 + k].data()));
     copy_at(in.face.data(), from.data(), n, out.face.data());
     copy_at(in.leaf.data(), from.data(), n, out.leaf.data());
     out.size = n;
