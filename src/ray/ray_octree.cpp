@@ -66,22 +66,43 @@ std::unique_ptr<RayOctree> RayOctree::build(const TriMesh& mesh, const Accelerat
       std::array<AABB3f, 8> boxes;
       for (int c = 0; c < 8; ++c) boxes[c] = detail::widened(child_box(p.box, c), o.margin_);
       const Vec3f mid = p.box.center();
-      for (std::uint32_t t : p.triangles) {
-        const Vec3f* corners = &o.corners_[3 * std::size_t(t)];
-        const AABB3f tri_box = triangle_bounds(corners[0], corners[1], corners[2]);
-        // The halves of each axis the (widened) triangle box reaches: a
-        // triangle inside one child needs no triangle-box test.
-        int lo_bits = 0, hi_bits = 0;
-        for (int a = 0; a < 3; ++a) {
-          if (tri_box.lo[a] <= mid[a] + o.margin_) lo_bits |= 4 >> a;
-          if (tri_box.hi[a] >= mid[a] - o.margin_) hi_bits |= 4 >> a;
+      auto classify = [&](std::size_t first, std::size_t last, std::array<std::vector<std::uint32_t>, 8>& out) {
+        for (std::size_t i = first; i < last; ++i) {
+          const std::uint32_t t = p.triangles[i];
+          const Vec3f* corners = &o.corners_[3 * std::size_t(t)];
+          const AABB3f tri_box = triangle_bounds(corners[0], corners[1], corners[2]);
+          // The halves of each axis the (widened) triangle box reaches: a
+          // triangle inside one child needs no triangle-box test.
+          int lo_bits = 0, hi_bits = 0;
+          for (int a = 0; a < 3; ++a) {
+            if (tri_box.lo[a] <= mid[a] + o.margin_) lo_bits |= 4 >> a;
+            if (tri_box.hi[a] >= mid[a] - o.margin_) hi_bits |= 4 >> a;
+          }
+          const bool single = (lo_bits ^ hi_bits) == 7;
+          for (int c = 0; c < 8; ++c) {
+            // Child c takes the upper half of the axes whose bit is set in c.
+            if ((c & ~hi_bits & 7) != 0 || (~c & ~lo_bits & 7) != 0) continue;
+            if (single || triangle_box_overlap(corners[0], corners[1], corners[2], boxes[c])) out[c].push_back(t);
+          }
         }
-        const bool single = (lo_bits ^ hi_bits) == 7;
+      };
+      // The top levels have fewer nodes than threads: a large node's triangles
+      // are classified in fixed chunks in parallel and the lists joined in
+      // order, the same lists as one pass.
+      constexpr std::size_t kChunk = 32768;
+      const std::size_t chunks = (p.triangles.size() + kChunk - 1) / kChunk;
+      if (chunks == 1) {
+        classify(0, p.triangles.size(), children[k]);
+      } else {
+        std::vector<std::array<std::vector<std::uint32_t>, 8>> parts(chunks);
+        parallel_for_each_index(0, chunks, [&](std::size_t j) {
+          classify(j * kChunk, std::min(p.triangles.size(), (j + 1) * kChunk), parts[j]);
+        }, 1);
         for (int c = 0; c < 8; ++c) {
-          // Child c takes the upper half of the axes whose bit is set in c.
-          if ((c & ~hi_bits & 7) != 0 || (~c & ~lo_bits & 7) != 0) continue;
-          if (single || triangle_box_overlap(corners[0], corners[1], corners[2], boxes[c]))
-            children[k][c].push_back(t);
+          std::size_t size = 0;
+          for (const auto& part : parts) size += part[c].size();
+          children[k][c].reserve(size);
+          for (const auto& part : parts) children[k][c].insert(children[k][c].end(), part[c].begin(), part[c].end());
         }
       }
       // A child is hit by about a quarter of the rays that hit its parent (the

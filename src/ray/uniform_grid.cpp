@@ -94,15 +94,24 @@ std::unique_ptr<UniformGrid> UniformGrid::build(const TriMesh& mesh, const Accel
   }, 1);
 
   // Counting sort by cell; within a cell the triangles stay in increasing order.
+  // Each thread takes a range of cells and reads every pair: the pairs are read
+  // in order, the counts and cursors (the cache misses) are shared out.
+  const std::size_t ranges = std::size_t(std::max(num_threads(), 1));
+  auto by_cell_range = [&](auto&& visit) {
+    parallel_for_each_index(0, ranges, [&](std::size_t r) {
+      const std::size_t first = cells * r / ranges, last = cells * (r + 1) / ranges;
+      for (const auto& chunk : pairs)
+        for (const auto& [cell, tri] : chunk)
+          if (cell >= first && cell < last) visit(cell, tri);
+    }, 1);
+  };
   std::vector<std::uint32_t> cell_begin(cells + 1, 0);
-  for (const auto& chunk : pairs)
-    for (const auto& [cell, tri] : chunk) ++cell_begin[cell + 1];
+  by_cell_range([&](std::uint32_t cell, std::uint32_t) { ++cell_begin[cell + 1]; });
   std::partial_sum(cell_begin.begin(), cell_begin.end(), cell_begin.begin());
   if (cell_begin.back() >= RayHit::no_hit) throw Error("uniform grid: more than 2^32 triangle references");
   std::vector<std::uint32_t> cell_triangles(cell_begin.back());
   std::vector<std::uint32_t> cursor(cell_begin.begin(), cell_begin.end() - 1);
-  for (const auto& chunk : pairs)
-    for (const auto& [cell, tri] : chunk) cell_triangles[cursor[cell]++] = tri;
+  by_cell_range([&](std::uint32_t cell, std::uint32_t tri) { cell_triangles[cursor[cell]++] = tri; });
   g.cell_begin_ = std::move(cell_begin);
   g.cell_triangles_ = std::move(cell_triangles);
   g.build_s_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -5,6 +5,7 @@
 // axis-aligned triangles, for random, axis-parallel, grazing and on-surface rays.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -383,6 +384,41 @@ TEST(Accelerators, ParallelQueriesGiveTheSameAnswers) {
     }
     EXPECT_NO_THROW(accel->validate());
   }
+}
+
+// The builds split their work by thread (the grid's cell ranges) and by fixed
+// chunks (the octree's large nodes); the arrays must not depend on either.
+TEST(Accelerators, GridAndOctreeBuildsAreTheSameOnAnyThreadCount) {
+  TriMesh mesh = ugly_soup(41, 800);  // small triangles, then ugly ones
+  Rng rng(42);
+  for (int i = 0; i < 40000; ++i) {
+    const Vec3f p = random_vec(rng, Vec3f::Constant(-1), Vec3f::Constant(1));
+    const auto base = std::uint32_t(mesh.vertices.size());
+    mesh.vertices.insert(mesh.vertices.end(), {p, p + 0.02f * random_direction(rng), p + 0.02f * random_direction(rng)});
+    mesh.triangles.push_back({base, base + 1, base + 2});
+  }
+  ASSERT_GT(mesh.num_triangles(), 32768u);  // two chunks at the octree's root
+  set_num_threads(1);
+  const auto grid1 = UniformGrid::build(mesh);
+  const auto octree1 = RayOctree::build(mesh);
+  set_num_threads(2);
+  const auto grid2 = UniformGrid::build(mesh);
+  const auto octree2 = RayOctree::build(mesh);
+  set_num_threads(0);
+  ASSERT_EQ(grid1->resolution(), grid2->resolution());
+  const Vec3i r = grid1->resolution();
+  for (int z = 0; z < r[2]; ++z)
+    for (int y = 0; y < r[1]; ++y)
+      for (int x = 0; x < r[0]; ++x) {
+        const auto a = grid1->cell(x, y, z), b = grid2->cell(x, y, z);
+        ASSERT_TRUE(std::equal(a.begin(), a.end(), b.begin(), b.end())) << x << " " << y << " " << z;
+      }
+  ASSERT_EQ(octree1->nodes().size(), octree2->nodes().size());
+  ASSERT_EQ(octree1->triangles().size(), octree2->triangles().size());
+  EXPECT_EQ(0, std::memcmp(octree1->nodes().data(), octree2->nodes().data(),
+                           octree1->nodes().size() * sizeof(RayOctree::Node)));
+  EXPECT_EQ(0, std::memcmp(octree1->triangles().data(), octree2->triangles().data(),
+                           octree1->triangles().size() * sizeof(std::uint32_t)));
 }
 
 TEST(Accelerators, CachesHelpCoherentRays) {
