@@ -337,8 +337,9 @@ void Delaunay3::build(Options options, bool may_split) {
     dimension_ = -1;
     return;
   }
-  if (may_split && num_threads() > 1 && n >= std::max<std::size_t>(options.parallel_from, 16) && build_split(active)) {
-    canonicalize();
+  std::size_t free = 0;
+  if (may_split && num_threads() > 1 && n >= std::max<std::size_t>(options.parallel_from, 16) && build_split(active, free)) {
+    canonicalize(free);
     return;
   }
   tets_.clear();  // (a parallel build that gave up may have left slots)
@@ -413,7 +414,7 @@ void Delaunay3::build(Options options, bool may_split) {
   conflicts_ = mesh.conflicts;
   flip_counts_ = mesh.flip_counts;
   last_ = mesh.last;
-  if (may_split) canonicalize();  // (the halves and seams of a parallel build need not be)
+  if (may_split) canonicalize(free_slots_.size());  // (the halves and seams of a parallel build need not be)
 }
 
 std::uint32_t Delaunay3::insert(const Vec3d& p) {
@@ -600,7 +601,7 @@ inline void canonical_positions(const std::uint32_t* v, std::uint8_t position[4]
 }
 }  // namespace
 
-void Delaunay3::canonicalize() {
+void Delaunay3::canonicalize(std::size_t free) {
   const std::size_t slots = tets_.size() / 8;
   const std::size_t n = points_.size();
   // Where entry j of slot s goes (set for every live slot; the only ones read).
@@ -639,7 +640,7 @@ void Delaunay3::canonicalize() {
       0, blocks + 1,
       [&](std::size_t task) {
         if (task == 0) {
-          out.resize(8 * slots);
+          out.resize(8 * (slots - std::min(free, slots)));
           return;
         }
         const std::size_t block = task - 1;
@@ -669,6 +670,7 @@ void Delaunay3::canonicalize() {
     offset[blocks * parts] = total;
   }
   const std::size_t live = offset[blocks * parts];
+  if (out.size() < 8 * live) out.resize(8 * live);  // (`free` was too high)
   // The public arrays (the finite slots in the new order) are written with
   // the sort, from the sorted keys: partition p's first public tetrahedron is
   // its first slot (block 0's start of it) less the ghosts before it.
