@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstring>
 #include <memory>
 #include <numeric>
 #include <optional>
@@ -336,8 +337,9 @@ void Delaunay3::build(Options options, bool may_split) {
     dimension_ = -1;
     return;
   }
-  if (may_split && num_threads() > 1 && n >= std::max<std::size_t>(options.parallel_from, 16) && build_split(active)) {
-    canonicalize();
+  std::size_t free = 0;
+  if (may_split && num_threads() > 1 && n >= std::max<std::size_t>(options.parallel_from, 16) && build_split(active, free)) {
+    canonicalize(free);
     return;
   }
   tets_.clear();  // (a parallel build that gave up may have left slots)
@@ -412,7 +414,7 @@ void Delaunay3::build(Options options, bool may_split) {
   conflicts_ = mesh.conflicts;
   flip_counts_ = mesh.flip_counts;
   last_ = mesh.last;
-  if (may_split) canonicalize();  // (the halves and seams of a parallel build need not be)
+  if (may_split) canonicalize(free_slots_.size());  // (the halves and seams of a parallel build need not be)
 }
 
 std::uint32_t Delaunay3::insert(const Vec3d& p) {
@@ -599,11 +601,11 @@ inline void canonical_positions(const std::uint32_t* v, std::uint8_t position[4]
 }
 }  // namespace
 
-void Delaunay3::canonicalize() {
+void Delaunay3::canonicalize(std::size_t free) {
   const std::size_t slots = tets_.size() / 8;
   const std::size_t n = points_.size();
   // Where entry j of slot s goes (set for every live slot; the only ones read).
-  // Here and for the keys: left uninitialized, as every entry read is written first.
+  // Left uninitialized, as every entry read is written first.
   const std::unique_ptr<std::array<std::uint8_t, 4>[]> place(new std::array<std::uint8_t, 4>[slots]);
   struct Key {  // a slot's canonical vertices
     std::uint32_t v[4];
@@ -621,10 +623,27 @@ void Delaunay3::canonicalize() {
   }
   std::vector<std::uint32_t> offset(blocks * parts + 1, 0);  // per (partition, block): where its keys start
   std::vector<std::uint32_t> ghosts_in(parts, 0);  // ghost slots per partition
+  // The new slots' array, which holds the keys (five words each) until they
+  // are sorted: fresh pages are slow to touch on this kind of machine, so the
+  // keys take no pages of their own. Allocated (and zeroed) by task 0, the
+  // first a thread starts, while the others count.
+  std::vector<std::uint32_t> out;
+  const auto put_key = [&](std::size_t i, const Key& key) { std::memcpy(&out[5 * i], &key, sizeof(Key)); };
+  const auto key_at = [&](std::size_t i) {
+    Key key;
+    std::memcpy(&key, &out[5 * i], sizeof(Key));
+    return key;
+  };
+  static_assert(sizeof(Key) == 5 * sizeof(std::uint32_t));
   // The canonical order of each slot's entries, and the keys per partition per block.
   parallel_for_each_index(
-      0, blocks,
-      [&](std::size_t block) {
+      0, blocks + 1,
+      [&](std::size_t task) {
+        if (task == 0) {
+          out.resize(8 * (slots - std::min(free, slots)));
+          return;
+        }
+        const std::size_t block = task - 1;
         std::uint32_t* count = &offset[block * parts];
         for (std::size_t s = block * kBlock; s < std::min(slots, (block + 1) * kBlock); ++s) {
           const std::uint32_t* v = &tets_[8 * s];
@@ -651,6 +670,7 @@ void Delaunay3::canonicalize() {
     offset[blocks * parts] = total;
   }
   const std::size_t live = offset[blocks * parts];
+  if (out.size() < 8 * live) out.resize(8 * live);  // (`free` was too high)
   // The public arrays (the finite slots in the new order) are written with
   // the sort, from the sorted keys: partition p's first public tetrahedron is
   // its first slot (block 0's start of it) less the ghosts before it.
@@ -663,7 +683,6 @@ void Delaunay3::canonicalize() {
   // The keys per partition; meanwhile (task 0, the first one a thread
   // starts) the arrays the sort fills are allocated: zeroing them is one
   // thread's work, which the others' keys overlap.
-  const std::unique_ptr<Key[]> keys(new Key[live]);
   std::vector<std::uint32_t> new_of;
   parallel_for_each_index(
       0, blocks + 1,
@@ -682,7 +701,7 @@ void Delaunay3::canonicalize() {
           std::uint8_t position[4];  // (again rather than from place: reads, no stores to forward)
           canonical_positions(v, position);
           const Key key = {{v[position[0]], v[position[1]], v[position[2]], v[position[3]]}, std::uint32_t(s)};
-          keys[next[key.v[0] >> shift]++] = key;
+          put_key(next[key.v[0] >> shift]++, key);
         }
       },
       1);
@@ -690,26 +709,23 @@ void Delaunay3::canonicalize() {
   const auto part_begin = [&](std::size_t p) -> std::size_t {
     return p == 0 ? 0 : offset[(blocks - 1) * parts + p - 1];
   };
-  // The sort (and, as task 0, the new slots' array allocated).
-  std::vector<std::uint32_t> out;
+  // The sort.
   parallel_for_each_index(
-      0, parts + 1,
-      [&](std::size_t task) {
-        if (task == 0) {
-          out.resize(8 * live);
-          return;
-        }
-        const std::size_t p = task - 1;
+      0, parts,
+      [&](std::size_t p) {
         const std::size_t begin = part_begin(p), end = offset[(blocks - 1) * parts + p];
         if (begin == end) return;
         // A counting sort on the first vertex, then each bucket by the other three.
         const std::uint32_t first = std::uint32_t(p << shift);
         const std::size_t width = std::size_t(1) << shift;
         std::vector<std::uint32_t> count(width + 1, 0);
-        for (std::size_t t = begin; t < end; ++t) ++count[keys[t].v[0] - first + 1];
+        for (std::size_t t = begin; t < end; ++t) ++count[key_at(t).v[0] - first + 1];
         for (std::size_t i = 0; i < width; ++i) count[i + 1] += count[i];
         std::vector<Key> sorted(end - begin);
-        for (std::size_t t = begin; t < end; ++t) sorted[count[keys[t].v[0] - first]++] = keys[t];
+        for (std::size_t t = begin; t < end; ++t) {
+          const Key key = key_at(t);
+          sorted[count[key.v[0] - first]++] = key;
+        }
         for (std::size_t i = 0, from = 0; i < width; from = count[i++]) {
           std::sort(sorted.begin() + std::ptrdiff_t(from), sorted.begin() + std::ptrdiff_t(count[i]),
                     [](const Key& a, const Key& b) { return std::lexicographical_compare(a.v + 1, a.v + 4, b.v + 1, b.v + 4); });
@@ -744,6 +760,7 @@ void Delaunay3::canonicalize() {
       }
     }
   });
+  out.resize(8 * live);  // (a shrink: the free slots go)
   tets_.swap(out);
   free_slots_.clear();
   last_ = last_ < slots && new_of[last_] != kNone ? new_of[last_] : 0;

@@ -63,7 +63,7 @@ std::vector<T> gather_slots(std::size_t slots, const Fn& fn) {
 
 }  // namespace
 
-bool Delaunay3::build_split(const std::vector<std::uint32_t>& active) {
+bool Delaunay3::build_split(const std::vector<std::uint32_t>& active, std::size_t& free) {
   double scale = 0;
   AABB3d bounds;
   for (const std::uint32_t i : active) {
@@ -118,6 +118,9 @@ bool Delaunay3::build_split(const std::vector<std::uint32_t>& active) {
   // does not wait for the other, and its thread helps with the other's pass.
   std::array<Delaunay3, 2> half;
   for (int h = 0; h < 2; ++h) hull_adjacent[h].resize(global[h].size());  // (allocated here, by the calling thread)
+  // Half 0's slots become the assembled array in place (fresh pages are slow
+  // to touch): room for every slot (address space only until used).
+  half[0].tets_.reserve(8 * 7 * active.size() + 64);
   parallel_for_each_index(
       0, 2,
       [&](std::size_t h) {
@@ -216,67 +219,44 @@ bool Delaunay3::build_split(const std::vector<std::uint32_t>& active) {
   std::sort(seam.begin(), seam.end());
   seam.erase(std::unique(seam.begin(), seam.end()), seam.end());
   if (seam.empty()) return false;
-  // The seam's own tetrahedralization (one thread) while the other numbers
-  // the kept slots and collects the seam's boundary.
+  // The assembled slots: half 0's at their own numbers, in place, then half
+  // 1's, then the fill; the seam's slots are left free (the canonical order
+  // drops them). The seam's own tetrahedralization (one thread) while the
+  // other collects the seam's boundary and makes room for half 1.
   Delaunay3 filler;
   filler.options_ = options_;
   filler.points_.resize(seam.size());
   for (std::size_t k = 0; k < seam.size(); ++k) filler.points_[k] = points_[seam[k]];
-  std::array<std::vector<std::uint32_t>, 2> renumber;
-  std::uint32_t next = 0;
+  const std::array<std::size_t, 2> base = {0, valid[0].size()};  // per half: its slots' first new number
   RegionFill seam_fill;  // its boundary: the face and the adjacency across it (new numbers)
   const auto to_global = [&](int h, std::uint32_t v) { return v == kGhost ? kGhost : global[h][v]; };
-  const auto number_kept = [&] {
-    // New slot numbers: the kept slots of half 0, then of half 1, then the fill.
-    for (int h = 0; h < 2; ++h) {
-      const std::size_t slots = valid[h].size(), blocks = (slots + kBlock - 1) / kBlock;
-      const auto keep = [&](std::size_t s) { return valid[h][s] && half[h].tets_[8 * s] != kNone; };
-      std::vector<std::uint32_t> first(blocks + 1, 0);  // per block: its first new number
-      parallel_for_each_index(
-          0, blocks,
-          [&](std::size_t b) {
-            for (std::size_t s = b * kBlock; s < std::min(slots, (b + 1) * kBlock); ++s) first[b + 1] += keep(s);
-          },
-          1);
-      first[0] = next;
-      for (std::size_t b = 0; b < blocks; ++b) first[b + 1] += first[b];
-      renumber[h].resize(slots);
-      parallel_for_each_index(
-          0, blocks,
-          [&](std::size_t b) {
-            std::uint32_t k = first[b];
-            for (std::size_t s = b * kBlock; s < std::min(slots, (b + 1) * kBlock); ++s) renumber[h][s] = keep(s) ? k++ : kNone;
-          },
-          1);
-      next = first[blocks];
-    }
+  const auto collect_boundary = [&] {
     // The seam region's boundary: kept slots' faces towards doubtful ones, seen from the seam's side.
     using BoundaryFace = std::pair<RegionFill::Face, std::uint32_t>;
     for (int h = 0; h < 2; ++h) {
       const std::vector<BoundaryFace> faces =
           gather_slots<BoundaryFace>(valid[h].size(), [&](std::size_t s, std::vector<BoundaryFace>& out) {
-            if (renumber[h][s] == kNone) return;
+            if (!valid[h][s]) return;
             for (std::uint32_t f = 0; f < 4; ++f) {
               const std::uint32_t a = half[h].tets_[8 * s + 4 + f], u = a >> 2;
               if (valid[h][u]) continue;
               std::uint32_t w[4];
               for (int k = 0; k < 4; ++k) w[k] = to_global(h, half[h].tets_[8 * std::size_t(u) + k]);
-              out.push_back({RegionFill::face_of(w, int(a & 3)), 4 * renumber[h][s] + f});
+              out.push_back({RegionFill::face_of(w, int(a & 3)), std::uint32_t(4 * (base[h] + s) + f)});
             }
           });
       seam_fill.boundary.insert(seam_fill.boundary.end(), faces.begin(), faces.end());
     }
+    tets_ = std::move(half[0].tets_);
+    tets_.resize(8 * (base[1] + valid[1].size()));
   };
   parallel_for_each_index(
       0, 2,
       [&](std::size_t task) {
         if (task == 0) {
           filler.build(options_, false);
-          // The assembled slots' array, zeroed here (the other task is the longer):
-          // at most every slot of both halves and of the filler.
-          tets_.assign(8 * (half[0].tets_.size() / 8 + half[1].tets_.size() / 8 + filler.tets_.size() / 8), 0);
         } else {
-          number_kept();
+          collect_boundary();
         }
       },
       1);
@@ -284,23 +264,31 @@ bool Delaunay3::build_split(const std::vector<std::uint32_t>& active) {
 
   // Nothing kept next to the seam (a small or flat half), or a face unmatched (not expected): build sequentially.
   if (!seam_fill.match(filler.tets_, seam)) return false;
-  for (const std::uint32_t s : seam_fill.fill) seam_fill.slot[s] = next++;
+  std::size_t next = base[1] + valid[1].size();
+  for (const std::uint32_t s : seam_fill.fill) seam_fill.slot[s] = std::uint32_t(next++);
+  tets_.resize(8 * next);
 
-  // Assemble: kept slots with their adjacencies renumbered (towards the seam: the fill's), then the fill.
-  tets_.resize(8 * std::size_t(next));  // (a shrink: zeroed above)
+  // Assemble: kept slots with their vertices global and their adjacencies
+  // renumbered (towards the seam: the fill's), the others free; then the fill.
   for (int h = 0; h < 2; ++h)
     parallel_for(0, valid[h].size(), 1 << 14, [&](std::size_t begin, std::size_t end) {
+      const std::uint32_t* from = h == 0 ? tets_.data() : half[1].tets_.data();
       for (std::size_t s = begin; s < end; ++s) {
-        const std::uint32_t t = renumber[h][s];
-        if (t == kNone) continue;
+        std::uint32_t* to = &tets_[8 * (base[h] + s)];
+        if (!valid[h][s]) {
+          std::fill_n(to, 4, kNone);
+          continue;
+        }
         for (int k = 0; k < 4; ++k) {
-          tets_[8 * std::size_t(t) + k] = to_global(h, half[h].tets_[8 * s + k]);
-          const std::uint32_t a = half[h].tets_[8 * s + 4 + k];
-          if (valid[h][a >> 2]) tets_[8 * std::size_t(t) + 4 + k] = 4 * renumber[h][a >> 2] + (a & 3);
+          const std::uint32_t a = from[8 * s + 4 + k];
+          to[k] = to_global(h, from[8 * s + k]);
+          if (valid[h][a >> 2]) to[4 + k] = std::uint32_t(4 * base[h]) + a;
         }
       }
     });
   seam_fill.write(tets_);
+  free = 0;  // (slots left free: the halves' free and seam slots)
+  for (int h = 0; h < 2; ++h) free += std::size_t(std::count(valid[h].begin(), valid[h].end(), seam_slot));
   // Representatives: equal points fall in the same half, whose first occurrence is the first here too.
   for (int h = 0; h < 2; ++h)
     for (std::size_t k = 0; k < global[h].size(); ++k) rep_[global[h][k]] = global[h][half[h].rep_[k]];

@@ -199,9 +199,12 @@ class Delaunay3 {
   // four vertices (the ghost for the infinite one, no_index in a free slot)
   // and four adjacencies, 4 * neighbour + the face's index in the neighbour.
   void build(Options options, bool may_split = true);
-  bool build_split(const std::vector<std::uint32_t>& active);  // false: the halves cannot be stitched, build sequentially
+  // false: the halves cannot be stitched, build sequentially; `free`: how many slots it left free.
+  bool build_split(const std::vector<std::uint32_t>& active, std::size_t& free);
   bool remove_locally(std::uint32_t v);  // false: the link is flat, rebuild instead
-  void canonicalize();  // slots in an order that depends only on the points; publishes them too
+  // Slots in an order that depends only on the points; publishes them too. `free`: how many
+  // slots are free (sizes an array; a wrong count costs time only).
+  void canonicalize(std::size_t free);
   void publish();  // (only vertex_slot_ left to do right after canonicalize: `published_`)
   void index_vertices();  // vertex_slot_ from the slots
   std::uint32_t start_slot(std::uint32_t hint) const;  // a live slot to walk from
