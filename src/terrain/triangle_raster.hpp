@@ -300,36 +300,51 @@ GEODS_TERRAIN_AVX512_INLINE void worst_block512(Worst512& w, const float* row, s
   w.at = _mm512_mask_mov_pd(w.at, gt, _mm512_add_pd(xr, _mm512_set1_pd(row_index)));
 }
 
+// The samples of a triangle at most 8 Blocks wide into w: per row Blocks
+// blocks from xmin, a lane inside where the three edge functions at
+// (xmin + lane, y), stepped by rows, are >= 0 (no division, no row set-up, no
+// branch per row).
+template <int Blocks>
+GEODS_TERRAIN_AVX512_INLINE void worst_narrow512(Worst512& w, const float* z, std::uint64_t n, const GridTriangle& t, P2 a,
+                                                 __m512d gx) {
+  const __m512i iota = _mm512_set_epi64(7, 6, 5, 4, 3, 2, 1, 0), zero = _mm512_setzero_si512();
+  __m512i edge[3][Blocks], down[3];
+  for (int e = 0; e < 3; ++e) {
+    const P2 p = t.v[e], q = t.v[(e + 1) % 3];
+    const __m512i right = _mm512_set1_epi64(q.y - p.y);  // an edge function falls by q.y - p.y per sample to the right
+    edge[e][0] = _mm512_sub_epi64(_mm512_set1_epi64((q.x - p.x) * (t.y0 - p.y) - (q.y - p.y) * (t.xmin - p.x)),
+                                  _mm512_mullo_epi64(right, iota));
+    for (int b = 1; b < Blocks; ++b) edge[e][b] = _mm512_sub_epi64(edge[e][b - 1], _mm512_slli_epi64(right, 3));
+    down[e] = _mm512_set1_epi64(q.x - p.x);
+  }
+  const unsigned width = unsigned(t.xmax - t.xmin + 1);
+  __mmask8 box[Blocks];
+  for (int b = 0; b < Blocks; ++b) box[b] = __mmask8(_bzhi_u32(0xFF, width > 8u * unsigned(b) ? width - 8u * unsigned(b) : 0u));
+  for (std::int64_t y = t.y0; y <= t.y1; ++y) {
+    const float* row = z + y * std::int64_t(n);
+    const __m512d base = _mm512_set1_pd(t.base(y, a.y));
+    const double index = double(y * std::int64_t(n) + a.x);
+    for (int b = 0; b < Blocks; ++b) {
+      const __mmask8 k = _mm512_mask_cmpge_epi64_mask(
+          _mm512_mask_cmpge_epi64_mask(_mm512_mask_cmpge_epi64_mask(box[b], edge[0][b], zero), edge[1][b], zero), edge[2][b], zero);
+      worst_block512(w, row, t.xmin + 8 * b, k, base, gx, a.x, index);
+      for (int e = 0; e < 3; ++e) edge[e][b] = _mm512_add_epi64(edge[e][b], down[e]);
+    }
+  }
+}
+
 // triangle_worst() with AVX-512: call it only when simd_level() is avx512.
-// Triangles at most 8 samples wide test the edge functions of the row's one
-// block (no division, no row set-up); wider ones walk the rows (RowWalk).
+// Triangles at most 16 samples wide take worst_narrow512(); wider ones walk
+// the rows (RowWalk), blocks of eight from each row's first sample.
 __attribute__((target("avx512f,avx512vl,avx512bw,avx512dq,avx2,bmi,bmi2"))) inline Worst triangle_worst_avx512(
     const float* z, std::uint64_t n, P2 a, P2 b, P2 c) {
   const GridTriangle t(z, n, a, b, c);
   Worst512 w{_mm512_setzero_pd(), _mm512_setzero_pd()};
   const __m512d gx = _mm512_set1_pd(t.gx);
-  // The row-major index of (a.x, y), the lanes adding x - a.x.
-  const auto row_index = [&](std::int64_t y) { return double(y * std::int64_t(n) + a.x); };
   if (t.xmax - t.xmin < 8) {
-    // The edge functions at (xmin + lane, y0), stepped by rows; a lane is inside
-    // where all three are >= 0 (and within the bounding box).
-    const __m512i iota = _mm512_set_epi64(7, 6, 5, 4, 3, 2, 1, 0);
-    __m512i edge[3];
-    std::int64_t down[3];
-    for (int e = 0; e < 3; ++e) {
-      const P2 p = t.v[e], q = t.v[(e + 1) % 3];
-      edge[e] = _mm512_sub_epi64(_mm512_set1_epi64((q.x - p.x) * (t.y0 - p.y) - (q.y - p.y) * (t.xmin - p.x)),
-                                 _mm512_mullo_epi64(_mm512_set1_epi64(q.y - p.y), iota));
-      down[e] = q.x - p.x;
-    }
-    const __mmask8 box = __mmask8(_bzhi_u32(0xFF, unsigned(t.xmax - t.xmin + 1)));
-    const __m512i zero = _mm512_setzero_si512();
-    for (std::int64_t y = t.y0; y <= t.y1; ++y) {
-      const __mmask8 k = _mm512_mask_cmpge_epi64_mask(
-          _mm512_mask_cmpge_epi64_mask(_mm512_mask_cmpge_epi64_mask(box, edge[0], zero), edge[1], zero), edge[2], zero);
-      worst_block512(w, z + y * std::int64_t(n), t.xmin, k, _mm512_set1_pd(t.base(y, a.y)), gx, a.x, row_index(y));
-      for (int e = 0; e < 3; ++e) edge[e] = _mm512_add_epi64(edge[e], _mm512_set1_epi64(down[e]));
-    }
+    worst_narrow512<1>(w, z, n, t, a, gx);
+  } else if (t.xmax - t.xmin < 16) {
+    worst_narrow512<2>(w, z, n, t, a, gx);
   } else {
     RowWalk walk(t);
     for (std::int64_t y = t.y0; y <= t.y1; ++y, walk.next()) {
@@ -337,7 +352,7 @@ __attribute__((target("avx512f,avx512vl,avx512bw,avx512dq,avx2,bmi,bmi2"))) inli
       walk.span(lo, hi);
       const float* row = z + y * std::int64_t(n);
       const __m512d base = _mm512_set1_pd(t.base(y, a.y));
-      const double index = row_index(y);
+      const double index = double(y * std::int64_t(n) + a.x);  // the row-major index of (a.x, y)
       for (std::int64_t x = lo; x <= hi; x += 8)
         worst_block512(w, row, x, __mmask8(_bzhi_u32(0xFF, unsigned(std::min<std::int64_t>(hi - x + 1, 8)))), base, gx,
                        a.x, index);
