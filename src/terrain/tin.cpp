@@ -179,7 +179,9 @@ class GreedyTin {
       // error never counts (most triangles of a fine TIN are such).
       if ((b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x) == 1) continue;
 #if defined(__x86_64__) && defined(__GNUC__)
-      const detail::Worst w = avx2_ ? detail::triangle_worst_avx2(z_, w_, a, b, c) : detail::triangle_worst(z_, w_, a, b, c);
+      const detail::Worst w = simd_ == SimdLevel::avx512 ? detail::triangle_worst_avx512(z_, w_, a, b, c)
+                              : simd_ == SimdLevel::avx2  ? detail::triangle_worst_avx2(z_, w_, a, b, c)
+                                                          : detail::triangle_worst(z_, w_, a, b, c);
 #else
       const detail::Worst w = detail::triangle_worst(z_, w_, a, b, c);
 #endif
@@ -196,7 +198,7 @@ class GreedyTin {
   const float* z_;
   std::uint64_t w_;
   double limit_;
-  bool avx2_ = simd_level() >= SimdLevel::avx2;  // the rows' kernel (the same errors at every level)
+  SimdLevel simd_ = simd_level();  // the scan's kernel (the same errors and samples at every level)
   Inserter& ins_;
   std::vector<P2>& pts_;  // per point of the triangulation
   std::vector<State, HugePageAllocator<State>> state_;

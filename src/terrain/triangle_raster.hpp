@@ -269,6 +269,105 @@ __attribute__((target("avx2"))) inline Worst triangle_worst_avx2(const float* z,
 }
 #endif
 
+#if defined(__x86_64__) && defined(__GNUC__)
+#define GEODS_TERRAIN_AVX512_INLINE __attribute__((target("avx512f,avx512vl,avx512bw,avx512dq,avx2,bmi,bmi2"), always_inline)) inline
+// The AVX-512 scan (simd_level() avx512): eight samples a block, the lanes past
+// a row's end masked off (masked loads do not fault), and per lane the largest
+// error and the row-major index where it first occurs, so that no row needs a
+// reduction of its own or a second search: at the end, the largest lane value
+// and, among the lanes holding it, the least index, the first worst sample in
+// row order. The same terms, rounded as written (the file is compiled without
+// FMA contraction), so the same error and sample as triangle_worst().
+// GCC 12 warns about the undefined pass-through operand inside its own
+// intrinsics (_mm512_reduce_max_pd, _mm512_mask_reduce_min_pd) once inlined.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wuninitialized"
+#if !defined(__clang__)
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
+struct Worst512 {
+  __m512d best, at;
+};
+
+// The samples x .. x + 7 of row y (at `row`) selected by k into the lanes' maxima.
+GEODS_TERRAIN_AVX512_INLINE void worst_block512(Worst512& w, const float* row, std::int64_t x, __mmask8 k, __m512d base,
+                                                __m512d gx, std::int64_t ax, double row_index) {
+  const __m512d xr = _mm512_add_pd(_mm512_set1_pd(double(x - ax)), _mm512_set_pd(7, 6, 5, 4, 3, 2, 1, 0));
+  const __m512d z = _mm512_cvtps_pd(_mm256_maskz_loadu_ps(k, row + x));
+  const __m512d d = _mm512_abs_pd(_mm512_sub_pd(z, _mm512_add_pd(base, _mm512_mul_pd(gx, xr))));
+  const __mmask8 gt = _mm512_mask_cmp_pd_mask(k, d, w.best, _CMP_GT_OQ);
+  w.best = _mm512_mask_mov_pd(w.best, gt, d);
+  w.at = _mm512_mask_mov_pd(w.at, gt, _mm512_add_pd(xr, _mm512_set1_pd(row_index)));
+}
+
+// The samples of a triangle at most 8 Blocks wide into w: per row Blocks
+// blocks from xmin, a lane inside where the three edge functions at
+// (xmin + lane, y), stepped by rows, are >= 0 (no division, no row set-up, no
+// branch per row).
+template <int Blocks>
+GEODS_TERRAIN_AVX512_INLINE void worst_narrow512(Worst512& w, const float* z, std::uint64_t n, const GridTriangle& t, P2 a,
+                                                 __m512d gx) {
+  const __m512i iota = _mm512_set_epi64(7, 6, 5, 4, 3, 2, 1, 0), zero = _mm512_setzero_si512();
+  __m512i edge[3][Blocks], down[3];
+  for (int e = 0; e < 3; ++e) {
+    const P2 p = t.v[e], q = t.v[(e + 1) % 3];
+    const __m512i right = _mm512_set1_epi64(q.y - p.y);  // an edge function falls by q.y - p.y per sample to the right
+    edge[e][0] = _mm512_sub_epi64(_mm512_set1_epi64((q.x - p.x) * (t.y0 - p.y) - (q.y - p.y) * (t.xmin - p.x)),
+                                  _mm512_mullo_epi64(right, iota));
+    for (int b = 1; b < Blocks; ++b) edge[e][b] = _mm512_sub_epi64(edge[e][b - 1], _mm512_slli_epi64(right, 3));
+    down[e] = _mm512_set1_epi64(q.x - p.x);
+  }
+  const unsigned width = unsigned(t.xmax - t.xmin + 1);
+  __mmask8 box[Blocks];
+  for (int b = 0; b < Blocks; ++b) box[b] = __mmask8(_bzhi_u32(0xFF, width > 8u * unsigned(b) ? width - 8u * unsigned(b) : 0u));
+  for (std::int64_t y = t.y0; y <= t.y1; ++y) {
+    const float* row = z + y * std::int64_t(n);
+    const __m512d base = _mm512_set1_pd(t.base(y, a.y));
+    const double index = double(y * std::int64_t(n) + a.x);
+    for (int b = 0; b < Blocks; ++b) {
+      const __mmask8 k = _mm512_mask_cmpge_epi64_mask(
+          _mm512_mask_cmpge_epi64_mask(_mm512_mask_cmpge_epi64_mask(box[b], edge[0][b], zero), edge[1][b], zero), edge[2][b], zero);
+      worst_block512(w, row, t.xmin + 8 * b, k, base, gx, a.x, index);
+      for (int e = 0; e < 3; ++e) edge[e][b] = _mm512_add_epi64(edge[e][b], down[e]);
+    }
+  }
+}
+
+// triangle_worst() with AVX-512: call it only when simd_level() is avx512.
+// Triangles at most 16 samples wide take worst_narrow512(); wider ones walk
+// the rows (RowWalk), blocks of eight from each row's first sample.
+__attribute__((target("avx512f,avx512vl,avx512bw,avx512dq,avx2,bmi,bmi2"))) inline Worst triangle_worst_avx512(
+    const float* z, std::uint64_t n, P2 a, P2 b, P2 c) {
+  const GridTriangle t(z, n, a, b, c);
+  Worst512 w{_mm512_setzero_pd(), _mm512_setzero_pd()};
+  const __m512d gx = _mm512_set1_pd(t.gx);
+  if (t.xmax - t.xmin < 8) {
+    worst_narrow512<1>(w, z, n, t, a, gx);
+  } else if (t.xmax - t.xmin < 16) {
+    worst_narrow512<2>(w, z, n, t, a, gx);
+  } else {
+    RowWalk walk(t);
+    for (std::int64_t y = t.y0; y <= t.y1; ++y, walk.next()) {
+      std::int64_t lo, hi;
+      walk.span(lo, hi);
+      const float* row = z + y * std::int64_t(n);
+      const __m512d base = _mm512_set1_pd(t.base(y, a.y));
+      const double index = double(y * std::int64_t(n) + a.x);  // the row-major index of (a.x, y)
+      for (std::int64_t x = lo; x <= hi; x += 8)
+        worst_block512(w, row, x, __mmask8(_bzhi_u32(0xFF, unsigned(std::min<std::int64_t>(hi - x + 1, 8)))), base, gx,
+                       a.x, index);
+    }
+  }
+  const double worst = _mm512_reduce_max_pd(w.best);
+  if (!(worst > 0)) return {};
+  const __mmask8 holding = _mm512_cmp_pd_mask(w.best, _mm512_set1_pd(worst), _CMP_EQ_OQ);
+  const std::int64_t at = std::int64_t(_mm512_mask_reduce_min_pd(holding, w.at));
+  return {worst, {at % std::int64_t(n), at / std::int64_t(n)}};
+}
+#pragma GCC diagnostic pop
+#undef GEODS_TERRAIN_AVX512_INLINE
+#endif
+
 // The same largest distance alone (equal to triangle_worst().error): triangles
 // of at most 3 x 3 samples (most of the 4-8 hierarchy's) test each sample,
 // larger ones take row maxima two doubles at a time.

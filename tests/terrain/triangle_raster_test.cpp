@@ -38,8 +38,9 @@ TEST(TriangleRaster, WorstSampleEqualsBruteForce) {
   for (float& v : z) v = float(rng() % 40);  // integer heights: many exact ties
   int checked = 0;
   const bool avx2 = simd_level() >= SimdLevel::avx2;
+  const bool avx512 = simd_level() >= SimdLevel::avx512;
   for (int it = 0; it < 20000; ++it) {
-    const std::int64_t span = it % 4 == 0 ? 3 : it % 4 == 1 ? 8 : n - 1;
+    const std::int64_t span = it % 4 == 0 ? 3 : it % 4 == 1 ? 8 : it % 4 == 2 ? 15 : n - 1;
     auto r = [&] { return std::int64_t(rng() % std::uint64_t(span + 1)); };
     const std::int64_t ox = std::int64_t(rng() % std::uint64_t(n - span)), oy = std::int64_t(rng() % std::uint64_t(n - span));
     P2 a{ox + r(), oy + r()}, b{ox + r(), oy + r()}, c{ox + r(), oy + r()};
@@ -55,6 +56,12 @@ TEST(TriangleRaster, WorstSampleEqualsBruteForce) {
       ASSERT_EQ(got2.error, want.error) << it;
       ASSERT_EQ(got2.at.x, want.at.x) << it;
       ASSERT_EQ(got2.at.y, want.at.y) << it;
+    }
+    if (avx512) {  // AVX-512 blocks of eight, masked, per-lane maxima and first indices
+      const Worst got3 = triangle_worst_avx512(z.data(), std::uint64_t(n), a, b, c);
+      ASSERT_EQ(got3.error, want.error) << it;
+      ASSERT_EQ(got3.at.x, want.at.x) << it;
+      ASSERT_EQ(got3.at.y, want.at.y) << it;
     }
 #endif
     ASSERT_EQ(triangle_error(z.data(), std::uint64_t(n), a, b, c), want.error) << it;
