@@ -89,124 +89,6 @@ template <int S>
   return m;
 }
 
-#if defined(__x86_64__) && defined(__GNUC__)
-// The finest levels' triangles hold a handful of samples each, so setting up
-// their planes and rows costs more than the samples: there four triangles of
-// the same shape are taken at once, one per lane (corner a of lane k at
-// pa + idx[k]), with the same terms as rows_error() and Plane, so the same values.
-struct Plane4 {
-  __m256d za, gx, gy;
-};
-
-__attribute__((target("avx2"))) inline __m256d gather4(const float* p, __m128i idx) {
-  return _mm256_cvtps_pd(_mm_i32gather_ps(p, idx, 4));
-}
-
-// Plane(z, n, a, a + u, a + v) of each lane.
-__attribute__((target("avx2"))) inline Plane4 plane4(const float* pa, __m128i idx, std::int64_t n, P2 u, P2 v) {
-  Plane4 p;
-  p.za = gather4(pa, idx);
-  const __m256d db = _mm256_sub_pd(gather4(pa + u.y * n + u.x, idx), p.za);
-  const __m256d dc = _mm256_sub_pd(gather4(pa + v.y * n + v.x, idx), p.za);
-  const double ux = double(u.x), uy = double(u.y), vx = double(v.x), vy = double(v.y);
-  const __m256d det = _mm256_set1_pd(ux * vy - uy * vx);
-  p.gx = _mm256_div_pd(_mm256_sub_pd(_mm256_mul_pd(db, _mm256_set1_pd(vy)), _mm256_mul_pd(dc, _mm256_set1_pd(uy))), det);
-  p.gy = _mm256_div_pd(_mm256_sub_pd(_mm256_mul_pd(dc, _mm256_set1_pd(ux)), _mm256_mul_pd(db, _mm256_set1_pd(vx))), det);
-  return p;
-}
-
-// rows_error() of each lane's triangle (same arguments), maxed into m.
-__attribute__((target("avx2"))) inline __m256d rows_error4(const float* pa, __m128i idx, std::int64_t n, const Plane4& p,
-                                                          std::int64_t r0, std::int64_t rows, std::int64_t lo0,
-                                                          std::int64_t dlo, std::int64_t hi0, std::int64_t dhi, __m256d m) {
-  const __m256d sign = _mm256_set1_pd(-0.0);
-  for (std::int64_t r = 0; r < rows; ++r) {
-    const std::int64_t dy = r0 + r;
-    const __m256d base = _mm256_add_pd(p.za, _mm256_mul_pd(p.gy, _mm256_set1_pd(double(dy))));
-    for (std::int64_t dx = lo0 + dlo * r; dx <= hi0 + dhi * r; ++dx) {
-      const __m256d h = gather4(pa + dy * n + dx, idx);
-      const __m256d d = _mm256_sub_pd(h, _mm256_add_pd(base, _mm256_mul_pd(p.gx, _mm256_set1_pd(double(dx)))));
-      m = _mm256_max_pd(_mm256_andnot_pd(sign, d), m);
-    }
-  }
-  return m;
-}
-
-// err[at + k st] = round_up(lane k of m).
-__attribute__((target("avx2"))) inline void store4(float* err, std::int64_t at, std::int64_t st, __m256d m) {
-  alignas(32) double w[4];
-  _mm256_store_pd(w, m);
-  for (int k = 0; k < 4; ++k) err[at + k * st] = round_up(w[k]);
-}
-
-// The red vertices (x + 4 k s, y), k = 0..3, all with their parents on the same
-// diagonal (level_errors() below, term for term).
-template <int S>
-__attribute__((target("avx2"))) void red4(const float* z, std::int64_t n, std::int64_t x, std::int64_t y, bool main_parents,
-                                         float* err) {
-  constexpr std::int64_t s = S;
-  const __m128i idx = _mm_setr_epi32(0, 4 * s, 8 * s, 12 * s);
-  __m256d m = _mm256_setzero_pd();
-  if (main_parents) {  // a = (x - s, y + s), b = a + (2s, -2s), c0 = a + (0, -2s), c1 = a + (2s, 0)
-    const float* pa = z + (y + s) * n + (x - s);
-    m = rows_error4(pa, idx, n, plane4(pa, idx, n, {2 * s, -2 * s}, {0, -2 * s}), -2 * s, 2 * s + 1, 0, 0, 2 * s, -1, m);
-    m = rows_error4(pa, idx, n, plane4(pa, idx, n, {2 * s, -2 * s}, {2 * s, 0}), -2 * s, 2 * s + 1, 2 * s, -1, 2 * s, 0, m);
-  } else {  // a = (x - s, y - s), b = a + (2s, 2s), c0 = a + (0, 2s), c1 = a + (2s, 0)
-    const float* pa = z + (y - s) * n + (x - s);
-    m = rows_error4(pa, idx, n, plane4(pa, idx, n, {2 * s, 2 * s}, {0, 2 * s}), 0, 2 * s + 1, 0, 0, 0, 1, m);
-    m = rows_error4(pa, idx, n, plane4(pa, idx, n, {2 * s, 2 * s}, {2 * s, 0}), 0, 2 * s + 1, 0, 1, 2 * s, 0, m);
-  }
-  store4(err, y * n + x, 4 * s, m);
-}
-
-// The blue vertices (x + 2 k s, y) of a horizontal edge with both triangles.
-template <int S>
-__attribute__((target("avx2"))) void blue_h4(const float* z, std::int64_t n, std::int64_t x, std::int64_t y, float* err) {
-  constexpr std::int64_t s = S;
-  const __m128i idx = _mm_setr_epi32(0, 2 * s, 4 * s, 6 * s);
-  const float* pa = z + y * n + (x - s);  // a = (x - s, y), b = a + (2s, 0)
-  __m256d m = rows_error4(pa, idx, n, plane4(pa, idx, n, {2 * s, 0}, {s, -s}), -s, s + 1, s, -1, s, 1, _mm256_setzero_pd());
-  m = rows_error4(pa, idx, n, plane4(pa, idx, n, {2 * s, 0}, {s, s}), 0, s + 1, 0, 1, 2 * s, -1, m);
-  store4(err, y * n + x, 2 * s, m);
-}
-
-// The blue vertices (x + 2 k s, y) of a vertical edge with both triangles.
-template <int S>
-__attribute__((target("avx2"))) void blue_v4(const float* z, std::int64_t n, std::int64_t x, std::int64_t y, float* err) {
-  constexpr std::int64_t s = S;
-  const __m128i idx = _mm_setr_epi32(0, 2 * s, 4 * s, 6 * s);
-  const float* pa = z + (y - s) * n + x;  // a = (x, y - s), b = a + (0, 2s)
-  const Plane4 p0 = plane4(pa, idx, n, {0, 2 * s}, {-s, s}), p1 = plane4(pa, idx, n, {0, 2 * s}, {s, s});
-  __m256d m = rows_error4(pa, idx, n, p0, 0, s + 1, 0, -1, 0, 0, _mm256_setzero_pd());
-  m = rows_error4(pa, idx, n, p0, s + 1, s, 1 - s, 1, 0, 0, m);
-  m = rows_error4(pa, idx, n, p1, 0, s + 1, 0, 0, 0, 1, m);
-  m = rows_error4(pa, idx, n, p1, s + 1, s, 0, 0, s - 1, -1, m);
-  store4(err, y * n + x, 2 * s, m);
-}
-
-// The nesting of the vertices v + k st, k = 0..3, whose four children are at
-// v + dw[j] (squared horizontal distances d2[j]): as the constructor's nest(),
-// term for term.
-__attribute__((target("avx2"))) void nest4(const float* z, float* err, float* rad, std::int64_t v, std::int64_t st,
-                                          const std::array<std::ptrdiff_t, 4>& dw, const std::array<double, 4>& d2) {
-  const __m128i idx = _mm_setr_epi32(0, int(st), int(2 * st), int(3 * st));
-  const __m256d zv = gather4(z + v, idx);
-  __m128 e = _mm_i32gather_ps(err + v, idx, 4);
-  __m256d best = _mm256_setzero_pd();
-  for (int j = 0; j < 4; ++j) {
-    e = _mm_max_ps(e, _mm_i32gather_ps(err + v + dw[j], idx, 4));
-    const __m256d dz = _mm256_sub_pd(gather4(z + v + dw[j], idx), zv);
-    const __m256d r = _mm256_add_pd(_mm256_sqrt_pd(_mm256_add_pd(_mm256_set1_pd(d2[j]), _mm256_mul_pd(dz, dz))),
-                                    gather4(rad + v + dw[j], idx));
-    best = _mm256_max_pd(best, r);
-  }
-  alignas(16) float ew[4];
-  _mm_store_ps(ew, e);
-  for (int k = 0; k < 4; ++k) err[v + k * st] = ew[k];
-  store4(rad, v, st, best);
-}
-#endif
-
 // The own errors of the vertices of spacing s = 2^t (S = s when it is a small
 // compile-time constant, else 0): red ones (square centres) split the two
 // halves of their 2s-square, blue ones the quarters of 2s-squares on both
@@ -216,25 +98,12 @@ template <int S>
 void level_errors(const float* z, std::int64_t n, std::int64_t W, std::int64_t H, std::uint32_t t, float* err) {
   const std::int64_t s = S ? S : std::int64_t(1) << t, N = n - 1, c = N / 2;
   auto in = [&](P2 p) { return p.x <= W - 1 && p.y <= H - 1; };
-#if defined(__x86_64__) && defined(__GNUC__)
-  [[maybe_unused]] const bool avx2 = simd_level() >= SimdLevel::avx2;
-#endif
   // Red: rows y = s, 3s, ...; x = s, 3s, ... The parents (the apexes) are the
   // square's corners on the diagonal that is not the hypotenuse.
   parallel_for(0, std::size_t(N / (2 * s)), S ? 8 : 1, [&](std::size_t b, std::size_t e) {
     for (std::size_t ry = b; ry < e; ++ry) {
       const std::int64_t y = (2 * std::int64_t(ry) + 1) * s;
-      std::int64_t x = s;
-#if defined(__x86_64__) && defined(__GNUC__)
-      if constexpr (S > 0)  // 8 vertices at a time, all inside, not the centre
-        if (avx2 && y + s <= H - 1)
-          for (; x + 15 * s <= W - 1 && !(y == c && x <= c && c <= x + 14 * s); x += 16 * s) {
-            const bool main_parents = ((((x - s) >> (t + 1)) + ((y - s) >> (t + 1))) & 1) != 0;
-            red4<S>(z, n, x, y, main_parents, err);
-            red4<S>(z, n, x + 2 * s, y, !main_parents, err);
-          }
-#endif
-      for (; x < N; x += 2 * s) {
+      for (std::int64_t x = s; x < N; x += 2 * s) {
         if (x == c && y == c) continue;  // the centre is always in the mesh
         const bool main_parents = ((((x - s) >> (t + 1)) + ((y - s) >> (t + 1))) & 1) != 0;
         double worst;
@@ -264,13 +133,7 @@ void level_errors(const float* z, std::int64_t n, std::int64_t W, std::int64_t H
   parallel_for(0, std::size_t(N / (2 * s) + 1), S ? 8 : 1, [&](std::size_t b, std::size_t e) {
     for (std::size_t ry = b; ry < e; ++ry) {
       const std::int64_t y = 2 * std::int64_t(ry) * s;
-      std::int64_t x = s;
-#if defined(__x86_64__) && defined(__GNUC__)
-      if constexpr (S > 0)  // 4 vertices at a time with both triangles inside
-        if (avx2 && y - s >= 0 && y + s <= H - 1)
-          for (; x + 7 * s <= W - 1; x += 8 * s) blue_h4<S>(z, n, x, y, err);
-#endif
-      for (; x < N; x += 2 * s) {
+      for (std::int64_t x = s; x < N; x += 2 * s) {
         const P2 a{x - s, y}, bb{x + s, y};
         double worst = 0;
         if (!in(a) || !in(bb)) {
@@ -296,12 +159,6 @@ void level_errors(const float* z, std::int64_t n, std::int64_t W, std::int64_t H
     for (std::size_t ry = b; ry < e; ++ry) {
       const std::int64_t y = (2 * std::int64_t(ry) + 1) * s;
       for (std::int64_t x = 0; x <= N; x += 2 * s) {
-#if defined(__x86_64__) && defined(__GNUC__)
-        if constexpr (S > 0)  // 4 vertices at a time with both triangles inside
-          if (avx2 && x > 0 && y + s <= H - 1)
-            for (; x + 7 * s <= W - 1; x += 8 * s) blue_v4<S>(z, n, x, y, err);
-        if (x > N) break;
-#endif
         const P2 a{x, y - s}, bb{x, y + s};
         double worst = 0;
         if (!in(a) || !in(bb)) {
@@ -348,25 +205,6 @@ void own_errors(const float* z, std::int64_t n, std::int64_t W, std::int64_t H, 
   }
 }
 
-// A std::allocator whose value-initialisation does nothing, for arrays that
-// are written whole before they are read.
-template <typename T>
-struct Unzeroed : std::allocator<T> {
-  template <typename U>
-  struct rebind {
-    using other = Unzeroed<U>;
-  };
-  Unzeroed() = default;
-  template <typename U>
-  Unzeroed(const Unzeroed<U>&) noexcept {}
-  template <typename U>
-  void construct(U*) noexcept {}
-  template <typename U, typename... Args>
-  void construct(U* p, Args&&... args) {
-    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
-  }
-};
-
 // The quarter turns R^-1 that take (dx, dy) (a red vertex relative to the
 // centre) into the bottom quarter Q0 of interleaved_slot(); dx, dy turned.
 int red_turns(std::int64_t& dx, std::int64_t& dy) {
@@ -378,14 +216,11 @@ int red_turns(std::int64_t& dx, std::int64_t& dy) {
   return q;
 }
 
-// put(slot, x, y) for every point (x, y) of the layout's n x n grid and
-// unused(slot) for every other slot, in parallel. The interleaved slots are
-// visited in order, each decoded to its point: the records are written once,
-// sequentially, and the grid is read along the level's Morton curve, which
-// stays local (stepping the grid's rows instead scattered the writes over
-// the level and took most of the layout fill).
-template <class Put, class Unused>
-void for_each_slot(const LayoutIndex& index, Put&& put, Unused&& unused) {
+// put(slot, x, y) for every point (x, y) of the layout's n x n grid, in
+// parallel: the interleaved slots by the level's Morton code stepped along the
+// rows of the level (no interleaved_slot() per vertex).
+template <class Put>
+void for_each_slot(const LayoutIndex& index, Put&& put) {
   const std::uint32_t K = index.levels();
   const std::uint64_t n = index.n();
   const std::int64_t N = std::int64_t(n) - 1, c = N / 2;
@@ -394,48 +229,47 @@ void for_each_slot(const LayoutIndex& index, Put&& put, Unused&& unused) {
       for (std::size_t y = b; y < e; ++y)
         for (std::size_t x = 0; x < n; ++x) put(y * n + x, std::int64_t(x), std::int64_t(y));
     });
-    return;
-  }
-  put(0, c, c);  // the centre, then the corners
-  put(1, 0, 0), put(2, N, 0), put(3, 0, N), put(4, N, N);
-  for (std::uint32_t t = 0; t < K; ++t) {
-    const std::int64_t s = std::int64_t(1) << t, m = std::int64_t(1) << (K - t);
-    const std::uint64_t base = index.level_base(t);
-    parallel_for(0, std::size_t(m * m), 4096, [&](std::size_t b, std::size_t e) {
-      for (std::size_t k = b; k < e; ++k) {
-        // interleaved_slot() backwards: Morton (i, j) of the rotated grid,
-        // (gx, gy) = the blue lattice point relative to the centre.
-        const auto ij = morton2d_decode64(k);
-        const std::int64_t i = ij[0], j = ij[1];
-        const std::int64_t gx = (i + j + 1 - m) * s, gy = (i - j) * s;
-        if (std::abs(gx) <= c && std::abs(gy) <= c) {
-          put(base + k, c + gx, c + gy);
-          continue;
+  } else {
+    // Level by level; along a row of blue vertices of spacing s (step 2 s)
+    // both coordinates of the level's Morton code grow by one.
+    for (const P2 p : {P2{0, 0}, P2{N, 0}, P2{0, N}, P2{N, N}, P2{c, c}})
+      put(index.interleaved_slot(std::uint32_t(p.x), std::uint32_t(p.y)), p.x, p.y);
+    constexpr std::uint64_t kEven = 0x5555555555555555ull, kOdd = ~kEven;
+    for (std::uint32_t t = 0; t < K; ++t) {
+      const std::int64_t s = std::int64_t(1) << t;
+      const std::uint64_t base = index.level_base(t);
+      // Rows k s: blue at x = s, 3s, ... (k even) or x = 0, 2s, ... (k odd);
+      // red at x = s, 3s, ... (k odd).
+      parallel_for(0, std::size_t(N / s + 1), 4, [&](std::size_t b, std::size_t e) {
+        for (std::size_t k = b; k < e; ++k) {
+          const std::int64_t y = std::int64_t(k) * s;
+          const std::int64_t x0 = (k & 1) ? 0 : s;
+          std::uint64_t m = index.interleaved_slot(std::uint32_t(x0), std::uint32_t(y)) - base;
+          for (std::int64_t x = x0; x <= N; x += 2 * s) {
+            put(base + m, x, y);
+            m = (((m | kOdd) + 1) & kEven) | (((m | kEven) + 2) & kOdd);
+          }
+          // Red ones: within a run of the same quarter turns the ghost slot
+          // moves by a reflection of the step, both Morton coordinates by +1
+          // (an even number of turns) or -1 (odd).
+          int run = -1;
+          if (k & 1)
+            for (std::int64_t x = s; x < N; x += 2 * s) {
+              if (x == c && y == c) continue;
+              std::int64_t dx = x - c, dy = y - c;
+              const int q = red_turns(dx, dy);
+              if (q != run) {
+                m = index.interleaved_slot(std::uint32_t(x), std::uint32_t(y)) - base, run = q;
+              } else if (q & 1) {
+                m = (((m & kEven) - 1) & kEven) | (((m & kOdd) - 2) & kOdd);
+              } else {
+                m = (((m | kOdd) + 1) & kEven) | (((m | kEven) + 2) & kOdd);
+              }
+              put(base + m, x, y);
+            }
         }
-        // A ghost, outside one side: turned to below the bottom side (q quarter
-        // turns), it is the image (dx + s, -2c - dy) of the red (dx, dy) of the
-        // bottom quarter Q0 when that is one (red_turns() gives 0 for it).
-        std::int64_t ex = gx, ey = gy;
-        int q = 0;
-        if (gx > c)
-          ex = gy, ey = -gx, q = 1;
-        else if (gy > c)
-          ex = -gx, ey = -gy, q = 2;
-        else if (gx < -c)
-          ex = -gy, ey = gx, q = 3;
-        const std::int64_t dx = ex - s, dy = -2 * c - ey;
-        if ((ex & s) != 0 || !(-dy > std::abs(dx) || (-dy == std::abs(dx) && dx < 0))) {
-          unused(base + k);
-          continue;
-        }
-        std::int64_t rx = dx, ry = dy;
-        for (int r = 0; r < q; ++r) {
-          const std::int64_t t0 = rx;
-          rx = -ry, ry = t0;  // R
-        }
-        put(base + k, c + rx, c + ry);
-      }
-    });
+      });
+    }
   }
 }
 
@@ -593,9 +427,6 @@ Terrain::Terrain(HeightField field, TerrainOptions options) {
     }
     rad[v] = round_up(best);
   };
-#if defined(__x86_64__) && defined(__GNUC__)
-  const bool avx2 = simd_level() >= SimdLevel::avx2;  // four vertices at a time (nest4)
-#endif
   for (std::uint32_t t = 0; t < K; ++t) {
     const std::int64_t s = std::int64_t(1) << t;
     // Blue vertices of spacing s >= 2: children are the red ones of spacing s / 2.
@@ -606,14 +437,7 @@ Terrain::Terrain(HeightField field, TerrainOptions options) {
         for (std::size_t r = b; r < e; ++r) {
           const std::int64_t y = std::int64_t(r) * s;
           const bool inner_row = y > 0 && y < N;
-          std::int64_t x = (r & 1) ? 0 : s;
-#if defined(__x86_64__) && defined(__GNUC__)
-          if (avx2 && inner_row) {
-            if (x == 0) nest(x, y, ch, false), x += 2 * s;
-            for (; x + 6 * s < N; x += 8 * s) nest4(z.data(), err.data(), rad.data(), y * std::int64_t(n) + x, 2 * s, ch.dw, ch.d2);
-          }
-#endif
-          for (; x <= N; x += 2 * s) nest(x, y, ch, inner_row && x > 0 && x < N);
+          for (std::int64_t x = ((r & 1) ? 0 : s); x <= N; x += 2 * s) nest(x, y, ch, inner_row && x > 0 && x < N);
         }
       });
     }
@@ -622,25 +446,16 @@ Terrain::Terrain(HeightField field, TerrainOptions options) {
     parallel_for(0, std::size_t(N / (2 * s)), 4, [&](std::size_t b, std::size_t e) {
       for (std::size_t r = b; r < e; ++r) {
         const std::int64_t y = std::int64_t(2 * r + 1) * s;
-        std::int64_t x = s;
-#if defined(__x86_64__) && defined(__GNUC__)
-        if (avx2)
-          for (; x + 6 * s < N; x += 8 * s) nest4(z.data(), err.data(), rad.data(), y * std::int64_t(n) + x, 2 * s, ch.dw, ch.d2);
-#endif
-        for (; x < N; x += 2 * s) nest(x, y, ch, true);
+        for (std::int64_t x = s; x < N; x += 2 * s) nest(x, y, ch, true);
       }
     });
   }
 
-  // Not zeroed first: the fill writes every slot once (huge pages here stalled now and then on a loaded machine).
-  std::vector<VertexRecord, Unzeroed<VertexRecord>> records(index_.slots());
-  for_each_slot(
-      index_,
-      [&](std::uint64_t slot, std::int64_t x, std::int64_t y) {
-        const std::uint64_t g = std::uint64_t(y) * n + std::uint64_t(x);
-        records[slot] = {z[g], err[g], rad[g]};
-      },
-      [&](std::uint64_t slot) { records[slot] = {}; });
+  std::vector<VertexRecord> records(index_.slots());  // (huge pages here stalled now and then on a loaded machine)
+  for_each_slot(index_, [&](std::uint64_t slot, std::int64_t x, std::int64_t y) {
+    const std::uint64_t g = std::uint64_t(y) * n + std::uint64_t(x);
+    records[slot] = {z[g], err[g], rad[g]};
+  });
   records_ = FlatArray<VertexRecord>(std::move(records));
   build_s_ = seconds_since(t0);
 }
@@ -903,12 +718,9 @@ TerrainMesh Terrain::refine_tiles(const Refinement& refinement, std::uint32_t ti
 
 std::vector<float, HugePageAllocator<float>> Terrain::heights_matrix() const {
   std::vector<float, HugePageAllocator<float>> z(width_ * height_);
-  for_each_slot(
-      index_,
-      [&](std::uint64_t slot, std::int64_t x, std::int64_t y) {
-        if (std::uint64_t(x) < width_ && std::uint64_t(y) < height_) z[std::uint64_t(y) * width_ + std::uint64_t(x)] = records_[slot].z;
-      },
-      [](std::uint64_t) {});
+  for_each_slot(index_, [&](std::uint64_t slot, std::int64_t x, std::int64_t y) {
+    if (std::uint64_t(x) < width_ && std::uint64_t(y) < height_) z[std::uint64_t(y) * width_ + std::uint64_t(x)] = records_[slot].z;
+  });
   return z;
 }
 
