@@ -11,7 +11,6 @@
 namespace geods::detail {
 
 void* allocate_huge_pages(std::size_t bytes, std::size_t alignment) {
-  constexpr std::size_t kHugePage = std::size_t(2) << 20;
   constexpr std::size_t kPage = 4096;
   const bool huge = bytes >= kHugePage / 2;  // rounding up wastes less than half
   const std::size_t align = huge ? kHugePage : std::max<std::size_t>(alignment, sizeof(void*));

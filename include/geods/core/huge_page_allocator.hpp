@@ -13,6 +13,7 @@
 namespace geods {
 
 namespace detail {
+inline constexpr std::size_t kHugePage = std::size_t(2) << 20;
 /// `bytes` of memory as described above; throws std::bad_alloc.
 void* allocate_huge_pages(std::size_t bytes, std::size_t alignment);
 }  // namespace detail
@@ -21,6 +22,7 @@ template <typename T>
 class HugePageAllocator {
  public:
   using value_type = T;
+  static constexpr std::size_t kHugePage = detail::kHugePage;
 
   HugePageAllocator() = default;
   template <typename U>
