@@ -1074,9 +1074,13 @@ class GridSolver {
     out.clear();
     out.reserve(n);
     for (int k = 0; k < Packed::k0; ++k) copy_at(in.f[k].data(), from.data(), n, out.f[k].data());
-    for (int k = 0; k < 8; ++k)  // unsorted: kept's own order, a plain copy
-      sorted ? copy_at(kept.k[k].data(), order.data(), n, out.f[Packed::k0 + k].data())
-             : void(std::copy_n(kept.k[k].data(), n, out.f[Packed::k0 + k].data()));
+    for (int k = 0; k < 8; ++k) {
+      if (sorted) {
+        copy_at(kept.k[k].data(), order.data(), n, out.f[Packed::k0 + k].data());
+      } else {  // kept's own order: a plain copy
+        std::copy_n(kept.k[k].data(), n, out.f[Packed::k0 + k].data());
+      }
+    }
     copy_at(in.face.data(), from.data(), n, out.face.data());
     copy_at(in.leaf.data(), from.data(), n, out.leaf.data());
     out.size = n;

@@ -226,6 +226,16 @@ inline constexpr std::int64_t kSmallSpan = 3;
   return w;
 }
 
+// row_max() by the kernel the scans use: AVX2 for rows of 4 or more samples
+// when `avx2` (simd_level() avx2 or above), else row_max() itself.
+[[gnu::always_inline]] inline double row_max_picked(bool avx2, const float* row, std::int64_t lo, std::int64_t hi,
+                                                    double base, double gx, std::int64_t ax) {
+#if defined(__x86_64__) && defined(__GNUC__)
+  if (avx2 && hi - lo >= 3) return row_max_avx2(row, lo, hi, base, gx, ax);
+#endif
+  return row_max(row, lo, hi, base, gx, ax);
+}
+
 template <bool Avx2>
 [[gnu::always_inline]] inline Worst triangle_worst_rows(const float* z, std::uint64_t n, P2 a, P2 b, P2 c) {
   const GridTriangle t(z, n, a, b, c);
@@ -239,13 +249,7 @@ template <bool Avx2>
     if (lo > hi) continue;
     const float* row = z + y * std::int64_t(n);
     const double base = t.base(y, a.y);
-    double m;
-#if defined(__x86_64__) && defined(__GNUC__)
-    if constexpr (Avx2)
-      m = hi - lo >= 3 ? row_max_avx2(row, lo, hi, base, t.gx, a.x) : row_max(row, lo, hi, base, t.gx, a.x);
-    else
-#endif
-      m = row_max(row, lo, hi, base, t.gx, a.x);
+    const double m = row_max_picked(Avx2, row, lo, hi, base, t.gx, a.x);
     if (m > worst) worst = m, wy = y, wlo = lo;
   }
   Worst w;
