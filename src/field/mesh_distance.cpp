@@ -1,5 +1,7 @@
 #include "geods/field/mesh_distance.hpp"
 
+#include <tbb/parallel_invoke.h>
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -83,10 +85,10 @@ MeshDistance MeshDistance::build(const TriMesh& mesh, const bvh::BuildOptions& o
   if (mesh.num_triangles() == 0) throw Error("signed distance: the mesh has no faces");
   mesh.require_valid("signed distance");
   MeshDistance md;
-  md.bvh_ = bvh::TriangleBvh::build(mesh, options);
-  md.depth_ = md.bvh_.topology().depth();
   md.faces_ = mesh.triangles;
-  md.fit_normals(mesh);
+  // The normals need only the mesh: they fill the threads the hierarchy's top levels leave idle.
+  tbb::parallel_invoke([&] { md.bvh_ = bvh::TriangleBvh::build(mesh, options); }, [&] { md.fit_normals(mesh); });
+  md.depth_ = md.bvh_.topology().depth();
   md.fit_moments();
   return md;
 }
@@ -184,9 +186,12 @@ void MeshDistance::fit_moments() {
           for (const Vec3d* v : {&a, &b, &c}) box_lo = box_lo.cwiseMin(*v), box_hi = box_hi.cwiseMax(*v);
         }
         m.centroid = area > 0 ? Vec3d(m.centroid / area) : Vec3d(0.5 * (box_lo + box_hi));
+        // The square root of the largest square: the same as the largest root (sqrt is monotone).
+        double radius2 = 0;
         for (std::uint32_t i = node.prim_first; i < node.prim_first + node.prim_count; ++i)
           for (const Vec3f* v : {&tris[i].a, &tris[i].b, &tris[i].c})
-            m.radius = std::max(m.radius, (v->cast<double>() - m.centroid).norm());
+            radius2 = std::max(radius2, (v->cast<double>() - m.centroid).squaredNorm());
+        m.radius = std::sqrt(radius2);
         moments_[k] = m;
       },
       16);
