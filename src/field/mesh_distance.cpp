@@ -102,8 +102,9 @@ void MeshDistance::fit_normals(const TriMesh& mesh) {
   std::vector<Vec3d> normals(n);
   face_normals_.resize(n);
   parallel_for_each_index(0, n, [&](std::size_t f) {
-    const Vec3d a = mesh.vertices[faces_[f][0]].cast<double>();
-    const Vec3d nn = (mesh.vertices[faces_[f][1]].cast<double>() - a).cross(mesh.vertices[faces_[f][2]].cast<double>() - a);
+    const Vec3d a = mesh.vertices[faces_[f][0]].cast<double>(), b = mesh.vertices[faces_[f][1]].cast<double>(),
+                c = mesh.vertices[faces_[f][2]].cast<double>();
+    const Vec3d nn = (b - a).cross(c - a);
     const double len = nn.norm();
     normals[f] = len > 0 ? Vec3d(nn / len) : Vec3d::Zero();
     face_normals_[f] = normals[f].cast<float>();
