@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <string>
@@ -74,15 +73,7 @@ const std::array<Vec3f, 7> kContainDirections = {
 
 TriangleBvh TriangleBvh::build(const TriMesh& mesh, const BuildOptions& options) {
   check_options(options);
-  // TriMesh::validate() also analyses the edges (O(n log n)); only indices
-  // and coordinates matter here, so check those and let validate() word the error.
-  std::atomic<bool> bad{false};
-  parallel_for(0, mesh.num_triangles(), 4096, [&](std::size_t b, std::size_t e) {
-    for (std::size_t i = b; i < e && !bad; ++i)
-      for (std::uint32_t v : mesh.triangles[i])
-        if (v >= mesh.num_vertices() || !mesh.vertices[v].allFinite()) bad = true;
-  });
-  if (bad) mesh.require_valid("bvh");
+  mesh.require_valid("bvh");
   Progress progress(options.progress, "bvh build", 3);
   TriangleBvh bvh;
   bvh.options_ = options;

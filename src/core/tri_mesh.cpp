@@ -1,10 +1,12 @@
 #include "geods/core/tri_mesh.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <string>
 
 #include "geods/core/error.hpp"
+#include "geods/core/parallel.hpp"
 #include "geods/core/triangle.hpp"
 
 namespace geods {
@@ -124,8 +126,20 @@ MeshReport TriMesh::validate() const {
 }
 
 void TriMesh::require_valid(const std::string& what) const {
+  // validate() also sorts the faces and edges (O(n log n)); valid() needs only
+  // the coordinates and the indices, so check those first and let validate() word the error.
+  std::atomic<bool> bad{false};
+  parallel_for(0, vertices.size(), 4096, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e && !bad; ++i)
+      if (!vertices[i].allFinite()) bad = true;
+  });
+  parallel_for(0, triangles.size(), 4096, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e && !bad; ++i)
+      for (const std::uint32_t v : triangles[i])
+        if (v >= vertices.size()) bad = true;
+  });
+  if (!bad) return;
   const MeshReport report = validate();
-  if (report.valid()) return;
   std::string message = what + ": invalid mesh";
   for (const std::string& p : report.problems()) message += "; " + p;
   if (!report.examples.empty()) message += " (first: " + report.examples.front() + ")";

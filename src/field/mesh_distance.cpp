@@ -1,11 +1,13 @@
 #include "geods/field/mesh_distance.hpp"
 
+#include <tbb/parallel_invoke.h>
+
 #include <algorithm>
+#include <atomic>
 #include <cmath>
-#include <numeric>
+#include <cstring>
 #include <numbers>
 #include <string>
-#include <tuple>
 
 #include "geods/bvh/traversal.hpp"
 #include "geods/core/error.hpp"
@@ -28,17 +30,28 @@ double solid_angle(const Vec3d& p, const Vec3f& a, const Vec3f& b, const Vec3f& 
 }
 
 // Vertex ids after welding vertices at equal positions: each vertex maps to
-// the smallest index of its position (deterministic).
+// the smallest index of its position (deterministic). Vertices go into a hash
+// table of positions in index order, so a position's first index is its smallest.
 std::vector<std::uint32_t> weld(const std::vector<Vec3f>& vertices) {
-  std::vector<std::uint32_t> order(vertices.size());
-  std::iota(order.begin(), order.end(), 0u);
-  const auto key = [&](std::uint32_t i) { return std::tuple(vertices[i].x(), vertices[i].y(), vertices[i].z()); };
-  std::sort(order.begin(), order.end(), [&](std::uint32_t i, std::uint32_t j) {
-    return std::pair(key(i), i) < std::pair(key(j), j);
-  });
+  int bits = 4;
+  while ((std::size_t(1) << bits) < 2 * vertices.size()) ++bits;
+  const std::size_t mask = (std::size_t(1) << bits) - 1;
+  std::vector<std::uint32_t> slots(mask + 1, kNoIndex);
   std::vector<std::uint32_t> id(vertices.size());
-  for (std::size_t k = 0; k < order.size(); ++k)
-    id[order[k]] = k > 0 && key(order[k]) == key(order[k - 1]) ? id[order[k - 1]] : order[k];
+  for (std::uint32_t v = 0; v < vertices.size(); ++v) {
+    const Vec3f& p = vertices[v];
+    std::uint64_t h = 0;
+    for (int c = 0; c < 3; ++c) {
+      const float x = p[c] + 0.0f;  // -0 becomes +0: the same position
+      std::uint32_t b;
+      std::memcpy(&b, &x, sizeof b);
+      h = (h + b) * 0x9E3779B97F4A7C15ull;
+    }
+    std::size_t s = std::size_t(h >> (64 - bits));
+    while (slots[s] != kNoIndex && vertices[slots[s]] != p) s = (s + 1) & mask;
+    if (slots[s] == kNoIndex) slots[s] = v;
+    id[v] = slots[s];
+  }
   return id;
 }
 
@@ -72,68 +85,84 @@ MeshDistance MeshDistance::build(const TriMesh& mesh, const bvh::BuildOptions& o
   if (mesh.num_triangles() == 0) throw Error("signed distance: the mesh has no faces");
   mesh.require_valid("signed distance");
   MeshDistance md;
-  md.bvh_ = bvh::TriangleBvh::build(mesh, options);
-  md.depth_ = md.bvh_.topology().depth();
   md.faces_ = mesh.triangles;
-  md.fit_normals(mesh);
+  // The normals need only the mesh: they fill the threads the hierarchy's top levels leave idle.
+  tbb::parallel_invoke([&] { md.bvh_ = bvh::TriangleBvh::build(mesh, options); }, [&] { md.fit_normals(mesh); });
+  md.depth_ = md.bvh_.topology().depth();
   md.fit_moments();
   return md;
 }
 
 void MeshDistance::fit_normals(const TriMesh& mesh) {
-  const std::size_t n = faces_.size();
+  const std::size_t n = faces_.size(), nv = mesh.num_vertices();
   const std::vector<std::uint32_t> id = weld(mesh.vertices);
+  const auto corner_vertex = [&](std::uint32_t c) { return id[faces_[c / 3][c % 3]]; };
+  const auto next = [](std::uint32_t c) { return c % 3 == 2 ? c - 2 : c + 1; };
+  const auto prev = [](std::uint32_t c) { return c % 3 == 0 ? c + 2 : c - 1; };
   std::vector<Vec3d> normals(n);
   face_normals_.resize(n);
-  std::vector<Vec3d> at_vertex(mesh.num_vertices(), Vec3d::Zero());
-  for (std::size_t f = 0; f < n; ++f) {
-    Vec3d v[3];
-    for (int i = 0; i < 3; ++i) v[i] = mesh.vertices[faces_[f][i]].cast<double>();
-    const Vec3d nn = (v[1] - v[0]).cross(v[2] - v[0]);
+  parallel_for_each_index(0, n, [&](std::size_t f) {
+    const Vec3d a = mesh.vertices[faces_[f][0]].cast<double>(), b = mesh.vertices[faces_[f][1]].cast<double>(),
+                c = mesh.vertices[faces_[f][2]].cast<double>();
+    const Vec3d nn = (b - a).cross(c - a);
     const double len = nn.norm();
     normals[f] = len > 0 ? Vec3d(nn / len) : Vec3d::Zero();
     face_normals_[f] = normals[f].cast<float>();
-    for (int i = 0; i < 3; ++i) {  // the angle at corner i weights the normal at its vertex
-      const Vec3d e1 = v[(i + 1) % 3] - v[i], e2 = v[(i + 2) % 3] - v[i];
-      const double angle = std::atan2(e1.cross(e2).norm(), e1.dot(e2));
-      at_vertex[id[faces_[f][i]]] += angle * normals[f];
-    }
-  }
-  vertex_normals_.resize(mesh.num_vertices());
-  for (std::size_t v = 0; v < vertex_normals_.size(); ++v) vertex_normals_[v] = at_vertex[id[v]].cast<float>();
-
-  // Edges by their welded ends: the normals of the faces on each are summed,
-  // and each direction is counted (closed: as often one way as the other).
-  struct EdgeUse {
-    std::uint32_t lo, hi, face;
-    std::uint8_t corner;
-    bool forward;
-  };
-  std::vector<EdgeUse> uses;
-  uses.reserve(3 * n);
-  for (std::size_t f = 0; f < n; ++f)
-    for (std::uint8_t i = 0; i < 3; ++i) {
-      const std::uint32_t a = id[faces_[f][i]], b = id[faces_[f][(i + 1) % 3]];
-      uses.push_back({std::min(a, b), std::max(a, b), std::uint32_t(f), i, a < b});
-    }
-  std::sort(uses.begin(), uses.end(), [](const EdgeUse& x, const EdgeUse& y) {
-    return std::tie(x.lo, x.hi, x.face, x.corner) < std::tie(y.lo, y.hi, y.face, y.corner);
   });
-  edge_normals_.assign(3 * n, Vec3f::Zero());
-  closed_ = true;
-  for (std::size_t b = 0; b < uses.size();) {
-    std::size_t e = b;
-    Vec3d sum = Vec3d::Zero();
-    long balance = 0;
-    for (; e < uses.size() && uses[e].lo == uses[b].lo && uses[e].hi == uses[b].hi; ++e) {
-      sum += normals[uses[e].face];
-      balance += uses[e].forward ? 1 : -1;
+
+  // The corners c = 3 face + i at each welded vertex, in increasing order (a
+  // counting sort), so that each vertex sums its corners in the order of the faces.
+  std::vector<std::uint32_t> first(nv + 1, 0), corners(3 * n);
+  for (std::uint32_t c = 0; c < 3 * n; ++c) ++first[corner_vertex(c)];
+  for (std::size_t v = 1; v <= nv; ++v) first[v] += first[v - 1];
+  for (std::uint32_t c = std::uint32_t(3 * n); c-- > 0;) corners[--first[corner_vertex(c)]] = c;
+
+  // Per welded vertex w, in parallel: its angle-weighted normal, and the edges
+  // whose smaller welded end is w: the normals of the faces on each are summed
+  // in face order, and each direction is counted (closed: as often one way as the other).
+  vertex_normals_.resize(nv);
+  edge_normals_.resize(3 * n);
+  std::atomic<bool> open{false};
+  parallel_for(0, nv, 1024, [&](std::size_t b, std::size_t e) {
+    std::vector<std::uint64_t> uses;  // (larger end << 32) | corner the edge starts at
+    for (std::size_t w = b; w < e; ++w) {
+      Vec3d sum = Vec3d::Zero();
+      uses.clear();
+      for (std::uint32_t k = first[w]; k < first[w + 1]; ++k) {
+        const std::uint32_t c = corners[k], f = c / 3, i = c % 3;
+        const Vec3d v0 = mesh.vertices[faces_[f][i]].cast<double>();
+        const Vec3d e1 = mesh.vertices[faces_[f][(i + 1) % 3]].cast<double>() - v0,
+                    e2 = mesh.vertices[faces_[f][(i + 2) % 3]].cast<double>() - v0;
+        const double angle = std::atan2(e1.cross(e2).norm(), e1.dot(e2));  // weights the normal at w
+        sum += angle * normals[f];
+        // The edge from this corner when its other end is not below w, the edge into it when that one's is above.
+        if (const std::uint32_t to = corner_vertex(next(c)); to >= w) uses.push_back(std::uint64_t(to) << 32 | c);
+        if (const std::uint32_t from = corner_vertex(prev(c)); from > w)
+          uses.push_back(std::uint64_t(from) << 32 | prev(c));
+      }
+      vertex_normals_[w] = sum.cast<float>();
+      std::sort(uses.begin(), uses.end());
+      for (std::size_t u = 0; u < uses.size();) {
+        std::size_t v = u;
+        Vec3d edge_sum = Vec3d::Zero();
+        long balance = 0;
+        for (; v < uses.size() && uses[v] >> 32 == uses[u] >> 32; ++v) {
+          const auto c = std::uint32_t(uses[v]);
+          edge_sum += normals[c / 3];
+          balance += corner_vertex(c) < corner_vertex(next(c)) ? 1 : -1;
+        }
+        // An edge between welded copies of one vertex belongs to a degenerate face: no boundary.
+        if (balance != 0 && uses[u] >> 32 != w) open = true;
+        for (std::size_t k = u; k < v; ++k) edge_normals_[std::uint32_t(uses[k])] = edge_sum.cast<float>();
+        u = v;
+      }
     }
-    // An edge between welded copies of one vertex belongs to a degenerate face: no boundary.
-    if (balance != 0 && uses[b].lo != uses[b].hi) closed_ = false;
-    for (std::size_t k = b; k < e; ++k) edge_normals_[3 * uses[k].face + uses[k].corner] = sum.cast<float>();
-    b = e;
-  }
+  });
+  closed_ = !open;
+  // Welded copies share the normal of their smallest index.
+  parallel_for_each_index(0, nv, [&](std::size_t v) {
+    if (id[v] != v) vertex_normals_[v] = vertex_normals_[id[v]];
+  });
 }
 
 void MeshDistance::fit_moments() {
@@ -158,9 +187,12 @@ void MeshDistance::fit_moments() {
           for (const Vec3d* v : {&a, &b, &c}) box_lo = box_lo.cwiseMin(*v), box_hi = box_hi.cwiseMax(*v);
         }
         m.centroid = area > 0 ? Vec3d(m.centroid / area) : Vec3d(0.5 * (box_lo + box_hi));
+        // The square root of the largest square: the same as the largest root (sqrt is monotone).
+        double radius2 = 0;
         for (std::uint32_t i = node.prim_first; i < node.prim_first + node.prim_count; ++i)
           for (const Vec3f* v : {&tris[i].a, &tris[i].b, &tris[i].c})
-            m.radius = std::max(m.radius, (v->cast<double>() - m.centroid).norm());
+            radius2 = std::max(radius2, (v->cast<double>() - m.centroid).squaredNorm());
+        m.radius = std::sqrt(radius2);
         moments_[k] = m;
       },
       16);
