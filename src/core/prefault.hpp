@@ -33,4 +33,13 @@ void reserve_prefaulted(std::vector<T>& v, std::size_t size) {
   prefault(v.data(), v.capacity() * sizeof(T));
 }
 
+/// std::vector<T>(size, value), its storage prefaulted before it is filled.
+template <class T>
+std::vector<T> prefaulted_vector(std::size_t size, const T& value = T()) {
+  std::vector<T> v;
+  reserve_prefaulted(v, size);
+  v.assign(size, value);
+  return v;
+}
+
 }  // namespace geods::detail

@@ -22,6 +22,7 @@ namespace geods::voronoi {
 namespace {
 
 using detail::prefault;
+using detail::prefaulted_vector;
 using detail::reserve_prefaulted;
 
 constexpr std::uint32_t kNone = Delaunay3::no_index;
@@ -386,7 +387,7 @@ void Delaunay3::build(Options options, bool may_split) {
   std::swap(sequence[1], sequence[kb]);
   std::swap(sequence[2], sequence[kc]);
   std::swap(sequence[3], sequence[kd]);
-  std::vector<Vec3d> coords;
+  std::vector<Vec3d> coords;  // (Vec3d's default constructor leaves it unset: no pass to fill)
   reserve_prefaulted(coords, n);
   coords.resize(n);
   parallel_for(0, n, 1 << 14, [&](std::size_t begin, std::size_t end) {
@@ -397,9 +398,7 @@ void Delaunay3::build(Options options, bool may_split) {
   reserve_prefaulted(tets_, 8 * 7 * n + 64);
   reserve_prefaulted(mesh.mark, 7 * n + 16);
   mesh.make_first(0, 1, 2, 3);
-  std::vector<std::uint32_t> merged;
-  reserve_prefaulted(merged, n);
-  merged.assign(n, kNone);  // per vertex k: the earlier vertex at the same place
+  std::vector<std::uint32_t> merged = prefaulted_vector(n, kNone);  // per vertex k: the earlier vertex at the same place
   std::size_t duplicates = 0;
   for (std::size_t k = 4; k < n; ++k) {
     merged[k] = mesh.insert(std::uint32_t(k));
@@ -407,9 +406,7 @@ void Delaunay3::build(Options options, bool may_split) {
   }
   // From here on a vertex is the index of the point it stands for: the first
   // occurrence among equal points.
-  std::vector<std::uint32_t> point_of;
-  reserve_prefaulted(point_of, n);
-  point_of.resize(n);
+  std::vector<std::uint32_t> point_of = prefaulted_vector<std::uint32_t>(n);
   for (std::size_t k = 0; k < n; ++k) point_of[k] = merged[k] == kNone ? sequence[k] : kNone;
   for (std::size_t k = 0; k < n; ++k)
     if (merged[k] != kNone) {
