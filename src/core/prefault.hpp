@@ -14,13 +14,13 @@
 
 namespace geods::detail {
 
-/// Maps the whole pages of [data, data + bytes) writable, if they are at least 1 MiB.
+/// Maps the whole pages of [data, data + bytes) writable, if they are at least 64 KiB.
 inline void prefault(const void* data, std::size_t bytes) {
 #if defined(__linux__) && defined(MADV_POPULATE_WRITE)
   constexpr std::uintptr_t kPage = 4096;
   const auto first = (reinterpret_cast<std::uintptr_t>(data) + kPage - 1) & ~(kPage - 1);
   const auto last = (reinterpret_cast<std::uintptr_t>(data) + bytes) & ~(kPage - 1);
-  if (last >= first + (std::uintptr_t(1) << 20)) madvise(reinterpret_cast<void*>(first), last - first, MADV_POPULATE_WRITE);
+  if (last >= first + (std::uintptr_t(1) << 16)) madvise(reinterpret_cast<void*>(first), last - first, MADV_POPULATE_WRITE);
 #else
   (void)data, (void)bytes;
 #endif
