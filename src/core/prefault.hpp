@@ -20,7 +20,13 @@ inline void prefault(const void* data, std::size_t bytes) {
   constexpr std::uintptr_t kPage = 4096;
   const auto first = (reinterpret_cast<std::uintptr_t>(data) + kPage - 1) & ~(kPage - 1);
   const auto last = (reinterpret_cast<std::uintptr_t>(data) + bytes) & ~(kPage - 1);
-  if (last >= first + (std::uintptr_t(1) << 16)) madvise(reinterpret_cast<void*>(first), last - first, MADV_POPULATE_WRITE);
+  if (last < first + (std::uintptr_t(1) << 16)) return;
+#if defined(MADV_HUGEPAGE)
+  constexpr std::uintptr_t kHuge = std::uintptr_t(2) << 20;
+  const auto huge_first = (first + kHuge - 1) & ~(kHuge - 1), huge_last = last & ~(kHuge - 1);
+  if (huge_last > huge_first) madvise(reinterpret_cast<void*>(huge_first), huge_last - huge_first, MADV_HUGEPAGE);
+#endif
+  madvise(reinterpret_cast<void*>(first), last - first, MADV_POPULATE_WRITE);
 #else
   (void)data, (void)bytes;
 #endif
