@@ -80,7 +80,8 @@ bool Delaunay3::build_split(const std::vector<std::uint32_t>& active, std::size_
   std::nth_element(xs.begin(), xs.begin() + std::ptrdiff_t(xs.size() / 2), xs.end());
   const double split = xs[xs.size() / 2];
   std::array<std::vector<std::uint32_t>, 2> global;  // per half, its points' indices here
-  const std::size_t below = std::size_t(std::count_if(active.begin(), active.end(), [&](std::uint32_t i) { return points_[i][0] < split; }));
+  const std::size_t below =
+      std::size_t(std::count_if(active.begin(), active.end(), [&](std::uint32_t i) { return points_[i][0] < split; }));
   detail::reserve_prefaulted(global[0], below);
   detail::reserve_prefaulted(global[1], active.size() - below);
   for (const std::uint32_t i : active) global[points_[i][0] < split ? 0 : 1].push_back(i);
@@ -123,7 +124,7 @@ bool Delaunay3::build_split(const std::vector<std::uint32_t>& active, std::size_
   std::array<Delaunay3, 2> half;
   for (int h = 0; h < 2; ++h) hull_adjacent[h].resize(global[h].size());  // (allocated here, by the calling thread)
   // Half 0's slots become the assembled array in place (fresh pages are slow
-  // to touch): room for every slot (address space only until used).
+  // to touch): room for every slot, prefaulted by half 0's build.
   half[0].tets_.reserve(8 * 7 * active.size() + 64);
   parallel_for_each_index(
       0, 2,
