@@ -5,6 +5,7 @@
 #include <bit>
 #include <cmath>
 
+#include "../core/prefault.hpp"
 #include "geods/core/morton.hpp"
 #include "geods/core/parallel.hpp"
 #include "geods/core/rng.hpp"
@@ -79,7 +80,7 @@ std::uint32_t hilbert_index3(std::uint32_t x, std::uint32_t y, std::uint32_t z) 
 void radix_sort(std::vector<std::uint64_t>& items, int first_bit, int bits) {
   constexpr int kDigit = 11;
   constexpr std::uint64_t kMask = (1u << kDigit) - 1;
-  std::vector<std::uint64_t> buffer(items.size());
+  std::vector<std::uint64_t> buffer = detail::prefaulted_vector<std::uint64_t>(items.size());
   std::vector<std::size_t> count(kMask + 2);
   for (int shift = first_bit; shift < first_bit + bits; shift += kDigit) {
     std::fill(count.begin(), count.end(), 0);
@@ -109,9 +110,9 @@ std::vector<std::uint32_t> brio_order(std::span<const Vec2d> points, std::span<c
   // consecutive rounds meet where they end. The key packs round (6 bits),
   // Hilbert index on a 2^14 grid (28 bits) and point index (30 bits).
   const int last_round = int(std::bit_width(n));
-  std::vector<std::uint64_t> keys(n);
+  std::vector<std::uint64_t> keys = detail::prefaulted_vector<std::uint64_t>(n);
   Rng rng(seed);
-  std::vector<std::uint64_t> random(n);
+  std::vector<std::uint64_t> random = detail::prefaulted_vector<std::uint64_t>(n);
   for (auto& r : random) r = rng();
   parallel_for(0, n, 4096, [&](std::size_t begin, std::size_t end) {
     for (std::size_t k = begin; k < end; ++k) {
@@ -127,7 +128,7 @@ std::vector<std::uint32_t> brio_order(std::span<const Vec2d> points, std::span<c
     }
   });
   radix_sort(keys, 30, 34);
-  std::vector<std::uint32_t> order(n);
+  std::vector<std::uint32_t> order = detail::prefaulted_vector<std::uint32_t>(n);
   for (std::size_t k = 0; k < n; ++k) order[k] = std::uint32_t(keys[k] & 0x3FFFFFFF);
   return order;
 }
@@ -146,9 +147,9 @@ std::vector<std::uint32_t> brio_order(std::span<const Vec3d> points, std::span<c
   }
   // As in 2D: the key packs round (6 bits), Hilbert index (27 bits) and point index (31 bits).
   const int last_round = int(std::bit_width(n));
-  std::vector<std::uint64_t> keys(n);
+  std::vector<std::uint64_t> keys = detail::prefaulted_vector<std::uint64_t>(n);
   Rng rng(seed);
-  std::vector<std::uint64_t> random(n);
+  std::vector<std::uint64_t> random = detail::prefaulted_vector<std::uint64_t>(n);
   for (auto& r : random) r = rng();
   constexpr std::uint32_t kHilbertMask = (1u << (3 * kBits3)) - 1;
   parallel_for(0, n, 4096, [&](std::size_t begin, std::size_t end) {
@@ -165,7 +166,7 @@ std::vector<std::uint32_t> brio_order(std::span<const Vec3d> points, std::span<c
     }
   });
   radix_sort(keys, 31, 33);
-  std::vector<std::uint32_t> order(n);
+  std::vector<std::uint32_t> order = detail::prefaulted_vector<std::uint32_t>(n);
   for (std::size_t k = 0; k < n; ++k) order[k] = std::uint32_t(keys[k] & 0x7FFFFFFF);
   return order;
 }

@@ -12,6 +12,7 @@
 #include <optional>
 #include <string>
 
+#include "../core/prefault.hpp"
 #include "brio_order.hpp"
 #include "delaunay3_mesh.hpp"
 #include "geods/core/error.hpp"
@@ -19,6 +20,10 @@
 
 namespace geods::voronoi {
 namespace {
+
+using detail::prefault;
+using detail::prefaulted_vector;
+using detail::reserve_prefaulted;
 
 constexpr std::uint32_t kNone = Delaunay3::no_index;
 
@@ -315,6 +320,7 @@ Delaunay3::Delaunay3(std::span<const Vec3d> points, Options options) : options_(
   for (std::size_t i = 0; i < points.size(); ++i)
     if (!std::isfinite(points[i][0]) || !std::isfinite(points[i][1]) || !std::isfinite(points[i][2]))
       throw Error("Delaunay3: point " + std::to_string(i) + " has a NaN or infinite coordinate");
+  reserve_prefaulted(points_, points.size());
   points_.assign(points.begin(), points.end());
   build(options);
   publish();
@@ -322,14 +328,16 @@ Delaunay3::Delaunay3(std::span<const Vec3d> points, Options options) : options_(
 
 void Delaunay3::build(Options options, bool may_split) {
   const std::size_t total = points_.size();
+  reserve_prefaulted(removed_, total);
   removed_.resize(total, 0);
+  reserve_prefaulted(rep_, total);
   rep_.assign(total, kNone);
   tets_.clear();
   free_slots_.clear();
   walk_steps_ = conflicts_ = seam_points_ = 0;
   flip_counts_ = {};
   std::vector<std::uint32_t> active;
-  active.reserve(total);
+  reserve_prefaulted(active, total);
   for (std::size_t i = 0; i < total; ++i)
     if (!removed_[i]) active.push_back(std::uint32_t(i));
   const std::size_t n = active.size();
@@ -373,20 +381,24 @@ void Delaunay3::build(Options options, bool may_split) {
 
   // The points' coordinates in insertion order (vertex k is order[k]), with
   // the first tetrahedron's corners first, so that insertion reads them sequentially.
-  std::vector<std::uint32_t> sequence(order);
+  std::vector<std::uint32_t> sequence;
+  reserve_prefaulted(sequence, n);
+  sequence.assign(order.begin(), order.end());
   std::swap(sequence[1], sequence[kb]);
   std::swap(sequence[2], sequence[kc]);
   std::swap(sequence[3], sequence[kd]);
-  std::vector<Vec3d> coords(n);
+  std::vector<Vec3d> coords;  // (Vec3d's default constructor leaves it unset: no pass to fill)
+  reserve_prefaulted(coords, n);
+  coords.resize(n);
   parallel_for(0, n, 1 << 14, [&](std::size_t begin, std::size_t end) {
     for (std::size_t k = begin; k < end; ++k) coords[k] = points_[sequence[k]];
   });
   Tet3Mesh mesh(coords, tets_, free_slots_);
   mesh.flips = options.insertion == Delaunay3Insertion::flips;
-  tets_.reserve(8 * 7 * n + 64);
-  mesh.mark.reserve(7 * n + 16);
+  reserve_prefaulted(tets_, 8 * 7 * n + 64);
+  reserve_prefaulted(mesh.mark, 7 * n + 16);
   mesh.make_first(0, 1, 2, 3);
-  std::vector<std::uint32_t> merged(n, kNone);  // per vertex k: the earlier vertex at the same place
+  std::vector<std::uint32_t> merged = prefaulted_vector(n, kNone);  // per vertex k: the earlier vertex at the same place
   std::size_t duplicates = 0;
   for (std::size_t k = 4; k < n; ++k) {
     merged[k] = mesh.insert(std::uint32_t(k));
@@ -394,7 +406,7 @@ void Delaunay3::build(Options options, bool may_split) {
   }
   // From here on a vertex is the index of the point it stands for: the first
   // occurrence among equal points.
-  std::vector<std::uint32_t> point_of(n);
+  std::vector<std::uint32_t> point_of = prefaulted_vector<std::uint32_t>(n);
   for (std::size_t k = 0; k < n; ++k) point_of[k] = merged[k] == kNone ? sequence[k] : kNone;
   for (std::size_t k = 0; k < n; ++k)
     if (merged[k] != kNone) {
@@ -607,6 +619,7 @@ void Delaunay3::canonicalize(std::size_t free) {
   // Where entry j of slot s goes (set for every live slot; the only ones read).
   // Left uninitialized, as every entry read is written first.
   const std::unique_ptr<std::array<std::uint8_t, 4>[]> place(new std::array<std::uint8_t, 4>[slots]);
+  prefault(place.get(), 4 * slots);
   struct Key {  // a slot's canonical vertices
     std::uint32_t v[4];
     std::uint32_t slot;
@@ -640,6 +653,7 @@ void Delaunay3::canonicalize(std::size_t free) {
       0, blocks + 1,
       [&](std::size_t task) {
         if (task == 0) {
+          reserve_prefaulted(out, 8 * (slots - std::min(free, slots)));
           out.resize(8 * (slots - std::min(free, slots)));
           return;
         }
@@ -688,8 +702,11 @@ void Delaunay3::canonicalize(std::size_t free) {
       0, blocks + 1,
       [&](std::size_t task) {
         if (task == 0) {
+          reserve_prefaulted(tetrahedra_, 4 * (live - ghosts));
           tetrahedra_.resize(4 * (live - ghosts));
+          reserve_prefaulted(public_of_, live);
           public_of_.resize(live);
+          reserve_prefaulted(new_of, slots);
           new_of.assign(slots, kNone);
           return;
         }
@@ -807,6 +824,7 @@ void Delaunay3::index_vertices() {
   // of the slots at once, the upper one's answer first.
   const std::size_t slots = tets_.size() / 8;
   const auto scan = [&](std::size_t begin, std::size_t end, std::vector<std::uint32_t>& into) {
+    reserve_prefaulted(into, points_.size());
     into.assign(points_.size(), kNone);
     for (std::size_t s = begin; s < end; ++s)
       for (int k = 0; k < 4; ++k) {

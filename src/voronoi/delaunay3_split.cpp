@@ -9,6 +9,7 @@
 #include <optional>
 #include <utility>
 
+#include "../core/prefault.hpp"
 #include "delaunay3_mesh.hpp"
 #include "geods/core/aabb.hpp"
 #include "geods/core/parallel.hpp"
@@ -74,11 +75,15 @@ bool Delaunay3::build_split(const std::vector<std::uint32_t>& active, std::size_
   // Squared distances of the certificates below must stay in double range: else build sequentially.
   if (!(scale < 1e100 && extent > 1e-100)) return false;
   // The halves: x below the median, and the rest (equal points stay together).
-  std::vector<double> xs(active.size());
+  std::vector<double> xs = detail::prefaulted_vector<double>(active.size());
   for (std::size_t k = 0; k < active.size(); ++k) xs[k] = points_[active[k]][0];
   std::nth_element(xs.begin(), xs.begin() + std::ptrdiff_t(xs.size() / 2), xs.end());
   const double split = xs[xs.size() / 2];
   std::array<std::vector<std::uint32_t>, 2> global;  // per half, its points' indices here
+  const std::size_t below =
+      std::size_t(std::count_if(active.begin(), active.end(), [&](std::uint32_t i) { return points_[i][0] < split; }));
+  detail::reserve_prefaulted(global[0], below);
+  detail::reserve_prefaulted(global[1], active.size() - below);
   for (const std::uint32_t i : active) global[points_[i][0] < split ? 0 : 1].push_back(i);
   if (global[0].size() < 8 || global[1].size() < 8) return false;
   const double tolerance = 1e-9 * scale;
@@ -119,13 +124,14 @@ bool Delaunay3::build_split(const std::vector<std::uint32_t>& active, std::size_
   std::array<Delaunay3, 2> half;
   for (int h = 0; h < 2; ++h) hull_adjacent[h].resize(global[h].size());  // (allocated here, by the calling thread)
   // Half 0's slots become the assembled array in place (fresh pages are slow
-  // to touch): room for every slot (address space only until used).
+  // to touch): room for every slot, prefaulted by half 0's build.
   half[0].tets_.reserve(8 * 7 * active.size() + 64);
   parallel_for_each_index(
       0, 2,
       [&](std::size_t h) {
         Delaunay3& self = half[h];
         self.options_ = options_;
+        detail::reserve_prefaulted(self.points_, global[h].size());
         self.points_.resize(global[h].size());
         for (std::size_t k = 0; k < global[h].size(); ++k) self.points_[k] = points_[global[h][k]];
         self.build(options_, false);
@@ -136,6 +142,7 @@ bool Delaunay3::build_split(const std::vector<std::uint32_t>& active, std::size_
             hull_start[h] = t[0];
           }
         const std::size_t slots = self.tets_.size() / 8;
+        detail::reserve_prefaulted(valid[h], slots);
         valid[h].assign(slots, seam_slot);
         parallel_for(0, slots, 1 << 12, [&](std::size_t begin, std::size_t end) {
           double deepest = 0;
