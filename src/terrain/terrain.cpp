@@ -601,24 +601,23 @@ class Refiner {
   double lambda_ = 1;
 };
 
-// The output mesh: the triangles and strip of `refiner` restricted to the field
-// (the padding dropped: every leaf triangle lies wholly inside or outside it),
-// vertices numbered in order of first use.
-TerrainMesh assemble(const Terrain& t, const Refiner& refiner) {
-  const std::uint64_t n = t.layout().n(), W = t.width(), H = t.height();
-  const bool full = W == n && H == n;  // no padding: every triangle is inside
-  auto inside = [&](std::uint64_t g) { return full || (g % n < W && g / n < H); };
-  TerrainMesh mesh;
-  std::vector<std::uint64_t> ids;  // the triangles: the strip's non-degenerate ones inside the field
-  // Strip: keep the triangles inside (degenerate ones too, they turn the
-  // strip); runs of kept triangles are joined by degenerate triangles that keep
-  // each triangle's parity, so the winding is what the submesh recursion made.
-  std::vector<std::uint64_t> strip;
+// The strip of `refiner` restricted to the field (the padding dropped: every
+// leaf triangle lies wholly inside or outside it): put(g) for each of its grid
+// ids in order. The triangles inside are kept (degenerate ones too, they turn
+// the strip); runs of kept triangles are joined by degenerate triangles that
+// keep each triangle's parity, so the winding is what the submesh recursion made.
+template <class Inside, class Put>
+void clip_strip(const Refiner& refiner, Inside inside, Put&& put) {
   const std::vector<std::uint64_t>& s = refiner.strip_;
-  std::vector<std::size_t> begins = refiner.strip_begin_;
-  begins.push_back(s.size());
-  for (std::size_t part = 0; part + 1 < begins.size(); ++part) {
-    const std::size_t b = begins[part], e = begins[part + 1];
+  const std::vector<std::size_t>& begins = refiner.strip_begin_;
+  std::size_t size = 0;  // of the clipped strip
+  std::uint64_t last = 0;
+  auto push = [&](std::uint64_t g) {
+    put(g);
+    last = g, ++size;
+  };
+  for (std::size_t part = 0; part < begins.size(); ++part) {
+    const std::size_t b = begins[part], e = part + 1 < begins.size() ? begins[part + 1] : s.size();
     std::size_t k = b;
     while (k + 2 < e) {
       if (!(inside(s[k]) && inside(s[k + 1]) && inside(s[k + 2]))) {
@@ -629,58 +628,84 @@ TerrainMesh assemble(const Terrain& t, const Refiner& refiner) {
       while (end + 3 < e && inside(s[end + 3])) ++end;
       // Join: ..., last, last, s[k], s[k] (degenerate triangles), one more
       // s[k] when needed so that the run's triangles keep their parity.
-      if (strip.empty())  // no leading degenerate triangles
+      if (size == 0) {  // no leading degenerate triangles
         while (k < end && (s[k] == s[k + 1] || s[k + 1] == s[k + 2] || s[k] == s[k + 2])) ++k;
-      if (!strip.empty()) {
-        strip.push_back(strip.back());
-        strip.push_back(s[k]);
+      } else {
+        push(last);
+        push(s[k]);
       }
       // The recursion's strip starts with its first corner twice: its
       // triangle k is counter-clockwise when k - b is odd.
-      if (strip.size() % 2 != (k - b + 1) % 2) strip.push_back(s[k]);
-      for (std::size_t q = k; q <= end + 2; ++q) strip.push_back(s[q]);
+      if (size % 2 != (k - b + 1) % 2) push(s[k]);
+      for (std::size_t q = k; q <= end + 2; ++q) push(s[q]);
       k = end + 1;
     }
   }
-  for (std::size_t part = 0; part + 1 < begins.size(); ++part)
-    for (std::size_t k = begins[part]; k + 2 < begins[part + 1]; ++k) {
-      const std::uint64_t a = s[k], b = s[k + 1], c = s[k + 2];
-      if (a != b && b != c && a != c && inside(a) && inside(b) && inside(c)) ids.insert(ids.end(), {a, b, c});
-    }
+}
+
+// The output mesh: the clipped strip, its non-degenerate triangles (made
+// counter-clockwise), vertices numbered in grid order. Every output array is
+// sized once: a counting pass over the strip first.
+TerrainMesh assemble(const Terrain& t, const Refiner& refiner) {
+  const std::uint64_t n = t.layout().n(), W = t.width(), H = t.height();
+  TerrainMesh mesh;
+  std::vector<std::uint64_t> strip;  // grid ids
+  auto clip = [&](auto&& put) {
+    if (W == n && H == n)  // no padding: every triangle is inside
+      clip_strip(refiner, [](std::uint64_t) { return true; }, put);
+    else
+      clip_strip(refiner, [&](std::uint64_t g) { return g % n < W && g / n < H; }, put);
+  };
+  std::size_t size = 0;
+  clip([&](std::uint64_t) { ++size; });
+  strip.reserve(size);
+  clip([&](std::uint64_t g) { strip.push_back(g); });
   // Vertices numbered in grid order: by a dense table up to 2^24 samples, else by sorting.
   std::vector<std::uint64_t> unique;
-  std::vector<std::uint32_t> dense;
+  std::vector<std::uint32_t, HugePageAllocator<std::uint32_t>> dense;
   constexpr std::uint32_t kUnused = std::numeric_limits<std::uint32_t>::max();
+  const auto place = [&](std::uint64_t g) {
+    const std::uint32_t x = std::uint32_t(g % n), y = std::uint32_t(g / n);
+    mesh.samples.push_back({x, y});
+    mesh.vertices.emplace_back(float(t.origin()[0] + double(x) * t.spacing()[0]),
+                               float(t.origin()[1] + double(y) * t.spacing()[1]), t.sample(x, y));
+  };
   if (n * n <= (std::uint64_t(1) << 24)) {
     dense.assign(n * n, kUnused);
-    for (const std::uint64_t g : ids) dense[g] = 0;
-    for (const std::uint64_t g : strip) dense[g] = 0;
+    std::size_t vertices = 0;
+    for (const std::uint64_t g : strip) {
+      vertices += dense[g] == kUnused;
+      dense[g] = 0;
+    }
+    mesh.samples.reserve(vertices);
+    mesh.vertices.reserve(vertices);
     for (std::uint64_t g = 0; g < n * n; ++g)
       if (dense[g] == 0) {
-        dense[g] = std::uint32_t(unique.size());
-        unique.push_back(g);
+        dense[g] = std::uint32_t(mesh.samples.size());
+        place(g);
       }
   } else {
-    unique = ids;
-    unique.insert(unique.end(), strip.begin(), strip.end());
+    unique = strip;
     std::sort(unique.begin(), unique.end());
     unique.erase(std::unique(unique.begin(), unique.end()), unique.end());
+    mesh.samples.reserve(unique.size());
+    mesh.vertices.reserve(unique.size());
+    for (const std::uint64_t g : unique) place(g);
   }
-  auto number = [&](std::uint64_t g) {
-    return dense.empty() ? std::uint32_t(std::lower_bound(unique.begin(), unique.end(), g) - unique.begin())
-                         : dense[g];
-  };
-  mesh.vertices.resize(unique.size());
-  mesh.samples.resize(unique.size());
-  for (std::size_t v = 0; v < unique.size(); ++v) {
-    const std::uint32_t x = std::uint32_t(unique[v] % n), y = std::uint32_t(unique[v] / n);
-    mesh.samples[v] = {x, y};
-    mesh.vertices[v] = Vec3f(float(t.origin()[0] + double(x) * t.spacing()[0]),
-                             float(t.origin()[1] + double(y) * t.spacing()[1]), t.sample(x, y));
+  mesh.strip.reserve(strip.size());
+  for (const std::uint64_t g : strip)
+    mesh.strip.push_back(dense.empty() ? std::uint32_t(std::lower_bound(unique.begin(), unique.end(), g) - unique.begin())
+                                       : dense[g]);
+  // The triangles: the strip's non-degenerate ones (the joins are all degenerate).
+  std::size_t triangles = 0;
+  for (std::size_t k = 0; k + 2 < mesh.strip.size(); ++k) {
+    const std::uint32_t a = mesh.strip[k], b = mesh.strip[k + 1], c = mesh.strip[k + 2];
+    triangles += a != b && b != c && a != c;
   }
-  mesh.triangles.reserve(ids.size() / 3);
-  for (std::size_t k = 0; k < ids.size(); k += 3) {
-    std::array<std::uint32_t, 3> tri{number(ids[k]), number(ids[k + 1]), number(ids[k + 2])};
+  mesh.triangles.reserve(triangles);
+  for (std::size_t k = 0; k + 2 < mesh.strip.size(); ++k) {
+    std::array<std::uint32_t, 3> tri{mesh.strip[k], mesh.strip[k + 1], mesh.strip[k + 2]};
+    if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2]) continue;
     // Counter-clockwise in grid coordinates.
     const auto& a = mesh.samples[tri[0]];
     const auto& b = mesh.samples[tri[1]];
@@ -690,8 +715,6 @@ TerrainMesh assemble(const Terrain& t, const Refiner& refiner) {
     if (cross < 0) std::swap(tri[1], tri[2]);
     mesh.triangles.push_back(tri);
   }
-  mesh.strip.reserve(strip.size());
-  for (const std::uint64_t g : strip) mesh.strip.push_back(number(g));
   return mesh;
 }
 
