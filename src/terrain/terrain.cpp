@@ -550,7 +550,7 @@ class Refiner {
     strip_begin_.push_back(first);
   }
 
-  std::vector<std::uint64_t> strip_;
+  std::vector<std::uint64_t, HugePageAllocator<std::uint64_t>> strip_;  // huge pages: fewer page faults
   std::vector<std::size_t> strip_begin_;  // where each square's strip starts
 
  private:
@@ -608,7 +608,7 @@ class Refiner {
 // keep each triangle's parity, so the winding is what the submesh recursion made.
 template <class Inside, class Put>
 void clip_strip(const Refiner& refiner, Inside inside, Put&& put) {
-  const std::vector<std::uint64_t>& s = refiner.strip_;
+  const auto& s = refiner.strip_;
   const std::vector<std::size_t>& begins = refiner.strip_begin_;
   std::size_t size = 0;  // of the clipped strip
   std::uint64_t last = 0;
@@ -649,7 +649,6 @@ void clip_strip(const Refiner& refiner, Inside inside, Put&& put) {
 TerrainMesh assemble(const Terrain& t, const Refiner& refiner) {
   const std::uint64_t n = t.layout().n(), W = t.width(), H = t.height();
   TerrainMesh mesh;
-  std::vector<std::uint64_t> strip;  // grid ids
   auto clip = [&](auto&& put) {
     if (W == n && H == n)  // no padding: every triangle is inside
       clip_strip(refiner, [](std::uint64_t) { return true; }, put);
@@ -658,22 +657,20 @@ TerrainMesh assemble(const Terrain& t, const Refiner& refiner) {
   };
   std::size_t size = 0;
   clip([&](std::uint64_t) { ++size; });
-  strip.reserve(size);
-  clip([&](std::uint64_t g) { strip.push_back(g); });
-  // Vertices numbered in grid order: by a dense table up to 2^24 samples, else by sorting.
-  std::vector<std::uint64_t> unique;
-  std::vector<std::uint32_t, HugePageAllocator<std::uint32_t>> dense;
-  constexpr std::uint32_t kUnused = std::numeric_limits<std::uint32_t>::max();
+  mesh.strip.reserve(size);
   const auto place = [&](std::uint64_t g) {
     const std::uint32_t x = std::uint32_t(g % n), y = std::uint32_t(g / n);
     mesh.samples.push_back({x, y});
     mesh.vertices.emplace_back(float(t.origin()[0] + double(x) * t.spacing()[0]),
                                float(t.origin()[1] + double(y) * t.spacing()[1]), t.sample(x, y));
   };
+  // Vertices numbered in grid order: by a dense table up to 2^24 samples, else by sorting.
   if (n * n <= (std::uint64_t(1) << 24)) {
-    dense.assign(n * n, kUnused);
+    clip([&](std::uint64_t g) { mesh.strip.push_back(std::uint32_t(g)); });  // grid ids, numbered below
+    constexpr std::uint32_t kUnused = std::numeric_limits<std::uint32_t>::max();
+    std::vector<std::uint32_t, HugePageAllocator<std::uint32_t>> dense(n * n, kUnused);
     std::size_t vertices = 0;
-    for (const std::uint64_t g : strip) {
+    for (const std::uint32_t g : mesh.strip) {
       vertices += dense[g] == kUnused;
       dense[g] = 0;
     }
@@ -684,18 +681,20 @@ TerrainMesh assemble(const Terrain& t, const Refiner& refiner) {
         dense[g] = std::uint32_t(mesh.samples.size());
         place(g);
       }
+    for (std::uint32_t& g : mesh.strip) g = dense[g];
   } else {
-    unique = strip;
+    std::vector<std::uint64_t> strip;  // grid ids
+    strip.reserve(size);
+    clip([&](std::uint64_t g) { strip.push_back(g); });
+    std::vector<std::uint64_t> unique = strip;
     std::sort(unique.begin(), unique.end());
     unique.erase(std::unique(unique.begin(), unique.end()), unique.end());
     mesh.samples.reserve(unique.size());
     mesh.vertices.reserve(unique.size());
     for (const std::uint64_t g : unique) place(g);
+    for (const std::uint64_t g : strip)
+      mesh.strip.push_back(std::uint32_t(std::lower_bound(unique.begin(), unique.end(), g) - unique.begin()));
   }
-  mesh.strip.reserve(strip.size());
-  for (const std::uint64_t g : strip)
-    mesh.strip.push_back(dense.empty() ? std::uint32_t(std::lower_bound(unique.begin(), unique.end(), g) - unique.begin())
-                                       : dense[g]);
   // The triangles: the strip's non-degenerate ones (the joins are all degenerate).
   std::size_t triangles = 0;
   for (std::size_t k = 0; k + 2 < mesh.strip.size(); ++k) {
