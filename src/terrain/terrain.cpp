@@ -544,7 +544,7 @@ class Refiner {
     strip_.push_back(id(X0, Y0));
     parity_ = 0;
     for (int q = 0; q < 4; ++q) {
-      submesh({C, CY}, mids[q], 2 * depth, kAllPlanes, true);
+      submesh({C, CY}, mids[q], 2 * depth, kAllPlanes);  // the centre: always in the mesh
       append(corners[q], 1);
     }
     strip_begin_.push_back(first);
@@ -571,14 +571,17 @@ class Refiner {
   static P2 child_left(P2 i, P2 j) { return (i.x == j.x || i.y == j.y) ? child_ccw(i, j) : child_cw(i, j); }
   static P2 child_right(P2 i, P2 j) { return (i.x == j.x || i.y == j.y) ? child_cw(i, j) : child_ccw(i, j); }
 
-  // L&P's submesh-refine(i, j, l): the triangle of apex i and split vertex j
-  // exists when i is active; its halves are the triangles of apex j.
-  void submesh(P2 i, P2 j, std::uint32_t l, unsigned planes, bool forced = false) {
-    if (l == 0) return;
-    if (!forced && !active(i.x, i.y, planes)) return;
-    submesh(j, child_left(i, j), l - 1, planes);
-    append(i, l & 1);
-    submesh(j, child_right(i, j), l - 1, planes);
+  // L&P's submesh-refine(i, j, l) for an active i (`planes` updated by its
+  // test): the triangle of apex i and split vertex j; its halves, the
+  // triangles of apex j, exist when j is active (one test for both).
+  void submesh(P2 i, P2 j, std::uint32_t l, unsigned planes) {
+    if (l > 1 && active(j.x, j.y, planes)) {
+      submesh(j, child_left(i, j), l - 1, planes);
+      append(i, l & 1);
+      submesh(j, child_right(i, j), l - 1, planes);
+    } else {
+      append(i, l & 1);
+    }
   }
 
   void append(P2 v, unsigned p) {
