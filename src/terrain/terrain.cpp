@@ -661,8 +661,15 @@ TerrainMesh assemble(const Terrain& t, const Refiner& refiner) {
   std::size_t size = 0;
   clip([&](std::uint64_t) { ++size; });
   mesh.strip.reserve(size);
-  const auto place = [&](std::uint64_t g) {
-    const std::uint32_t x = std::uint32_t(g % n), y = std::uint32_t(g / n);
+  advise_huge_pages(mesh.strip);
+  // The output arrays in huge pages where they are large (their first touch is most of their cost).
+  const auto reserve_vertices = [&](std::size_t count) {
+    mesh.samples.reserve(count);
+    mesh.vertices.reserve(count);
+    advise_huge_pages(mesh.samples);
+    advise_huge_pages(mesh.vertices);
+  };
+  const auto place = [&](std::uint32_t x, std::uint32_t y) {
     mesh.samples.push_back({x, y});
     mesh.vertices.emplace_back(float(t.origin()[0] + double(x) * t.spacing()[0]),
                                float(t.origin()[1] + double(y) * t.spacing()[1]), t.sample(x, y));
@@ -677,13 +684,13 @@ TerrainMesh assemble(const Terrain& t, const Refiner& refiner) {
       vertices += dense[g] == kUnused;
       dense[g] = 0;
     }
-    mesh.samples.reserve(vertices);
-    mesh.vertices.reserve(vertices);
-    for (std::uint64_t g = 0; g < n * n; ++g)
-      if (dense[g] == 0) {
-        dense[g] = std::uint32_t(mesh.samples.size());
-        place(g);
-      }
+    reserve_vertices(vertices);
+    for (std::uint32_t y = 0, g = 0; y < n; ++y)
+      for (std::uint32_t x = 0; x < n; ++x, ++g)
+        if (dense[g] == 0) {
+          dense[g] = std::uint32_t(mesh.samples.size());
+          place(x, y);
+        }
     for (std::uint32_t& g : mesh.strip) g = dense[g];
   } else {
     std::vector<std::uint64_t> strip;  // grid ids
@@ -692,9 +699,8 @@ TerrainMesh assemble(const Terrain& t, const Refiner& refiner) {
     std::vector<std::uint64_t> unique = strip;
     std::sort(unique.begin(), unique.end());
     unique.erase(std::unique(unique.begin(), unique.end()), unique.end());
-    mesh.samples.reserve(unique.size());
-    mesh.vertices.reserve(unique.size());
-    for (const std::uint64_t g : unique) place(g);
+    reserve_vertices(unique.size());
+    for (const std::uint64_t g : unique) place(std::uint32_t(g % n), std::uint32_t(g / n));
     for (const std::uint64_t g : strip)
       mesh.strip.push_back(std::uint32_t(std::lower_bound(unique.begin(), unique.end(), g) - unique.begin()));
   }
@@ -705,6 +711,7 @@ TerrainMesh assemble(const Terrain& t, const Refiner& refiner) {
     triangles += a != b && b != c && a != c;
   }
   mesh.triangles.reserve(triangles);
+  advise_huge_pages(mesh.triangles);
   for (std::size_t k = 0; k + 2 < mesh.strip.size(); ++k) {
     std::array<std::uint32_t, 3> tri{mesh.strip[k], mesh.strip[k + 1], mesh.strip[k + 2]};
     if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2]) continue;
