@@ -658,8 +658,12 @@ TerrainMesh assemble(const Terrain& t, const Refiner& refiner) {
     else
       clip_strip(refiner, [&](std::uint64_t g) { return g % n < W && g / n < H; }, put);
   };
-  std::size_t size = 0;
-  clip([&](std::uint64_t) { ++size; });
+  std::size_t size = 0, triangles = 0;  // of the clipped strip; its non-degenerate triangles
+  std::uint64_t last[2] = {};
+  clip([&](std::uint64_t g) {
+    triangles += size >= 2 && g != last[0] && g != last[1] && last[0] != last[1];
+    last[1] = last[0], last[0] = g, ++size;
+  });
   mesh.strip.reserve(size);
   advise_huge_pages(mesh.strip);
   // The output arrays in huge pages where they are large (their first touch is most of their cost).
@@ -704,25 +708,15 @@ TerrainMesh assemble(const Terrain& t, const Refiner& refiner) {
     for (const std::uint64_t g : strip)
       mesh.strip.push_back(std::uint32_t(std::lower_bound(unique.begin(), unique.end(), g) - unique.begin()));
   }
-  // The triangles: the strip's non-degenerate ones (the joins are all degenerate).
-  std::size_t triangles = 0;
-  for (std::size_t k = 0; k + 2 < mesh.strip.size(); ++k) {
-    const std::uint32_t a = mesh.strip[k], b = mesh.strip[k + 1], c = mesh.strip[k + 2];
-    triangles += a != b && b != c && a != c;
-  }
+  // The triangles: the strip's non-degenerate ones (the joins are all
+  // degenerate), counter-clockwise in grid coordinates: the strip's triangle k
+  // is when k is even, its mirror image when k is odd.
   mesh.triangles.reserve(triangles);
   advise_huge_pages(mesh.triangles);
   for (std::size_t k = 0; k + 2 < mesh.strip.size(); ++k) {
-    std::array<std::uint32_t, 3> tri{mesh.strip[k], mesh.strip[k + 1], mesh.strip[k + 2]};
-    if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2]) continue;
-    // Counter-clockwise in grid coordinates.
-    const auto& a = mesh.samples[tri[0]];
-    const auto& b = mesh.samples[tri[1]];
-    const auto& c = mesh.samples[tri[2]];
-    const std::int64_t cross = (std::int64_t(b[0]) - a[0]) * (std::int64_t(c[1]) - a[1]) -
-                               (std::int64_t(b[1]) - a[1]) * (std::int64_t(c[0]) - a[0]);
-    if (cross < 0) std::swap(tri[1], tri[2]);
-    mesh.triangles.push_back(tri);
+    const std::uint32_t a = mesh.strip[k], b = mesh.strip[k + 1], c = mesh.strip[k + 2];
+    if (a == b || b == c || a == c) continue;
+    mesh.triangles.push_back(k % 2 ? std::array{a, c, b} : std::array{a, b, c});
   }
   return mesh;
 }
