@@ -483,6 +483,8 @@ namespace {
 
 // The refinement of one square of the grid: L&P's submesh recursion in doubled
 // coordinates (a split vertex of the finest triangles lies between samples).
+// Id: the type of the grid ids y n + x (32 bits where they fit: half the memory).
+template <class Id>
 class Refiner {
  public:
   Refiner(const Terrain& t, const Refinement& r) : t_(t), r_(r) {
@@ -550,11 +552,11 @@ class Refiner {
     strip_begin_.push_back(first);
   }
 
-  std::vector<std::uint64_t, HugePageAllocator<std::uint64_t>> strip_;  // huge pages: fewer page faults
+  std::vector<Id, HugePageAllocator<Id>> strip_;  // huge pages: fewer page faults
   std::vector<std::size_t> strip_begin_;  // where each square's strip starts
 
  private:
-  std::uint64_t id(std::int64_t x2, std::int64_t y2) const { return std::uint64_t(y2 / 2) * n_ + std::uint64_t(x2 / 2); }
+  Id id(std::int64_t x2, std::int64_t y2) const { return Id(std::uint64_t(y2 / 2) * n_ + std::uint64_t(x2 / 2)); }
 
   // The children of split vertex j in the triangle of apex i: the split
   // vertices of its halves, in the order the strip walks them (L&P's c_l, c_r):
@@ -585,7 +587,7 @@ class Refiner {
   }
 
   void append(P2 v, unsigned p) {
-    const std::uint64_t w = id(v.x, v.y);
+    const Id w = id(v.x, v.y);
     const std::size_t k = strip_.size();
     if (w == strip_[k - 1] || w == strip_[k - 2]) return;
     if (p != parity_)
@@ -609,8 +611,8 @@ class Refiner {
 // ids in order. The triangles inside are kept (degenerate ones too, they turn
 // the strip); runs of kept triangles are joined by degenerate triangles that
 // keep each triangle's parity, so the winding is what the submesh recursion made.
-template <class Inside, class Put>
-void clip_strip(const Refiner& refiner, Inside inside, Put&& put) {
+template <class Id, class Inside, class Put>
+void clip_strip(const Refiner<Id>& refiner, Inside inside, Put&& put) {
   const auto& s = refiner.strip_;
   const std::vector<std::size_t>& begins = refiner.strip_begin_;
   std::size_t size = 0;  // of the clipped strip
@@ -649,7 +651,8 @@ void clip_strip(const Refiner& refiner, Inside inside, Put&& put) {
 // The output mesh: the clipped strip, its non-degenerate triangles (made
 // counter-clockwise), vertices numbered in grid order. Every output array is
 // sized once: a counting pass over the strip first.
-TerrainMesh assemble(const Terrain& t, const Refiner& refiner) {
+template <class Id>
+TerrainMesh assemble(const Terrain& t, const Refiner<Id>& refiner) {
   const std::uint64_t n = t.layout().n(), W = t.width(), H = t.height();
   TerrainMesh mesh;
   auto clip = [&](auto&& put) {
@@ -731,16 +734,20 @@ TerrainMesh Terrain::refine_tiles(const Refinement& refinement, std::uint32_t ti
   if (tiles < 1 || !std::has_single_bit(tiles) || tiles > (1u << (K - 1)))
     throw Error("terrain refine: tiles must be a power of two from 1 to " + std::to_string(1u << (K - 1)) +
                 " for this grid, got " + std::to_string(tiles));
-  Refiner refiner(*this, refinement);
   const std::int64_t L = (std::int64_t(1) << K) / tiles;
   const std::uint32_t depth = std::uint32_t(std::countr_zero(std::uint64_t(L)));
-  for (std::uint32_t ty = 0; ty < tiles; ++ty)
-    for (std::uint32_t tx = 0; tx < tiles; ++tx) {
-      const std::int64_t x0 = std::int64_t(tx) * L, y0 = std::int64_t(ty) * L;
-      if (std::uint64_t(x0) >= width_ - 1 || std::uint64_t(y0) >= height_ - 1) continue;  // all padding
-      refiner.square(x0, y0, L, depth);
-    }
-  return assemble(*this, refiner);
+  const auto run = [&]<class Id>(Id) {
+    Refiner<Id> refiner(*this, refinement);
+    for (std::uint32_t ty = 0; ty < tiles; ++ty)
+      for (std::uint32_t tx = 0; tx < tiles; ++tx) {
+        const std::int64_t x0 = std::int64_t(tx) * L, y0 = std::int64_t(ty) * L;
+        if (std::uint64_t(x0) >= width_ - 1 || std::uint64_t(y0) >= height_ - 1) continue;  // all padding
+        refiner.square(x0, y0, L, depth);
+      }
+    return assemble(*this, refiner);
+  };
+  const std::uint64_t n = index_.n();
+  return n * n <= (std::uint64_t(1) << 32) ? run(std::uint32_t()) : run(std::uint64_t());
 }
 
 std::vector<float, HugePageAllocator<float>> Terrain::heights_matrix() const {
