@@ -546,7 +546,7 @@ class Refiner {
     strip_.push_back(id(X0, Y0));
     parity_ = 0;
     for (int q = 0; q < 4; ++q) {
-      submesh({C, CY}, mids[q], 2 * depth, kAllPlanes);  // the centre: always in the mesh
+      submesh(C, CY, mids[q].x, mids[q].y, 2 * depth, kAllPlanes);  // the centre: always in the mesh
       append(corners[q], 1);
     }
     strip_begin_.push_back(first);
@@ -558,31 +558,25 @@ class Refiner {
  private:
   Id id(std::int64_t x2, std::int64_t y2) const { return Id(std::uint64_t(y2 / 2) * n_ + std::uint64_t(x2 / 2)); }
 
-  // The children of split vertex j in the triangle of apex i: the split
-  // vertices of its halves, in the order the strip walks them (L&P's c_l, c_r):
-  // for an axis-aligned i - j the one counter-clockwise from i - j first, for a
-  // diagonal one the clockwise one (the walk turns at every level).
-  static P2 child_ccw(P2 i, P2 j) {
-    const std::int64_t dx = i.x - j.x, dy = i.y - j.y;
-    return {(j.x - dy + i.x) / 2, (j.y + dx + i.y) / 2};
-  }
-  static P2 child_cw(P2 i, P2 j) {
-    const std::int64_t dx = i.x - j.x, dy = i.y - j.y;
-    return {(j.x + dy + i.x) / 2, (j.y - dx + i.y) / 2};
-  }
-  static P2 child_left(P2 i, P2 j) { return (i.x == j.x || i.y == j.y) ? child_ccw(i, j) : child_cw(i, j); }
-  static P2 child_right(P2 i, P2 j) { return (i.x == j.x || i.y == j.y) ? child_cw(i, j) : child_ccw(i, j); }
-
   // L&P's submesh-refine(i, j, l) for an active i (`planes` updated by its
   // test): the triangle of apex i and split vertex j; its halves, the
-  // triangles of apex j, exist when j is active (one test for both).
-  void submesh(P2 i, P2 j, std::uint32_t l, unsigned planes) {
-    if (l > 1 && active(j.x, j.y, planes)) {
-      submesh(j, child_left(i, j), l - 1, planes);
-      append(i, l & 1);
-      submesh(j, child_right(i, j), l - 1, planes);
+  // triangles of apex j, exist when j is active (one test for both). The
+  // coordinates as scalars: pairs were packed into vector registers through
+  // the stack, a stalled load (store forwarding) per call.
+  void submesh(std::int64_t ix, std::int64_t iy, std::int64_t jx, std::int64_t jy, std::uint32_t l, unsigned planes) {
+    if (l > 1 && active(jx, jy, planes)) {
+      // The children of j: the split vertices of the halves, in the order the
+      // strip walks them (L&P's c_l, c_r): for an axis-aligned i - j the one
+      // counter-clockwise from i - j first, for a diagonal one the clockwise
+      // one (the walk turns at every level).
+      const std::int64_t dx = ix - jx, dy = iy - jy, sx = ix + jx, sy = iy + jy;
+      const std::int64_t ccw_x = (sx - dy) / 2, ccw_y = (sy + dx) / 2, cw_x = (sx + dy) / 2, cw_y = (sy - dx) / 2;
+      const bool axis = dx == 0 || dy == 0;
+      submesh(jx, jy, axis ? ccw_x : cw_x, axis ? ccw_y : cw_y, l - 1, planes);
+      append({ix, iy}, l & 1);
+      submesh(jx, jy, axis ? cw_x : ccw_x, axis ? cw_y : ccw_y, l - 1, planes);
     } else {
-      append(i, l & 1);
+      append({ix, iy}, l & 1);
     }
   }
 
