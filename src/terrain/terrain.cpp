@@ -661,9 +661,9 @@ TerrainMesh assemble(const Terrain& t, const Refiner<Id>& refiner) {
     triangles += size >= 2 && g != last[0] && g != last[1] && last[0] != last[1];
     last[1] = last[0], last[0] = g, ++size;
   });
+  // The output arrays in huge pages where they are large (their first touch is most of their cost).
   mesh.strip.reserve(size);
   advise_huge_pages(mesh.strip);
-  // The output arrays in huge pages where they are large (their first touch is most of their cost).
   const auto reserve_vertices = [&](std::size_t count) {
     mesh.samples.reserve(count);
     mesh.vertices.reserve(count);
