@@ -3,12 +3,25 @@
 #include "geods/core/parallel.hpp"
 
 #include <algorithm>
+#include <cstdint>
 
 #if defined(__linux__)
 #include <sys/mman.h>
 #endif
 
 namespace geods::detail {
+
+void advise_huge_pages(void* p, std::size_t bytes) {
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+  constexpr std::uintptr_t kPage = 4096;
+  const auto first = (reinterpret_cast<std::uintptr_t>(p) + kPage - 1) & ~(kPage - 1);
+  const auto last = (reinterpret_cast<std::uintptr_t>(p) + bytes) & ~(kPage - 1);
+  if (last > first && last - first >= kHugePage)
+    madvise(reinterpret_cast<void*>(first), last - first, MADV_HUGEPAGE);  // advice only: failure leaves ordinary pages
+#else
+  (void)p, (void)bytes;
+#endif
+}
 
 void* allocate_huge_pages(std::size_t bytes, std::size_t alignment) {
   constexpr std::size_t kPage = 4096;
@@ -18,9 +31,7 @@ void* allocate_huge_pages(std::size_t bytes, std::size_t alignment) {
   void* p = std::aligned_alloc(align, bytes);
   if (!p) throw std::bad_alloc();
   if (!huge) return p;
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
-  madvise(p, bytes, MADV_HUGEPAGE);  // advice only: failure leaves ordinary pages
-#endif
+  advise_huge_pages(p, bytes);
   // One write per small page (which faults in the whole huge page where there is one), a
   // huge page per task: the fresh memory's contents are unspecified, so a zero changes nothing.
   auto* bytes_of = static_cast<volatile char*>(p);

@@ -483,6 +483,8 @@ namespace {
 
 // The refinement of one square of the grid: L&P's submesh recursion in doubled
 // coordinates (a split vertex of the finest triangles lies between samples).
+// Id: the type of the grid ids y n + x (32 bits where they fit: half the memory).
+template <class Id>
 class Refiner {
  public:
   Refiner(const Terrain& t, const Refinement& r) : t_(t), r_(r) {
@@ -544,45 +546,42 @@ class Refiner {
     strip_.push_back(id(X0, Y0));
     parity_ = 0;
     for (int q = 0; q < 4; ++q) {
-      submesh({C, CY}, mids[q], 2 * depth, kAllPlanes, true);
+      submesh(C, CY, mids[q].x, mids[q].y, 2 * depth, kAllPlanes);  // the centre: always in the mesh
       append(corners[q], 1);
     }
     strip_begin_.push_back(first);
   }
 
-  std::vector<std::uint64_t> strip_;
+  std::vector<Id, HugePageAllocator<Id>> strip_;  // huge pages: fewer page faults
   std::vector<std::size_t> strip_begin_;  // where each square's strip starts
 
  private:
-  std::uint64_t id(std::int64_t x2, std::int64_t y2) const { return std::uint64_t(y2 / 2) * n_ + std::uint64_t(x2 / 2); }
+  Id id(std::int64_t x2, std::int64_t y2) const { return Id(std::uint64_t(y2 / 2) * n_ + std::uint64_t(x2 / 2)); }
 
-  // The children of split vertex j in the triangle of apex i: the split
-  // vertices of its halves, in the order the strip walks them (L&P's c_l, c_r):
-  // for an axis-aligned i - j the one counter-clockwise from i - j first, for a
-  // diagonal one the clockwise one (the walk turns at every level).
-  static P2 child_ccw(P2 i, P2 j) {
-    const std::int64_t dx = i.x - j.x, dy = i.y - j.y;
-    return {(j.x - dy + i.x) / 2, (j.y + dx + i.y) / 2};
-  }
-  static P2 child_cw(P2 i, P2 j) {
-    const std::int64_t dx = i.x - j.x, dy = i.y - j.y;
-    return {(j.x + dy + i.x) / 2, (j.y - dx + i.y) / 2};
-  }
-  static P2 child_left(P2 i, P2 j) { return (i.x == j.x || i.y == j.y) ? child_ccw(i, j) : child_cw(i, j); }
-  static P2 child_right(P2 i, P2 j) { return (i.x == j.x || i.y == j.y) ? child_cw(i, j) : child_ccw(i, j); }
-
-  // L&P's submesh-refine(i, j, l): the triangle of apex i and split vertex j
-  // exists when i is active; its halves are the triangles of apex j.
-  void submesh(P2 i, P2 j, std::uint32_t l, unsigned planes, bool forced = false) {
-    if (l == 0) return;
-    if (!forced && !active(i.x, i.y, planes)) return;
-    submesh(j, child_left(i, j), l - 1, planes);
-    append(i, l & 1);
-    submesh(j, child_right(i, j), l - 1, planes);
+  // L&P's submesh-refine(i, j, l) for an active i (`planes` updated by its
+  // test): the triangle of apex i and split vertex j; its halves, the
+  // triangles of apex j, exist when j is active (one test for both). The
+  // coordinates as scalars: pairs were packed into vector registers through
+  // the stack, a stalled load (store forwarding) per call.
+  void submesh(std::int64_t ix, std::int64_t iy, std::int64_t jx, std::int64_t jy, std::uint32_t l, unsigned planes) {
+    if (l > 1 && active(jx, jy, planes)) {
+      // The children of j: the split vertices of the halves, in the order the
+      // strip walks them (L&P's c_l, c_r): for an axis-aligned i - j the one
+      // counter-clockwise from i - j first, for a diagonal one the clockwise
+      // one (the walk turns at every level).
+      const std::int64_t dx = ix - jx, dy = iy - jy, sx = ix + jx, sy = iy + jy;
+      const std::int64_t ccw_x = (sx - dy) / 2, ccw_y = (sy + dx) / 2, cw_x = (sx + dy) / 2, cw_y = (sy - dx) / 2;
+      const bool axis = dx == 0 || dy == 0;
+      submesh(jx, jy, axis ? ccw_x : cw_x, axis ? ccw_y : cw_y, l - 1, planes);
+      append({ix, iy}, l & 1);
+      submesh(jx, jy, axis ? cw_x : ccw_x, axis ? cw_y : ccw_y, l - 1, planes);
+    } else {
+      append({ix, iy}, l & 1);
+    }
   }
 
   void append(P2 v, unsigned p) {
-    const std::uint64_t w = id(v.x, v.y);
+    const Id w = id(v.x, v.y);
     const std::size_t k = strip_.size();
     if (w == strip_[k - 1] || w == strip_[k - 2]) return;
     if (p != parity_)
@@ -601,24 +600,23 @@ class Refiner {
   double lambda_ = 1;
 };
 
-// The output mesh: the triangles and strip of `refiner` restricted to the field
-// (the padding dropped: every leaf triangle lies wholly inside or outside it),
-// vertices numbered in order of first use.
-TerrainMesh assemble(const Terrain& t, const Refiner& refiner) {
-  const std::uint64_t n = t.layout().n(), W = t.width(), H = t.height();
-  const bool full = W == n && H == n;  // no padding: every triangle is inside
-  auto inside = [&](std::uint64_t g) { return full || (g % n < W && g / n < H); };
-  TerrainMesh mesh;
-  std::vector<std::uint64_t> ids;  // the triangles: the strip's non-degenerate ones inside the field
-  // Strip: keep the triangles inside (degenerate ones too, they turn the
-  // strip); runs of kept triangles are joined by degenerate triangles that keep
-  // each triangle's parity, so the winding is what the submesh recursion made.
-  std::vector<std::uint64_t> strip;
-  const std::vector<std::uint64_t>& s = refiner.strip_;
-  std::vector<std::size_t> begins = refiner.strip_begin_;
-  begins.push_back(s.size());
-  for (std::size_t part = 0; part + 1 < begins.size(); ++part) {
-    const std::size_t b = begins[part], e = begins[part + 1];
+// The strip of `refiner` restricted to the field (the padding dropped: every
+// leaf triangle lies wholly inside or outside it): put(g) for each of its grid
+// ids in order. The triangles inside are kept (degenerate ones too, they turn
+// the strip); runs of kept triangles are joined by degenerate triangles that
+// keep each triangle's parity, so the winding is what the submesh recursion made.
+template <class Id, class Inside, class Put>
+void clip_strip(const Refiner<Id>& refiner, Inside inside, Put&& put) {
+  const auto& s = refiner.strip_;
+  const std::vector<std::size_t>& begins = refiner.strip_begin_;
+  std::size_t size = 0;  // of the clipped strip
+  std::uint64_t last = 0;
+  auto push = [&](std::uint64_t g) {
+    put(g);
+    last = g, ++size;
+  };
+  for (std::size_t part = 0; part < begins.size(); ++part) {
+    const std::size_t b = begins[part], e = part + 1 < begins.size() ? begins[part + 1] : s.size();
     std::size_t k = b;
     while (k + 2 < e) {
       if (!(inside(s[k]) && inside(s[k + 1]) && inside(s[k + 2]))) {
@@ -629,69 +627,94 @@ TerrainMesh assemble(const Terrain& t, const Refiner& refiner) {
       while (end + 3 < e && inside(s[end + 3])) ++end;
       // Join: ..., last, last, s[k], s[k] (degenerate triangles), one more
       // s[k] when needed so that the run's triangles keep their parity.
-      if (strip.empty())  // no leading degenerate triangles
+      if (size == 0) {  // no leading degenerate triangles
         while (k < end && (s[k] == s[k + 1] || s[k + 1] == s[k + 2] || s[k] == s[k + 2])) ++k;
-      if (!strip.empty()) {
-        strip.push_back(strip.back());
-        strip.push_back(s[k]);
+      } else {
+        push(last);
+        push(s[k]);
       }
       // The recursion's strip starts with its first corner twice: its
       // triangle k is counter-clockwise when k - b is odd.
-      if (strip.size() % 2 != (k - b + 1) % 2) strip.push_back(s[k]);
-      for (std::size_t q = k; q <= end + 2; ++q) strip.push_back(s[q]);
+      if (size % 2 != (k - b + 1) % 2) push(s[k]);
+      for (std::size_t q = k; q <= end + 2; ++q) push(s[q]);
       k = end + 1;
     }
   }
-  for (std::size_t part = 0; part + 1 < begins.size(); ++part)
-    for (std::size_t k = begins[part]; k + 2 < begins[part + 1]; ++k) {
-      const std::uint64_t a = s[k], b = s[k + 1], c = s[k + 2];
-      if (a != b && b != c && a != c && inside(a) && inside(b) && inside(c)) ids.insert(ids.end(), {a, b, c});
-    }
+}
+
+// The output mesh: the clipped strip, its non-degenerate triangles (made
+// counter-clockwise), vertices numbered in grid order. Every output array is
+// sized once: a counting pass over the strip first.
+template <class Id>
+TerrainMesh assemble(const Terrain& t, const Refiner<Id>& refiner) {
+  const std::uint64_t n = t.layout().n(), W = t.width(), H = t.height();
+  TerrainMesh mesh;
+  auto clip = [&](auto&& put) {
+    if (W == n && H == n)  // no padding: every triangle is inside
+      clip_strip(refiner, [](std::uint64_t) { return true; }, put);
+    else
+      clip_strip(refiner, [&](std::uint64_t g) { return g % n < W && g / n < H; }, put);
+  };
+  std::size_t size = 0, triangles = 0;  // of the clipped strip; its non-degenerate triangles
+  std::uint64_t last[2] = {};
+  clip([&](std::uint64_t g) {
+    triangles += size >= 2 && g != last[0] && g != last[1] && last[0] != last[1];
+    last[1] = last[0], last[0] = g, ++size;
+  });
+  // The output arrays in huge pages where they are large (their first touch is most of their cost).
+  mesh.strip.reserve(size);
+  advise_huge_pages(mesh.strip);
+  const auto reserve_vertices = [&](std::size_t count) {
+    mesh.samples.reserve(count);
+    mesh.vertices.reserve(count);
+    advise_huge_pages(mesh.samples);
+    advise_huge_pages(mesh.vertices);
+  };
+  const auto place = [&](std::uint32_t x, std::uint32_t y) {
+    mesh.samples.push_back({x, y});
+    mesh.vertices.emplace_back(float(t.origin()[0] + double(x) * t.spacing()[0]),
+                               float(t.origin()[1] + double(y) * t.spacing()[1]), t.sample(x, y));
+  };
   // Vertices numbered in grid order: by a dense table up to 2^24 samples, else by sorting.
-  std::vector<std::uint64_t> unique;
-  std::vector<std::uint32_t> dense;
-  constexpr std::uint32_t kUnused = std::numeric_limits<std::uint32_t>::max();
   if (n * n <= (std::uint64_t(1) << 24)) {
-    dense.assign(n * n, kUnused);
-    for (const std::uint64_t g : ids) dense[g] = 0;
-    for (const std::uint64_t g : strip) dense[g] = 0;
-    for (std::uint64_t g = 0; g < n * n; ++g)
-      if (dense[g] == 0) {
-        dense[g] = std::uint32_t(unique.size());
-        unique.push_back(g);
-      }
+    clip([&](std::uint64_t g) { mesh.strip.push_back(std::uint32_t(g)); });  // grid ids, numbered below
+    constexpr std::uint32_t kUnused = std::numeric_limits<std::uint32_t>::max();
+    std::vector<std::uint32_t, HugePageAllocator<std::uint32_t>> dense(n * n, kUnused);
+    std::size_t vertices = 0;
+    for (const std::uint32_t g : mesh.strip) {
+      vertices += dense[g] == kUnused;
+      dense[g] = 0;
+    }
+    reserve_vertices(vertices);
+    for (std::uint32_t y = 0, g = 0; y < n; ++y)
+      for (std::uint32_t x = 0; x < n; ++x, ++g)
+        if (dense[g] == 0) {
+          dense[g] = std::uint32_t(mesh.samples.size());
+          place(x, y);
+        }
+    for (std::uint32_t& g : mesh.strip) g = dense[g];
   } else {
-    unique = ids;
-    unique.insert(unique.end(), strip.begin(), strip.end());
+    std::vector<std::uint64_t> strip;  // grid ids
+    strip.reserve(size);
+    clip([&](std::uint64_t g) { strip.push_back(g); });
+    std::vector<std::uint64_t> unique = strip;
     std::sort(unique.begin(), unique.end());
     unique.erase(std::unique(unique.begin(), unique.end()), unique.end());
+    reserve_vertices(unique.size());
+    for (const std::uint64_t g : unique) place(std::uint32_t(g % n), std::uint32_t(g / n));
+    for (const std::uint64_t g : strip)
+      mesh.strip.push_back(std::uint32_t(std::lower_bound(unique.begin(), unique.end(), g) - unique.begin()));
   }
-  auto number = [&](std::uint64_t g) {
-    return dense.empty() ? std::uint32_t(std::lower_bound(unique.begin(), unique.end(), g) - unique.begin())
-                         : dense[g];
-  };
-  mesh.vertices.resize(unique.size());
-  mesh.samples.resize(unique.size());
-  for (std::size_t v = 0; v < unique.size(); ++v) {
-    const std::uint32_t x = std::uint32_t(unique[v] % n), y = std::uint32_t(unique[v] / n);
-    mesh.samples[v] = {x, y};
-    mesh.vertices[v] = Vec3f(float(t.origin()[0] + double(x) * t.spacing()[0]),
-                             float(t.origin()[1] + double(y) * t.spacing()[1]), t.sample(x, y));
+  // The triangles: the strip's non-degenerate ones (the joins are all
+  // degenerate), counter-clockwise in grid coordinates: the strip's triangle k
+  // is when k is even, its mirror image when k is odd.
+  mesh.triangles.reserve(triangles);
+  advise_huge_pages(mesh.triangles);
+  for (std::size_t k = 0; k + 2 < mesh.strip.size(); ++k) {
+    const std::uint32_t a = mesh.strip[k], b = mesh.strip[k + 1], c = mesh.strip[k + 2];
+    if (a == b || b == c || a == c) continue;
+    mesh.triangles.push_back(k % 2 ? std::array{a, c, b} : std::array{a, b, c});
   }
-  mesh.triangles.reserve(ids.size() / 3);
-  for (std::size_t k = 0; k < ids.size(); k += 3) {
-    std::array<std::uint32_t, 3> tri{number(ids[k]), number(ids[k + 1]), number(ids[k + 2])};
-    // Counter-clockwise in grid coordinates.
-    const auto& a = mesh.samples[tri[0]];
-    const auto& b = mesh.samples[tri[1]];
-    const auto& c = mesh.samples[tri[2]];
-    const std::int64_t cross = (std::int64_t(b[0]) - a[0]) * (std::int64_t(c[1]) - a[1]) -
-                               (std::int64_t(b[1]) - a[1]) * (std::int64_t(c[0]) - a[0]);
-    if (cross < 0) std::swap(tri[1], tri[2]);
-    mesh.triangles.push_back(tri);
-  }
-  mesh.strip.reserve(strip.size());
-  for (const std::uint64_t g : strip) mesh.strip.push_back(number(g));
   return mesh;
 }
 
@@ -705,16 +728,20 @@ TerrainMesh Terrain::refine_tiles(const Refinement& refinement, std::uint32_t ti
   if (tiles < 1 || !std::has_single_bit(tiles) || tiles > (1u << (K - 1)))
     throw Error("terrain refine: tiles must be a power of two from 1 to " + std::to_string(1u << (K - 1)) +
                 " for this grid, got " + std::to_string(tiles));
-  Refiner refiner(*this, refinement);
   const std::int64_t L = (std::int64_t(1) << K) / tiles;
   const std::uint32_t depth = std::uint32_t(std::countr_zero(std::uint64_t(L)));
-  for (std::uint32_t ty = 0; ty < tiles; ++ty)
-    for (std::uint32_t tx = 0; tx < tiles; ++tx) {
-      const std::int64_t x0 = std::int64_t(tx) * L, y0 = std::int64_t(ty) * L;
-      if (std::uint64_t(x0) >= width_ - 1 || std::uint64_t(y0) >= height_ - 1) continue;  // all padding
-      refiner.square(x0, y0, L, depth);
-    }
-  return assemble(*this, refiner);
+  const auto run = [&]<class Id>(Id) {
+    Refiner<Id> refiner(*this, refinement);
+    for (std::uint32_t ty = 0; ty < tiles; ++ty)
+      for (std::uint32_t tx = 0; tx < tiles; ++tx) {
+        const std::int64_t x0 = std::int64_t(tx) * L, y0 = std::int64_t(ty) * L;
+        if (std::uint64_t(x0) >= width_ - 1 || std::uint64_t(y0) >= height_ - 1) continue;  // all padding
+        refiner.square(x0, y0, L, depth);
+      }
+    return assemble(*this, refiner);
+  };
+  const std::uint64_t n = index_.n();
+  return n * n <= (std::uint64_t(1) << 32) ? run(std::uint32_t()) : run(std::uint64_t());
 }
 
 std::vector<float, HugePageAllocator<float>> Terrain::heights_matrix() const {

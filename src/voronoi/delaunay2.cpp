@@ -11,14 +11,12 @@
 #include <numeric>
 #include <optional>
 #include <type_traits>
-#if defined(__linux__)
-#include <sys/mman.h>
-#endif
 
 #include "brio_order.hpp"
 #include "constrained_delaunay.hpp"
 #include "exact_compare.hpp"
 #include "geods/core/error.hpp"
+#include "geods/core/huge_page_allocator.hpp"
 #include "geods/core/parallel.hpp"
 #include "geods/core/predicates.hpp"
 #include "geods/core/rng.hpp"
@@ -603,25 +601,6 @@ std::uint32_t Delaunay2::Inserter::insert(const Vec2d& p, std::uint32_t near) {
   }
   return i;
 }
-
-namespace {
-
-// Asks for transparent huge pages for the storage of v (a hint; the kernel may
-// be set to use them only where asked).
-template <class T>
-void advise_huge_pages(const std::vector<T>& v) {
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
-  constexpr std::uintptr_t kPage = 4096;
-  const auto first = (reinterpret_cast<std::uintptr_t>(v.data()) + kPage - 1) & ~(kPage - 1);
-  const auto last = (reinterpret_cast<std::uintptr_t>(v.data() + v.capacity())) & ~(kPage - 1);
-  if (last - first >= (std::uintptr_t(1) << 21) && last > first)
-    madvise(reinterpret_cast<void*>(first), last - first, MADV_HUGEPAGE);
-#else
-  (void)v;
-#endif
-}
-
-}  // namespace
 
 void Delaunay2::Inserter::reserve(std::size_t more) {
   Editor& e = *editor_;

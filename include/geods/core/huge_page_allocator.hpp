@@ -6,9 +6,12 @@
 // miss, and first touched by all threads, so that the kernel's zeroing of fresh
 // pages is shared instead of falling on whichever thread writes the array first.
 // Smaller blocks and other systems get ordinary aligned memory.
+// advise_huge_pages() asks the same for a std::vector's storage (a hint: the
+// kernel may be set to use them only where asked; the pages are touched later).
 #include <cstddef>
 #include <cstdlib>
 #include <new>
+#include <vector>
 
 namespace geods {
 
@@ -16,7 +19,17 @@ namespace detail {
 inline constexpr std::size_t kHugePage = std::size_t(2) << 20;
 /// `bytes` of memory as described above; throws std::bad_alloc.
 void* allocate_huge_pages(std::size_t bytes, std::size_t alignment);
+/// Advises transparent huge pages for the whole small pages of [p, p + bytes) (2 MiB or more).
+void advise_huge_pages(void* p, std::size_t bytes);
 }  // namespace detail
+
+/// Asks for transparent huge pages for v's storage (its capacity), before
+/// it is first written: a fresh 2 MiB page costs one fault where 512 small
+/// ones cost 512.
+template <typename T, typename A>
+void advise_huge_pages(const std::vector<T, A>& v) {
+  detail::advise_huge_pages(const_cast<T*>(v.data()), v.capacity() * sizeof(T));
+}
 
 template <typename T>
 class HugePageAllocator {
