@@ -23,6 +23,19 @@ void advise_huge_pages(void* p, std::size_t bytes) {
 #endif
 }
 
+void prefault(const void* p, std::size_t bytes) {
+#if defined(__linux__) && defined(MADV_POPULATE_WRITE)
+  constexpr std::uintptr_t kPage = 4096;
+  const auto first = (reinterpret_cast<std::uintptr_t>(p) + kPage - 1) & ~(kPage - 1);
+  const auto last = (reinterpret_cast<std::uintptr_t>(p) + bytes) & ~(kPage - 1);
+  if (last < first + (std::uintptr_t(1) << 16)) return;
+  advise_huge_pages(reinterpret_cast<void*>(first), last - first);
+  madvise(reinterpret_cast<void*>(first), last - first, MADV_POPULATE_WRITE);
+#else
+  (void)p, (void)bytes;
+#endif
+}
+
 void* allocate_huge_pages(std::size_t bytes, std::size_t alignment) {
   constexpr std::size_t kPage = 4096;
   const bool huge = bytes >= kHugePage / 2;  // rounding up wastes less than half
