@@ -722,8 +722,10 @@ void check_scaled_copies(const std::vector<int>& good_exponents, const std::vect
     EXPECT_THROW((KdTree<T, 3>(p, d)), Error) << s;
     // A far query against unit points overflows the same way.
     const std::vector<T> far{s, 0, 0};
-    if (s > 1) EXPECT_THROW(reference.query(std::span<const T>(far), 1), Error) << s;
-    if (s > 1) EXPECT_THROW(reference.query_radius(std::span<const T>(far), 1.0), Error) << s;
+    if (s > 1) {
+      EXPECT_THROW(reference.query(std::span<const T>(far), 1), Error) << s;
+      EXPECT_THROW(reference.query_radius(std::span<const T>(far), 1.0), Error) << s;
+    }
   }
 }
 
