@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <utility>
 
 #if defined(__linux__)
 #include <sys/mman.h>
@@ -11,13 +12,22 @@
 
 namespace geods::detail {
 
-void advise_huge_pages(void* p, std::size_t bytes) {
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
+namespace {
+
+// The whole small pages of [p, p + bytes): their start and their length (0 if none).
+[[maybe_unused]] std::pair<void*, std::size_t> whole_pages(const void* p, std::size_t bytes) {
   constexpr std::uintptr_t kPage = 4096;
   const auto first = (reinterpret_cast<std::uintptr_t>(p) + kPage - 1) & ~(kPage - 1);
   const auto last = (reinterpret_cast<std::uintptr_t>(p) + bytes) & ~(kPage - 1);
-  if (last > first && last - first >= kHugePage)
-    madvise(reinterpret_cast<void*>(first), last - first, MADV_HUGEPAGE);  // advice only: failure leaves ordinary pages
+  return {reinterpret_cast<void*>(first), last > first ? last - first : 0};
+}
+
+}  // namespace
+
+void advise_huge_pages(void* p, std::size_t bytes) {
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+  const auto [first, length] = whole_pages(p, bytes);
+  if (length >= kHugePage) madvise(first, length, MADV_HUGEPAGE);  // advice only: failure leaves ordinary pages
 #else
   (void)p, (void)bytes;
 #endif
@@ -25,12 +35,10 @@ void advise_huge_pages(void* p, std::size_t bytes) {
 
 void prefault(const void* p, std::size_t bytes) {
 #if defined(__linux__) && defined(MADV_POPULATE_WRITE)
-  constexpr std::uintptr_t kPage = 4096;
-  const auto first = (reinterpret_cast<std::uintptr_t>(p) + kPage - 1) & ~(kPage - 1);
-  const auto last = (reinterpret_cast<std::uintptr_t>(p) + bytes) & ~(kPage - 1);
-  if (last < first + (std::uintptr_t(1) << 16)) return;
-  advise_huge_pages(reinterpret_cast<void*>(first), last - first);
-  madvise(reinterpret_cast<void*>(first), last - first, MADV_POPULATE_WRITE);
+  const auto [first, length] = whole_pages(p, bytes);
+  if (length < (std::size_t(1) << 16)) return;
+  advise_huge_pages(first, length);
+  madvise(first, length, MADV_POPULATE_WRITE);
 #else
   (void)p, (void)bytes;
 #endif

@@ -5,13 +5,13 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <cstring>
 #include <numbers>
 #include <string>
 
 #include "geods/bvh/traversal.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"
+#include "geods/core/weld.hpp"
 
 namespace geods::field {
 namespace {
@@ -27,32 +27,6 @@ double solid_angle(const Vec3d& p, const Vec3f& a, const Vec3f& b, const Vec3f& 
   const double det = u.dot(v.cross(w));
   const double den = lu * lv * lw + u.dot(v) * lw + v.dot(w) * lu + w.dot(u) * lv;
   return 2 * std::atan2(det, den);
-}
-
-// Vertex ids after welding vertices at equal positions: each vertex maps to
-// the smallest index of its position (deterministic). Vertices go into a hash
-// table of positions in index order, so a position's first index is its smallest.
-std::vector<std::uint32_t> weld(const std::vector<Vec3f>& vertices) {
-  int bits = 4;
-  while ((std::size_t(1) << bits) < 2 * vertices.size()) ++bits;
-  const std::size_t mask = (std::size_t(1) << bits) - 1;
-  std::vector<std::uint32_t> slots(mask + 1, kNoIndex);
-  std::vector<std::uint32_t> id(vertices.size());
-  for (std::uint32_t v = 0; v < vertices.size(); ++v) {
-    const Vec3f& p = vertices[v];
-    std::uint64_t h = 0;
-    for (int c = 0; c < 3; ++c) {
-      const float x = p[c] + 0.0f;  // -0 becomes +0: the same position
-      std::uint32_t b;
-      std::memcpy(&b, &x, sizeof b);
-      h = (h + b) * 0x9E3779B97F4A7C15ull;
-    }
-    std::size_t s = std::size_t(h >> (64 - bits));
-    while (slots[s] != kNoIndex && vertices[slots[s]] != p) s = (s + 1) & mask;
-    if (slots[s] == kNoIndex) slots[s] = v;
-    id[v] = slots[s];
-  }
-  return id;
 }
 
 }  // namespace

@@ -7,9 +7,10 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
-#include <unordered_map>
+#include <utility>
 
 #include "file_util.hpp"
+#include "geods/core/weld.hpp"
 #include "geods/io/mesh_io.hpp"
 #include "ply.hpp"
 
@@ -174,40 +175,38 @@ void check_obj(const fs::path& path, std::string_view text) {
   }
 }
 
-// STL: facets with their own corners; coincident corners (same float bits,
-// -0 and +0 alike) become one vertex.
-class CornerMerger {
- public:
-  std::uint32_t add(TriMesh& mesh, const Vec3f& p) {
-    const Vec3f q = p + Vec3f::Zero();  // -0 + 0 = +0
-    std::array<std::uint32_t, 3> key;
-    std::memcpy(key.data(), q.data(), sizeof(key));
-    const auto [it, inserted] = index_.try_emplace(key, std::uint32_t(mesh.vertices.size()));
-    if (inserted) mesh.vertices.push_back(q);
-    return it->second;
-  }
-
- private:
-  struct Hash {
-    std::size_t operator()(const std::array<std::uint32_t, 3>& k) const {
-      return std::size_t(k[0]) * 0x9e3779b97f4a7c15ull ^ std::size_t(k[1]) * 0xc2b2ae3d27d4eb4full ^ std::size_t(k[2]) * 0x165667b19e3779f9ull;
-    }
-  };
-  std::unordered_map<std::array<std::uint32_t, 3>, std::uint32_t, Hash> index_;
-};
-
-void add_facet(const fs::path& path, TriMesh& mesh, CornerMerger& merger, const Vec3f (&corners)[3], std::size_t facet) {
-  TriMesh::Triangle t;
+// STL: facets with their own corners, read as three vertices each;
+// merge_corners() then makes coincident corners (same floats, -0 and +0 alike)
+// one vertex, numbered in order of first use.
+void add_facet(const fs::path& path, TriMesh& mesh, const Vec3f (&corners)[3], std::size_t facet) {
+  const auto first = std::uint32_t(mesh.vertices.size());
   for (int c = 0; c < 3; ++c) {
     if (!corners[c].allFinite()) fail(path, "facet " + std::to_string(facet) + " has a non-finite coordinate");
-    t[std::size_t(c)] = merger.add(mesh, corners[c]);
+    mesh.vertices.push_back(corners[c]);
   }
-  mesh.triangles.push_back(t);
+  mesh.triangles.push_back({first, first + 1, first + 2});
+}
+
+TriMesh merge_corners(TriMesh mesh) {
+  const std::vector<std::uint32_t> id = weld(mesh.vertices);
+  std::vector<std::uint32_t> number(id.size());
+  std::uint32_t kept = 0;
+  for (std::size_t v = 0; v < id.size(); ++v) {
+    if (id[v] != v) {
+      number[v] = number[id[v]];  // id[v] < v: numbered already
+      continue;
+    }
+    number[v] = kept;
+    mesh.vertices[kept++] = mesh.vertices[v] + Vec3f::Zero();  // -0 + 0 = +0
+  }
+  mesh.vertices.resize(kept);
+  for (TriMesh::Triangle& t : mesh.triangles)
+    for (std::uint32_t& c : t) c = number[c];
+  return mesh;
 }
 
 TriMesh mesh_from_stl(const fs::path& path, std::span<const std::uint8_t> bytes) {
   TriMesh mesh;
-  CornerMerger merger;
   // Binary if the size matches the facet count exactly: binary files may also start with "solid".
   if (bytes.size() >= 84) {
     const std::uint64_t n = detail::load<std::uint32_t>(bytes.data() + 80, false);
@@ -218,10 +217,10 @@ TriMesh mesh_from_stl(const fs::path& path, std::span<const std::uint8_t> bytes)
         Vec3f corners[3];
         for (int c = 0; c < 3; ++c)
           for (int k = 0; k < 3; ++k) corners[c][k] = detail::load<float>(p + 12 * c + 4 * k, false);
-        add_facet(path, mesh, merger, corners, f);
+        add_facet(path, mesh, corners, f);
       }
       if (mesh.triangles.empty()) fail(path, "no triangles (binary STL with 0 facets)");
-      return mesh;
+      return merge_corners(std::move(mesh));
     }
   }
   const std::string_view text = detail::as_text(bytes);
@@ -268,14 +267,14 @@ TriMesh mesh_from_stl(const fs::path& path, std::span<const std::uint8_t> bytes)
       }
       expect("endloop");
       expect("endfacet");
-      add_facet(path, mesh, merger, corners, mesh.triangles.size());
+      add_facet(path, mesh, corners, mesh.triangles.size());
     } else {
       fail(path, "malformed ascii STL: unexpected '" + std::string(t.substr(0, 30)) + "' after facet " + std::to_string(mesh.triangles.size()));
     }
   }
   if (!ended) fail(path, "truncated: no 'endsolid'");
   if (mesh.triangles.empty()) fail(path, "no triangles");
-  return mesh;
+  return merge_corners(std::move(mesh));
 }
 
 void check_glb(const fs::path& path, std::span<const std::uint8_t> bytes) {
