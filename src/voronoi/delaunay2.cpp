@@ -12,6 +12,7 @@
 #include <optional>
 #include <type_traits>
 
+#include "../core/prefault.hpp"
 #include "brio_order.hpp"
 #include "constrained_delaunay.hpp"
 #include "exact_compare.hpp"
@@ -352,15 +353,23 @@ void Delaunay2::Editor::build_degenerate() {
 
 void Delaunay2::Editor::publish() {
   const std::uint32_t internal = std::uint32_t(core.vert.size() / 3);
+  // Fresh storage is mapped in one call, not a page fault per 4 KiB page as it is first written
+  // (grown geometrically: insert() publishes after every point).
+  const auto room = [](auto& v, std::size_t size) {
+    if (v.capacity() < size) geods::detail::reserve_prefaulted(v, std::max(size, 2 * v.capacity()));
+  };
+  room(public_triangle, internal);
   public_triangle.assign(internal, kNone);
   internal_triangle.clear();
-  internal_triangle.reserve(internal);
+  room(internal_triangle, internal);
   for (std::uint32_t t = 0; t < internal; ++t) {
     if (core.vert[3 * t] == kNone || core.is_ghost_triangle(t)) continue;
     public_triangle[t] = std::uint32_t(internal_triangle.size());
     internal_triangle.push_back(t);
   }
   const std::size_t m = internal_triangle.size();
+  room(triangles, 3 * m);
+  room(halfedges, 3 * m);
   triangles.resize(3 * m);
   halfedges.resize(3 * m);
   constexpr std::size_t kAhead = 16;  // the neighbours' numbers and the points are read at random: ask ahead
@@ -381,6 +390,7 @@ void Delaunay2::Editor::publish() {
   if (has_constraints)
     for (std::size_t k = 0; k < m; ++k)
       for (std::uint32_t s = 0; s < 3; ++s) constrained[3 * k + s] = fixed[3 * internal_triangle[k] + s];
+  room(core.vertex_edge, core.coords.size());
   core.vertex_edge.assign(core.coords.size(), kNone);
   for (std::uint32_t h = 0; h < core.vert.size(); ++h)
     if (core.vert[h] != kGhost && core.vert[h] != kNone) core.vertex_edge[core.vert[h]] = h;
