@@ -78,6 +78,19 @@ class MaxHeap4 {
     }
     h[i] = e;
   }
+  // The triangle of the entry the pops will likely stop at: the top if it is
+  // current, else (a stale top) its largest child, which the pop raises, unchecked.
+  template <class Current>
+  std::uint32_t likely_next(Current current) const {
+    const std::size_t n = heap_.size() - kPad;
+    const Entry* h = heap_.data() + kPad;
+    if (n == 0) return voronoi::Delaunay2::no_edge;
+    if (current(h[0]) || n == 1) return h[0].triangle;
+    std::size_t best = 1;
+    for (std::size_t c = 2; c < std::min<std::size_t>(5, n); ++c)
+      if (h[best].error < h[c].error) best = c;
+    return h[best].triangle;
+  }
   void pop() {
     const Entry last = heap_.back();
     heap_.pop_back();
@@ -126,10 +139,16 @@ class GreedyTin {
     if (i != pts_.size()) throw Error("terrain tin: a sample was inserted twice");
     pts_.push_back(p);
     if (!scan) return;
-    // The next insertion likely starts at the queue's top: fetch its triangle while this one is rescanned.
-    const std::uint32_t next = queue_.empty() ? voronoi::Delaunay2::no_edge : queue_.top().triangle;
+    // Fetch the next insertion's triangle while this one is rescanned. It is the first current entry the
+    // queue pops: its top, unless the top is stale (most pops are) or this insertion changed its triangle.
+    const std::span<const Inserter::Triangle> changed = ins_.changed();
+    const std::uint32_t next = queue_.likely_next([&](const Entry& e) {
+      for (const Inserter::Triangle& t : changed)
+        if (t.handle == e.triangle) return false;
+      return state_[e.triangle].error == e.error;
+    });
     if (next != voronoi::Delaunay2::no_edge) ins_.prefetch(next);
-    rescan(ins_.changed());
+    rescan(changed);
     // Then its neighbours (the rescan's pushes rarely change the top).
     if (next != voronoi::Delaunay2::no_edge) ins_.prefetch_neighbors(next);
   }
@@ -235,8 +254,7 @@ TileTin tile_tin(const float* z, std::uint64_t w, P2 c00, P2 c11, double limit, 
     // Room for every sample, up to 2^22 (a few hundred MB of address space; larger tiles grow as needed).
     const std::size_t room = std::min(std::size_t(c11.x - c00.x + 1) * std::size_t(c11.y - c00.y + 1), std::size_t(1) << 22);
     ins.reserve(room);
-    tin.pts_.reserve(room);
-    advise_huge_pages(tin.pts_);  // touched as it fills: a fault per 2 MiB, not per 4 KiB
+    geods::detail::reserve_growing(tin.pts_, room);
     GreedyTin g(z, w, limit, ins, tin.pts_);
     g.reserve(room);
     for (const P2& p : border) g.insert(p, voronoi::Delaunay2::no_edge, false);
@@ -322,6 +340,7 @@ TerrainMesh Terrain::tin(double max_error, std::uint32_t tiles) const {
       const TileTin g = tile_tin(z.data(), width_, P2{xs[tx], ys[ty]}, P2{xs[tx + 1], ys[ty + 1]}, limit, border_limit);
       const auto& tri = g.dt.triangles();
       if (tiles == 1) reserve_mesh(mesh, g.pts_.size(), tri.size() / 3);
+      geods::detail::reserve_prefaulted(vertex_of, g.pts_.size());
       vertex_of.resize(g.pts_.size());
       for (std::size_t i = 0; i < g.pts_.size(); ++i) {
         const P2 p = g.pts_[i];

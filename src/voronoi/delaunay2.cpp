@@ -615,10 +615,7 @@ std::uint32_t Delaunay2::Inserter::insert(const Vec2d& p, std::uint32_t near) {
 void Delaunay2::Inserter::reserve(std::size_t more) {
   Editor& e = *editor_;
   const std::size_t n = e.points.size() + more, half_edges = 6 * n + 12;  // a closed triangulation: 2n - 2 triangles
-  const auto grow = [](auto& v, std::size_t size) {
-    v.reserve(size);
-    advise_huge_pages(v);
-  };
+  const auto grow = [](auto& v, std::size_t size) { geods::detail::reserve_growing(v, size); };
   grow(e.points, n), grow(e.rep, n), grow(e.original_of, n), grow(e.internal_of, n);
   grow(e.core.coords, n), grow(e.core.vertex_edge, n), grow(e.core.vert, half_edges), grow(e.core.twin, half_edges);
 }
@@ -626,14 +623,16 @@ void Delaunay2::Inserter::reserve(std::size_t more) {
 void Delaunay2::Inserter::prefetch(std::uint32_t h) const {
   const DelaunayCore& core = editor_->core;
   if (h >= core.vert.size() / 3) return;
-  __builtin_prefetch(&core.twin[3 * h]);
-  for (std::uint32_t e = 3 * h; e < 3 * h + 3; ++e)
-    if (core.vert[e] < core.coords.size()) __builtin_prefetch(&core.coords[core.vert[e]]);
+  // No reads: h's entries are not in cache yet (a triangle's three may straddle two lines).
+  __builtin_prefetch(&core.vert[3 * h]), __builtin_prefetch(&core.vert[3 * h + 2]);
+  __builtin_prefetch(&core.twin[3 * h], 1), __builtin_prefetch(&core.twin[3 * h + 2], 1);
 }
 
 void Delaunay2::Inserter::prefetch_neighbors(std::uint32_t h) const {
   const DelaunayCore& core = editor_->core;
   if (h >= core.vert.size() / 3) return;
+  for (std::uint32_t e = 3 * h; e < 3 * h + 3; ++e)
+    if (core.vert[e] < core.coords.size()) __builtin_prefetch(&core.coords[core.vert[e]]);
   for (std::uint32_t e = 3 * h; e < 3 * h + 3; ++e) {
     const std::uint32_t t = core.twin[e] / 3;
     if (3 * std::size_t(t) + 2 >= core.vert.size()) continue;

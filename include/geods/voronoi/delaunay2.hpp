@@ -269,14 +269,16 @@ class Delaunay2::Inserter {
   /// Room for `more` points without reallocation, the large arrays on
   /// transparent huge pages where the system allows (insertions read them at
   /// random; with 4 KiB pages nearly every read also misses the TLB). The
-  /// memory is only touched as the triangulation grows.
+  /// memory is touched as the triangulation grows, but for the small pages
+  /// before each array's first huge page, which are mapped at once.
   void reserve(std::size_t more);
-  /// A hint that a coming insert() starts at triangle h: its arrays and
-  /// corners are fetched into the cache meanwhile (they lie anywhere in memory).
+  /// A hint that a coming insert() starts at triangle h: its arrays are
+  /// fetched into the cache meanwhile (they lie anywhere in memory); nothing
+  /// is read, so the hint does not wait for them.
   void prefetch(std::uint32_t h) const;
-  /// The next step of that hint, some time after prefetch(h): the arrays of
-  /// h's neighbours across its edges (which the split relinks and the flips
-  /// test), found through h's twins, which prefetch(h) fetched.
+  /// The next step of that hint, some time after prefetch(h): h's corners and
+  /// the arrays of h's neighbours across its edges (which the split relinks
+  /// and the flips test), found through h's arrays, which prefetch(h) fetched.
   void prefetch_neighbors(std::uint32_t h) const;
   /// One more than the largest handle.
   std::uint32_t handle_count() const;
