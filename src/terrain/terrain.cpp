@@ -89,20 +89,166 @@ template <int S>
   return m;
 }
 
+#if defined(__x86_64__) && defined(__GNUC__)
+#define GEODS_TERRAIN_AVX2_INLINE __attribute__((target("avx2"), always_inline)) inline
+// The fine levels with AVX2, four vertices of one kind at a time (the lanes
+// St samples apart along a row): the same planes and terms as rows_error<S>,
+// lane by lane, so the same errors bit for bit.
+
+// p[0], p[St], p[2 St], p[3 St] as doubles (reads up to p[3 St + 3]).
+template <int St>
+GEODS_TERRAIN_AVX2_INLINE __m256d load4(const float* p) {
+  if constexpr (St == 2) {
+    const __m256 v = _mm256_permutevar8x32_ps(_mm256_loadu_ps(p), _mm256_set_epi32(7, 5, 3, 1, 6, 4, 2, 0));
+    return _mm256_cvtps_pd(_mm256_castps256_ps128(v));
+  } else if constexpr (St == 4) {  // p0 p0 p8 p8 | p4 p4 p12 p12, then in order
+    const __m256 v = _mm256_shuffle_ps(_mm256_loadu_ps(p), _mm256_loadu_ps(p + 8), 0);
+    return _mm256_cvtps_pd(_mm256_castps256_ps128(_mm256_permutevar8x32_ps(v, _mm256_set_epi32(7, 5, 3, 1, 6, 2, 4, 0))));
+  } else {
+    return _mm256_cvtps_pd(_mm_set_ps(p[3 * St], p[2 * St], p[St], p[0]));
+  }
+}
+
+// detail::Plane of the corners at offsets a, b, c from the lanes' vertices v.
+struct Plane4 {
+  const float* a;
+  __m256d za, gx, gy;
+};
+template <int St>
+GEODS_TERRAIN_AVX2_INLINE Plane4 plane4(const float* v, std::int64_t n, P2 a, P2 b, P2 c) {
+  Plane4 p;
+  p.a = v + a.y * n + a.x;
+  p.za = load4<St>(p.a);
+  const __m256d zb = load4<St>(v + b.y * n + b.x), zc = load4<St>(v + c.y * n + c.x);
+  const double ux = double(b.x - a.x), uy = double(b.y - a.y), vx = double(c.x - a.x), vy = double(c.y - a.y);
+  // det is +-2^k (+-2 s^2 or +-4 s^2): dividing by it is multiplying by 1 / det, exactly.
+  const __m256d inv = _mm256_set1_pd(1 / (ux * vy - uy * vx));
+  const __m256d db = _mm256_sub_pd(zb, p.za), dc = _mm256_sub_pd(zc, p.za);
+  p.gx = _mm256_mul_pd(_mm256_sub_pd(_mm256_mul_pd(db, _mm256_set1_pd(vy)), _mm256_mul_pd(dc, _mm256_set1_pd(uy))), inv);
+  p.gy = _mm256_mul_pd(_mm256_sub_pd(_mm256_mul_pd(dc, _mm256_set1_pd(ux)), _mm256_mul_pd(db, _mm256_set1_pd(vx))), inv);
+  return p;
+}
+
+// rows_error<S>() of the four lanes, into m.
+template <int St>
+GEODS_TERRAIN_AVX2_INLINE void rows4(__m256d& m, std::int64_t n, const Plane4& p, std::int64_t r0, std::int64_t rows,
+                                      std::int64_t lo0, std::int64_t dlo, std::int64_t hi0, std::int64_t dhi) {
+  const __m256d sign = _mm256_set1_pd(-0.0);
+  for (std::int64_t r = 0; r < rows; ++r) {
+    const std::int64_t dy = r0 + r;
+    const __m256d base = _mm256_add_pd(p.za, _mm256_mul_pd(p.gy, _mm256_set1_pd(double(dy))));
+    const float* row = p.a + dy * n;
+    for (std::int64_t dx = lo0 + dlo * r; dx <= hi0 + dhi * r; ++dx) {
+      const __m256d d = _mm256_sub_pd(load4<St>(row + dx), _mm256_add_pd(base, _mm256_mul_pd(p.gx, _mm256_set1_pd(double(dx)))));
+      m = _mm256_max_pd(_mm256_andnot_pd(sign, d), m);
+    }
+  }
+}
+
+// err of the lanes' vertices (x + St j, y): round_up() of m, +inf where a
+// corner of the diamond (spacing s) leaves W x H.
+template <int St>
+GEODS_TERRAIN_AVX2_INLINE void store4(float* err, std::int64_t n, std::int64_t x, std::int64_t y, std::int64_t s, std::int64_t W,
+                                      std::int64_t H, __m256d m) {
+  const __m128 f = _mm256_cvtpd_ps(m);
+  const __m256d below = _mm256_cmp_pd(_mm256_cvtps_pd(f), m, _CMP_LT_OQ);  // all ones: one ulp up
+  const __m128i up = _mm_srli_epi32(_mm256_castsi256_si128(_mm256_permutevar8x32_epi32(_mm256_castpd_si256(below),
+                                                                                        _mm256_set_epi32(7, 5, 3, 1, 6, 4, 2, 0))), 31);
+  alignas(16) float out[4];
+  _mm_store_ps(out, _mm_castsi128_ps(_mm_add_epi32(_mm_castps_si128(f), up)));
+  float* e = err + y * n + x;
+  for (int j = 0; j < 4; ++j) e[St * j] = x + St * j + s > W - 1 || y + s > H - 1 ? kInf : out[j];
+}
+
+// The red vertices of row y (spacing S, N / S >= 16): both diagonals, four
+// vertices of one at a time (4 S apart).
+template <int S>
+__attribute__((target("avx2"))) void red_row_avx2(const float* z, std::int64_t n, std::int64_t W, std::int64_t H, std::uint32_t t,
+                                                  std::int64_t y, float* err) {
+  constexpr std::int64_t s = S;
+  const std::int64_t N = n - 1;
+  for (std::int64_t parity = 0; parity < 2; ++parity) {
+    const bool main_parents = ((parity + ((y - s) >> (t + 1))) & 1) != 0;
+    for (std::int64_t x = s + 2 * s * parity; x < N; x += 16 * s) {
+      const float* v = z + y * n + x;
+      __m256d m = _mm256_setzero_pd();
+      if (main_parents) {
+        const P2 a{-s, s}, b{s, -s};
+        rows4<4 * S>(m, n, plane4<4 * S>(v, n, a, b, {-s, -s}), -2 * s, 2 * s + 1, 0, 0, 2 * s, -1);
+        rows4<4 * S>(m, n, plane4<4 * S>(v, n, a, b, {s, s}), -2 * s, 2 * s + 1, 2 * s, -1, 2 * s, 0);
+      } else {
+        const P2 a{-s, -s}, b{s, s};
+        rows4<4 * S>(m, n, plane4<4 * S>(v, n, a, b, {-s, s}), 0, 2 * s + 1, 0, 0, 0, 1);
+        rows4<4 * S>(m, n, plane4<4 * S>(v, n, a, b, {s, -s}), 0, 2 * s + 1, 0, 1, 2 * s, 0);
+      }
+      store4<4 * S>(err, n, x, y, s, W, H, m);
+    }
+  }
+}
+
+// The blue vertices of row y on horizontal edges (0 < y < N): all of them.
+template <int S>
+__attribute__((target("avx2"))) void blue_h_row_avx2(const float* z, std::int64_t n, std::int64_t W, std::int64_t H, std::int64_t y,
+                                                     float* err) {
+  constexpr std::int64_t s = S;
+  for (std::int64_t x = s; x < n - 1; x += 8 * s) {
+    const float* v = z + y * n + x;
+    __m256d m = _mm256_setzero_pd();
+    rows4<2 * S>(m, n, plane4<2 * S>(v, n, {-s, 0}, {s, 0}, {0, -s}), -s, s + 1, s, -1, s, 1);
+    rows4<2 * S>(m, n, plane4<2 * S>(v, n, {-s, 0}, {s, 0}, {0, s}), 0, s + 1, 0, 1, 2 * s, -1);
+    store4<2 * S>(err, n, x, y, s, W, H, m);
+  }
+}
+
+// The blue vertices of row y on vertical edges from x = 2 S to N - 8 S;
+// returns the first x not done.
+template <int S>
+__attribute__((target("avx2"))) std::int64_t blue_v_row_avx2(const float* z, std::int64_t n, std::int64_t W, std::int64_t H,
+                                                             std::int64_t y, float* err) {
+  constexpr std::int64_t s = S;
+  std::int64_t x = 2 * s;
+  for (; x + 6 * s <= n - 1 - 2 * s; x += 8 * s) {
+    const float* v = z + y * n + x;
+    __m256d m = _mm256_setzero_pd();
+    const Plane4 l = plane4<2 * S>(v, n, {0, -s}, {0, s}, {-s, 0}), r = plane4<2 * S>(v, n, {0, -s}, {0, s}, {s, 0});
+    rows4<2 * S>(m, n, l, 0, s + 1, 0, -1, 0, 0);
+    rows4<2 * S>(m, n, l, s + 1, s, 1 - s, 1, 0, 0);
+    rows4<2 * S>(m, n, r, 0, s + 1, 0, 0, 0, 1);
+    rows4<2 * S>(m, n, r, s + 1, s, 0, 0, s - 1, -1);
+    store4<2 * S>(err, n, x, y, s, W, H, m);
+  }
+  return x;
+}
+#undef GEODS_TERRAIN_AVX2_INLINE
+#endif
+
 // The own errors of the vertices of spacing s = 2^t (S = s when it is a small
 // compile-time constant, else 0): red ones (square centres) split the two
 // halves of their 2s-square, blue ones the quarters of 2s-squares on both
 // sides of their edge. err[y n + x] = the largest error of the triangles,
-// rounded up to a float; +inf when a corner of one lies outside W x H.
+// rounded up to a float; +inf when a corner of one lies outside W x H. With
+// AVX2 (and N / S >= 16, so that groups of four fill the rows) the fine
+// levels take the kernels above, but for the first and last rows of blue
+// vertices on horizontal edges and the first and last four on vertical ones.
 template <int S>
 void level_errors(const float* z, std::int64_t n, std::int64_t W, std::int64_t H, std::uint32_t t, float* err) {
   const std::int64_t s = S ? S : std::int64_t(1) << t, N = n - 1, c = N / 2;
+#if defined(__x86_64__) && defined(__GNUC__)
+  const bool wide = S > 0 && N / s >= 16 && simd_level() >= SimdLevel::avx2;
+#endif
   auto in = [&](P2 p) { return p.x <= W - 1 && p.y <= H - 1; };
   // Red: rows y = s, 3s, ...; x = s, 3s, ... The parents (the apexes) are the
   // square's corners on the diagonal that is not the hypotenuse.
   parallel_for(0, std::size_t(N / (2 * s)), S ? 8 : 1, [&](std::size_t b, std::size_t e) {
     for (std::size_t ry = b; ry < e; ++ry) {
       const std::int64_t y = (2 * std::int64_t(ry) + 1) * s;
+#if defined(__x86_64__) && defined(__GNUC__)
+      if constexpr (S > 0)
+        if (wide) {
+          red_row_avx2<S>(z, n, W, H, t, y, err);
+          continue;
+        }
+#endif
       for (std::int64_t x = s; x < N; x += 2 * s) {
         if (x == c && y == c) continue;  // the centre is always in the mesh
         const bool main_parents = ((((x - s) >> (t + 1)) + ((y - s) >> (t + 1))) & 1) != 0;
@@ -133,6 +279,13 @@ void level_errors(const float* z, std::int64_t n, std::int64_t W, std::int64_t H
   parallel_for(0, std::size_t(N / (2 * s) + 1), S ? 8 : 1, [&](std::size_t b, std::size_t e) {
     for (std::size_t ry = b; ry < e; ++ry) {
       const std::int64_t y = 2 * std::int64_t(ry) * s;
+#if defined(__x86_64__) && defined(__GNUC__)
+      if constexpr (S > 0)
+        if (wide && y > 0 && y < N) {
+          blue_h_row_avx2<S>(z, n, W, H, y, err);
+          continue;
+        }
+#endif
       for (std::int64_t x = s; x < N; x += 2 * s) {
         const P2 a{x - s, y}, bb{x + s, y};
         double worst = 0;
@@ -158,7 +311,12 @@ void level_errors(const float* z, std::int64_t n, std::int64_t W, std::int64_t H
   parallel_for(0, std::size_t(N / (2 * s)), S ? 8 : 1, [&](std::size_t b, std::size_t e) {
     for (std::size_t ry = b; ry < e; ++ry) {
       const std::int64_t y = (2 * std::int64_t(ry) + 1) * s;
-      for (std::int64_t x = 0; x <= N; x += 2 * s) {
+      std::int64_t done = 2 * s;  // the vertices x in [2 s, done) are done
+#if defined(__x86_64__) && defined(__GNUC__)
+      if constexpr (S > 0)
+        if (wide) done = blue_v_row_avx2<S>(z, n, W, H, y, err);
+#endif
+      for (std::int64_t x = 0; x <= N; x = x == 0 ? done : x + 2 * s) {
         const P2 a{x, y - s}, bb{x, y + s};
         double worst = 0;
         if (!in(a) || !in(bb)) {
@@ -339,8 +497,9 @@ Terrain::Terrain(HeightField field, TerrainOptions options) {
   const std::int64_t W = std::int64_t(width_), H = std::int64_t(height_);
   index_ = LayoutIndex(options.layout, K);
 
-  // Heights of the padded grid (the padding repeats the last row and column).
-  std::vector<float, HugePageAllocator<float>> z(n * n);
+  // Heights of the padded grid (the padding repeats the last row and column),
+  // and 8 more: the fine levels' kernels load 8 or 16 floats for 4 or 13.
+  std::vector<float, HugePageAllocator<float>> z(n * n + 8);
   parallel_for(0, n, 16, [&](std::size_t b, std::size_t e) {
     bool finite = true;
     for (std::size_t y = b; y < e; ++y) {
