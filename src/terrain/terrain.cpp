@@ -358,6 +358,10 @@ void own_errors(const float* z, std::int64_t n, std::int64_t W, std::int64_t H, 
       level_errors<2>(z, n, W, H, t, err);
     else if (t == 2)
       level_errors<4>(z, n, W, H, t, err);
+    else if (t == 3)
+      level_errors<8>(z, n, W, H, t, err);
+    else if (t == 4)
+      level_errors<16>(z, n, W, H, t, err);
     else
       level_errors<0>(z, n, W, H, t, err);
   }
