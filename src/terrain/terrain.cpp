@@ -134,13 +134,17 @@ template <int St>
 GEODS_TERRAIN_AVX2_INLINE void rows4(__m256d& m, std::int64_t n, const Plane4& p, std::int64_t r0, std::int64_t rows,
                                       std::int64_t lo0, std::int64_t dlo, std::int64_t hi0, std::int64_t dhi) {
   const __m256d sign = _mm256_set1_pd(-0.0);
+  // A term times a zero offset is +-0: left out, it changes at most the sign
+  // of a zero, which the absolute value drops; so the same |d|. At the
+  // plane's origin |d| = 0.
   for (std::int64_t r = 0; r < rows; ++r) {
     const std::int64_t dy = r0 + r;
-    const __m256d base = _mm256_add_pd(p.za, _mm256_mul_pd(p.gy, _mm256_set1_pd(double(dy))));
+    const __m256d base = dy == 0 ? p.za : _mm256_add_pd(p.za, _mm256_mul_pd(p.gy, _mm256_set1_pd(double(dy))));
     const float* row = p.a + dy * n;
     for (std::int64_t dx = lo0 + dlo * r; dx <= hi0 + dhi * r; ++dx) {
-      const __m256d d = _mm256_sub_pd(load4<St>(row + dx), _mm256_add_pd(base, _mm256_mul_pd(p.gx, _mm256_set1_pd(double(dx)))));
-      m = _mm256_max_pd(_mm256_andnot_pd(sign, d), m);
+      if (dx == 0 && dy == 0) continue;
+      const __m256d q = dx == 0 ? base : _mm256_add_pd(base, _mm256_mul_pd(p.gx, _mm256_set1_pd(double(dx))));
+      m = _mm256_max_pd(_mm256_andnot_pd(sign, _mm256_sub_pd(load4<St>(row + dx), q)), m);
     }
   }
 }
