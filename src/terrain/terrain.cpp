@@ -147,23 +147,24 @@ GEODS_TERRAIN_AVX2_INLINE void rows4(__m256d& m, std::int64_t n, const Plane4& p
     const std::int64_t dy = r0 + r, lo = lo0 + dlo * r, hi = hi0 + dhi * r;
     const __m256d base = dy == 0 ? p.za : _mm256_add_pd(p.za, _mm256_mul_pd(p.gy, _mm256_set1_pd(double(dy))));
     const float* row = p.a + dy * n;
-    if (St >= 8 && hi - lo >= 2) {
-      for (std::int64_t b = lo; b <= hi; b += 8) {
-        const float* q = row + b;
-        const __m256 l0 = _mm256_loadu_ps(q), l1 = _mm256_loadu_ps(q + St), l2 = _mm256_loadu_ps(q + 2 * St),
-                     l3 = _mm256_loadu_ps(q + 3 * St);
-        const __m256 t0 = _mm256_unpacklo_ps(l0, l1), t1 = _mm256_unpackhi_ps(l0, l1), t2 = _mm256_unpacklo_ps(l2, l3),
-                     t3 = _mm256_unpackhi_ps(l2, l3);
-        const __m256 c[4] = {_mm256_shuffle_ps(t0, t2, 0x44), _mm256_shuffle_ps(t0, t2, 0xEE), _mm256_shuffle_ps(t1, t3, 0x44),
-                             _mm256_shuffle_ps(t1, t3, 0xEE)};  // samples b + k (low half), b + k + 4 (high)
-        for (int k = 0; k < 8 && b + k <= hi; ++k) {
-          if (b + k == 0 && dy == 0) continue;  // the plane's origin: |d| = 0
-          const __m128 h = k < 4 ? _mm256_castps256_ps128(c[k]) : _mm256_extractf128_ps(c[k - 4], 1);
-          term4(m, p, base, _mm256_cvtps_pd(h), b + k);
+    if constexpr (St >= 8)
+      if (hi - lo >= 2) {
+        for (std::int64_t b = lo; b <= hi; b += 8) {
+          const float* q = row + b;
+          const __m256 l0 = _mm256_loadu_ps(q), l1 = _mm256_loadu_ps(q + St), l2 = _mm256_loadu_ps(q + 2 * St),
+                       l3 = _mm256_loadu_ps(q + 3 * St);
+          const __m256 t0 = _mm256_unpacklo_ps(l0, l1), t1 = _mm256_unpackhi_ps(l0, l1), t2 = _mm256_unpacklo_ps(l2, l3),
+                       t3 = _mm256_unpackhi_ps(l2, l3);
+          const __m256 c[4] = {_mm256_shuffle_ps(t0, t2, 0x44), _mm256_shuffle_ps(t0, t2, 0xEE), _mm256_shuffle_ps(t1, t3, 0x44),
+                               _mm256_shuffle_ps(t1, t3, 0xEE)};  // samples b + k (low half), b + k + 4 (high)
+          for (int k = 0; k < 8 && b + k <= hi; ++k) {
+            if (b + k == 0 && dy == 0) continue;  // the plane's origin: |d| = 0
+            const __m128 h = k < 4 ? _mm256_castps256_ps128(c[k]) : _mm256_extractf128_ps(c[k - 4], 1);
+            term4(m, p, base, _mm256_cvtps_pd(h), b + k);
+          }
         }
+        continue;
       }
-      continue;
-    }
     for (std::int64_t dx = lo; dx <= hi; ++dx)
       if (dx != 0 || dy != 0) term4(m, p, base, load4<St>(row + dx), dx);  // at the plane's origin |d| = 0
   }
@@ -176,8 +177,8 @@ GEODS_TERRAIN_AVX2_INLINE void store4(float* err, std::int64_t n, std::int64_t x
                                       std::int64_t H, __m256d m) {
   const __m128 f = _mm256_cvtpd_ps(m);
   const __m256d below = _mm256_cmp_pd(_mm256_cvtps_pd(f), m, _CMP_LT_OQ);  // all ones: one ulp up
-  const __m128i up = _mm_srli_epi32(_mm256_castsi256_si128(_mm256_permutevar8x32_epi32(_mm256_castpd_si256(below),
-                                                                                        _mm256_set_epi32(7, 5, 3, 1, 6, 4, 2, 0))), 31);
+  const __m256i low_halves = _mm256_permutevar8x32_epi32(_mm256_castpd_si256(below), _mm256_set_epi32(7, 5, 3, 1, 6, 4, 2, 0));
+  const __m128i up = _mm_srli_epi32(_mm256_castsi256_si128(low_halves), 31);
   alignas(16) float out[4];
   _mm_store_ps(out, _mm_castsi128_ps(_mm_add_epi32(_mm_castps_si128(f), up)));
   float* e = err + y * n + x;
@@ -556,7 +557,8 @@ Terrain::Terrain(HeightField field, TerrainOptions options) {
   index_ = LayoutIndex(options.layout, K);
 
   // Heights of the padded grid (the padding repeats the last row and column),
-  // and 8 more: the fine levels' kernels load 8 or 16 floats for 4 or 13.
+  // and 8 more: the fine levels' kernels load up to 7 floats past the last
+  // sample they use.
   std::vector<float, HugePageAllocator<float>> z(n * n + 8);
   parallel_for(0, n, 16, [&](std::size_t b, std::size_t e) {
     bool finite = true;
@@ -655,7 +657,10 @@ Terrain::Terrain(HeightField field, TerrainOptions options) {
           std::int64_t x = (r & 1) ? 0 : s;
 #if defined(__x86_64__) && defined(__GNUC__)
           if (inner_row && avx2) {
-            if (x == 0) nest(x, y, ch, false), x += 2 * s;
+            if (x == 0) {  // on the border: not all four children
+              nest(0, y, ch, false);
+              x = 2 * s;
+            }
             x = nest_row_avx2(z.data(), err.data(), rad.data(), std::int64_t(n), y, x, N, 2 * s, ch);
           }
 #endif
