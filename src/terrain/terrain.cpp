@@ -89,24 +89,51 @@ template <int S>
   return m;
 }
 
+// The children of a vertex in the nesting: their offsets, as index offsets, and
+// their squared horizontal distances.
+struct Children {
+  std::array<P2, 4> off;
+  std::array<std::ptrdiff_t, 4> dw;
+  std::array<double, 4> d2;
+};
+
 #if defined(__x86_64__) && defined(__GNUC__)
 #define GEODS_TERRAIN_AVX2_INLINE __attribute__((target("avx2"), always_inline)) inline
 // The fine levels with AVX2, four vertices of one kind at a time (the lanes
 // St samples apart along a row): the same planes and terms as rows_error<S>,
 // lane by lane, so the same errors bit for bit.
 
-// p[0], p[St], p[2 St], p[3 St] as doubles (reads up to p[3 St + 3]).
+// p[0], p[St], p[2 St], p[3 St] (reads up to p[3 St + 3]).
 template <int St>
-GEODS_TERRAIN_AVX2_INLINE __m256d load4(const float* p) {
+GEODS_TERRAIN_AVX2_INLINE __m128 load4f(const float* p) {
   if constexpr (St == 2) {
-    const __m256 v = _mm256_permutevar8x32_ps(_mm256_loadu_ps(p), _mm256_set_epi32(7, 5, 3, 1, 6, 4, 2, 0));
-    return _mm256_cvtps_pd(_mm256_castps256_ps128(v));
+    return _mm256_castps256_ps128(_mm256_permutevar8x32_ps(_mm256_loadu_ps(p), _mm256_set_epi32(7, 5, 3, 1, 6, 4, 2, 0)));
   } else if constexpr (St == 4) {  // p0 p0 p8 p8 | p4 p4 p12 p12, then in order
     const __m256 v = _mm256_shuffle_ps(_mm256_loadu_ps(p), _mm256_loadu_ps(p + 8), 0);
-    return _mm256_cvtps_pd(_mm256_castps256_ps128(_mm256_permutevar8x32_ps(v, _mm256_set_epi32(7, 5, 3, 1, 6, 2, 4, 0))));
+    return _mm256_castps256_ps128(_mm256_permutevar8x32_ps(v, _mm256_set_epi32(7, 5, 3, 1, 6, 2, 4, 0)));
   } else {
-    return _mm256_cvtps_pd(_mm_set_ps(p[3 * St], p[2 * St], p[St], p[0]));
+    return _mm_set_ps(p[3 * St], p[2 * St], p[St], p[0]);
   }
+}
+template <int St>
+GEODS_TERRAIN_AVX2_INLINE __m256d load4(const float* p) {
+  return _mm256_cvtps_pd(load4f<St>(p));
+}
+
+// p[0], p[St], p[2 St], p[3 St] = v.
+template <int St>
+GEODS_TERRAIN_AVX2_INLINE void store4f(float* p, __m128 v) {
+  alignas(16) float out[4];
+  _mm_store_ps(out, v);
+  for (int j = 0; j < 4; ++j) p[St * j] = out[j];
+}
+
+// round_up() of four doubles.
+GEODS_TERRAIN_AVX2_INLINE __m128 round_up4(__m256d m) {
+  const __m128 f = _mm256_cvtpd_ps(m);
+  const __m256d below = _mm256_cmp_pd(_mm256_cvtps_pd(f), m, _CMP_LT_OQ);  // all ones: one ulp up
+  const __m256i low_halves = _mm256_permutevar8x32_epi32(_mm256_castpd_si256(below), _mm256_set_epi32(7, 5, 3, 1, 6, 4, 2, 0));
+  return _mm_castsi128_ps(_mm_add_epi32(_mm_castps_si128(f), _mm_srli_epi32(_mm256_castsi256_si128(low_halves), 31)));
 }
 
 // detail::Plane of the corners at offsets a, b, c from the lanes' vertices v.
@@ -175,12 +202,8 @@ GEODS_TERRAIN_AVX2_INLINE void rows4(__m256d& m, std::int64_t n, const Plane4& p
 template <int St>
 GEODS_TERRAIN_AVX2_INLINE void store4(float* err, std::int64_t n, std::int64_t x, std::int64_t y, std::int64_t s, std::int64_t W,
                                       std::int64_t H, __m256d m) {
-  const __m128 f = _mm256_cvtpd_ps(m);
-  const __m256d below = _mm256_cmp_pd(_mm256_cvtps_pd(f), m, _CMP_LT_OQ);  // all ones: one ulp up
-  const __m256i low_halves = _mm256_permutevar8x32_epi32(_mm256_castpd_si256(below), _mm256_set_epi32(7, 5, 3, 1, 6, 4, 2, 0));
-  const __m128i up = _mm_srli_epi32(_mm256_castsi256_si128(low_halves), 31);
   alignas(16) float out[4];
-  _mm_store_ps(out, _mm_castsi128_ps(_mm_add_epi32(_mm_castps_si128(f), up)));
+  _mm_store_ps(out, round_up4(m));
   float* e = err + y * n + x;
   for (int j = 0; j < 4; ++j) e[St * j] = x + St * j + s > W - 1 || y + s > H - 1 ? kInf : out[j];
 }
@@ -241,6 +264,50 @@ __attribute__((target("avx2"))) std::int64_t blue_v_row_avx2(const float* z, std
     rows4<2 * S>(m, n, r, 0, s + 1, 0, 0, 0, 1);
     rows4<2 * S>(m, n, r, s + 1, s, 0, 0, s - 1, -1);
     store4<2 * S>(err, n, x, y, s, W, H, m);
+  }
+  return x;
+}
+
+// The nesting (nest() in the constructor) of the vertices x0, x0 + step, ...
+// < x1 of row y, whose four children lie in the grid: the four square roots
+// in one instruction (the same terms as two at a time). Returns the first x
+// not done.
+__attribute__((target("avx2"))) std::int64_t nest_row_avx2(const float* z, float* err, float* rad, std::int64_t n, std::int64_t y,
+                                                   std::int64_t x0, std::int64_t x1, std::int64_t step, const Children& ch) {
+  const __m256d d2 = _mm256_loadu_pd(ch.d2.data());
+  std::int64_t x = x0;
+  for (; x < x1; x += step) {
+    const std::ptrdiff_t v = y * n + x, w0 = v + ch.dw[0], w1 = v + ch.dw[1], w2 = v + ch.dw[2], w3 = v + ch.dw[3];
+    err[v] = std::max({err[v], err[w0], err[w1], err[w2], err[w3]});
+    const __m256d dz = _mm256_sub_pd(_mm256_cvtps_pd(_mm_set_ps(z[w3], z[w2], z[w1], z[w0])), _mm256_set1_pd(z[v]));
+    const __m256d r = _mm256_add_pd(_mm256_sqrt_pd(_mm256_add_pd(d2, _mm256_mul_pd(dz, dz))),
+                                    _mm256_cvtps_pd(_mm_set_ps(rad[w3], rad[w2], rad[w1], rad[w0])));
+    const __m128d m = _mm_max_pd(_mm256_castpd256_pd128(r), _mm256_extractf128_pd(r, 1));
+    rad[v] = round_up(std::max(_mm_cvtsd_f64(m), _mm_cvtsd_f64(_mm_unpackhi_pd(m, m))));
+  }
+  return x;
+}
+
+// nest_row_avx2() four vertices at a time (the lanes St = 2 s apart, all four
+// with four children): the same maxima and terms lane by lane.
+template <int St>
+__attribute__((target("avx2"))) std::int64_t nest_row4(const float* z, float* err, float* rad, std::int64_t n, std::int64_t y,
+                                                       std::int64_t x0, std::int64_t x1, const Children& ch) {
+  std::int64_t x = x0;
+  for (; x + 3 * St < x1; x += 4 * St) {
+    const std::ptrdiff_t v = y * n + x;
+    __m128 e = load4f<St>(err + v);
+    const __m256d zv = load4<St>(z + v);
+    __m256d best = _mm256_setzero_pd();
+    for (int k = 0; k < 4; ++k) {
+      const std::ptrdiff_t w = v + ch.dw[k];
+      e = _mm_max_ps(e, load4f<St>(err + w));
+      const __m256d dz = _mm256_sub_pd(load4<St>(z + w), zv);
+      best = _mm256_max_pd(best, _mm256_add_pd(_mm256_sqrt_pd(_mm256_add_pd(_mm256_set1_pd(ch.d2[k]), _mm256_mul_pd(dz, dz))),
+                                               load4<St>(rad + w)));
+    }
+    store4f<St>(err + v, e);
+    store4f<St>(rad + v, round_up4(best));
   }
   return x;
 }
@@ -460,36 +527,6 @@ void for_each_slot(const LayoutIndex& index, Put&& put) {
   }
 }
 
-// The children of a vertex in the nesting: their offsets, as index offsets, and
-// their squared horizontal distances.
-struct Children {
-  std::array<P2, 4> off;
-  std::array<std::ptrdiff_t, 4> dw;
-  std::array<double, 4> d2;
-};
-
-#if defined(__x86_64__) && defined(__GNUC__)
-// The nesting (nest() in the constructor) of the vertices x0, x0 + step, ...
-// < x1 of row y, whose four children lie in the grid: the four square roots
-// in one instruction (the same terms as two at a time). Returns the first x
-// not done.
-__attribute__((target("avx2"))) std::int64_t nest_row_avx2(const float* z, float* err, float* rad, std::int64_t n, std::int64_t y,
-                                                   std::int64_t x0, std::int64_t x1, std::int64_t step, const Children& ch) {
-  const __m256d d2 = _mm256_loadu_pd(ch.d2.data());
-  std::int64_t x = x0;
-  for (; x < x1; x += step) {
-    const std::ptrdiff_t v = y * n + x, w0 = v + ch.dw[0], w1 = v + ch.dw[1], w2 = v + ch.dw[2], w3 = v + ch.dw[3];
-    err[v] = std::max({err[v], err[w0], err[w1], err[w2], err[w3]});
-    const __m256d dz = _mm256_sub_pd(_mm256_cvtps_pd(_mm_set_ps(z[w3], z[w2], z[w1], z[w0])), _mm256_set1_pd(z[v]));
-    const __m256d r = _mm256_add_pd(_mm256_sqrt_pd(_mm256_add_pd(d2, _mm256_mul_pd(dz, dz))),
-                                    _mm256_cvtps_pd(_mm_set_ps(rad[w3], rad[w2], rad[w1], rad[w0])));
-    const __m128d m = _mm_max_pd(_mm256_castpd256_pd128(r), _mm256_extractf128_pd(r, 1));
-    rad[v] = round_up(std::max(_mm_cvtsd_f64(m), _mm_cvtsd_f64(_mm_unpackhi_pd(m, m))));
-  }
-  return x;
-}
-#endif
-
 }  // namespace
 
 // ---------------------------------------------------------------- layout
@@ -585,13 +622,13 @@ Terrain::Terrain(HeightField field, TerrainOptions options) {
   // field (the padding), so that those vertices are always refined and no
   // final triangle straddles the field's border. Level by level, every
   // triangle's rows as spans known by arithmetic (no point-in-triangle tests).
-  std::vector<float, HugePageAllocator<float>> err(n * n, 0.0f);
+  std::vector<float, HugePageAllocator<float>> err(n * n + 8, 0.0f);  // 8 more as z
   own_errors(z.data(), std::int64_t(n), W, H, K, err.data());
 
   // Nesting, finest level first: error = max(own, children's); radius = max over
   // children of (distance + child's radius), rounded up, so that a child's
   // sphere lies in its parent's.
-  std::vector<float, HugePageAllocator<float>> rad(n * n, 0.0f);
+  std::vector<float, HugePageAllocator<float>> rad(n * n + 8, 0.0f);
 #if defined(__x86_64__) && defined(__GNUC__)
   const bool avx2 = simd_level() >= SimdLevel::avx2;
 #endif
@@ -646,6 +683,15 @@ Terrain::Terrain(HeightField field, TerrainOptions options) {
   };
   for (std::uint32_t t = 0; t < K; ++t) {
     const std::int64_t s = std::int64_t(1) << t;
+#if defined(__x86_64__) && defined(__GNUC__)
+    // The vertices x, x + 2 s, ... < N of row y with four children each, with
+    // AVX2; returns the first x not done.
+    auto nest_row = [&](std::int64_t y, std::int64_t x, const Children& ch) {
+      if (s == 1) x = nest_row4<2>(z.data(), err.data(), rad.data(), std::int64_t(n), y, x, N, ch);
+      if (s == 2) x = nest_row4<4>(z.data(), err.data(), rad.data(), std::int64_t(n), y, x, N, ch);
+      return nest_row_avx2(z.data(), err.data(), rad.data(), std::int64_t(n), y, x, N, 2 * s, ch);
+    };
+#endif
     // Blue vertices of spacing s >= 2: children are the red ones of spacing s / 2.
     if (s >= 2) {
       const std::int64_t h = s / 2;
@@ -661,7 +707,7 @@ Terrain::Terrain(HeightField field, TerrainOptions options) {
               nest(0, y, ch, false);
               x = 2 * s;
             }
-            x = nest_row_avx2(z.data(), err.data(), rad.data(), std::int64_t(n), y, x, N, 2 * s, ch);
+            x = nest_row(y, x, ch);
           }
 #endif
           for (; x <= N; x += 2 * s) nest(x, y, ch, inner_row && x > 0 && x < N);
@@ -675,7 +721,7 @@ Terrain::Terrain(HeightField field, TerrainOptions options) {
         const std::int64_t y = std::int64_t(2 * r + 1) * s;
 #if defined(__x86_64__) && defined(__GNUC__)
         if (avx2) {
-          nest_row_avx2(z.data(), err.data(), rad.data(), std::int64_t(n), y, s, N, 2 * s, ch);
+          nest_row(y, s, ch);
           continue;
         }
 #endif
