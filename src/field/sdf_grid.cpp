@@ -20,6 +20,7 @@
 #include "../core/prefault.hpp"
 #include "geods/bvh/traversal.hpp"
 #include "geods/core/error.hpp"
+#include "geods/core/morton.hpp"
 #include "geods/core/parallel.hpp"
 #include "geods/core/simd_level.hpp"
 
@@ -1340,9 +1341,18 @@ SdfGrid sdf_grid(const MeshDistance& mesh, const Grid3Geometry& grid, const SdfG
   result.stats.tiles = num_tiles;
   std::atomic<std::size_t> in_band{0}, outside{0}, windings{0};
   std::atomic<std::uint64_t> candidates{0};
+  // The tiles in Morton order: consecutive tiles, and each thread's share, are
+  // neighbours in space whose faces are still in cache.
+  std::vector<std::pair<std::uint64_t, std::size_t>> order(num_tiles);
+  for (std::size_t t = 0; t < num_tiles; ++t)
+    order[t] = {morton3d_encode64(std::uint32_t(t % tiles[0]), std::uint32_t(t / tiles[0] % tiles[1]),
+                                  std::uint32_t(t / (tiles[0] * tiles[1]))),
+                t};
+  std::sort(order.begin(), order.end());
   parallel_for_each_index(
       0, num_tiles,
-      [&](std::size_t t) {
+      [&](std::size_t m) {
+        const std::size_t t = order[m].second;
         const std::array<std::size_t, 3> c{t % tiles[0], t / tiles[0] % tiles[1], t / (tiles[0] * tiles[1])};
         std::array<std::size_t, 3> lo, hi;
         for (int a = 0; a < 3; ++a) lo[a] = c[a] * kTile, hi[a] = std::min(lo[a] + kTile, grid.dims[a]);
