@@ -459,50 +459,10 @@ GEODS_AVX512_INLINE __mmask16 valid(std::size_t i, std::size_t size) {
   return i + 16 <= size ? __mmask16(0xffff) : i >= size ? __mmask16(0) : __mmask16((1u << (size - i)) - 1);
 }
 
-// Of entries [i, i + 16) of t, those that pass the corner test (as the
-// eight-wide corner_test()), with their squared distances from the 8 corners (dv).
-GEODS_AVX512_INLINE __mmask16 corner_pass(const Packed& t, std::size_t i, const std::array<Vec3f, 8>& corners,
-                                          const std::array<float, 8>* bound2, int sets, __m512 (&dv)[8]) {
-  __mmask16 pass = 0;
-  for (int k = 0; k < 8; ++k) {
-    dv[k] = distance16(t.f, i, _mm512_set1_ps(corners[k].x()), _mm512_set1_ps(corners[k].y()),
-                       _mm512_set1_ps(corners[k].z()));
-    pass |= _mm512_cmp_ps_mask(dv[k], _mm512_set1_ps(bound2[0][k]), _CMP_LE_OQ);
-  }
-  for (int j = 1; j < sets; ++j) {
-    __mmask16 also = 0;
-    for (int k = 0; k < 8; ++k) also |= _mm512_cmp_ps_mask(dv[k], _mm512_set1_ps(bound2[j][k]), _CMP_LE_OQ);
-    pass &= also;
-  }
-  return pass & valid(i, t.size);
-}
-
-GEODS_AVX512_FN void corner_test(const Packed& t, const std::array<Vec3f, 8>& corners, const std::array<float, 8>* bound2,
-                                 int sets, Kept& kept) {
-  kept.reset(t.size);
-  const __m512i lanes = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
-  for (std::size_t i = 0; i < t.size; i += 16) {
-    __m512 dv[8];
-    const __mmask16 pass = corner_pass(t, i, corners, bound2, sets, dv);
-    if (!pass) continue;
-    // The passing lanes packed to the end of kept's arrays; key = the
-    // smallest of the 8 distances (as min(key, d) in the eight-wide loop).
-    const std::size_t e = kept.size;
-    __m512 key = dv[0];
-    for (int k = 0; k < 8; ++k) {
-      _mm512_mask_compressstoreu_ps(kept.k[k].data() + e, pass, dv[k]);
-      key = _mm512_mask_blend_ps(_mm512_cmp_ps_mask(dv[k], key, _CMP_LT_OQ), key, dv[k]);
-    }
-    _mm512_mask_compressstoreu_ps(kept.key.data() + e, pass, key);
-    _mm512_mask_compressstoreu_epi32(kept.index.data() + e, pass,
-                                     _mm512_add_epi32(lanes, _mm512_set1_epi32(std::int32_t(i))));
-    kept.size += std::size_t(__builtin_popcount(pass));
-  }
-}
-
-// The entries of t that pass the corner test, in order, into out: their
-// quantities, faces, leaves and corner distances (k0..k7) by compress stores
-// (an unsorted filter(): gathers by their positions cost four times more).
+// The entries of t that pass the corner test (as the eight-wide
+// corner_test()), in order, into out: their quantities, faces, leaves and
+// squared distances from the 8 corners (k0..k7), by compress stores (copies
+// by position, gathers, cost four times more).
 GEODS_AVX512_FN void corner_copy(const Packed& t, const std::array<Vec3f, 8>& corners, const std::array<float, 8>* bound2,
                                  int sets, Packed& out) {
   out.clear();
@@ -510,7 +470,18 @@ GEODS_AVX512_FN void corner_copy(const Packed& t, const std::array<Vec3f, 8>& co
   std::size_t e = 0;
   for (std::size_t i = 0; i < t.size; i += 16) {
     __m512 dv[8];
-    const __mmask16 pass = corner_pass(t, i, corners, bound2, sets, dv);
+    __mmask16 pass = 0;
+    for (int k = 0; k < 8; ++k) {
+      dv[k] = distance16(t.f, i, _mm512_set1_ps(corners[k].x()), _mm512_set1_ps(corners[k].y()),
+                         _mm512_set1_ps(corners[k].z()));
+      pass |= _mm512_cmp_ps_mask(dv[k], _mm512_set1_ps(bound2[0][k]), _CMP_LE_OQ);
+    }
+    for (int j = 1; j < sets; ++j) {
+      __mmask16 also = 0;
+      for (int k = 0; k < 8; ++k) also |= _mm512_cmp_ps_mask(dv[k], _mm512_set1_ps(bound2[j][k]), _CMP_LE_OQ);
+      pass &= also;
+    }
+    pass &= valid(i, t.size);
     if (!pass) continue;
     for (int k = 0; k < Packed::k0; ++k) _mm512_mask_compressstoreu_ps(out.f[k].data() + e, pass, at(t.f, k, i));
     for (int k = 0; k < 8; ++k) _mm512_mask_compressstoreu_ps(out.f[Packed::k0 + k].data() + e, pass, dv[k]);
@@ -681,10 +652,10 @@ GEODS_AVX512_FN void row_bounds(const Packed& t, float wy, float wz, float* row)
 }
 
 // As nearest() above; groups of 8 are searched and bounded two at a time.
-// With `row` (row_bounds() of p's row), the bounds come from there.
+// With `row` (row_bounds() of p's row), the bounds come from there. (The
+// lists are not sorted here, see filter(): every pair is bounded.)
 GEODS_AVX512_FN std::size_t nearest(const Packed& t, const Vec3f& p, const InBlock* in_block, float slack,
                                     std::size_t seed, float& d2, const float* row = nullptr) {
-  const float* floor = in_block && !t.floor.empty() ? t.floor.data() : nullptr;
   const InBlock at_p = in_block ? *in_block : InBlock{};
   Search s{t,
            _mm512_set1_ps(p.x()),
@@ -699,7 +670,6 @@ GEODS_AVX512_FN std::size_t nearest(const Packed& t, const Vec3f& p, const InBlo
   if (seed >= pairs) seed = 0;
   s.pair(seed);
   for (std::size_t c = 0; c < pairs; ++c) {
-    if (floor && floor[2 * c] > s.reach2 * (1 + 1e-4f)) break;  // the groups are sorted by their floors
     if (c == seed || (in_block && s.beyond(c, at_p.spread, slack))) continue;
     s.pair(c);
   }
@@ -1061,7 +1031,10 @@ class GridSolver {
   // `sorted`: ordered by the smallest of them, with each group's floor, a
   // bound below the squared distance from any point of the box to any of
   // the group's faces (by the concavity above: at least the smallest corner
-  // distance less the largest spread).
+  // distance less the largest spread). With AVX-512 always in `in`'s order
+  // (the hierarchy's leaf order, spatially coherent), written by compress
+  // stores: the sort's copies by position (gathers) cost more than its order
+  // saves in the searches.
   void filter(const Packed& in, const SampleBox& box, const Vec3f& q, Packed& out, Kept& kept,
               bool sorted, std::span<const Vec3f> more = {}) const {
     std::array<std::array<float, 8>, 2 + kBlocks> sets;
@@ -1069,12 +1042,9 @@ class GridSolver {
     sets[0] = bounds_from(box, q);
     for (int j = 1; j < num_sets; ++j) sets[j] = bounds_from(box, more[j - 1]);
 #ifdef GEODS_SDF_AVX512
-    if (wide_ && !sorted) return avx512::corner_copy(in, box.corners, sets.data(), num_sets, out);
-    if (wide_)
-      avx512::corner_test(in, box.corners, sets.data(), num_sets, kept);
-    else
+    if (wide_) return avx512::corner_copy(in, box.corners, sets.data(), num_sets, out);
 #endif
-      corner_test(in, box.corners, sets.data(), num_sets, kept);
+    corner_test(in, box.corners, sets.data(), num_sets, kept);
     // The order of the entries: `sorted`, nearly by key, by a counting sort
     // into buckets of equal key ranges (in index order within a bucket: kept
     // is in index order); the order changes only how soon a search may stop,
