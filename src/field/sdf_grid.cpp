@@ -11,6 +11,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstring>
+#include <numeric>
 #include <span>
 #include <string>
 #include <type_traits>
@@ -985,8 +986,10 @@ class GridSolver {
                   return false;
                 }
               },
-              [&](const bvh::TopoNode& node) {
-                for (std::uint32_t i = node.prim_first; i < node.prim_first + node.prim_count; ++i) found.push_back(i);
+              [&](const bvh::TopoNode& node) {  // one resize a leaf, not a push_back (a call) a face
+                const std::size_t at = found.size();
+                found.resize(at + node.prim_count);
+                std::iota(found.begin() + std::ptrdiff_t(at), found.end(), node.prim_first);
               },
               [](float) { return true; });
         },
