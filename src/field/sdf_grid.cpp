@@ -195,16 +195,18 @@ __attribute__((target_clones("avx2", "default"))) void corner_test(const Packed&
   }
 }
 
-// The positions in a tile's list of each block's candidates (the first
-// count[b] of list[b]).
+// Each block's candidates in a tile's list: their positions (the first
+// count[b] of list[b]), or with AVX-512, per 16 entries, the mask of those
+// that are (mask[b][i / 16]).
 struct Survivors {
   std::array<std::vector<std::uint32_t>, kBlocks> list;
+  std::array<std::vector<std::uint16_t>, kBlocks> mask;
   std::array<std::size_t, kBlocks> count{};
   // Empty, with room for n each and a vector's overhang.
   void reset(std::size_t blocks, std::size_t n) {
     for (std::size_t b = 0; b < blocks; ++b) {
       count[b] = 0;
-      if (list[b].size() < n + 16) list[b].resize(n + 16);
+      if (list[b].size() < n + 16) list[b].resize(n + 16), mask[b].resize(n / 16 + 1);
     }
   }
   std::span<const std::uint32_t> operator[](std::size_t b) const { return {list[b].data(), count[b]}; }
@@ -522,17 +524,32 @@ GEODS_AVX512_FN void lattice_filter(const Packed& t, const Lattice& lat,
               _mm512_set1_ps(lat.spread[l]));
         }
     const __mmask16 ok = valid(i, t.size);
-    const __m512i index = _mm512_add_epi32(_mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15),
-                                           _mm512_set1_epi32(std::int32_t(i)));
     for (std::size_t b = 0; b < lat.blocks; ++b) {
       __mmask16 pass = 0;
       for (int k = 0; k < 8; ++k)
         pass |= _mm512_cmp_ps_mask(lb[lat.corner[b][k]], _mm512_set1_ps(lat.bound2[b][k]), _CMP_LE_OQ);
       pass &= ok;
-      _mm512_mask_compressstoreu_epi32(out.list[b].data() + out.count[b], pass, index);
+      out.mask[b][i / 16] = pass;
       out.count[b] += std::size_t(__builtin_popcount(pass));
     }
   }
+}
+
+// out = the entries of `in` set in `mask` (one mask per 16 entries), in
+// order: their first k0 quantities, faces and leaves, by compress stores.
+GEODS_AVX512_FN void select(const Packed& in, const std::vector<std::uint16_t>& mask, Packed& out) {
+  out.clear();
+  out.reserve(in.size);
+  std::size_t e = 0;
+  for (std::size_t i = 0; i < in.size; i += 16) {
+    const __mmask16 m = mask[i / 16];
+    if (!m) continue;
+    for (int k = 0; k < Packed::k0; ++k) _mm512_mask_compressstoreu_ps(out.f[k].data() + e, m, at(in.f, k, i));
+    _mm512_mask_compressstoreu_epi32(out.face.data() + e, m, _mm512_loadu_si512(in.face.data() + i));
+    _mm512_mask_compressstoreu_epi32(out.leaf.data() + e, m, _mm512_loadu_si512(in.leaf.data() + i));
+    e += std::size_t(__builtin_popcount(m));
+  }
+  out.size = e;
 }
 
 // best_lane() of sixteen lanes by vector reductions (the scalar loop's
@@ -809,7 +826,12 @@ class GridSolver {
         const SampleBox block = block_box(b);
         const Closest& c = block_closest[b];
         if (std::sqrt(c.d2) - block.radius > band_ + margin_) continue;
-        select(tile_list, survivors[b], near, Packed::k0);
+#ifdef GEODS_SDF_AVX512
+        if (wide_)
+          avx512::select(tile_list, survivors.mask[b], near);
+        else
+#endif
+          select(tile_list, survivors[b], near, Packed::k0);
         filter(near, block, c.point, block_list, kept, true, std::span(anchors.data(), num_anchors));
         const BlockWeights weights = block_weights(block);  // in_box of each sample
         std::size_t seed = 0;  // the group of the previous sample's nearest face
