@@ -598,15 +598,17 @@ GEODS_AVX512_FN void gather(const std::uint32_t* src, const std::uint32_t* index
   }
 }
 
-// out[k][j] = rows[index[j] * stride + k] for j < n and k < fields: the
-// quantities of entries stored row by row (one or two cache lines per entry).
-GEODS_AVX512_FN void gather_rows(const float* rows, int stride, int fields, const std::uint32_t* index, std::size_t n,
-                                 Packed::Arrays& out) {
+// out[k][j] = rows[index[j] * (k0 + 1) + k] for j < n and k < k0, and
+// face[j] the bits of rows[index[j] * (k0 + 1) + k0]: the quantities and
+// face of entries stored row by row (one or two cache lines per entry).
+GEODS_AVX512_FN void gather_rows(const float* rows, const std::uint32_t* index, std::size_t n, Packed::Arrays& out,
+                                 std::int32_t* face) {
   for (std::size_t j = 0; j < n; j += 16) {
     const __mmask16 m = valid(j, n);
-    const __m512i at = _mm512_mullo_epi32(_mm512_maskz_loadu_epi32(m, index + j), _mm512_set1_epi32(stride));
-    for (int k = 0; k < fields; ++k)
+    const __m512i at = _mm512_mullo_epi32(_mm512_maskz_loadu_epi32(m, index + j), _mm512_set1_epi32(Packed::k0 + 1));
+    for (int k = 0; k < Packed::k0; ++k)
       _mm512_mask_storeu_ps(out[k].data() + j, m, _mm512_mask_i32gather_ps(_mm512_setzero_ps(), m, at, rows + k, 4));
+    _mm512_mask_storeu_epi32(face + j, m, _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), m, at, rows + Packed::k0, 4));
   }
 }
 
@@ -715,7 +717,8 @@ class GridSolver {
     all_.reserve(n);
     all_.size = n;
     if (n >= std::size_t(std::numeric_limits<std::int32_t>::max())) throw Error("sdf grid: too many faces");
-    if (wide_ && n < std::size_t(std::numeric_limits<std::int32_t>::max()) / Packed::k0) rows_.resize(n * Packed::k0);
+    constexpr std::size_t kRow = Packed::k0 + 1;  // a row: the k0 quantities and the face
+    if (wide_ && n < std::size_t(std::numeric_limits<std::int32_t>::max()) / kRow) rows_.resize(n * kRow);
     parallel_for_each_index(0, n, [&](std::size_t i) {
       const BvhTriangle& t = tris_[i];
       const Vec3f ab = t.b - t.a, ac = t.c - t.a, bc = t.c - t.b, nn = ab.cross(ac);
@@ -726,10 +729,12 @@ class GridSolver {
           d11, den > 0 ? 1 / den : 0.0f, nn2 > 0 && den > 0 ? 1 / nn2 : 0.0f, d00 > 0 ? 1 / d00 : 0.0f,
           d11 > 0 ? 1 / d11 : 0.0f, bc.squaredNorm() > 0 ? 1 / bc.squaredNorm() : 0.0f};
       for (int k = 0; k < Packed::kFields; ++k) all_.f[k][i] = std::isfinite(values[k]) ? values[k] : 0.0f;
-      if (!rows_.empty())
-        for (int k = 0; k < Packed::k0; ++k) rows_[i * Packed::k0 + std::size_t(k)] = all_.f[k][i];
       all_.leaf[i] = std::uint32_t(i);
       all_.face[i] = std::int32_t(ids_[i]);
+      if (!rows_.empty()) {
+        for (int k = 0; k < Packed::k0; ++k) rows_[i * kRow + std::size_t(k)] = all_.f[k][i];
+        std::memcpy(&rows_[i * kRow + Packed::k0], &all_.face[i], sizeof(float));
+      }
     });
     // Float rounding of distances is below this (relative to the scene's size).
     const AABB3f mb = std::visit([](const auto& v) { return bvh::bounds(v[0]); }, mesh.bvh().volumes());
@@ -1020,9 +1025,8 @@ class GridSolver {
     if (!rows_.empty()) {  // from the rows: fewer cache lines than the columns of all_
       near.clear();
       near.reserve(found.size());
-      avx512::gather_rows(rows_.data(), Packed::k0, Packed::k0, found.data(), found.size(), near.f);
-      copy_at(all_.face.data(), found.data(), found.size(), near.face.data());
-      copy_at(all_.leaf.data(), found.data(), found.size(), near.leaf.data());
+      avx512::gather_rows(rows_.data(), found.data(), found.size(), near.f, near.face.data());
+      std::copy_n(found.data(), found.size(), near.leaf.data());  // all_'s leaves are its positions
       near.size = found.size();
     } else
 #endif
@@ -1172,7 +1176,7 @@ class GridSolver {
   const std::uint32_t* ids_;
   bool wide_ = simd_level() == SimdLevel::avx512;  // the AVX-512 kernels
   Packed all_;                  // every triangle, in leaf order
-  std::vector<float> rows_;     // with AVX-512: all_'s first k0 quantities, entry by entry
+  std::vector<float> rows_;     // with AVX-512: all_'s first k0 quantities and face, entry by entry
   float margin_ = 0;
   float slack_ = 0;
   float band_ = kInf;
