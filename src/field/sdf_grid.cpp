@@ -11,14 +11,17 @@
 #include <atomic>
 #include <cmath>
 #include <cstring>
+#include <numeric>
 #include <span>
 #include <string>
 #include <type_traits>
 
 #include <fmt/format.h>
 
+#include "../core/prefault.hpp"
 #include "geods/bvh/traversal.hpp"
 #include "geods/core/error.hpp"
+#include "geods/core/morton.hpp"
 #include "geods/core/parallel.hpp"
 #include "geods/core/simd_level.hpp"
 
@@ -192,16 +195,18 @@ __attribute__((target_clones("avx2", "default"))) void corner_test(const Packed&
   }
 }
 
-// The positions in a tile's list of each block's candidates (the first
-// count[b] of list[b]).
+// Each block's candidates in a tile's list: their positions (the first
+// count[b] of list[b]), or with AVX-512, per 16 entries, the mask of those
+// that are (mask[b][i / 16]).
 struct Survivors {
   std::array<std::vector<std::uint32_t>, kBlocks> list;
+  std::array<std::vector<std::uint16_t>, kBlocks> mask;
   std::array<std::size_t, kBlocks> count{};
   // Empty, with room for n each and a vector's overhang.
   void reset(std::size_t blocks, std::size_t n) {
     for (std::size_t b = 0; b < blocks; ++b) {
       count[b] = 0;
-      if (list[b].size() < n + 16) list[b].resize(n + 16);
+      if (list[b].size() < n + 16) list[b].resize(n + 16), mask[b].resize(n / 16 + 1);
     }
   }
   std::span<const std::uint32_t> operator[](std::size_t b) const { return {list[b].data(), count[b]}; }
@@ -457,10 +462,15 @@ GEODS_AVX512_INLINE __mmask16 valid(std::size_t i, std::size_t size) {
   return i + 16 <= size ? __mmask16(0xffff) : i >= size ? __mmask16(0) : __mmask16((1u << (size - i)) - 1);
 }
 
-GEODS_AVX512_FN void corner_test(const Packed& t, const std::array<Vec3f, 8>& corners, const std::array<float, 8>* bound2,
-                                 int sets, Kept& kept) {
-  kept.reset(t.size);
-  const __m512i lanes = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+// The entries of t that pass the corner test (as the eight-wide
+// corner_test()), in order, into out: their quantities, faces, leaves and
+// squared distances from the 8 corners (k0..k7), by compress stores (copies
+// by position, gathers, cost four times more).
+GEODS_AVX512_FN void corner_copy(const Packed& t, const std::array<Vec3f, 8>& corners, const std::array<float, 8>* bound2,
+                                 int sets, Packed& out) {
+  out.clear();
+  out.reserve(t.size);
+  std::size_t e = 0;
   for (std::size_t i = 0; i < t.size; i += 16) {
     __m512 dv[8];
     __mmask16 pass = 0;
@@ -476,19 +486,14 @@ GEODS_AVX512_FN void corner_test(const Packed& t, const std::array<Vec3f, 8>& co
     }
     pass &= valid(i, t.size);
     if (!pass) continue;
-    // The passing lanes packed to the end of kept's arrays; key = the
-    // smallest of the 8 distances (as min(key, d) in the eight-wide loop).
-    const std::size_t e = kept.size;
-    __m512 key = dv[0];
-    for (int k = 0; k < 8; ++k) {
-      _mm512_mask_compressstoreu_ps(kept.k[k].data() + e, pass, dv[k]);
-      key = _mm512_mask_blend_ps(_mm512_cmp_ps_mask(dv[k], key, _CMP_LT_OQ), key, dv[k]);
-    }
-    _mm512_mask_compressstoreu_ps(kept.key.data() + e, pass, key);
-    _mm512_mask_compressstoreu_epi32(kept.index.data() + e, pass,
-                                     _mm512_add_epi32(lanes, _mm512_set1_epi32(std::int32_t(i))));
-    kept.size += std::size_t(__builtin_popcount(pass));
+    for (int k = 0; k < Packed::k0; ++k) _mm512_mask_compressstoreu_ps(out.f[k].data() + e, pass, at(t.f, k, i));
+    for (int k = 0; k < 8; ++k) _mm512_mask_compressstoreu_ps(out.f[Packed::k0 + k].data() + e, pass, dv[k]);
+    _mm512_mask_compressstoreu_epi32(out.face.data() + e, pass, _mm512_loadu_si512(t.face.data() + i));
+    _mm512_mask_compressstoreu_epi32(out.leaf.data() + e, pass, _mm512_loadu_si512(t.leaf.data() + i));
+    e += std::size_t(__builtin_popcount(pass));
   }
+  out.size = e;
+  out.floor.clear();
 }
 
 GEODS_AVX512_FN void lattice_filter(const Packed& t, const Lattice& lat,
@@ -519,17 +524,32 @@ GEODS_AVX512_FN void lattice_filter(const Packed& t, const Lattice& lat,
               _mm512_set1_ps(lat.spread[l]));
         }
     const __mmask16 ok = valid(i, t.size);
-    const __m512i index = _mm512_add_epi32(_mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15),
-                                           _mm512_set1_epi32(std::int32_t(i)));
     for (std::size_t b = 0; b < lat.blocks; ++b) {
       __mmask16 pass = 0;
       for (int k = 0; k < 8; ++k)
         pass |= _mm512_cmp_ps_mask(lb[lat.corner[b][k]], _mm512_set1_ps(lat.bound2[b][k]), _CMP_LE_OQ);
       pass &= ok;
-      _mm512_mask_compressstoreu_epi32(out.list[b].data() + out.count[b], pass, index);
+      out.mask[b][i / 16] = pass;
       out.count[b] += std::size_t(__builtin_popcount(pass));
     }
   }
+}
+
+// out = the entries of `in` set in `mask` (one mask per 16 entries), in
+// order: their first k0 quantities, faces and leaves, by compress stores.
+GEODS_AVX512_FN void select(const Packed& in, const std::vector<std::uint16_t>& mask, Packed& out) {
+  out.clear();
+  out.reserve(in.size);
+  std::size_t e = 0;
+  for (std::size_t i = 0; i < in.size; i += 16) {
+    const __mmask16 m = mask[i / 16];
+    if (!m) continue;
+    for (int k = 0; k < Packed::k0; ++k) _mm512_mask_compressstoreu_ps(out.f[k].data() + e, m, at(in.f, k, i));
+    _mm512_mask_compressstoreu_epi32(out.face.data() + e, m, _mm512_loadu_si512(in.face.data() + i));
+    _mm512_mask_compressstoreu_epi32(out.leaf.data() + e, m, _mm512_loadu_si512(in.leaf.data() + i));
+    e += std::size_t(__builtin_popcount(m));
+  }
+  out.size = e;
 }
 
 // best_lane() of sixteen lanes by vector reductions (the scalar loop's
@@ -578,15 +598,17 @@ GEODS_AVX512_FN void gather(const std::uint32_t* src, const std::uint32_t* index
   }
 }
 
-// out[k][j] = rows[index[j] * stride + k] for j < n and k < fields: the
-// quantities of entries stored row by row (one or two cache lines per entry).
-GEODS_AVX512_FN void gather_rows(const float* rows, int stride, int fields, const std::uint32_t* index, std::size_t n,
-                                 Packed::Arrays& out) {
+// out[k][j] = rows[index[j] * (k0 + 1) + k] for j < n and k < k0, and
+// face[j] the bits of rows[index[j] * (k0 + 1) + k0]: the quantities and
+// face of entries stored row by row (one or two cache lines per entry).
+GEODS_AVX512_FN void gather_rows(const float* rows, const std::uint32_t* index, std::size_t n, Packed::Arrays& out,
+                                 std::int32_t* face) {
   for (std::size_t j = 0; j < n; j += 16) {
     const __mmask16 m = valid(j, n);
-    const __m512i at = _mm512_mullo_epi32(_mm512_maskz_loadu_epi32(m, index + j), _mm512_set1_epi32(stride));
-    for (int k = 0; k < fields; ++k)
+    const __m512i at = _mm512_mullo_epi32(_mm512_maskz_loadu_epi32(m, index + j), _mm512_set1_epi32(Packed::k0 + 1));
+    for (int k = 0; k < Packed::k0; ++k)
       _mm512_mask_storeu_ps(out[k].data() + j, m, _mm512_mask_i32gather_ps(_mm512_setzero_ps(), m, at, rows + k, 4));
+    _mm512_mask_storeu_epi32(face + j, m, _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), m, at, rows + Packed::k0, 4));
   }
 }
 
@@ -650,10 +672,10 @@ GEODS_AVX512_FN void row_bounds(const Packed& t, float wy, float wz, float* row)
 }
 
 // As nearest() above; groups of 8 are searched and bounded two at a time.
-// With `row` (row_bounds() of p's row), the bounds come from there.
+// With `row` (row_bounds() of p's row), the bounds come from there. (The
+// lists are not sorted here, see filter(): every pair is bounded.)
 GEODS_AVX512_FN std::size_t nearest(const Packed& t, const Vec3f& p, const InBlock* in_block, float slack,
                                     std::size_t seed, float& d2, const float* row = nullptr) {
-  const float* floor = in_block && !t.floor.empty() ? t.floor.data() : nullptr;
   const InBlock at_p = in_block ? *in_block : InBlock{};
   Search s{t,
            _mm512_set1_ps(p.x()),
@@ -668,7 +690,6 @@ GEODS_AVX512_FN std::size_t nearest(const Packed& t, const Vec3f& p, const InBlo
   if (seed >= pairs) seed = 0;
   s.pair(seed);
   for (std::size_t c = 0; c < pairs; ++c) {
-    if (floor && floor[2 * c] > s.reach2 * (1 + 1e-4f)) break;  // the groups are sorted by their floors
     if (c == seed || (in_block && s.beyond(c, at_p.spread, slack))) continue;
     s.pair(c);
   }
@@ -696,7 +717,8 @@ class GridSolver {
     all_.reserve(n);
     all_.size = n;
     if (n >= std::size_t(std::numeric_limits<std::int32_t>::max())) throw Error("sdf grid: too many faces");
-    if (wide_ && n < std::size_t(std::numeric_limits<std::int32_t>::max()) / Packed::k0) rows_.resize(n * Packed::k0);
+    constexpr std::size_t kRow = Packed::k0 + 1;  // a row: the k0 quantities and the face
+    if (wide_ && n < std::size_t(std::numeric_limits<std::int32_t>::max()) / kRow) rows_.resize(n * kRow);
     parallel_for_each_index(0, n, [&](std::size_t i) {
       const BvhTriangle& t = tris_[i];
       const Vec3f ab = t.b - t.a, ac = t.c - t.a, bc = t.c - t.b, nn = ab.cross(ac);
@@ -707,10 +729,12 @@ class GridSolver {
           d11, den > 0 ? 1 / den : 0.0f, nn2 > 0 && den > 0 ? 1 / nn2 : 0.0f, d00 > 0 ? 1 / d00 : 0.0f,
           d11 > 0 ? 1 / d11 : 0.0f, bc.squaredNorm() > 0 ? 1 / bc.squaredNorm() : 0.0f};
       for (int k = 0; k < Packed::kFields; ++k) all_.f[k][i] = std::isfinite(values[k]) ? values[k] : 0.0f;
-      if (!rows_.empty())
-        for (int k = 0; k < Packed::k0; ++k) rows_[i * Packed::k0 + std::size_t(k)] = all_.f[k][i];
       all_.leaf[i] = std::uint32_t(i);
       all_.face[i] = std::int32_t(ids_[i]);
+      if (!rows_.empty()) {
+        for (int k = 0; k < Packed::k0; ++k) rows_[i * kRow + std::size_t(k)] = all_.f[k][i];
+        std::memcpy(&rows_[i * kRow + Packed::k0], &all_.face[i], sizeof(float));
+      }
     });
     // Float rounding of distances is below this (relative to the scene's size).
     const AABB3f mb = std::visit([](const auto& v) { return bvh::bounds(v[0]); }, mesh.bvh().volumes());
@@ -807,7 +831,12 @@ class GridSolver {
         const SampleBox block = block_box(b);
         const Closest& c = block_closest[b];
         if (std::sqrt(c.d2) - block.radius > band_ + margin_) continue;
-        select(tile_list, survivors[b], near, Packed::k0);
+#ifdef GEODS_SDF_AVX512
+        if (wide_)
+          avx512::select(tile_list, survivors.mask[b], near);
+        else
+#endif
+          select(tile_list, survivors[b], near, Packed::k0);
         filter(near, block, c.point, block_list, kept, true, std::span(anchors.data(), num_anchors));
         const BlockWeights weights = block_weights(block);  // in_box of each sample
         std::size_t seed = 0;  // the group of the previous sample's nearest face
@@ -984,8 +1013,10 @@ class GridSolver {
                   return false;
                 }
               },
-              [&](const bvh::TopoNode& node) {
-                for (std::uint32_t i = node.prim_first; i < node.prim_first + node.prim_count; ++i) found.push_back(i);
+              [&](const bvh::TopoNode& node) {  // one resize a leaf, not a push_back (a call) a face
+                const std::size_t at = found.size();
+                found.resize(at + node.prim_count);
+                std::iota(found.begin() + std::ptrdiff_t(at), found.end(), node.prim_first);
               },
               [](float) { return true; });
         },
@@ -994,9 +1025,8 @@ class GridSolver {
     if (!rows_.empty()) {  // from the rows: fewer cache lines than the columns of all_
       near.clear();
       near.reserve(found.size());
-      avx512::gather_rows(rows_.data(), Packed::k0, Packed::k0, found.data(), found.size(), near.f);
-      copy_at(all_.face.data(), found.data(), found.size(), near.face.data());
-      copy_at(all_.leaf.data(), found.data(), found.size(), near.leaf.data());
+      avx512::gather_rows(rows_.data(), found.data(), found.size(), near.f, near.face.data());
+      std::copy_n(found.data(), found.size(), near.leaf.data());  // all_'s leaves are its positions
       near.size = found.size();
     } else
 #endif
@@ -1030,7 +1060,10 @@ class GridSolver {
   // `sorted`: ordered by the smallest of them, with each group's floor, a
   // bound below the squared distance from any point of the box to any of
   // the group's faces (by the concavity above: at least the smallest corner
-  // distance less the largest spread).
+  // distance less the largest spread). With AVX-512 always in `in`'s order
+  // (the hierarchy's leaf order, spatially coherent), written by compress
+  // stores: the sort's copies by position (gathers) cost more than its order
+  // saves in the searches.
   void filter(const Packed& in, const SampleBox& box, const Vec3f& q, Packed& out, Kept& kept,
               bool sorted, std::span<const Vec3f> more = {}) const {
     std::array<std::array<float, 8>, 2 + kBlocks> sets;
@@ -1038,11 +1071,9 @@ class GridSolver {
     sets[0] = bounds_from(box, q);
     for (int j = 1; j < num_sets; ++j) sets[j] = bounds_from(box, more[j - 1]);
 #ifdef GEODS_SDF_AVX512
-    if (wide_)
-      avx512::corner_test(in, box.corners, sets.data(), num_sets, kept);
-    else
+    if (wide_) return avx512::corner_copy(in, box.corners, sets.data(), num_sets, out);
 #endif
-      corner_test(in, box.corners, sets.data(), num_sets, kept);
+    corner_test(in, box.corners, sets.data(), num_sets, kept);
     // The order of the entries: `sorted`, nearly by key, by a counting sort
     // into buckets of equal key ranges (in index order within a bucket: kept
     // is in index order); the order changes only how soon a search may stop,
@@ -1145,7 +1176,7 @@ class GridSolver {
   const std::uint32_t* ids_;
   bool wide_ = simd_level() == SimdLevel::avx512;  // the AVX-512 kernels
   Packed all_;                  // every triangle, in leaf order
-  std::vector<float> rows_;     // with AVX-512: all_'s first k0 quantities, entry by entry
+  std::vector<float> rows_;     // with AVX-512: all_'s first k0 quantities and face, entry by entry
   float margin_ = 0;
   float slack_ = 0;
   float band_ = kInf;
@@ -1292,8 +1323,9 @@ SdfGrid sdf_grid(const MeshDistance& mesh, const Grid3Geometry& grid, const SdfG
 
   SdfGrid result;
   static_cast<Grid3Geometry&>(result.distance) = grid;
-  result.distance.data.resize(n);
-  if (options.faces) result.faces.resize(n);
+  // Prefaulted (huge pages where the kernel gives them): a fault per 4 KiB page cost more than the writes.
+  result.distance.data = detail::prefaulted_vector<float>(n);
+  if (options.faces) result.faces = detail::prefaulted_vector<std::uint32_t>(n);
   result.stats.samples = n;
   if (n == 0) return result;
   if (options.method == SdfMethod::propagation) {
@@ -1308,9 +1340,18 @@ SdfGrid sdf_grid(const MeshDistance& mesh, const Grid3Geometry& grid, const SdfG
   result.stats.tiles = num_tiles;
   std::atomic<std::size_t> in_band{0}, outside{0}, windings{0};
   std::atomic<std::uint64_t> candidates{0};
+  // The tiles in Morton order: consecutive tiles, and each thread's share, are
+  // neighbours in space whose faces are still in cache.
+  std::vector<std::pair<std::uint64_t, std::size_t>> order(num_tiles);
+  for (std::size_t t = 0; t < num_tiles; ++t)
+    order[t] = {morton3d_encode64(std::uint32_t(t % tiles[0]), std::uint32_t(t / tiles[0] % tiles[1]),
+                                  std::uint32_t(t / (tiles[0] * tiles[1]))),
+                t};
+  std::sort(order.begin(), order.end());
   parallel_for_each_index(
       0, num_tiles,
-      [&](std::size_t t) {
+      [&](std::size_t m) {
+        const std::size_t t = order[m].second;
         const std::array<std::size_t, 3> c{t % tiles[0], t / tiles[0] % tiles[1], t / (tiles[0] * tiles[1])};
         std::array<std::size_t, 3> lo, hi;
         for (int a = 0; a < 3; ++a) lo[a] = c[a] * kTile, hi[a] = std::min(lo[a] + kTile, grid.dims[a]);

@@ -89,20 +89,258 @@ template <int S>
   return m;
 }
 
+// The children of a vertex in the nesting: their offsets, as index offsets, and
+// their squared horizontal distances.
+struct Children {
+  std::array<P2, 4> off;
+  std::array<std::ptrdiff_t, 4> dw;
+  std::array<double, 4> d2;
+};
+
+#if defined(__x86_64__) && defined(__GNUC__)
+#define GEODS_TERRAIN_AVX2_INLINE __attribute__((target("avx2"), always_inline)) inline
+// The fine levels with AVX2, four vertices of one kind at a time (the lanes
+// St samples apart along a row): the same planes and terms as rows_error<S>,
+// lane by lane, so the same errors bit for bit.
+
+// p[0], p[St], p[2 St], p[3 St] (reads up to p[3 St + 3]).
+template <int St>
+GEODS_TERRAIN_AVX2_INLINE __m128 load4f(const float* p) {
+  if constexpr (St == 2) {
+    return _mm256_castps256_ps128(_mm256_permutevar8x32_ps(_mm256_loadu_ps(p), _mm256_set_epi32(7, 5, 3, 1, 6, 4, 2, 0)));
+  } else if constexpr (St == 4) {  // p0 p0 p8 p8 | p4 p4 p12 p12, then in order
+    const __m256 v = _mm256_shuffle_ps(_mm256_loadu_ps(p), _mm256_loadu_ps(p + 8), 0);
+    return _mm256_castps256_ps128(_mm256_permutevar8x32_ps(v, _mm256_set_epi32(7, 5, 3, 1, 6, 2, 4, 0)));
+  } else {
+    return _mm_set_ps(p[3 * St], p[2 * St], p[St], p[0]);
+  }
+}
+template <int St>
+GEODS_TERRAIN_AVX2_INLINE __m256d load4(const float* p) {
+  return _mm256_cvtps_pd(load4f<St>(p));
+}
+
+// p[0], p[St], p[2 St], p[3 St] = v.
+template <int St>
+GEODS_TERRAIN_AVX2_INLINE void store4f(float* p, __m128 v) {
+  alignas(16) float out[4];
+  _mm_store_ps(out, v);
+  for (int j = 0; j < 4; ++j) p[St * j] = out[j];
+}
+
+// round_up() of four doubles.
+GEODS_TERRAIN_AVX2_INLINE __m128 round_up4(__m256d m) {
+  const __m128 f = _mm256_cvtpd_ps(m);
+  const __m256d below = _mm256_cmp_pd(_mm256_cvtps_pd(f), m, _CMP_LT_OQ);  // all ones: one ulp up
+  const __m256i low_halves = _mm256_permutevar8x32_epi32(_mm256_castpd_si256(below), _mm256_set_epi32(7, 5, 3, 1, 6, 4, 2, 0));
+  return _mm_castsi128_ps(_mm_add_epi32(_mm_castps_si128(f), _mm_srli_epi32(_mm256_castsi256_si128(low_halves), 31)));
+}
+
+// detail::Plane of the corners at offsets a, b, c from the lanes' vertices v.
+struct Plane4 {
+  const float* a;
+  __m256d za, gx, gy;
+};
+template <int St>
+GEODS_TERRAIN_AVX2_INLINE Plane4 plane4(const float* v, std::int64_t n, P2 a, P2 b, P2 c) {
+  Plane4 p;
+  p.a = v + a.y * n + a.x;
+  p.za = load4<St>(p.a);
+  const __m256d zb = load4<St>(v + b.y * n + b.x), zc = load4<St>(v + c.y * n + c.x);
+  const double ux = double(b.x - a.x), uy = double(b.y - a.y), vx = double(c.x - a.x), vy = double(c.y - a.y);
+  // det is +-2^k (+-2 s^2 or +-4 s^2): dividing by it is multiplying by 1 / det, exactly.
+  const __m256d inv = _mm256_set1_pd(1 / (ux * vy - uy * vx));
+  const __m256d db = _mm256_sub_pd(zb, p.za), dc = _mm256_sub_pd(zc, p.za);
+  p.gx = _mm256_mul_pd(_mm256_sub_pd(_mm256_mul_pd(db, _mm256_set1_pd(vy)), _mm256_mul_pd(dc, _mm256_set1_pd(uy))), inv);
+  p.gy = _mm256_mul_pd(_mm256_sub_pd(_mm256_mul_pd(dc, _mm256_set1_pd(ux)), _mm256_mul_pd(db, _mm256_set1_pd(vx))), inv);
+  return p;
+}
+
+// The term of the lanes' samples h at (dx, dy) from the plane's origin into m.
+// A term times a zero offset is +-0: left out, it changes at most the sign of
+// a zero, which the absolute value drops; so the same |d|.
+GEODS_TERRAIN_AVX2_INLINE void term4(__m256d& m, const Plane4& p, __m256d base, __m256d h, std::int64_t dx) {
+  const __m256d q = dx == 0 ? base : _mm256_add_pd(base, _mm256_mul_pd(p.gx, _mm256_set1_pd(double(dx))));
+  m = _mm256_max_pd(_mm256_andnot_pd(_mm256_set1_pd(-0.0), _mm256_sub_pd(h, q)), m);
+}
+
+// rows_error<S>() of the four lanes, into m. Lanes 8 or more samples apart
+// take rows of three or more samples eight at a time, by a 4 x 8
+// transposition of eight floats per lane (reads up to row + 3 St + hi + 7).
+template <int St>
+GEODS_TERRAIN_AVX2_INLINE void rows4(__m256d& m, std::int64_t n, const Plane4& p, std::int64_t r0, std::int64_t rows,
+                                      std::int64_t lo0, std::int64_t dlo, std::int64_t hi0, std::int64_t dhi) {
+  for (std::int64_t r = 0; r < rows; ++r) {
+    const std::int64_t dy = r0 + r, lo = lo0 + dlo * r, hi = hi0 + dhi * r;
+    const __m256d base = dy == 0 ? p.za : _mm256_add_pd(p.za, _mm256_mul_pd(p.gy, _mm256_set1_pd(double(dy))));
+    const float* row = p.a + dy * n;
+    if constexpr (St >= 8)
+      if (hi - lo >= 2) {
+        for (std::int64_t b = lo; b <= hi; b += 8) {
+          const float* q = row + b;
+          const __m256 l0 = _mm256_loadu_ps(q), l1 = _mm256_loadu_ps(q + St), l2 = _mm256_loadu_ps(q + 2 * St),
+                       l3 = _mm256_loadu_ps(q + 3 * St);
+          const __m256 t0 = _mm256_unpacklo_ps(l0, l1), t1 = _mm256_unpackhi_ps(l0, l1), t2 = _mm256_unpacklo_ps(l2, l3),
+                       t3 = _mm256_unpackhi_ps(l2, l3);
+          const __m256 c[4] = {_mm256_shuffle_ps(t0, t2, 0x44), _mm256_shuffle_ps(t0, t2, 0xEE), _mm256_shuffle_ps(t1, t3, 0x44),
+                               _mm256_shuffle_ps(t1, t3, 0xEE)};  // samples b + k (low half), b + k + 4 (high)
+          for (int k = 0; k < 8 && b + k <= hi; ++k) {
+            if (b + k == 0 && dy == 0) continue;  // the plane's origin: |d| = 0
+            const __m128 h = k < 4 ? _mm256_castps256_ps128(c[k]) : _mm256_extractf128_ps(c[k - 4], 1);
+            term4(m, p, base, _mm256_cvtps_pd(h), b + k);
+          }
+        }
+        continue;
+      }
+    for (std::int64_t dx = lo; dx <= hi; ++dx)
+      if (dx != 0 || dy != 0) term4(m, p, base, load4<St>(row + dx), dx);  // at the plane's origin |d| = 0
+  }
+}
+
+// err of the lanes' vertices (x + St j, y): round_up() of m, +inf where a
+// corner of the diamond (spacing s) leaves W x H.
+template <int St>
+GEODS_TERRAIN_AVX2_INLINE void store4(float* err, std::int64_t n, std::int64_t x, std::int64_t y, std::int64_t s, std::int64_t W,
+                                      std::int64_t H, __m256d m) {
+  alignas(16) float out[4];
+  _mm_store_ps(out, round_up4(m));
+  float* e = err + y * n + x;
+  for (int j = 0; j < 4; ++j) e[St * j] = x + St * j + s > W - 1 || y + s > H - 1 ? kInf : out[j];
+}
+
+// The red vertices of row y (spacing S, N / S >= 16): both diagonals, four
+// vertices of one at a time (4 S apart).
+template <int S>
+__attribute__((target("avx2"))) void red_row_avx2(const float* z, std::int64_t n, std::int64_t W, std::int64_t H, std::uint32_t t,
+                                                  std::int64_t y, float* err) {
+  constexpr std::int64_t s = S;
+  const std::int64_t N = n - 1;
+  for (std::int64_t parity = 0; parity < 2; ++parity) {
+    const bool main_parents = ((parity + ((y - s) >> (t + 1))) & 1) != 0;
+    for (std::int64_t x = s + 2 * s * parity; x < N; x += 16 * s) {
+      const float* v = z + y * n + x;
+      __m256d m = _mm256_setzero_pd();
+      if (main_parents) {
+        const P2 a{-s, s}, b{s, -s};
+        rows4<4 * S>(m, n, plane4<4 * S>(v, n, a, b, {-s, -s}), -2 * s, 2 * s + 1, 0, 0, 2 * s, -1);
+        rows4<4 * S>(m, n, plane4<4 * S>(v, n, a, b, {s, s}), -2 * s, 2 * s + 1, 2 * s, -1, 2 * s, 0);
+      } else {
+        const P2 a{-s, -s}, b{s, s};
+        rows4<4 * S>(m, n, plane4<4 * S>(v, n, a, b, {-s, s}), 0, 2 * s + 1, 0, 0, 0, 1);
+        rows4<4 * S>(m, n, plane4<4 * S>(v, n, a, b, {s, -s}), 0, 2 * s + 1, 0, 1, 2 * s, 0);
+      }
+      store4<4 * S>(err, n, x, y, s, W, H, m);
+    }
+  }
+}
+
+// The blue vertices of row y on horizontal edges (0 < y < N): all of them.
+template <int S>
+__attribute__((target("avx2"))) void blue_h_row_avx2(const float* z, std::int64_t n, std::int64_t W, std::int64_t H, std::int64_t y,
+                                                     float* err) {
+  constexpr std::int64_t s = S;
+  for (std::int64_t x = s; x < n - 1; x += 8 * s) {
+    const float* v = z + y * n + x;
+    __m256d m = _mm256_setzero_pd();
+    rows4<2 * S>(m, n, plane4<2 * S>(v, n, {-s, 0}, {s, 0}, {0, -s}), -s, s + 1, s, -1, s, 1);
+    rows4<2 * S>(m, n, plane4<2 * S>(v, n, {-s, 0}, {s, 0}, {0, s}), 0, s + 1, 0, 1, 2 * s, -1);
+    store4<2 * S>(err, n, x, y, s, W, H, m);
+  }
+}
+
+// The blue vertices of row y on vertical edges from x = 2 S to N - 8 S;
+// returns the first x not done.
+template <int S>
+__attribute__((target("avx2"))) std::int64_t blue_v_row_avx2(const float* z, std::int64_t n, std::int64_t W, std::int64_t H,
+                                                             std::int64_t y, float* err) {
+  constexpr std::int64_t s = S;
+  std::int64_t x = 2 * s;
+  for (; x + 6 * s <= n - 1 - 2 * s; x += 8 * s) {
+    const float* v = z + y * n + x;
+    __m256d m = _mm256_setzero_pd();
+    const Plane4 l = plane4<2 * S>(v, n, {0, -s}, {0, s}, {-s, 0}), r = plane4<2 * S>(v, n, {0, -s}, {0, s}, {s, 0});
+    rows4<2 * S>(m, n, l, 0, s + 1, 0, -1, 0, 0);
+    rows4<2 * S>(m, n, l, s + 1, s, 1 - s, 1, 0, 0);
+    rows4<2 * S>(m, n, r, 0, s + 1, 0, 0, 0, 1);
+    rows4<2 * S>(m, n, r, s + 1, s, 0, 0, s - 1, -1);
+    store4<2 * S>(err, n, x, y, s, W, H, m);
+  }
+  return x;
+}
+
+// The nesting (nest() in the constructor) of the vertices x0, x0 + step, ...
+// < x1 of row y, whose four children lie in the grid: the four square roots
+// in one instruction (the same terms as two at a time). Returns the first x
+// not done.
+__attribute__((target("avx2"))) std::int64_t nest_row_avx2(const float* z, float* err, float* rad, std::int64_t n, std::int64_t y,
+                                                   std::int64_t x0, std::int64_t x1, std::int64_t step, const Children& ch) {
+  const __m256d d2 = _mm256_loadu_pd(ch.d2.data());
+  std::int64_t x = x0;
+  for (; x < x1; x += step) {
+    const std::ptrdiff_t v = y * n + x, w0 = v + ch.dw[0], w1 = v + ch.dw[1], w2 = v + ch.dw[2], w3 = v + ch.dw[3];
+    err[v] = std::max({err[v], err[w0], err[w1], err[w2], err[w3]});
+    const __m256d dz = _mm256_sub_pd(_mm256_cvtps_pd(_mm_set_ps(z[w3], z[w2], z[w1], z[w0])), _mm256_set1_pd(z[v]));
+    const __m256d r = _mm256_add_pd(_mm256_sqrt_pd(_mm256_add_pd(d2, _mm256_mul_pd(dz, dz))),
+                                    _mm256_cvtps_pd(_mm_set_ps(rad[w3], rad[w2], rad[w1], rad[w0])));
+    const __m128d m = _mm_max_pd(_mm256_castpd256_pd128(r), _mm256_extractf128_pd(r, 1));
+    rad[v] = round_up(std::max(_mm_cvtsd_f64(m), _mm_cvtsd_f64(_mm_unpackhi_pd(m, m))));
+  }
+  return x;
+}
+
+// nest_row_avx2() four vertices at a time (the lanes St = 2 s apart, all four
+// with four children): the same maxima and terms lane by lane.
+template <int St>
+__attribute__((target("avx2"))) std::int64_t nest_row4(const float* z, float* err, float* rad, std::int64_t n, std::int64_t y,
+                                                       std::int64_t x0, std::int64_t x1, const Children& ch) {
+  std::int64_t x = x0;
+  for (; x + 3 * St < x1; x += 4 * St) {
+    const std::ptrdiff_t v = y * n + x;
+    __m128 e = load4f<St>(err + v);
+    const __m256d zv = load4<St>(z + v);
+    __m256d best = _mm256_setzero_pd();
+    for (int k = 0; k < 4; ++k) {
+      const std::ptrdiff_t w = v + ch.dw[k];
+      e = _mm_max_ps(e, load4f<St>(err + w));
+      const __m256d dz = _mm256_sub_pd(load4<St>(z + w), zv);
+      best = _mm256_max_pd(best, _mm256_add_pd(_mm256_sqrt_pd(_mm256_add_pd(_mm256_set1_pd(ch.d2[k]), _mm256_mul_pd(dz, dz))),
+                                               load4<St>(rad + w)));
+    }
+    store4f<St>(err + v, e);
+    store4f<St>(rad + v, round_up4(best));
+  }
+  return x;
+}
+#undef GEODS_TERRAIN_AVX2_INLINE
+#endif
+
 // The own errors of the vertices of spacing s = 2^t (S = s when it is a small
 // compile-time constant, else 0): red ones (square centres) split the two
 // halves of their 2s-square, blue ones the quarters of 2s-squares on both
 // sides of their edge. err[y n + x] = the largest error of the triangles,
-// rounded up to a float; +inf when a corner of one lies outside W x H.
+// rounded up to a float; +inf when a corner of one lies outside W x H. With
+// AVX2 (and N / S >= 16, so that groups of four fill the rows) the fine
+// levels take the kernels above, but for the first and last rows of blue
+// vertices on horizontal edges and the first and last four on vertical ones.
 template <int S>
 void level_errors(const float* z, std::int64_t n, std::int64_t W, std::int64_t H, std::uint32_t t, float* err) {
   const std::int64_t s = S ? S : std::int64_t(1) << t, N = n - 1, c = N / 2;
+#if defined(__x86_64__) && defined(__GNUC__)
+  const bool wide = S > 0 && N / s >= 16 && simd_level() >= SimdLevel::avx2;
+#endif
   auto in = [&](P2 p) { return p.x <= W - 1 && p.y <= H - 1; };
   // Red: rows y = s, 3s, ...; x = s, 3s, ... The parents (the apexes) are the
   // square's corners on the diagonal that is not the hypotenuse.
   parallel_for(0, std::size_t(N / (2 * s)), S ? 8 : 1, [&](std::size_t b, std::size_t e) {
     for (std::size_t ry = b; ry < e; ++ry) {
       const std::int64_t y = (2 * std::int64_t(ry) + 1) * s;
+#if defined(__x86_64__) && defined(__GNUC__)
+      if constexpr (S > 0)
+        if (wide) {
+          red_row_avx2<S>(z, n, W, H, t, y, err);
+          continue;
+        }
+#endif
       for (std::int64_t x = s; x < N; x += 2 * s) {
         if (x == c && y == c) continue;  // the centre is always in the mesh
         const bool main_parents = ((((x - s) >> (t + 1)) + ((y - s) >> (t + 1))) & 1) != 0;
@@ -133,6 +371,13 @@ void level_errors(const float* z, std::int64_t n, std::int64_t W, std::int64_t H
   parallel_for(0, std::size_t(N / (2 * s) + 1), S ? 8 : 1, [&](std::size_t b, std::size_t e) {
     for (std::size_t ry = b; ry < e; ++ry) {
       const std::int64_t y = 2 * std::int64_t(ry) * s;
+#if defined(__x86_64__) && defined(__GNUC__)
+      if constexpr (S > 0)
+        if (wide && y > 0 && y < N) {
+          blue_h_row_avx2<S>(z, n, W, H, y, err);
+          continue;
+        }
+#endif
       for (std::int64_t x = s; x < N; x += 2 * s) {
         const P2 a{x - s, y}, bb{x + s, y};
         double worst = 0;
@@ -158,7 +403,12 @@ void level_errors(const float* z, std::int64_t n, std::int64_t W, std::int64_t H
   parallel_for(0, std::size_t(N / (2 * s)), S ? 8 : 1, [&](std::size_t b, std::size_t e) {
     for (std::size_t ry = b; ry < e; ++ry) {
       const std::int64_t y = (2 * std::int64_t(ry) + 1) * s;
-      for (std::int64_t x = 0; x <= N; x += 2 * s) {
+      std::int64_t done = 2 * s;  // the vertices x in [2 s, done) are done
+#if defined(__x86_64__) && defined(__GNUC__)
+      if constexpr (S > 0)
+        if (wide) done = blue_v_row_avx2<S>(z, n, W, H, y, err);
+#endif
+      for (std::int64_t x = 0; x <= N; x = x == 0 ? done : x + 2 * s) {
         const P2 a{x, y - s}, bb{x, y + s};
         double worst = 0;
         if (!in(a) || !in(bb)) {
@@ -200,6 +450,10 @@ void own_errors(const float* z, std::int64_t n, std::int64_t W, std::int64_t H, 
       level_errors<2>(z, n, W, H, t, err);
     else if (t == 2)
       level_errors<4>(z, n, W, H, t, err);
+    else if (t == 3)
+      level_errors<8>(z, n, W, H, t, err);
+    else if (t == 4)
+      level_errors<16>(z, n, W, H, t, err);
     else
       level_errors<0>(z, n, W, H, t, err);
   }
@@ -339,8 +593,10 @@ Terrain::Terrain(HeightField field, TerrainOptions options) {
   const std::int64_t W = std::int64_t(width_), H = std::int64_t(height_);
   index_ = LayoutIndex(options.layout, K);
 
-  // Heights of the padded grid (the padding repeats the last row and column).
-  std::vector<float, HugePageAllocator<float>> z(n * n);
+  // Heights of the padded grid (the padding repeats the last row and column),
+  // and 8 more: the fine levels' kernels load up to 7 floats past the last
+  // sample they use.
+  std::vector<float, HugePageAllocator<float>> z(n * n + 8);
   parallel_for(0, n, 16, [&](std::size_t b, std::size_t e) {
     bool finite = true;
     for (std::size_t y = b; y < e; ++y) {
@@ -366,21 +622,19 @@ Terrain::Terrain(HeightField field, TerrainOptions options) {
   // field (the padding), so that those vertices are always refined and no
   // final triangle straddles the field's border. Level by level, every
   // triangle's rows as spans known by arithmetic (no point-in-triangle tests).
-  std::vector<float, HugePageAllocator<float>> err(n * n, 0.0f);
+  std::vector<float, HugePageAllocator<float>> err(n * n + 8, 0.0f);  // 8 more as z
   own_errors(z.data(), std::int64_t(n), W, H, K, err.data());
 
   // Nesting, finest level first: error = max(own, children's); radius = max over
   // children of (distance + child's radius), rounded up, so that a child's
   // sphere lies in its parent's.
-  std::vector<float, HugePageAllocator<float>> rad(n * n, 0.0f);
+  std::vector<float, HugePageAllocator<float>> rad(n * n + 8, 0.0f);
+#if defined(__x86_64__) && defined(__GNUC__)
+  const bool avx2 = simd_level() >= SimdLevel::avx2;
+#endif
   const double sx = std::abs(spacing_[0]), sy = std::abs(spacing_[1]);
   // Vertex (x, y) from its children at offsets off[k] (skipped outside the
   // grid); the radius is rounded up once (rounding up is monotone).
-  struct Children {
-    std::array<P2, 4> off;
-    std::array<std::ptrdiff_t, 4> dw;  // index offsets
-    std::array<double, 4> d2;          // squared horizontal distances
-  };
   auto children = [&](const std::array<P2, 4>& off) {
     Children ch{off, {}, {}};
     for (int k = 0; k < 4; ++k) {
@@ -429,6 +683,15 @@ Terrain::Terrain(HeightField field, TerrainOptions options) {
   };
   for (std::uint32_t t = 0; t < K; ++t) {
     const std::int64_t s = std::int64_t(1) << t;
+#if defined(__x86_64__) && defined(__GNUC__)
+    // The vertices x, x + 2 s, ... < N of row y with four children each, with
+    // AVX2; returns the first x not done.
+    auto nest_row = [&](std::int64_t y, std::int64_t x, const Children& ch) {
+      if (s == 1) x = nest_row4<2>(z.data(), err.data(), rad.data(), std::int64_t(n), y, x, N, ch);
+      if (s == 2) x = nest_row4<4>(z.data(), err.data(), rad.data(), std::int64_t(n), y, x, N, ch);
+      return nest_row_avx2(z.data(), err.data(), rad.data(), std::int64_t(n), y, x, N, 2 * s, ch);
+    };
+#endif
     // Blue vertices of spacing s >= 2: children are the red ones of spacing s / 2.
     if (s >= 2) {
       const std::int64_t h = s / 2;
@@ -437,7 +700,17 @@ Terrain::Terrain(HeightField field, TerrainOptions options) {
         for (std::size_t r = b; r < e; ++r) {
           const std::int64_t y = std::int64_t(r) * s;
           const bool inner_row = y > 0 && y < N;
-          for (std::int64_t x = ((r & 1) ? 0 : s); x <= N; x += 2 * s) nest(x, y, ch, inner_row && x > 0 && x < N);
+          std::int64_t x = (r & 1) ? 0 : s;
+#if defined(__x86_64__) && defined(__GNUC__)
+          if (inner_row && avx2) {
+            if (x == 0) {  // on the border: not all four children
+              nest(0, y, ch, false);
+              x = 2 * s;
+            }
+            x = nest_row(y, x, ch);
+          }
+#endif
+          for (; x <= N; x += 2 * s) nest(x, y, ch, inner_row && x > 0 && x < N);
         }
       });
     }
@@ -446,6 +719,12 @@ Terrain::Terrain(HeightField field, TerrainOptions options) {
     parallel_for(0, std::size_t(N / (2 * s)), 4, [&](std::size_t b, std::size_t e) {
       for (std::size_t r = b; r < e; ++r) {
         const std::int64_t y = std::int64_t(2 * r + 1) * s;
+#if defined(__x86_64__) && defined(__GNUC__)
+        if (avx2) {
+          nest_row(y, s, ch);
+          continue;
+        }
+#endif
         for (std::int64_t x = s; x < N; x += 2 * s) nest(x, y, ch, true);
       }
     });
