@@ -149,7 +149,7 @@ class GreedyTin {
     });
     if (next != voronoi::Delaunay2::no_edge) ins_.prefetch(next);
     rescan(changed);
-    // Then its neighbours (the rescan's pushes rarely change the top).
+    // Then its corners and neighbours (the rescan's pushes rarely change the guess).
     if (next != voronoi::Delaunay2::no_edge) ins_.prefetch_neighbors(next);
   }
   // Scans every triangle.
