@@ -696,7 +696,8 @@ void Delaunay3::canonicalize(std::size_t free) {
   }
   // The keys per partition; meanwhile (task 0, the first one a thread
   // starts) the arrays the sort fills are allocated: zeroing them is one
-  // thread's work, which the others' keys overlap.
+  // thread's work, which the others' keys overlap. (After a parallel build
+  // tetrahedra_ already holds storage, touched: the dead slots of a half.)
   std::vector<std::uint32_t> new_of;
   parallel_for_each_index(
       0, blocks + 1,

@@ -22,23 +22,40 @@ namespace {
 constexpr std::uint32_t kNone = Delaunay3::no_index;
 constexpr std::uint32_t kGhost = Tet3Mesh::kGhost;
 
-// The point of a convex polytope's vertices (given by their adjacency) that is
-// farthest along `direction`: a strict hill climb from `start` (on a convex
-// polytope a vertex that no neighbour beats is a maximum).
-std::uint32_t extreme_vertex(const std::vector<std::vector<std::uint32_t>>& adjacent, std::span<const Vec3d> points,
-                             const Vec3d& direction, std::uint32_t start) {
-  std::uint32_t best = start;
-  double value = direction.dot(points[best]);
-  for (bool moved = true; moved;) {
-    moved = false;
-    for (const std::uint32_t u : adjacent[best])
-      if (const double x = direction.dot(points[u]); x > value) {
-        best = u, value = x, moved = true;
-        break;
-      }
+// A convex polytope's vertex graph over its own vertices only (a few thousand:
+// an array over every point would be megabytes of fresh pages to clear).
+struct HullGraph {
+  std::vector<std::uint32_t> vertex;                 // the hull's vertices, ascending
+  std::vector<std::vector<std::uint32_t>> adjacent;  // per hull vertex: its neighbours' places in `vertex`
+
+  explicit HullGraph(const std::vector<Delaunay3::Triangle>& faces) {
+    for (const Delaunay3::Triangle& t : faces) vertex.insert(vertex.end(), t.begin(), t.end());
+    std::sort(vertex.begin(), vertex.end());
+    vertex.erase(std::unique(vertex.begin(), vertex.end()), vertex.end());
+    adjacent.resize(vertex.size());
+    const auto place = [&](std::uint32_t v) {
+      return std::uint32_t(std::lower_bound(vertex.begin(), vertex.end(), v) - vertex.begin());
+    };
+    for (const Delaunay3::Triangle& t : faces)
+      for (int k = 0; k < 3; ++k) adjacent[place(t[k])].push_back(place(t[(k + 1) % 3]));
   }
-  return best;
-}
+
+  // The vertex farthest along `direction` (its place): a strict hill climb from
+  // place `start` (on a convex polytope a vertex that no neighbour beats is a maximum).
+  std::uint32_t extreme(std::span<const Vec3d> points, const Vec3d& direction, std::uint32_t start) const {
+    std::uint32_t best = start;
+    double value = direction.dot(points[vertex[best]]);
+    for (bool moved = true; moved;) {
+      moved = false;
+      for (const std::uint32_t u : adjacent[best])
+        if (const double x = direction.dot(points[vertex[u]]); x > value) {
+          best = u, value = x, moved = true;
+          break;
+        }
+    }
+    return best;
+  }
+};
 
 constexpr std::size_t kBlock = 1 << 14;  // slots per block of the parallel passes over a half's slots
 
@@ -115,14 +132,12 @@ bool Delaunay3::build_split(const std::vector<std::uint32_t>& active, std::size_
   const double far = 16 * extent / std::cbrt(double(active.size()));  // 16 mean spacings
   std::array<std::vector<std::uint8_t>, 2> valid;
   std::array<std::atomic<double>, 2> beyond{};  // per half: how far its pending spheres reach past the split
-  // Per half, its hull's vertex adjacency (for the extreme points the other half's hull faces ask for).
-  std::array<std::vector<std::vector<std::uint32_t>>, 2> hull_adjacent;
-  std::array<std::uint32_t, 2> hull_start{};
+  // Per half, its hull's vertex graph (for the extreme points the other half's hull faces ask for).
+  std::array<std::optional<HullGraph>, 2> hull_graph;
   // Each half, once built, indexes its hull and classifies its finite slots
   // (which need nothing of the other half) at once: the half built first
   // does not wait for the other, and its thread helps with the other's pass.
   std::array<Delaunay3, 2> half;
-  for (int h = 0; h < 2; ++h) hull_adjacent[h].resize(global[h].size());  // (allocated here, by the calling thread)
   // Half 0's slots become the assembled array in place (fresh pages are slow
   // to touch): room for every slot, prefaulted by half 0's build.
   half[0].tets_.reserve(8 * 7 * active.size() + 64);
@@ -136,11 +151,7 @@ bool Delaunay3::build_split(const std::vector<std::uint32_t>& active, std::size_
         for (std::size_t k = 0; k < global[h].size(); ++k) self.points_[k] = points_[global[h][k]];
         self.build(options_, false);
         if (self.dimension_ < 3) return;
-        for (const auto& t : self.hull())
-          for (int k = 0; k < 3; ++k) {
-            hull_adjacent[h][t[k]].push_back(t[(k + 1) % 3]);
-            hull_start[h] = t[0];
-          }
+        hull_graph[h].emplace(self.hull());
         const std::size_t slots = self.tets_.size() / 8;
         detail::reserve_prefaulted(valid[h], slots);
         valid[h].assign(slots, seam_slot);
@@ -175,7 +186,7 @@ bool Delaunay3::build_split(const std::vector<std::uint32_t>& active, std::size_
     const Delaunay3& other = half[1 - h];
     const Vec3d* C = self.points_.data();
     parallel_for(0, valid[h].size(), 1 << 12, [&](std::size_t begin, std::size_t end) {
-      std::uint32_t climb = hull_start[1 - h];
+      std::uint32_t climb = 0;
       for (std::size_t s = begin; s < end; ++s) {
         if (valid[h][s] != hull_face) continue;
         valid[h][s] = seam_slot;
@@ -186,8 +197,8 @@ bool Delaunay3::build_split(const std::vector<std::uint32_t>& active, std::size_
         const Vec3d normal = (b - a).cross(c - a);  // outwards: the face is counter-clockwise seen from the ghost's side
         const double length = normal.norm();
         if (!(length > 0)) continue;
-        climb = extreme_vertex(hull_adjacent[1 - h], other.points_, normal, climb);
-        valid[h][s] = normal.dot(other.points_[climb] - a) / length < -tolerance ? kept : seam_slot;
+        climb = hull_graph[1 - h]->extreme(other.points_, normal, climb);
+        valid[h][s] = normal.dot(other.points_[hull_graph[1 - h]->vertex[climb]] - a) / length < -tolerance ? kept : seam_slot;
       }
     });
   }
@@ -294,6 +305,9 @@ bool Delaunay3::build_split(const std::vector<std::uint32_t>& active, std::size_
       }
     });
   seam_fill.write(tets_);
+  // Half 1's slots are dead, and their pages touched: they take the public
+  // tetrahedra that the canonical order writes (a fresh page costs more than its writes).
+  tetrahedra_ = std::move(half[1].tets_);
   free = 0;  // (slots left free: the halves' free and seam slots)
   for (int h = 0; h < 2; ++h) free += std::size_t(std::count(valid[h].begin(), valid[h].end(), seam_slot));
   // Representatives: equal points fall in the same half, whose first occurrence is the first here too.
