@@ -326,7 +326,7 @@ Delaunay3::Delaunay3(std::span<const Vec3d> points, Options options) : options_(
   publish();
 }
 
-void Delaunay3::build(Options options, bool may_split) {
+void Delaunay3::build(Options options, bool may_split, std::vector<std::uint32_t>* vertex_points) {
   const std::size_t total = points_.size();
   reserve_prefaulted(removed_, total);
   removed_.resize(total, 0);
@@ -415,6 +415,15 @@ void Delaunay3::build(Options options, bool may_split) {
     }
   for (std::size_t k = 0; k < n; ++k) rep_[sequence[k]] = point_of[merged[k] == kNone ? k : merged[k]];
   (void)duplicates;
+  walk_steps_ = mesh.walk_steps;
+  conflicts_ = mesh.conflicts;
+  flip_counts_ = mesh.flip_counts;
+  last_ = mesh.last;
+  if (vertex_points) {
+    points_.swap(coords);
+    *vertex_points = std::move(point_of);
+    return;
+  }
   parallel_for(0, tets_.size() / 8, 1 << 14, [&](std::size_t begin, std::size_t end) {
     for (std::size_t t = begin; t < end; ++t)
       for (int j = 0; j < 4; ++j) {
@@ -422,10 +431,6 @@ void Delaunay3::build(Options options, bool may_split) {
         if ((v & Tet3Mesh::kGhostBit) == 0) v = point_of[v];
       }
   });
-  walk_steps_ = mesh.walk_steps;
-  conflicts_ = mesh.conflicts;
-  flip_counts_ = mesh.flip_counts;
-  last_ = mesh.last;
   if (may_split) canonicalize(free_slots_.size());  // (the halves and seams of a parallel build need not be)
 }
 

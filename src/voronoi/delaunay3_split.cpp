@@ -138,6 +138,7 @@ bool Delaunay3::build_split(const std::vector<std::uint32_t>& active, std::size_
   // (which need nothing of the other half) at once: the half built first
   // does not wait for the other, and its thread helps with the other's pass.
   std::array<Delaunay3, 2> half;
+  std::array<std::vector<std::uint32_t>, 2> vertex_global;  // per half: its vertices' points here
   // Half 0's slots become the assembled array in place (fresh pages are slow
   // to touch): room for every slot, prefaulted by half 0's build.
   half[0].tets_.reserve(8 * 7 * active.size() + 64);
@@ -149,8 +150,13 @@ bool Delaunay3::build_split(const std::vector<std::uint32_t>& active, std::size_
         detail::reserve_prefaulted(self.points_, global[h].size());
         self.points_.resize(global[h].size());
         for (std::size_t k = 0; k < global[h].size(); ++k) self.points_[k] = points_[global[h][k]];
-        self.build(options_, false);
+        // (vertices in insertion order: the passes below read their coordinates and global ids in order)
+        self.build(options_, false, &vertex_global[h]);
         if (self.dimension_ < 3) return;
+        parallel_for(0, vertex_global[h].size(), 1 << 14, [&](std::size_t begin, std::size_t end) {
+          for (std::size_t k = begin; k < end; ++k)
+            if (vertex_global[h][k] != kNone) vertex_global[h][k] = global[h][vertex_global[h][k]];
+        });
         hull_graph[h].emplace(self.hull());
         const std::size_t slots = self.tets_.size() / 8;
         detail::reserve_prefaulted(valid[h], slots);
@@ -230,7 +236,7 @@ bool Delaunay3::build_split(const std::vector<std::uint32_t>& active, std::size_
           const std::uint32_t* v = &half[h].tets_[8 * s];
           if (v[0] == kNone || valid[h][s]) return;
           for (int k = 0; k < 4; ++k)
-            if (v[k] != kGhost) out.push_back(global[h][v[k]]);
+            if (v[k] != kGhost) out.push_back(vertex_global[h][v[k]]);
         });
     seam.insert(seam.end(), more.begin(), more.end());
   }
@@ -247,7 +253,7 @@ bool Delaunay3::build_split(const std::vector<std::uint32_t>& active, std::size_
   for (std::size_t k = 0; k < seam.size(); ++k) filler.points_[k] = points_[seam[k]];
   const std::array<std::size_t, 2> base = {0, valid[0].size()};  // per half: its slots' first new number
   RegionFill seam_fill;  // its boundary: the face and the adjacency across it (new numbers)
-  const auto to_global = [&](int h, std::uint32_t v) { return v == kGhost ? kGhost : global[h][v]; };
+  const auto to_global = [&](int h, std::uint32_t v) { return v == kGhost ? kGhost : vertex_global[h][v]; };
   const auto collect_boundary = [&] {
     // The seam region's boundary: kept slots' faces towards doubtful ones, seen from the seam's side.
     using BoundaryFace = std::pair<RegionFill::Face, std::uint32_t>;

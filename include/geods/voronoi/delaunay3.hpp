@@ -198,7 +198,11 @@ class Delaunay3 {
   // vertices in insertion order, renumbered at the end): per slot eight words,
   // four vertices (the ghost for the infinite one, no_index in a free slot)
   // and four adjacencies, 4 * neighbour + the face's index in the neighbour.
-  void build(Options options, bool may_split = true);
+  // With `vertex_points` (a half of a parallel build) the vertices keep their
+  // insertion order, which is coherent in space: points_ becomes the vertices'
+  // coordinates in that order and *vertex_points each vertex's point (no_index
+  // for a duplicate's); rep_ stays over the points.
+  void build(Options options, bool may_split = true, std::vector<std::uint32_t>* vertex_points = nullptr);
   // false: the halves cannot be stitched, build sequentially; `free`: how many slots it left free.
   bool build_split(const std::vector<std::uint32_t>& active, std::size_t& free);
   bool remove_locally(std::uint32_t v);  // false: the link is flat, rebuild instead
