@@ -542,28 +542,42 @@ bool RegionFill::match(const std::vector<std::uint32_t>& filler, std::span<const
   std::sort(boundary.begin(), boundary.end());
   const std::size_t slots = filler.size() / 8;
   mapped.resize(filler.size());
-  for (std::size_t k = 0; k < filler.size(); k += 8)
-    for (int j = 0; j < 4; ++j) {
-      const std::uint32_t u = filler[k + j];
-      mapped[k + j] = (u & Tet3Mesh::kGhostBit) ? u : ids[u];
-      mapped[k + 4 + j] = filler[k + 4 + j];
-    }
   slot.assign(slots, kNone);
   outer.assign(4 * slots, kNone);
   fill.clear();
-  std::size_t matched = 0;
-  for (std::size_t s = 0; s < slots; ++s) {
-    if (mapped[8 * s] == kNone) continue;
-    for (int j = 0; j < 4; ++j) {
-      const Face face = face_of(&mapped[8 * s], j);
-      const auto it = std::lower_bound(boundary.begin(), boundary.end(), std::pair(face, std::uint32_t(0)));
-      if (it == boundary.end() || it->first != face) continue;
-      outer[4 * s + j] = it->second;
-      ++matched;
-      if (slot[s] == kNone) slot[s] = 0, fill.push_back(std::uint32_t(s));
-    }
-  }
-  if (matched != boundary.size()) return false;
+  // Every filler face looked up among the boundary's (a seam's filler has
+  // hundreds of thousands): blocks of slots in parallel, each listing its
+  // slots with a boundary face, concatenated in slot order.
+  constexpr std::size_t kBlock = 1 << 12;
+  const std::size_t blocks = (slots + kBlock - 1) / kBlock;
+  std::vector<std::vector<std::uint32_t>> found(blocks);
+  std::vector<std::size_t> matched(blocks, 0);
+  parallel_for_each_index(
+      0, blocks,
+      [&](std::size_t block) {
+        for (std::size_t s = block * kBlock; s < std::min(slots, (block + 1) * kBlock); ++s) {
+          for (int j = 0; j < 4; ++j) {
+            const std::uint32_t u = filler[8 * s + j];
+            mapped[8 * s + j] = (u & Tet3Mesh::kGhostBit) ? u : ids[u];
+            mapped[8 * s + 4 + j] = filler[8 * s + 4 + j];
+          }
+          if (mapped[8 * s] == kNone) continue;
+          bool on_boundary = false;
+          for (int j = 0; j < 4; ++j) {
+            const Face face = face_of(&mapped[8 * s], j);
+            const auto it = std::lower_bound(boundary.begin(), boundary.end(), std::pair(face, std::uint32_t(0)));
+            if (it == boundary.end() || it->first != face) continue;
+            outer[4 * s + j] = it->second;
+            ++matched[block];
+            on_boundary = true;
+          }
+          if (on_boundary) found[block].push_back(std::uint32_t(s));
+        }
+      },
+      1);
+  for (std::size_t block = 0; block < blocks; ++block)
+    for (const std::uint32_t s : found[block]) slot[s] = 0, fill.push_back(s);
+  if (std::accumulate(matched.begin(), matched.end(), std::size_t(0)) != boundary.size()) return false;
   for (std::size_t k = 0; k < fill.size(); ++k)
     for (int j = 0; j < 4; ++j) {
       const std::uint32_t s = fill[k], n = mapped[8 * std::size_t(s) + 4 + j] >> 2;
