@@ -346,8 +346,10 @@ void Delaunay3::build(Options options, bool may_split, std::vector<std::uint32_t
     return;
   }
   std::size_t free = 0;
-  if (may_split && num_threads() > 1 && n >= std::max<std::size_t>(options.parallel_from, 16) && build_split(active, free)) {
-    canonicalize(free);
+  std::vector<std::uint32_t> storage;
+  if (may_split && num_threads() > 1 && n >= std::max<std::size_t>(options.parallel_from, 16) &&
+      build_split(active, free, storage)) {
+    canonicalize(free, std::move(storage));
     return;
   }
   tets_.clear();  // (a parallel build that gave up may have left slots)
@@ -632,7 +634,7 @@ inline void canonical_positions(const std::uint32_t* v, std::uint8_t position[4]
 }
 }  // namespace
 
-void Delaunay3::canonicalize(std::size_t free) {
+void Delaunay3::canonicalize(std::size_t free, std::vector<std::uint32_t> storage) {
   const std::size_t slots = tets_.size() / 8;
   const std::size_t n = points_.size();
   // Where entry j of slot s goes (set for every live slot; the only ones read).
@@ -658,8 +660,8 @@ void Delaunay3::canonicalize(std::size_t free) {
   // The new slots' array, which holds the keys (five words each) until they
   // are sorted: fresh pages are slow to touch on this kind of machine, so the
   // keys take no pages of their own. Allocated (and zeroed) by task 0, the
-  // first a thread starts, while the others count.
-  std::vector<std::uint32_t> out;
+  // first a thread starts, while the others count, unless `storage` has room.
+  std::vector<std::uint32_t> out = std::move(storage);
   const auto put_key = [&](std::size_t i, const Key& key) { std::memcpy(&out[5 * i], &key, sizeof(Key)); };
   const auto key_at = [&](std::size_t i) {
     Key key;
@@ -716,7 +718,7 @@ void Delaunay3::canonicalize(std::size_t free) {
   // The keys per partition; meanwhile (task 0, the first one a thread
   // starts) the arrays the sort fills are allocated: zeroing them is one
   // thread's work, which the others' keys overlap. (After a parallel build
-  // tetrahedra_ already holds storage, touched: the dead slots of a half.)
+  // tetrahedra_ already has room, its pages touched.)
   std::vector<std::uint32_t> new_of;
   parallel_for_each_index(
       0, blocks + 1,

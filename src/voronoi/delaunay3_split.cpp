@@ -81,7 +81,8 @@ std::vector<T> gather_slots(std::size_t slots, const Fn& fn) {
 
 }  // namespace
 
-bool Delaunay3::build_split(const std::vector<std::uint32_t>& active, std::size_t& free) {
+bool Delaunay3::build_split(const std::vector<std::uint32_t>& active, std::size_t& free,
+                            std::vector<std::uint32_t>& storage) {
   double scale = 0;
   AABB3d bounds;
   for (const std::uint32_t i : active) {
@@ -139,12 +140,19 @@ bool Delaunay3::build_split(const std::vector<std::uint32_t>& active, std::size_
   // does not wait for the other, and its thread helps with the other's pass.
   std::array<Delaunay3, 2> half;
   std::array<std::vector<std::uint32_t>, 2> vertex_global;  // per half: its vertices' points here
-  // Half 0's slots become the assembled array in place (fresh pages are slow
-  // to touch): room for every slot, prefaulted by half 0's build.
-  half[0].tets_.reserve(8 * 7 * active.size() + 64);
+  // Half 0's slots become the assembled array in place, and half 1's, once
+  // dead, the canonical order's new slots: room for every slot in both,
+  // prefaulted by the halves' builds (fresh pages are slow to touch, and so
+  // both threads touch them at once); and the public tetrahedra's, by the
+  // thread that is free first.
+  for (int h = 0; h < 2; ++h) half[h].tets_.reserve(8 * 7 * active.size() + 64);
   parallel_for_each_index(
-      0, 2,
+      0, 3,
       [&](std::size_t h) {
+        if (h == 2) {
+          detail::reserve_prefaulted(tetrahedra_, 4 * 7 * active.size() + 64);
+          return;
+        }
         Delaunay3& self = half[h];
         self.options_ = options_;
         detail::reserve_prefaulted(self.points_, global[h].size());
@@ -311,9 +319,7 @@ bool Delaunay3::build_split(const std::vector<std::uint32_t>& active, std::size_
       }
     });
   seam_fill.write(tets_);
-  // Half 1's slots are dead, and their pages touched: they take the public
-  // tetrahedra that the canonical order writes (a fresh page costs more than its writes).
-  tetrahedra_ = std::move(half[1].tets_);
+  storage = std::move(half[1].tets_);
   free = 0;  // (slots left free: the halves' free and seam slots)
   for (int h = 0; h < 2; ++h) free += std::size_t(std::count(valid[h].begin(), valid[h].end(), seam_slot));
   // Representatives: equal points fall in the same half, whose first occurrence is the first here too.
