@@ -326,7 +326,7 @@ Delaunay3::Delaunay3(std::span<const Vec3d> points, Options options) : options_(
   publish();
 }
 
-void Delaunay3::build(Options options, bool may_split) {
+void Delaunay3::build(Options options, bool may_split, std::vector<std::uint32_t>* vertex_points) {
   const std::size_t total = points_.size();
   reserve_prefaulted(removed_, total);
   removed_.resize(total, 0);
@@ -346,8 +346,10 @@ void Delaunay3::build(Options options, bool may_split) {
     return;
   }
   std::size_t free = 0;
-  if (may_split && num_threads() > 1 && n >= std::max<std::size_t>(options.parallel_from, 16) && build_split(active, free)) {
-    canonicalize(free);
+  std::vector<std::uint32_t> storage;
+  if (may_split && num_threads() > 1 && n >= std::max<std::size_t>(options.parallel_from, 16) &&
+      build_split(active, free, storage)) {
+    canonicalize(free, std::move(storage));
     return;
   }
   tets_.clear();  // (a parallel build that gave up may have left slots)
@@ -415,6 +417,15 @@ void Delaunay3::build(Options options, bool may_split) {
     }
   for (std::size_t k = 0; k < n; ++k) rep_[sequence[k]] = point_of[merged[k] == kNone ? k : merged[k]];
   (void)duplicates;
+  walk_steps_ = mesh.walk_steps;
+  conflicts_ = mesh.conflicts;
+  flip_counts_ = mesh.flip_counts;
+  last_ = mesh.last;
+  if (vertex_points) {
+    points_.swap(coords);
+    *vertex_points = std::move(point_of);
+    return;
+  }
   parallel_for(0, tets_.size() / 8, 1 << 14, [&](std::size_t begin, std::size_t end) {
     for (std::size_t t = begin; t < end; ++t)
       for (int j = 0; j < 4; ++j) {
@@ -422,10 +433,6 @@ void Delaunay3::build(Options options, bool may_split) {
         if ((v & Tet3Mesh::kGhostBit) == 0) v = point_of[v];
       }
   });
-  walk_steps_ = mesh.walk_steps;
-  conflicts_ = mesh.conflicts;
-  flip_counts_ = mesh.flip_counts;
-  last_ = mesh.last;
   if (may_split) canonicalize(free_slots_.size());  // (the halves and seams of a parallel build need not be)
 }
 
@@ -537,28 +544,42 @@ bool RegionFill::match(const std::vector<std::uint32_t>& filler, std::span<const
   std::sort(boundary.begin(), boundary.end());
   const std::size_t slots = filler.size() / 8;
   mapped.resize(filler.size());
-  for (std::size_t k = 0; k < filler.size(); k += 8)
-    for (int j = 0; j < 4; ++j) {
-      const std::uint32_t u = filler[k + j];
-      mapped[k + j] = (u & Tet3Mesh::kGhostBit) ? u : ids[u];
-      mapped[k + 4 + j] = filler[k + 4 + j];
-    }
   slot.assign(slots, kNone);
   outer.assign(4 * slots, kNone);
   fill.clear();
-  std::size_t matched = 0;
-  for (std::size_t s = 0; s < slots; ++s) {
-    if (mapped[8 * s] == kNone) continue;
-    for (int j = 0; j < 4; ++j) {
-      const Face face = face_of(&mapped[8 * s], j);
-      const auto it = std::lower_bound(boundary.begin(), boundary.end(), std::pair(face, std::uint32_t(0)));
-      if (it == boundary.end() || it->first != face) continue;
-      outer[4 * s + j] = it->second;
-      ++matched;
-      if (slot[s] == kNone) slot[s] = 0, fill.push_back(std::uint32_t(s));
-    }
-  }
-  if (matched != boundary.size()) return false;
+  // Every filler face looked up among the boundary's (a seam's filler has
+  // hundreds of thousands): blocks of slots in parallel, each listing its
+  // slots with a boundary face, concatenated in slot order.
+  constexpr std::size_t kBlock = 1 << 12;
+  const std::size_t blocks = (slots + kBlock - 1) / kBlock;
+  std::vector<std::vector<std::uint32_t>> found(blocks);
+  std::vector<std::size_t> matched(blocks, 0);
+  parallel_for_each_index(
+      0, blocks,
+      [&](std::size_t block) {
+        for (std::size_t s = block * kBlock; s < std::min(slots, (block + 1) * kBlock); ++s) {
+          for (int j = 0; j < 4; ++j) {
+            const std::uint32_t u = filler[8 * s + j];
+            mapped[8 * s + j] = (u & Tet3Mesh::kGhostBit) ? u : ids[u];
+            mapped[8 * s + 4 + j] = filler[8 * s + 4 + j];
+          }
+          if (mapped[8 * s] == kNone) continue;
+          bool on_boundary = false;
+          for (int j = 0; j < 4; ++j) {
+            const Face face = face_of(&mapped[8 * s], j);
+            const auto it = std::lower_bound(boundary.begin(), boundary.end(), std::pair(face, std::uint32_t(0)));
+            if (it == boundary.end() || it->first != face) continue;
+            outer[4 * s + j] = it->second;
+            ++matched[block];
+            on_boundary = true;
+          }
+          if (on_boundary) found[block].push_back(std::uint32_t(s));
+        }
+      },
+      1);
+  for (std::size_t block = 0; block < blocks; ++block)
+    for (const std::uint32_t s : found[block]) slot[s] = 0, fill.push_back(s);
+  if (std::accumulate(matched.begin(), matched.end(), std::size_t(0)) != boundary.size()) return false;
   for (std::size_t k = 0; k < fill.size(); ++k)
     for (int j = 0; j < 4; ++j) {
       const std::uint32_t s = fill[k], n = mapped[8 * std::size_t(s) + 4 + j] >> 2;
@@ -613,7 +634,7 @@ inline void canonical_positions(const std::uint32_t* v, std::uint8_t position[4]
 }
 }  // namespace
 
-void Delaunay3::canonicalize(std::size_t free) {
+void Delaunay3::canonicalize(std::size_t free, std::vector<std::uint32_t> storage) {
   const std::size_t slots = tets_.size() / 8;
   const std::size_t n = points_.size();
   // Where entry j of slot s goes (set for every live slot; the only ones read).
@@ -639,8 +660,8 @@ void Delaunay3::canonicalize(std::size_t free) {
   // The new slots' array, which holds the keys (five words each) until they
   // are sorted: fresh pages are slow to touch on this kind of machine, so the
   // keys take no pages of their own. Allocated (and zeroed) by task 0, the
-  // first a thread starts, while the others count.
-  std::vector<std::uint32_t> out;
+  // first a thread starts, while the others count, unless `storage` has room.
+  std::vector<std::uint32_t> out = std::move(storage);
   const auto put_key = [&](std::size_t i, const Key& key) { std::memcpy(&out[5 * i], &key, sizeof(Key)); };
   const auto key_at = [&](std::size_t i) {
     Key key;
@@ -696,7 +717,8 @@ void Delaunay3::canonicalize(std::size_t free) {
   }
   // The keys per partition; meanwhile (task 0, the first one a thread
   // starts) the arrays the sort fills are allocated: zeroing them is one
-  // thread's work, which the others' keys overlap.
+  // thread's work, which the others' keys overlap. (After a parallel build
+  // tetrahedra_ already has room, its pages touched.)
   std::vector<std::uint32_t> new_of;
   parallel_for_each_index(
       0, blocks + 1,

@@ -22,23 +22,40 @@ namespace {
 constexpr std::uint32_t kNone = Delaunay3::no_index;
 constexpr std::uint32_t kGhost = Tet3Mesh::kGhost;
 
-// The point of a convex polytope's vertices (given by their adjacency) that is
-// farthest along `direction`: a strict hill climb from `start` (on a convex
-// polytope a vertex that no neighbour beats is a maximum).
-std::uint32_t extreme_vertex(const std::vector<std::vector<std::uint32_t>>& adjacent, std::span<const Vec3d> points,
-                             const Vec3d& direction, std::uint32_t start) {
-  std::uint32_t best = start;
-  double value = direction.dot(points[best]);
-  for (bool moved = true; moved;) {
-    moved = false;
-    for (const std::uint32_t u : adjacent[best])
-      if (const double x = direction.dot(points[u]); x > value) {
-        best = u, value = x, moved = true;
-        break;
-      }
+// A convex polytope's vertex graph over its own vertices only (a few thousand:
+// an array over every point would be megabytes of fresh pages to clear).
+struct HullGraph {
+  std::vector<std::uint32_t> vertex;                 // the hull's vertices, ascending
+  std::vector<std::vector<std::uint32_t>> adjacent;  // per hull vertex: its neighbours' places in `vertex`
+
+  explicit HullGraph(const std::vector<Delaunay3::Triangle>& faces) {
+    for (const Delaunay3::Triangle& t : faces) vertex.insert(vertex.end(), t.begin(), t.end());
+    std::sort(vertex.begin(), vertex.end());
+    vertex.erase(std::unique(vertex.begin(), vertex.end()), vertex.end());
+    adjacent.resize(vertex.size());
+    const auto place = [&](std::uint32_t v) {
+      return std::uint32_t(std::lower_bound(vertex.begin(), vertex.end(), v) - vertex.begin());
+    };
+    for (const Delaunay3::Triangle& t : faces)
+      for (int k = 0; k < 3; ++k) adjacent[place(t[k])].push_back(place(t[(k + 1) % 3]));
   }
-  return best;
-}
+
+  // The vertex farthest along `direction` (its place): a strict hill climb from
+  // place `start` (on a convex polytope a vertex that no neighbour beats is a maximum).
+  std::uint32_t extreme(std::span<const Vec3d> points, const Vec3d& direction, std::uint32_t start) const {
+    std::uint32_t best = start;
+    double value = direction.dot(points[vertex[best]]);
+    for (bool moved = true; moved;) {
+      moved = false;
+      for (const std::uint32_t u : adjacent[best])
+        if (const double x = direction.dot(points[vertex[u]]); x > value) {
+          best = u, value = x, moved = true;
+          break;
+        }
+    }
+    return best;
+  }
+};
 
 constexpr std::size_t kBlock = 1 << 14;  // slots per block of the parallel passes over a half's slots
 
@@ -64,7 +81,8 @@ std::vector<T> gather_slots(std::size_t slots, const Fn& fn) {
 
 }  // namespace
 
-bool Delaunay3::build_split(const std::vector<std::uint32_t>& active, std::size_t& free) {
+bool Delaunay3::build_split(const std::vector<std::uint32_t>& active, std::size_t& free,
+                            std::vector<std::uint32_t>& storage) {
   double scale = 0;
   AABB3d bounds;
   for (const std::uint32_t i : active) {
@@ -115,32 +133,39 @@ bool Delaunay3::build_split(const std::vector<std::uint32_t>& active, std::size_
   const double far = 16 * extent / std::cbrt(double(active.size()));  // 16 mean spacings
   std::array<std::vector<std::uint8_t>, 2> valid;
   std::array<std::atomic<double>, 2> beyond{};  // per half: how far its pending spheres reach past the split
-  // Per half, its hull's vertex adjacency (for the extreme points the other half's hull faces ask for).
-  std::array<std::vector<std::vector<std::uint32_t>>, 2> hull_adjacent;
-  std::array<std::uint32_t, 2> hull_start{};
+  // Per half, its hull's vertex graph (for the extreme points the other half's hull faces ask for).
+  std::array<std::optional<HullGraph>, 2> hull_graph;
   // Each half, once built, indexes its hull and classifies its finite slots
   // (which need nothing of the other half) at once: the half built first
   // does not wait for the other, and its thread helps with the other's pass.
   std::array<Delaunay3, 2> half;
-  for (int h = 0; h < 2; ++h) hull_adjacent[h].resize(global[h].size());  // (allocated here, by the calling thread)
-  // Half 0's slots become the assembled array in place (fresh pages are slow
-  // to touch): room for every slot, prefaulted by half 0's build.
-  half[0].tets_.reserve(8 * 7 * active.size() + 64);
+  std::array<std::vector<std::uint32_t>, 2> vertex_global;  // per half: its vertices' points here
+  // Half 0's slots become the assembled array in place, and half 1's, once
+  // dead, the canonical order's new slots: room for every slot in both,
+  // prefaulted by the halves' builds (fresh pages are slow to touch, and so
+  // both threads touch them at once); and the public tetrahedra's, by the
+  // thread that is free first.
+  for (int h = 0; h < 2; ++h) half[h].tets_.reserve(8 * 7 * active.size() + 64);
   parallel_for_each_index(
-      0, 2,
+      0, 3,
       [&](std::size_t h) {
+        if (h == 2) {
+          detail::reserve_prefaulted(tetrahedra_, 4 * 7 * active.size() + 64);
+          return;
+        }
         Delaunay3& self = half[h];
         self.options_ = options_;
         detail::reserve_prefaulted(self.points_, global[h].size());
         self.points_.resize(global[h].size());
         for (std::size_t k = 0; k < global[h].size(); ++k) self.points_[k] = points_[global[h][k]];
-        self.build(options_, false);
+        // (vertices in insertion order: the passes below read their coordinates and global ids in order)
+        self.build(options_, false, &vertex_global[h]);
         if (self.dimension_ < 3) return;
-        for (const auto& t : self.hull())
-          for (int k = 0; k < 3; ++k) {
-            hull_adjacent[h][t[k]].push_back(t[(k + 1) % 3]);
-            hull_start[h] = t[0];
-          }
+        parallel_for(0, vertex_global[h].size(), 1 << 14, [&](std::size_t begin, std::size_t end) {
+          for (std::size_t k = begin; k < end; ++k)
+            if (vertex_global[h][k] != kNone) vertex_global[h][k] = global[h][vertex_global[h][k]];
+        });
+        hull_graph[h].emplace(self.hull());
         const std::size_t slots = self.tets_.size() / 8;
         detail::reserve_prefaulted(valid[h], slots);
         valid[h].assign(slots, seam_slot);
@@ -175,7 +200,7 @@ bool Delaunay3::build_split(const std::vector<std::uint32_t>& active, std::size_
     const Delaunay3& other = half[1 - h];
     const Vec3d* C = self.points_.data();
     parallel_for(0, valid[h].size(), 1 << 12, [&](std::size_t begin, std::size_t end) {
-      std::uint32_t climb = hull_start[1 - h];
+      std::uint32_t climb = 0;
       for (std::size_t s = begin; s < end; ++s) {
         if (valid[h][s] != hull_face) continue;
         valid[h][s] = seam_slot;
@@ -186,8 +211,8 @@ bool Delaunay3::build_split(const std::vector<std::uint32_t>& active, std::size_
         const Vec3d normal = (b - a).cross(c - a);  // outwards: the face is counter-clockwise seen from the ghost's side
         const double length = normal.norm();
         if (!(length > 0)) continue;
-        climb = extreme_vertex(hull_adjacent[1 - h], other.points_, normal, climb);
-        valid[h][s] = normal.dot(other.points_[climb] - a) / length < -tolerance ? kept : seam_slot;
+        climb = hull_graph[1 - h]->extreme(other.points_, normal, climb);
+        valid[h][s] = normal.dot(other.points_[hull_graph[1 - h]->vertex[climb]] - a) / length < -tolerance ? kept : seam_slot;
       }
     });
   }
@@ -219,7 +244,7 @@ bool Delaunay3::build_split(const std::vector<std::uint32_t>& active, std::size_
           const std::uint32_t* v = &half[h].tets_[8 * s];
           if (v[0] == kNone || valid[h][s]) return;
           for (int k = 0; k < 4; ++k)
-            if (v[k] != kGhost) out.push_back(global[h][v[k]]);
+            if (v[k] != kGhost) out.push_back(vertex_global[h][v[k]]);
         });
     seam.insert(seam.end(), more.begin(), more.end());
   }
@@ -236,7 +261,7 @@ bool Delaunay3::build_split(const std::vector<std::uint32_t>& active, std::size_
   for (std::size_t k = 0; k < seam.size(); ++k) filler.points_[k] = points_[seam[k]];
   const std::array<std::size_t, 2> base = {0, valid[0].size()};  // per half: its slots' first new number
   RegionFill seam_fill;  // its boundary: the face and the adjacency across it (new numbers)
-  const auto to_global = [&](int h, std::uint32_t v) { return v == kGhost ? kGhost : global[h][v]; };
+  const auto to_global = [&](int h, std::uint32_t v) { return v == kGhost ? kGhost : vertex_global[h][v]; };
   const auto collect_boundary = [&] {
     // The seam region's boundary: kept slots' faces towards doubtful ones, seen from the seam's side.
     using BoundaryFace = std::pair<RegionFill::Face, std::uint32_t>;
@@ -294,6 +319,7 @@ bool Delaunay3::build_split(const std::vector<std::uint32_t>& active, std::size_
       }
     });
   seam_fill.write(tets_);
+  storage = std::move(half[1].tets_);
   free = 0;  // (slots left free: the halves' free and seam slots)
   for (int h = 0; h < 2; ++h) free += std::size_t(std::count(valid[h].begin(), valid[h].end(), seam_slot));
   // Representatives: equal points fall in the same half, whose first occurrence is the first here too.

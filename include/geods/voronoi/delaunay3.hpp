@@ -198,13 +198,19 @@ class Delaunay3 {
   // vertices in insertion order, renumbered at the end): per slot eight words,
   // four vertices (the ghost for the infinite one, no_index in a free slot)
   // and four adjacencies, 4 * neighbour + the face's index in the neighbour.
-  void build(Options options, bool may_split = true);
-  // false: the halves cannot be stitched, build sequentially; `free`: how many slots it left free.
-  bool build_split(const std::vector<std::uint32_t>& active, std::size_t& free);
+  // With `vertex_points` (a half of a parallel build) the vertices keep their
+  // insertion order, which is coherent in space: points_ becomes the vertices'
+  // coordinates in that order and *vertex_points each vertex's point (no_index
+  // for a duplicate's); rep_ stays over the points.
+  void build(Options options, bool may_split = true, std::vector<std::uint32_t>* vertex_points = nullptr);
+  // false: the halves cannot be stitched, build sequentially; `free`: how many slots it left free;
+  // `storage`: a dead array, its pages touched, for canonicalize's new slots.
+  bool build_split(const std::vector<std::uint32_t>& active, std::size_t& free, std::vector<std::uint32_t>& storage);
   bool remove_locally(std::uint32_t v);  // false: the link is flat, rebuild instead
   // Slots in an order that depends only on the points; publishes them too. `free`: how many
-  // slots are free (sizes an array; a wrong count costs time only).
-  void canonicalize(std::size_t free);
+  // slots are free (sizes an array; a wrong count costs time only); `storage`: memory for
+  // the new slots (its contents are overwritten).
+  void canonicalize(std::size_t free, std::vector<std::uint32_t> storage = {});
   void publish();  // (only vertex_slot_ left to do right after canonicalize: `published_`)
   void index_vertices();  // vertex_slot_ from the slots
   std::uint32_t start_slot(std::uint32_t hint) const;  // a live slot to walk from
