@@ -202,10 +202,10 @@ GEODS_TERRAIN_AVX2_INLINE void rows4(__m256d& m, std::int64_t n, const Plane4& p
 template <int St>
 GEODS_TERRAIN_AVX2_INLINE void store4(float* err, std::int64_t n, std::int64_t x, std::int64_t y, std::int64_t s, std::int64_t W,
                                       std::int64_t H, __m256d m) {
-  alignas(16) float out[4];
-  _mm_store_ps(out, round_up4(m));
   float* e = err + y * n + x;
-  for (int j = 0; j < 4; ++j) e[St * j] = x + St * j + s > W - 1 || y + s > H - 1 ? kInf : out[j];
+  store4f<St>(e, round_up4(m));
+  for (int j = 0; j < 4; ++j)
+    if (x + St * j + s > W - 1 || y + s > H - 1) e[St * j] = kInf;
 }
 
 // The red vertices of row y (spacing S, N / S >= 16): both diagonals, four
