@@ -8,6 +8,7 @@
 #include <numbers>
 #include <string>
 
+#include "../core/prefault.hpp"
 #include "geods/bvh/traversal.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"
@@ -59,7 +60,8 @@ MeshDistance MeshDistance::build(const TriMesh& mesh, const bvh::BuildOptions& o
   if (mesh.num_triangles() == 0) throw Error("signed distance: the mesh has no faces");
   mesh.require_valid("signed distance");
   MeshDistance md;
-  md.faces_ = mesh.triangles;
+  detail::reserve_prefaulted(md.faces_, mesh.num_triangles());  // mapped at once: cheaper than a fault per page
+  md.faces_.assign(mesh.triangles.begin(), mesh.triangles.end());
   // The normals need only the mesh: they fill the threads the hierarchy's top levels leave idle.
   tbb::parallel_invoke([&] { md.bvh_ = bvh::TriangleBvh::build(mesh, options); }, [&] { md.fit_normals(mesh); });
   md.depth_ = md.bvh_.topology().depth();
@@ -73,7 +75,12 @@ void MeshDistance::fit_normals(const TriMesh& mesh) {
   const auto corner_vertex = [&](std::uint32_t c) { return id[faces_[c / 3][c % 3]]; };
   const auto next = [](std::uint32_t c) { return c % 3 == 2 ? c - 2 : c + 1; };
   const auto prev = [](std::uint32_t c) { return c % 3 == 0 ? c + 2 : c - 1; };
-  std::vector<Vec3d> normals(n);
+  // The large arrays mapped before they are written (a page fault per 4 KiB
+  // page cost about as much as the whole pass); no zeroing: every entry is written.
+  std::vector<Vec3d> normals;
+  detail::reserve_prefaulted(normals, n);
+  normals.resize(n);
+  detail::reserve_prefaulted(face_normals_, n);
   face_normals_.resize(n);
   parallel_for_each_index(0, n, [&](std::size_t f) {
     const Vec3d a = mesh.vertices[faces_[f][0]].cast<double>(), b = mesh.vertices[faces_[f][1]].cast<double>(),
@@ -86,7 +93,7 @@ void MeshDistance::fit_normals(const TriMesh& mesh) {
 
   // The corners c = 3 face + i at each welded vertex, in increasing order (a
   // counting sort), so that each vertex sums its corners in the order of the faces.
-  std::vector<std::uint32_t> first(nv + 1, 0), corners(3 * n);
+  std::vector<std::uint32_t> first(nv + 1, 0), corners = detail::prefaulted_vector<std::uint32_t>(3 * n);
   for (std::uint32_t c = 0; c < 3 * n; ++c) ++first[corner_vertex(c)];
   for (std::size_t v = 1; v <= nv; ++v) first[v] += first[v - 1];
   for (std::uint32_t c = std::uint32_t(3 * n); c-- > 0;) corners[--first[corner_vertex(c)]] = c;
@@ -94,7 +101,9 @@ void MeshDistance::fit_normals(const TriMesh& mesh) {
   // Per welded vertex w, in parallel: its angle-weighted normal, and the edges
   // whose smaller welded end is w: the normals of the faces on each are summed
   // in face order, and each direction is counted (closed: as often one way as the other).
+  detail::reserve_prefaulted(vertex_normals_, nv);
   vertex_normals_.resize(nv);
+  detail::reserve_prefaulted(edge_normals_, 3 * n);
   edge_normals_.resize(3 * n);
   std::atomic<bool> open{false};
   parallel_for(0, nv, 1024, [&](std::size_t b, std::size_t e) {
@@ -142,6 +151,7 @@ void MeshDistance::fit_normals(const TriMesh& mesh) {
 void MeshDistance::fit_moments() {
   const bvh::Topology& topo = bvh_.topology();
   const auto& tris = bvh_.triangles();
+  detail::reserve_prefaulted(moments_, topo.nodes.size());
   moments_.assign(topo.nodes.size(), Moment{});
   // Each node from its own range of triangles (O(n log n) in all).
   parallel_for_each_index(

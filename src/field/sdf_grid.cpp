@@ -10,7 +10,9 @@
 #include <array>
 #include <atomic>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
+#include <memory>
 #include <numeric>
 #include <span>
 #include <string>
@@ -21,6 +23,7 @@
 #include "../core/prefault.hpp"
 #include "geods/bvh/traversal.hpp"
 #include "geods/core/error.hpp"
+#include "geods/core/huge_page_allocator.hpp"
 #include "geods/core/morton.hpp"
 #include "geods/core/parallel.hpp"
 #include "geods/core/simd_level.hpp"
@@ -714,11 +717,16 @@ class GridSolver {
       : mesh_(mesh), grid_(grid), options_(options), tris_(mesh.triangles().data()),
         ids_(mesh.bvh().triangle_ids().data()) {
     const std::size_t n = mesh.triangles().size();
-    all_.reserve(n);
-    all_.size = n;
     if (n >= std::size_t(std::numeric_limits<std::int32_t>::max())) throw Error("sdf grid: too many faces");
     constexpr std::size_t kRow = Packed::k0 + 1;  // a row: the k0 quantities and the face
-    if (wide_ && n < std::size_t(std::numeric_limits<std::int32_t>::max()) / kRow) rows_.resize(n * kRow);
+    // Only the rows where they serve (all_ is then never read). Not zeroed: the fill below writes
+    // every entry, its threads touching the fresh pages (a serial zeroing cost more than the fill).
+    if (wide_ && n > 0 && n < std::size_t(std::numeric_limits<std::int32_t>::max()) / kRow) {
+      rows_.reset(static_cast<float*>(detail::allocate_huge_pages(n * kRow * sizeof(float), alignof(float))));
+    } else {
+      all_.reserve(n);
+      all_.size = n;
+    }
     parallel_for_each_index(0, n, [&](std::size_t i) {
       const BvhTriangle& t = tris_[i];
       const Vec3f ab = t.b - t.a, ac = t.c - t.a, bc = t.c - t.b, nn = ab.cross(ac);
@@ -728,12 +736,15 @@ class GridSolver {
           t.a.x(), t.a.y(), t.a.z(), ab.x(), ab.y(), ab.z(), ac.x(), ac.y(), ac.z(), nn.x(), nn.y(), nn.z(), d00, d01,
           d11, den > 0 ? 1 / den : 0.0f, nn2 > 0 && den > 0 ? 1 / nn2 : 0.0f, d00 > 0 ? 1 / d00 : 0.0f,
           d11 > 0 ? 1 / d11 : 0.0f, bc.squaredNorm() > 0 ? 1 / bc.squaredNorm() : 0.0f};
-      for (int k = 0; k < Packed::kFields; ++k) all_.f[k][i] = std::isfinite(values[k]) ? values[k] : 0.0f;
-      all_.leaf[i] = std::uint32_t(i);
-      all_.face[i] = std::int32_t(ids_[i]);
-      if (!rows_.empty()) {
-        for (int k = 0; k < Packed::k0; ++k) rows_[i * kRow + std::size_t(k)] = all_.f[k][i];
-        std::memcpy(&rows_[i * kRow + Packed::k0], &all_.face[i], sizeof(float));
+      const auto face = std::int32_t(ids_[i]);
+      if (rows_) {
+        for (int k = 0; k < Packed::k0; ++k)
+          rows_[i * kRow + std::size_t(k)] = std::isfinite(values[k]) ? values[k] : 0.0f;
+        std::memcpy(&rows_[i * kRow + Packed::k0], &face, sizeof(float));
+      } else {
+        for (int k = 0; k < Packed::kFields; ++k) all_.f[k][i] = std::isfinite(values[k]) ? values[k] : 0.0f;
+        all_.leaf[i] = std::uint32_t(i);
+        all_.face[i] = face;
       }
     });
     // Float rounding of distances is below this (relative to the scene's size).
@@ -1022,10 +1033,10 @@ class GridSolver {
         },
         mesh_.bvh().volumes());
 #ifdef GEODS_SDF_AVX512
-    if (!rows_.empty()) {  // from the rows: fewer cache lines than the columns of all_
+    if (rows_) {  // from the rows: fewer cache lines than the columns of all_
       near.clear();
       near.reserve(found.size());
-      avx512::gather_rows(rows_.data(), found.data(), found.size(), near.f, near.face.data());
+      avx512::gather_rows(rows_.get(), found.data(), found.size(), near.f, near.face.data());
       std::copy_n(found.data(), found.size(), near.leaf.data());  // all_'s leaves are its positions
       near.size = found.size();
     } else
@@ -1175,8 +1186,11 @@ class GridSolver {
   const BvhTriangle* tris_;
   const std::uint32_t* ids_;
   bool wide_ = simd_level() == SimdLevel::avx512;  // the AVX-512 kernels
-  Packed all_;                  // every triangle, in leaf order
-  std::vector<float> rows_;     // with AVX-512: all_'s first k0 quantities and face, entry by entry
+  struct Free {
+    void operator()(float* p) const { std::free(p); }
+  };
+  Packed all_;                          // every triangle, in leaf order (without rows_)
+  std::unique_ptr<float[], Free> rows_;  // with AVX-512: the first k0 quantities and face, entry by entry
   float margin_ = 0;
   float slack_ = 0;
   float band_ = kInf;
