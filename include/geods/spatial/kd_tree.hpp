@@ -53,6 +53,7 @@
 #include "geods/core/coordinate_range.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/flat_array.hpp"
+#include "geods/core/huge_page_allocator.hpp"
 #include "geods/core/parallel.hpp"
 #include "geods/core/vec.hpp"
 #include "geods/spatial/knn_result.hpp"
@@ -982,9 +983,11 @@ class KdTree {
     T x[kGroupDim][4];        // x[axis][lane]
     std::uint32_t index[4];  // kNoIndex in padding lanes
   };
+  // In huge pages (when large), as the BVH's nodes: a query's cache misses at random
+  // in 16 MB of groups (1M float 3D points) then cost no TLB miss (page walk) on top.
   struct Packed {
-    std::vector<PackedNode> nodes;
-    std::vector<Group> groups;
+    std::vector<PackedNode, HugePageAllocator<PackedNode>> nodes;
+    std::vector<Group, HugePageAllocator<Group>> groups;
   };
 
   // Whether tree_order is the packed layout (else the plain copy ordered_).
@@ -1083,6 +1086,7 @@ class KdTree {
         std::swap(near, far);
         cut = to_low * to_low;
       }
+      prefetch(far);
       enter(near, mindist);
       const T old = dists[axis];
       mindist += cut - old;
@@ -1091,6 +1095,15 @@ class KdTree {
         enter(far, mindist);
         dists[axis] = old;
       }
+    }
+
+    // The far child is fetched while the near one is searched: it is often visited next.
+    void prefetch(const Child& c) const {
+      if (c.count > leaf_size) {
+        __builtin_prefetch(nodes + c.node);
+        return;
+      }
+      for (std::uint32_t i = 0; i < c.count; i += 4) __builtin_prefetch(groups + c.group + i / 4);
     }
 
     void leaf(const Group* g, std::uint32_t count) const {
