@@ -473,44 +473,28 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray, 
   vf tmin_v;
   splat(tmin_v, tmin);
   TraversalStack<WideEntry> stack(traversal_stack_size(depth_, W));
-  // The arrays' addresses as locals: read through `this` and `nodes` they
-  // were reloaded (two dependent loads) at every node and leaf.
-  const WideNode<W>* const node_array = nodes.data();
-  const TriangleGroup* const groups = groups_.data();
   // Start fetching what a child needs, every cache line of it (a node: 2 or
-  // 4 lines; a leaf: its groups); the cache misses on nodes and triangles
-  // dominate incoherent rays.
+  // 4 lines; a leaf: its groups of 160 bytes, which straddle lines); the cache
+  // misses on nodes and triangles dominate incoherent rays.
   auto prefetch = [&](const WideEntry& e) GEODS_BVH_INLINE_LAMBDA {
     if (e.count == 0) {
-      const char* p = reinterpret_cast<const char*>(&node_array[e.child]);
+      const char* p = reinterpret_cast<const char*>(&nodes[e.child]);
       for (std::size_t k = 0; k < sizeof(WideNode<W>); k += 64) __builtin_prefetch(p + k);
       return;
     }
-    // A group (160 bytes, 32-byte aligned) lies on exactly 3 lines: at its
-    // start, +64 and +128. A loop per group, not per line: leaves have 1 or
-    // 2 groups, and a trip count of 3, 5 or 6 lines mispredicted its exit.
-    static_assert(sizeof(TriangleGroup) == 160 && alignof(TriangleGroup) == 32);
-    for (std::uint32_t g = e.child; g < e.child + e.count; ++g) {
-      const char* p = reinterpret_cast<const char*>(&groups[g]);
-      __builtin_prefetch(p);
-      __builtin_prefetch(p + 64);
-      __builtin_prefetch(p + 128);
-    }
+    const std::uintptr_t first = reinterpret_cast<std::uintptr_t>(&groups_[e.child]) & ~std::uintptr_t(63);
+    const std::uintptr_t last = reinterpret_cast<std::uintptr_t>(&groups_[e.child] + e.count) - 1;
+    for (std::uintptr_t p = first; p <= last; p += 64) __builtin_prefetch(reinterpret_cast<const void*>(p));
   };
   // Without a NaN among the slab distances (a finite origin, finite nonzero
-  // inverse directions, tmin and tmax not NaN) and with tmin >= 0 (so every
-  // entry distance is >= 0), the four-way max and min are taken as two levels
-  // of a tree instead of a chain, and instead of widening the far bound of
-  // each axis and tmax by kWiden = 1 + 6 2^-24, the nearest entry is shrunk
-  // once by kShrink = 1 - 8 2^-24: tn kShrink <= tf holds whenever
-  // tn <= tf kWiden did (rounding included), so no box the chain enters is
-  // dropped, and the keys (tn) are the chain's: the same visiting order, the
-  // same hits; two multiplications fewer per node, one fewer on the far
-  // bounds' dependency chain.
-  bool no_nan = !std::isnan(tmin) && !std::isnan(tmax) && tmin >= 0;
+  // inverse directions, tmin and tmax not NaN) the four-way max and min are
+  // taken as two levels of a tree instead of a chain, with the far bound
+  // widened per axis (x -> x (1 + 4e-7) rounds monotonically, so the minimum
+  // of the widened values is the widened minimum): the same values and mask
+  // as the chain, a shorter dependency chain from a node's bounds to its mask.
+  bool no_nan = !std::isnan(tmin) && !std::isnan(tmax);
   for (int a = 0; a < 3; ++a) no_nan = no_nan && std::isfinite(ray.origin[a]) && std::isfinite(inv[a][0]) && inv[a][0] != 0.0f;
   constexpr float kWiden = 1.0f + 4e-7f;
-  constexpr float kShrink = 1.0f - 0x1p-21f;
   auto mask_bits = [&](const auto& m) GEODS_BVH_INLINE_LAMBDA {
 #if defined(GEODS_BVH_SIMD_DISPATCH)
     if constexpr (Avx && W == 8) return lane_bits_avx(m);
@@ -527,7 +511,7 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray, 
     t1 = (hi - org[a]) * inv[a];
   };
   auto children = [&](const WideEntry& e, float* keys) GEODS_BVH_INLINE_LAMBDA {
-    const WideNode<W>& node = node_array[e.child];
+    const WideNode<W>& node = nodes[e.child];
     vf tmax_v;
     splat(tmax_v, tmax);
     if (no_nan) [[likely]] {
@@ -535,14 +519,18 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray, 
       slab(node, 0, t0x, t1x);
       slab(node, 1, t0y, t1y);
       slab(node, 2, t0z, t1z);
+      t1x *= kWiden;
+      t1y *= kWiden;
+      t1z *= kWiden;
       const vf n01 = t0x > t0y ? t0x : t0y;
       const vf n2 = t0z > tmin_v ? t0z : tmin_v;
       const vf tn = n01 > n2 ? n01 : n2;
       const vf f01 = t1x < t1y ? t1x : t1y;
-      const vf f2 = t1z < tmax_v ? t1z : tmax_v;
+      const vf tmw = tmax_v * kWiden;
+      const vf f2 = t1z < tmw ? t1z : tmw;
       const vf tf = f01 < f2 ? f01 : f2;
       std::memcpy(keys, &tn, sizeof tn);
-      return mask_bits(tn * kShrink <= tf);
+      return mask_bits(tn <= tf);
     }
     vf tn = tmin_v, tf = tmax_v;
     for (int a = 0; a < 3; ++a) {
@@ -557,14 +545,14 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray, 
     return mask_bits(tn <= tf * kWiden);
   };
   auto child = [&](const WideEntry& e, int i, float t) GEODS_BVH_INLINE_LAMBDA {
-    const WideEntry c{node_array[e.child].child[i], node_array[e.child].count[i], t};
+    const WideEntry c{nodes[e.child].child[i], nodes[e.child].count[i], t};
     prefetch(c);
     return c;
   };
   auto leaf = [&](const WideEntry& e) GEODS_BVH_INLINE_LAMBDA {
     for (std::uint32_t g = e.child; g < e.child + e.count; ++g) {
       RayTriangle4Test::vf t, u, v;
-      const int mask = test.intersect(groups[g], tmin, tmax, t, u, v);
+      const int mask = test.intersect(groups_[g], tmin, tmax, t, u, v);
       if (mask == 0) continue;
       // The nearest lane, ties to the last one: what testing the triangles
       // one after the other, each against the shrinking tmax, would keep.
@@ -575,7 +563,7 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray, 
           if ((mask >> i & 1) && t[i] <= t[best]) best = i;
       }
       tmax = t[best];
-      hit = {t[best], groups[g].index[best], u[best], v[best]};
+      hit = {t[best], groups_[g].index[best], u[best], v[best]};
       if (any) return false;
     }
     return true;
