@@ -189,7 +189,7 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
   // the packet's ranges bound every lane's (a NaN from 0 * inf drops the
   // axis, as it does for the lane). A child this rejects, every lane's own
   // slab test rejects too.
-  auto frustum = [&](const WideNode<W>& node) GEODS_BVH_INLINE_LAMBDA {
+  auto frustum = [&](const WideNode<W>& node, float* near_out) GEODS_BVH_INLINE_LAMBDA {
     using vw = typename WideVector<W>::vf;
     vw tn = wide_splat<W>(tmin_lo), tf = wide_splat<W>(tmax_hi);
     for (int a = 0; a < 3; ++a) {
@@ -211,14 +211,18 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
       tn = near > tn ? near : tn;
       tf = far < tf ? far : tf;
     }
+    std::memcpy(near_out, &tn, sizeof tn);
     return wide_bits(tn <= tf * wide_splat<W>(widen));
   };
+  // With all three axes in the frustum its entry distance orders the
+  // children (a lower bound of every lane's); else the lanes' nearest entry.
+  const bool frustum_keys = same_sign[0] && same_sign[1] && same_sign[2];
   // Per child of the node being opened: the lanes that enter it.
   std::uint32_t child_mask[W];
   auto children = [&](const PacketEntry& e, float* keys) GEODS_BVH_INLINE_LAMBDA {
     const std::uint32_t lanes = e.mask & ~done;
     const WideNode<W>& node = nodes[e.child];
-    unsigned candidates = frustum(node);
+    unsigned candidates = frustum(node, keys);
     unsigned bits = 0;
     for (; candidates != 0; candidates &= candidates - 1) {
       const int c = __builtin_ctz(candidates);
@@ -238,7 +242,7 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
       const std::uint32_t m = lanes & lane_bits(enter);
       if (m == 0) continue;
       child_mask[c] = m;
-      keys[c] = lane_min(lane_mask(m) ? tn : inf);
+      if (!frustum_keys) keys[c] = lane_min(lane_mask(m) ? tn : inf);
       bits |= 1u << c;
     }
     return bits;
