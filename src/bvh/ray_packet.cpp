@@ -43,11 +43,8 @@ GEODS_BVH_INLINE unsigned lane_bits(vi m) {
 #endif
 }
 
-GEODS_BVH_INLINE vf splat(float x) {
-  vf r;
-  for (int i = 0; i < P; ++i) r[i] = x;
-  return r;
-}
+// (vector + scalar: one broadcast; a lane-by-lane loop compiles to inserts.)
+GEODS_BVH_INLINE vf splat(float x) { return vf{} + x; }
 
 // W-wide vectors over the children of a node.
 template <int W>
@@ -57,9 +54,7 @@ struct WideVector {
 };
 template <int W>
 GEODS_BVH_INLINE typename WideVector<W>::vf wide_splat(float x) {
-  typename WideVector<W>::vf r;
-  for (int i = 0; i < W; ++i) r[i] = x;
-  return r;
+  return typename WideVector<W>::vf{} + x;
 }
 template <typename V>
 GEODS_BVH_INLINE V nan_min(V a, V b) {  // a NaN in either gives NaN
@@ -86,9 +81,9 @@ GEODS_BVH_INLINE unsigned wide_bits(M m) {
 
 // Lane i's bit of `bits` as a vector mask (all ones where set).
 GEODS_BVH_INLINE vi lane_mask(std::uint32_t bits) {
-  vi b, one;
-  for (int i = 0; i < P; ++i) b[i] = std::int32_t(bits), one[i] = 1 << i;
-  return (b & one) != 0;
+  vi one;
+  for (int i = 0; i < P; ++i) one[i] = 1 << i;
+  return ((vi{} + std::int32_t(bits)) & one) != 0;
 }
 
 // The least (greatest) lane of x.
@@ -313,9 +308,7 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
           }
         }
         if (hits == 0) continue;
-        vi prim;
-        for (int i = 0; i < P; ++i) prim[i] = std::int32_t(group.index[k]);
-        record(hits, t, prim, u, v);
+        record(hits, t, vi{} + std::int32_t(group.index[k]), u, v);
         lanes &= ~done;
       }
     }
