@@ -18,6 +18,10 @@
 #if defined(__SSE__)
 #include <xmmintrin.h>
 #endif
+#if defined(__x86_64__) && defined(__GNUC__)
+#include <immintrin.h>
+#define GEODS_PACKET_SIMD_DISPATCH 1
+#endif
 
 // 8-lane vectors are passed between inlined helpers only.
 #pragma GCC diagnostic ignored "-Wpsabi"
@@ -30,8 +34,19 @@ constexpr int P = kPacketSize;
 typedef float vf __attribute__((vector_size(4 * P)));
 typedef std::int32_t vi __attribute__((vector_size(4 * P)));
 
-// Bit i set where lane i of a comparison result is true.
+#if defined(GEODS_PACKET_SIMD_DISPATCH)
+// One movemask for the 8 lanes; inlined only into the AVX kernels (their flatten).
+__attribute__((target("avx"))) inline unsigned lane_bits_avx(vi m) {
+  return unsigned(_mm256_movemask_ps(reinterpret_cast<__m256>(m)));
+}
+#endif
+
+// Bit i set where lane i of a comparison result is true (Avx: the caller runs AVX).
+template <bool Avx>
 GEODS_BVH_INLINE unsigned lane_bits(vi m) {
+#if defined(GEODS_PACKET_SIMD_DISPATCH)
+  if constexpr (Avx) return lane_bits_avx(m);
+#endif
 #if defined(__SSE__)
   __m128 half[2];
   std::memcpy(half, &m, sizeof half);
@@ -64,11 +79,11 @@ template <typename V>
 GEODS_BVH_INLINE V nan_max(V a, V b) {
   return (a > b) | (a != a) ? a : b;
 }
-template <typename M>
+template <bool Avx, typename M>
 GEODS_BVH_INLINE unsigned wide_bits(M m) {
   unsigned bits = 0;
   if constexpr (sizeof(M) == 32) {
-    return lane_bits(m);
+    return lane_bits<Avx>(m);
   } else {
 #if defined(__SSE__)
     bits = unsigned(_mm_movemask_ps(reinterpret_cast<__m128>(m)));
@@ -112,7 +127,7 @@ bool alone(const Ray3f& r) {
 // The traversal of the active lanes of `packet`; `any`: occlusion (a lane
 // stops at its first hit). Lanes in `ambiguous` found two different
 // triangles at their closest t: the caller shoots them alone.
-template <int W>
+template <int W, bool Avx>
 GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const FlatArray<TriangleGroup>& groups,
                                       int depth, const RayPacket& packet, std::uint32_t active, bool any,
                                       HitPacket& out, std::uint32_t& done, std::uint32_t& ambiguous) {
@@ -142,8 +157,8 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
   const vi z1 = adir[1] > adir[0];
   const vi z2 = adir[2] > (z1 ? adir[1] : adir[0]);
   const vf dz = z2 ? dir[2] : z1 ? dir[1] : dir[0];
-  const unsigned kz_bits[2] = {lane_bits(z1 & ~z2) & active, lane_bits(z2) & active};
-  const unsigned negz = lane_bits(dz < splat(0.0f)) & active;
+  const unsigned kz_bits[2] = {lane_bits<Avx>(z1 & ~z2) & active, lane_bits<Avx>(z2) & active};
+  const unsigned negz = lane_bits<Avx>(dz < splat(0.0f)) & active;
   const bool same_axes = (kz_bits[0] == 0 || kz_bits[0] == active) && (kz_bits[1] == 0 || kz_bits[1] == active) &&
                          (negz == 0 || negz == active);
   int kz = kz_bits[1] ? 2 : kz_bits[0] ? 1 : 0, kx = (kz + 1) % 3, ky = (kx + 1) % 3;
@@ -163,7 +178,7 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
   for (int a = 0; a < 3; ++a) {
     o_lo[a] = lane_min(org[a]), o_hi[a] = lane_max(org[a]);
     i_lo[a] = lane_min(inv[a]), i_hi[a] = lane_max(inv[a]);
-    const unsigned negatives = lane_bits(neg[a]) & active;
+    const unsigned negatives = lane_bits<Avx>(neg[a]) & active;
     same_sign[a] = negatives == 0 || negatives == active;
   }
   const float tmin_lo = lane_min(tmin_v);
@@ -176,7 +191,7 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
   // of the single ray). Lanes that entered later are dropped by the tests below it.
   auto live = [&](const PacketEntry& e) GEODS_BVH_INLINE_LAMBDA {
     const vf slack = (hit_t < splat(0.0f) ? -hit_t : hit_t) * splat(4e-7f);
-    return e.mask & ~done & lane_bits(splat(e.key) <= hit_t + slack);
+    return e.mask & ~done & lane_bits<Avx>(splat(e.key) <= hit_t + slack);
   };
   // The children that some lane may enter, all W at once: a lane's entry
   // and exit distances along an axis are products of (bound - origin) and the
@@ -207,7 +222,7 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
       tf = far < tf ? far : tf;
     }
     std::memcpy(near_out, &tn, sizeof tn);
-    return wide_bits(tn <= tf * wide_splat<W>(widen));
+    return wide_bits<Avx>(tn <= tf * wide_splat<W>(widen));
   };
   // With all three axes in the frustum its entry distance orders the
   // children (a lower bound of every lane's); else the lanes' nearest entry.
@@ -234,7 +249,7 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
         tf = far < tf ? far : tf;
       }
       const vi enter = tn <= tf * splat(widen);
-      const std::uint32_t m = lanes & lane_bits(enter);
+      const std::uint32_t m = lanes & lane_bits<Avx>(enter);
       if (m == 0) continue;
       child_mask[c] = m;
       if (!frustum_keys) keys[c] = lane_min(lane_mask(m) ? tn : inf);
@@ -260,8 +275,8 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
   auto record = [&](std::uint32_t hits, vf t, vi prim, vf u, vf v) GEODS_BVH_INLINE_LAMBDA {
     const vi m = lane_mask(hits);
     const vi had = hit_prim != (vi{} - 1);
-    ambiguous &= ~lane_bits(m & had & (t < hit_t));
-    ambiguous |= lane_bits(m & had & (t == hit_t) & (prim != hit_prim));
+    ambiguous &= ~lane_bits<Avx>(m & had & (t < hit_t));
+    ambiguous |= lane_bits<Avx>(m & had & (t == hit_t) & (prim != hit_prim));
     hit_t = m ? t : hit_t;
     hit_prim = m ? prim : hit_prim;
     hit_u = m ? u : hit_u;
@@ -290,12 +305,12 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
         const vi mixed = ((eu < zero) | (ev < zero) | (ew < zero)) & ((eu > zero) | (ev > zero) | (ew > zero));
         const vf det = eu + ev + ew;
         const vi inside = ~mixed & ~on_edge & (det != zero) & (det - det == zero);
-        const std::uint32_t edge = lane_bits(on_edge) & lanes;
-        if ((lane_bits(inside) & lanes) == 0 && edge == 0) continue;
+        const std::uint32_t edge = lane_bits<Avx>(on_edge) & lanes;
+        if ((lane_bits<Avx>(inside) & lanes) == 0 && edge == 0) continue;
         const vf scaled_t = eu * (sh_z * pz[0]) + ev * (sh_z * pz[1]) + ew * (sh_z * pz[2]);
         const vf inv_det = splat(1.0f) / det;
         vf t = scaled_t * inv_det, u = ev * inv_det, v = ew * inv_det;
-        std::uint32_t hits = lane_bits(inside & (t >= tmin_v) & (t <= hit_t)) & lanes;
+        std::uint32_t hits = lane_bits<Avx>(inside & (t >= tmin_v) & (t <= hit_t)) & lanes;
         for (std::uint32_t b = edge; b != 0; b &= b - 1) {  // the scalar test's double-precision path
           const int i = __builtin_ctz(b);
           const Vec3f a(group.corner[0][0][k], group.corner[0][1][k], group.corner[0][2][k]);
@@ -354,7 +369,7 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
   } else {
     traverse<W, true>(root, stack, is_leaf, children, child, leaf, still_needed);
   }
-  for (std::uint32_t b = active & lane_bits(hit_prim != (vi{} - 1)); b != 0; b &= b - 1) {
+  for (std::uint32_t b = active & lane_bits<Avx>(hit_prim != (vi{} - 1)); b != 0; b &= b - 1) {
     const int i = __builtin_ctz(b);
     out.hits[i] = {hit_t[i], std::uint32_t(hit_prim[i]), hit_u[i], hit_v[i]};
   }
@@ -364,30 +379,29 @@ template <int W>
 void packet_portable(const FlatArray<WideNode<W>>& nodes, const FlatArray<TriangleGroup>& groups, int depth,
                      const RayPacket& packet, std::uint32_t active, bool any, HitPacket& out, std::uint32_t& done,
                      std::uint32_t& ambiguous) {
-  packet_traverse<W>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
+  packet_traverse<W, false>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
 }
 
-#if defined(__x86_64__) && defined(__GNUC__)
-#define GEODS_PACKET_SIMD_DISPATCH 1
+#if defined(GEODS_PACKET_SIMD_DISPATCH)
 template <int W>
 __attribute__((target("avx"), flatten)) void packet_avx(const FlatArray<WideNode<W>>& nodes,
                                                          const FlatArray<TriangleGroup>& groups, int depth,
                                                          const RayPacket& packet, std::uint32_t active, bool any,
                                                          HitPacket& out, std::uint32_t& done,
                                                          std::uint32_t& ambiguous) {
-  packet_traverse<W>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
+  packet_traverse<W, true>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
 }
 template <int W>
 __attribute__((target("avx2,bmi,bmi2,lzcnt,popcnt"), flatten)) void packet_avx2(
     const FlatArray<WideNode<W>>& nodes, const FlatArray<TriangleGroup>& groups, int depth, const RayPacket& packet,
     std::uint32_t active, bool any, HitPacket& out, std::uint32_t& done, std::uint32_t& ambiguous) {
-  packet_traverse<W>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
+  packet_traverse<W, true>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
 }
 template <int W>
 __attribute__((target("avx512f,avx512vl,avx512bw,avx512dq,avx2,bmi,bmi2,lzcnt,popcnt"), flatten)) void packet_avx512(
     const FlatArray<WideNode<W>>& nodes, const FlatArray<TriangleGroup>& groups, int depth, const RayPacket& packet,
     std::uint32_t active, bool any, HitPacket& out, std::uint32_t& done, std::uint32_t& ambiguous) {
-  packet_traverse<W>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
+  packet_traverse<W, true>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
 }
 #endif
 
