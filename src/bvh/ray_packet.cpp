@@ -58,8 +58,13 @@ GEODS_BVH_INLINE unsigned lane_bits(vi m) {
 #endif
 }
 
-// (vector + scalar: one broadcast; a lane-by-lane loop compiles to inserts.)
-GEODS_BVH_INLINE vf splat(float x) { return vf{} + x; }
+// (A shuffle of lane 0 compiles to one broadcast; an initializer list or a
+// lane-by-lane loop to inserts, vector + scalar to an addition of zero too.)
+static_assert(P == 8);
+GEODS_BVH_INLINE vf splat(float x) {
+  const vf v = {x};
+  return __builtin_shufflevector(v, v, 0, 0, 0, 0, 0, 0, 0, 0);
+}
 
 // W-wide vectors over the children of a node.
 template <int W>
@@ -69,15 +74,12 @@ struct WideVector {
 };
 template <int W>
 GEODS_BVH_INLINE typename WideVector<W>::vf wide_splat(float x) {
-  return typename WideVector<W>::vf{} + x;
-}
-template <typename V>
-GEODS_BVH_INLINE V nan_min(V a, V b) {  // a NaN in either gives NaN
-  return (a < b) | (a != a) ? a : b;
-}
-template <typename V>
-GEODS_BVH_INLINE V nan_max(V a, V b) {
-  return (a > b) | (a != a) ? a : b;
+  const typename WideVector<W>::vf v = {x};
+  if constexpr (W == 8) {
+    return __builtin_shufflevector(v, v, 0, 0, 0, 0, 0, 0, 0, 0);
+  } else {
+    return __builtin_shufflevector(v, v, 0, 0, 0, 0);
+  }
 }
 template <bool Avx, typename M>
 GEODS_BVH_INLINE unsigned wide_bits(M m) {
@@ -170,17 +172,26 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
     for (std::uint32_t b = active; b != 0; b &= b - 1) new (&tests[__builtin_ctz(b)]) RayTriangle4Test(packet.rays[__builtin_ctz(b)]);
   // The packet's bounds for the frustum test (interval arithmetic over the
   // lanes): per axis the range of the origins and of the inverse directions,
-  // used where every lane's inverse direction has the same sign.
+  // used where every lane's inverse direction is finite and of the same sign;
+  // there the near and far bound rows of a node are the same for every lane.
   const vf inf = splat(std::numeric_limits<float>::infinity());
   const vi active_v = lane_mask(active);
-  float o_lo[3], o_hi[3], i_lo[3], i_hi[3];
-  bool same_sign[3];
+  using vw = typename WideVector<W>::vf;
+  bool in_frustum[3];
+  int near_row[3], far_row[3];
+  vw near_o[3], far_o[3], i_lo[3], i_hi[3];
   for (int a = 0; a < 3; ++a) {
-    o_lo[a] = lane_min(org[a]), o_hi[a] = lane_max(org[a]);
-    i_lo[a] = lane_min(inv[a]), i_hi[a] = lane_max(inv[a]);
+    const float o_lo = lane_min(org[a]), o_hi = lane_max(org[a]), inv_lo = lane_min(inv[a]), inv_hi = lane_max(inv[a]);
     const unsigned negatives = lane_bits<Avx>(neg[a]) & active;
-    same_sign[a] = negatives == 0 || negatives == active;
+    in_frustum[a] = (negatives == 0 || negatives == active) && std::isfinite(inv_lo) && std::isfinite(inv_hi);
+    const bool positive = negatives == 0;
+    near_row[a] = positive ? 2 * a : 2 * a + 1;  // entering at lo - origin: least at the largest origin
+    far_row[a] = positive ? 2 * a + 1 : 2 * a;
+    near_o[a] = wide_splat<W>(positive ? o_hi : o_lo);
+    far_o[a] = wide_splat<W>(positive ? o_lo : o_hi);
+    i_lo[a] = wide_splat<W>(inv_lo), i_hi[a] = wide_splat<W>(inv_hi);
   }
+  const bool same_signs = in_frustum[0] && in_frustum[1] && in_frustum[2];
   const float tmin_lo = lane_min(tmin_v);
   // The greatest tmax of the lanes still running: the frustum's far end.
   float tmax_hi = lane_max(active_v ? hit_t : -inf);
@@ -196,28 +207,19 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
   // The children that some lane may enter, all W at once: a lane's entry
   // and exit distances along an axis are products of (bound - origin) and the
   // inverse direction, and rounding is monotone, so the extreme products of
-  // the packet's ranges bound every lane's (a NaN from 0 * inf drops the
-  // axis, as it does for the lane). A child this rejects, every lane's own
-  // slab test rejects too.
+  // the packet's ranges bound every lane's (finite inverses: no NaN). A child
+  // this rejects, every lane's own slab test rejects too.
   auto frustum = [&](const WideNode<W>& node, float* near_out) GEODS_BVH_INLINE_LAMBDA {
-    using vw = typename WideVector<W>::vf;
     vw tn = wide_splat<W>(tmin_lo), tf = wide_splat<W>(tmax_hi);
     for (int a = 0; a < 3; ++a) {
-      if (!same_sign[a]) continue;
-      vw lo, hi;
-      std::memcpy(&lo, node.bounds[2 * a], sizeof lo);
-      std::memcpy(&hi, node.bounds[2 * a + 1], sizeof hi);
-      const vw i0 = wide_splat<W>(i_lo[a]), i1 = wide_splat<W>(i_hi[a]);
-      vw near, far;
-      if (i_lo[a] >= 0) {  // entering at lo - origin: least at the largest origin
-        const vw lo_min = lo - wide_splat<W>(o_hi[a]), hi_max = hi - wide_splat<W>(o_lo[a]);
-        near = nan_min(lo_min * i0, lo_min * i1);
-        far = nan_max(hi_max * i0, hi_max * i1);
-      } else {  // negative inverse: entering at hi, exiting at lo
-        const vw hi_max = hi - wide_splat<W>(o_lo[a]), lo_min = lo - wide_splat<W>(o_hi[a]);
-        near = nan_min(hi_max * i0, hi_max * i1);
-        far = nan_max(lo_min * i0, lo_min * i1);
-      }
+      if (!in_frustum[a]) continue;
+      vw n, f;
+      std::memcpy(&n, node.bounds[near_row[a]], sizeof n);
+      std::memcpy(&f, node.bounds[far_row[a]], sizeof f);
+      n -= near_o[a];
+      f -= far_o[a];
+      const vw near_lo = n * i_lo[a], near_hi = n * i_hi[a], far_lo = f * i_lo[a], far_hi = f * i_hi[a];
+      const vw near = near_lo < near_hi ? near_lo : near_hi, far = far_lo > far_hi ? far_lo : far_hi;
       tn = near > tn ? near : tn;
       tf = far < tf ? far : tf;
     }
@@ -226,7 +228,6 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
   };
   // With all three axes in the frustum its entry distance orders the
   // children (a lower bound of every lane's); else the lanes' nearest entry.
-  const bool frustum_keys = same_sign[0] && same_sign[1] && same_sign[2];
   // Per child of the node being opened: the lanes that enter it.
   std::uint32_t child_mask[W];
   auto children = [&](const PacketEntry& e, float* keys) GEODS_BVH_INLINE_LAMBDA {
@@ -241,18 +242,25 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
       for (int a = 0; a < 3; ++a) {
         // The single ray's slab test, lane by lane: the near bound by the
         // sign of the inverse direction, NaNs (0 * inf) leave the interval.
-        const vf t_lo = (splat(node.bounds[2 * a][c]) - org[a]) * inv[a];
-        const vf t_hi = (splat(node.bounds[2 * a + 1][c]) - org[a]) * inv[a];
-        const vf near = neg[a] ? t_hi : t_lo;
-        const vf far = neg[a] ? t_lo : t_hi;
-        tn = near > tn ? near : tn;
-        tf = far < tf ? far : tf;
+        if (same_signs) {
+          const vf near = (splat(node.bounds[near_row[a]][c]) - org[a]) * inv[a];
+          const vf far = (splat(node.bounds[far_row[a]][c]) - org[a]) * inv[a];
+          tn = near > tn ? near : tn;
+          tf = far < tf ? far : tf;
+        } else {
+          const vf t_lo = (splat(node.bounds[2 * a][c]) - org[a]) * inv[a];
+          const vf t_hi = (splat(node.bounds[2 * a + 1][c]) - org[a]) * inv[a];
+          const vf near = neg[a] ? t_hi : t_lo;
+          const vf far = neg[a] ? t_lo : t_hi;
+          tn = near > tn ? near : tn;
+          tf = far < tf ? far : tf;
+        }
       }
       const vi enter = tn <= tf * splat(widen);
       const std::uint32_t m = lanes & lane_bits<Avx>(enter);
       if (m == 0) continue;
       child_mask[c] = m;
-      if (!frustum_keys) keys[c] = lane_min(lane_mask(m) ? tn : inf);
+      if (!same_signs) keys[c] = lane_min(lane_mask(m) ? tn : inf);
       bits |= 1u << c;
     }
     return bits;
