@@ -168,8 +168,7 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
   const vf sh_x = dir[kx] / dir[kz], sh_y = dir[ky] / dir[kz], sh_z = splat(1.0f) / dir[kz];
   alignas(64) unsigned char test_storage[P][sizeof(RayTriangle4Test)];
   RayTriangle4Test* tests = reinterpret_cast<RayTriangle4Test*>(test_storage);
-  if (!same_axes)
-    for (std::uint32_t b = active; b != 0; b &= b - 1) new (&tests[__builtin_ctz(b)]) RayTriangle4Test(packet.rays[__builtin_ctz(b)]);
+  std::uint32_t built = 0;  // lanes whose tests[] is set up (on first use)
   // The packet's bounds for the frustum test (interval arithmetic over the
   // lanes): per axis the range of the origins and of the inverse directions,
   // used where every lane's inverse direction is finite and of the same sign;
@@ -338,6 +337,8 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
   };
   // Otherwise each lane tests the groups 4 triangles at a time.
   auto leaf_lanes = [&](const PacketEntry& e, std::uint32_t lanes) GEODS_BVH_INLINE_LAMBDA {
+    for (std::uint32_t b = lanes & ~built; b != 0; b &= b - 1) new (&tests[__builtin_ctz(b)]) RayTriangle4Test(packet.rays[__builtin_ctz(b)]);
+    built |= lanes;
     for (std::uint32_t g = e.child; g < e.child + e.count && lanes != 0; ++g) {
       const TriangleGroup& group = groups[g];
       for (std::uint32_t b = lanes; b != 0; b &= b - 1) {
@@ -361,7 +362,9 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
   auto leaf = [&](const PacketEntry& e) GEODS_BVH_INLINE_LAMBDA {
     const std::uint32_t lanes = live(e);
     if (lanes == 0) return true;
-    if (same_axes) {
+    // A triangle against all lanes costs about what a group of 4 costs one
+    // lane: with fewer than 3 lanes in the leaf, each lane tests the groups.
+    if (same_axes && __builtin_popcount(lanes) >= 3) {
       leaf_rays(e, lanes);
     } else {
       leaf_lanes(e, lanes);
