@@ -112,8 +112,8 @@ GEODS_BVH_INLINE float lane_min(vf x) {
 GEODS_BVH_INLINE float lane_max(vf x) { return -lane_min(-x); }
 
 // A child waiting to be visited (an inner WideNode, count 0, or a leaf's
-// groups), with the lanes that entered its box and the nearest of their
-// entries, the key the children are ordered by.
+// groups), with the lanes that entered its box and a lower bound of their
+// entries into it, the key the children are ordered by.
 struct PacketEntry {
   std::uint32_t child, count;
   float key;
@@ -225,9 +225,9 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
     std::memcpy(near_out, &tn, sizeof tn);
     return wide_bits<Avx>(tn <= tf * wide_splat<W>(widen));
   };
-  // With all three axes in the frustum its entry distance orders the
-  // children (a lower bound of every lane's); else the lanes' nearest entry.
-  // Per child of the node being opened: the lanes that enter it.
+  // Per child of the node being opened: the lanes that enter it. With all
+  // three axes in the frustum, its entry distance (a lower bound of every
+  // lane's) is the child's key; else the lanes' nearest entry.
   std::uint32_t child_mask[W];
   auto children = [&](const PacketEntry& e, float* keys) GEODS_BVH_INLINE_LAMBDA {
     const std::uint32_t lanes = e.mask & ~done;
