@@ -8,9 +8,9 @@
 // against all children at once, and each child it keeps against all active
 // rays (one 8-lane slab test; a child is visited when any lane hits it, with
 // the mask of the lanes that do). At a leaf, when every ray is sheared along
-// the same axes (coherent packets) and at least 3 lanes are live, each
-// triangle is tested against all lanes at once; else each live ray tests the
-// leaf's triangle groups (RayTriangle4Test).
+// the same axes (coherent packets), at least 3 lanes are live and the CPU
+// runs AVX, each triangle is tested against all lanes at once; else each
+// live ray tests the leaf's triangle groups (RayTriangle4Test).
 //
 // Each ray's answer is bit-identical to the single-ray query: the slab test
 // of a lane is the single-ray test's arithmetic, the triangle test is the
