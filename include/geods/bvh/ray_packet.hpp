@@ -4,10 +4,13 @@
 // Embree's rtcIntersect8/rtcOccluded8). A packet holds up to kPacketSize = 8
 // rays (one AVX register of floats per ray attribute) and an active mask. The
 // rays share every node fetch, stack entry and ordering decision: at each
-// wide node each child box is tested against all active rays of the packet
-// at once (one 8-lane slab test per child; a child is visited when any lane
-// hits it, with the mask of the lanes that do), and at a leaf every ray
-// still active in it tests the leaf's triangle groups (RayTriangle4Test).
+// wide node the packet's frustum (interval bounds of its rays) is tested
+// against all children at once, and each child it keeps against all active
+// rays (one 8-lane slab test; a child is visited when any lane hits it, with
+// the mask of the lanes that do). At a leaf, when every ray is sheared along
+// the same axes (coherent packets), at least 3 lanes are live and the CPU
+// runs AVX, each triangle is tested against all lanes at once; else each
+// live ray tests the leaf's triangle groups (RayTriangle4Test).
 //
 // Each ray's answer is bit-identical to the single-ray query: the slab test
 // of a lane is the single-ray test's arithmetic, the triangle test is the
