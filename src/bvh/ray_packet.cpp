@@ -304,20 +304,13 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
           px[c] = (splat(group.corner[c][kx][k]) - ox) - sh_x * pz[c];
           py[c] = (splat(group.corner[c][ky][k]) - oy) - sh_y * pz[c];
         }
-        const vf eu = px[2] * py[1] - py[2] * px[1];
-        const vf ev = px[0] * py[2] - py[0] * px[2];
-        const vf ew = px[1] * py[0] - py[1] * px[0];
-        const vf zero = splat(0.0f);
-        const vi on_edge = (eu == zero) | (ev == zero) | (ew == zero);
-        const vi mixed = ((eu < zero) | (ev < zero) | (ew < zero)) & ((eu > zero) | (ev > zero) | (ew > zero));
-        const vf det = eu + ev + ew;
-        const vi inside = ~mixed & ~on_edge & (det != zero) & (det - det == zero);
-        const std::uint32_t edge = lane_bits<Avx>(on_edge) & lanes;
-        if ((lane_bits<Avx>(inside) & lanes) == 0 && edge == 0) continue;
-        const vf scaled_t = eu * (sh_z * pz[0]) + ev * (sh_z * pz[1]) + ew * (sh_z * pz[2]);
-        const vf inv_det = splat(1.0f) / det;
-        vf t = scaled_t * inv_det, u = ev * inv_det, v = ew * inv_det;
-        std::uint32_t hits = lane_bits<Avx>(inside & (t >= tmin_v) & (t <= hit_t)) & lanes;
+        const ShearedEdges<vf> ed = sheared_edges(px, py);
+        const std::uint32_t edge = lane_bits<Avx>(ed.on_edge) & lanes;
+        if ((lane_bits<Avx>(ed.inside) & lanes) == 0 && edge == 0) continue;
+        const vf scaled_t = ed.eu * (sh_z * pz[0]) + ed.ev * (sh_z * pz[1]) + ed.ew * (sh_z * pz[2]);
+        const vf inv_det = splat(1.0f) / ed.det;
+        vf t = scaled_t * inv_det, u = ed.ev * inv_det, v = ed.ew * inv_det;
+        std::uint32_t hits = lane_bits<Avx>(ed.inside & (t >= tmin_v) & (t <= hit_t)) & lanes;
         for (std::uint32_t b = edge; b != 0; b &= b - 1) {  // the scalar test's double-precision path
           const int i = __builtin_ctz(b);
           const Vec3f a(group.corner[0][0][k], group.corner[0][1][k], group.corner[0][2][k]);

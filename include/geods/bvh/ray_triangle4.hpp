@@ -25,6 +25,34 @@ struct alignas(32) TriangleGroup {  // 160 bytes
   std::uint32_t index[4];
 };
 
+/// The watertight test's edge functions of a triangle whose corners, relative to
+/// the ray's origin in its sheared frame, are (px, py): RayTriangleTest's
+/// operations in its order, for any vector of lanes (the triangles of a group
+/// against one ray here, one triangle against the rays of a packet in
+/// ray_packet.cpp). `inside`: lanes hit unless t is out of range; `on_edge`:
+/// lanes for the scalar test's double-precision path.
+template <typename VF>
+struct ShearedEdges {
+  using VI = decltype(VF{} < VF{});
+  VF eu, ev, ew, det;
+  VI on_edge, inside;
+};
+template <typename VF>
+[[gnu::always_inline]] inline ShearedEdges<VF> sheared_edges(const VF (&px)[3], const VF (&py)[3]) {
+  ShearedEdges<VF> e;
+  e.eu = px[2] * py[1] - py[2] * px[1];
+  e.ev = px[0] * py[2] - py[0] * px[2];
+  e.ew = px[1] * py[0] - py[1] * px[0];
+  const VF zero{};
+  e.on_edge = (e.eu == zero) | (e.ev == zero) | (e.ew == zero);
+  const auto mixed =
+      ((e.eu < zero) | (e.ev < zero) | (e.ew < zero)) & ((e.eu > zero) | (e.ev > zero) | (e.ew > zero));
+  e.det = e.eu + e.ev + e.ew;
+  // det - det is 0 exactly for a finite det (NaN for inf and NaN).
+  e.inside = ~mixed & ~e.on_edge & (e.det != zero) & (e.det - e.det == zero);
+  return e;
+}
+
 class RayTriangle4Test {
  public:
   typedef float vf __attribute__((vector_size(16)));
@@ -51,24 +79,16 @@ class RayTriangle4Test {
       px[c] = (load(g.corner[c][axis_[0]]) - origin_[0]) - shear_x_ * pz[c];
       py[c] = (load(g.corner[c][axis_[1]]) - origin_[1]) - shear_y_ * pz[c];
     }
-    const vf eu = px[2] * py[1] - py[2] * px[1];
-    const vf ev = px[0] * py[2] - py[0] * px[2];
-    const vf ew = px[1] * py[0] - py[1] * px[0];
-    const vf zero = splat(0.0f);
-    const vi on_edge = (eu == zero) | (ev == zero) | (ew == zero);
-    const vi mixed = ((eu < zero) | (ev < zero) | (ew < zero)) & ((eu > zero) | (ev > zero) | (ew > zero));
-    const vf det = eu + ev + ew;
-    // det - det is 0 exactly for a finite det (NaN for inf and NaN).
-    const vi inside = ~mixed & ~on_edge & (det != zero) & (det - det == zero);
-    const int edge_mask = movemask(on_edge);
+    const ShearedEdges<vf> e = sheared_edges(px, py);
+    const int edge_mask = movemask(e.on_edge);
     // Most groups a ray reaches are missed: skip the division then.
-    if (movemask(inside) == 0 && edge_mask == 0) return 0;
-    const vf scaled_t = eu * (shear_z_ * pz[0]) + ev * (shear_z_ * pz[1]) + ew * (shear_z_ * pz[2]);
-    const vf inv_det = splat(1.0f) / det;
+    if (movemask(e.inside) == 0 && edge_mask == 0) return 0;
+    const vf scaled_t = e.eu * (shear_z_ * pz[0]) + e.ev * (shear_z_ * pz[1]) + e.ew * (shear_z_ * pz[2]);
+    const vf inv_det = splat(1.0f) / e.det;
     t = scaled_t * inv_det;
-    u = ev * inv_det;
-    v = ew * inv_det;
-    int mask = movemask(inside & (t >= splat(tmin)) & (t <= splat(tmax)));
+    u = e.ev * inv_det;
+    v = e.ew * inv_det;
+    int mask = movemask(e.inside & (t >= splat(tmin)) & (t <= splat(tmax)));
     if (edge_mask != 0) [[unlikely]] {
       for (int i = 0; i < 4; ++i) {
         if (!(edge_mask >> i & 1)) continue;
