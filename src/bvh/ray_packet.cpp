@@ -176,13 +176,14 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
   const vf inf = splat(std::numeric_limits<float>::infinity());
   const vi active_v = lane_mask(active);
   using vw = typename WideVector<W>::vf;
-  bool in_frustum[3];
+  bool one_sign[3], in_frustum[3];
   int near_row[3], far_row[3];
   vw near_o[3], far_o[3], i_lo[3], i_hi[3];
   for (int a = 0; a < 3; ++a) {
     const float o_lo = lane_min(org[a]), o_hi = lane_max(org[a]), inv_lo = lane_min(inv[a]), inv_hi = lane_max(inv[a]);
     const unsigned negatives = lane_bits<Avx>(neg[a]) & active;
-    in_frustum[a] = (negatives == 0 || negatives == active) && std::isfinite(inv_lo) && std::isfinite(inv_hi);
+    one_sign[a] = negatives == 0 || negatives == active;
+    in_frustum[a] = one_sign[a] && std::isfinite(inv_lo) && std::isfinite(inv_hi);
     const bool positive = negatives == 0;
     near_row[a] = positive ? 2 * a : 2 * a + 1;  // entering at lo - origin: least at the largest origin
     far_row[a] = positive ? 2 * a + 1 : 2 * a;
@@ -190,7 +191,7 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
     far_o[a] = wide_splat<W>(positive ? o_lo : o_hi);
     i_lo[a] = wide_splat<W>(inv_lo), i_hi[a] = wide_splat<W>(inv_hi);
   }
-  const bool same_signs = in_frustum[0] && in_frustum[1] && in_frustum[2];
+  const bool full_frustum = in_frustum[0] && in_frustum[1] && in_frustum[2];  // its entry distances are the keys
   const float tmin_lo = lane_min(tmin_v);
   // The greatest tmax of the lanes still running: the frustum's far end.
   float tmax_hi = lane_max(active_v ? hit_t : -inf);
@@ -240,26 +241,26 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
       vf tn = tmin_v, tf = hit_t;
       for (int a = 0; a < 3; ++a) {
         // The single ray's slab test, lane by lane: the near bound by the
-        // sign of the inverse direction, NaNs (0 * inf) leave the interval.
-        if (same_signs) {
-          const vf near = (splat(node.bounds[near_row[a]][c]) - org[a]) * inv[a];
-          const vf far = (splat(node.bounds[far_row[a]][c]) - org[a]) * inv[a];
-          tn = near > tn ? near : tn;
-          tf = far < tf ? far : tf;
+        // sign of the inverse direction (one row for all lanes where they
+        // share it, else a blend), NaNs (0 * inf) leave the interval.
+        vf near, far;
+        if (one_sign[a]) {
+          near = (splat(node.bounds[near_row[a]][c]) - org[a]) * inv[a];
+          far = (splat(node.bounds[far_row[a]][c]) - org[a]) * inv[a];
         } else {
           const vf t_lo = (splat(node.bounds[2 * a][c]) - org[a]) * inv[a];
           const vf t_hi = (splat(node.bounds[2 * a + 1][c]) - org[a]) * inv[a];
-          const vf near = neg[a] ? t_hi : t_lo;
-          const vf far = neg[a] ? t_lo : t_hi;
-          tn = near > tn ? near : tn;
-          tf = far < tf ? far : tf;
+          near = neg[a] ? t_hi : t_lo;
+          far = neg[a] ? t_lo : t_hi;
         }
+        tn = near > tn ? near : tn;
+        tf = far < tf ? far : tf;
       }
       const vi enter = tn <= tf * splat(widen);
       const std::uint32_t m = lanes & lane_bits<Avx>(enter);
       if (m == 0) continue;
       child_mask[c] = m;
-      if (!same_signs) keys[c] = lane_min(lane_mask(m) ? tn : inf);
+      if (!full_frustum) keys[c] = lane_min(lane_mask(m) ? tn : inf);
       bits |= 1u << c;
     }
     return bits;
