@@ -321,7 +321,9 @@ __attribute__((target("avx2"))) std::int64_t nest_row4(const float* z, float* er
 // rounded up to a float; +inf when a corner of one lies outside W x H. With
 // AVX2 (and N / S >= 16, so that groups of four fill the rows) the fine
 // levels take the kernels above, but for the first and last rows of blue
-// vertices on horizontal edges and the first and last four on vertical ones.
+// vertices on horizontal edges and the first and last four on vertical ones,
+// and the rows whose triangles reach the grid's last row (the kernels load a
+// few floats past the samples they use, and z may end there).
 template <int S>
 void level_errors(const float* z, std::int64_t n, std::int64_t W, std::int64_t H, std::uint32_t t, float* err) {
   const std::int64_t s = S ? S : std::int64_t(1) << t, N = n - 1, c = N / 2;
@@ -336,7 +338,7 @@ void level_errors(const float* z, std::int64_t n, std::int64_t W, std::int64_t H
       const std::int64_t y = (2 * std::int64_t(ry) + 1) * s;
 #if defined(__x86_64__) && defined(__GNUC__)
       if constexpr (S > 0)
-        if (wide) {
+        if (wide && y + s < N) {
           red_row_avx2<S>(z, n, W, H, t, y, err);
           continue;
         }
@@ -406,7 +408,7 @@ void level_errors(const float* z, std::int64_t n, std::int64_t W, std::int64_t H
       std::int64_t done = 2 * s;  // the vertices x in [2 s, done) are done
 #if defined(__x86_64__) && defined(__GNUC__)
       if constexpr (S > 0)
-        if (wide) done = blue_v_row_avx2<S>(z, n, W, H, y, err);
+        if (wide && y + s < N) done = blue_v_row_avx2<S>(z, n, W, H, y, err);
 #endif
       for (std::int64_t x = 0; x <= N; x = x == 0 ? done : x + 2 * s) {
         const P2 a{x, y - s}, bb{x, y + s};
@@ -593,28 +595,33 @@ Terrain::Terrain(HeightField field, TerrainOptions options) {
   const std::int64_t W = std::int64_t(width_), H = std::int64_t(height_);
   index_ = LayoutIndex(options.layout, K);
 
-  // Heights of the padded grid (the padding repeats the last row and column),
-  // and 8 more: the fine levels' kernels load up to 7 floats past the last
-  // sample they use.
-  std::vector<float, HugePageAllocator<float>> z(n * n + 8);
-  parallel_for(0, n, 16, [&](std::size_t b, std::size_t e) {
-    bool finite = true;
-    for (std::size_t y = b; y < e; ++y) {
-      const float* src = field.heights.data() + std::min<std::size_t>(y, height_ - 1) * width_;
-      float* dst = z.data() + y * n;
-      if (z_scale_ == 1) {
-        std::copy(src, src + width_, dst);  // finite (checked, missing ones filled)
-      } else {
-        for (std::size_t x = 0; x < width_; ++x) {
-          dst[x] = float(double(src[x]) * z_scale_);
-          finite &= std::isfinite(dst[x]);
+  // Heights of the padded grid (the padding repeats the last row and column):
+  // the field's own samples where it is n x n and unscaled, no copy (fresh
+  // memory costs more than the copy on some machines: a page fault per page).
+  std::vector<float, HugePageAllocator<float>> padded;
+  const float* z = field.heights.data();
+  if (width_ != n || height_ != n || z_scale_ != 1) {
+    padded.resize(n * n);
+    parallel_for(0, n, 16, [&](std::size_t b, std::size_t e) {
+      bool finite = true;
+      for (std::size_t y = b; y < e; ++y) {
+        const float* src = field.heights.data() + std::min<std::size_t>(y, height_ - 1) * width_;
+        float* dst = padded.data() + y * n;
+        if (z_scale_ == 1) {
+          std::copy(src, src + width_, dst);  // finite (checked, missing ones filled)
+        } else {
+          for (std::size_t x = 0; x < width_; ++x) {
+            dst[x] = float(double(src[x]) * z_scale_);
+            finite &= std::isfinite(dst[x]);
+          }
         }
+        std::fill(dst + width_, dst + n, dst[width_ - 1]);
       }
-      std::fill(dst + width_, dst + n, dst[width_ - 1]);
-    }
-    if (!finite) throw Error("terrain: a height times z_scale overflows a float");
-  });
-  field.heights = {};
+      if (!finite) throw Error("terrain: a height times z_scale overflows a float");
+    });
+    field.heights = {};
+    z = padded.data();
+  }
 
   const std::int64_t N = std::int64_t(n) - 1;
   // Own error of each vertex: the largest vertical distance between the grid and
@@ -622,13 +629,15 @@ Terrain::Terrain(HeightField field, TerrainOptions options) {
   // field (the padding), so that those vertices are always refined and no
   // final triangle straddles the field's border. Level by level, every
   // triangle's rows as spans known by arithmetic (no point-in-triangle tests).
-  std::vector<float, HugePageAllocator<float>> err(n * n + 8, 0.0f);  // 8 more as z
-  own_errors(z.data(), std::int64_t(n), W, H, K, err.data());
+  // The errors and the radii (below) in one array: one allocation of fresh memory.
+  std::vector<float, HugePageAllocator<float>> err_rad(2 * n * n, 0.0f);
+  float* err = err_rad.data();
+  float* rad = err + n * n;
+  own_errors(z, std::int64_t(n), W, H, K, err);
 
   // Nesting, finest level first: error = max(own, children's); radius = max over
   // children of (distance + child's radius), rounded up, so that a child's
   // sphere lies in its parent's.
-  std::vector<float, HugePageAllocator<float>> rad(n * n + 8, 0.0f);
 #if defined(__x86_64__) && defined(__GNUC__)
   const bool avx2 = simd_level() >= SimdLevel::avx2;
 #endif
@@ -687,9 +696,11 @@ Terrain::Terrain(HeightField field, TerrainOptions options) {
     // The vertices x, x + 2 s, ... < N of row y with four children each, with
     // AVX2; returns the first x not done.
     auto nest_row = [&](std::int64_t y, std::int64_t x, const Children& ch) {
-      if (s == 1) x = nest_row4<2>(z.data(), err.data(), rad.data(), std::int64_t(n), y, x, N, ch);
-      if (s == 2) x = nest_row4<4>(z.data(), err.data(), rad.data(), std::int64_t(n), y, x, N, ch);
-      return nest_row_avx2(z.data(), err.data(), rad.data(), std::int64_t(n), y, x, N, 2 * s, ch);
+      if (y + s < N) {  // nest_row4 loads past its children: not in the grid's last row
+        if (s == 1) x = nest_row4<2>(z, err, rad, std::int64_t(n), y, x, N, ch);
+        if (s == 2) x = nest_row4<4>(z, err, rad, std::int64_t(n), y, x, N, ch);
+      }
+      return nest_row_avx2(z, err, rad, std::int64_t(n), y, x, N, 2 * s, ch);
     };
 #endif
     // Blue vertices of spacing s >= 2: children are the red ones of spacing s / 2.
