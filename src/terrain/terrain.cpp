@@ -486,19 +486,20 @@ void for_each_slot(const LayoutIndex& index, Put&& put) {
         for (std::size_t x = 0; x < n; ++x) put(y * n + x, std::int64_t(x), std::int64_t(y));
     });
   } else {
-    // Level by level; along a row of blue vertices of spacing s (step 2 s)
+    // Row by row (each row of the heights read once), in each row the levels
+    // whose rows it is; along a row of blue vertices of spacing s (step 2 s)
     // both coordinates of the level's Morton code grow by one.
     for (const P2 p : {P2{0, 0}, P2{N, 0}, P2{0, N}, P2{N, N}, P2{c, c}})
       put(index.interleaved_slot(std::uint32_t(p.x), std::uint32_t(p.y)), p.x, p.y);
     constexpr std::uint64_t kEven = 0x5555555555555555ull, kOdd = ~kEven;
-    for (std::uint32_t t = 0; t < K; ++t) {
-      const std::int64_t s = std::int64_t(1) << t;
-      const std::uint64_t base = index.level_base(t);
-      // Rows k s: blue at x = s, 3s, ... (k even) or x = 0, 2s, ... (k odd);
-      // red at x = s, 3s, ... (k odd).
-      parallel_for(0, std::size_t(N / s + 1), 4, [&](std::size_t b, std::size_t e) {
-        for (std::size_t k = b; k < e; ++k) {
-          const std::int64_t y = std::int64_t(k) * s;
+    parallel_for(0, n, 4, [&](std::size_t b, std::size_t e) {
+      for (std::size_t row = b; row < e; ++row) {
+        const std::int64_t y = std::int64_t(row);
+        // Rows k s of the level of spacing s: blue at x = s, 3s, ... (k even) or
+        // x = 0, 2s, ... (k odd); red at x = s, 3s, ... (k odd).
+        for (std::uint32_t t = 0; t < K && (y & ((std::int64_t(1) << t) - 1)) == 0; ++t) {
+          const std::int64_t s = std::int64_t(1) << t, k = y >> t;
+          const std::uint64_t base = index.level_base(t);
           const std::int64_t x0 = (k & 1) ? 0 : s;
           std::uint64_t m = index.interleaved_slot(std::uint32_t(x0), std::uint32_t(y)) - base;
           for (std::int64_t x = x0; x <= N; x += 2 * s) {
@@ -524,8 +525,8 @@ void for_each_slot(const LayoutIndex& index, Put&& put) {
               put(base + m, x, y);
             }
         }
-      });
-    }
+      }
+    });
   }
 }
 
