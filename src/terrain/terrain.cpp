@@ -581,10 +581,10 @@ std::uint64_t LayoutIndex::interleaved_slot(std::uint32_t x, std::uint32_t y) co
 
 Terrain::Terrain(HeightField field, TerrainOptions options) {
   const auto t0 = std::chrono::steady_clock::now();
-  check_height_field(field);
+  const std::size_t missing = check_height_field(field);
   if (!std::isfinite(options.z_scale) || options.z_scale == 0)
     throw Error("terrain: z_scale " + format_number(options.z_scale) + " is not finite and nonzero");
-  filled_ = fill_missing(field);
+  filled_ = missing ? fill_missing(field) : 0;  // no second pass over a field without missing samples
   width_ = field.width;
   height_ = field.height;
   spacing_ = field.spacing;
