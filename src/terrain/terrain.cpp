@@ -48,6 +48,7 @@ template <int S>
   double m = 0;
 #if defined(__x86_64__) && defined(__GNUC__)
   const bool avx2 = S == 0 && simd_level() >= SimdLevel::avx2;  // long rows only
+  const bool avx512 = avx2 && simd_level() >= SimdLevel::avx512;
 #endif
 #if defined(__SSE2__)
   __m128d m2 = _mm_setzero_pd();
@@ -76,7 +77,8 @@ template <int S>
       const std::int64_t lo = a.x + lo0 + dlo * r, hi = a.x + hi0 + dhi * r;
 #if defined(__x86_64__) && defined(__GNUC__)
       if (hi - lo >= 7 && avx2) {
-        m = std::max(m, detail::row_max_avx2(row, lo, hi, p.base(dy), p.gx, a.x));
+        m = std::max(m, avx512 ? detail::row_max_avx512(row, lo, hi, p.base(dy), p.gx, a.x)
+                               : detail::row_max_avx2(row, lo, hi, p.base(dy), p.gx, a.x));
         continue;
       }
 #endif
