@@ -314,6 +314,58 @@ __attribute__((target("avx2"))) std::int64_t nest_row4(const float* z, float* er
   return x;
 }
 #undef GEODS_TERRAIN_AVX2_INLINE
+
+#define GEODS_TERRAIN_AVX512_INLINE __attribute__((target("avx512f,avx512vl,avx512dq,avx2"), always_inline)) inline
+// GCC 12 warns about the undefined pass-through operand inside its own AVX-512 intrinsics.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wuninitialized"
+#if !defined(__clang__)
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
+// p[0], p[St], ..., p[7 St] for St = 2 or 4 (reads up to p[7 St + St - 1], as load4f reads past its last lane).
+template <int St>
+GEODS_TERRAIN_AVX512_INLINE __m256 load8f(const float* p) {
+  if constexpr (St == 2) {
+    return _mm512_castps512_ps256(_mm512_permutexvar_ps(_mm512_set_epi32(0, 0, 0, 0, 0, 0, 0, 0, 14, 12, 10, 8, 6, 4, 2, 0),
+                                                        _mm512_loadu_ps(p)));
+  } else {
+    static_assert(St == 4);
+    return _mm512_castps512_ps256(_mm512_permutex2var_ps(
+        _mm512_loadu_ps(p), _mm512_set_epi32(0, 0, 0, 0, 0, 0, 0, 0, 28, 24, 20, 16, 12, 8, 4, 0), _mm512_loadu_ps(p + 16)));
+  }
+}
+
+// nest_row4() eight vertices at a time with AVX-512: the same maxima and terms lane by lane.
+template <int St>
+__attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) std::int64_t nest_row8(const float* z, float* err, float* rad, std::int64_t n,
+                                                                               std::int64_t y, std::int64_t x0, std::int64_t x1,
+                                                                               const Children& ch) {
+  std::int64_t x = x0;
+  for (; x + 7 * St < x1; x += 8 * St) {
+    const std::ptrdiff_t v = y * n + x;
+    __m256 e = load8f<St>(err + v);
+    const __m512d zv = _mm512_cvtps_pd(load8f<St>(z + v));
+    __m512d best = _mm512_setzero_pd();
+    for (int k = 0; k < 4; ++k) {
+      const std::ptrdiff_t w = v + ch.dw[k];
+      e = _mm256_max_ps(e, load8f<St>(err + w));
+      const __m512d dz = _mm512_sub_pd(_mm512_cvtps_pd(load8f<St>(z + w)), zv);
+      best = _mm512_max_pd(best, _mm512_add_pd(_mm512_sqrt_pd(_mm512_add_pd(_mm512_set1_pd(ch.d2[k]), _mm512_mul_pd(dz, dz))),
+                                               _mm512_cvtps_pd(load8f<St>(rad + w))));
+    }
+    // round_up() of the eight: one ulp up where the float is below the double.
+    const __m256 f = _mm512_cvtpd_ps(best);
+    const __mmask8 below = _mm512_cmp_pd_mask(_mm512_cvtps_pd(f), best, _CMP_LT_OQ);
+    const __m256i r = _mm256_mask_add_epi32(_mm256_castps_si256(f), below, _mm256_castps_si256(f), _mm256_set1_epi32(1));
+    alignas(32) float eo[8], ro[8];
+    _mm256_store_ps(eo, e);
+    _mm256_store_si256(reinterpret_cast<__m256i*>(ro), r);
+    for (int j = 0; j < 8; ++j) err[v + St * j] = eo[j], rad[v + St * j] = ro[j];
+  }
+  return x;
+}
+#pragma GCC diagnostic pop
+#undef GEODS_TERRAIN_AVX512_INLINE
 #endif
 
 // The own errors of the vertices of spacing s = 2^t (S = s when it is a small
@@ -642,7 +694,7 @@ Terrain::Terrain(HeightField field, TerrainOptions options) {
   // children of (distance + child's radius), rounded up, so that a child's
   // sphere lies in its parent's.
 #if defined(__x86_64__) && defined(__GNUC__)
-  const bool avx2 = simd_level() >= SimdLevel::avx2;
+  const bool avx2 = simd_level() >= SimdLevel::avx2, avx512 = simd_level() >= SimdLevel::avx512;
 #endif
   const double sx = std::abs(spacing_[0]), sy = std::abs(spacing_[1]);
   // Vertex (x, y) from its children at offsets off[k] (skipped outside the
@@ -699,7 +751,9 @@ Terrain::Terrain(HeightField field, TerrainOptions options) {
     // The vertices x, x + 2 s, ... < N of row y with four children each, with
     // AVX2; returns the first x not done.
     auto nest_row = [&](std::int64_t y, std::int64_t x, const Children& ch) {
-      if (y + s < N) {  // nest_row4 loads past its children: not in the grid's last row
+      if (y + s < N) {  // nest_row4 and nest_row8 load past its children: not in the grid's last row
+        if (s == 1 && avx512) x = nest_row8<2>(z, err, rad, std::int64_t(n), y, x, N, ch);
+        if (s == 2 && avx512) x = nest_row8<4>(z, err, rad, std::int64_t(n), y, x, N, ch);
         if (s == 1) x = nest_row4<2>(z, err, rad, std::int64_t(n), y, x, N, ch);
         if (s == 2) x = nest_row4<4>(z, err, rad, std::int64_t(n), y, x, N, ch);
       }
