@@ -364,6 +364,110 @@ __attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) std::int64_t nest_row8
   }
   return x;
 }
+
+// The fine levels' kernels with eight lanes (the lanes St = 2 or 4 samples
+// apart): Plane4, term4, rows4 and store4 lane by lane, so the same errors.
+struct Plane8 {
+  const float* a;
+  __m512d za, gx, gy;
+};
+template <int St>
+GEODS_TERRAIN_AVX512_INLINE Plane8 plane8(const float* v, std::int64_t n, P2 a, P2 b, P2 c) {
+  Plane8 p;
+  p.a = v + a.y * n + a.x;
+  p.za = _mm512_cvtps_pd(load8f<St>(p.a));
+  const __m512d zb = _mm512_cvtps_pd(load8f<St>(v + b.y * n + b.x)), zc = _mm512_cvtps_pd(load8f<St>(v + c.y * n + c.x));
+  const double ux = double(b.x - a.x), uy = double(b.y - a.y), vx = double(c.x - a.x), vy = double(c.y - a.y);
+  const __m512d inv = _mm512_set1_pd(1 / (ux * vy - uy * vx));
+  const __m512d db = _mm512_sub_pd(zb, p.za), dc = _mm512_sub_pd(zc, p.za);
+  p.gx = _mm512_mul_pd(_mm512_sub_pd(_mm512_mul_pd(db, _mm512_set1_pd(vy)), _mm512_mul_pd(dc, _mm512_set1_pd(uy))), inv);
+  p.gy = _mm512_mul_pd(_mm512_sub_pd(_mm512_mul_pd(dc, _mm512_set1_pd(ux)), _mm512_mul_pd(db, _mm512_set1_pd(vx))), inv);
+  return p;
+}
+template <int St>
+GEODS_TERRAIN_AVX512_INLINE void rows8(__m512d& m, std::int64_t n, const Plane8& p, std::int64_t r0, std::int64_t rows,
+                                       std::int64_t lo0, std::int64_t dlo, std::int64_t hi0, std::int64_t dhi) {
+  for (std::int64_t r = 0; r < rows; ++r) {
+    const std::int64_t dy = r0 + r, lo = lo0 + dlo * r, hi = hi0 + dhi * r;
+    const __m512d base = dy == 0 ? p.za : _mm512_add_pd(p.za, _mm512_mul_pd(p.gy, _mm512_set1_pd(double(dy))));
+    const float* row = p.a + dy * n;
+    for (std::int64_t dx = lo; dx <= hi; ++dx) {
+      if (dx == 0 && dy == 0) continue;  // the plane's origin: |d| = 0
+      const __m512d q = dx == 0 ? base : _mm512_add_pd(base, _mm512_mul_pd(p.gx, _mm512_set1_pd(double(dx))));
+      m = _mm512_max_pd(_mm512_abs_pd(_mm512_sub_pd(_mm512_cvtps_pd(load8f<St>(row + dx)), q)), m);
+    }
+  }
+}
+template <int St>
+GEODS_TERRAIN_AVX512_INLINE void store8(float* err, std::int64_t n, std::int64_t x, std::int64_t y, std::int64_t s, std::int64_t W,
+                                        std::int64_t H, __m512d m) {
+  const __m256 f = _mm512_cvtpd_ps(m);
+  const __mmask8 below = _mm512_cmp_pd_mask(_mm512_cvtps_pd(f), m, _CMP_LT_OQ);  // round_up(): one ulp up
+  alignas(32) float out[8];
+  _mm256_store_si256(reinterpret_cast<__m256i*>(out),
+                     _mm256_mask_add_epi32(_mm256_castps_si256(f), below, _mm256_castps_si256(f), _mm256_set1_epi32(1)));
+  float* e = err + y * n + x;
+  for (int j = 0; j < 8; ++j) e[St * j] = x + St * j + s > W - 1 || y + s > H - 1 ? kInf : out[j];
+}
+
+// red_row_avx2<1>() eight vertices at a time (N >= 32).
+__attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) void red_row1_avx512(const float* z, std::int64_t n, std::int64_t W,
+                                                                              std::int64_t H, std::uint32_t t, std::int64_t y,
+                                                                              float* err) {
+  constexpr std::int64_t s = 1;
+  const std::int64_t N = n - 1;
+  for (std::int64_t parity = 0; parity < 2; ++parity) {
+    const bool main_parents = ((parity + ((y - s) >> (t + 1))) & 1) != 0;
+    for (std::int64_t x = s + 2 * s * parity; x < N; x += 32 * s) {
+      const float* v = z + y * n + x;
+      __m512d m = _mm512_setzero_pd();
+      if (main_parents) {
+        const P2 a{-s, s}, b{s, -s};
+        rows8<4>(m, n, plane8<4>(v, n, a, b, {-s, -s}), -2 * s, 2 * s + 1, 0, 0, 2 * s, -1);
+        rows8<4>(m, n, plane8<4>(v, n, a, b, {s, s}), -2 * s, 2 * s + 1, 2 * s, -1, 2 * s, 0);
+      } else {
+        const P2 a{-s, -s}, b{s, s};
+        rows8<4>(m, n, plane8<4>(v, n, a, b, {-s, s}), 0, 2 * s + 1, 0, 0, 0, 1);
+        rows8<4>(m, n, plane8<4>(v, n, a, b, {s, -s}), 0, 2 * s + 1, 0, 1, 2 * s, 0);
+      }
+      store8<4>(err, n, x, y, s, W, H, m);
+    }
+  }
+}
+
+// blue_h_row_avx2<S>() eight vertices at a time (S = 1, 2; N / S >= 32).
+template <int S>
+__attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) void blue_h_row_avx512(const float* z, std::int64_t n, std::int64_t W,
+                                                                                std::int64_t H, std::int64_t y, float* err) {
+  constexpr std::int64_t s = S;
+  for (std::int64_t x = s; x < n - 1; x += 16 * s) {
+    const float* v = z + y * n + x;
+    __m512d m = _mm512_setzero_pd();
+    rows8<2 * S>(m, n, plane8<2 * S>(v, n, {-s, 0}, {s, 0}, {0, -s}), -s, s + 1, s, -1, s, 1);
+    rows8<2 * S>(m, n, plane8<2 * S>(v, n, {-s, 0}, {s, 0}, {0, s}), 0, s + 1, 0, 1, 2 * s, -1);
+    store8<2 * S>(err, n, x, y, s, W, H, m);
+  }
+}
+
+// blue_v_row_avx2<S>() eight vertices at a time from x = 2 S (S = 1, 2);
+// returns the first x not done.
+template <int S>
+__attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) std::int64_t blue_v_row_avx512(const float* z, std::int64_t n, std::int64_t W,
+                                                                                        std::int64_t H, std::int64_t y, float* err) {
+  constexpr std::int64_t s = S;
+  std::int64_t x = 2 * s;
+  for (; x + 14 * s <= n - 1 - 2 * s; x += 16 * s) {
+    const float* v = z + y * n + x;
+    __m512d m = _mm512_setzero_pd();
+    const Plane8 l = plane8<2 * S>(v, n, {0, -s}, {0, s}, {-s, 0}), r = plane8<2 * S>(v, n, {0, -s}, {0, s}, {s, 0});
+    rows8<2 * S>(m, n, l, 0, s + 1, 0, -1, 0, 0);
+    rows8<2 * S>(m, n, l, s + 1, s, 1 - s, 1, 0, 0);
+    rows8<2 * S>(m, n, r, 0, s + 1, 0, 0, 0, 1);
+    rows8<2 * S>(m, n, r, s + 1, s, 0, 0, s - 1, -1);
+    store8<2 * S>(err, n, x, y, s, W, H, m);
+  }
+  return x;
+}
 #pragma GCC diagnostic pop
 #undef GEODS_TERRAIN_AVX512_INLINE
 #endif
@@ -383,6 +487,7 @@ void level_errors(const float* z, std::int64_t n, std::int64_t W, std::int64_t H
   const std::int64_t s = S ? S : std::int64_t(1) << t, N = n - 1, c = N / 2;
 #if defined(__x86_64__) && defined(__GNUC__)
   const bool wide = S > 0 && N / s >= 16 && simd_level() >= SimdLevel::avx2;
+  const bool wide8 = S > 0 && S <= 2 && N / s >= 32 && simd_level() >= SimdLevel::avx512;  // blue; red for S = 1
 #endif
   auto in = [&](P2 p) { return p.x <= W - 1 && p.y <= H - 1; };
   // Red: rows y = s, 3s, ...; x = s, 3s, ... The parents (the apexes) are the
@@ -393,6 +498,11 @@ void level_errors(const float* z, std::int64_t n, std::int64_t W, std::int64_t H
 #if defined(__x86_64__) && defined(__GNUC__)
       if constexpr (S > 0)
         if (wide && y + s < N) {
+          if constexpr (S == 1)
+            if (wide8) {
+              red_row1_avx512(z, n, W, H, t, y, err);
+              continue;
+            }
           red_row_avx2<S>(z, n, W, H, t, y, err);
           continue;
         }
@@ -430,6 +540,11 @@ void level_errors(const float* z, std::int64_t n, std::int64_t W, std::int64_t H
 #if defined(__x86_64__) && defined(__GNUC__)
       if constexpr (S > 0)
         if (wide && y > 0 && y < N) {
+          if constexpr (S <= 2)
+            if (wide8) {
+              blue_h_row_avx512<S>(z, n, W, H, y, err);
+              continue;
+            }
           blue_h_row_avx2<S>(z, n, W, H, y, err);
           continue;
         }
@@ -462,7 +577,12 @@ void level_errors(const float* z, std::int64_t n, std::int64_t W, std::int64_t H
       std::int64_t done = 2 * s;  // the vertices x in [2 s, done) are done
 #if defined(__x86_64__) && defined(__GNUC__)
       if constexpr (S > 0)
-        if (wide && y + s < N) done = blue_v_row_avx2<S>(z, n, W, H, y, err);
+        if (wide && y + s < N) {
+          if constexpr (S <= 2)
+            done = wide8 ? blue_v_row_avx512<S>(z, n, W, H, y, err) : blue_v_row_avx2<S>(z, n, W, H, y, err);
+          else
+            done = blue_v_row_avx2<S>(z, n, W, H, y, err);
+        }
 #endif
       for (std::int64_t x = 0; x <= N; x = x == 0 ? done : x + 2 * s) {
         const P2 a{x, y - s}, bb{x, y + s};
