@@ -322,16 +322,21 @@ __attribute__((target("avx2"))) std::int64_t nest_row4(const float* z, float* er
 #if !defined(__clang__)
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #endif
-// p[0], p[St], ..., p[7 St] for St = 2 or 4 (reads up to p[7 St + St - 1], as load4f reads past its last lane).
+// p[0], p[St], ..., p[7 St] for St = 2, 4, 8 (reads up to p[8 St - 1], past the last lane as load4f does).
 template <int St>
 GEODS_TERRAIN_AVX512_INLINE __m256 load8f(const float* p) {
   if constexpr (St == 2) {
     return _mm512_castps512_ps256(_mm512_permutexvar_ps(_mm512_set_epi32(0, 0, 0, 0, 0, 0, 0, 0, 14, 12, 10, 8, 6, 4, 2, 0),
                                                         _mm512_loadu_ps(p)));
-  } else {
-    static_assert(St == 4);
+  } else if constexpr (St == 4) {
     return _mm512_castps512_ps256(_mm512_permutex2var_ps(
         _mm512_loadu_ps(p), _mm512_set_epi32(0, 0, 0, 0, 0, 0, 0, 0, 28, 24, 20, 16, 12, 8, 4, 0), _mm512_loadu_ps(p + 16)));
+  } else {
+    static_assert(St == 8);
+    const __m512i every8 = _mm512_set_epi32(0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 24, 16, 8, 0);
+    const __m512 lo = _mm512_permutex2var_ps(_mm512_loadu_ps(p), every8, _mm512_loadu_ps(p + 16));
+    const __m512 hi = _mm512_permutex2var_ps(_mm512_loadu_ps(p + 32), every8, _mm512_loadu_ps(p + 48));
+    return _mm256_insertf128_ps(_mm512_castps512_ps256(lo), _mm512_castps512_ps128(hi), 1);
   }
 }
 
@@ -365,7 +370,7 @@ __attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) std::int64_t nest_row8
   return x;
 }
 
-// The fine levels' kernels with eight lanes (the lanes St = 2 or 4 samples
+// The fine levels' kernels with eight lanes (the lanes St = 2, 4 or 8 samples
 // apart): Plane4, term4, rows4 and store4 lane by lane, so the same errors.
 struct Plane8 {
   const float* a;
@@ -410,11 +415,12 @@ GEODS_TERRAIN_AVX512_INLINE void store8(float* err, std::int64_t n, std::int64_t
   for (int j = 0; j < 8; ++j) e[St * j] = x + St * j + s > W - 1 || y + s > H - 1 ? kInf : out[j];
 }
 
-// red_row_avx2<1>() eight vertices at a time (N >= 32).
-__attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) void red_row1_avx512(const float* z, std::int64_t n, std::int64_t W,
+// red_row_avx2<S>() eight vertices at a time (S = 1, 2; N / S >= 32).
+template <int S>
+__attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) void red_row_avx512(const float* z, std::int64_t n, std::int64_t W,
                                                                               std::int64_t H, std::uint32_t t, std::int64_t y,
                                                                               float* err) {
-  constexpr std::int64_t s = 1;
+  constexpr std::int64_t s = S;
   const std::int64_t N = n - 1;
   for (std::int64_t parity = 0; parity < 2; ++parity) {
     const bool main_parents = ((parity + ((y - s) >> (t + 1))) & 1) != 0;
@@ -423,19 +429,19 @@ __attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) void red_row1_avx512(c
       __m512d m = _mm512_setzero_pd();
       if (main_parents) {
         const P2 a{-s, s}, b{s, -s};
-        rows8<4>(m, n, plane8<4>(v, n, a, b, {-s, -s}), -2 * s, 2 * s + 1, 0, 0, 2 * s, -1);
-        rows8<4>(m, n, plane8<4>(v, n, a, b, {s, s}), -2 * s, 2 * s + 1, 2 * s, -1, 2 * s, 0);
+        rows8<4 * S>(m, n, plane8<4 * S>(v, n, a, b, {-s, -s}), -2 * s, 2 * s + 1, 0, 0, 2 * s, -1);
+        rows8<4 * S>(m, n, plane8<4 * S>(v, n, a, b, {s, s}), -2 * s, 2 * s + 1, 2 * s, -1, 2 * s, 0);
       } else {
         const P2 a{-s, -s}, b{s, s};
-        rows8<4>(m, n, plane8<4>(v, n, a, b, {-s, s}), 0, 2 * s + 1, 0, 0, 0, 1);
-        rows8<4>(m, n, plane8<4>(v, n, a, b, {s, -s}), 0, 2 * s + 1, 0, 1, 2 * s, 0);
+        rows8<4 * S>(m, n, plane8<4 * S>(v, n, a, b, {-s, s}), 0, 2 * s + 1, 0, 0, 0, 1);
+        rows8<4 * S>(m, n, plane8<4 * S>(v, n, a, b, {s, -s}), 0, 2 * s + 1, 0, 1, 2 * s, 0);
       }
-      store8<4>(err, n, x, y, s, W, H, m);
+      store8<4 * S>(err, n, x, y, s, W, H, m);
     }
   }
 }
 
-// blue_h_row_avx2<S>() eight vertices at a time (S = 1, 2; N / S >= 32).
+// blue_h_row_avx2<S>() eight vertices at a time (S = 1, 2, 4; N / S >= 32).
 template <int S>
 __attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) void blue_h_row_avx512(const float* z, std::int64_t n, std::int64_t W,
                                                                                 std::int64_t H, std::int64_t y, float* err) {
@@ -449,7 +455,7 @@ __attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) void blue_h_row_avx512
   }
 }
 
-// blue_v_row_avx2<S>() eight vertices at a time from x = 2 S (S = 1, 2);
+// blue_v_row_avx2<S>() eight vertices at a time from x = 2 S (S = 1, 2, 4);
 // returns the first x not done.
 template <int S>
 __attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) std::int64_t blue_v_row_avx512(const float* z, std::int64_t n, std::int64_t W,
@@ -487,7 +493,7 @@ void level_errors(const float* z, std::int64_t n, std::int64_t W, std::int64_t H
   const std::int64_t s = S ? S : std::int64_t(1) << t, N = n - 1, c = N / 2;
 #if defined(__x86_64__) && defined(__GNUC__)
   const bool wide = S > 0 && N / s >= 16 && simd_level() >= SimdLevel::avx2;
-  const bool wide8 = S > 0 && S <= 2 && N / s >= 32 && simd_level() >= SimdLevel::avx512;  // blue; red for S = 1
+  const bool wide8 = S > 0 && S <= 4 && N / s >= 32 && simd_level() >= SimdLevel::avx512;  // lanes at most 8 apart
 #endif
   auto in = [&](P2 p) { return p.x <= W - 1 && p.y <= H - 1; };
   // Red: rows y = s, 3s, ...; x = s, 3s, ... The parents (the apexes) are the
@@ -498,9 +504,9 @@ void level_errors(const float* z, std::int64_t n, std::int64_t W, std::int64_t H
 #if defined(__x86_64__) && defined(__GNUC__)
       if constexpr (S > 0)
         if (wide && y + s < N) {
-          if constexpr (S == 1)
+          if constexpr (S <= 2)
             if (wide8) {
-              red_row1_avx512(z, n, W, H, t, y, err);
+              red_row_avx512<S>(z, n, W, H, t, y, err);
               continue;
             }
           red_row_avx2<S>(z, n, W, H, t, y, err);
@@ -540,7 +546,7 @@ void level_errors(const float* z, std::int64_t n, std::int64_t W, std::int64_t H
 #if defined(__x86_64__) && defined(__GNUC__)
       if constexpr (S > 0)
         if (wide && y > 0 && y < N) {
-          if constexpr (S <= 2)
+          if constexpr (S <= 4)
             if (wide8) {
               blue_h_row_avx512<S>(z, n, W, H, y, err);
               continue;
@@ -578,7 +584,7 @@ void level_errors(const float* z, std::int64_t n, std::int64_t W, std::int64_t H
 #if defined(__x86_64__) && defined(__GNUC__)
       if constexpr (S > 0)
         if (wide && y + s < N) {
-          if constexpr (S <= 2)
+          if constexpr (S <= 4)
             done = wide8 ? blue_v_row_avx512<S>(z, n, W, H, y, err) : blue_v_row_avx2<S>(z, n, W, H, y, err);
           else
             done = blue_v_row_avx2<S>(z, n, W, H, y, err);
