@@ -485,10 +485,11 @@ __attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) std::int64_t blue_v_ro
 // rounded up to a float; +inf when a corner of one lies outside W x H. With
 // AVX2 (and N / S >= 16, so that groups of four fill the rows) the fine
 // levels take the kernels above (eight vertices at a time with AVX-512 where
-// their lanes are at most 8 samples apart and N / S >= 32), but for the first and last rows of blue
-// vertices on horizontal edges and the first and last four on vertical ones,
-// and the rows whose triangles reach the grid's last row (the kernels load a
-// few floats past the samples they use, and z may end there).
+// their lanes are at most 8 samples apart and N / S >= 32), but for the
+// first and last rows of blue vertices on horizontal edges, the first and
+// last few on vertical ones, and the rows whose triangles reach the grid's
+// last row (the kernels load a few floats past the samples they use, and z
+// may end there).
 template <int S>
 void level_errors(const float* z, std::int64_t n, std::int64_t W, std::int64_t H, std::uint32_t t, float* err) {
   const std::int64_t s = S ? S : std::int64_t(1) << t, N = n - 1, c = N / 2;
