@@ -170,7 +170,7 @@ std::size_t HeightField::missing() const {
   return std::size_t(std::count_if(heights.begin(), heights.end(), [](float z) { return std::isnan(z); }));
 }
 
-void check_height_field(const HeightField& f) {
+std::size_t check_height_field(const HeightField& f) {
   if (f.width < 2 || f.height < 2)
     throw Error("height field of " + std::to_string(f.width) + " x " + std::to_string(f.height) +
                 " samples: at least 2 x 2 are needed");
@@ -191,6 +191,7 @@ void check_height_field(const HeightField& f) {
   }
   if (infinite) throw Error("height field: an infinite sample");
   if (valid == 0) throw Error("height field: every sample is missing (NaN or no-data)");
+  return f.heights.size() - valid;
 }
 
 std::size_t fill_missing(HeightField& f) {

@@ -48,6 +48,7 @@ template <int S>
   double m = 0;
 #if defined(__x86_64__) && defined(__GNUC__)
   const bool avx2 = S == 0 && simd_level() >= SimdLevel::avx2;  // long rows only
+  const bool avx512 = avx2 && simd_level() >= SimdLevel::avx512;
 #endif
 #if defined(__SSE2__)
   __m128d m2 = _mm_setzero_pd();
@@ -76,7 +77,8 @@ template <int S>
       const std::int64_t lo = a.x + lo0 + dlo * r, hi = a.x + hi0 + dhi * r;
 #if defined(__x86_64__) && defined(__GNUC__)
       if (hi - lo >= 7 && avx2) {
-        m = std::max(m, detail::row_max_avx2(row, lo, hi, p.base(dy), p.gx, a.x));
+        m = std::max(m, avx512 ? detail::row_max_avx512(row, lo, hi, p.base(dy), p.gx, a.x)
+                               : detail::row_max_avx2(row, lo, hi, p.base(dy), p.gx, a.x));
         continue;
       }
 #endif
@@ -312,6 +314,168 @@ __attribute__((target("avx2"))) std::int64_t nest_row4(const float* z, float* er
   return x;
 }
 #undef GEODS_TERRAIN_AVX2_INLINE
+
+#define GEODS_TERRAIN_AVX512_INLINE __attribute__((target("avx512f,avx512vl,avx512dq,avx2"), always_inline)) inline
+// GCC 12 warns about the undefined pass-through operand inside its own AVX-512 intrinsics.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wuninitialized"
+#if !defined(__clang__)
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
+// p[0], p[St], ..., p[7 St] for St = 2, 4, 8 (reads up to p[8 St - 1], past the last lane as load4f does).
+template <int St>
+GEODS_TERRAIN_AVX512_INLINE __m256 load8f(const float* p) {
+  if constexpr (St == 2) {
+    return _mm512_castps512_ps256(_mm512_permutexvar_ps(_mm512_set_epi32(0, 0, 0, 0, 0, 0, 0, 0, 14, 12, 10, 8, 6, 4, 2, 0),
+                                                        _mm512_loadu_ps(p)));
+  } else if constexpr (St == 4) {
+    return _mm512_castps512_ps256(_mm512_permutex2var_ps(
+        _mm512_loadu_ps(p), _mm512_set_epi32(0, 0, 0, 0, 0, 0, 0, 0, 28, 24, 20, 16, 12, 8, 4, 0), _mm512_loadu_ps(p + 16)));
+  } else {
+    static_assert(St == 8);
+    const __m512i every8 = _mm512_set_epi32(0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 24, 16, 8, 0);
+    const __m512 lo = _mm512_permutex2var_ps(_mm512_loadu_ps(p), every8, _mm512_loadu_ps(p + 16));
+    const __m512 hi = _mm512_permutex2var_ps(_mm512_loadu_ps(p + 32), every8, _mm512_loadu_ps(p + 48));
+    return _mm256_insertf128_ps(_mm512_castps512_ps256(lo), _mm512_castps512_ps128(hi), 1);
+  }
+}
+
+// nest_row4() eight vertices at a time with AVX-512: the same maxima and terms lane by lane.
+template <int St>
+__attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) std::int64_t nest_row8(const float* z, float* err, float* rad, std::int64_t n,
+                                                                               std::int64_t y, std::int64_t x0, std::int64_t x1,
+                                                                               const Children& ch) {
+  std::int64_t x = x0;
+  for (; x + 7 * St < x1; x += 8 * St) {
+    const std::ptrdiff_t v = y * n + x;
+    __m256 e = load8f<St>(err + v);
+    const __m512d zv = _mm512_cvtps_pd(load8f<St>(z + v));
+    __m512d best = _mm512_setzero_pd();
+    for (int k = 0; k < 4; ++k) {
+      const std::ptrdiff_t w = v + ch.dw[k];
+      e = _mm256_max_ps(e, load8f<St>(err + w));
+      const __m512d dz = _mm512_sub_pd(_mm512_cvtps_pd(load8f<St>(z + w)), zv);
+      best = _mm512_max_pd(best, _mm512_add_pd(_mm512_sqrt_pd(_mm512_add_pd(_mm512_set1_pd(ch.d2[k]), _mm512_mul_pd(dz, dz))),
+                                               _mm512_cvtps_pd(load8f<St>(rad + w))));
+    }
+    // round_up() of the eight: one ulp up where the float is below the double.
+    const __m256 f = _mm512_cvtpd_ps(best);
+    const __mmask8 below = _mm512_cmp_pd_mask(_mm512_cvtps_pd(f), best, _CMP_LT_OQ);
+    const __m256i r = _mm256_mask_add_epi32(_mm256_castps_si256(f), below, _mm256_castps_si256(f), _mm256_set1_epi32(1));
+    alignas(32) float eo[8], ro[8];
+    _mm256_store_ps(eo, e);
+    _mm256_store_si256(reinterpret_cast<__m256i*>(ro), r);
+    for (int j = 0; j < 8; ++j) err[v + St * j] = eo[j], rad[v + St * j] = ro[j];
+  }
+  return x;
+}
+
+// The fine levels' kernels with eight lanes (the lanes St = 2, 4 or 8 samples
+// apart): Plane4, term4, rows4 and store4 lane by lane, so the same errors.
+struct Plane8 {
+  const float* a;
+  __m512d za, gx, gy;
+};
+template <int St>
+GEODS_TERRAIN_AVX512_INLINE Plane8 plane8(const float* v, std::int64_t n, P2 a, P2 b, P2 c) {
+  Plane8 p;
+  p.a = v + a.y * n + a.x;
+  p.za = _mm512_cvtps_pd(load8f<St>(p.a));
+  const __m512d zb = _mm512_cvtps_pd(load8f<St>(v + b.y * n + b.x)), zc = _mm512_cvtps_pd(load8f<St>(v + c.y * n + c.x));
+  const double ux = double(b.x - a.x), uy = double(b.y - a.y), vx = double(c.x - a.x), vy = double(c.y - a.y);
+  const __m512d inv = _mm512_set1_pd(1 / (ux * vy - uy * vx));
+  const __m512d db = _mm512_sub_pd(zb, p.za), dc = _mm512_sub_pd(zc, p.za);
+  p.gx = _mm512_mul_pd(_mm512_sub_pd(_mm512_mul_pd(db, _mm512_set1_pd(vy)), _mm512_mul_pd(dc, _mm512_set1_pd(uy))), inv);
+  p.gy = _mm512_mul_pd(_mm512_sub_pd(_mm512_mul_pd(dc, _mm512_set1_pd(ux)), _mm512_mul_pd(db, _mm512_set1_pd(vx))), inv);
+  return p;
+}
+template <int St>
+GEODS_TERRAIN_AVX512_INLINE void rows8(__m512d& m, std::int64_t n, const Plane8& p, std::int64_t r0, std::int64_t rows,
+                                       std::int64_t lo0, std::int64_t dlo, std::int64_t hi0, std::int64_t dhi) {
+  for (std::int64_t r = 0; r < rows; ++r) {
+    const std::int64_t dy = r0 + r, lo = lo0 + dlo * r, hi = hi0 + dhi * r;
+    const __m512d base = dy == 0 ? p.za : _mm512_add_pd(p.za, _mm512_mul_pd(p.gy, _mm512_set1_pd(double(dy))));
+    const float* row = p.a + dy * n;
+    for (std::int64_t dx = lo; dx <= hi; ++dx) {
+      if (dx == 0 && dy == 0) continue;  // the plane's origin: |d| = 0
+      const __m512d q = dx == 0 ? base : _mm512_add_pd(base, _mm512_mul_pd(p.gx, _mm512_set1_pd(double(dx))));
+      m = _mm512_max_pd(_mm512_abs_pd(_mm512_sub_pd(_mm512_cvtps_pd(load8f<St>(row + dx)), q)), m);
+    }
+  }
+}
+template <int St>
+GEODS_TERRAIN_AVX512_INLINE void store8(float* err, std::int64_t n, std::int64_t x, std::int64_t y, std::int64_t s, std::int64_t W,
+                                        std::int64_t H, __m512d m) {
+  const __m256 f = _mm512_cvtpd_ps(m);
+  const __mmask8 below = _mm512_cmp_pd_mask(_mm512_cvtps_pd(f), m, _CMP_LT_OQ);  // round_up(): one ulp up
+  alignas(32) float out[8];
+  _mm256_store_si256(reinterpret_cast<__m256i*>(out),
+                     _mm256_mask_add_epi32(_mm256_castps_si256(f), below, _mm256_castps_si256(f), _mm256_set1_epi32(1)));
+  float* e = err + y * n + x;
+  for (int j = 0; j < 8; ++j) e[St * j] = x + St * j + s > W - 1 || y + s > H - 1 ? kInf : out[j];
+}
+
+// red_row_avx2<S>() eight vertices at a time (S = 1, 2; N / S >= 32).
+template <int S>
+__attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) void red_row_avx512(const float* z, std::int64_t n, std::int64_t W,
+                                                                              std::int64_t H, std::uint32_t t, std::int64_t y,
+                                                                              float* err) {
+  constexpr std::int64_t s = S;
+  const std::int64_t N = n - 1;
+  for (std::int64_t parity = 0; parity < 2; ++parity) {
+    const bool main_parents = ((parity + ((y - s) >> (t + 1))) & 1) != 0;
+    for (std::int64_t x = s + 2 * s * parity; x < N; x += 32 * s) {
+      const float* v = z + y * n + x;
+      __m512d m = _mm512_setzero_pd();
+      if (main_parents) {
+        const P2 a{-s, s}, b{s, -s};
+        rows8<4 * S>(m, n, plane8<4 * S>(v, n, a, b, {-s, -s}), -2 * s, 2 * s + 1, 0, 0, 2 * s, -1);
+        rows8<4 * S>(m, n, plane8<4 * S>(v, n, a, b, {s, s}), -2 * s, 2 * s + 1, 2 * s, -1, 2 * s, 0);
+      } else {
+        const P2 a{-s, -s}, b{s, s};
+        rows8<4 * S>(m, n, plane8<4 * S>(v, n, a, b, {-s, s}), 0, 2 * s + 1, 0, 0, 0, 1);
+        rows8<4 * S>(m, n, plane8<4 * S>(v, n, a, b, {s, -s}), 0, 2 * s + 1, 0, 1, 2 * s, 0);
+      }
+      store8<4 * S>(err, n, x, y, s, W, H, m);
+    }
+  }
+}
+
+// blue_h_row_avx2<S>() eight vertices at a time (S = 1, 2, 4; N / S >= 32).
+template <int S>
+__attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) void blue_h_row_avx512(const float* z, std::int64_t n, std::int64_t W,
+                                                                                std::int64_t H, std::int64_t y, float* err) {
+  constexpr std::int64_t s = S;
+  for (std::int64_t x = s; x < n - 1; x += 16 * s) {
+    const float* v = z + y * n + x;
+    __m512d m = _mm512_setzero_pd();
+    rows8<2 * S>(m, n, plane8<2 * S>(v, n, {-s, 0}, {s, 0}, {0, -s}), -s, s + 1, s, -1, s, 1);
+    rows8<2 * S>(m, n, plane8<2 * S>(v, n, {-s, 0}, {s, 0}, {0, s}), 0, s + 1, 0, 1, 2 * s, -1);
+    store8<2 * S>(err, n, x, y, s, W, H, m);
+  }
+}
+
+// blue_v_row_avx2<S>() eight vertices at a time from x = 2 S (S = 1, 2, 4);
+// returns the first x not done.
+template <int S>
+__attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) std::int64_t blue_v_row_avx512(const float* z, std::int64_t n, std::int64_t W,
+                                                                                        std::int64_t H, std::int64_t y, float* err) {
+  constexpr std::int64_t s = S;
+  std::int64_t x = 2 * s;
+  for (; x + 14 * s <= n - 1 - 2 * s; x += 16 * s) {
+    const float* v = z + y * n + x;
+    __m512d m = _mm512_setzero_pd();
+    const Plane8 l = plane8<2 * S>(v, n, {0, -s}, {0, s}, {-s, 0}), r = plane8<2 * S>(v, n, {0, -s}, {0, s}, {s, 0});
+    rows8<2 * S>(m, n, l, 0, s + 1, 0, -1, 0, 0);
+    rows8<2 * S>(m, n, l, s + 1, s, 1 - s, 1, 0, 0);
+    rows8<2 * S>(m, n, r, 0, s + 1, 0, 0, 0, 1);
+    rows8<2 * S>(m, n, r, s + 1, s, 0, 0, s - 1, -1);
+    store8<2 * S>(err, n, x, y, s, W, H, m);
+  }
+  return x;
+}
+#pragma GCC diagnostic pop
+#undef GEODS_TERRAIN_AVX512_INLINE
 #endif
 
 // The own errors of the vertices of spacing s = 2^t (S = s when it is a small
@@ -320,13 +484,18 @@ __attribute__((target("avx2"))) std::int64_t nest_row4(const float* z, float* er
 // sides of their edge. err[y n + x] = the largest error of the triangles,
 // rounded up to a float; +inf when a corner of one lies outside W x H. With
 // AVX2 (and N / S >= 16, so that groups of four fill the rows) the fine
-// levels take the kernels above, but for the first and last rows of blue
-// vertices on horizontal edges and the first and last four on vertical ones.
+// levels take the kernels above (eight vertices at a time with AVX-512 where
+// their lanes are at most 8 samples apart and N / S >= 32), but for the
+// first and last rows of blue vertices on horizontal edges, the first and
+// last few on vertical ones, and the rows whose triangles reach the grid's
+// last row (the kernels load a few floats past the samples they use, and z
+// may end there).
 template <int S>
 void level_errors(const float* z, std::int64_t n, std::int64_t W, std::int64_t H, std::uint32_t t, float* err) {
   const std::int64_t s = S ? S : std::int64_t(1) << t, N = n - 1, c = N / 2;
 #if defined(__x86_64__) && defined(__GNUC__)
   const bool wide = S > 0 && N / s >= 16 && simd_level() >= SimdLevel::avx2;
+  const bool wide8 = S > 0 && S <= 4 && N / s >= 32 && simd_level() >= SimdLevel::avx512;  // lanes at most 8 apart
 #endif
   auto in = [&](P2 p) { return p.x <= W - 1 && p.y <= H - 1; };
   // Red: rows y = s, 3s, ...; x = s, 3s, ... The parents (the apexes) are the
@@ -336,7 +505,12 @@ void level_errors(const float* z, std::int64_t n, std::int64_t W, std::int64_t H
       const std::int64_t y = (2 * std::int64_t(ry) + 1) * s;
 #if defined(__x86_64__) && defined(__GNUC__)
       if constexpr (S > 0)
-        if (wide) {
+        if (wide && y + s < N) {
+          if constexpr (S <= 2)
+            if (wide8) {
+              red_row_avx512<S>(z, n, W, H, t, y, err);
+              continue;
+            }
           red_row_avx2<S>(z, n, W, H, t, y, err);
           continue;
         }
@@ -374,6 +548,11 @@ void level_errors(const float* z, std::int64_t n, std::int64_t W, std::int64_t H
 #if defined(__x86_64__) && defined(__GNUC__)
       if constexpr (S > 0)
         if (wide && y > 0 && y < N) {
+          if constexpr (S <= 4)
+            if (wide8) {
+              blue_h_row_avx512<S>(z, n, W, H, y, err);
+              continue;
+            }
           blue_h_row_avx2<S>(z, n, W, H, y, err);
           continue;
         }
@@ -406,7 +585,12 @@ void level_errors(const float* z, std::int64_t n, std::int64_t W, std::int64_t H
       std::int64_t done = 2 * s;  // the vertices x in [2 s, done) are done
 #if defined(__x86_64__) && defined(__GNUC__)
       if constexpr (S > 0)
-        if (wide) done = blue_v_row_avx2<S>(z, n, W, H, y, err);
+        if (wide && y + s < N) {
+          if constexpr (S <= 4)
+            done = wide8 ? blue_v_row_avx512<S>(z, n, W, H, y, err) : blue_v_row_avx2<S>(z, n, W, H, y, err);
+          else
+            done = blue_v_row_avx2<S>(z, n, W, H, y, err);
+        }
 #endif
       for (std::int64_t x = 0; x <= N; x = x == 0 ? done : x + 2 * s) {
         const P2 a{x, y - s}, bb{x, y + s};
@@ -484,19 +668,20 @@ void for_each_slot(const LayoutIndex& index, Put&& put) {
         for (std::size_t x = 0; x < n; ++x) put(y * n + x, std::int64_t(x), std::int64_t(y));
     });
   } else {
-    // Level by level; along a row of blue vertices of spacing s (step 2 s)
+    // Row by row (each row of the heights read once), in each row the levels
+    // whose rows it is; along a row of blue vertices of spacing s (step 2 s)
     // both coordinates of the level's Morton code grow by one.
     for (const P2 p : {P2{0, 0}, P2{N, 0}, P2{0, N}, P2{N, N}, P2{c, c}})
       put(index.interleaved_slot(std::uint32_t(p.x), std::uint32_t(p.y)), p.x, p.y);
     constexpr std::uint64_t kEven = 0x5555555555555555ull, kOdd = ~kEven;
-    for (std::uint32_t t = 0; t < K; ++t) {
-      const std::int64_t s = std::int64_t(1) << t;
-      const std::uint64_t base = index.level_base(t);
-      // Rows k s: blue at x = s, 3s, ... (k even) or x = 0, 2s, ... (k odd);
-      // red at x = s, 3s, ... (k odd).
-      parallel_for(0, std::size_t(N / s + 1), 4, [&](std::size_t b, std::size_t e) {
-        for (std::size_t k = b; k < e; ++k) {
-          const std::int64_t y = std::int64_t(k) * s;
+    parallel_for(0, n, 4, [&](std::size_t b, std::size_t e) {
+      for (std::size_t row = b; row < e; ++row) {
+        const std::int64_t y = std::int64_t(row);
+        // Rows k s of the level of spacing s: blue at x = s, 3s, ... (k even) or
+        // x = 0, 2s, ... (k odd); red at x = s, 3s, ... (k odd).
+        for (std::uint32_t t = 0; t < K && (y & ((std::int64_t(1) << t) - 1)) == 0; ++t) {
+          const std::int64_t s = std::int64_t(1) << t, k = y >> t;
+          const std::uint64_t base = index.level_base(t);
           const std::int64_t x0 = (k & 1) ? 0 : s;
           std::uint64_t m = index.interleaved_slot(std::uint32_t(x0), std::uint32_t(y)) - base;
           for (std::int64_t x = x0; x <= N; x += 2 * s) {
@@ -522,8 +707,8 @@ void for_each_slot(const LayoutIndex& index, Put&& put) {
               put(base + m, x, y);
             }
         }
-      });
-    }
+      }
+    });
   }
 }
 
@@ -578,10 +763,10 @@ std::uint64_t LayoutIndex::interleaved_slot(std::uint32_t x, std::uint32_t y) co
 
 Terrain::Terrain(HeightField field, TerrainOptions options) {
   const auto t0 = std::chrono::steady_clock::now();
-  check_height_field(field);
+  const std::size_t missing = check_height_field(field);
   if (!std::isfinite(options.z_scale) || options.z_scale == 0)
     throw Error("terrain: z_scale " + format_number(options.z_scale) + " is not finite and nonzero");
-  filled_ = fill_missing(field);
+  filled_ = missing ? fill_missing(field) : 0;  // no second pass over a field without missing samples
   width_ = field.width;
   height_ = field.height;
   spacing_ = field.spacing;
@@ -593,28 +778,33 @@ Terrain::Terrain(HeightField field, TerrainOptions options) {
   const std::int64_t W = std::int64_t(width_), H = std::int64_t(height_);
   index_ = LayoutIndex(options.layout, K);
 
-  // Heights of the padded grid (the padding repeats the last row and column),
-  // and 8 more: the fine levels' kernels load up to 7 floats past the last
-  // sample they use.
-  std::vector<float, HugePageAllocator<float>> z(n * n + 8);
-  parallel_for(0, n, 16, [&](std::size_t b, std::size_t e) {
-    bool finite = true;
-    for (std::size_t y = b; y < e; ++y) {
-      const float* src = field.heights.data() + std::min<std::size_t>(y, height_ - 1) * width_;
-      float* dst = z.data() + y * n;
-      if (z_scale_ == 1) {
-        std::copy(src, src + width_, dst);  // finite (checked, missing ones filled)
-      } else {
-        for (std::size_t x = 0; x < width_; ++x) {
-          dst[x] = float(double(src[x]) * z_scale_);
-          finite &= std::isfinite(dst[x]);
+  // Heights of the padded grid (the padding repeats the last row and column):
+  // the field's own samples where it is n x n and unscaled, no copy (fresh
+  // memory costs more than the copy on some machines: a page fault per page).
+  std::vector<float, HugePageAllocator<float>> padded;
+  const float* z = field.heights.data();
+  if (width_ != n || height_ != n || z_scale_ != 1) {
+    padded.resize(n * n);
+    parallel_for(0, n, 16, [&](std::size_t b, std::size_t e) {
+      bool finite = true;
+      for (std::size_t y = b; y < e; ++y) {
+        const float* src = field.heights.data() + std::min<std::size_t>(y, height_ - 1) * width_;
+        float* dst = padded.data() + y * n;
+        if (z_scale_ == 1) {
+          std::copy(src, src + width_, dst);  // finite (checked, missing ones filled)
+        } else {
+          for (std::size_t x = 0; x < width_; ++x) {
+            dst[x] = float(double(src[x]) * z_scale_);
+            finite &= std::isfinite(dst[x]);
+          }
         }
+        std::fill(dst + width_, dst + n, dst[width_ - 1]);
       }
-      std::fill(dst + width_, dst + n, dst[width_ - 1]);
-    }
-    if (!finite) throw Error("terrain: a height times z_scale overflows a float");
-  });
-  field.heights = {};
+      if (!finite) throw Error("terrain: a height times z_scale overflows a float");
+    });
+    field.heights = {};
+    z = padded.data();
+  }
 
   const std::int64_t N = std::int64_t(n) - 1;
   // Own error of each vertex: the largest vertical distance between the grid and
@@ -622,15 +812,17 @@ Terrain::Terrain(HeightField field, TerrainOptions options) {
   // field (the padding), so that those vertices are always refined and no
   // final triangle straddles the field's border. Level by level, every
   // triangle's rows as spans known by arithmetic (no point-in-triangle tests).
-  std::vector<float, HugePageAllocator<float>> err(n * n + 8, 0.0f);  // 8 more as z
-  own_errors(z.data(), std::int64_t(n), W, H, K, err.data());
+  // The errors and the radii (below) in one array: one allocation of fresh memory.
+  std::vector<float, HugePageAllocator<float>> err_rad(2 * n * n, 0.0f);
+  float* err = err_rad.data();
+  float* rad = err + n * n;
+  own_errors(z, std::int64_t(n), W, H, K, err);
 
   // Nesting, finest level first: error = max(own, children's); radius = max over
   // children of (distance + child's radius), rounded up, so that a child's
   // sphere lies in its parent's.
-  std::vector<float, HugePageAllocator<float>> rad(n * n + 8, 0.0f);
 #if defined(__x86_64__) && defined(__GNUC__)
-  const bool avx2 = simd_level() >= SimdLevel::avx2;
+  const bool avx2 = simd_level() >= SimdLevel::avx2, avx512 = simd_level() >= SimdLevel::avx512;
 #endif
   const double sx = std::abs(spacing_[0]), sy = std::abs(spacing_[1]);
   // Vertex (x, y) from its children at offsets off[k] (skipped outside the
@@ -687,9 +879,13 @@ Terrain::Terrain(HeightField field, TerrainOptions options) {
     // The vertices x, x + 2 s, ... < N of row y with four children each, with
     // AVX2; returns the first x not done.
     auto nest_row = [&](std::int64_t y, std::int64_t x, const Children& ch) {
-      if (s == 1) x = nest_row4<2>(z.data(), err.data(), rad.data(), std::int64_t(n), y, x, N, ch);
-      if (s == 2) x = nest_row4<4>(z.data(), err.data(), rad.data(), std::int64_t(n), y, x, N, ch);
-      return nest_row_avx2(z.data(), err.data(), rad.data(), std::int64_t(n), y, x, N, 2 * s, ch);
+      if (y + s < N) {  // nest_row4 and nest_row8 load past its children: not in the grid's last row
+        if (s == 1 && avx512) x = nest_row8<2>(z, err, rad, std::int64_t(n), y, x, N, ch);
+        if (s == 2 && avx512) x = nest_row8<4>(z, err, rad, std::int64_t(n), y, x, N, ch);
+        if (s == 1) x = nest_row4<2>(z, err, rad, std::int64_t(n), y, x, N, ch);
+        if (s == 2) x = nest_row4<4>(z, err, rad, std::int64_t(n), y, x, N, ch);
+      }
+      return nest_row_avx2(z, err, rad, std::int64_t(n), y, x, N, 2 * s, ch);
     };
 #endif
     // Blue vertices of spacing s >= 2: children are the red ones of spacing s / 2.

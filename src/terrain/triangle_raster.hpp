@@ -100,6 +100,38 @@ __attribute__((target("avx2"))) inline double row_max_avx2(const float* row, std
   const __m128d m2 = _mm_max_pd(_mm256_castpd256_pd128(mm), _mm256_extractf128_pd(mm, 1));
   return std::max(_mm_cvtsd_f64(m2), _mm_cvtsd_f64(_mm_unpackhi_pd(m2, m2)));
 }
+
+// row_max_avx2() eight doubles at a time, the last samples as one masked
+// block (masked loads do not fault), for rows of at least 8 samples, when
+// simd_level() is avx512: the same terms and maxima lane by lane. (GCC 12
+// warns about the undefined pass-through operand inside _mm512_reduce_max_pd.)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wuninitialized"
+#if !defined(__clang__)
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
+__attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) inline double row_max_avx512(const float* row, std::int64_t lo, std::int64_t hi,
+                                                                              double base, double gx, std::int64_t ax) {
+  const __m512d vg = _mm512_set1_pd(gx), vb = _mm512_set1_pd(base), eight = _mm512_set1_pd(8.0);
+  __m512d x0 = _mm512_add_pd(_mm512_set1_pd(double(lo - ax)), _mm512_set_pd(7, 6, 5, 4, 3, 2, 1, 0));
+  __m512d m0 = _mm512_setzero_pd(), m1 = _mm512_setzero_pd();
+  std::int64_t i = lo;
+  for (; i + 15 <= hi; i += 16) {
+    const __m512d x1 = _mm512_add_pd(x0, eight);
+    const __m512d z0 = _mm512_cvtps_pd(_mm256_loadu_ps(row + i)), z1 = _mm512_cvtps_pd(_mm256_loadu_ps(row + i + 8));
+    m0 = _mm512_max_pd(_mm512_abs_pd(_mm512_sub_pd(z0, _mm512_add_pd(vb, _mm512_mul_pd(vg, x0)))), m0);
+    m1 = _mm512_max_pd(_mm512_abs_pd(_mm512_sub_pd(z1, _mm512_add_pd(vb, _mm512_mul_pd(vg, x1)))), m1);
+    x0 = _mm512_add_pd(x1, eight);
+  }
+  for (; i <= hi; i += 8) {
+    const __mmask8 k = hi - i >= 7 ? __mmask8(0xFF) : __mmask8((1u << unsigned(hi - i + 1)) - 1);
+    const __m512d z0 = _mm512_cvtps_pd(_mm256_maskz_loadu_ps(k, row + i));
+    m1 = _mm512_mask_max_pd(m1, k, _mm512_abs_pd(_mm512_sub_pd(z0, _mm512_add_pd(vb, _mm512_mul_pd(vg, x0)))), m1);
+    x0 = _mm512_add_pd(x0, eight);
+  }
+  return _mm512_reduce_max_pd(_mm512_max_pd(m0, m1));
+}
+#pragma GCC diagnostic pop
 #endif
 
 // A grid triangle (a, b, c): its plane and the samples of each of its rows.

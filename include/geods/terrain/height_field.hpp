@@ -42,8 +42,9 @@ HeightField make_height_field(std::span<const float> heights, std::size_t width,
 
 /// Checks the rules every field obeys: at least 2 x 2 samples, heights.size() ==
 /// width * height, finite nonzero spacing, at least one non-NaN sample, no
-/// infinite sample. Throws geods::Error saying what is wrong.
-void check_height_field(const HeightField& field);
+/// infinite sample. Throws geods::Error saying what is wrong. Returns the
+/// number of missing (NaN) samples, counted in the same pass.
+std::size_t check_height_field(const HeightField& field);
 
 /// The no-data rule: every missing (NaN) sample takes the height of its
 /// nearest valid sample (Euclidean distance in samples; ties to the lowest
