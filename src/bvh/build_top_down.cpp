@@ -268,52 +268,84 @@ class TopDown {
       return begin;
     }
     if (best_axis < 0) return begin;  // all centroids equal: median split by id
-    // std::partition's algorithm (libstdc++'s bidirectional one: the same
-    // order, so the same tree as before), with the boxes and centroid boxes of
-    // both sides gathered on the way instead of in two more passes.
-    const float inf = std::numeric_limits<float>::infinity();
-    Float4 lo[2], hi[2], clo[2], chi[2];
-    for (int s = 0; s < 2; ++s) {
-      lo[s] = clo[s] = Float4{inf, inf, inf, inf};
-      hi[s] = chi[s] = -lo[s];
-    }
-    auto add = [&](int s, const PrimRef& r) {
-      lo[s] = min4(lo[s], load4(r.box.lo.data()));
-      hi[s] = max4(hi[s], load4(r.box.hi.data()));
-      const Float4 c = load4(r.center.data());
-      clo[s] = min4(clo[s], c);
-      chi[s] = max4(chi[s], c);
-    };
-    auto is_left = [&](const PrimRef& r) { return bins_of(r)[best_axis] <= best_bin; };
-    PrimRef* front = refs_.data() + begin;
-    PrimRef* back = refs_.data() + end;
-    for (;;) {
-      for (;;) {
-        if (front == back) goto done;
-        if (!is_left(*front)) break;
-        add(0, *front);
-        ++front;
-      }
-      add(1, *front);  // goes right: stays at the split or is swapped to back
-      --back;
-      for (;;) {
-        if (front == back) goto done;
-        if (is_left(*back)) break;
-        add(1, *back);
-        --back;
-      }
-      add(0, *back);
-      std::iter_swap(front, back);
-      ++front;
-    }
-  done:
+    // The boxes of both sides are the unions of their bins.
+    Bin box[2];
+    box[0].reset(), box[1].reset();
+    for (int k = 0; k < nbins; ++k) box[k <= best_bin ? 0 : 1].extend(bins.bin[best_axis][k]);
     for (int s = 0; s < 2; ++s)
-      for (int a = 0; a < 3; ++a) {
-        side[s].box.lo[a] = lo[s][a], side[s].box.hi[a] = hi[s][a];
-        side[s].centroid.lo[a] = clo[s][a], side[s].centroid.hi[a] = chi[s][a];
-      }
+      for (int a = 0; a < 3; ++a) side[s].box.lo[a] = box[s].lo[a], side[s].box.hi[a] = box[s].hi[a];
     have_sides = true;
-    return std::uint32_t(front - refs_.data());
+    return partition(begin, end, [&](const PrimRef& r) { return bins_of(r)[best_axis] <= best_bin; }, side);
+  }
+
+  // std::partition's result (libstdc++'s bidirectional algorithm: the same
+  // order, so the same tree as before) and the centroid boxes of both sides,
+  // without data-dependent branches. That algorithm swaps the j-th
+  // right-going primitive of [begin, mid), counted from the left, with the
+  // j-th left-going one of [mid, end), counted from the right, and moves
+  // nothing else. So: the sides as bits, 64 to a word, then the pairs.
+  template <typename IsLeft>
+  std::uint32_t partition(std::uint32_t begin, std::uint32_t end, const IsLeft& is_left, RangeBounds side[2]) {
+    const std::uint32_t count = end - begin, words = (count + 63) / 64;
+    thread_local std::vector<std::uint64_t> left_bits;
+    if (left_bits.size() < words) left_bits.resize(words);
+    std::uint64_t* bits = left_bits.data();
+    const float inf = std::numeric_limits<float>::infinity();
+    const Float4 pos = {inf, inf, inf, inf}, neg = -pos;
+    // Two sets of accumulators: the min/max chains of consecutive primitives overlap.
+    Float4 clo[2][2] = {{pos, pos}, {pos, pos}}, chi[2][2] = {{neg, neg}, {neg, neg}};
+    std::uint32_t left_count = 0;
+    const PrimRef* p = refs_.data() + begin;
+    for (std::uint32_t w = 0; w < words; ++w) {
+      const std::uint32_t n = std::min<std::uint32_t>(64, count - 64 * w);
+      std::uint64_t word = 0;
+      for (std::uint32_t j = 0; j < n; ++j) {
+        const PrimRef& r = p[64 * w + j];
+        const bool l = is_left(r);
+        word |= std::uint64_t(l) << j;
+        const Int4 m = -Int4{l, l, l, l};
+        const Float4 c = load4(r.center.data());
+        Float4* lo = clo[j & 1];
+        Float4* hi = chi[j & 1];
+        lo[0] = min4(lo[0], m ? c : pos), hi[0] = max4(hi[0], m ? c : neg);
+        lo[1] = min4(lo[1], m ? pos : c), hi[1] = max4(hi[1], m ? neg : c);
+      }
+      bits[w] = word;
+      left_count += std::uint32_t(__builtin_popcountll(word));
+    }
+    for (int s = 0; s < 2; ++s) {
+      const Float4 lo = min4(clo[0][s], clo[1][s]), hi = max4(chi[0][s], chi[1][s]);
+      for (int a = 0; a < 3; ++a) side[s].centroid.lo[a] = lo[a], side[s].centroid.hi[a] = hi[a];
+    }
+    // Right-going ones below mid (front, upwards) and left-going ones from mid on (back, downwards).
+    const std::uint32_t mid = left_count;
+    std::uint32_t swaps = 0;
+    for (std::uint32_t w = 0; 64 * w < mid; ++w) {
+      const std::uint32_t n = std::min<std::uint32_t>(64, mid - 64 * w);
+      const std::uint64_t valid = n == 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << n) - 1;
+      swaps += std::uint32_t(__builtin_popcountll(~bits[w] & valid));
+    }
+    auto front_bits = [&](std::uint32_t w) {
+      const std::uint32_t n = std::min<std::uint32_t>(64, mid - 64 * w);
+      return ~bits[w] & (n == 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << n) - 1);
+    };
+    auto back_bits = [&](std::uint32_t w) {
+      return 64 * w >= mid ? bits[w] : bits[w] & ~((std::uint64_t(1) << (mid - 64 * w)) - 1);
+    };
+    PrimRef* q = refs_.data() + begin;
+    std::uint32_t fw = 0, bw = words - 1;
+    std::uint64_t front = swaps ? front_bits(0) : 0, back = swaps ? back_bits(bw) : 0;
+    for (std::uint32_t k = 0; k < swaps; ++k) {
+      while (front == 0) front = front_bits(++fw);
+      while (back == 0) back = back_bits(--bw);
+      const std::uint32_t i = 64 * fw + std::uint32_t(__builtin_ctzll(front));
+      const int top = 63 - __builtin_clzll(back);
+      const std::uint32_t j = 64 * bw + std::uint32_t(top);
+      front &= front - 1;
+      back &= ~(std::uint64_t(1) << top);
+      std::swap(q[i], q[j]);
+    }
+    return begin + mid;
   }
 
   // Plane through the barycenter of the centroids, orthogonal to their
