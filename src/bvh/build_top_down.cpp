@@ -12,7 +12,10 @@
 #include <atomic>
 #include <cmath>
 #include <cstddef>
+#include <cstdlib>
 #include <cstring>
+#include <memory>
+#include <type_traits>
 #include <vector>
 
 #include "binary_tree.hpp"
@@ -90,20 +93,50 @@ struct PrimRef {
 };
 static_assert(sizeof(AABB3f) == 24 && offsetof(PrimRef, center) == 24, "PrimRef layout");
 
+// An array of n elements in memory advised to use huge pages, not yet touched:
+// the builder constructs each element itself, in parallel (a std::vector
+// would first initialize them all on one thread), and of the 2 n binary nodes
+// only the pages of those made are ever faulted in.
+template <typename T>
+class UntouchedArray {
+ public:
+  explicit UntouchedArray(std::size_t n) : size_(n) {
+    static_assert(std::is_trivially_destructible_v<T>);  // freeing the memory ends them
+    std::size_t bytes = std::max<std::size_t>(n, 1) * sizeof(T);
+    const bool huge = bytes >= geods::detail::kHugePage / 2;
+    const std::size_t align = huge ? geods::detail::kHugePage : std::max(alignof(T), sizeof(void*));
+    bytes = (bytes + align - 1) / align * align;  // aligned_alloc wants a multiple of the alignment
+    data_.reset(static_cast<T*>(std::aligned_alloc(align, bytes)));
+    if (!data_) throw std::bad_alloc();
+    if (huge) geods::detail::advise_huge_pages(data_.get(), bytes);
+  }
+  std::size_t size() const { return size_; }
+  T* data() { return data_.get(); }
+  const T* data() const { return data_.get(); }
+  T& operator[](std::size_t i) { return data_[i]; }
+  const T& operator[](std::size_t i) const { return data_[i]; }
+
+ private:
+  struct Free {
+    void operator()(T* p) const { std::free(p); }
+  };
+  std::unique_ptr<T[], Free> data_;
+  std::size_t size_;
+};
+
 class TopDown {
  public:
   TopDown(std::span<const AABB3f> boxes, const BuildOptions& options)
-      : options_(options), refs_(boxes.size()) {
+      : options_(options), refs_(boxes.size()), nodes_(2 * boxes.size()) {
     parallel_for_each_index(0, boxes.size(), [&](std::size_t i) {
-      refs_[i] = {boxes[i], boxes[i].center(), std::uint32_t(i)};
+      std::construct_at(&refs_[i], PrimRef{boxes[i], boxes[i].center(), std::uint32_t(i)});
     });
-    tree_.nodes.resize(2 * boxes.size());
   }
 
   BinaryTree run() {
     const auto n = std::uint32_t(refs_.size());
     tree_.root = build(0, n, bounds(0, n), 0);
-    tree_.nodes.resize(next_.load());
+    tree_.nodes.assign(nodes_.data(), nodes_.data() + next_.load());
     tree_.prims.resize(n);
     for (std::uint32_t i = 0; i < n; ++i) tree_.prims[i] = refs_[i].id;
     return std::move(tree_);
@@ -130,14 +163,14 @@ class TopDown {
   }
 
   std::uint32_t make_leaf(std::uint32_t id, std::uint32_t begin, std::uint32_t end) {
-    tree_.nodes[id].prim_first = begin;
-    tree_.nodes[id].prim_count = end - begin;
+    nodes_[id].prim_first = begin;
+    nodes_[id].prim_count = end - begin;
     return id;
   }
 
   std::uint32_t build(std::uint32_t begin, std::uint32_t end, const RangeBounds& rb, int depth) {
     const std::uint32_t id = next_.fetch_add(1);
-    BinaryNode& node = tree_.nodes[id];
+    BinaryNode& node = *std::construct_at(&nodes_[id]);
     node.box = rb.box;
     node.prim_count = end - begin;
     const std::uint32_t count = end - begin;
@@ -170,8 +203,8 @@ class TopDown {
       left = build(begin, mid, side[0], depth + 1);
       right = build(mid, end, side[1], depth + 1);
     }
-    tree_.nodes[id].left = left;
-    tree_.nodes[id].right = right;
+    nodes_[id].left = left;
+    nodes_[id].right = right;
     return id;
   }
 
@@ -446,7 +479,8 @@ class TopDown {
 
   const BuildOptions& options_;
   // The primitives move with the partitions, so every scan reads them in order.
-  std::vector<PrimRef, HugePageAllocator<PrimRef>> refs_;
+  UntouchedArray<PrimRef> refs_;
+  UntouchedArray<BinaryNode> nodes_;
   BinaryTree tree_;
   std::atomic<std::uint32_t> next_{0};
 };
