@@ -18,6 +18,10 @@
 #include <type_traits>
 #include <vector>
 
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
+
 #include "binary_tree.hpp"
 #include "geods/core/parallel.hpp"
 
@@ -47,6 +51,14 @@ inline Float4 load4(const float* p) {
 }
 inline Float4 min4(Float4 a, Float4 b) { return a < b ? a : b; }
 inline Float4 max4(Float4 a, Float4 b) { return a > b ? a : b; }
+// Whether any lane of a comparison result is true.
+inline bool any4(Int4 m) {
+#if defined(__SSE2__)
+  return _mm_movemask_ps(_mm_castsi128_ps(__m128i(m))) != 0;
+#else
+  return (m[0] | m[1] | m[2] | m[3]) != 0;
+#endif
+}
 
 // A bin of the SAH builder, 4-wide (the fourth lane is ignored): resetting
 // only the bins in use is cheap, and one bin update is two SIMD operations.
@@ -276,22 +288,29 @@ class TopDown {
     const float parent_area = rb.box.surface_area();
     float best_cost = std::numeric_limits<float>::infinity();
     int best_axis = -1, best_bin = -1;
-    std::array<float, kMaxBins> right_cost;
+    // The costs of all axes first, the three side by side (independent
+    // dependency chains), then the least in axis-major order (the first least
+    // wins, as when each axis was swept and compared in turn).
+    const float inf = std::numeric_limits<float>::infinity();
+    float right_cost[3][kMaxBins], cost[3][kMaxBins];
+    Bin acc[3];
+    for (Bin& b : acc) b.reset();
+    for (int k = nbins - 1; k > 0; --k)
+      for (int a = 0; a < 3; ++a) {
+        acc[a].extend(bins.bin[a][k]);
+        right_cost[a][k] = acc[a].area() * leaf_tests(acc[a].n);
+      }
+    for (Bin& b : acc) b.reset();
+    for (int k = 0; k < nbins - 1; ++k)
+      for (int a = 0; a < 3; ++a) {
+        acc[a].extend(bins.bin[a][k]);
+        const bool split = acc[a].n != 0 && acc[a].n != count;
+        cost[a][k] = split ? acc[a].area() * leaf_tests(acc[a].n) + right_cost[a][k + 1] : inf;
+      }
     for (int a = 0; a < 3; ++a) {
       if (scale[a] == 0) continue;
-      Bin acc;
-      acc.reset();
-      for (int k = nbins - 1; k > 0; --k) {
-        acc.extend(bins.bin[a][k]);
-        right_cost[k] = acc.area() * leaf_tests(acc.n);
-      }
-      acc.reset();
-      for (int k = 0; k < nbins - 1; ++k) {
-        acc.extend(bins.bin[a][k]);
-        if (acc.n == 0 || acc.n == count) continue;
-        const float cost = acc.area() * leaf_tests(acc.n) + right_cost[k + 1];
-        if (cost < best_cost) best_cost = cost, best_axis = a, best_bin = k;
-      }
+      for (int k = 0; k < nbins - 1; ++k)
+        if (cost[a][k] < best_cost) best_cost = cost[a][k], best_axis = a, best_bin = k;
     }
     const float leaf_cost = leaf_tests(count);
     const float split_cost =
@@ -308,7 +327,15 @@ class TopDown {
     for (int s = 0; s < 2; ++s)
       for (int a = 0; a < 3; ++a) side[s].box.lo[a] = box[s].lo[a], side[s].box.hi[a] = box[s].hi[a];
     have_sides = true;
-    return partition(begin, end, [&](const PrimRef& r) { return bins_of(r)[best_axis] <= best_bin; }, side);
+    // bins_of(r)[best_axis] <= best_bin, without the clamps (they never move a
+    // bin across best_bin) and without picking a lane: the others' limits are
+    // never exceeded.
+    Int4 limit = {INT32_MAX, INT32_MAX, INT32_MAX, INT32_MAX};
+    limit[best_axis] = best_bin;
+    return partition(begin, end, [&](const PrimRef& r) {
+      const Float4 lo = load4(r.box.lo.data()), hi = load4(r.box.hi.data());
+      return !any4(__builtin_convertvector((lo + hi - origin) * scale, Int4) > limit);
+    }, side);
   }
 
   // std::partition's result (libstdc++'s bidirectional algorithm: the same
@@ -325,31 +352,38 @@ class TopDown {
     std::uint64_t* bits = left_bits.data();
     const float inf = std::numeric_limits<float>::infinity();
     const Float4 pos = {inf, inf, inf, inf}, neg = -pos;
-    // Two sets of accumulators: the min/max chains of consecutive primitives overlap.
-    Float4 clo[2][2] = {{pos, pos}, {pos, pos}}, chi[2][2] = {{neg, neg}, {neg, neg}};
+    // Two sets of accumulators, for even and odd primitives: their min/max chains overlap.
+    Float4 lo0 = pos, hi0 = neg, lo1 = pos, hi1 = neg, lo2 = pos, hi2 = neg, lo3 = pos, hi3 = neg;
+    auto add = [&](const PrimRef& r, bool l, Float4& llo, Float4& lhi, Float4& rlo, Float4& rhi) {
+      const Int4 m = -Int4{l, l, l, l};
+      const Float4 c = load4(r.center.data());
+      llo = min4(llo, m ? c : pos), lhi = max4(lhi, m ? c : neg);
+      rlo = min4(rlo, m ? pos : c), rhi = max4(rhi, m ? neg : c);
+    };
     std::uint32_t left_count = 0;
     const PrimRef* p = refs_.data() + begin;
     for (std::uint32_t w = 0; w < words; ++w) {
       const std::uint32_t n = std::min<std::uint32_t>(64, count - 64 * w);
+      const PrimRef* r = p + 64 * w;
       std::uint64_t word = 0;
-      for (std::uint32_t j = 0; j < n; ++j) {
-        const PrimRef& r = p[64 * w + j];
-        const bool l = is_left(r);
-        word |= std::uint64_t(l) << j;
-        const Int4 m = -Int4{l, l, l, l};
-        const Float4 c = load4(r.center.data());
-        Float4* lo = clo[j & 1];
-        Float4* hi = chi[j & 1];
-        lo[0] = min4(lo[0], m ? c : pos), hi[0] = max4(hi[0], m ? c : neg);
-        lo[1] = min4(lo[1], m ? pos : c), hi[1] = max4(hi[1], m ? neg : c);
+      std::uint32_t j = 0;
+      for (; j + 1 < n; j += 2) {
+        const bool l0 = is_left(r[j]), l1 = is_left(r[j + 1]);
+        word |= (std::uint64_t(l0) | std::uint64_t(l1) << 1) << j;
+        add(r[j], l0, lo0, hi0, lo1, hi1);
+        add(r[j + 1], l1, lo2, hi2, lo3, hi3);
+      }
+      if (j < n) {
+        const bool l0 = is_left(r[j]);
+        word |= std::uint64_t(l0) << j;
+        add(r[j], l0, lo0, hi0, lo1, hi1);
       }
       bits[w] = word;
       left_count += std::uint32_t(__builtin_popcountll(word));
     }
-    for (int s = 0; s < 2; ++s) {
-      const Float4 lo = min4(clo[0][s], clo[1][s]), hi = max4(chi[0][s], chi[1][s]);
-      for (int a = 0; a < 3; ++a) side[s].centroid.lo[a] = lo[a], side[s].centroid.hi[a] = hi[a];
-    }
+    const Float4 lo[2] = {min4(lo0, lo2), min4(lo1, lo3)}, hi[2] = {max4(hi0, hi2), max4(hi1, hi3)};
+    for (int s = 0; s < 2; ++s)
+      for (int a = 0; a < 3; ++a) side[s].centroid.lo[a] = lo[s][a], side[s].centroid.hi[a] = hi[s][a];
     // Right-going ones below mid (front, upwards) and left-going ones from mid on (back, downwards).
     const std::uint32_t mid = left_count;
     std::uint32_t swaps = 0;
