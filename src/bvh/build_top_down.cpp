@@ -237,6 +237,16 @@ class TopDown {
   std::uint32_t split_sah(std::uint32_t begin, std::uint32_t end, const RangeBounds& rb, bool& leaf,
                           RangeBounds side[2], bool& have_sides) {
     const std::uint32_t count = end - begin;
+    // The wide AABB layout tests leaf triangles in groups of 4
+    // (ray_triangle4.hpp): a leaf costs one test per started group.
+    const bool grouped = options_.bv == BoundingVolume::aabb && options_.arity >= 4;
+    auto leaf_tests = [&](std::uint32_t n) { return float(grouped ? (n + 3) / 4 : n); };
+    // Then a leaf of up to 4 costs 1, and any split at least 1 (plus areas
+    // times tests, never negative): the leaf, without binning.
+    if (grouped && count <= std::min<std::uint32_t>(4, std::uint32_t(options_.leaf_size))) {
+      leaf = true;
+      return begin;
+    }
     // Fewer bins than primitives would leave most of them empty.
     const int nbins = std::clamp<int>(int(count), 2, std::min<int>(options_.sah_bins, kMaxBins));
     // Bins of the doubled centers lo + hi (exactly twice the centers).
@@ -281,10 +291,6 @@ class TopDown {
             return a;
           });
     }
-    // The wide AABB layout tests leaf triangles in groups of 4
-    // (ray_triangle4.hpp): a leaf costs one test per started group.
-    const bool grouped = options_.bv == BoundingVolume::aabb && options_.arity >= 4;
-    auto leaf_tests = [&](std::uint32_t n) { return float(grouped ? (n + 3) / 4 : n); };
     const float parent_area = rb.box.surface_area();
     float best_cost = std::numeric_limits<float>::infinity();
     int best_axis = -1, best_bin = -1;
