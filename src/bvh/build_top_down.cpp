@@ -145,13 +145,13 @@ class TopDown {
     });
   }
 
-  BinaryTree run() {
+  Topology run() {
     const auto n = std::uint32_t(refs_.size());
-    tree_.root = build(0, n, bounds(0, n), 0);
-    tree_.nodes.assign(nodes_.data(), nodes_.data() + next_.load());
-    tree_.prims.resize(n);
-    for (std::uint32_t i = 0; i < n; ++i) tree_.prims[i] = refs_[i].id;
-    return std::move(tree_);
+    const std::uint32_t root = build(0, n, bounds(0, n), 0);
+    UntouchedArray<std::uint32_t> prims(n);
+    parallel_for_each_index(0, n, [&](std::size_t i) { prims[i] = refs_[i].id; });
+    return finalize({{nodes_.data(), next_.load()}, root, {prims.data(), n}, false}, options_.leaf_size,
+                    options_.arity);
   }
 
  private:
@@ -521,13 +521,12 @@ class TopDown {
   // The primitives move with the partitions, so every scan reads them in order.
   UntouchedArray<PrimRef> refs_;
   UntouchedArray<BinaryNode> nodes_;
-  BinaryTree tree_;
   std::atomic<std::uint32_t> next_{0};
 };
 
 }  // namespace
 
-BinaryTree build_top_down(std::span<const AABB3f> boxes, const BuildOptions& options) {
+Topology build_top_down(std::span<const AABB3f> boxes, const BuildOptions& options) {
   return TopDown(boxes, options).run();
 }
 

@@ -17,9 +17,10 @@ namespace {
 
 using detail::BinaryNode;
 using detail::BinaryTree;
+using detail::BinaryTreeView;
 
 // Appends the primitives of the subtree at `id` in depth-first leaf order.
-void gather_prims(const BinaryTree& tree, std::uint32_t id, std::vector<std::uint32_t>& out,
+void gather_prims(const BinaryTreeView& tree, std::uint32_t id, std::vector<std::uint32_t>& out,
                   std::vector<std::uint32_t>& stack) {
   stack.clear();
   stack.push_back(id);
@@ -41,7 +42,7 @@ void gather_prims(const BinaryTree& tree, std::uint32_t id, std::vector<std::uin
 // other than the root for which skip(b) holds gets its topology node but no
 // descendants: skipped(b, t) is called instead, in depth-first order.
 template <typename Skip, typename Skipped>
-void number(const BinaryTree& tree, int leaf_size, int arity, std::uint32_t root, std::uint32_t root_id,
+void number(const BinaryTreeView& tree, int leaf_size, int arity, std::uint32_t root, std::uint32_t root_id,
             std::vector<TopoNode>& nodes, std::vector<std::uint32_t>& prim_order, const Skip& skip,
             const Skipped& skipped) {
   auto final_leaf = [&](std::uint32_t id) {
@@ -87,12 +88,14 @@ void number(const BinaryTree& tree, int leaf_size, int arity, std::uint32_t root
   }
 }
 
+}  // namespace
+
 // Renumbers depth first (so the result does not depend on the order in which
 // parallel builders allocated nodes) and collapses to the arity. With more
 // than one thread, the subtrees below a cut near the top are numbered in
 // parallel on their own and copied into place: in depth-first order a node's
 // descendants are one contiguous run, numbered as on their own.
-Topology finalize(const BinaryTree& tree, int leaf_size, int arity) {
+Topology detail::finalize(const BinaryTreeView& tree, int leaf_size, int arity) {
   std::vector<TopoNode> nodes(1);
   std::vector<std::uint32_t> prim_order;
   prim_order.reserve(tree.prims.size());
@@ -147,8 +150,6 @@ Topology finalize(const BinaryTree& tree, int leaf_size, int arity) {
   return {std::move(nodes), std::move(prim_order)};
 }
 
-}  // namespace
-
 int Topology::depth() const {
   if (nodes.empty()) return 0;
   // Children always come after their parent, so one forward pass suffices.
@@ -179,12 +180,12 @@ Topology build_topology(std::span<const AABB3f> boxes, const BuildOptions& optio
     case Builder::sah:
     case Builder::median:
     case Builder::pca:
-    case Builder::boxtree: tree = detail::build_top_down(boxes, options); break;
+    case Builder::boxtree: return detail::build_top_down(boxes, options);
     case Builder::bottom_up: tree = detail::build_bottom_up(boxes, options); break;
     case Builder::tiling: tree = detail::build_tiling(boxes, options); break;
     case Builder::insertion: tree = detail::build_insertion(boxes, options); break;
   }
-  return finalize(tree, options.leaf_size, options.arity);
+  return detail::finalize(tree, options.leaf_size, options.arity);
 }
 
 }  // namespace geods::bvh
