@@ -8,7 +8,6 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
-#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstddef>
@@ -23,6 +22,7 @@
 #endif
 
 #include "binary_tree.hpp"
+#include "geods/core/huge_page_allocator.hpp"
 #include "geods/core/parallel.hpp"
 
 namespace geods::bvh::detail {
