@@ -3,6 +3,7 @@
 // is renumbered depth first and collapsed to the requested arity (finalize).
 #include <cstdint>
 #include <limits>
+#include <span>
 #include <vector>
 
 #include "geods/bvh/topology.hpp"
@@ -32,7 +33,24 @@ struct BinaryTree {
   bool merge_small_subtrees = false;
 };
 
-BinaryTree build_top_down(std::span<const AABB3f> boxes, const BuildOptions& options);
+/// A binary tree's nodes and primitives where they are: a BinaryTree's, or the
+/// top-down builder's own arrays (no copy into a BinaryTree).
+struct BinaryTreeView {
+  std::span<const BinaryNode> nodes;
+  std::uint32_t root = kNone;
+  std::span<const std::uint32_t> prims;
+  bool merge_small_subtrees = false;
+
+  BinaryTreeView(std::span<const BinaryNode> n, std::uint32_t r, std::span<const std::uint32_t> p, bool merge)
+      : nodes(n), root(r), prims(p), merge_small_subtrees(merge) {}
+  BinaryTreeView(const BinaryTree& tree)  // NOLINT(google-explicit-constructor)
+      : BinaryTreeView(tree.nodes, tree.root, tree.prims, tree.merge_small_subtrees) {}
+};
+
+/// Renumbers depth first and collapses to the arity (topology.cpp).
+Topology finalize(const BinaryTreeView& tree, int leaf_size, int arity);
+
+Topology build_top_down(std::span<const AABB3f> boxes, const BuildOptions& options);  // finalized
 BinaryTree build_bottom_up(std::span<const AABB3f> boxes, const BuildOptions& options);
 BinaryTree build_tiling(std::span<const AABB3f> boxes, const BuildOptions& options);
 BinaryTree build_insertion(std::span<const AABB3f> boxes, const BuildOptions& options);

@@ -8,14 +8,21 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
-#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstddef>
+#include <cstdlib>
 #include <cstring>
+#include <memory>
+#include <type_traits>
 #include <vector>
 
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
+
 #include "binary_tree.hpp"
+#include "geods/core/huge_page_allocator.hpp"
 #include "geods/core/parallel.hpp"
 
 namespace geods::bvh::detail {
@@ -44,6 +51,14 @@ inline Float4 load4(const float* p) {
 }
 inline Float4 min4(Float4 a, Float4 b) { return a < b ? a : b; }
 inline Float4 max4(Float4 a, Float4 b) { return a > b ? a : b; }
+// Whether any lane of a comparison result is true.
+inline bool any4(Int4 m) {
+#if defined(__SSE2__)
+  return _mm_movemask_ps(_mm_castsi128_ps(__m128i(m))) != 0;
+#else
+  return (m[0] | m[1] | m[2] | m[3]) != 0;
+#endif
+}
 
 // A bin of the SAH builder, 4-wide (the fourth lane is ignored): resetting
 // only the bins in use is cheap, and one bin update is two SIMD operations.
@@ -90,23 +105,53 @@ struct PrimRef {
 };
 static_assert(sizeof(AABB3f) == 24 && offsetof(PrimRef, center) == 24, "PrimRef layout");
 
+// An array of n elements in memory advised to use huge pages, not yet touched:
+// the builder constructs each element itself, in parallel (a std::vector
+// would first initialize them all on one thread), and of the 2 n binary nodes
+// only the pages of those made are ever faulted in.
+template <typename T>
+class UntouchedArray {
+ public:
+  explicit UntouchedArray(std::size_t n) : size_(n) {
+    static_assert(std::is_trivially_destructible_v<T>);  // freeing the memory ends them
+    std::size_t bytes = std::max<std::size_t>(n, 1) * sizeof(T);
+    const bool huge = bytes >= geods::detail::kHugePage / 2;
+    const std::size_t align = huge ? geods::detail::kHugePage : std::max(alignof(T), sizeof(void*));
+    bytes = (bytes + align - 1) / align * align;  // aligned_alloc wants a multiple of the alignment
+    data_.reset(static_cast<T*>(std::aligned_alloc(align, bytes)));
+    if (!data_) throw std::bad_alloc();
+    if (huge) geods::detail::advise_huge_pages(data_.get(), bytes);
+  }
+  std::size_t size() const { return size_; }
+  T* data() { return data_.get(); }
+  const T* data() const { return data_.get(); }
+  T& operator[](std::size_t i) { return data_[i]; }
+  const T& operator[](std::size_t i) const { return data_[i]; }
+
+ private:
+  struct Free {
+    void operator()(T* p) const { std::free(p); }
+  };
+  std::unique_ptr<T[], Free> data_;
+  std::size_t size_;
+};
+
 class TopDown {
  public:
   TopDown(std::span<const AABB3f> boxes, const BuildOptions& options)
-      : options_(options), refs_(boxes.size()) {
+      : options_(options), refs_(boxes.size()), nodes_(2 * boxes.size()) {
     parallel_for_each_index(0, boxes.size(), [&](std::size_t i) {
-      refs_[i] = {boxes[i], boxes[i].center(), std::uint32_t(i)};
+      std::construct_at(&refs_[i], PrimRef{boxes[i], boxes[i].center(), std::uint32_t(i)});
     });
-    tree_.nodes.resize(2 * boxes.size());
   }
 
-  BinaryTree run() {
+  Topology run() {
     const auto n = std::uint32_t(refs_.size());
-    tree_.root = build(0, n, bounds(0, n), 0);
-    tree_.nodes.resize(next_.load());
-    tree_.prims.resize(n);
-    for (std::uint32_t i = 0; i < n; ++i) tree_.prims[i] = refs_[i].id;
-    return std::move(tree_);
+    const std::uint32_t root = build(0, n, bounds(0, n), 0);
+    UntouchedArray<std::uint32_t> prims(n);
+    parallel_for_each_index(0, n, [&](std::size_t i) { prims[i] = refs_[i].id; });
+    return finalize({{nodes_.data(), next_.load()}, root, {prims.data(), n}, false}, options_.leaf_size,
+                    options_.arity);
   }
 
  private:
@@ -130,14 +175,14 @@ class TopDown {
   }
 
   std::uint32_t make_leaf(std::uint32_t id, std::uint32_t begin, std::uint32_t end) {
-    tree_.nodes[id].prim_first = begin;
-    tree_.nodes[id].prim_count = end - begin;
+    nodes_[id].prim_first = begin;
+    nodes_[id].prim_count = end - begin;
     return id;
   }
 
   std::uint32_t build(std::uint32_t begin, std::uint32_t end, const RangeBounds& rb, int depth) {
     const std::uint32_t id = next_.fetch_add(1);
-    BinaryNode& node = tree_.nodes[id];
+    BinaryNode& node = *std::construct_at(&nodes_[id]);
     node.box = rb.box;
     node.prim_count = end - begin;
     const std::uint32_t count = end - begin;
@@ -170,8 +215,8 @@ class TopDown {
       left = build(begin, mid, side[0], depth + 1);
       right = build(mid, end, side[1], depth + 1);
     }
-    tree_.nodes[id].left = left;
-    tree_.nodes[id].right = right;
+    nodes_[id].left = left;
+    nodes_[id].right = right;
     return id;
   }
 
@@ -192,6 +237,16 @@ class TopDown {
   std::uint32_t split_sah(std::uint32_t begin, std::uint32_t end, const RangeBounds& rb, bool& leaf,
                           RangeBounds side[2], bool& have_sides) {
     const std::uint32_t count = end - begin;
+    // The wide AABB layout tests leaf triangles in groups of 4
+    // (ray_triangle4.hpp): a leaf costs one test per started group.
+    const bool grouped = options_.bv == BoundingVolume::aabb && options_.arity >= 4;
+    auto leaf_tests = [&](std::uint32_t n) { return float(grouped ? (n + 3) / 4 : n); };
+    // Then a leaf of up to 4 costs 1, and any split at least 1 (plus areas
+    // times tests, never negative): the leaf, without binning.
+    if (grouped && count <= std::min<std::uint32_t>(4, std::uint32_t(options_.leaf_size))) {
+      leaf = true;
+      return begin;
+    }
     // Fewer bins than primitives would leave most of them empty.
     const int nbins = std::clamp<int>(int(count), 2, std::min<int>(options_.sah_bins, kMaxBins));
     // Bins of the doubled centers lo + hi (exactly twice the centers).
@@ -236,29 +291,32 @@ class TopDown {
             return a;
           });
     }
-    // The wide AABB layout tests leaf triangles in groups of 4
-    // (ray_triangle4.hpp): a leaf costs one test per started group.
-    const bool grouped = options_.bv == BoundingVolume::aabb && options_.arity >= 4;
-    auto leaf_tests = [&](std::uint32_t n) { return float(grouped ? (n + 3) / 4 : n); };
     const float parent_area = rb.box.surface_area();
     float best_cost = std::numeric_limits<float>::infinity();
     int best_axis = -1, best_bin = -1;
-    std::array<float, kMaxBins> right_cost;
+    // The costs of all axes first, the three side by side (independent
+    // dependency chains), then the least in axis-major order (the first least
+    // wins, as when each axis was swept and compared in turn).
+    const float inf = std::numeric_limits<float>::infinity();
+    float right_cost[3][kMaxBins], cost[3][kMaxBins];
+    Bin acc[3];
+    for (Bin& b : acc) b.reset();
+    for (int k = nbins - 1; k > 0; --k)
+      for (int a = 0; a < 3; ++a) {
+        acc[a].extend(bins.bin[a][k]);
+        right_cost[a][k] = acc[a].area() * leaf_tests(acc[a].n);
+      }
+    for (Bin& b : acc) b.reset();
+    for (int k = 0; k < nbins - 1; ++k)
+      for (int a = 0; a < 3; ++a) {
+        acc[a].extend(bins.bin[a][k]);
+        const bool split = acc[a].n != 0 && acc[a].n != count;
+        cost[a][k] = split ? acc[a].area() * leaf_tests(acc[a].n) + right_cost[a][k + 1] : inf;
+      }
     for (int a = 0; a < 3; ++a) {
       if (scale[a] == 0) continue;
-      Bin acc;
-      acc.reset();
-      for (int k = nbins - 1; k > 0; --k) {
-        acc.extend(bins.bin[a][k]);
-        right_cost[k] = acc.area() * leaf_tests(acc.n);
-      }
-      acc.reset();
-      for (int k = 0; k < nbins - 1; ++k) {
-        acc.extend(bins.bin[a][k]);
-        if (acc.n == 0 || acc.n == count) continue;
-        const float cost = acc.area() * leaf_tests(acc.n) + right_cost[k + 1];
-        if (cost < best_cost) best_cost = cost, best_axis = a, best_bin = k;
-      }
+      for (int k = 0; k < nbins - 1; ++k)
+        if (cost[a][k] < best_cost) best_cost = cost[a][k], best_axis = a, best_bin = k;
     }
     const float leaf_cost = leaf_tests(count);
     const float split_cost =
@@ -268,52 +326,99 @@ class TopDown {
       return begin;
     }
     if (best_axis < 0) return begin;  // all centroids equal: median split by id
-    // std::partition's algorithm (libstdc++'s bidirectional one: the same
-    // order, so the same tree as before), with the boxes and centroid boxes of
-    // both sides gathered on the way instead of in two more passes.
-    const float inf = std::numeric_limits<float>::infinity();
-    Float4 lo[2], hi[2], clo[2], chi[2];
-    for (int s = 0; s < 2; ++s) {
-      lo[s] = clo[s] = Float4{inf, inf, inf, inf};
-      hi[s] = chi[s] = -lo[s];
-    }
-    auto add = [&](int s, const PrimRef& r) {
-      lo[s] = min4(lo[s], load4(r.box.lo.data()));
-      hi[s] = max4(hi[s], load4(r.box.hi.data()));
-      const Float4 c = load4(r.center.data());
-      clo[s] = min4(clo[s], c);
-      chi[s] = max4(chi[s], c);
-    };
-    auto is_left = [&](const PrimRef& r) { return bins_of(r)[best_axis] <= best_bin; };
-    PrimRef* front = refs_.data() + begin;
-    PrimRef* back = refs_.data() + end;
-    for (;;) {
-      for (;;) {
-        if (front == back) goto done;
-        if (!is_left(*front)) break;
-        add(0, *front);
-        ++front;
-      }
-      add(1, *front);  // goes right: stays at the split or is swapped to back
-      --back;
-      for (;;) {
-        if (front == back) goto done;
-        if (is_left(*back)) break;
-        add(1, *back);
-        --back;
-      }
-      add(0, *back);
-      std::iter_swap(front, back);
-      ++front;
-    }
-  done:
+    // The boxes of both sides are the unions of their bins.
+    Bin box[2];
+    box[0].reset(), box[1].reset();
+    for (int k = 0; k < nbins; ++k) box[k <= best_bin ? 0 : 1].extend(bins.bin[best_axis][k]);
     for (int s = 0; s < 2; ++s)
-      for (int a = 0; a < 3; ++a) {
-        side[s].box.lo[a] = lo[s][a], side[s].box.hi[a] = hi[s][a];
-        side[s].centroid.lo[a] = clo[s][a], side[s].centroid.hi[a] = chi[s][a];
-      }
+      for (int a = 0; a < 3; ++a) side[s].box.lo[a] = box[s].lo[a], side[s].box.hi[a] = box[s].hi[a];
     have_sides = true;
-    return std::uint32_t(front - refs_.data());
+    // bins_of(r)[best_axis] <= best_bin, without the clamps (they never move a
+    // bin across best_bin) and without picking a lane: the others' limits are
+    // never exceeded.
+    Int4 limit = {INT32_MAX, INT32_MAX, INT32_MAX, INT32_MAX};
+    limit[best_axis] = best_bin;
+    return partition(begin, end, [&](const PrimRef& r) {
+      const Float4 lo = load4(r.box.lo.data()), hi = load4(r.box.hi.data());
+      return !any4(__builtin_convertvector((lo + hi - origin) * scale, Int4) > limit);
+    }, side);
+  }
+
+  // std::partition's result (libstdc++'s bidirectional algorithm: the same
+  // order, so the same tree as before) and the centroid boxes of both sides,
+  // without data-dependent branches. That algorithm swaps the j-th
+  // right-going primitive of [begin, mid), counted from the left, with the
+  // j-th left-going one of [mid, end), counted from the right, and moves
+  // nothing else. So: the sides as bits, 64 to a word, then the pairs.
+  template <typename IsLeft>
+  std::uint32_t partition(std::uint32_t begin, std::uint32_t end, const IsLeft& is_left, RangeBounds side[2]) {
+    const std::uint32_t count = end - begin, words = (count + 63) / 64;
+    thread_local std::vector<std::uint64_t> left_bits;
+    if (left_bits.size() < words) left_bits.resize(words);
+    std::uint64_t* bits = left_bits.data();
+    const float inf = std::numeric_limits<float>::infinity();
+    const Float4 pos = {inf, inf, inf, inf}, neg = -pos;
+    // Two sets of accumulators, for even and odd primitives: their min/max chains overlap.
+    Float4 lo0 = pos, hi0 = neg, lo1 = pos, hi1 = neg, lo2 = pos, hi2 = neg, lo3 = pos, hi3 = neg;
+    auto add = [&](const PrimRef& r, bool l, Float4& llo, Float4& lhi, Float4& rlo, Float4& rhi) {
+      const Int4 m = -Int4{l, l, l, l};
+      const Float4 c = load4(r.center.data());
+      llo = min4(llo, m ? c : pos), lhi = max4(lhi, m ? c : neg);
+      rlo = min4(rlo, m ? pos : c), rhi = max4(rhi, m ? neg : c);
+    };
+    std::uint32_t left_count = 0;
+    const PrimRef* p = refs_.data() + begin;
+    for (std::uint32_t w = 0; w < words; ++w) {
+      const std::uint32_t n = std::min<std::uint32_t>(64, count - 64 * w);
+      const PrimRef* r = p + 64 * w;
+      std::uint64_t word = 0;
+      std::uint32_t j = 0;
+      for (; j + 1 < n; j += 2) {
+        const bool l0 = is_left(r[j]), l1 = is_left(r[j + 1]);
+        word |= (std::uint64_t(l0) | std::uint64_t(l1) << 1) << j;
+        add(r[j], l0, lo0, hi0, lo1, hi1);
+        add(r[j + 1], l1, lo2, hi2, lo3, hi3);
+      }
+      if (j < n) {
+        const bool l0 = is_left(r[j]);
+        word |= std::uint64_t(l0) << j;
+        add(r[j], l0, lo0, hi0, lo1, hi1);
+      }
+      bits[w] = word;
+      left_count += std::uint32_t(__builtin_popcountll(word));
+    }
+    const Float4 lo[2] = {min4(lo0, lo2), min4(lo1, lo3)}, hi[2] = {max4(hi0, hi2), max4(hi1, hi3)};
+    for (int s = 0; s < 2; ++s)
+      for (int a = 0; a < 3; ++a) side[s].centroid.lo[a] = lo[s][a], side[s].centroid.hi[a] = hi[s][a];
+    // Right-going ones below mid (front, upwards) and left-going ones from mid on (back, downwards).
+    const std::uint32_t mid = left_count;
+    std::uint32_t swaps = 0;
+    for (std::uint32_t w = 0; 64 * w < mid; ++w) {
+      const std::uint32_t n = std::min<std::uint32_t>(64, mid - 64 * w);
+      const std::uint64_t valid = n == 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << n) - 1;
+      swaps += std::uint32_t(__builtin_popcountll(~bits[w] & valid));
+    }
+    auto front_bits = [&](std::uint32_t w) {
+      const std::uint32_t n = std::min<std::uint32_t>(64, mid - 64 * w);
+      return ~bits[w] & (n == 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << n) - 1);
+    };
+    auto back_bits = [&](std::uint32_t w) {
+      return 64 * w >= mid ? bits[w] : bits[w] & ~((std::uint64_t(1) << (mid - 64 * w)) - 1);
+    };
+    PrimRef* q = refs_.data() + begin;
+    std::uint32_t fw = 0, bw = words - 1;
+    std::uint64_t front = swaps ? front_bits(0) : 0, back = swaps ? back_bits(bw) : 0;
+    for (std::uint32_t k = 0; k < swaps; ++k) {
+      while (front == 0) front = front_bits(++fw);
+      while (back == 0) back = back_bits(--bw);
+      const std::uint32_t i = 64 * fw + std::uint32_t(__builtin_ctzll(front));
+      const int top = 63 - __builtin_clzll(back);
+      const std::uint32_t j = 64 * bw + std::uint32_t(top);
+      front &= front - 1;
+      back &= ~(std::uint64_t(1) << top);
+      std::swap(q[i], q[j]);
+    }
+    return begin + mid;
   }
 
   // Plane through the barycenter of the centroids, orthogonal to their
@@ -414,14 +519,14 @@ class TopDown {
 
   const BuildOptions& options_;
   // The primitives move with the partitions, so every scan reads them in order.
-  std::vector<PrimRef, HugePageAllocator<PrimRef>> refs_;
-  BinaryTree tree_;
+  UntouchedArray<PrimRef> refs_;
+  UntouchedArray<BinaryNode> nodes_;
   std::atomic<std::uint32_t> next_{0};
 };
 
 }  // namespace
 
-BinaryTree build_top_down(std::span<const AABB3f> boxes, const BuildOptions& options) {
+Topology build_top_down(std::span<const AABB3f> boxes, const BuildOptions& options) {
   return TopDown(boxes, options).run();
 }
 
