@@ -112,15 +112,11 @@ static_assert(sizeof(AABB3f) == 24 && offsetof(PrimRef, center) == 24, "PrimRef 
 template <typename T>
 class UntouchedArray {
  public:
-  explicit UntouchedArray(std::size_t n) : size_(n) {
+  explicit UntouchedArray(std::size_t n)
+      : data_(static_cast<T*>(geods::detail::allocate_huge_pages(std::max<std::size_t>(n, 1) * sizeof(T), alignof(T),
+                                                                  /*touched=*/false))),
+        size_(n) {
     static_assert(std::is_trivially_destructible_v<T>);  // freeing the memory ends them
-    std::size_t bytes = std::max<std::size_t>(n, 1) * sizeof(T);
-    const bool huge = bytes >= geods::detail::kHugePage / 2;
-    const std::size_t align = huge ? geods::detail::kHugePage : std::max(alignof(T), sizeof(void*));
-    bytes = (bytes + align - 1) / align * align;  // aligned_alloc wants a multiple of the alignment
-    data_.reset(static_cast<T*>(std::aligned_alloc(align, bytes)));
-    if (!data_) throw std::bad_alloc();
-    if (huge) geods::detail::advise_huge_pages(data_.get(), bytes);
   }
   std::size_t size() const { return size_; }
   T* data() { return data_.get(); }

@@ -17,6 +17,7 @@
 #include "geods/core/simd_level.hpp"
 #include "geods/bvh/traversal.hpp"
 #include "geods/core/convex_hull3.hpp"
+#include "geods/core/default_init_allocator.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"
 #include "geods/core/triangle.hpp"
@@ -67,28 +68,11 @@ const std::array<Vec3f, 7> kContainDirections = {
     Vec3f(0.7254f, -0.0631f, 0.7147f).normalized(), Vec3f(-0.2050f, -0.1241f, 1.4897f).normalized(),
     Vec3f(1.4090f, 1.4172f, 0.6715f).normalized()};
 
-// HugePageAllocator (its pages faulted in by all threads) whose vectors leave
-// new elements default-initialized: the build fills its triangle copies and
-// groups in parallel right after allocating them, and value-initializing them
-// first would write them all once more, on one thread.
+// The triangle copies and groups are filled in parallel right after they are
+// sized: not value-initialized first (on one thread), their huge pages faulted
+// in by all threads.
 template <typename T>
-struct FilledLaterAllocator : HugePageAllocator<T> {
-  template <typename U>
-  struct rebind {
-    using other = FilledLaterAllocator<U>;
-  };
-  FilledLaterAllocator() = default;
-  template <typename U>
-  FilledLaterAllocator(const FilledLaterAllocator<U>&) {}
-  template <typename U>
-  void construct(U* p) {
-    ::new (static_cast<void*>(p)) U;
-  }
-  template <typename U, typename... Args>
-  void construct(U* p, Args&&... args) {
-    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
-  }
-};
+using FilledLater = std::vector<T, DefaultInitAllocator<HugePageAllocator<T>>>;
 
 }  // namespace
 
@@ -110,7 +94,7 @@ TriangleBvh TriangleBvh::build(const TriMesh& mesh, const BuildOptions& options)
   bvh.topology_ = build_topology(boxes, options);
   bvh.depth_ = bvh.topology_.depth();
   progress.update(1);
-  std::vector<Triangle, FilledLaterAllocator<Triangle>> triangles(n);
+  FilledLater<Triangle> triangles(n);
   parallel_for_each_index(0, n, [&](std::size_t i) {
     const auto& t = mesh.triangles[bvh.topology_.prim_order[i]];
     triangles[i] = {mesh.vertices[t[0]], mesh.vertices[t[1]], mesh.vertices[t[2]]};
@@ -228,7 +212,7 @@ void TriangleBvh::build_wide() {
       wide_index[i] = inner++;
     }
   }
-  std::vector<TriangleGroup, FilledLaterAllocator<TriangleGroup>> group_array(groups);
+  FilledLater<TriangleGroup> group_array(groups);
   parallel_for(0, nodes.size(), 1024, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) {
       if (!nodes[i].leaf()) continue;

@@ -44,7 +44,7 @@ void prefault(const void* p, std::size_t bytes) {
 #endif
 }
 
-void* allocate_huge_pages(std::size_t bytes, std::size_t alignment) {
+void* allocate_huge_pages(std::size_t bytes, std::size_t alignment, bool touched) {
   constexpr std::size_t kPage = 4096;
   const bool huge = bytes >= kHugePage / 2;  // rounding up wastes less than half
   const std::size_t align = huge ? kHugePage : std::max<std::size_t>(alignment, sizeof(void*));
@@ -53,6 +53,7 @@ void* allocate_huge_pages(std::size_t bytes, std::size_t alignment) {
   if (!p) throw std::bad_alloc();
   if (!huge) return p;
   advise_huge_pages(p, bytes);
+  if (!touched) return p;
   // One write per small page (which faults in the whole huge page where there is one), a
   // huge page per task: the fresh memory's contents are unspecified, so a zero changes nothing.
   auto* bytes_of = static_cast<volatile char*>(p);

@@ -17,8 +17,10 @@ namespace geods {
 
 namespace detail {
 inline constexpr std::size_t kHugePage = std::size_t(2) << 20;
-/// `bytes` of memory as described above; throws std::bad_alloc.
-void* allocate_huge_pages(std::size_t bytes, std::size_t alignment);
+/// `bytes` of memory as described above; throws std::bad_alloc. With touched = false
+/// the pages are left for the caller's first writes to fault in (for arrays whose
+/// elements are written in parallel, or of which only a part is ever written).
+void* allocate_huge_pages(std::size_t bytes, std::size_t alignment, bool touched = true);
 /// Advises transparent huge pages for the whole small pages of [p, p + bytes) (2 MiB or more).
 void advise_huge_pages(void* p, std::size_t bytes);
 /// Maps the whole small pages of [p, p + bytes) writable before they are written, if they

@@ -21,11 +21,11 @@
 // smallest distance; among sites at exactly equal distance, any one of them.
 #include <cstdint>
 #include <memory>
-#include <new>
 #include <span>
 #include <utility>
 #include <vector>
 
+#include "geods/core/default_init_allocator.hpp"
 #include "geods/core/vec.hpp"
 #include "geods/voronoi/voronoi2.hpp"
 
@@ -72,25 +72,7 @@ class SlabLocator {
   double slab_middle(std::size_t s) const;  // an x inside slab s
   // The entries are all written by the parallel fill and sorts: resize() leaves them
   // uninitialized (no sequential zero-fill of n^1.5 entries; their pages are first touched in parallel).
-  template <typename T>
-  struct Uninitialized : std::allocator<T> {
-    template <typename U>
-    struct rebind {
-      using other = Uninitialized<U>;
-    };
-    Uninitialized() = default;
-    template <typename U>
-    Uninitialized(const Uninitialized<U>&) noexcept {}
-    template <typename U>
-    void construct(U* p) noexcept {
-      ::new (static_cast<void*>(p)) U;
-    }
-    template <typename U, typename... Args>
-    void construct(U* p, Args&&... args) {
-      ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
-    }
-  };
-  using Entries = std::vector<std::uint32_t, Uninitialized<std::uint32_t>>;
+  using Entries = std::vector<std::uint32_t, DefaultInitAllocator<std::allocator<std::uint32_t>>>;
 
   const Voronoi2* diagram_;
   std::vector<Line> lines_;                  // per half-edge of the diagram (only stored ones are set)
