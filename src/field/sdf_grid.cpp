@@ -850,7 +850,10 @@ class GridSolver {
           select(tile_list, survivors[b], near, Packed::k0);
         filter(near, block, c.point, block_list, kept, true, std::span(anchors.data(), num_anchors));
         const BlockWeights weights = block_weights(block);  // in_box of each sample
-        std::size_t seed = 0;  // the group of the previous sample's nearest face
+        // Each sample's search starts from the group of its neighbour's nearest face one row back
+        // (else one layer back, else the sample before): not the sample just before, so that
+        // consecutive searches do not wait for each other.
+        std::array<std::uint32_t, kBlock * kBlock * kBlock> slot{};
         // The block's corner samples have their distances from every face of
         // the list already (k0..k7): their nearest entries in one pass.
         std::array<std::size_t, 8> corner{};
@@ -882,9 +885,11 @@ class GridSolver {
 #ifdef GEODS_SDF_AVX512
                 if (wide_ && !row_ready) avx512::row_bounds(block_list, at_p.wy, at_p.wz, row.data()), row_ready = true;
 #endif
-                s = closest_in(block_list, p, &at_p, seed, wide_ ? row.data() : nullptr, false);
+                const std::size_t here = (i - block.lo[0]) + kBlock * ((j - block.lo[1]) + kBlock * (k - block.lo[2]));
+                const std::size_t from = j > block.lo[1] ? here - kBlock : k > block.lo[2] ? here - kBlock * kBlock : here - 1;
+                s = closest_in(block_list, p, &at_p, slot[from] / 8, wide_ ? row.data() : nullptr, false);
               }
-              seed = s.slot / 8;
+              slot[(i - block.lo[0]) + kBlock * ((j - block.lo[1]) + kBlock * (k - block.lo[2]))] = std::uint32_t(s.slot);
               const float d = std::sqrt(s.d2);
               if (d > band_) continue;
               stats.candidates_per_sample += double(block_list.size);
