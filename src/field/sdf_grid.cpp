@@ -601,17 +601,57 @@ GEODS_AVX512_FN void gather(const std::uint32_t* src, const std::uint32_t* index
   }
 }
 
+// The 16 x 16 transpose of r (o[k] lane m = r[m] lane k), of which only the first `outputs`
+// rows are written: four rounds of in-lane and cross-lane shuffles.
+template <int outputs>
+GEODS_AVX512_INLINE void transpose16(const __m512 (&r)[16], __m512 (&o)[16]) {
+  __m512 t[16], u[16];
+  for (int m = 0; m < 16; m += 2) t[m] = _mm512_unpacklo_ps(r[m], r[m + 1]), t[m + 1] = _mm512_unpackhi_ps(r[m], r[m + 1]);
+  // u[4 g + f]: rows 4 g .. 4 g + 3 of columns f, f + 4, f + 8, f + 12 (one per 128-bit lane).
+  for (int g = 0; g < 4; ++g) {
+    const __m512d a = _mm512_castps_pd(t[4 * g]), b = _mm512_castps_pd(t[4 * g + 1]);
+    const __m512d c = _mm512_castps_pd(t[4 * g + 2]), d = _mm512_castps_pd(t[4 * g + 3]);
+    u[4 * g] = _mm512_castpd_ps(_mm512_unpacklo_pd(a, c));
+    u[4 * g + 1] = _mm512_castpd_ps(_mm512_unpackhi_pd(a, c));
+    u[4 * g + 2] = _mm512_castpd_ps(_mm512_unpacklo_pd(b, d));
+    u[4 * g + 3] = _mm512_castpd_ps(_mm512_unpackhi_pd(b, d));
+  }
+  for (int f = 0; f < 4; ++f) {
+    if (f < outputs) {  // columns f and f + 8
+      const __m512 v = _mm512_shuffle_f32x4(u[f], u[4 + f], 0x88), w = _mm512_shuffle_f32x4(u[8 + f], u[12 + f], 0x88);
+      o[f] = _mm512_shuffle_f32x4(v, w, 0x88);
+      if (f + 8 < outputs) o[f + 8] = _mm512_shuffle_f32x4(v, w, 0xdd);
+    }
+    if (f + 4 < outputs) {  // columns f + 4 and f + 12
+      const __m512 v = _mm512_shuffle_f32x4(u[f], u[4 + f], 0xdd), w = _mm512_shuffle_f32x4(u[8 + f], u[12 + f], 0xdd);
+      o[f + 4] = _mm512_shuffle_f32x4(v, w, 0x88);
+      if (f + 12 < outputs) o[f + 12] = _mm512_shuffle_f32x4(v, w, 0xdd);
+    }
+  }
+}
+
 // out[k][j] = rows[index[j] * (k0 + 1) + k] for j < n and k < k0, and
 // face[j] the bits of rows[index[j] * (k0 + 1) + k0]: the quantities and
-// face of entries stored row by row (one or two cache lines per entry).
+// face of entries stored row by row (one or two cache lines per entry),
+// 16 rows at a time loaded whole and transposed (gathers cost three times more).
+// The rows are followed by 16 floats of padding (a row's second load reads past it);
+// out and face have room for n rounded up to 16.
 GEODS_AVX512_FN void gather_rows(const float* rows, const std::uint32_t* index, std::size_t n, Packed::Arrays& out,
                                  std::int32_t* face) {
+  static_assert(Packed::k0 + 1 > 16 && Packed::k0 + 1 <= 32);
+  constexpr int kRest = Packed::k0 + 1 - 16;  // the second load's columns
   for (std::size_t j = 0; j < n; j += 16) {
-    const __mmask16 m = valid(j, n);
-    const __m512i at = _mm512_mullo_epi32(_mm512_maskz_loadu_epi32(m, index + j), _mm512_set1_epi32(Packed::k0 + 1));
-    for (int k = 0; k < Packed::k0; ++k)
-      _mm512_mask_storeu_ps(out[k].data() + j, m, _mm512_mask_i32gather_ps(_mm512_setzero_ps(), m, at, rows + k, 4));
-    _mm512_mask_storeu_epi32(face + j, m, _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), m, at, rows + Packed::k0, 4));
+    __m512 lo[16], hi[16], o[16];
+    for (int m = 0; m < 16; ++m) {
+      const float* row = rows + std::size_t(j + std::size_t(m) < n ? index[j + std::size_t(m)] : index[0]) * (Packed::k0 + 1);
+      lo[m] = _mm512_loadu_ps(row);
+      hi[m] = _mm512_loadu_ps(row + 16);
+    }
+    transpose16<16>(lo, o);
+    for (int k = 0; k < 16; ++k) _mm512_storeu_ps(out[k].data() + j, o[k]);
+    transpose16<kRest>(hi, o);
+    for (int k = 16; k < Packed::k0; ++k) _mm512_storeu_ps(out[k].data() + j, o[k - 16]);
+    _mm512_storeu_ps(reinterpret_cast<float*>(face + j), o[kRest - 1]);
   }
 }
 
@@ -728,7 +768,8 @@ class GridSolver {
     // Only the rows where they serve (all_ is then never read). Not zeroed: the fill below writes
     // every entry, its threads touching the fresh pages (a serial zeroing cost more than the fill).
     if (wide_ && n > 0 && n < std::size_t(std::numeric_limits<std::int32_t>::max()) / kRow) {
-      rows_.reset(static_cast<float*>(detail::allocate_huge_pages(n * kRow * sizeof(float), alignof(float))));
+      // 16 floats of padding: gather_rows() reads 32 floats from a row's start.
+      rows_.reset(static_cast<float*>(detail::allocate_huge_pages((n * kRow + 16) * sizeof(float), alignof(float))));
     } else {
       all_.reserve(n);
       all_.size = n;
