@@ -980,7 +980,7 @@ class GridSolver {
           } else {
             const Vec3f p = grid_.position(i, j, k);
             if (options_.sign == SignMethod::winding) {
-              in = mesh_.winding_number(p) > 0.5;
+              in = mesh_.inside_by_winding(p);
               ++stats.winding_numbers;
             } else {
               in = mesh_.inside_by_pseudonormal(p, mesh_.query(p, SignMethod::none));
@@ -1357,7 +1357,7 @@ void propagate(const MeshDistance& mesh, const Grid3Geometry& grid, const SdfGri
     if (options.sign == SignMethod::pseudonormal) {
       inside = (p - c).dot(mesh.pseudonormal(face[s], region)) < 0;
     } else if (options.sign == SignMethod::winding) {
-      inside = mesh.winding_number(p) > 0.5;
+      inside = mesh.inside_by_winding(p);
       ++windings;
     }
     d2[s] = inside ? -d : d;
