@@ -1049,6 +1049,11 @@ class GridSolver {
     const std::array<float, 8> bound2 = bounds_from(box, q);
     const bvh::Topology& topo = mesh_.bvh().topology();
     found.clear();
+#if defined(__SSE2__)
+    const __m128 c0 = _mm_setr_ps(box.corners[0].x(), box.corners[0].y(), box.corners[0].z(), 0.0f);
+    const __m128 c7 = _mm_setr_ps(box.corners[7].x(), box.corners[7].y(), box.corners[7].z(), 0.0f);
+    const __m128 bound_lo = _mm_loadu_ps(bound2.data()), bound_hi = _mm_loadu_ps(bound2.data() + 4);
+#endif
     std::visit(
         [&](const auto& volumes) {
           bvh::TraversalStack<bvh::NodeRef> stack(mesh_.stack_size());
@@ -1059,6 +1064,25 @@ class GridSolver {
                   // The corners take two coordinates per axis: six squared
                   // gaps instead of 8 box distances (most nodes tested fail all 8).
                   const AABB3f& v = volumes[node];
+#if defined(__SSE2__)
+                  // The same sums in four lanes: corners 0-3, then 4-7.
+                  static_assert(sizeof(AABB3f) == 6 * sizeof(float));
+                  const __m128 lo = _mm_loadu_ps(v.lo.data());  // lo, hi.x
+                  const __m128 hi = _mm_shuffle_ps(_mm_loadu_ps(v.lo.data() + 2), _mm_loadu_ps(v.lo.data() + 2),
+                                                   _MM_SHUFFLE(3, 3, 2, 1));  // hi, hi.z
+                  const auto squared_gap = [&](__m128 c) {
+                    const __m128 g = _mm_max_ps(_mm_max_ps(_mm_sub_ps(lo, c), _mm_sub_ps(c, hi)), _mm_setzero_ps());
+                    return _mm_mul_ps(g, g);
+                  };
+                  const __m128 g0 = squared_gap(c0), g7 = squared_gap(c7);
+                  const __m128 xy = _mm_unpacklo_ps(g0, g7);  // x0 x7 y0 y7
+                  const __m128 sum = _mm_add_ps(_mm_movelh_ps(xy, xy), _mm_shuffle_ps(xy, xy, _MM_SHUFFLE(3, 3, 2, 2)));
+                  const __m128 near_lo =
+                      _mm_cmple_ps(_mm_add_ps(sum, _mm_shuffle_ps(g0, g0, _MM_SHUFFLE(2, 2, 2, 2))), bound_lo);
+                  const __m128 near_hi =
+                      _mm_cmple_ps(_mm_add_ps(sum, _mm_shuffle_ps(g7, g7, _MM_SHUFFLE(2, 2, 2, 2))), bound_hi);
+                  return _mm_movemask_ps(_mm_or_ps(near_lo, near_hi)) != 0;
+#else
                   std::array<std::array<float, 2>, 3> gap;
                   for (int a = 0; a < 3; ++a)
                     for (int e = 0; e < 2; ++e) {
@@ -1070,6 +1094,7 @@ class GridSolver {
                   for (int k = 0; k < 8; ++k)
                     near |= gap[0][k & 1] + gap[1][k >> 1 & 1] + gap[2][k >> 2 & 1] <= bound2[k];
                   return near;
+#endif
                 } else {
                   for (int k = 0; k < 8; ++k)
                     if (bvh::squared_distance(volumes[node], box.corners[k]) <= bound2[k]) return true;
