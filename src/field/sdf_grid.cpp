@@ -810,7 +810,7 @@ class GridSolver {
     const MeshPointDistance centre = mesh_.query(box.centre, SignMethod::none);
     const std::size_t nx = box.hi[0] - box.lo[0], ny = box.hi[1] - box.lo[1];
     std::array<float, kTile * kTile * kTile> ud;  // unsigned distances (inf: outside the band)
-    std::array<Closest, kTile * kTile * kTile> best;
+    std::array<std::uint32_t, kTile * kTile * kTile> leaf;  // of each sample's closest (read only where ud < inf)
     ud.fill(kInf);
     const auto local = [&](std::size_t i, std::size_t j, std::size_t k) {
       return (i - box.lo[0]) + nx * ((j - box.lo[1]) + ny * (k - box.lo[2]));
@@ -941,7 +941,7 @@ class GridSolver {
               if (d > band_) continue;
               stats.candidates_per_sample += double(block_list.size);
               ud[local(i, j, k)] = d;
-              best[local(i, j, k)] = s;
+              leaf[local(i, j, k)] = s.leaf;
               ++stats.in_band;
             }
           }
@@ -958,15 +958,14 @@ class GridSolver {
         for (std::size_t i = box.lo[0]; i < box.hi[0]; ++i) {
           const std::size_t l = local(i, j, k), g = grid_.index(i, j, k);
           const float d = ud[l];
-          const Closest& c = best[l];
-          if (faces) faces[g] = d < kInf ? ids_[c.leaf] : kNoIndex;
+          if (faces) faces[g] = d < kInf ? ids_[leaf[l]] : kNoIndex;
           bool in = false;
           const auto apart = [&](std::size_t n, float h) { return d + ud[n] > h * (1 + 1e-5f) + 2 * margin_; };
           if (options_.sign == SignMethod::none) {
           } else if (options_.sign == SignMethod::pseudonormal && d < kInf) {
             // The side of the closest point's feature (the samples keep only their face).
-            const std::uint32_t face = ids_[c.leaf];
-            const BvhTriangle& tri = tris_[c.leaf];
+            const std::uint32_t face = ids_[leaf[l]];
+            const BvhTriangle& tri = tris_[leaf[l]];
             const Vec3f p = grid_.position(i, j, k);
             TriangleRegion region;
             const Vec3f q = closest_point_on_triangle(p, tri.a, tri.b, tri.c, region);
