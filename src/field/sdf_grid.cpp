@@ -570,25 +570,32 @@ GEODS_AVX512_INLINE std::size_t best_lane16(__m512 best, __m512i face, __m512i e
   return std::size_t(ba[__builtin_ctz(chosen)]);
 }
 
-// As corner_nearest() above, sixteen entries at a time.
+// As corner_nearest() above, sixteen entries at a time, the 8 corners side by side (their
+// chains of comparisons are independent: interleaved, they do not wait for each other).
 GEODS_AVX512_FN void corner_nearest(const Packed& t, std::array<std::size_t, 8>& index, std::array<float, 8>& dist2) {
   const __m512i lanes = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
-  for (int c = 0; c < 8; ++c) {
-    __m512 best = _mm512_set1_ps(kInf);
-    __m512i at = _mm512_setzero_si512(), best_face = _mm512_set1_epi32(std::numeric_limits<std::int32_t>::max());
-    const float* k = t.f[Packed::k0 + c].data();
-    for (std::size_t i = 0; i < t.size; i += 16) {
-      const __m512 r = _mm512_mask_blend_ps(valid(i, t.size), _mm512_set1_ps(kInf), _mm512_loadu_ps(k + i));
-      const __m512i face = _mm512_loadu_si512(t.face.data() + i);
-      const __mmask16 closer = _mm512_cmp_ps_mask(r, best, _CMP_LT_OQ) |
-                               (_mm512_cmp_ps_mask(r, best, _CMP_EQ_OQ) & _mm512_cmplt_epi32_mask(face, best_face));
-      best = _mm512_mask_blend_ps(closer, best, r);
-      best_face = _mm512_mask_blend_epi32(closer, best_face, face);
-      at = _mm512_mask_blend_epi32(closer, at, _mm512_add_epi32(lanes, _mm512_set1_epi32(std::int32_t(i))));
+  __m512 best[8];
+  __m512i at[8], best_face[8];
+  for (int c = 0; c < 8; ++c)
+    best[c] = _mm512_set1_ps(kInf), at[c] = _mm512_setzero_si512(),
+    best_face[c] = _mm512_set1_epi32(std::numeric_limits<std::int32_t>::max());
+  for (std::size_t i = 0; i < t.size; i += 16) {
+    const __mmask16 ok = valid(i, t.size);
+    const __m512i face = _mm512_loadu_si512(t.face.data() + i);
+    const __m512i entry = _mm512_add_epi32(lanes, _mm512_set1_epi32(std::int32_t(i)));
+    for (int c = 0; c < 8; ++c) {
+      const __m512 r = _mm512_mask_blend_ps(ok, _mm512_set1_ps(kInf), _mm512_loadu_ps(t.f[Packed::k0 + c].data() + i));
+      const __mmask16 closer = _mm512_cmp_ps_mask(r, best[c], _CMP_LT_OQ) |
+                               (_mm512_cmp_ps_mask(r, best[c], _CMP_EQ_OQ) & _mm512_cmplt_epi32_mask(face, best_face[c]));
+      best[c] = _mm512_mask_blend_ps(closer, best[c], r);
+      best_face[c] = _mm512_mask_blend_epi32(closer, best_face[c], face);
+      at[c] = _mm512_mask_blend_epi32(closer, at[c], entry);
     }
+  }
+  for (int c = 0; c < 8; ++c) {
     float d2;
-    index[c] = best_lane16(best, best_face, at, d2);
-    dist2[c] = d2;
+    index[std::size_t(c)] = best_lane16(best[c], best_face[c], at[c], d2);
+    dist2[std::size_t(c)] = d2;
   }
 }
 
