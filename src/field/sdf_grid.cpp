@@ -570,25 +570,32 @@ GEODS_AVX512_INLINE std::size_t best_lane16(__m512 best, __m512i face, __m512i e
   return std::size_t(ba[__builtin_ctz(chosen)]);
 }
 
-// As corner_nearest() above, sixteen entries at a time.
+// As corner_nearest() above, sixteen entries at a time, the 8 corners side by side (their
+// chains of comparisons are independent: interleaved, they do not wait for each other).
 GEODS_AVX512_FN void corner_nearest(const Packed& t, std::array<std::size_t, 8>& index, std::array<float, 8>& dist2) {
   const __m512i lanes = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
-  for (int c = 0; c < 8; ++c) {
-    __m512 best = _mm512_set1_ps(kInf);
-    __m512i at = _mm512_setzero_si512(), best_face = _mm512_set1_epi32(std::numeric_limits<std::int32_t>::max());
-    const float* k = t.f[Packed::k0 + c].data();
-    for (std::size_t i = 0; i < t.size; i += 16) {
-      const __m512 r = _mm512_mask_blend_ps(valid(i, t.size), _mm512_set1_ps(kInf), _mm512_loadu_ps(k + i));
-      const __m512i face = _mm512_loadu_si512(t.face.data() + i);
-      const __mmask16 closer = _mm512_cmp_ps_mask(r, best, _CMP_LT_OQ) |
-                               (_mm512_cmp_ps_mask(r, best, _CMP_EQ_OQ) & _mm512_cmplt_epi32_mask(face, best_face));
-      best = _mm512_mask_blend_ps(closer, best, r);
-      best_face = _mm512_mask_blend_epi32(closer, best_face, face);
-      at = _mm512_mask_blend_epi32(closer, at, _mm512_add_epi32(lanes, _mm512_set1_epi32(std::int32_t(i))));
+  __m512 best[8];
+  __m512i at[8], best_face[8];
+  for (int c = 0; c < 8; ++c)
+    best[c] = _mm512_set1_ps(kInf), at[c] = _mm512_setzero_si512(),
+    best_face[c] = _mm512_set1_epi32(std::numeric_limits<std::int32_t>::max());
+  for (std::size_t i = 0; i < t.size; i += 16) {
+    const __mmask16 ok = valid(i, t.size);
+    const __m512i face = _mm512_loadu_si512(t.face.data() + i);
+    const __m512i entry = _mm512_add_epi32(lanes, _mm512_set1_epi32(std::int32_t(i)));
+    for (int c = 0; c < 8; ++c) {
+      const __m512 r = _mm512_mask_blend_ps(ok, _mm512_set1_ps(kInf), _mm512_loadu_ps(t.f[Packed::k0 + c].data() + i));
+      const __mmask16 closer = _mm512_cmp_ps_mask(r, best[c], _CMP_LT_OQ) |
+                               (_mm512_cmp_ps_mask(r, best[c], _CMP_EQ_OQ) & _mm512_cmplt_epi32_mask(face, best_face[c]));
+      best[c] = _mm512_mask_blend_ps(closer, best[c], r);
+      best_face[c] = _mm512_mask_blend_epi32(closer, best_face[c], face);
+      at[c] = _mm512_mask_blend_epi32(closer, at[c], entry);
     }
+  }
+  for (int c = 0; c < 8; ++c) {
     float d2;
-    index[c] = best_lane16(best, best_face, at, d2);
-    dist2[c] = d2;
+    index[std::size_t(c)] = best_lane16(best[c], best_face[c], at[c], d2);
+    dist2[std::size_t(c)] = d2;
   }
 }
 
@@ -601,17 +608,57 @@ GEODS_AVX512_FN void gather(const std::uint32_t* src, const std::uint32_t* index
   }
 }
 
+// The 16 x 16 transpose of r (o[k] lane m = r[m] lane k), of which only the first `outputs`
+// rows are written: four rounds of in-lane and cross-lane shuffles.
+template <int outputs>
+GEODS_AVX512_INLINE void transpose16(const __m512 (&r)[16], __m512 (&o)[16]) {
+  __m512 t[16], u[16];
+  for (int m = 0; m < 16; m += 2) t[m] = _mm512_unpacklo_ps(r[m], r[m + 1]), t[m + 1] = _mm512_unpackhi_ps(r[m], r[m + 1]);
+  // u[4 g + f]: rows 4 g .. 4 g + 3 of columns f, f + 4, f + 8, f + 12 (one per 128-bit lane).
+  for (int g = 0; g < 4; ++g) {
+    const __m512d a = _mm512_castps_pd(t[4 * g]), b = _mm512_castps_pd(t[4 * g + 1]);
+    const __m512d c = _mm512_castps_pd(t[4 * g + 2]), d = _mm512_castps_pd(t[4 * g + 3]);
+    u[4 * g] = _mm512_castpd_ps(_mm512_unpacklo_pd(a, c));
+    u[4 * g + 1] = _mm512_castpd_ps(_mm512_unpackhi_pd(a, c));
+    u[4 * g + 2] = _mm512_castpd_ps(_mm512_unpacklo_pd(b, d));
+    u[4 * g + 3] = _mm512_castpd_ps(_mm512_unpackhi_pd(b, d));
+  }
+  for (int f = 0; f < 4; ++f) {
+    if (f < outputs) {  // columns f and f + 8
+      const __m512 v = _mm512_shuffle_f32x4(u[f], u[4 + f], 0x88), w = _mm512_shuffle_f32x4(u[8 + f], u[12 + f], 0x88);
+      o[f] = _mm512_shuffle_f32x4(v, w, 0x88);
+      if (f + 8 < outputs) o[f + 8] = _mm512_shuffle_f32x4(v, w, 0xdd);
+    }
+    if (f + 4 < outputs) {  // columns f + 4 and f + 12
+      const __m512 v = _mm512_shuffle_f32x4(u[f], u[4 + f], 0xdd), w = _mm512_shuffle_f32x4(u[8 + f], u[12 + f], 0xdd);
+      o[f + 4] = _mm512_shuffle_f32x4(v, w, 0x88);
+      if (f + 12 < outputs) o[f + 12] = _mm512_shuffle_f32x4(v, w, 0xdd);
+    }
+  }
+}
+
 // out[k][j] = rows[index[j] * (k0 + 1) + k] for j < n and k < k0, and
 // face[j] the bits of rows[index[j] * (k0 + 1) + k0]: the quantities and
-// face of entries stored row by row (one or two cache lines per entry).
+// face of entries stored row by row (one or two cache lines per entry),
+// 16 rows at a time loaded whole and transposed (gathers cost three times more).
+// The rows are followed by 16 floats of padding (a row's second load reads past it);
+// out and face have room for n rounded up to 16.
 GEODS_AVX512_FN void gather_rows(const float* rows, const std::uint32_t* index, std::size_t n, Packed::Arrays& out,
                                  std::int32_t* face) {
+  static_assert(Packed::k0 + 1 > 16 && Packed::k0 + 1 <= 32);
+  constexpr int kRest = Packed::k0 + 1 - 16;  // the second load's columns
   for (std::size_t j = 0; j < n; j += 16) {
-    const __mmask16 m = valid(j, n);
-    const __m512i at = _mm512_mullo_epi32(_mm512_maskz_loadu_epi32(m, index + j), _mm512_set1_epi32(Packed::k0 + 1));
-    for (int k = 0; k < Packed::k0; ++k)
-      _mm512_mask_storeu_ps(out[k].data() + j, m, _mm512_mask_i32gather_ps(_mm512_setzero_ps(), m, at, rows + k, 4));
-    _mm512_mask_storeu_epi32(face + j, m, _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), m, at, rows + Packed::k0, 4));
+    __m512 lo[16], hi[16], o[16];
+    for (int m = 0; m < 16; ++m) {
+      const float* row = rows + std::size_t(j + std::size_t(m) < n ? index[j + std::size_t(m)] : index[0]) * (Packed::k0 + 1);
+      lo[m] = _mm512_loadu_ps(row);
+      hi[m] = _mm512_loadu_ps(row + 16);
+    }
+    transpose16<16>(lo, o);
+    for (int k = 0; k < 16; ++k) _mm512_storeu_ps(out[k].data() + j, o[k]);
+    transpose16<kRest>(hi, o);
+    for (int k = 16; k < Packed::k0; ++k) _mm512_storeu_ps(out[k].data() + j, o[k - 16]);
+    _mm512_storeu_ps(reinterpret_cast<float*>(face + j), o[kRest - 1]);
   }
 }
 
@@ -692,9 +739,15 @@ GEODS_AVX512_FN std::size_t nearest(const Packed& t, const Vec3f& p, const InBlo
   seed /= 2;  // the pair of group `seed`
   if (seed >= pairs) seed = 0;
   s.pair(seed);
-  for (std::size_t c = 0; c < pairs; ++c) {
-    if (c == seed || (in_block && s.beyond(c, at_p.spread, slack))) continue;
-    s.pair(c);
+  // The pairs to search, 64 at a time: those not beyond the seed's distance, from their bounds
+  // without a branch each (a branch per pair mispredicted often), then searched in order.
+  for (std::size_t first = 0; first < pairs; first += 64) {
+    const std::size_t n = std::min<std::size_t>(64, pairs - first);
+    std::uint64_t todo = n == 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << n) - 1;
+    if (seed >= first && seed < first + n) todo &= ~(std::uint64_t(1) << (seed - first));
+    if (in_block)
+      for (std::size_t c = 0; c < n; ++c) todo &= ~(std::uint64_t(s.beyond(first + c, at_p.spread, slack)) << c);
+    for (; todo; todo &= todo - 1) s.pair(first + std::size_t(__builtin_ctzll(todo)));
   }
   return best_lane16(s.best, s.best_face, s.at_lane, d2);
 }
@@ -722,7 +775,8 @@ class GridSolver {
     // Only the rows where they serve (all_ is then never read). Not zeroed: the fill below writes
     // every entry, its threads touching the fresh pages (a serial zeroing cost more than the fill).
     if (wide_ && n > 0 && n < std::size_t(std::numeric_limits<std::int32_t>::max()) / kRow) {
-      rows_.reset(static_cast<float*>(detail::allocate_huge_pages(n * kRow * sizeof(float), alignof(float))));
+      // 16 floats of padding: gather_rows() reads 32 floats from a row's start.
+      rows_.reset(static_cast<float*>(detail::allocate_huge_pages((n * kRow + 16) * sizeof(float), alignof(float))));
     } else {
       all_.reserve(n);
       all_.size = n;
@@ -763,7 +817,7 @@ class GridSolver {
     const MeshPointDistance centre = mesh_.query(box.centre, SignMethod::none);
     const std::size_t nx = box.hi[0] - box.lo[0], ny = box.hi[1] - box.lo[1];
     std::array<float, kTile * kTile * kTile> ud;  // unsigned distances (inf: outside the band)
-    std::array<Closest, kTile * kTile * kTile> best;
+    std::array<std::uint32_t, kTile * kTile * kTile> leaf;  // of each sample's closest (read only where ud < inf)
     ud.fill(kInf);
     const auto local = [&](std::size_t i, std::size_t j, std::size_t k) {
       return (i - box.lo[0]) + nx * ((j - box.lo[1]) + ny * (k - box.lo[2]));
@@ -850,7 +904,10 @@ class GridSolver {
           select(tile_list, survivors[b], near, Packed::k0);
         filter(near, block, c.point, block_list, kept, true, std::span(anchors.data(), num_anchors));
         const BlockWeights weights = block_weights(block);  // in_box of each sample
-        std::size_t seed = 0;  // the group of the previous sample's nearest face
+        // Each sample's search starts from the group of its neighbour's nearest face one row back
+        // (else one layer back, else the sample before): not the sample just before, so that
+        // consecutive searches do not wait for each other.
+        std::array<std::uint32_t, kBlock * kBlock * kBlock> slot{};
         // The block's corner samples have their distances from every face of
         // the list already (k0..k7): their nearest entries in one pass.
         std::array<std::size_t, 8> corner{};
@@ -882,14 +939,16 @@ class GridSolver {
 #ifdef GEODS_SDF_AVX512
                 if (wide_ && !row_ready) avx512::row_bounds(block_list, at_p.wy, at_p.wz, row.data()), row_ready = true;
 #endif
-                s = closest_in(block_list, p, &at_p, seed, wide_ ? row.data() : nullptr, false);
+                const std::size_t here = (i - block.lo[0]) + kBlock * ((j - block.lo[1]) + kBlock * (k - block.lo[2]));
+                const std::size_t from = j > block.lo[1] ? here - kBlock : k > block.lo[2] ? here - kBlock * kBlock : here - 1;
+                s = closest_in(block_list, p, &at_p, slot[from] / 8, wide_ ? row.data() : nullptr, false);
               }
-              seed = s.slot / 8;
+              slot[(i - block.lo[0]) + kBlock * ((j - block.lo[1]) + kBlock * (k - block.lo[2]))] = std::uint32_t(s.slot);
               const float d = std::sqrt(s.d2);
               if (d > band_) continue;
               stats.candidates_per_sample += double(block_list.size);
               ud[local(i, j, k)] = d;
-              best[local(i, j, k)] = s;
+              leaf[local(i, j, k)] = s.leaf;
               ++stats.in_band;
             }
           }
@@ -906,15 +965,14 @@ class GridSolver {
         for (std::size_t i = box.lo[0]; i < box.hi[0]; ++i) {
           const std::size_t l = local(i, j, k), g = grid_.index(i, j, k);
           const float d = ud[l];
-          const Closest& c = best[l];
-          if (faces) faces[g] = d < kInf ? ids_[c.leaf] : kNoIndex;
+          if (faces) faces[g] = d < kInf ? ids_[leaf[l]] : kNoIndex;
           bool in = false;
           const auto apart = [&](std::size_t n, float h) { return d + ud[n] > h * (1 + 1e-5f) + 2 * margin_; };
           if (options_.sign == SignMethod::none) {
           } else if (options_.sign == SignMethod::pseudonormal && d < kInf) {
             // The side of the closest point's feature (the samples keep only their face).
-            const std::uint32_t face = ids_[c.leaf];
-            const BvhTriangle& tri = tris_[c.leaf];
+            const std::uint32_t face = ids_[leaf[l]];
+            const BvhTriangle& tri = tris_[leaf[l]];
             const Vec3f p = grid_.position(i, j, k);
             TriangleRegion region;
             const Vec3f q = closest_point_on_triangle(p, tri.a, tri.b, tri.c, region);
@@ -928,7 +986,7 @@ class GridSolver {
           } else {
             const Vec3f p = grid_.position(i, j, k);
             if (options_.sign == SignMethod::winding) {
-              in = mesh_.winding_number(p) > 0.5;
+              in = mesh_.inside_by_winding(p);
               ++stats.winding_numbers;
             } else {
               in = mesh_.inside_by_pseudonormal(p, mesh_.query(p, SignMethod::none));
@@ -997,6 +1055,11 @@ class GridSolver {
     const std::array<float, 8> bound2 = bounds_from(box, q);
     const bvh::Topology& topo = mesh_.bvh().topology();
     found.clear();
+#if defined(__SSE2__)
+    const __m128 c0 = _mm_setr_ps(box.corners[0].x(), box.corners[0].y(), box.corners[0].z(), 0.0f);
+    const __m128 c7 = _mm_setr_ps(box.corners[7].x(), box.corners[7].y(), box.corners[7].z(), 0.0f);
+    const __m128 bound_lo = _mm_loadu_ps(bound2.data()), bound_hi = _mm_loadu_ps(bound2.data() + 4);
+#endif
     std::visit(
         [&](const auto& volumes) {
           bvh::TraversalStack<bvh::NodeRef> stack(mesh_.stack_size());
@@ -1007,6 +1070,25 @@ class GridSolver {
                   // The corners take two coordinates per axis: six squared
                   // gaps instead of 8 box distances (most nodes tested fail all 8).
                   const AABB3f& v = volumes[node];
+#if defined(__SSE2__)
+                  // The same sums in four lanes: corners 0-3, then 4-7.
+                  static_assert(sizeof(AABB3f) == 6 * sizeof(float));
+                  const __m128 lo = _mm_loadu_ps(v.lo.data());  // lo, hi.x
+                  const __m128 hi = _mm_shuffle_ps(_mm_loadu_ps(v.lo.data() + 2), _mm_loadu_ps(v.lo.data() + 2),
+                                                   _MM_SHUFFLE(3, 3, 2, 1));  // hi, hi.z
+                  const auto squared_gap = [&](__m128 c) {
+                    const __m128 g = _mm_max_ps(_mm_max_ps(_mm_sub_ps(lo, c), _mm_sub_ps(c, hi)), _mm_setzero_ps());
+                    return _mm_mul_ps(g, g);
+                  };
+                  const __m128 g0 = squared_gap(c0), g7 = squared_gap(c7);
+                  const __m128 xy = _mm_unpacklo_ps(g0, g7);  // x0 x7 y0 y7
+                  const __m128 sum = _mm_add_ps(_mm_movelh_ps(xy, xy), _mm_shuffle_ps(xy, xy, _MM_SHUFFLE(3, 3, 2, 2)));
+                  const __m128 near_lo =
+                      _mm_cmple_ps(_mm_add_ps(sum, _mm_shuffle_ps(g0, g0, _MM_SHUFFLE(2, 2, 2, 2))), bound_lo);
+                  const __m128 near_hi =
+                      _mm_cmple_ps(_mm_add_ps(sum, _mm_shuffle_ps(g7, g7, _MM_SHUFFLE(2, 2, 2, 2))), bound_hi);
+                  return _mm_movemask_ps(_mm_or_ps(near_lo, near_hi)) != 0;
+#else
                   std::array<std::array<float, 2>, 3> gap;
                   for (int a = 0; a < 3; ++a)
                     for (int e = 0; e < 2; ++e) {
@@ -1018,6 +1100,7 @@ class GridSolver {
                   for (int k = 0; k < 8; ++k)
                     near |= gap[0][k & 1] + gap[1][k >> 1 & 1] + gap[2][k >> 2 & 1] <= bound2[k];
                   return near;
+#endif
                 } else {
                   for (int k = 0; k < 8; ++k)
                     if (bvh::squared_distance(volumes[node], box.corners[k]) <= bound2[k]) return true;
@@ -1305,7 +1388,7 @@ void propagate(const MeshDistance& mesh, const Grid3Geometry& grid, const SdfGri
     if (options.sign == SignMethod::pseudonormal) {
       inside = (p - c).dot(mesh.pseudonormal(face[s], region)) < 0;
     } else if (options.sign == SignMethod::winding) {
-      inside = mesh.winding_number(p) > 0.5;
+      inside = mesh.inside_by_winding(p);
       ++windings;
     }
     d2[s] = inside ? -d : d;

@@ -316,6 +316,40 @@ TEST(SignedDistance, OpenMeshHasASensibleInside) {
   }
 }
 
+TEST(MeshDistance, InsideByWindingIsTheWindingNumbersSide) {
+  // Its polynomial arctangent must never change the side: on grids over the closed bunny
+  // and the bunny with a hole, and at the centroids of the hole's missing faces (winding
+  // numbers near 1/2, where the exact sum decides).
+  TriMesh open = data_mesh("bunny.ply");
+  const TriMesh closed = open;
+  std::vector<Vec3f> points;
+  for (std::size_t t = 100; t < 130; ++t) {
+    const auto& f = open.triangles[t];
+    points.push_back((open.vertices[f[0]] + open.vertices[f[1]] + open.vertices[f[2]]) / 3);
+  }
+  open.triangles.erase(open.triangles.begin() + 100, open.triangles.begin() + 130);
+  const Grid3Geometry grid = sdf_grid_geometry(open.bounds(), 20, 0, 2);
+  for (std::size_t s = 0; s < grid.dims[0] * grid.dims[1] * grid.dims[2]; ++s)
+    points.push_back(grid.position(s % grid.dims[0], s / grid.dims[0] % grid.dims[1], s / (grid.dims[0] * grid.dims[1])));
+  std::size_t near_half = 0;
+  for (const TriMesh* m : {static_cast<const TriMesh*>(&open), &closed}) {
+    const MeshDistance md = MeshDistance::build(*m);
+    for (const Vec3f& p : points) {
+      const double w = md.winding_number(p);
+      ASSERT_EQ(md.inside_by_winding(p), w > 0.5) << p.transpose() << " w = " << w;
+      near_half += std::abs(w - 0.5) < 0.25;
+    }
+  }
+  EXPECT_GT(near_half, 0u);
+  // On a lone triangle, inside it (w = +-1/2 exactly: the exact sum decides) and beside it.
+  TriMesh one;
+  one.vertices = {Vec3f(0, 0, 0), Vec3f(1, 0, 0), Vec3f(0, 1, 0)};
+  one.triangles = {{0, 1, 2}};
+  const MeshDistance md = MeshDistance::build(one);
+  for (const Vec3f& p : {Vec3f(0.25f, 0.25f, 0), Vec3f(2, 2, 0), Vec3f(0.25f, 0.25f, 1e-30f), Vec3f(0.25f, 0.25f, -1e-30f)})
+    EXPECT_EQ(md.inside_by_winding(p), md.winding_number(p) > 0.5) << p.transpose();
+}
+
 TEST(SdfGrid, DegenerateAndDuplicatedFaces) {
   // A cube with unwelded corners (each face its own vertices), a degenerate
   // face (a segment) and a point face, and a duplicated face.

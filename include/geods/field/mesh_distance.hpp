@@ -83,6 +83,10 @@ class MeshDistance {
   /// The generalized winding number at p: the solid angle the mesh covers
   /// seen from p over 4 pi (1 inside a closed outward mesh, 0 outside).
   double winding_number(const Vec3f& p) const;
+  /// winding_number(p) > 0.5, the same answer at less cost: the triangles' solid
+  /// angles by a polynomial arctangent, the exact sum only where its error bound
+  /// does not settle the answer.
+  bool inside_by_winding(const Vec3f& p) const;
   /// Whether p is inside by the pseudonormal of the closest feature `q`
   /// (a result of query()); false on the surface.
   bool inside_by_pseudonormal(const Vec3f& p, const MeshPointDistance& q) const;
@@ -115,6 +119,10 @@ class MeshDistance {
   };
   void fit_normals(const TriMesh& mesh);
   void fit_moments();
+  // The solid angle the mesh covers seen from p, each triangle's by `angle`
+  // (winding_number's traversal); `triangles` counts those.
+  template <class Angle>
+  double solid_angle_sum(const Vec3f& p, const Angle& angle, std::size_t& triangles) const;
 
   bvh::TriangleBvh bvh_;
   std::vector<TriMesh::Triangle> faces_;       // the mesh's faces (vertex indices)
