@@ -147,7 +147,7 @@ class Exact {
         if (sign_ == SignMethod::pseudonormal && !far)
           sign = mesh_.inside_by_pseudonormal(pf, r) ? -1 : 1;
         else
-          sign = mesh_.winding_number(pf) > 0.5 ? -1 : 1;
+          sign = mesh_.inside_by_winding(pf) ? -1 : 1;
       }
     }
     const double d = sign * u;
