@@ -926,6 +926,7 @@ class GridSolver {
             bool row_ready = false;
             for (std::size_t i = block.lo[0]; i < block.hi[0]; ++i) {
               const Vec3f p = grid_.position(i, j, k);
+              const std::size_t here = (i - block.lo[0]) + kBlock * ((j - block.lo[1]) + kBlock * (k - block.lo[2]));
               // The block's corner samples have their distances from every face
               // of the list already (k0..k7): the nearest is the smallest of them.
               const int cx = i == block.lo[0] ? 0 : i + 1 == block.hi[0] ? 1 : -1;
@@ -939,11 +940,10 @@ class GridSolver {
 #ifdef GEODS_SDF_AVX512
                 if (wide_ && !row_ready) avx512::row_bounds(block_list, at_p.wy, at_p.wz, row.data()), row_ready = true;
 #endif
-                const std::size_t here = (i - block.lo[0]) + kBlock * ((j - block.lo[1]) + kBlock * (k - block.lo[2]));
                 const std::size_t from = j > block.lo[1] ? here - kBlock : k > block.lo[2] ? here - kBlock * kBlock : here - 1;
                 s = closest_in(block_list, p, &at_p, slot[from] / 8, wide_ ? row.data() : nullptr, false);
               }
-              slot[(i - block.lo[0]) + kBlock * ((j - block.lo[1]) + kBlock * (k - block.lo[2]))] = std::uint32_t(s.slot);
+              slot[here] = std::uint32_t(s.slot);
               const float d = std::sqrt(s.d2);
               if (d > band_) continue;
               stats.candidates_per_sample += double(block_list.size);
