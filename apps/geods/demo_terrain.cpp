@@ -187,7 +187,8 @@ void run_terrain(const DemoContext& context, DemoResult& result) {
   result.text =
       "Terrain level of detail (seed §2.3): the 4-8 hierarchy of Lindstrom & Pascucci with nested errors and nested "
       "bounding spheres, so that refinement by a screen-space error with frustum culling is crack-free by "
-      "construction; the vertices in the interleaved red/blue quadtree layout; one triangle strip per view.";
+      "construction; the vertex records in a matrix in memory, in the interleaved red/blue quadtree layout in "
+      "files; one triangle strip per view.";
 }
 
 const bool registered = register_demo_step(

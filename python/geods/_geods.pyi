@@ -938,7 +938,7 @@ class Terrain:
     """Terrain level of detail (Lindstrom-Pascucci 4-8 hierarchy) over a height field.
     """
     def __init__(self, heights: Any, spacing: Sequence[Sequence[float]] = ..., z_scale: float = ..., layout: str = ...) -> None:
-        """Builds the hierarchy of a 2-D array of heights, (ny, nx) of any float or int dtype (rows = y; NaN = missing, filled from the nearest valid sample) or of a height-field file (.png, .bmp, .npy, .ter, GeoTIFF...).
+        """Builds the hierarchy of a 2-D array of heights, (ny, nx) of any float or int dtype (rows = y; NaN = missing, filled from the nearest valid sample) or of a height-field file (.png, .bmp, .npy, .ter, GeoTIFF...). layout: 'matrix' (the faster in memory) or 'interleaved'; save() writes the interleaved layout either way.
         """
     @property
     def height(self) -> int: ...
@@ -950,7 +950,7 @@ class Terrain:
         """(V float32 (n, 3), F int32 (m, 3)): the crack-free mesh within max_error of every sample, and/or the view-dependent one for camera = {'eye', 'target', 'up', 'fov', 'size'} and pixel_error (default 1).
         """
     def save(self, path: str | os.PathLike[str]) -> None:
-        """Writes the terrain (memory-mapped by load()).
+        """Writes the terrain in the interleaved layout (memory-mapped by load()).
         """
     def stats(self) -> dict[str, Any]:
         """dict of the TerrainStats fields

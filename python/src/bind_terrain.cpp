@@ -85,16 +85,17 @@ void bind_terrain(py::module_& m) {
                        const std::string& layout) {
              terrain::TerrainOptions o;
              o.z_scale = z_scale;
-             if (layout == "matrix") o.layout = terrain::Layout::matrix;
-             else if (layout != "interleaved")
+             if (layout == "interleaved") o.layout = terrain::Layout::interleaved;
+             else if (layout != "matrix")
                throw Error("Terrain: layout must be 'interleaved' or 'matrix', got '" + layout + "'");
              terrain::HeightField f = field_from(heights, spacing);
              return without_gil([&] { return terrain::Terrain(std::move(f), o); });
            }),
            py::arg("heights"), py::arg("spacing") = std::array<double, 2>{1, 1}, py::arg("z_scale") = 1.0,
-           py::arg("layout") = "interleaved",
+           py::arg("layout") = "matrix",
            "Builds the hierarchy of a 2-D array of heights, (ny, nx) of any float or int dtype (rows = y; NaN = missing, filled from the nearest "
-           "valid sample) or of a height-field file (.png, .bmp, .npy, .ter, GeoTIFF...).")
+           "valid sample) or of a height-field file (.png, .bmp, .npy, .ter, GeoTIFF...). layout: 'matrix' (the faster in memory) or "
+           "'interleaved'; save() writes the interleaved layout either way.")
       .def(
           "refine",
           [](const terrain::Terrain& t, std::optional<double> max_error, std::optional<py::dict> camera,
@@ -125,7 +126,7 @@ void bind_terrain(py::module_& m) {
       .def_property_readonly("width", &terrain::Terrain::width)
       .def_property_readonly("height", &terrain::Terrain::height)
       .def("stats", [](const terrain::Terrain& t) { return stats_dict(t.stats()); }, "dict of the TerrainStats fields")
-      .def("save", &terrain::Terrain::save, py::arg("path"), "Writes the terrain (memory-mapped by load()).")
+      .def("save", &terrain::Terrain::save, py::arg("path"), "Writes the terrain in the interleaved layout (memory-mapped by load()).")
       .def_static(
           "load", [](const std::filesystem::path& path) { return terrain::Terrain::load(path); }, py::arg("path"),
           "Maps a terrain written by save(): its vertex records are read in place.");

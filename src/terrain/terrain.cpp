@@ -1251,16 +1251,29 @@ double Terrain::measure_error(const TerrainMesh& mesh) const {
 // ---------------------------------------------------------------- file
 
 void Terrain::save(const std::filesystem::path& path) const {
+  // Files are interleaved (for terrains larger than RAM: a mapped view reads the
+  // pages of the coarse levels and of the fine vertices it visits); a matrix
+  // terrain's records are rearranged, the unused slots zero as a build leaves them.
+  const LayoutIndex file(Layout::interleaved, index_.levels());
+  std::vector<VertexRecord, HugePageAllocator<VertexRecord>> rearranged;
+  std::span<const VertexRecord> records = records_.span();
+  if (index_.layout() != Layout::interleaved) {
+    rearranged.resize(file.slots());
+    for_each_slot(file, [&](std::uint64_t slot, std::int64_t x, std::int64_t y) {
+      rearranged[slot] = record(std::uint32_t(x), std::uint32_t(y));
+    });
+    records = rearranged;
+  }
   ArchiveWriter w(std::string(kTerrainArchiveKind), kTerrainArchiveVersion);
   w.add_value("width", width_);
   w.add_value("height", height_);
   w.add_value("levels", std::uint64_t(index_.levels()));
-  w.add_value("layout", std::uint32_t(index_.layout()));
+  w.add_value("layout", std::uint32_t(file.layout()));
   w.add_value("spacing", spacing_);
   w.add_value("origin", origin_);
   w.add_value("z_scale", z_scale_);
   w.add_value("filled", filled_);
-  w.add("records", records_);
+  w.add("records", records);
   w.write(path);
 }
 

@@ -10,6 +10,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <map>
 #include <random>
@@ -473,12 +474,18 @@ TEST(Terrain, TilesMeetWithoutCracks) {
 TEST(Terrain, MappedFileGivesTheSameMeshes) {
   const std::filesystem::path path = std::filesystem::temp_directory_path() / "geods_terrain_test.geodsterrain";
   const HeightField f = real_field();
-  const Terrain t(f, {.z_scale = 0.5});
+  const Terrain t(f, {.z_scale = 0.5});  // the matrix layout (the default); the file is interleaved
+  ASSERT_EQ(t.layout().layout(), Layout::matrix);
   t.save(path);
   for (const auto verify : {Archive::Verify::checksums, Archive::Verify::structure_only}) {
     const Terrain u = Terrain::load(path, verify);
     EXPECT_TRUE(u.records().mapped());
     EXPECT_EQ(u.width(), t.width());
+    ASSERT_EQ(u.layout().layout(), Layout::interleaved);
+    const std::uint32_t n = std::uint32_t(t.layout().n());
+    for (std::uint32_t y = 0; y < n; ++y)
+      for (std::uint32_t x = 0; x < n; ++x)
+        ASSERT_EQ(std::memcmp(&u.record(x, y), &t.record(x, y), sizeof(VertexRecord)), 0) << x << " " << y;
     for (const double e : {1.0, 10.0}) {
       const TerrainMesh a = t.refine(by_error(e)), b = u.refine(by_error(e));
       EXPECT_EQ(a.strip, b.strip);
@@ -486,6 +493,15 @@ TEST(Terrain, MappedFileGivesTheSameMeshes) {
       EXPECT_EQ(a.vertices, b.vertices);
     }
   }
+  // An interleaved terrain writes the same file.
+  const std::filesystem::path path2 = std::filesystem::temp_directory_path() / "geods_terrain_test2.geodsterrain";
+  Terrain(f, {.z_scale = 0.5, .layout = Layout::interleaved}).save(path2);
+  const auto bytes = [](const std::filesystem::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  EXPECT_EQ(bytes(path), bytes(path2));
+  std::filesystem::remove(path2);
   // Truncated and foreign files.
   const auto size = std::filesystem::file_size(path);
   std::filesystem::resize_file(path, size - 100);

@@ -5,8 +5,8 @@
 // error or by a screen-space error with frustum culling is crack-free by
 // construction; output as one generalized triangle strip (the submesh
 // recursion with its turns) and as indexed triangles. The per-vertex records
-// live in one flat array in the interleaved red/blue quadtree layout (or the
-// matrix layout), saved and memory-mapped as is.
+// live in one flat array, in memory in the matrix layout (or the interleaved
+// red/blue quadtree layout), saved in the interleaved one and memory-mapped as is.
 #include <array>
 #include <cstdint>
 #include <filesystem>
@@ -69,7 +69,9 @@ class LayoutIndex {
 
 struct TerrainOptions {
   double z_scale = 1;  // heights are multiplied by it
-  Layout layout = Layout::interleaved;
+  /// In memory the matrix layout builds and refines faster (docs/terrain.md,
+  /// Speed); save() writes the interleaved layout either way.
+  Layout layout = Layout::matrix;
 };
 
 /// A camera for view-dependent refinement: an image of width x height pixels.
@@ -152,7 +154,9 @@ class Terrain {
   float sample(std::uint32_t x, std::uint32_t y) const { return record(x, y).z; }
   TerrainStats stats() const;
 
-  /// Writes the terrain as a geods archive (kind "terrain.Terrain").
+  /// Writes the terrain as a geods archive (kind "terrain.Terrain"), its
+  /// records in the interleaved layout (a matrix terrain's rearranged), whose
+  /// coarse levels share pages: a view of a mapped file reads fewer of them.
   void save(const std::filesystem::path& path) const;
   /// Maps a saved terrain: the vertex records are read in place, page by page
   /// as views touch them. Verify::checksums reads the whole file once;
