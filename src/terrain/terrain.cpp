@@ -322,7 +322,7 @@ __attribute__((target("avx2"))) std::int64_t nest_row4(const float* z, float* er
 #if !defined(__clang__)
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #endif
-// p[0], p[St], ..., p[7 St] for St = 2, 4, 8 (reads up to p[8 St - 1], past the last lane as load4f does).
+// p[0], p[St], ..., p[7 St] (for St = 2, 4, 8 reads up to p[8 St - 1], past the last lane as load4f does).
 template <int St>
 GEODS_TERRAIN_AVX512_INLINE __m256 load8f(const float* p) {
   if constexpr (St == 2) {
@@ -331,6 +331,8 @@ GEODS_TERRAIN_AVX512_INLINE __m256 load8f(const float* p) {
   } else if constexpr (St == 4) {
     return _mm512_castps512_ps256(_mm512_permutex2var_ps(
         _mm512_loadu_ps(p), _mm512_set_epi32(0, 0, 0, 0, 0, 0, 0, 0, 28, 24, 20, 16, 12, 8, 4, 0), _mm512_loadu_ps(p + 16)));
+  } else if constexpr (St >= 16) {
+    return _mm256_set_ps(p[7 * St], p[6 * St], p[5 * St], p[4 * St], p[3 * St], p[2 * St], p[St], p[0]);
   } else {
     static_assert(St == 8);
     const __m512i every8 = _mm512_set_epi32(0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 24, 16, 8, 0);
@@ -389,6 +391,13 @@ GEODS_TERRAIN_AVX512_INLINE Plane8 plane8(const float* v, std::int64_t n, P2 a, 
   p.gy = _mm512_mul_pd(_mm512_sub_pd(_mm512_mul_pd(dc, _mm512_set1_pd(ux)), _mm512_mul_pd(db, _mm512_set1_pd(vx))), inv);
   return p;
 }
+GEODS_TERRAIN_AVX512_INLINE void term8(__m512d& m, const Plane8& p, __m512d base, __m256 h, std::int64_t dx) {
+  const __m512d q = dx == 0 ? base : _mm512_add_pd(base, _mm512_mul_pd(p.gx, _mm512_set1_pd(double(dx))));
+  m = _mm512_max_pd(_mm512_abs_pd(_mm512_sub_pd(_mm512_cvtps_pd(h), q)), m);
+}
+// Lanes 16 or more samples apart take rows of three or more samples eight at a
+// time, by an 8 x 8 transposition of eight floats per lane (reads up to
+// row + 7 St + hi + 7), as rows4 does for lanes 8 apart.
 template <int St>
 GEODS_TERRAIN_AVX512_INLINE void rows8(__m512d& m, std::int64_t n, const Plane8& p, std::int64_t r0, std::int64_t rows,
                                        std::int64_t lo0, std::int64_t dlo, std::int64_t hi0, std::int64_t dhi) {
@@ -396,11 +405,32 @@ GEODS_TERRAIN_AVX512_INLINE void rows8(__m512d& m, std::int64_t n, const Plane8&
     const std::int64_t dy = r0 + r, lo = lo0 + dlo * r, hi = hi0 + dhi * r;
     const __m512d base = dy == 0 ? p.za : _mm512_add_pd(p.za, _mm512_mul_pd(p.gy, _mm512_set1_pd(double(dy))));
     const float* row = p.a + dy * n;
-    for (std::int64_t dx = lo; dx <= hi; ++dx) {
-      if (dx == 0 && dy == 0) continue;  // the plane's origin: |d| = 0
-      const __m512d q = dx == 0 ? base : _mm512_add_pd(base, _mm512_mul_pd(p.gx, _mm512_set1_pd(double(dx))));
-      m = _mm512_max_pd(_mm512_abs_pd(_mm512_sub_pd(_mm512_cvtps_pd(load8f<St>(row + dx)), q)), m);
-    }
+    if constexpr (St >= 16)
+      if (hi - lo >= 2) {
+        for (std::int64_t b = lo; b <= hi; b += 8) {
+          const float* q = row + b;
+          __m256 l[8], t[8];
+          for (int j = 0; j < 8; ++j) l[j] = _mm256_loadu_ps(q + j * St);
+          for (int j = 0; j < 8; j += 2)
+            t[j] = _mm256_unpacklo_ps(l[j], l[j + 1]), t[j + 1] = _mm256_unpackhi_ps(l[j], l[j + 1]);
+          // u[4 h + k]: sample b + k (low half) and b + k + 4 (high) of lanes 4 h .. 4 h + 3.
+          __m256 u[8];
+          for (int h = 0; h < 2; ++h) {
+            const __m256 *a = t + 4 * h;
+            u[4 * h] = _mm256_shuffle_ps(a[0], a[2], 0x44), u[4 * h + 1] = _mm256_shuffle_ps(a[0], a[2], 0xEE);
+            u[4 * h + 2] = _mm256_shuffle_ps(a[1], a[3], 0x44), u[4 * h + 3] = _mm256_shuffle_ps(a[1], a[3], 0xEE);
+          }
+          for (int k = 0; k < 8 && b + k <= hi; ++k) {
+            if (b + k == 0 && dy == 0) continue;  // the plane's origin: |d| = 0
+            const int i = k & 3;
+            const __m256 h = k < 4 ? _mm256_permute2f128_ps(u[i], u[4 + i], 0x20) : _mm256_permute2f128_ps(u[i], u[4 + i], 0x31);
+            term8(m, p, base, h, b + k);
+          }
+        }
+        continue;
+      }
+    for (std::int64_t dx = lo; dx <= hi; ++dx)
+      if (dx != 0 || dy != 0) term8(m, p, base, load8f<St>(row + dx), dx);  // at the plane's origin |d| = 0
   }
 }
 template <int St>
@@ -415,7 +445,7 @@ GEODS_TERRAIN_AVX512_INLINE void store8(float* err, std::int64_t n, std::int64_t
   for (int j = 0; j < 8; ++j) e[St * j] = x + St * j + s > W - 1 || y + s > H - 1 ? kInf : out[j];
 }
 
-// red_row_avx2<S>() eight vertices at a time (S = 1, 2; N / S >= 32).
+// red_row_avx2<S>() eight vertices at a time (N / S >= 32).
 template <int S>
 __attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) void red_row_avx512(const float* z, std::int64_t n, std::int64_t W,
                                                                               std::int64_t H, std::uint32_t t, std::int64_t y,
@@ -441,7 +471,7 @@ __attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) void red_row_avx512(co
   }
 }
 
-// blue_h_row_avx2<S>() eight vertices at a time (S = 1, 2, 4; N / S >= 32).
+// blue_h_row_avx2<S>() eight vertices at a time (N / S >= 32).
 template <int S>
 __attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) void blue_h_row_avx512(const float* z, std::int64_t n, std::int64_t W,
                                                                                 std::int64_t H, std::int64_t y, float* err) {
@@ -455,7 +485,7 @@ __attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) void blue_h_row_avx512
   }
 }
 
-// blue_v_row_avx2<S>() eight vertices at a time from x = 2 S (S = 1, 2, 4);
+// blue_v_row_avx2<S>() eight vertices at a time from x = 2 S;
 // returns the first x not done.
 template <int S>
 __attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) std::int64_t blue_v_row_avx512(const float* z, std::int64_t n, std::int64_t W,
@@ -485,7 +515,7 @@ __attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) std::int64_t blue_v_ro
 // rounded up to a float; +inf when a corner of one lies outside W x H. With
 // AVX2 (and N / S >= 16, so that groups of four fill the rows) the fine
 // levels take the kernels above (eight vertices at a time with AVX-512 where
-// their lanes are at most 8 samples apart and N / S >= 32), but for the
+// N / S >= 32), but for the
 // first and last rows of blue vertices on horizontal edges, the first and
 // last few on vertical ones, and the rows whose triangles reach the grid's
 // last row (the kernels load a few floats past the samples they use, and z
@@ -495,7 +525,7 @@ void level_errors(const float* z, std::int64_t n, std::int64_t W, std::int64_t H
   const std::int64_t s = S ? S : std::int64_t(1) << t, N = n - 1, c = N / 2;
 #if defined(__x86_64__) && defined(__GNUC__)
   const bool wide = S > 0 && N / s >= 16 && simd_level() >= SimdLevel::avx2;
-  const bool wide8 = S > 0 && S <= 4 && N / s >= 32 && simd_level() >= SimdLevel::avx512;  // lanes at most 8 apart
+  const bool wide8 = S > 0 && N / s >= 32 && simd_level() >= SimdLevel::avx512;
 #endif
   auto in = [&](P2 p) { return p.x <= W - 1 && p.y <= H - 1; };
   // Red: rows y = s, 3s, ...; x = s, 3s, ... The parents (the apexes) are the
@@ -506,12 +536,10 @@ void level_errors(const float* z, std::int64_t n, std::int64_t W, std::int64_t H
 #if defined(__x86_64__) && defined(__GNUC__)
       if constexpr (S > 0)
         if (wide && y + s < N) {
-          if constexpr (S <= 2)
-            if (wide8) {
-              red_row_avx512<S>(z, n, W, H, t, y, err);
-              continue;
-            }
-          red_row_avx2<S>(z, n, W, H, t, y, err);
+          if (wide8)
+            red_row_avx512<S>(z, n, W, H, t, y, err);
+          else
+            red_row_avx2<S>(z, n, W, H, t, y, err);
           continue;
         }
 #endif
@@ -548,12 +576,10 @@ void level_errors(const float* z, std::int64_t n, std::int64_t W, std::int64_t H
 #if defined(__x86_64__) && defined(__GNUC__)
       if constexpr (S > 0)
         if (wide && y > 0 && y < N) {
-          if constexpr (S <= 4)
-            if (wide8) {
-              blue_h_row_avx512<S>(z, n, W, H, y, err);
-              continue;
-            }
-          blue_h_row_avx2<S>(z, n, W, H, y, err);
+          if (wide8)
+            blue_h_row_avx512<S>(z, n, W, H, y, err);
+          else
+            blue_h_row_avx2<S>(z, n, W, H, y, err);
           continue;
         }
 #endif
@@ -585,12 +611,7 @@ void level_errors(const float* z, std::int64_t n, std::int64_t W, std::int64_t H
       std::int64_t done = 2 * s;  // the vertices x in [2 s, done) are done
 #if defined(__x86_64__) && defined(__GNUC__)
       if constexpr (S > 0)
-        if (wide && y + s < N) {
-          if constexpr (S <= 4)
-            done = wide8 ? blue_v_row_avx512<S>(z, n, W, H, y, err) : blue_v_row_avx2<S>(z, n, W, H, y, err);
-          else
-            done = blue_v_row_avx2<S>(z, n, W, H, y, err);
-        }
+        if (wide && y + s < N) done = wide8 ? blue_v_row_avx512<S>(z, n, W, H, y, err) : blue_v_row_avx2<S>(z, n, W, H, y, err);
 #endif
       for (std::int64_t x = 0; x <= N; x = x == 0 ? done : x + 2 * s) {
         const P2 a{x, y - s}, bb{x, y + s};
@@ -626,6 +647,7 @@ void level_errors(const float* z, std::int64_t n, std::int64_t W, std::int64_t H
 }
 
 // The own errors of every vertex but the corners and the centre (0 there).
+// Spacings 1 to 32 as fixed stencils (the SIMD kernels; spacing 64 that way was slower).
 void own_errors(const float* z, std::int64_t n, std::int64_t W, std::int64_t H, std::uint32_t K, float* err) {
   for (std::uint32_t t = 0; t < K; ++t) {
     if (t == 0)
@@ -638,6 +660,8 @@ void own_errors(const float* z, std::int64_t n, std::int64_t W, std::int64_t H, 
       level_errors<8>(z, n, W, H, t, err);
     else if (t == 4)
       level_errors<16>(z, n, W, H, t, err);
+    else if (t == 5)
+      level_errors<32>(z, n, W, H, t, err);
     else
       level_errors<0>(z, n, W, H, t, err);
   }

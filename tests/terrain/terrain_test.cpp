@@ -596,11 +596,13 @@ TEST(Terrain, GreedyTinTheSameAtEverySimdLevel) {
 
 // The fine levels' AVX2 kernels, the AVX2 and AVX-512 row kernels and the
 // nesting's give the records of the portable code bit for bit: fields wide
-// enough for every kernel (spacing 1 to 16), padded on one side or both,
+// enough for every kernel (spacing 1 to 32, eight lanes up to 128 samples
+// apart in the 1025-sample grid), padded on one side or both,
 // non-square, the heights scaled from 1e-3 to 1e30, in both layouts.
 TEST(Terrain, RecordsTheSameAtEverySimdLevel) {
   const std::vector<std::pair<HeightField, double>> fields = {
-      {noise(257, 257, 21), 1}, {noise(300, 170, 22, 1000), 1e-3}, {noise(129, 400, 23), 1e30}, {real_field(), 1}};
+      {noise(257, 257, 21), 1}, {noise(300, 170, 22, 1000), 1e-3}, {noise(129, 400, 23), 1e30}, {noise(1025, 600, 24), 1},
+      {real_field(), 1}};
   const SimdLevel level = simd_level();
   for (const auto& [f, scale] : fields)
     for (const Layout layout : {Layout::interleaved, Layout::matrix}) {
