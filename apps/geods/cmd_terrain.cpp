@@ -46,7 +46,8 @@ class TerrainCommand : public Command {
         ->delimiter(',')
         ->expected(2);
     app.add_option("--z-scale", z_scale_, "Height scale (default 1)");
-    app.add_option("--layout", layout_, "Vertex layout in memory: matrix (default) or interleaved; --save writes interleaved");
+    app.add_option("--layout", layout_,
+                   "Vertex layout in memory: matrix (default; interleaved with --save) or interleaved; files are interleaved");
     add_save(app, save_, "the terrain (memory-mapped when read back)", "Terrain.load");
     add_output(app, "--strip", strip_, "The triangle strip as int64 vertex indices", io::OutputKind::array);
     add_output(app, "--png", png_, "A rendering of the mesh from the camera (or a three-quarter view)",
@@ -84,7 +85,8 @@ class TerrainCommand : public Command {
       if (!spacing_.empty()) field.spacing = {spacing_[0], spacing_[1]};
       terrain::TerrainOptions options;
       options.z_scale = z_scale_;
-      if (layout_ == "interleaved") options.layout = terrain::Layout::interleaved;
+      // With --save the file's layout unless asked: no rearranging, no second copy of the records.
+      if (layout_ == "interleaved" || (layout_.empty() && !save_.empty())) options.layout = terrain::Layout::interleaved;
       else if (!layout_.empty() && layout_ != "matrix")
         throw Error("terrain: --layout must be interleaved or matrix, got '" + layout_ + "'");
       t = terrain::Terrain(std::move(field), options);

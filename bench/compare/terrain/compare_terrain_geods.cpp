@@ -2,7 +2,7 @@
 // 344 x 403 int16 metres, public domain) mirrored into 1025^2 (as field.mjs does for martini
 // and delatin): sample (x, y) is the DEM's (reflect(x, 403), reflect(y, 344)).
 // Variants: e<T>: the 4-8 mesh within T of every sample (build_s = the hierarchy, query_s =
-// the refinement); tin_e<T>: the greedy TIN within T; view: view-dependent refinement
+// the refinement; the default layout, matrix); tin_e<T>: the greedy TIN within T; view: view-dependent refinement
 // (tau = 1 pixel, 1024 x 768, 60 degrees) from 16 low viewpoints, query_s = per view;
 // view_matrix: the same with the matrix layout; stream_bound: the floor of the exact nested
 // errors, one streaming pass per level (2 log2(n - 1) passes) of the library's row kernel (AVX2 where the CPU has it)
