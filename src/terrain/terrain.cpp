@@ -342,6 +342,23 @@ GEODS_TERRAIN_AVX512_INLINE __m256 load8f(const float* p) {
   }
 }
 
+// p[0], p[St], ..., p[7 St] = v: for St = 2 and 4 by masked stores of the
+// lanes spread apart (the floats between untouched), else one at a time.
+template <int St>
+GEODS_TERRAIN_AVX512_INLINE void store8f(float* p, __m256 v) {
+  const __m512 w = _mm512_castps256_ps512(v);
+  if constexpr (St == 2) {
+    _mm512_mask_storeu_ps(p, 0x5555, _mm512_permutexvar_ps(_mm512_set_epi32(0, 7, 0, 6, 0, 5, 0, 4, 0, 3, 0, 2, 0, 1, 0, 0), w));
+  } else if constexpr (St == 4) {
+    _mm512_mask_storeu_ps(p, 0x1111, _mm512_permutexvar_ps(_mm512_set_epi32(0, 0, 0, 3, 0, 0, 0, 2, 0, 0, 0, 1, 0, 0, 0, 0), w));
+    _mm512_mask_storeu_ps(p + 16, 0x1111, _mm512_permutexvar_ps(_mm512_set_epi32(0, 0, 0, 7, 0, 0, 0, 6, 0, 0, 0, 5, 0, 0, 0, 4), w));
+  } else {
+    alignas(32) float out[8];
+    _mm256_store_ps(out, v);
+    for (int j = 0; j < 8; ++j) p[St * j] = out[j];
+  }
+}
+
 // nest_row4() eight vertices at a time with AVX-512: the same maxima and terms lane by lane.
 template <int St>
 __attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) std::int64_t nest_row8(const float* z, float* err, float* rad, std::int64_t n,
@@ -438,10 +455,14 @@ GEODS_TERRAIN_AVX512_INLINE void store8(float* err, std::int64_t n, std::int64_t
                                         std::int64_t H, __m512d m) {
   const __m256 f = _mm512_cvtpd_ps(m);
   const __mmask8 below = _mm512_cmp_pd_mask(_mm512_cvtps_pd(f), m, _CMP_LT_OQ);  // round_up(): one ulp up
-  alignas(32) float out[8];
-  _mm256_store_si256(reinterpret_cast<__m256i*>(out),
-                     _mm256_mask_add_epi32(_mm256_castps_si256(f), below, _mm256_castps_si256(f), _mm256_set1_epi32(1)));
+  const __m256 r = _mm256_castsi256_ps(_mm256_mask_add_epi32(_mm256_castps_si256(f), below, _mm256_castps_si256(f), _mm256_set1_epi32(1)));
   float* e = err + y * n + x;
+  if (x + 7 * St + s <= W - 1 && y + s <= H - 1) {  // every diamond in the field
+    store8f<St>(e, r);
+    return;
+  }
+  alignas(32) float out[8];
+  _mm256_store_ps(out, r);
   for (int j = 0; j < 8; ++j) e[St * j] = x + St * j + s > W - 1 || y + s > H - 1 ? kInf : out[j];
 }
 
