@@ -165,11 +165,15 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
   // against all lanes at once; else each lane tests groups of 4 (RayTriangle4Test).
   vf adir[3];
   for (int a = 0; a < 3; ++a) adir[a] = dir[a] < splat<P>(0.0f) ? -dir[a] : dir[a];
+  // (Comparisons are combined as bit masks: GCC scalarizes & and | of
+  // 16-lane comparisons inlined into AVX-512 code.)
   const vi z1 = adir[1] > adir[0];
-  const vi z2 = adir[2] > (z1 ? adir[1] : adir[0]);
-  const vf dz = z2 ? dir[2] : z1 ? dir[1] : dir[0];
-  const unsigned kz_bits[2] = {lane_bits<L>(z1 & ~z2) & active, lane_bits<L>(z2) & active};
-  const unsigned negz = lane_bits<L>(dz < splat<P>(0.0f)) & active;
+  const unsigned z1_bits = lane_bits<L>(z1), z2_bits = lane_bits<L>(adir[2] > (z1 ? adir[1] : adir[0]));
+  const unsigned kz_bits[2] = {z1_bits & ~z2_bits & active, z2_bits & active};
+  unsigned negative[3];
+  for (int a = 0; a < 3; ++a) negative[a] = lane_bits<L>(dir[a] < splat<P>(0.0f));
+  const unsigned negz =
+      ((negative[2] & z2_bits) | (negative[1] & z1_bits & ~z2_bits) | (negative[0] & ~z1_bits & ~z2_bits)) & active;
   const bool same_axes = (kz_bits[0] == 0 || kz_bits[0] == active) && (kz_bits[1] == 0 || kz_bits[1] == active) &&
                          (negz == 0 || negz == active);
   int kz = kz_bits[1] ? 2 : kz_bits[0] ? 1 : 0, kx = (kz + 1) % 3, ky = (kx + 1) % 3;
@@ -291,9 +295,9 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
   // ambiguous (shot again alone), a closer one clears that.
   auto record = [&](std::uint32_t hits, vf t, vi prim, vf u, vf v) GEODS_BVH_INLINE_LAMBDA {
     const vi m = lane_mask<P>(hits);
-    const vi had = hit_prim != (vi{} - 1);
-    ambiguous &= ~lane_bits<L>(m & had & (t < hit_t));
-    ambiguous |= lane_bits<L>(m & had & (t == hit_t) & (prim != hit_prim));
+    const std::uint32_t had = hits & lane_bits<L>(hit_prim != (vi{} - 1));
+    ambiguous &= ~(had & lane_bits<L>(t < hit_t));
+    ambiguous |= had & lane_bits<L>(t == hit_t) & lane_bits<L>(prim != hit_prim);
     hit_t = m ? t : hit_t;
     hit_prim = m ? prim : hit_prim;
     hit_u = m ? u : hit_u;
@@ -314,13 +318,13 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
           px[c] = (splat<P>(group.corner[c][kx][k]) - ox) - sh_x * pz[c];
           py[c] = (splat<P>(group.corner[c][ky][k]) - oy) - sh_y * pz[c];
         }
-        const ShearedEdges<vf> ed = sheared_edges(px, py);
-        const std::uint32_t edge = lane_bits<L>(ed.on_edge) & lanes;
-        if ((lane_bits<L>(ed.inside) & lanes) == 0 && edge == 0) continue;
+        const auto ed = sheared_edges(px, py, [](vi m) GEODS_BVH_INLINE_LAMBDA { return lane_bits<L>(m); });
+        const std::uint32_t edge = ed.on_edge & lanes;
+        if ((ed.inside & lanes) == 0 && edge == 0) continue;
         const vf scaled_t = ed.eu * (sh_z * pz[0]) + ed.ev * (sh_z * pz[1]) + ed.ew * (sh_z * pz[2]);
         const vf inv_det = splat<P>(1.0f) / ed.det;
         vf t = scaled_t * inv_det, u = ed.ev * inv_det, v = ed.ew * inv_det;
-        std::uint32_t hits = lane_bits<L>(ed.inside & (t >= tmin_v) & (t <= hit_t)) & lanes;
+        std::uint32_t hits = ed.inside & lane_bits<L>(t >= tmin_v) & lane_bits<L>(t <= hit_t) & lanes;
         for (std::uint32_t b = edge; b != 0; b &= b - 1) {  // the scalar test's double-precision path
           const int i = __builtin_ctz(b);
           const Vec3f a(group.corner[0][0][k], group.corner[0][1][k], group.corner[0][2][k]);
@@ -430,14 +434,20 @@ void packet_best(const FlatArray<WideNode<W>>& nodes, const FlatArray<TriangleGr
     const RayPacketN<P>& packet, std::uint32_t active, bool any, HitPacketN<P>& out, std::uint32_t& done,
     std::uint32_t& ambiguous) {
 #if defined(GEODS_PACKET_SIMD_DISPATCH)
-  switch (simd_level()) {
-    case SimdLevel::avx512: return packet_avx512<W, P>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
-    case SimdLevel::avx2: return packet_avx2<W, P>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
-    case SimdLevel::avx: return packet_avx<W, P>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
-    case SimdLevel::portable: break;
+  if constexpr (P == 16) {  // only with AVX-512 (sixteen_wide)
+    packet_avx512<W, P>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
+  } else {
+    switch (simd_level()) {
+      case SimdLevel::avx512: return packet_avx512<W, P>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
+      case SimdLevel::avx2: return packet_avx2<W, P>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
+      case SimdLevel::avx: return packet_avx<W, P>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
+      case SimdLevel::portable: break;
+    }
+    packet_portable<W, P>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
   }
-#endif
+#else
   packet_portable<W, P>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
+#endif
 }
 
 // The lanes the packet traversal takes, and the others shot alone into `out`.
@@ -510,7 +520,13 @@ std::uint32_t occluded_packet(const TriangleBvh& bvh, const RayPacketN<P>& packe
 }
 
 // Packets of 16 where the kernel runs 16 lanes wide (AVX-512), else as two of 8.
-bool sixteen_wide() { return simd_level() == SimdLevel::avx512; }
+bool sixteen_wide() {
+#if defined(GEODS_PACKET_SIMD_DISPATCH)
+  return simd_level() == SimdLevel::avx512;
+#else
+  return false;
+#endif
+}
 RayPacket half(const RayPacket16& packet, int h) {
   RayPacket r;
   std::copy_n(packet.rays + 8 * h, 8, r.rays);
