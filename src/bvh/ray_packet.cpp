@@ -11,6 +11,7 @@
 #include <limits>
 #include <new>
 #include <string>
+#include <type_traits>
 
 #include "geods/bvh/traversal.hpp"
 #include "geods/bvh/triangle_bvh.hpp"
@@ -305,7 +306,18 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
     if (any) done |= hits;
   };
   // Every lane sheared along the same axes: one triangle against all lanes
-  // at once, each lane doing the scalar test's operations in its order.
+  // at once, each lane doing the scalar test's operations in its order. The
+  // edge tests' masks: 8 lanes combine vector masks (one movemask), 16 lanes
+  // bit masks (GCC scalarizes & and | of 16-lane comparisons in AVX-512 code).
+  const auto edge_bits = [](vi m) GEODS_BVH_INLINE_LAMBDA { return lane_bits<L>(m); };
+  using EdgeMask = std::conditional_t<P == 16, decltype(edge_bits), SameMask>;
+  const auto bits_of = [](auto m) GEODS_BVH_INLINE_LAMBDA {
+    if constexpr (std::is_same_v<decltype(m), vi>) {
+      return lane_bits<L>(m);
+    } else {
+      return m;
+    }
+  };
   auto leaf_rays = [&](const PacketEntry& e, std::uint32_t lanes) GEODS_BVH_INLINE_LAMBDA {
     const vf ox = org[kx], oy = org[ky], oz = org[kz];
     for (std::uint32_t g = e.child; g < e.child + e.count && lanes != 0; ++g) {
@@ -318,13 +330,18 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
           px[c] = (splat<P>(group.corner[c][kx][k]) - ox) - sh_x * pz[c];
           py[c] = (splat<P>(group.corner[c][ky][k]) - oy) - sh_y * pz[c];
         }
-        const auto ed = sheared_edges(px, py, [](vi m) GEODS_BVH_INLINE_LAMBDA { return lane_bits<L>(m); });
-        const std::uint32_t edge = ed.on_edge & lanes;
-        if ((ed.inside & lanes) == 0 && edge == 0) continue;
+        const auto ed = sheared_edges(px, py, EdgeMask{});
+        const std::uint32_t edge = bits_of(ed.on_edge) & lanes;
+        if ((bits_of(ed.inside) & lanes) == 0 && edge == 0) continue;
         const vf scaled_t = ed.eu * (sh_z * pz[0]) + ed.ev * (sh_z * pz[1]) + ed.ew * (sh_z * pz[2]);
         const vf inv_det = splat<P>(1.0f) / ed.det;
         vf t = scaled_t * inv_det, u = ed.ev * inv_det, v = ed.ew * inv_det;
-        std::uint32_t hits = ed.inside & lane_bits<L>(t >= tmin_v) & lane_bits<L>(t <= hit_t) & lanes;
+        std::uint32_t hits;
+        if constexpr (P == 16) {
+          hits = ed.inside & lane_bits<L>(t >= tmin_v) & lane_bits<L>(t <= hit_t) & lanes;
+        } else {
+          hits = lane_bits<L>(ed.inside & (t >= tmin_v) & (t <= hit_t)) & lanes;
+        }
         for (std::uint32_t b = edge; b != 0; b &= b - 1) {  // the scalar test's double-precision path
           const int i = __builtin_ctz(b);
           const Vec3f a(group.corner[0][0][k], group.corner[0][1][k], group.corner[0][2][k]);
