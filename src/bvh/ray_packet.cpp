@@ -388,9 +388,9 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
     if (lanes == 0) return true;
     // With AVX a triangle against all lanes costs about what a group of 4
     // costs one lane: with fewer than 3 lanes in the leaf, each lane tests
-    // the groups. Without AVX the 8 lanes take two 4-wide operations, and
-    // each lane tests the groups (portable 100k closest: 0.17-0.19 s of CPU
-    // against 0.21-0.26 s).
+    // the groups (16 lanes too: 2 and 6 measured no faster). Without AVX
+    // the 8 lanes take two 4-wide operations, and each lane tests the groups
+    // (portable 100k closest: 0.17-0.19 s of CPU against 0.21-0.26 s).
     if (L != SimdLevel::portable && same_axes && __builtin_popcount(lanes) >= 3) {
       leaf_rays(e, lanes);
     } else {
