@@ -55,8 +55,9 @@ template <SimdLevel L, typename M>
 GEODS_BVH_INLINE unsigned lane_bits(M m) {
   constexpr int n = int(sizeof(M) / 4);
 #if defined(GEODS_PACKET_SIMD_DISPATCH)
-  if constexpr (n == 16 && L == SimdLevel::avx512) return lane_bits_avx512(m);
-  if constexpr (n >= 8 && L != SimdLevel::portable) {
+  if constexpr (n == 16 && L == SimdLevel::avx512) {
+    return lane_bits_avx512(m);
+  } else if constexpr (n >= 8 && L != SimdLevel::portable) {
     Lanes<8>::vi half[n / 8];
     std::memcpy(half, &m, sizeof half);
     unsigned bits = 0;
