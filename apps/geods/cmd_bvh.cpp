@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <type_traits>
 
 #include "command.hpp"
 #include "geods/core/error.hpp"
@@ -34,9 +35,12 @@ class BvhCommand : public Command {
     app.add_option("--leaf-size", leaf_size_, "Most triangles per leaf (1..255)");
     app.add_option("--arity", arity_, "Children per node: 2, 4 or 8");
     app.add_option("--rays", rays_, "Rays, n x 6 (ox oy oz dx dy dz; .npy, .csv)");
-    app.add_flag("--packets", packets_,
-                 "Shoot --rays in packets of 8 consecutive rays traversed together (the same hits; faster for "
-                 "coherent rays in neighbouring order)");
+    app.add_option("--packets", packet_size_,
+                   "Shoot --rays in packets of 8 (or 16: --packets 16) consecutive rays traversed together (the "
+                   "same hits; faster for coherent rays in neighbouring order: 4 x 2 or 4 x 4 pixel tiles)")
+        ->expected(0, 1)
+        ->default_str("8")
+        ->check(CLI::IsMember({8, 16}));
     add_output(app, "-o,--output", output_, "Output for --rays: float64 n x 2 (t, triangle), inf and -1 on a miss",
                io::OutputKind::table);
     add_save(app, save_, "the hierarchy", "TriangleBvh.load");
@@ -81,17 +85,22 @@ class BvhCommand : public Command {
         ray.direction = Vec3f(float(r[3]), float(r[4]), float(r[5]));
         return ray;
       };
-      if (packets_) {
-        const std::size_t packets = (rays.rows + bvh::kPacketSize - 1) / bvh::kPacketSize;
-        parallel_for_each_index(0, packets, [&](std::size_t p) {
-          bvh::RayPacket packet;
-          const std::size_t first = p * bvh::kPacketSize;
-          const std::size_t n = std::min<std::size_t>(bvh::kPacketSize, rays.rows - first);
+      // Packets of N rays, packets in parallel.
+      const auto shoot_packets = [&]<int N>(std::integral_constant<int, N>) {
+        parallel_for_each_index(0, (rays.rows + N - 1) / N, [&](std::size_t p) {
+          bvh::RayPacketN<N> packet;
+          const std::size_t first = p * N;
+          const std::size_t n = std::min<std::size_t>(N, rays.rows - first);
           for (std::size_t i = 0; i < n; ++i) packet.rays[i] = ray_at(first + i);
           packet.active = (1u << n) - 1;
-          const bvh::HitPacket h = bvh.intersect(packet);
+          const bvh::HitPacketN<N> h = bvh.intersect(packet);
           for (std::size_t i = 0; i < n; ++i) put(first + i, h.hits[i]);
         }, 32);
+      };
+      if (packet_size_ == 16) {
+        shoot_packets(std::integral_constant<int, 16>{});
+      } else if (packet_size_ == 8) {
+        shoot_packets(std::integral_constant<int, 8>{});
       } else {
         parallel_for_each_index(0, rays.rows, [&](std::size_t i) { put(i, bvh.intersect(ray_at(i))); }, 256);
       }
@@ -113,7 +122,8 @@ class BvhCommand : public Command {
       j["rays"] = rays.rows;
       j["hits"] = hits;
       j["query_s"] = query_s;
-      j["packets"] = packets_;
+      j["packets"] = packet_size_ != 0;
+      j["packet_size"] = packet_size_;
       j["simd_level"] = simd_level_name(simd_level());
       j["mrays_per_s"] = query_s > 0 ? double(rays.rows) / query_s * 1e-6 : 0.0;
     }
@@ -136,7 +146,7 @@ class BvhCommand : public Command {
   std::string mesh_, rays_, output_, save_;
   std::string builder_ = "sah", bv_ = "aabb";
   int leaf_size_ = 8, arity_ = 4;
-  bool packets_ = false;
+  int packet_size_ = 0;  // 0: one ray at a time
 };
 
 const bool registered = register_command<BvhCommand>();

@@ -56,7 +56,7 @@ class RenderCommand : public Command {
     app.add_option("--camera", camera_, "ex,ey,ez,tx,ty,tz,ux,uy,uz,fov (default: a three-quarter view of the mesh)");
     app.add_flag("--shadows", shadows_, "Hard shadows (any-hit rays towards the light)");
     app.add_flag("--packets,!--no-packets", packets_,
-                 "Shoot primary and shadow rays in packets of 4 x 2 pixels (default; the same picture)");
+                 "Shoot primary and shadow rays in packets of 4 x 4 pixels (default; the same picture)");
   }
 
   void run(const RunContext& context, Report& report) override {

@@ -70,17 +70,19 @@ class PyBvh {
     return out;
   }
 
-  // Packets of 8 consecutive rays (TriangleBvh::intersect_packets), packets in parallel.
-  py::tuple intersect_packets(const Rows<float>& origins, const Rows<float>& directions, const Rows<float>& tmax) const {
+  // Packets of packet_size (8 or 16) consecutive rays (TriangleBvh::intersect_packets), packets in parallel.
+  py::tuple intersect_packets(const Rows<float>& origins, const Rows<float>& directions, const Rows<float>& tmax,
+                              int packet_size) const {
     const std::vector<Ray3f> r = rays_from_arrays(origins, directions, tmax, "TriangleBvh.intersect_packets");
+    if (packet_size != 8 && packet_size != 16) throw Error("TriangleBvh.intersect_packets: packet_size must be 8 or 16");
     HitArrays hits(r.size());
     {
       py::gil_scoped_release release;
-      const std::size_t packets = (r.size() + bvh::kPacketSize - 1) / bvh::kPacketSize;
+      const std::size_t size = std::size_t(packet_size), packets = (r.size() + size - 1) / size;
       parallel_for_each_index(0, packets, [&](std::size_t p) {
-        const std::size_t first = p * bvh::kPacketSize, n = std::min<std::size_t>(bvh::kPacketSize, r.size() - first);
-        RayHit out[bvh::kPacketSize];
-        bvh_.intersect_packets(std::span<const Ray3f>(r.data() + first, n), std::span<RayHit>(out, n));
+        const std::size_t first = p * size, n = std::min(size, r.size() - first);
+        RayHit out[16];
+        bvh_.intersect_packets(std::span<const Ray3f>(r.data() + first, n), std::span<RayHit>(out, n), packet_size);
         for (std::size_t i = 0; i < n; ++i) hits.set(first + i, out[i]);
       }, 32);
     }
@@ -88,16 +90,17 @@ class PyBvh {
   }
 
   py::array_t<bool> occluded_packets(const Rows<float>& origins, const Rows<float>& directions,
-                                     const Rows<float>& tmax) const {
+                                     const Rows<float>& tmax, int packet_size) const {
     const std::vector<Ray3f> r = rays_from_arrays(origins, directions, tmax, "TriangleBvh.occluded_packets");
+    if (packet_size != 8 && packet_size != 16) throw Error("TriangleBvh.occluded_packets: packet_size must be 8 or 16");
     py::array_t<bool> out(py::ssize_t(r.size()));
     bool* po = out.mutable_data();
     py::gil_scoped_release release;
-    const std::size_t packets = (r.size() + bvh::kPacketSize - 1) / bvh::kPacketSize;
+    const std::size_t size = std::size_t(packet_size), packets = (r.size() + size - 1) / size;
     parallel_for_each_index(0, packets, [&](std::size_t p) {
-      const std::size_t first = p * bvh::kPacketSize, n = std::min<std::size_t>(bvh::kPacketSize, r.size() - first);
-      std::uint8_t o[bvh::kPacketSize];
-      bvh_.occluded_packets(std::span<const Ray3f>(r.data() + first, n), std::span<std::uint8_t>(o, n));
+      const std::size_t first = p * size, n = std::min(size, r.size() - first);
+      std::uint8_t o[16];
+      bvh_.occluded_packets(std::span<const Ray3f>(r.data() + first, n), std::span<std::uint8_t>(o, n), packet_size);
       for (std::size_t i = 0; i < n; ++i) po[first + i] = o[i] != 0;
     }, 32);
     return out;
@@ -204,13 +207,14 @@ void bind_bvh(py::module_& m) {
       .def("occluded", &PyBvh::occluded, py::arg("origins"), py::arg("directions"), py::arg("tmax") = inf,
            "Whether each ray (origins, directions float32 (n, 3)) hits anything with t in [0, tmax]: bool (n,).")
       .def("intersect_packets", &PyBvh::intersect_packets, py::arg("origins"), py::arg("directions"),
-           py::arg("tmax") = inf,
-           "intersect() with the rays in packets of 8 consecutive rays traversed together (give coherent rays, "
-           "e.g. the pixels of 4 x 2 tiles, next to each other): the same hits, bit for bit. origins, directions "
-           "float32 (n, 3) -> (t float32 (n,), prim int64 (n,), u, v float32 (n,)).")
+           py::arg("tmax") = inf, py::arg("packet_size") = bvh::kPacketSize,
+           "intersect() with the rays in packets of packet_size (8 or 16) consecutive rays traversed together "
+           "(give coherent rays, e.g. the pixels of 4 x 2 or 4 x 4 tiles, next to each other): the same hits, bit "
+           "for bit. origins, directions float32 (n, 3) -> (t float32 (n,), prim int64 (n,), u, v float32 (n,)).")
       .def("occluded_packets", &PyBvh::occluded_packets, py::arg("origins"), py::arg("directions"),
-           py::arg("tmax") = inf,
-           "occluded() with the rays in packets of 8 consecutive rays: origins, directions float32 (n, 3) -> bool (n,).")
+           py::arg("tmax") = inf, py::arg("packet_size") = bvh::kPacketSize,
+           "occluded() with the rays in packets of packet_size (8 or 16) consecutive rays: origins, directions "
+           "float32 (n, 3) -> bool (n,).")
       .def("closest_point", &PyBvh::closest_point, py::arg("points"),
            "Closest points of the mesh to points (n, 3): (points float32 (n, 3), prim int64 (n,), distance float32 (n,)).")
       .def("contains", &PyBvh::contains, py::arg("points"),

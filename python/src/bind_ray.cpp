@@ -136,7 +136,7 @@ void bind_ray(py::module_& m) {
         py::arg("packets") = true,
         "Ray-traces the mesh (Lambert shading, optional hard shadows) into an (height, width, 3) uint8 image. "
         "camera: (ex, ey, ez, tx, ty, tz, ux, uy, uz[, fov]); default a three-quarter view. packets: rays in "
-        "packets of 4 x 2 pixels (the same image as packets=False, one ray at a time).");
+        "packets of 4 x 4 pixels (the same image as packets=False, one ray at a time).");
 }
 
 }  // namespace geods::python

@@ -251,8 +251,8 @@ def test_load_refuses_bad_files(bunny, tmp_path):
         geods.Bvh.load(tmp_path / "missing.bvh")
 
 
-def camera_rays(V, width, height):
-    """Pinhole camera rays in 4 x 2 pixel tiles (coherent packets), float32."""
+def camera_rays(V, width, height, tile_h=2):
+    """Pinhole camera rays in 4 x tile_h pixel tiles (coherent packets), float32."""
     lo, hi = V.min(0), V.max(0)
     eye = (lo + hi) / 2 + 1.5 * (hi - lo)
     forward = (lo + hi) / 2 - eye
@@ -261,9 +261,9 @@ def camera_rays(V, width, height):
     right /= np.linalg.norm(right)
     up = np.cross(right, forward)
     dirs = []
-    for ty in range(0, height, 2):
+    for ty in range(0, height, tile_h):
         for tx in range(0, width, 4):
-            for y in range(ty, ty + 2):
+            for y in range(ty, ty + tile_h):
                 for x in range(tx, tx + 4):
                     dirs.append(forward + (x / width - 0.5) * 0.8 * right - (y / height - 0.5) * 0.8 * up)
     d = np.array(dirs)
@@ -272,10 +272,11 @@ def camera_rays(V, width, height):
 
 
 @pytest.mark.parametrize("arity", [4, 8])
-def test_packets_give_the_single_ray_hits_bit_for_bit(bunny, arity):
+@pytest.mark.parametrize("packet_size", [8, 16])
+def test_packets_give_the_single_ray_hits_bit_for_bit(bunny, arity, packet_size):
     V, F = bunny
     bvh = geods.TriangleBvh(V, F, arity=arity)
-    o1, d1 = camera_rays(V, 32, 16)
+    o1, d1 = camera_rays(V, 32, 16, tile_h=packet_size // 4)
     o2, d2 = rays_at(V, 101, 9)  # incoherent, and not a multiple of 8
     d2[::7] = [1, 0, 0]          # axis-parallel rays among them
     o3 = np.tile((V.min(0) + V.max(0)) / 2, (40, 1)).astype(np.float32)  # from inside the boxes
@@ -283,12 +284,12 @@ def test_packets_give_the_single_ray_hits_bit_for_bit(bunny, arity):
     origins, directions = np.vstack([o1, o2, o3]), np.vstack([d1, d2, d3])
     for tmax in (np.inf, np.float32(0.3)):
         single = bvh.intersect(origins, directions, tmax)
-        packets = bvh.intersect_packets(origins, directions, tmax)
+        packets = bvh.intersect_packets(origins, directions, tmax, packet_size=packet_size)
         for a, b in zip(single, packets):  # t, prim, u, v: the same bits
             assert a.dtype == b.dtype and a.tobytes() == b.tobytes()
-        blocked = bvh.occluded_packets(origins, directions, tmax)
+        blocked = bvh.occluded_packets(origins, directions, tmax, packet_size=packet_size)
         assert blocked.dtype == np.bool_ and np.array_equal(blocked, bvh.occluded(origins, directions, tmax))
-    t = bvh.intersect_packets(o1, d1)[0]
+    t = bvh.intersect_packets(o1, d1, packet_size=packet_size)[0]
     expected = brute_intersect(V, F, o1[::3], d1[::3])
     hit = np.isfinite(expected)
     assert hit.sum() > 10
@@ -296,6 +297,8 @@ def test_packets_give_the_single_ray_hits_bit_for_bit(bunny, arity):
     assert np.allclose(t[::3][hit], expected[hit], rtol=1e-5, atol=1e-6)
     with pytest.raises(geods.Error):
         bvh.intersect_packets(np.zeros((2, 3)), np.zeros((3, 3)))
+    with pytest.raises(geods.Error):
+        bvh.occluded_packets(o1, d1, packet_size=4)
 
 
 def test_simd_level_names_and_cap(bunny):
@@ -329,10 +332,18 @@ def test_cli_packets_and_simd(cli, data_dir, workdir):
     out = subprocess.run([cli, "bvh", data_dir / "bunny.ply", "--arity", "8", "--rays", "prays.npy", "-o", "phits.npy",
                           "--packets", "--simd", "portable", "--json"], cwd=workdir, check=True, capture_output=True, text=True)
     report = json.loads(out.stdout)
-    assert report["packets"] is True and report["simd_level"] == "portable"
+    assert report["packets"] is True and report["packet_size"] == 8 and report["simd_level"] == "portable"
     hits = np.load(workdir / "phits.npy")
     t, prim, _, _ = geods.TriangleBvh(V, F, arity=8).intersect(origins, directions)
     assert np.array_equal(hits[:, 1], prim) and np.array_equal(hits[:, 0][prim >= 0], t[prim >= 0].astype(np.float64))
+    # Packets of 16 (4 x 2 tiles two by two here): the same hits.
+    out = subprocess.run([cli, "bvh", data_dir / "bunny.ply", "--arity", "8", "--rays", "prays.npy", "-o", "phits16.npy",
+                          "--packets", "16", "--json"], cwd=workdir, check=True, capture_output=True, text=True)
+    assert json.loads(out.stdout)["packet_size"] == 16
+    assert np.array_equal(np.load(workdir / "phits16.npy"), hits)
+    bad = subprocess.run([cli, "bvh", data_dir / "bunny.ply", "--rays", "prays.npy", "--packets", "4"], cwd=workdir,
+                         capture_output=True, text=True)
+    assert bad.returncode != 0
     # --simd caps like GEODS_SIMD: a level above the CPU's runs the CPU's best.
     out = subprocess.run([cli, "bvh", data_dir / "bunny.ply", "--simd", "avx512", "--json"], capture_output=True, text=True, check=True)
     assert json.loads(out.stdout)["build_s"] >= 0

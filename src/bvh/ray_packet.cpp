@@ -1,5 +1,6 @@
-// The packet traversal of TriangleBvh (ray_packet.hpp): up to 8 rays through
-// the wide AABB layout together, on the one depth-first loop of traversal.hpp.
+// The packet traversal of TriangleBvh (ray_packet.hpp): up to 8 or 16 rays
+// through the wide AABB layout together, on the one depth-first loop of
+// traversal.hpp; one kernel over the packet's lanes (P) and the node's (W).
 // Compiled once more for AVX, AVX2 and AVX-512 and chosen at run time by
 // simd_level() (core/simd_level.hpp), like the single-ray traversal; this
 // file is compiled with -ffp-contract=off, so every level does the same IEEE
@@ -9,6 +10,8 @@
 #include <cstring>
 #include <limits>
 #include <new>
+#include <string>
+#include <type_traits>
 
 #include "geods/bvh/traversal.hpp"
 #include "geods/bvh/triangle_bvh.hpp"
@@ -23,93 +26,99 @@
 #define GEODS_PACKET_SIMD_DISPATCH 1
 #endif
 
-// 8-lane vectors are passed between inlined helpers only.
+// Lane vectors are passed between inlined helpers only.
 #pragma GCC diagnostic ignored "-Wpsabi"
 
 namespace geods::bvh {
 
 namespace {
 
-constexpr int P = kPacketSize;
-typedef float vf __attribute__((vector_size(4 * P)));
-typedef std::int32_t vi __attribute__((vector_size(4 * P)));
+// N-wide vectors: over the rays of a packet (P = 8, 16) or the children of a node (W = 4, 8).
+template <int N>
+struct Lanes {
+  typedef float vf __attribute__((vector_size(4 * N)));
+  typedef std::int32_t vi __attribute__((vector_size(4 * N)));
+};
 
 #if defined(GEODS_PACKET_SIMD_DISPATCH)
-// One movemask for the 8 lanes; inlined only into the AVX kernels (their flatten).
-__attribute__((target("avx"))) inline unsigned lane_bits_avx(vi m) {
+// One movemask per register; inlined only into the AVX (AVX-512) kernels (their flatten).
+__attribute__((target("avx"))) inline unsigned lane_bits_avx(Lanes<8>::vi m) {
   return unsigned(_mm256_movemask_ps(reinterpret_cast<__m256>(m)));
+}
+__attribute__((target("avx512f,avx512dq"))) inline unsigned lane_bits_avx512(Lanes<16>::vi m) {
+  return unsigned(_mm512_movepi32_mask(reinterpret_cast<__m512i>(m)));
 }
 #endif
 
-// Bit i set where lane i of a comparison result is true (Avx: the caller runs AVX).
-template <bool Avx>
-GEODS_BVH_INLINE unsigned lane_bits(vi m) {
+// Bit i set where lane i of a comparison result is true (L: the kernel's level).
+template <SimdLevel L, typename M>
+GEODS_BVH_INLINE unsigned lane_bits(M m) {
+  constexpr int n = int(sizeof(M) / 4);
 #if defined(GEODS_PACKET_SIMD_DISPATCH)
-  if constexpr (Avx) return lane_bits_avx(m);
+  if constexpr (n == 16 && L == SimdLevel::avx512) {
+    return lane_bits_avx512(m);
+  } else if constexpr (n >= 8 && L != SimdLevel::portable) {
+    Lanes<8>::vi half[n / 8];
+    std::memcpy(half, &m, sizeof half);
+    unsigned bits = 0;
+    for (int h = 0; h < n / 8; ++h) bits |= lane_bits_avx(half[h]) << 8 * h;
+    return bits;
+  }
 #endif
 #if defined(__SSE__)
-  __m128 half[2];
-  std::memcpy(half, &m, sizeof half);
-  return unsigned(_mm_movemask_ps(half[0])) | unsigned(_mm_movemask_ps(half[1])) << 4;
+  __m128 quarter[n / 4];
+  std::memcpy(quarter, &m, sizeof quarter);
+  unsigned bits = 0;
+  for (int q = 0; q < n / 4; ++q) bits |= unsigned(_mm_movemask_ps(quarter[q])) << 4 * q;
+  return bits;
 #else
   unsigned bits = 0;
-  for (int i = 0; i < P; ++i) bits |= unsigned(m[i] & 1) << i;
+  for (int i = 0; i < n; ++i) bits |= unsigned(m[i] & 1) << i;
   return bits;
 #endif
 }
 
 // (A shuffle of lane 0 compiles to one broadcast; an initializer list or a
 // lane-by-lane loop to inserts, vector + scalar to an addition of zero too.)
-static_assert(P == 8);
-GEODS_BVH_INLINE vf splat(float x) {
-  const vf v = {x};
-  return __builtin_shufflevector(v, v, 0, 0, 0, 0, 0, 0, 0, 0);
-}
-
-// W-wide vectors over the children of a node.
-template <int W>
-struct WideVector {
-  typedef float vf __attribute__((vector_size(4 * W)));
-  typedef std::int32_t vi __attribute__((vector_size(4 * W)));
-};
-template <int W>
-GEODS_BVH_INLINE typename WideVector<W>::vf wide_splat(float x) {
-  const typename WideVector<W>::vf v = {x};
-  if constexpr (W == 8) {
+template <int N>
+GEODS_BVH_INLINE typename Lanes<N>::vf splat(float x) {
+  const typename Lanes<N>::vf v = {x};
+  if constexpr (N == 16) {
+    return __builtin_shufflevector(v, v, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0);
+  } else if constexpr (N == 8) {
     return __builtin_shufflevector(v, v, 0, 0, 0, 0, 0, 0, 0, 0);
   } else {
+    static_assert(N == 4);
     return __builtin_shufflevector(v, v, 0, 0, 0, 0);
   }
 }
-template <bool Avx, typename M>
-GEODS_BVH_INLINE unsigned wide_bits(M m) {
-  unsigned bits = 0;
-  if constexpr (sizeof(M) == 32) {
-    return lane_bits<Avx>(m);
-  } else {
-#if defined(__SSE__)
-    bits = unsigned(_mm_movemask_ps(reinterpret_cast<__m128>(m)));
-#else
-    for (int i = 0; i < int(sizeof(M) / 4); ++i) bits |= unsigned(m[i] & 1) << i;
-#endif
-  }
-  return bits;
-}
 
 // Lane i's bit of `bits` as a vector mask (all ones where set).
-GEODS_BVH_INLINE vi lane_mask(std::uint32_t bits) {
-  vi one;
-  for (int i = 0; i < P; ++i) one[i] = 1 << i;
-  return ((vi{} + std::int32_t(bits)) & one) != 0;
+template <int N>
+GEODS_BVH_INLINE typename Lanes<N>::vi lane_mask(std::uint32_t bits) {
+  typename Lanes<N>::vi one;
+  for (int i = 0; i < N; ++i) one[i] = 1 << i;
+  return ((typename Lanes<N>::vi{} + std::int32_t(bits)) & one) != 0;
 }
 
 // The least (greatest) lane of x.
-GEODS_BVH_INLINE float lane_min(vf x) {
-  x = x < __builtin_shufflevector(x, x, 4, 5, 6, 7, 0, 1, 2, 3) ? x : __builtin_shufflevector(x, x, 4, 5, 6, 7, 0, 1, 2, 3);
-  x = x < __builtin_shufflevector(x, x, 2, 3, 0, 1, 6, 7, 4, 5) ? x : __builtin_shufflevector(x, x, 2, 3, 0, 1, 6, 7, 4, 5);
-  return x[0] < x[1] ? x[0] : x[1];
+template <typename V>
+GEODS_BVH_INLINE float lane_min(V x) {
+  if constexpr (sizeof(V) == 64) {
+    const auto lo = __builtin_shufflevector(x, x, 0, 1, 2, 3, 4, 5, 6, 7);
+    const auto hi = __builtin_shufflevector(x, x, 8, 9, 10, 11, 12, 13, 14, 15);
+    return lane_min(lo < hi ? lo : hi);
+  } else {
+    static_assert(sizeof(V) == 32);
+    x = x < __builtin_shufflevector(x, x, 4, 5, 6, 7, 0, 1, 2, 3) ? x : __builtin_shufflevector(x, x, 4, 5, 6, 7, 0, 1, 2, 3);
+    x = x < __builtin_shufflevector(x, x, 2, 3, 0, 1, 6, 7, 4, 5) ? x : __builtin_shufflevector(x, x, 2, 3, 0, 1, 6, 7, 4, 5);
+    return x[0] < x[1] ? x[0] : x[1];
+  }
 }
-GEODS_BVH_INLINE float lane_max(vf x) { return -lane_min(-x); }
+template <typename V>
+GEODS_BVH_INLINE float lane_max(V x) {
+  return -lane_min(-x);
+}
 
 // A child waiting to be visited (an inner WideNode, count 0, or a leaf's
 // groups), with the lanes that entered its box and a lower bound of their
@@ -129,10 +138,12 @@ bool alone(const Ray3f& r) {
 // The traversal of the active lanes of `packet`; `any`: occlusion (a lane
 // stops at its first hit). Lanes in `ambiguous` found two different
 // triangles at their closest t: the caller shoots them alone.
-template <int W, bool Avx>
+template <int W, int P, SimdLevel L>
 GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const FlatArray<TriangleGroup>& groups,
-                                      int depth, const RayPacket& packet, std::uint32_t active, bool any,
-                                      HitPacket& out, std::uint32_t& done, std::uint32_t& ambiguous) {
+                                      int depth, const RayPacketN<P>& packet, std::uint32_t active, bool any,
+                                      HitPacketN<P>& out, std::uint32_t& done, std::uint32_t& ambiguous) {
+  using vf = typename Lanes<P>::vf;
+  using vi = typename Lanes<P>::vi;
   // The rays side by side; inactive lanes repeat the first active ray.
   vf org[3], dir[3], tmin_v;
   vf hit_t;  // the closest hit so far (ray.tmax before one): the lane's tmax
@@ -145,27 +156,31 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
   vf inv[3];
   vi neg[3];
   for (int a = 0; a < 3; ++a) {
-    inv[a] = splat(1.0f) / dir[a];
-    neg[a] = inv[a] < splat(0.0f);
+    inv[a] = splat<P>(1.0f) / dir[a];
+    neg[a] = inv[a] < splat<P>(0.0f);
   }
   vi hit_prim = vi{} - 1;  // RayHit::no_hit
-  vf hit_u = splat(0.0f), hit_v = splat(0.0f);
+  vf hit_u = splat<P>(0.0f), hit_v = splat<P>(0.0f);
   // The watertight test's axes (RayTriangleTest): the largest direction
   // component is z, x and y follow it, swapped for a negative z. When every
   // lane has the same axes (coherent packets), a leaf tests each triangle
   // against all lanes at once; else each lane tests groups of 4 (RayTriangle4Test).
   vf adir[3];
-  for (int a = 0; a < 3; ++a) adir[a] = dir[a] < splat(0.0f) ? -dir[a] : dir[a];
+  for (int a = 0; a < 3; ++a) adir[a] = dir[a] < splat<P>(0.0f) ? -dir[a] : dir[a];
+  // (Comparisons are combined as bit masks: GCC scalarizes & and | of
+  // 16-lane comparisons inlined into AVX-512 code.)
   const vi z1 = adir[1] > adir[0];
-  const vi z2 = adir[2] > (z1 ? adir[1] : adir[0]);
-  const vf dz = z2 ? dir[2] : z1 ? dir[1] : dir[0];
-  const unsigned kz_bits[2] = {lane_bits<Avx>(z1 & ~z2) & active, lane_bits<Avx>(z2) & active};
-  const unsigned negz = lane_bits<Avx>(dz < splat(0.0f)) & active;
+  const unsigned z1_bits = lane_bits<L>(z1), z2_bits = lane_bits<L>(adir[2] > (z1 ? adir[1] : adir[0]));
+  const unsigned kz_bits[2] = {z1_bits & ~z2_bits & active, z2_bits & active};
+  unsigned negative[3];
+  for (int a = 0; a < 3; ++a) negative[a] = lane_bits<L>(dir[a] < splat<P>(0.0f));
+  const unsigned negz =
+      ((negative[2] & z2_bits) | (negative[1] & z1_bits & ~z2_bits) | (negative[0] & ~z1_bits & ~z2_bits)) & active;
   const bool same_axes = (kz_bits[0] == 0 || kz_bits[0] == active) && (kz_bits[1] == 0 || kz_bits[1] == active) &&
                          (negz == 0 || negz == active);
   int kz = kz_bits[1] ? 2 : kz_bits[0] ? 1 : 0, kx = (kz + 1) % 3, ky = (kx + 1) % 3;
   if (negz) std::swap(kx, ky);
-  const vf sh_x = dir[kx] / dir[kz], sh_y = dir[ky] / dir[kz], sh_z = splat(1.0f) / dir[kz];
+  const vf sh_x = dir[kx] / dir[kz], sh_y = dir[ky] / dir[kz], sh_z = splat<P>(1.0f) / dir[kz];
   alignas(64) unsigned char test_storage[P][sizeof(RayTriangle4Test)];
   RayTriangle4Test* tests = reinterpret_cast<RayTriangle4Test*>(test_storage);
   std::uint32_t built = 0;  // lanes whose tests[] is set up (on first use)
@@ -173,23 +188,23 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
   // lanes): per axis the range of the origins and of the inverse directions,
   // used where every lane's inverse direction is finite and of the same sign;
   // there the near and far bound rows of a node are the same for every lane.
-  const vf inf = splat(std::numeric_limits<float>::infinity());
-  const vi active_v = lane_mask(active);
-  using vw = typename WideVector<W>::vf;
+  const vf inf = splat<P>(std::numeric_limits<float>::infinity());
+  const vi active_v = lane_mask<P>(active);
+  using vw = typename Lanes<W>::vf;
   bool one_sign[3], in_frustum[3];
   int near_row[3], far_row[3];
   vw near_o[3], far_o[3], i_lo[3], i_hi[3];
   for (int a = 0; a < 3; ++a) {
     const float o_lo = lane_min(org[a]), o_hi = lane_max(org[a]), inv_lo = lane_min(inv[a]), inv_hi = lane_max(inv[a]);
-    const unsigned negatives = lane_bits<Avx>(neg[a]) & active;
+    const unsigned negatives = lane_bits<L>(neg[a]) & active;
     one_sign[a] = negatives == 0 || negatives == active;
     in_frustum[a] = one_sign[a] && std::isfinite(inv_lo) && std::isfinite(inv_hi);
     const bool positive = negatives == 0;
     near_row[a] = positive ? 2 * a : 2 * a + 1;  // entering at lo - origin: least at the largest origin
     far_row[a] = positive ? 2 * a + 1 : 2 * a;
-    near_o[a] = wide_splat<W>(positive ? o_hi : o_lo);
-    far_o[a] = wide_splat<W>(positive ? o_lo : o_hi);
-    i_lo[a] = wide_splat<W>(inv_lo), i_hi[a] = wide_splat<W>(inv_hi);
+    near_o[a] = splat<W>(positive ? o_hi : o_lo);
+    far_o[a] = splat<W>(positive ? o_lo : o_hi);
+    i_lo[a] = splat<W>(inv_lo), i_hi[a] = splat<W>(inv_hi);
   }
   const bool full_frustum = in_frustum[0] && in_frustum[1] && in_frustum[2];  // its entry distances are the keys
   const float tmin_lo = lane_min(tmin_v);
@@ -201,8 +216,8 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
   // entry into its box is no later than their tmax allows (may_hit_before
   // of the single ray). Lanes that entered later are dropped by the tests below it.
   auto live = [&](const PacketEntry& e) GEODS_BVH_INLINE_LAMBDA {
-    const vf slack = (hit_t < splat(0.0f) ? -hit_t : hit_t) * splat(4e-7f);
-    return e.mask & ~done & lane_bits<Avx>(splat(e.key) <= hit_t + slack);
+    const vf slack = (hit_t < splat<P>(0.0f) ? -hit_t : hit_t) * splat<P>(4e-7f);
+    return e.mask & ~done & lane_bits<L>(splat<P>(e.key) <= hit_t + slack);
   };
   // The children that some lane may enter, all W at once: a lane's entry
   // and exit distances along an axis are products of (bound - origin) and the
@@ -210,7 +225,7 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
   // the packet's ranges bound every lane's (finite inverses: no NaN). A child
   // this rejects, every lane's own slab test rejects too.
   auto frustum = [&](const WideNode<W>& node, float* near_out) GEODS_BVH_INLINE_LAMBDA {
-    vw tn = wide_splat<W>(tmin_lo), tf = wide_splat<W>(tmax_hi);
+    vw tn = splat<W>(tmin_lo), tf = splat<W>(tmax_hi);
     for (int a = 0; a < 3; ++a) {
       if (!in_frustum[a]) continue;
       vw n, f;
@@ -224,7 +239,7 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
       tf = far < tf ? far : tf;
     }
     std::memcpy(near_out, &tn, sizeof tn);
-    return wide_bits<Avx>(tn <= tf * wide_splat<W>(widen));
+    return lane_bits<L>(tn <= tf * splat<W>(widen));
   };
   // Per child of the node being opened: the lanes that enter it. With all
   // three axes in the frustum, its entry distance (a lower bound of every
@@ -245,22 +260,22 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
         // share it, else a blend), NaNs (0 * inf) leave the interval.
         vf near, far;
         if (one_sign[a]) {
-          near = (splat(node.bounds[near_row[a]][c]) - org[a]) * inv[a];
-          far = (splat(node.bounds[far_row[a]][c]) - org[a]) * inv[a];
+          near = (splat<P>(node.bounds[near_row[a]][c]) - org[a]) * inv[a];
+          far = (splat<P>(node.bounds[far_row[a]][c]) - org[a]) * inv[a];
         } else {
-          const vf t_lo = (splat(node.bounds[2 * a][c]) - org[a]) * inv[a];
-          const vf t_hi = (splat(node.bounds[2 * a + 1][c]) - org[a]) * inv[a];
+          const vf t_lo = (splat<P>(node.bounds[2 * a][c]) - org[a]) * inv[a];
+          const vf t_hi = (splat<P>(node.bounds[2 * a + 1][c]) - org[a]) * inv[a];
           near = neg[a] ? t_hi : t_lo;
           far = neg[a] ? t_lo : t_hi;
         }
         tn = near > tn ? near : tn;
         tf = far < tf ? far : tf;
       }
-      const vi enter = tn <= tf * splat(widen);
-      const std::uint32_t m = lanes & lane_bits<Avx>(enter);
+      const vi enter = tn <= tf * splat<P>(widen);
+      const std::uint32_t m = lanes & lane_bits<L>(enter);
       if (m == 0) continue;
       child_mask[c] = m;
-      if (!full_frustum) keys[c] = lane_min(lane_mask(m) ? tn : inf);
+      if (!full_frustum) keys[c] = lane_min(lane_mask<P>(m) ? tn : inf);
       bits |= 1u << c;
     }
     return bits;
@@ -281,10 +296,10 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
   // closest so far; a second triangle at a lane's closest t makes it
   // ambiguous (shot again alone), a closer one clears that.
   auto record = [&](std::uint32_t hits, vf t, vi prim, vf u, vf v) GEODS_BVH_INLINE_LAMBDA {
-    const vi m = lane_mask(hits);
-    const vi had = hit_prim != (vi{} - 1);
-    ambiguous &= ~lane_bits<Avx>(m & had & (t < hit_t));
-    ambiguous |= lane_bits<Avx>(m & had & (t == hit_t) & (prim != hit_prim));
+    const vi m = lane_mask<P>(hits);
+    const std::uint32_t had = hits & lane_bits<L>(hit_prim != (vi{} - 1));
+    ambiguous &= ~(had & lane_bits<L>(t < hit_t));
+    ambiguous |= had & lane_bits<L>(t == hit_t) & lane_bits<L>(prim != hit_prim);
     hit_t = m ? t : hit_t;
     hit_prim = m ? prim : hit_prim;
     hit_u = m ? u : hit_u;
@@ -292,7 +307,18 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
     if (any) done |= hits;
   };
   // Every lane sheared along the same axes: one triangle against all lanes
-  // at once, each lane doing the scalar test's operations in its order.
+  // at once, each lane doing the scalar test's operations in its order. The
+  // edge tests' masks: 8 lanes combine vector masks (one movemask), 16 lanes
+  // bit masks (GCC scalarizes & and | of 16-lane comparisons in AVX-512 code).
+  const auto edge_bits = [](vi m) GEODS_BVH_INLINE_LAMBDA { return lane_bits<L>(m); };
+  using EdgeMask = std::conditional_t<P == 16, decltype(edge_bits), SameMask>;
+  const auto bits_of = [](auto m) GEODS_BVH_INLINE_LAMBDA {
+    if constexpr (std::is_same_v<decltype(m), vi>) {
+      return lane_bits<L>(m);
+    } else {
+      return m;
+    }
+  };
   auto leaf_rays = [&](const PacketEntry& e, std::uint32_t lanes) GEODS_BVH_INLINE_LAMBDA {
     const vf ox = org[kx], oy = org[ky], oz = org[kz];
     for (std::uint32_t g = e.child; g < e.child + e.count && lanes != 0; ++g) {
@@ -301,17 +327,22 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
         if (k > 0 && group.index[k] == group.index[k - 1]) break;  // unused lanes repeat the last triangle
         vf px[3], py[3], pz[3];
         for (int c = 0; c < 3; ++c) {
-          pz[c] = splat(group.corner[c][kz][k]) - oz;
-          px[c] = (splat(group.corner[c][kx][k]) - ox) - sh_x * pz[c];
-          py[c] = (splat(group.corner[c][ky][k]) - oy) - sh_y * pz[c];
+          pz[c] = splat<P>(group.corner[c][kz][k]) - oz;
+          px[c] = (splat<P>(group.corner[c][kx][k]) - ox) - sh_x * pz[c];
+          py[c] = (splat<P>(group.corner[c][ky][k]) - oy) - sh_y * pz[c];
         }
-        const ShearedEdges<vf> ed = sheared_edges(px, py);
-        const std::uint32_t edge = lane_bits<Avx>(ed.on_edge) & lanes;
-        if ((lane_bits<Avx>(ed.inside) & lanes) == 0 && edge == 0) continue;
+        const auto ed = sheared_edges(px, py, EdgeMask{});
+        const std::uint32_t edge = bits_of(ed.on_edge) & lanes;
+        if ((bits_of(ed.inside) & lanes) == 0 && edge == 0) continue;
         const vf scaled_t = ed.eu * (sh_z * pz[0]) + ed.ev * (sh_z * pz[1]) + ed.ew * (sh_z * pz[2]);
-        const vf inv_det = splat(1.0f) / ed.det;
+        const vf inv_det = splat<P>(1.0f) / ed.det;
         vf t = scaled_t * inv_det, u = ed.ev * inv_det, v = ed.ew * inv_det;
-        std::uint32_t hits = lane_bits<Avx>(ed.inside & (t >= tmin_v) & (t <= hit_t)) & lanes;
+        std::uint32_t hits;
+        if constexpr (P == 16) {
+          hits = ed.inside & lane_bits<L>(t >= tmin_v) & lane_bits<L>(t <= hit_t) & lanes;
+        } else {
+          hits = lane_bits<L>(ed.inside & (t >= tmin_v) & (t <= hit_t)) & lanes;
+        }
         for (std::uint32_t b = edge; b != 0; b &= b - 1) {  // the scalar test's double-precision path
           const int i = __builtin_ctz(b);
           const Vec3f a(group.corner[0][0][k], group.corner[0][1][k], group.corner[0][2][k]);
@@ -347,7 +378,7 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
         const std::uint32_t prim = group.index[best];
         bool tie = false;
         for (int k = 0; k < 4; ++k) tie |= (mask >> k & 1) && t[k] == t[best] && group.index[k] != prim;
-        record(1u << i, splat(t[best]), vi{} + std::int32_t(prim), splat(u[best]), splat(v[best]));
+        record(1u << i, splat<P>(t[best]), vi{} + std::int32_t(prim), splat<P>(u[best]), splat<P>(v[best]));
         if (tie) ambiguous |= 1u << i;
       }
       lanes &= ~done;
@@ -358,15 +389,15 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
     if (lanes == 0) return true;
     // With AVX a triangle against all lanes costs about what a group of 4
     // costs one lane: with fewer than 3 lanes in the leaf, each lane tests
-    // the groups. Without AVX the 8 lanes take two 4-wide operations, and
-    // each lane tests the groups (portable 100k closest: 0.17-0.19 s of CPU
-    // against 0.21-0.26 s).
-    if (Avx && same_axes && __builtin_popcount(lanes) >= 3) {
+    // the groups (16 lanes too: 2 and 6 measured no faster). Without AVX
+    // the 8 lanes take two 4-wide operations, and each lane tests the groups
+    // (portable 100k closest: 0.17-0.19 s of CPU against 0.21-0.26 s).
+    if (L != SimdLevel::portable && same_axes && __builtin_popcount(lanes) >= 3) {
       leaf_rays(e, lanes);
     } else {
       leaf_lanes(e, lanes);
     }
-    tmax_hi = lane_max(lane_mask(active & ~done) ? hit_t : -inf);
+    tmax_hi = lane_max(lane_mask<P>(active & ~done) ? hit_t : -inf);
     return (active & ~done) != 0;
   };
   const auto is_leaf = [](const PacketEntry& e) GEODS_BVH_INLINE_LAMBDA { return e.count != 0; };
@@ -377,63 +408,69 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
   } else {
     traverse<W, true>(root, stack, is_leaf, children, child, leaf, still_needed);
   }
-  for (std::uint32_t b = active & lane_bits<Avx>(hit_prim != (vi{} - 1)); b != 0; b &= b - 1) {
+  for (std::uint32_t b = active & lane_bits<L>(hit_prim != (vi{} - 1)); b != 0; b &= b - 1) {
     const int i = __builtin_ctz(b);
     out.hits[i] = {hit_t[i], std::uint32_t(hit_prim[i]), hit_u[i], hit_v[i]};
   }
 }
 
-template <int W>
+// The kernel at each level (ray_packet.hpp: where the CPU runs no AVX-512, a
+// packet of 16 is traced as two of 8).
+template <int W, int P>
 void packet_portable(const FlatArray<WideNode<W>>& nodes, const FlatArray<TriangleGroup>& groups, int depth,
-                     const RayPacket& packet, std::uint32_t active, bool any, HitPacket& out, std::uint32_t& done,
-                     std::uint32_t& ambiguous) {
-  packet_traverse<W, false>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
+    const RayPacketN<P>& packet, std::uint32_t active, bool any, HitPacketN<P>& out, std::uint32_t& done,
+    std::uint32_t& ambiguous) {
+  packet_traverse<W, P, SimdLevel::portable>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
 }
 
 #if defined(GEODS_PACKET_SIMD_DISPATCH)
-template <int W>
-__attribute__((target("avx"), flatten)) void packet_avx(const FlatArray<WideNode<W>>& nodes,
-                                                         const FlatArray<TriangleGroup>& groups, int depth,
-                                                         const RayPacket& packet, std::uint32_t active, bool any,
-                                                         HitPacket& out, std::uint32_t& done,
-                                                         std::uint32_t& ambiguous) {
-  packet_traverse<W, true>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
+template <int W, int P>
+__attribute__((target("avx"), flatten)) void packet_avx(
+    const FlatArray<WideNode<W>>& nodes, const FlatArray<TriangleGroup>& groups, int depth,
+    const RayPacketN<P>& packet, std::uint32_t active, bool any, HitPacketN<P>& out, std::uint32_t& done,
+    std::uint32_t& ambiguous) {
+  packet_traverse<W, P, SimdLevel::avx>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
 }
-template <int W>
+template <int W, int P>
 __attribute__((target("avx2,bmi,bmi2,lzcnt,popcnt"), flatten)) void packet_avx2(
-    const FlatArray<WideNode<W>>& nodes, const FlatArray<TriangleGroup>& groups, int depth, const RayPacket& packet,
-    std::uint32_t active, bool any, HitPacket& out, std::uint32_t& done, std::uint32_t& ambiguous) {
-  packet_traverse<W, true>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
+    const FlatArray<WideNode<W>>& nodes, const FlatArray<TriangleGroup>& groups, int depth,
+    const RayPacketN<P>& packet, std::uint32_t active, bool any, HitPacketN<P>& out, std::uint32_t& done,
+    std::uint32_t& ambiguous) {
+  packet_traverse<W, P, SimdLevel::avx2>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
 }
-template <int W>
+template <int W, int P>
 __attribute__((target("avx512f,avx512vl,avx512bw,avx512dq,avx2,bmi,bmi2,lzcnt,popcnt"), flatten)) void packet_avx512(
-    const FlatArray<WideNode<W>>& nodes, const FlatArray<TriangleGroup>& groups, int depth, const RayPacket& packet,
-    std::uint32_t active, bool any, HitPacket& out, std::uint32_t& done, std::uint32_t& ambiguous) {
-  packet_traverse<W, true>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
+    const FlatArray<WideNode<W>>& nodes, const FlatArray<TriangleGroup>& groups, int depth,
+    const RayPacketN<P>& packet, std::uint32_t active, bool any, HitPacketN<P>& out, std::uint32_t& done,
+    std::uint32_t& ambiguous) {
+  packet_traverse<W, P, SimdLevel::avx512>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
 }
 #endif
 
-template <int W>
+template <int W, int P>
 void packet_best(const FlatArray<WideNode<W>>& nodes, const FlatArray<TriangleGroup>& groups, int depth,
-                 const RayPacket& packet, std::uint32_t active, bool any, HitPacket& out, std::uint32_t& done,
-                 std::uint32_t& ambiguous) {
+    const RayPacketN<P>& packet, std::uint32_t active, bool any, HitPacketN<P>& out, std::uint32_t& done,
+    std::uint32_t& ambiguous) {
 #if defined(GEODS_PACKET_SIMD_DISPATCH)
-  switch (simd_level()) {
-    case SimdLevel::avx512: return packet_avx512<W>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
-    case SimdLevel::avx2: return packet_avx2<W>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
-    case SimdLevel::avx: return packet_avx<W>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
-    case SimdLevel::portable: break;
+  if constexpr (P == 16) {  // only with AVX-512 (sixteen_wide)
+    packet_avx512<W, P>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
+  } else {
+    switch (simd_level()) {
+      case SimdLevel::avx512: return packet_avx512<W, P>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
+      case SimdLevel::avx2: return packet_avx2<W, P>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
+      case SimdLevel::avx: return packet_avx<W, P>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
+      case SimdLevel::portable: break;
+    }
+    packet_portable<W, P>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
   }
+#else
+  packet_portable<W, P>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
 #endif
-  packet_portable<W>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
 }
-
-}  // namespace
-
-namespace {
 
 // The lanes the packet traversal takes, and the others shot alone into `out`.
-std::uint32_t split_lanes(const TriangleBvh& bvh, const RayPacket& packet, bool any, HitPacket& out,
+template <int P>
+std::uint32_t split_lanes(const TriangleBvh& bvh, const RayPacketN<P>& packet, bool any, HitPacketN<P>& out,
                           std::uint32_t& occluded) {
   const std::uint32_t active = packet.active & ((1u << P) - 1);
   const bool wide = !bvh.wide4_nodes().empty() || !bvh.wide8_nodes().empty();
@@ -461,63 +498,124 @@ std::uint32_t split_lanes(const TriangleBvh& bvh, const RayPacket& packet, bool 
   return lanes;
 }
 
-void run_packet(const TriangleBvh& bvh, const RayPacket& packet, std::uint32_t lanes, bool any, HitPacket& out,
-                std::uint32_t& done, std::uint32_t& ambiguous) {
+template <int P>
+void run_packet(const TriangleBvh& bvh, const RayPacketN<P>& packet, std::uint32_t lanes, bool any,
+                HitPacketN<P>& out, std::uint32_t& done, std::uint32_t& ambiguous) {
   if (!bvh.wide8_nodes().empty()) {
-    packet_best<8>(bvh.wide8_nodes(), bvh.triangle_groups(), bvh.depth(), packet, lanes, any, out, done, ambiguous);
+    packet_best<8, P>(bvh.wide8_nodes(), bvh.triangle_groups(), bvh.depth(), packet, lanes, any, out, done,
+                      ambiguous);
   } else {
-    packet_best<4>(bvh.wide4_nodes(), bvh.triangle_groups(), bvh.depth(), packet, lanes, any, out, done, ambiguous);
+    packet_best<4, P>(bvh.wide4_nodes(), bvh.triangle_groups(), bvh.depth(), packet, lanes, any, out, done,
+                      ambiguous);
   }
 }
 
-}  // namespace
-
-HitPacket TriangleBvh::intersect(const RayPacket& packet) const {
-  HitPacket out;
+template <int P>
+HitPacketN<P> intersect_packet(const TriangleBvh& bvh, const RayPacketN<P>& packet) {
+  HitPacketN<P> out;
   std::uint32_t unused = 0;
-  const std::uint32_t lanes = split_lanes(*this, packet, false, out, unused);
+  const std::uint32_t lanes = split_lanes(bvh, packet, false, out, unused);
   if (lanes == 0) return out;
   std::uint32_t done = 0, ambiguous = 0;
-  run_packet(*this, packet, lanes, false, out, done, ambiguous);
+  run_packet(bvh, packet, lanes, false, out, done, ambiguous);
   // Two triangles at a ray's closest t: the single ray's order decides.
   for (std::uint32_t b = ambiguous & lanes; b != 0; b &= b - 1) {
     const int i = __builtin_ctz(b);
-    out.hits[i] = intersect(packet.rays[i]);
+    out.hits[i] = bvh.intersect(packet.rays[i]);
   }
   return out;
 }
 
-std::uint32_t TriangleBvh::occluded(const RayPacket& packet) const {
-  HitPacket out;
+template <int P>
+std::uint32_t occluded_packet(const TriangleBvh& bvh, const RayPacketN<P>& packet) {
+  HitPacketN<P> out;
   std::uint32_t occluded = 0;
-  const std::uint32_t lanes = split_lanes(*this, packet, true, out, occluded);
+  const std::uint32_t lanes = split_lanes(bvh, packet, true, out, occluded);
   if (lanes == 0) return occluded;
   std::uint32_t done = 0, ambiguous = 0;
-  run_packet(*this, packet, lanes, true, out, done, ambiguous);
+  run_packet(bvh, packet, lanes, true, out, done, ambiguous);
   return occluded | (done & lanes);
 }
 
-void TriangleBvh::intersect_packets(std::span<const Ray3f> rays, std::span<RayHit> hits) const {
-  if (hits.size() != rays.size()) throw Error("TriangleBvh::intersect_packets: one hit per ray expected");
+// Packets of 16 where the kernel runs 16 lanes wide (AVX-512), else as two of 8.
+bool sixteen_wide() {
+#if defined(GEODS_PACKET_SIMD_DISPATCH)
+  return simd_level() == SimdLevel::avx512;
+#else
+  return false;
+#endif
+}
+RayPacket half(const RayPacket16& packet, int h) {
+  RayPacket r;
+  std::copy_n(packet.rays + 8 * h, 8, r.rays);
+  r.active = packet.active >> 8 * h & 0xffu;
+  return r;
+}
+
+template <int P>
+void intersect_all(const TriangleBvh& bvh, std::span<const Ray3f> rays, std::span<RayHit> hits) {
   for (std::size_t first = 0; first < rays.size(); first += P) {
-    RayPacket packet;
+    RayPacketN<P> packet;
     const std::size_t n = std::min<std::size_t>(P, rays.size() - first);
     for (std::size_t i = 0; i < n; ++i) packet.rays[i] = rays[first + i];
     packet.active = (1u << n) - 1;
-    const HitPacket out = intersect(packet);
+    const HitPacketN<P> out = bvh.intersect(packet);
     for (std::size_t i = 0; i < n; ++i) hits[first + i] = out.hits[i];
   }
 }
 
-void TriangleBvh::occluded_packets(std::span<const Ray3f> rays, std::span<std::uint8_t> occluded_out) const {
-  if (occluded_out.size() != rays.size()) throw Error("TriangleBvh::occluded_packets: one answer per ray expected");
+template <int P>
+void occluded_all(const TriangleBvh& bvh, std::span<const Ray3f> rays, std::span<std::uint8_t> occluded_out) {
   for (std::size_t first = 0; first < rays.size(); first += P) {
-    RayPacket packet;
+    RayPacketN<P> packet;
     const std::size_t n = std::min<std::size_t>(P, rays.size() - first);
     for (std::size_t i = 0; i < n; ++i) packet.rays[i] = rays[first + i];
     packet.active = (1u << n) - 1;
-    const std::uint32_t mask = occluded(packet);
+    const std::uint32_t mask = bvh.occluded(packet);
     for (std::size_t i = 0; i < n; ++i) occluded_out[first + i] = std::uint8_t(mask >> i & 1);
+  }
+}
+
+void check_packet_size(int packet_size, const char* what) {
+  if (packet_size != 8 && packet_size != 16) throw Error(std::string(what) + ": packet_size must be 8 or 16");
+}
+
+}  // namespace
+
+HitPacket TriangleBvh::intersect(const RayPacket& packet) const { return intersect_packet(*this, packet); }
+
+std::uint32_t TriangleBvh::occluded(const RayPacket& packet) const { return occluded_packet(*this, packet); }
+
+HitPacket16 TriangleBvh::intersect(const RayPacket16& packet) const {
+  if (sixteen_wide()) return intersect_packet(*this, packet);
+  HitPacket16 out;
+  for (int h = 0; h < 2; ++h) std::copy_n(intersect(half(packet, h)).hits, 8, out.hits + 8 * h);
+  return out;
+}
+
+std::uint32_t TriangleBvh::occluded(const RayPacket16& packet) const {
+  if (sixteen_wide()) return occluded_packet(*this, packet);
+  return occluded(half(packet, 0)) | occluded(half(packet, 1)) << 8;
+}
+
+void TriangleBvh::intersect_packets(std::span<const Ray3f> rays, std::span<RayHit> hits, int packet_size) const {
+  if (hits.size() != rays.size()) throw Error("TriangleBvh::intersect_packets: one hit per ray expected");
+  check_packet_size(packet_size, "TriangleBvh::intersect_packets");
+  if (packet_size == 16) {
+    intersect_all<16>(*this, rays, hits);
+  } else {
+    intersect_all<8>(*this, rays, hits);
+  }
+}
+
+void TriangleBvh::occluded_packets(std::span<const Ray3f> rays, std::span<std::uint8_t> occluded_out,
+                                   int packet_size) const {
+  if (occluded_out.size() != rays.size()) throw Error("TriangleBvh::occluded_packets: one answer per ray expected");
+  check_packet_size(packet_size, "TriangleBvh::occluded_packets");
+  if (packet_size == 16) {
+    occluded_all<16>(*this, rays, occluded_out);
+  } else {
+    occluded_all<8>(*this, rays, occluded_out);
   }
 }
 

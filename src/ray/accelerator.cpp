@@ -153,46 +153,75 @@ bool Accelerator::occluded(const Ray3f& ray, RayCache& cache) const {
 namespace {
 
 // The packet with only its active rays that can hit anything (Accelerator::shootable).
-template <typename Shootable>
-bvh::RayPacket shootable_lanes(const bvh::RayPacket& packet, Shootable&& shootable) {
-  bvh::RayPacket shot = packet;
-  shot.active &= (1u << bvh::kPacketSize) - 1;
-  for (int i = 0; i < bvh::kPacketSize; ++i)
+template <int N, typename Shootable>
+bvh::RayPacketN<N> shootable_lanes(const bvh::RayPacketN<N>& packet, Shootable&& shootable) {
+  bvh::RayPacketN<N> shot = packet;
+  shot.active &= (1u << N) - 1;
+  for (int i = 0; i < N; ++i)
     if (!shootable(packet.rays[i])) shot.active &= ~(1u << i);
   return shot;
 }
 
 }  // namespace
 
-bvh::HitPacket Accelerator::intersect(const bvh::RayPacket& packet, RayCache& cache) const {
-  const bvh::RayPacket shot = shootable_lanes(packet, shootable);
+template <int N>
+bvh::HitPacketN<N> Accelerator::intersect_packet(const bvh::RayPacketN<N>& packet, RayCache& cache) const {
+  const bvh::RayPacketN<N> shot = shootable_lanes(packet, shootable);
   if (shot.active == 0 || corners_.empty()) return {};
   if (cache.owner != id_) cache = RayCache{id_};
-  bvh::HitPacket out = closest_hits(shot, cache);
-  for (int i = 0; i < bvh::kPacketSize; ++i)
+  bvh::HitPacketN<N> out = closest_hits(shot, cache);
+  for (int i = 0; i < N; ++i)
     if (!(shot.active >> i & 1) || !out.hits[i].hit()) out.hits[i] = RayHit{};
   return out;
 }
 
-std::uint32_t Accelerator::occluded(const bvh::RayPacket& packet, RayCache& cache) const {
-  const bvh::RayPacket shot = shootable_lanes(packet, shootable);
+template <int N>
+std::uint32_t Accelerator::occluded_packet(const bvh::RayPacketN<N>& packet, RayCache& cache) const {
+  const bvh::RayPacketN<N> shot = shootable_lanes(packet, shootable);
   if (shot.active == 0 || corners_.empty()) return 0;
   if (cache.owner != id_) cache = RayCache{id_};
   return any_hits(shot, cache) & shot.active;
 }
 
-bvh::HitPacket Accelerator::closest_hits(const bvh::RayPacket& packet, RayCache& cache) const {
-  bvh::HitPacket out;
-  for (int i = 0; i < bvh::kPacketSize; ++i)
+template <int N>
+bvh::HitPacketN<N> Accelerator::closest_hits_one_by_one(const bvh::RayPacketN<N>& packet, RayCache& cache) const {
+  bvh::HitPacketN<N> out;
+  for (int i = 0; i < N; ++i)
     if (packet.active >> i & 1) out.hits[i] = intersect(packet.rays[i], cache);
   return out;
 }
 
-std::uint32_t Accelerator::any_hits(const bvh::RayPacket& packet, RayCache& cache) const {
+template <int N>
+std::uint32_t Accelerator::any_hits_one_by_one(const bvh::RayPacketN<N>& packet, RayCache& cache) const {
   std::uint32_t mask = 0;
-  for (int i = 0; i < bvh::kPacketSize; ++i)
+  for (int i = 0; i < N; ++i)
     if ((packet.active >> i & 1) && occluded(packet.rays[i], cache)) mask |= 1u << i;
   return mask;
+}
+
+bvh::HitPacket Accelerator::intersect(const bvh::RayPacket& packet, RayCache& cache) const {
+  return intersect_packet(packet, cache);
+}
+std::uint32_t Accelerator::occluded(const bvh::RayPacket& packet, RayCache& cache) const {
+  return occluded_packet(packet, cache);
+}
+bvh::HitPacket16 Accelerator::intersect(const bvh::RayPacket16& packet, RayCache& cache) const {
+  return intersect_packet(packet, cache);
+}
+std::uint32_t Accelerator::occluded(const bvh::RayPacket16& packet, RayCache& cache) const {
+  return occluded_packet(packet, cache);
+}
+bvh::HitPacket Accelerator::closest_hits(const bvh::RayPacket& packet, RayCache& cache) const {
+  return closest_hits_one_by_one(packet, cache);
+}
+std::uint32_t Accelerator::any_hits(const bvh::RayPacket& packet, RayCache& cache) const {
+  return any_hits_one_by_one(packet, cache);
+}
+bvh::HitPacket16 Accelerator::closest_hits(const bvh::RayPacket16& packet, RayCache& cache) const {
+  return closest_hits_one_by_one(packet, cache);
+}
+std::uint32_t Accelerator::any_hits(const bvh::RayPacket16& packet, RayCache& cache) const {
+  return any_hits_one_by_one(packet, cache);
 }
 
 std::unique_ptr<Accelerator> make_accelerator(const TriMesh& mesh, AcceleratorKind kind,

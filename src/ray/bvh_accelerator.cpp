@@ -42,6 +42,14 @@ std::uint32_t BvhAccelerator::any_hits(const bvh::RayPacket& packet, RayCache&) 
   return bvh_.occluded(packet);
 }
 
+bvh::HitPacket16 BvhAccelerator::closest_hits(const bvh::RayPacket16& packet, RayCache&) const {
+  return bvh_.intersect(packet);
+}
+
+std::uint32_t BvhAccelerator::any_hits(const bvh::RayPacket16& packet, RayCache&) const {
+  return bvh_.occluded(packet);
+}
+
 AcceleratorStats BvhAccelerator::stats() const {
   const bvh::BvhStats b = bvh_.stats();
   AcceleratorStats s;

@@ -14,9 +14,12 @@ namespace geods::ray {
 
 namespace {
 
-constexpr int kTile = 16;  // a multiple of the 4 x 2 pixel blocks of a packet
-constexpr int kBlockX = 4, kBlockY = 2;
-static_assert(kBlockX * kBlockY == bvh::kPacketSize);
+constexpr int kTile = 16;  // a multiple of the 4 x 4 pixel blocks of a packet
+constexpr int kBlockX = 4, kBlockY = 4;
+using Packet = bvh::RayPacket16;  // 16 rays: faster than 8 (docs/ray.md)
+using Hits = bvh::HitPacket16;
+constexpr int kBlock = Packet::size;
+static_assert(kBlockX * kBlockY == kBlock);
 
 // Area-weighted vertex normals for smooth shading when the mesh has none.
 std::vector<Vec3f> vertex_normals(const TriMesh& mesh) {
@@ -103,31 +106,31 @@ RenderResult render(const TriMesh& mesh, const Accelerator& accel, const RenderO
     RayCache primary_cache, shadow_cache;
     std::uint64_t tile_rays = 0, tile_hits = 0;
     const int x0 = int(tile % std::size_t(tiles_x)) * kTile, y0 = int(tile / std::size_t(tiles_x)) * kTile;
-    // Blocks of 4 x 2 pixels: one packet of primary rays, then one of the
+    // Blocks of 4 x 4 pixels: one packet of primary rays, then one of the
     // shadow rays of the lit pixels (ray by ray without options.packets).
     for (int by = y0; by < std::min(y0 + kTile, height); by += kBlockY)
       for (int bx = x0; bx < std::min(x0 + kTile, width); bx += kBlockX) {
-        bvh::RayPacket primary;
+        Packet primary;
         primary.active = 0;
-        for (int i = 0; i < bvh::kPacketSize; ++i) {
+        for (int i = 0; i < kBlock; ++i) {
           const int x = bx + i % kBlockX, y = by + i / kBlockX;
           if (x >= width || y >= height) continue;
           primary.rays[i] = frame.ray(float(x) + 0.5f, float(y) + 0.5f);
           primary.active |= 1u << i;
           ++tile_rays;
         }
-        bvh::HitPacket primary_hits;
+        Hits primary_hits;
         if (options.packets) {
           primary_hits = accel.intersect(primary, primary_cache);
         } else {
-          for (int i = 0; i < bvh::kPacketSize; ++i)
+          for (int i = 0; i < kBlock; ++i)
             if (primary.active >> i & 1) primary_hits.hits[i] = accel.intersect(primary.rays[i], primary_cache);
         }
-        Vec3f colors[bvh::kPacketSize];
-        float keys[bvh::kPacketSize], fills[bvh::kPacketSize];
-        bvh::RayPacket shadow;
+        Vec3f colors[kBlock];
+        float keys[kBlock], fills[kBlock];
+        Packet shadow;
         shadow.active = 0;
-        for (int i = 0; i < bvh::kPacketSize; ++i) {
+        for (int i = 0; i < kBlock; ++i) {
           if (!(primary.active >> i & 1)) continue;
           const Ray3f& ray = primary.rays[i];
           const RayHit& hit = primary_hits.hits[i];
@@ -161,11 +164,11 @@ RenderResult render(const TriMesh& mesh, const Accelerator& accel, const RenderO
           if (options.packets) {
             blocked = accel.occluded(shadow, shadow_cache);
           } else {
-            for (int i = 0; i < bvh::kPacketSize; ++i)
+            for (int i = 0; i < kBlock; ++i)
               if ((shadow.active >> i & 1) && accel.occluded(shadow.rays[i], shadow_cache)) blocked |= 1u << i;
           }
         }
-        for (int i = 0; i < bvh::kPacketSize; ++i) {
+        for (int i = 0; i < kBlock; ++i) {
           if (!(primary.active >> i & 1)) continue;
           if (primary_hits.hits[i].hit()) {
             const float key = (blocked >> i & 1) ? 0.0f : keys[i];

@@ -1,8 +1,9 @@
 // Packets of rays (ray_packet.hpp) against the single-ray queries on the same
 // rays: bit-identical closest hits (t, u, v, triangle) and occlusion for every
 // ray, on incoherent, coherent (pinhole camera tiles) and degenerate rays,
-// rays from inside boxes and axis-parallel rays, 4 and 8 wide, the fallback
-// layouts, partial masks and every SIMD level; brute force checks the t.
+// rays from inside boxes and axis-parallel rays, packets of 8 and 16, 4 and 8
+// wide, the fallback layouts, partial masks and every SIMD level; brute force
+// checks the t.
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -25,17 +26,18 @@ struct LevelGuard {
   ~LevelGuard() { set_simd_level(saved); }
 };
 
-// Packets of consecutive rays with the given active masks (cycled) against
-// one ray at a time; returns the number of hits.
+// Packets of N consecutive rays with the given active masks (cycled; empty:
+// all rays) against one ray at a time; returns the number of hits.
+template <int N>
 std::size_t expect_packets_match(const TriangleBvh& bvh, const std::vector<Ray3f>& rays, const std::string& what,
-                                 const std::vector<std::uint32_t>& masks = {0xff}) {
+                                 const std::vector<std::uint32_t>& masks = {}) {
   std::size_t hits = 0, k = 0;
-  for (std::size_t first = 0; first < rays.size(); first += kPacketSize, ++k) {
-    RayPacket packet;
-    const std::size_t n = std::min<std::size_t>(kPacketSize, rays.size() - first);
+  for (std::size_t first = 0; first < rays.size(); first += N, ++k) {
+    RayPacketN<N> packet;
+    const std::size_t n = std::min<std::size_t>(N, rays.size() - first);
     for (std::size_t i = 0; i < n; ++i) packet.rays[i] = rays[first + i];
-    packet.active = masks[k % masks.size()] & ((1u << n) - 1);
-    const HitPacket out = bvh.intersect(packet);
+    packet.active = (masks.empty() ? ~0u : masks[k % masks.size()]) & ((1u << n) - 1);
+    const HitPacketN<N> out = bvh.intersect(packet);
     const std::uint32_t blocked = bvh.occluded(packet);
     for (std::size_t i = 0; i < n; ++i) {
       if (!(packet.active >> i & 1)) {
@@ -45,41 +47,45 @@ std::size_t expect_packets_match(const TriangleBvh& bvh, const std::vector<Ray3f
       }
       const RayHit single = bvh.intersect(rays[first + i]);
       EXPECT_TRUE(same_bits(out.hits[i], single))
-          << what << " ray " << first + i << ": packet t " << out.hits[i].t << " prim " << out.hits[i].prim
+          << what << " packet of " << N << " ray " << first + i << ": packet t " << out.hits[i].t << " prim " << out.hits[i].prim
           << ", single t " << single.t << " prim " << single.prim;
-      EXPECT_EQ(bool(blocked >> i & 1), bvh.occluded(rays[first + i])) << what << " ray " << first + i;
+      EXPECT_EQ(bool(blocked >> i & 1), bvh.occluded(rays[first + i])) << what << " packet of " << N << " ray " << first + i;
       hits += single.hit();
     }
   }
   return hits;
 }
 
-// Every layout the packet reads (4 and 8 wide) and one it does not (OBBs: ray by ray).
+// Every layout the packet reads (4 and 8 wide) and one it does not (OBBs: ray
+// by ray), packets of 8 and of 16.
 void expect_layouts_match(const TriMesh& mesh, const std::vector<Ray3f>& rays, const std::string& what) {
   for (int arity : {4, 8}) {
     BuildOptions options;
     options.arity = arity;
     const TriangleBvh bvh = TriangleBvh::build(mesh, options);
-    const std::size_t hits = expect_packets_match(bvh, rays, what + " arity " + std::to_string(arity),
-                                                  {0xff, 0x5a, 0x81, 0x01, 0xfe, 0x00});
+    const std::string name = what + " arity " + std::to_string(arity);
+    const std::size_t hits = expect_packets_match<8>(bvh, rays, name, {0xff, 0x5a, 0x81, 0x01, 0xfe, 0x00});
     EXPECT_GT(hits, rays.size() / 20) << what << ": the rays must hit something to compare";
+    expect_packets_match<16>(bvh, rays, name, {0xffff, 0x5aa5, 0x8001, 0x0001, 0xfffe, 0x0000, 0x00ff, 0xff00, 0x0700});
   }
   BuildOptions obb;
   obb.bv = BoundingVolume::obb;
-  expect_packets_match(TriangleBvh::build(mesh, obb), std::vector<Ray3f>(rays.begin(), rays.begin() + std::min<std::size_t>(rays.size(), 400)),
-                       what + " obb");
+  const TriangleBvh obb_bvh = TriangleBvh::build(mesh, obb);
+  const std::vector<Ray3f> some(rays.begin(), rays.begin() + std::min<std::size_t>(rays.size(), 400));
+  expect_packets_match<8>(obb_bvh, some, what + " obb");
+  expect_packets_match<16>(obb_bvh, some, what + " obb");
 }
 
-// Primary rays of a pinhole camera in 4 x 2 pixel tiles (coherent packets).
-std::vector<Ray3f> camera_rays(const AABB3f& box, Vec3f eye, int width, int height) {
+// Primary rays of a pinhole camera in 4 x tile_h pixel tiles (coherent packets).
+std::vector<Ray3f> camera_rays(const AABB3f& box, Vec3f eye, int width, int height, int tile_h = 2) {
   const Vec3f target = box.center();
   const Vec3f forward = (target - eye).normalized();
   const Vec3f right = forward.cross(Vec3f::UnitY()).normalized();
   const Vec3f up = right.cross(forward);
   std::vector<Ray3f> rays;
-  for (int ty = 0; ty < height; ty += 2)
+  for (int ty = 0; ty < height; ty += tile_h)
     for (int tx = 0; tx < width; tx += 4)
-      for (int y = ty; y < ty + 2; ++y)
+      for (int y = ty; y < ty + tile_h; ++y)
         for (int x = tx; x < tx + 4; ++x) {
           Ray3f r;
           r.origin = eye;
@@ -101,17 +107,25 @@ TEST(RayPacket, CoherentCameraRaysMatchTheSingleRayAndBruteForce) {
   const AABB3f box = bunny.bounds();
   const std::vector<Ray3f> rays = camera_rays(box, box.center() + 1.5f * box.extent(), 48, 32);
   expect_layouts_match(bunny, rays, "bunny camera");
+  // 4 x 4 tiles: the packets of 16 of rtcIntersect16.
+  const std::vector<Ray3f> tiles16 = camera_rays(box, box.center() + 1.5f * box.extent(), 48, 32, 4);
+  expect_layouts_match(bunny, tiles16, "bunny camera 4 x 4");
   BuildOptions options;
   options.arity = 8;
   const TriangleBvh bvh = TriangleBvh::build(bunny, options);
-  std::vector<RayHit> hits(rays.size());
+  std::vector<RayHit> hits(rays.size()), hits16(rays.size());
   bvh.intersect_packets(rays, hits);
-  std::vector<std::uint8_t> blocked(rays.size());
+  bvh.intersect_packets(tiles16, hits16, 16);
+  std::vector<std::uint8_t> blocked(rays.size()), blocked16(rays.size());
   bvh.occluded_packets(rays, blocked);
+  bvh.occluded_packets(tiles16, blocked16, 16);
   for (std::size_t i = 0; i < rays.size(); i += 7) {
     const RayHit brute = test::brute_intersect(bunny, rays[i]);
     EXPECT_EQ(hits[i].t, brute.t) << "ray " << i;
     EXPECT_EQ(bool(blocked[i]), brute.hit()) << "ray " << i;
+    const RayHit brute16 = test::brute_intersect(bunny, tiles16[i]);
+    EXPECT_EQ(hits16[i].t, brute16.t) << "4 x 4 ray " << i;
+    EXPECT_EQ(bool(blocked16[i]), brute16.hit()) << "4 x 4 ray " << i;
   }
   // Shadow rays from the hits towards a light (any hit), a short tmax too.
   std::vector<Ray3f> shadows;
@@ -124,7 +138,8 @@ TEST(RayPacket, CoherentCameraRaysMatchTheSingleRayAndBruteForce) {
     shadows.push_back(s);
   }
   ASSERT_GT(shadows.size(), rays.size() / 10);
-  expect_packets_match(bvh, shadows, "shadow rays");
+  expect_packets_match<8>(bvh, shadows, "shadow rays");
+  expect_packets_match<16>(bvh, shadows, "shadow rays");
 }
 
 TEST(RayPacket, RaysFromInsideBoxesAndAxisParallelRays) {
@@ -200,6 +215,8 @@ TEST(RayPacket, EveryLevelGivesThePortableSingleRayHits) {
   const TriMesh bunny = test::data_mesh("bunny.ply");
   const AABB3f box = bunny.bounds();
   std::vector<Ray3f> rays = camera_rays(box, box.center() + 1.5f * box.extent(), 32, 16);
+  const std::vector<Ray3f> tiles16 = camera_rays(box, box.center() + 1.5f * box.extent(), 32, 16, 4);
+  rays.insert(rays.end(), tiles16.begin(), tiles16.end());
   const std::vector<Ray3f> hard = test::test_rays(bunny, 512, 41);
   rays.insert(rays.end(), hard.begin(), hard.end());
   BuildOptions options;
@@ -212,13 +229,15 @@ TEST(RayPacket, EveryLevelGivesThePortableSingleRayHits) {
   for (SimdLevel level : {SimdLevel::portable, SimdLevel::avx, SimdLevel::avx2, SimdLevel::avx512}) {
     if (level > best_simd_level()) continue;
     set_simd_level(level);
-    std::vector<RayHit> hits(rays.size());
-    std::vector<std::uint8_t> occ(rays.size());
-    bvh.intersect_packets(rays, hits);
-    bvh.occluded_packets(rays, occ);
-    for (std::size_t i = 0; i < rays.size(); ++i) {
-      ASSERT_TRUE(same_bits(hits[i], expected[i])) << simd_level_name(level) << " ray " << i;
-      ASSERT_EQ(occ[i], blocked[i]) << simd_level_name(level) << " ray " << i;
+    for (int size : {8, 16}) {
+      std::vector<RayHit> hits(rays.size());
+      std::vector<std::uint8_t> occ(rays.size());
+      bvh.intersect_packets(rays, hits, size);
+      bvh.occluded_packets(rays, occ, size);
+      for (std::size_t i = 0; i < rays.size(); ++i) {
+        ASSERT_TRUE(same_bits(hits[i], expected[i])) << simd_level_name(level) << " packets of " << size << " ray " << i;
+        ASSERT_EQ(occ[i], blocked[i]) << simd_level_name(level) << " packets of " << size << " ray " << i;
+      }
     }
   }
 }
@@ -230,11 +249,19 @@ TEST(RayPacket, EmptyHierarchyAndSizeMismatch) {
   const HitPacket out = empty.intersect(packet);
   for (const RayHit& h : out.hits) EXPECT_FALSE(h.hit());
   EXPECT_EQ(empty.occluded(packet), 0u);
+  RayPacket16 packet16;
+  for (Ray3f& r : packet16.rays) r.direction = Vec3f(0, 0, 1);
+  for (const RayHit& h : empty.intersect(packet16).hits) EXPECT_FALSE(h.hit());
+  EXPECT_EQ(empty.occluded(packet16), 0u);
   std::vector<Ray3f> rays(10);
   std::vector<RayHit> hits(9);
   std::vector<std::uint8_t> occ(11);
   EXPECT_THROW(empty.intersect_packets(rays, hits), Error);
   EXPECT_THROW(empty.occluded_packets(rays, occ), Error);
+  std::vector<RayHit> ten(10);
+  std::vector<std::uint8_t> ten_occ(10);
+  EXPECT_THROW(empty.intersect_packets(rays, ten, 4), Error);
+  EXPECT_THROW(empty.occluded_packets(rays, ten_occ, 32), Error);
 }
 
 }  // namespace

@@ -637,8 +637,36 @@ TEST(AcceleratorArchive, InconsistentGridsAndOctreesAreRefused) {
 namespace geods::ray {
 namespace {
 
-// The packet queries of every kind give what one ray at a time gives (the BVH
-// traverses the packet together; the others loop), bad rays and partial masks included.
+// Packets of N consecutive rays against one ray at a time.
+template <int N>
+std::size_t expect_packets_answer_as_single_rays(const Accelerator& accel, AcceleratorKind kind,
+                                                 const std::vector<Ray3f>& rays) {
+  RayCache cache, shadow_cache;
+  std::size_t hits = 0;
+  for (std::size_t first = 0; first + N <= rays.size(); first += N) {
+    bvh::RayPacketN<N> packet;
+    for (int i = 0; i < N; ++i) packet.rays[i] = rays[first + std::size_t(i)];
+    packet.active = first % 3 == 0 ? (1u << N) - 1 : 0xb7b7u & ((1u << N) - 1);
+    const bvh::HitPacketN<N> out = accel.intersect(packet, cache);
+    const std::uint32_t blocked = accel.occluded(packet, shadow_cache);
+    for (int i = 0; i < N; ++i) {
+      const Ray3f& r = packet.rays[i];
+      const bool active = packet.active >> i & 1;
+      const RayHit single = active ? accel.intersect(r) : RayHit{};
+      EXPECT_EQ(std::memcmp(&out.hits[i].t, &single.t, sizeof(float)), 0)
+          << to_string(kind) << " packet of " << N << " ray " << first + i;
+      EXPECT_EQ(out.hits[i].prim, single.prim) << to_string(kind) << " packet of " << N << " ray " << first + i;
+      EXPECT_EQ(bool(blocked >> i & 1), active && accel.occluded(r))
+          << to_string(kind) << " packet of " << N << " ray " << first + i;
+      hits += single.hit();
+    }
+  }
+  return hits;
+}
+
+// The packet queries of every kind, of 8 and 16 rays, give what one ray at a
+// time gives (the BVH traverses the packet together; the others loop), bad
+// rays and partial masks included.
 TEST(Accelerators, PacketsAnswerAsSingleRays) {
   const TriMesh mesh = load("bunny.ply");
   std::vector<Ray3f> rays = test_rays(mesh, 17, 400);
@@ -647,25 +675,8 @@ TEST(Accelerators, PacketsAnswerAsSingleRays) {
   rays[21].tmin = 2, rays[21].tmax = 1;
   for (AcceleratorKind kind : all_accelerator_kinds()) {
     const auto accel = make_accelerator(mesh, kind);
-    RayCache cache, shadow_cache;
-    std::size_t hits = 0;
-    for (std::size_t first = 0; first + bvh::kPacketSize <= rays.size(); first += bvh::kPacketSize) {
-      bvh::RayPacket packet;
-      for (int i = 0; i < bvh::kPacketSize; ++i) packet.rays[i] = rays[first + std::size_t(i)];
-      packet.active = first % 3 == 0 ? 0xffu : 0xb7u;
-      const bvh::HitPacket out = accel->intersect(packet, cache);
-      const std::uint32_t blocked = accel->occluded(packet, shadow_cache);
-      for (int i = 0; i < bvh::kPacketSize; ++i) {
-        const Ray3f& r = packet.rays[i];
-        const bool active = packet.active >> i & 1;
-        const RayHit single = active ? accel->intersect(r) : RayHit{};
-        EXPECT_EQ(std::memcmp(&out.hits[i].t, &single.t, sizeof(float)), 0) << to_string(kind) << " ray " << first + i;
-        EXPECT_EQ(out.hits[i].prim, single.prim) << to_string(kind) << " ray " << first + i;
-        EXPECT_EQ(bool(blocked >> i & 1), active && accel->occluded(r)) << to_string(kind) << " ray " << first + i;
-        hits += single.hit();
-      }
-    }
-    EXPECT_GT(hits, rays.size() / 10) << to_string(kind);
+    EXPECT_GT(expect_packets_answer_as_single_rays<8>(*accel, kind, rays), rays.size() / 10) << to_string(kind);
+    EXPECT_GT(expect_packets_answer_as_single_rays<16>(*accel, kind, rays), rays.size() / 10) << to_string(kind);
   }
 }
 

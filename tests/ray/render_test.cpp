@@ -114,7 +114,7 @@ TEST(Render, ShadowsDarkenAndUseTheOccluderCache) {
 }
 
 TEST(Render, PacketsGiveTheSamePictureAsSingleRays) {
-  // Sizes that are not multiples of the 4 x 2 pixel packets; 4 and 8 wide
+  // Sizes that are not multiples of the 4 x 4 pixel packets; 4 and 8 wide
   // BVHs (packet traversal) and the octree (ray by ray behind the interface).
   const TriMesh mesh = bunny();
   RenderOptions options;

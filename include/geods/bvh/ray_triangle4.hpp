@@ -30,26 +30,33 @@ struct alignas(32) TriangleGroup {  // 160 bytes
 /// operations in its order, for any vector of lanes (the triangles of a group
 /// against one ray here, one triangle against the rays of a packet in
 /// ray_packet.cpp). `inside`: lanes hit unless t is out of range; `on_edge`:
-/// lanes for the scalar test's double-precision path.
-template <typename VF>
-struct ShearedEdges {
-  using VI = decltype(VF{} < VF{});
-  VF eu, ev, ew, det;
-  VI on_edge, inside;
+/// lanes for the scalar test's double-precision path. As vector masks, or as
+/// bit masks with a `bits` that turns each comparison into one (packets of
+/// 16: GCC scalarizes & and | of 16-lane comparisons inlined into AVX-512 code).
+struct SameMask {
+  template <typename M>
+  M operator()(M m) const {
+    return m;
+  }
 };
-template <typename VF>
-[[gnu::always_inline]] inline ShearedEdges<VF> sheared_edges(const VF (&px)[3], const VF (&py)[3]) {
-  ShearedEdges<VF> e;
+template <typename VF, typename Mask = decltype(VF{} < VF{})>
+struct ShearedEdges {
+  VF eu, ev, ew, det;
+  Mask on_edge, inside;
+};
+template <typename VF, typename Bits = SameMask>
+[[gnu::always_inline]] inline auto sheared_edges(const VF (&px)[3], const VF (&py)[3], Bits bits = {}) {
+  ShearedEdges<VF, decltype(bits(VF{} < VF{}))> e;
   e.eu = px[2] * py[1] - py[2] * px[1];
   e.ev = px[0] * py[2] - py[0] * px[2];
   e.ew = px[1] * py[0] - py[1] * px[0];
   const VF zero{};
-  e.on_edge = (e.eu == zero) | (e.ev == zero) | (e.ew == zero);
-  const auto mixed =
-      ((e.eu < zero) | (e.ev < zero) | (e.ew < zero)) & ((e.eu > zero) | (e.ev > zero) | (e.ew > zero));
+  e.on_edge = bits(e.eu == zero) | bits(e.ev == zero) | bits(e.ew == zero);
+  const auto mixed = (bits(e.eu < zero) | bits(e.ev < zero) | bits(e.ew < zero)) &
+                     (bits(e.eu > zero) | bits(e.ev > zero) | bits(e.ew > zero));
   e.det = e.eu + e.ev + e.ew;
   // det - det is 0 exactly for a finite det (NaN for inf and NaN).
-  e.inside = ~mixed & ~e.on_edge & (e.det != zero) & (e.det - e.det == zero);
+  e.inside = ~mixed & ~e.on_edge & bits(e.det != zero) & bits(e.det - e.det == zero);
   return e;
 }
 

@@ -109,17 +109,21 @@ class TriangleBvh {
   RayHit intersect(const Ray3f& ray) const;
   /// Whether any triangle is hit with t in [ray.tmin, ray.tmax].
   bool occluded(const Ray3f& ray) const;
-  /// Packets of up to kPacketSize rays traversed together (ray_packet.hpp;
+  /// Packets of up to 8 or 16 rays traversed together (ray_packet.hpp;
   /// src/bvh/ray_packet.cpp): hits[i] (bit i of occluded's mask) is exactly
   /// what intersect(rays[i]) (occluded(rays[i])) answers, for every active i.
   /// With AABBs and arity 4 or 8 (the wide layout), else one ray at a time.
   HitPacket intersect(const RayPacket& packet) const;
   std::uint32_t occluded(const RayPacket& packet) const;
-  /// Every ray, in packets of kPacketSize consecutive rays (give coherent
-  /// rays in neighbouring order: pixels of small tiles); hits.size() and
-  /// occluded.size() must be rays.size() (geods::Error otherwise).
-  void intersect_packets(std::span<const Ray3f> rays, std::span<RayHit> hits) const;
-  void occluded_packets(std::span<const Ray3f> rays, std::span<std::uint8_t> occluded) const;
+  HitPacket16 intersect(const RayPacket16& packet) const;
+  std::uint32_t occluded(const RayPacket16& packet) const;
+  /// Every ray, in packets of packet_size (8 or 16) consecutive rays (give
+  /// coherent rays in neighbouring order: pixels of 4 x 2 or 4 x 4 tiles);
+  /// hits.size() and occluded.size() must be rays.size(), packet_size 8 or
+  /// 16 (geods::Error otherwise).
+  void intersect_packets(std::span<const Ray3f> rays, std::span<RayHit> hits, int packet_size = kPacketSize) const;
+  void occluded_packets(std::span<const Ray3f> rays, std::span<std::uint8_t> occluded,
+                        int packet_size = kPacketSize) const;
   /// Closest point of the mesh to p, if closer than max_distance.
   ClosestPoint closest_point(const Vec3f& p, float max_distance = std::numeric_limits<float>::infinity()) const;
   /// Whether p is inside the mesh, which should be closed. Parity of the

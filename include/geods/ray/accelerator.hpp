@@ -107,13 +107,16 @@ class Accelerator {
   /// triangle that blocked the previous ray is tried first (the occluder cache).
   bool occluded(const Ray3f& ray) const;
   bool occluded(const Ray3f& ray, RayCache& cache) const;
-  /// Up to 8 rays at once (bvh::RayPacket, bit i of `active`: rays[i] is
-  /// shot): hits[i] is what intersect(rays[i], cache) answers (no hit for the
-  /// inactive rays), bit i of the mask what occluded(rays[i], cache) answers.
-  /// The BVH traverses the packet's rays together (bvh/ray_packet.hpp); the
-  /// other kinds shoot them one by one in lane order.
+  /// Up to 8 or 16 rays at once (bvh::RayPacket, bvh::RayPacket16; bit i of
+  /// `active`: rays[i] is shot): hits[i] is what intersect(rays[i], cache)
+  /// answers (no hit for the inactive rays), bit i of the mask what
+  /// occluded(rays[i], cache) answers. The BVH traverses the packet's rays
+  /// together (bvh/ray_packet.hpp); the other kinds shoot them one by one in
+  /// lane order.
   bvh::HitPacket intersect(const bvh::RayPacket& packet, RayCache& cache) const;
   std::uint32_t occluded(const bvh::RayPacket& packet, RayCache& cache) const;
+  bvh::HitPacket16 intersect(const bvh::RayPacket16& packet, RayCache& cache) const;
+  std::uint32_t occluded(const bvh::RayPacket16& packet, RayCache& cache) const;
 
   /// Writes the accelerator to `path` (an archive of kind "ray.<Class>");
   /// throws geods::Error naming the file if it cannot be written.
@@ -146,6 +149,8 @@ class Accelerator {
   /// The packet queries on shootable rays (default: ray by ray with the cache).
   virtual bvh::HitPacket closest_hits(const bvh::RayPacket& packet, RayCache& cache) const;
   virtual std::uint32_t any_hits(const bvh::RayPacket& packet, RayCache& cache) const;
+  virtual bvh::HitPacket16 closest_hits(const bvh::RayPacket16& packet, RayCache& cache) const;
+  virtual std::uint32_t any_hits(const bvh::RayPacket16& packet, RayCache& cache) const;
 
   /// Tests triangle `prim` and keeps it in `best` if it is closer (ties: smaller index).
   bool test_closest(const RayTriangleTest<float>& test, std::uint32_t prim, float tmin, RayHit& best) const {
@@ -174,6 +179,15 @@ class Accelerator {
 
  private:
   void set_bounds();
+  // The packet queries of either size (accelerator.cpp).
+  template <int N>
+  bvh::HitPacketN<N> intersect_packet(const bvh::RayPacketN<N>& packet, RayCache& cache) const;
+  template <int N>
+  std::uint32_t occluded_packet(const bvh::RayPacketN<N>& packet, RayCache& cache) const;
+  template <int N>
+  bvh::HitPacketN<N> closest_hits_one_by_one(const bvh::RayPacketN<N>& packet, RayCache& cache) const;
+  template <int N>
+  std::uint32_t any_hits_one_by_one(const bvh::RayPacketN<N>& packet, RayCache& cache) const;
 
   std::uint64_t id_;
 };

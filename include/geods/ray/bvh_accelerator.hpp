@@ -33,6 +33,8 @@ class BvhAccelerator final : public Accelerator {
   /// does not say which triangle blocks a ray).
   bvh::HitPacket closest_hits(const bvh::RayPacket& packet, RayCache& cache) const override;
   std::uint32_t any_hits(const bvh::RayPacket& packet, RayCache& cache) const override;
+  bvh::HitPacket16 closest_hits(const bvh::RayPacket16& packet, RayCache& cache) const override;
+  std::uint32_t any_hits(const bvh::RayPacket16& packet, RayCache& cache) const override;
 
  private:
   explicit BvhAccelerator(const TriMesh& mesh) : Accelerator(mesh) {}

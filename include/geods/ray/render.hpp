@@ -2,7 +2,7 @@
 // A small ray tracer over any accelerator: one primary ray per pixel, Lambert
 // shading (two-sided) with one directional light above and to the left of the
 // camera, optional hard shadows by any-hit rays that use the occluder cache.
-// Parallel over 16 x 16 tiles, rays in packets of 4 x 2 pixels; the image
+// Parallel over 16 x 16 tiles, rays in packets of 4 x 4 pixels; the image
 // does not depend on the thread count or on the packets.
 #include <cstdint>
 #include <optional>
@@ -19,7 +19,7 @@ struct RenderOptions {
   int width = 512, height = 512;
   std::optional<Camera> camera;  // default: Camera::framing(mesh bounds)
   bool shadows = false;
-  /// Primary and shadow rays in packets of 4 x 2 pixels (Accelerator's packet
+  /// Primary and shadow rays in packets of 4 x 4 pixels (Accelerator's packet
   /// queries; the BVH traverses them together). The image is the same either way.
   bool packets = true;
   AcceleratorKind accel = AcceleratorKind::bvh;
