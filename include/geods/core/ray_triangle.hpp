@@ -43,8 +43,7 @@ class RayTriangleTest {
     const T a0 = std::abs(d[0]), a1 = std::abs(d[1]);
     const int y_over_x = int(a1 > a0);
     kz_ = y_over_x + int(std::abs(d[2]) > std::max(a0, a1)) * (2 - y_over_x);  // max: a1 if a1 > a0, else a0
-    constexpr int kNext[3] = {1, 2, 0};
-    const int next = kNext[kz_], after = kNext[next];
+    const int next = kz_ + 1 - 3 * int(kz_ == 2), after = 3 - kz_ - next;
     const int swap = -int(d[kz_] < T(0));
     kx_ = next ^ ((next ^ after) & swap);
     ky_ = after ^ ((next ^ after) & swap);
