@@ -5,6 +5,7 @@
 // evaluated in the same way for every triangle that shares an edge, so a ray
 // through a shared edge or vertex of a closed mesh hits at least one of the
 // triangles around it: it never slips through a crack.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -34,14 +35,18 @@ class RayTriangleTest {
  public:
   explicit RayTriangleTest(const Ray<T>& ray) : origin_(ray.origin) {
     const Vec<T, 3>& d = ray.direction;
-    kz_ = 0;
-    if (std::abs(d[1]) > std::abs(d[kz_])) kz_ = 1;
-    if (std::abs(d[2]) > std::abs(d[kz_])) kz_ = 2;
-    kx_ = (kz_ + 1) % 3;
-    ky_ = (kx_ + 1) % 3;
-    // Swapping x and y for a negative z keeps the winding, so the sign of the
-    // edge functions does not depend on the ray's direction.
-    if (d[kz_] < T(0)) std::swap(kx_, ky_);
+    // kz: the largest |d| component, the first of equals; kx, ky the next two,
+    // swapped for a negative z (which keeps the winding, so the sign of the
+    // edge functions does not depend on the ray's direction). Computed without
+    // branches (GCC keeps them for ?: here): on random directions they
+    // mispredict, a per-ray cost of incoherent rays.
+    const T a0 = std::abs(d[0]), a1 = std::abs(d[1]);
+    const int y_over_x = int(a1 > a0);
+    kz_ = y_over_x + int(std::abs(d[2]) > std::max(a0, a1)) * (2 - y_over_x);  // max: a1 if a1 > a0, else a0
+    const int next = kz_ + 1 - 3 * int(kz_ == 2), after = 3 - kz_ - next;
+    const int swap = -int(d[kz_] < T(0));
+    kx_ = next ^ ((next ^ after) & swap);
+    ky_ = after ^ ((next ^ after) & swap);
     shear_x_ = d[kx_] / d[kz_];
     shear_y_ = d[ky_] / d[kz_];
     shear_z_ = T(1) / d[kz_];
