@@ -12,6 +12,7 @@
 #include <limits>
 #include <string>
 
+#include "geods/core/default_init_allocator.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/huge_page_allocator.hpp"
 #include "geods/core/morton.hpp"
@@ -874,9 +875,13 @@ Terrain::Terrain(HeightField field, TerrainOptions options) {
   // final triangle straddles the field's border. Level by level, every
   // triangle's rows as spans known by arithmetic (no point-in-triangle tests).
   // The errors and the radii (below) in one array: one allocation of fresh memory.
-  std::vector<float, HugePageAllocator<float>> err_rad(2 * n * n, 0.0f);
+  // own_errors() writes every error but the roots' (the corners, the centre);
+  // the radii of the leaves (and corners) stay 0.
+  std::vector<float, DefaultInitAllocator<HugePageAllocator<float>>> err_rad(2 * n * n);
   float* err = err_rad.data();
   float* rad = err + n * n;
+  std::fill(rad, rad + n * n, 0.0f);
+  for (const std::uint64_t g : {std::uint64_t(0), n - 1, n * n - n, n * n - 1, n * n / 2}) err[g] = 0;
   own_errors(z, std::int64_t(n), W, H, K, err);
 
   // Nesting, finest level first: error = max(own, children's); radius = max over
