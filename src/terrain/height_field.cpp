@@ -185,9 +185,16 @@ std::size_t check_height_field(const HeightField& f) {
   for (const double o : f.origin)
     if (!std::isfinite(o)) throw Error("height field: origin " + format_number(o) + " is not finite");
   std::size_t valid = 0, infinite = 0;
-  for (const float z : f.heights) {  // no early exit: the loop vectorizes
-    infinite += std::isinf(z);
-    valid += !std::isnan(z);
+  // No early exit, and 32-bit counts per block: the loop vectorizes four samples an instruction.
+  constexpr std::size_t kBlock = std::size_t(1) << 30;
+  for (std::size_t b = 0; b < f.heights.size(); b += kBlock) {
+    const std::size_t e = std::min(f.heights.size(), b + kBlock);
+    std::uint32_t inf = 0, nan = 0;
+    for (std::size_t i = b; i < e; ++i) {
+      inf += std::isinf(f.heights[i]);
+      nan += std::isnan(f.heights[i]);
+    }
+    infinite += inf, valid += e - b - nan;
   }
   if (infinite) throw Error("height field: an infinite sample");
   if (valid == 0) throw Error("height field: every sample is missing (NaN or no-data)");

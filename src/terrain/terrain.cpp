@@ -12,6 +12,7 @@
 #include <limits>
 #include <string>
 
+#include "geods/core/default_init_allocator.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/huge_page_allocator.hpp"
 #include "geods/core/morton.hpp"
@@ -37,6 +38,29 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
+#if defined(__x86_64__) && defined(__GNUC__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wuninitialized"
+#if !defined(__clang__)
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
+// rows_error<0>() with AVX-512: every row by row_max8(), short ones too (one
+// masked block), the rows' terms kept in two vectors and reduced once per
+// triangle instead of once per row.
+__attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) double rows_error_avx512(const float* z, std::int64_t n, const detail::Plane& p,
+                                                                                P2 a, std::int64_t r0, std::int64_t rows,
+                                                                                std::int64_t lo0, std::int64_t dlo, std::int64_t hi0,
+                                                                                std::int64_t dhi) {
+  __m512d m0 = _mm512_setzero_pd(), m1 = _mm512_setzero_pd();
+  for (std::int64_t r = 0; r < rows; ++r) {
+    const std::int64_t dy = r0 + r;
+    detail::row_max8(z + (a.y + dy) * n, a.x + lo0 + dlo * r, a.x + hi0 + dhi * r, p.base(dy), p.gx, a.x, m0, m1);
+  }
+  return _mm512_reduce_max_pd(_mm512_max_pd(m0, m1));
+}
+#pragma GCC diagnostic pop
+#endif
+
 // The largest |z - plane| over the samples of a triangle whose corner a is the
 // plane's origin: rows a.y + r0 + r for r in [0, rows), row r covering
 // x in [a.x + lo0 + dlo r, a.x + hi0 + dhi r]. Every term rounded as
@@ -49,6 +73,7 @@ template <int S>
 #if defined(__x86_64__) && defined(__GNUC__)
   const bool avx2 = S == 0 && simd_level() >= SimdLevel::avx2;  // long rows only
   const bool avx512 = avx2 && simd_level() >= SimdLevel::avx512;
+  if (avx512) return rows_error_avx512(z, n, p, a, r0, rows, lo0, dlo, hi0, dhi);
 #endif
 #if defined(__SSE2__)
   __m128d m2 = _mm_setzero_pd();
@@ -77,8 +102,7 @@ template <int S>
       const std::int64_t lo = a.x + lo0 + dlo * r, hi = a.x + hi0 + dhi * r;
 #if defined(__x86_64__) && defined(__GNUC__)
       if (hi - lo >= 7 && avx2) {
-        m = std::max(m, avx512 ? detail::row_max_avx512(row, lo, hi, p.base(dy), p.gx, a.x)
-                               : detail::row_max_avx2(row, lo, hi, p.base(dy), p.gx, a.x));
+        m = std::max(m, detail::row_max_avx2(row, lo, hi, p.base(dy), p.gx, a.x));
         continue;
       }
 #endif
@@ -688,6 +712,45 @@ void own_errors(const float* z, std::int64_t n, std::int64_t W, std::int64_t H, 
   }
 }
 
+// The matrix layout's records (slot = sample index) from the heights, errors
+// and radii: four records by three 16-byte stores at a time (a third faster
+// than assigning them one by one).
+void fill_matrix(VertexRecord* records, const float* z, const float* err, const float* rad, std::size_t count) {
+  static_assert(sizeof(VertexRecord) == 3 * sizeof(float));
+  std::size_t done = 0;
+#if defined(__SSE2__)
+  done = count / 4 * 4;
+  parallel_for(0, count / 4, 8192, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) {
+      const __m128 h = _mm_loadu_ps(z + 4 * i), r = _mm_loadu_ps(err + 4 * i), d = _mm_loadu_ps(rad + 4 * i);
+      const __m128 lo = _mm_unpacklo_ps(h, r), hi = _mm_unpackhi_ps(h, r);  // z0 e0 z1 e1, z2 e2 z3 e3
+      float* out = reinterpret_cast<float*>(records + 4 * i);
+      _mm_storeu_ps(out, _mm_shuffle_ps(lo, _mm_shuffle_ps(d, h, _MM_SHUFFLE(1, 1, 0, 0)), _MM_SHUFFLE(2, 0, 1, 0)));  // z0 e0 r0 z1
+      _mm_storeu_ps(out + 4, _mm_shuffle_ps(_mm_unpacklo_ps(r, d), hi, _MM_SHUFFLE(1, 0, 3, 2)));                     // e1 r1 z2 e2
+      _mm_storeu_ps(out + 8, _mm_shuffle_ps(_mm_shuffle_ps(d, hi, _MM_SHUFFLE(2, 2, 2, 2)), _mm_shuffle_ps(hi, d, _MM_SHUFFLE(3, 3, 3, 3)),
+                                            _MM_SHUFFLE(2, 0, 2, 0)));  // r2 z3 e3 r3
+    }
+  });
+#endif
+  for (std::size_t g = done; g < count; ++g) records[g] = {z[g], err[g], rad[g]};
+}
+
+// The records' allocator: huge pages, the records left unwritten when the vector
+// is sized (VertexRecord is an aggregate of floats, an implicit-lifetime type,
+// which the fill then assigns).
+template <class T>
+struct FilledOnce : HugePageAllocator<T> {
+  template <class U>
+  struct rebind {
+    using other = FilledOnce<U>;
+  };
+  FilledOnce() = default;
+  template <class U>
+  FilledOnce(const FilledOnce<U>&) noexcept {}  // NOLINT(google-explicit-constructor)
+  template <class U>
+  void construct(U*) noexcept {}
+};
+
 // The quarter turns R^-1 that take (dx, dy) (a red vertex relative to the
 // centre) into the bottom quarter Q0 of interleaved_slot(); dx, dy turned.
 int red_turns(std::int64_t& dx, std::int64_t& dy) {
@@ -858,9 +921,13 @@ Terrain::Terrain(HeightField field, TerrainOptions options) {
   // final triangle straddles the field's border. Level by level, every
   // triangle's rows as spans known by arithmetic (no point-in-triangle tests).
   // The errors and the radii (below) in one array: one allocation of fresh memory.
-  std::vector<float, HugePageAllocator<float>> err_rad(2 * n * n, 0.0f);
+  // own_errors() writes every error but the roots' (the corners, the centre);
+  // the radii of the leaves (and corners) stay 0.
+  std::vector<float, DefaultInitAllocator<HugePageAllocator<float>>> err_rad(2 * n * n);
   float* err = err_rad.data();
   float* rad = err + n * n;
+  std::fill(rad, rad + n * n, 0.0f);
+  for (const std::uint64_t g : {std::uint64_t(0), n - 1, n * n - n, n * n - 1, n * n / 2}) err[g] = 0;
   own_errors(z, std::int64_t(n), W, H, K, err);
 
   // Nesting, finest level first: error = max(own, children's); radius = max over
@@ -972,11 +1039,16 @@ Terrain::Terrain(HeightField field, TerrainOptions options) {
   }
 
   // Huge pages: 4 KiB pages cost a fault each (about 4 300 for 1025², 25-30 ms of CPU in this VM, more than the errors).
-  std::vector<VertexRecord, HugePageAllocator<VertexRecord>> records(index_.slots());
-  for_each_slot(index_, [&](std::uint64_t slot, std::int64_t x, std::int64_t y) {
-    const std::uint64_t g = std::uint64_t(y) * n + std::uint64_t(x);
-    records[slot] = {z[g], err[g], rad[g]};
-  });
+  // Not zeroed where the fill writes every slot (the matrix layout): the 12.6 MB of 1025² are written once.
+  std::vector<VertexRecord, FilledOnce<VertexRecord>> records(index_.slots());
+  if (index_.layout() != Layout::matrix) std::fill(records.begin(), records.end(), VertexRecord{});  // ghost slots
+  if (index_.layout() == Layout::matrix)
+    fill_matrix(records.data(), z, err, rad, n * n);
+  else
+    for_each_slot(index_, [&](std::uint64_t slot, std::int64_t x, std::int64_t y) {
+      const std::uint64_t g = std::uint64_t(y) * n + std::uint64_t(x);
+      records[slot] = {z[g], err[g], rad[g]};
+    });
   records_ = FlatArray<VertexRecord>(std::move(records));
   build_s_ = seconds_since(t0);
 }

@@ -102,19 +102,14 @@ __attribute__((target("avx2"))) inline double row_max_avx2(const float* row, std
 }
 
 // row_max_avx2() eight doubles at a time, the last samples as one masked
-// block (masked loads do not fault), for rows of at least 8 samples, when
-// simd_level() is avx512: the same terms and maxima lane by lane. (GCC 12
-// warns about the undefined pass-through operand inside _mm512_reduce_max_pd.)
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wuninitialized"
-#if !defined(__clang__)
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#endif
-__attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) inline double row_max_avx512(const float* row, std::int64_t lo, std::int64_t hi,
-                                                                              double base, double gx, std::int64_t ax) {
+// block (masked loads do not fault), when simd_level() is avx512: the same
+// terms lane by lane, taken into the lanes of m0 and m1 (rows of any length,
+// none where lo > hi) so that the rows of a triangle are reduced once.
+__attribute__((target("avx512f,avx512vl,avx512dq,avx2"), always_inline)) inline void row_max8(const float* row, std::int64_t lo,
+                                                                                            std::int64_t hi, double base, double gx,
+                                                                                            std::int64_t ax, __m512d& m0, __m512d& m1) {
   const __m512d vg = _mm512_set1_pd(gx), vb = _mm512_set1_pd(base), eight = _mm512_set1_pd(8.0);
   __m512d x0 = _mm512_add_pd(_mm512_set1_pd(double(lo - ax)), _mm512_set_pd(7, 6, 5, 4, 3, 2, 1, 0));
-  __m512d m0 = _mm512_setzero_pd(), m1 = _mm512_setzero_pd();
   std::int64_t i = lo;
   for (; i + 15 <= hi; i += 16) {
     const __m512d x1 = _mm512_add_pd(x0, eight);
@@ -129,9 +124,7 @@ __attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) inline double row_max_
     m1 = _mm512_mask_max_pd(m1, k, _mm512_abs_pd(_mm512_sub_pd(z0, _mm512_add_pd(vb, _mm512_mul_pd(vg, x0)))), m1);
     x0 = _mm512_add_pd(x0, eight);
   }
-  return _mm512_reduce_max_pd(_mm512_max_pd(m0, m1));
 }
-#pragma GCC diagnostic pop
 #endif
 
 // A grid triangle (a, b, c): its plane and the samples of each of its rows.
