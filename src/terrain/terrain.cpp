@@ -735,22 +735,6 @@ void fill_matrix(VertexRecord* records, const float* z, const float* err, const 
   for (std::size_t g = done; g < count; ++g) records[g] = {z[g], err[g], rad[g]};
 }
 
-// The records' allocator: huge pages, the records left unwritten when the vector
-// is sized (VertexRecord is an aggregate of floats, an implicit-lifetime type,
-// which the fill then assigns).
-template <class T>
-struct FilledOnce : HugePageAllocator<T> {
-  template <class U>
-  struct rebind {
-    using other = FilledOnce<U>;
-  };
-  FilledOnce() = default;
-  template <class U>
-  FilledOnce(const FilledOnce<U>&) noexcept {}  // NOLINT(google-explicit-constructor)
-  template <class U>
-  void construct(U*) noexcept {}
-};
-
 // The quarter turns R^-1 that take (dx, dy) (a red vertex relative to the
 // centre) into the bottom quarter Q0 of interleaved_slot(); dx, dy turned.
 int red_turns(std::int64_t& dx, std::int64_t& dy) {
@@ -1040,7 +1024,7 @@ Terrain::Terrain(HeightField field, TerrainOptions options) {
 
   // Huge pages: 4 KiB pages cost a fault each (about 4 300 for 1025², 25-30 ms of CPU in this VM, more than the errors).
   // Not zeroed where the fill writes every slot (the matrix layout): the 12.6 MB of 1025² are written once.
-  std::vector<VertexRecord, FilledOnce<VertexRecord>> records(index_.slots());
+  std::vector<VertexRecord, DefaultInitAllocator<HugePageAllocator<VertexRecord>>> records(index_.slots());
   if (index_.layout() != Layout::matrix) std::fill(records.begin(), records.end(), VertexRecord{});  // ghost slots
   if (index_.layout() == Layout::matrix)
     fill_matrix(records.data(), z, err, rad, n * n);

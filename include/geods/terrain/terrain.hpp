@@ -39,8 +39,10 @@ enum class Layout : std::uint32_t {
 };
 
 /// One vertex: its height (times z_scale), nested error, nested bounding-sphere radius.
+/// A plain aggregate (VertexRecord{} is all zero): the build leaves the records
+/// of a layout without unused slots unwritten until its fill assigns them.
 struct VertexRecord {
-  float z = 0, error = 0, radius = 0;
+  float z, error, radius;
 };
 
 /// The slot arithmetic of a layout for a grid of n = 2^levels + 1 samples per side.
