@@ -144,8 +144,8 @@ class Bvh:
     def intersect(self, origins: ArrayLike, directions: ArrayLike, tmax: ArrayLike = ...) -> tuple[Any, ...]:
         """Closest hits of rays origins, directions float32 (n, 3): (t float32 (n,), prim int64 (n,), u, v float32 (n,)); t = inf and prim = -1 on a miss. Rays in parallel.
         """
-    def intersect_packets(self, origins: ArrayLike, directions: ArrayLike, tmax: ArrayLike = ...) -> tuple[Any, ...]:
-        """intersect() with the rays in packets of 8 consecutive rays traversed together (give coherent rays, e.g. the pixels of 4 x 2 tiles, next to each other): the same hits, bit for bit. origins, directions float32 (n, 3) -> (t float32 (n,), prim int64 (n,), u, v float32 (n,)).
+    def intersect_packets(self, origins: ArrayLike, directions: ArrayLike, tmax: ArrayLike = ..., packet_size: int = ...) -> tuple[Any, ...]:
+        """intersect() with the rays in packets of packet_size (8 or 16) consecutive rays traversed together (give coherent rays, e.g. the pixels of 4 x 2 or 4 x 4 tiles, next to each other): the same hits, bit for bit. origins, directions float32 (n, 3) -> (t float32 (n,), prim int64 (n,), u, v float32 (n,)).
         """
     @staticmethod
     def load(path: str | os.PathLike[str]) -> TriangleBvh:
@@ -154,8 +154,8 @@ class Bvh:
     def occluded(self, origins: ArrayLike, directions: ArrayLike, tmax: ArrayLike = ...) -> NDArray[numpy.bool_]:
         """Whether each ray (origins, directions float32 (n, 3)) hits anything with t in [0, tmax]: bool (n,).
         """
-    def occluded_packets(self, origins: ArrayLike, directions: ArrayLike, tmax: ArrayLike = ...) -> NDArray[numpy.bool_]:
-        """occluded() with the rays in packets of 8 consecutive rays: origins, directions float32 (n, 3) -> bool (n,).
+    def occluded_packets(self, origins: ArrayLike, directions: ArrayLike, tmax: ArrayLike = ..., packet_size: int = ...) -> NDArray[numpy.bool_]:
+        """occluded() with the rays in packets of packet_size (8 or 16) consecutive rays: origins, directions float32 (n, 3) -> bool (n,).
         """
     def save(self, path: str | os.PathLike[str]) -> None:
         """Writes the hierarchy with its triangles to a binary file.
@@ -985,8 +985,8 @@ class TriangleBvh:
     def intersect(self, origins: ArrayLike, directions: ArrayLike, tmax: ArrayLike = ...) -> tuple[Any, ...]:
         """Closest hits of rays origins, directions float32 (n, 3): (t float32 (n,), prim int64 (n,), u, v float32 (n,)); t = inf and prim = -1 on a miss. Rays in parallel.
         """
-    def intersect_packets(self, origins: ArrayLike, directions: ArrayLike, tmax: ArrayLike = ...) -> tuple[Any, ...]:
-        """intersect() with the rays in packets of 8 consecutive rays traversed together (give coherent rays, e.g. the pixels of 4 x 2 tiles, next to each other): the same hits, bit for bit. origins, directions float32 (n, 3) -> (t float32 (n,), prim int64 (n,), u, v float32 (n,)).
+    def intersect_packets(self, origins: ArrayLike, directions: ArrayLike, tmax: ArrayLike = ..., packet_size: int = ...) -> tuple[Any, ...]:
+        """intersect() with the rays in packets of packet_size (8 or 16) consecutive rays traversed together (give coherent rays, e.g. the pixels of 4 x 2 or 4 x 4 tiles, next to each other): the same hits, bit for bit. origins, directions float32 (n, 3) -> (t float32 (n,), prim int64 (n,), u, v float32 (n,)).
         """
     @staticmethod
     def load(path: str | os.PathLike[str]) -> TriangleBvh:
@@ -995,8 +995,8 @@ class TriangleBvh:
     def occluded(self, origins: ArrayLike, directions: ArrayLike, tmax: ArrayLike = ...) -> NDArray[numpy.bool_]:
         """Whether each ray (origins, directions float32 (n, 3)) hits anything with t in [0, tmax]: bool (n,).
         """
-    def occluded_packets(self, origins: ArrayLike, directions: ArrayLike, tmax: ArrayLike = ...) -> NDArray[numpy.bool_]:
-        """occluded() with the rays in packets of 8 consecutive rays: origins, directions float32 (n, 3) -> bool (n,).
+    def occluded_packets(self, origins: ArrayLike, directions: ArrayLike, tmax: ArrayLike = ..., packet_size: int = ...) -> NDArray[numpy.bool_]:
+        """occluded() with the rays in packets of packet_size (8 or 16) consecutive rays: origins, directions float32 (n, 3) -> bool (n,).
         """
     def save(self, path: str | os.PathLike[str]) -> None:
         """Writes the hierarchy with its triangles to a binary file.
@@ -1349,7 +1349,7 @@ def read_volume(path: str | os.PathLike[str], with_meta: bool = ...) -> Any:
     """
 
 def render(V: ArrayLike, F: ArrayLike, width: int = ..., height: int = ..., camera: Sequence[float] | None = ..., accel: str = ..., shadows: bool = ..., packets: bool = ...) -> NDArray[numpy.uint8]:
-    """Ray-traces the mesh (Lambert shading, optional hard shadows) into an (height, width, 3) uint8 image. camera: (ex, ey, ez, tx, ty, tz, ux, uy, uz[, fov]); default a three-quarter view. packets: rays in packets of 4 x 2 pixels (the same image as packets=False, one ray at a time).
+    """Ray-traces the mesh (Lambert shading, optional hard shadows) into an (height, width, 3) uint8 image. camera: (ex, ey, ez, tx, ty, tz, ux, uy, uz[, fov]); default a three-quarter view. packets: rays in packets of 4 x 4 pixels (the same image as packets=False, one ray at a time).
     """
 
 def sdf_grid(V: ArrayLike, F: ArrayLike, res: Any = ..., spacing: Any = ..., padding: float = ..., band: Any = ..., sign: str = ..., origin: Any = ..., dims: Any = ..., return_faces: bool = ..., method: str = ...) -> tuple[Any, ...]:
