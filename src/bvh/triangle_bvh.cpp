@@ -480,22 +480,18 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray, 
   vf tmin_v;
   splat(tmin_v, tmin);
   TraversalStack<WideEntry> stack(traversal_stack_size(depth_, W));
-  // Start fetching what a child needs (the cache misses on nodes and
-  // triangles dominate incoherent rays): the same 6 lines from its first one
-  // whether it is a node (4 lines, 8 wide; the lines after it are often a
-  // sibling's) or a leaf (up to 2 groups of 160 bytes, which straddle lines:
-  // up to 6 lines, leaf size 8), without a branch on which it is (a branch that
-  // mispredicts on incoherent rays).
-  const char* const node_base = reinterpret_cast<const char*>(nodes.data());
-  const char* const group_base = reinterpret_cast<const char*>(groups_.data());
+  // Start fetching what a child needs, every cache line of it (a node: 2 or
+  // 4 lines; a leaf: its groups of 160 bytes, which straddle lines); the cache
+  // misses on nodes and triangles dominate incoherent rays.
   auto prefetch = [&](const WideEntry& e) GEODS_BVH_INLINE_LAMBDA {
-    // All ones for a leaf (selects by masks: GCC would branch on ?: here).
-    const std::uintptr_t leaf_child = -std::uintptr_t(e.count != 0);
-    const std::uintptr_t nb = reinterpret_cast<std::uintptr_t>(node_base);
-    const std::uintptr_t base = nb ^ ((nb ^ reinterpret_cast<std::uintptr_t>(group_base)) & leaf_child);
-    const std::uintptr_t size = sizeof(WideNode<W>) ^ ((sizeof(WideNode<W>) ^ sizeof(TriangleGroup)) & leaf_child);
-    const std::uintptr_t first = (base + e.child * size) & ~std::uintptr_t(63);
-    for (std::uintptr_t k = 0; k < 6; ++k) __builtin_prefetch(reinterpret_cast<const void*>(first + 64 * k));
+    if (e.count == 0) {
+      const char* p = reinterpret_cast<const char*>(&nodes[e.child]);
+      for (std::size_t k = 0; k < sizeof(WideNode<W>); k += 64) __builtin_prefetch(p + k);
+      return;
+    }
+    const std::uintptr_t first = reinterpret_cast<std::uintptr_t>(&groups_[e.child]) & ~std::uintptr_t(63);
+    const std::uintptr_t last = reinterpret_cast<std::uintptr_t>(&groups_[e.child] + e.count) - 1;
+    for (std::uintptr_t p = first; p <= last; p += 64) __builtin_prefetch(reinterpret_cast<const void*>(p));
   };
   // Without a NaN among the slab distances (a finite origin, finite nonzero
   // inverse directions, tmin and tmax not NaN) the four-way max and min are
