@@ -6,7 +6,6 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
-#include <type_traits>
 
 #include "command.hpp"
 #include "geods/core/error.hpp"
@@ -85,22 +84,12 @@ class BvhCommand : public Command {
         ray.direction = Vec3f(float(r[3]), float(r[4]), float(r[5]));
         return ray;
       };
-      // Packets of N rays, packets in parallel.
-      const auto shoot_packets = [&]<int N>(std::integral_constant<int, N>) {
-        parallel_for_each_index(0, (rays.rows + N - 1) / N, [&](std::size_t p) {
-          bvh::RayPacketN<N> packet;
-          const std::size_t first = p * N;
-          const std::size_t n = std::min<std::size_t>(N, rays.rows - first);
-          for (std::size_t i = 0; i < n; ++i) packet.rays[i] = ray_at(first + i);
-          packet.active = (1u << n) - 1;
-          const bvh::HitPacketN<N> h = bvh.intersect(packet);
-          for (std::size_t i = 0; i < n; ++i) put(first + i, h.hits[i]);
-        }, 32);
-      };
-      if (packet_size_ == 16) {
-        shoot_packets(std::integral_constant<int, 16>{});
-      } else if (packet_size_ == 8) {
-        shoot_packets(std::integral_constant<int, 8>{});
+      if (packet_size_ != 0) {
+        std::vector<Ray3f> all(rays.rows);
+        std::vector<RayHit> found(rays.rows);
+        parallel_for_each_index(0, rays.rows, [&](std::size_t i) { all[i] = ray_at(i); });
+        bvh.intersect_packets(all, found, packet_size_);
+        for (std::size_t i = 0; i < rays.rows; ++i) put(i, found[i]);
       } else {
         parallel_for_each_index(0, rays.rows, [&](std::size_t i) { put(i, bvh.intersect(ray_at(i))); }, 256);
       }

@@ -70,21 +70,16 @@ class PyBvh {
     return out;
   }
 
-  // Packets of packet_size (8 or 16) consecutive rays (TriangleBvh::intersect_packets), packets in parallel.
+  // TriangleBvh::intersect_packets (packets of packet_size consecutive rays, in parallel).
   py::tuple intersect_packets(const Rows<float>& origins, const Rows<float>& directions, const Rows<float>& tmax,
                               int packet_size) const {
     const std::vector<Ray3f> r = rays_from_arrays(origins, directions, tmax, "TriangleBvh.intersect_packets");
-    if (packet_size != 8 && packet_size != 16) throw Error("TriangleBvh.intersect_packets: packet_size must be 8 or 16");
     HitArrays hits(r.size());
     {
       py::gil_scoped_release release;
-      const std::size_t size = std::size_t(packet_size), packets = (r.size() + size - 1) / size;
-      parallel_for_each_index(0, packets, [&](std::size_t p) {
-        const std::size_t first = p * size, n = std::min(size, r.size() - first);
-        RayHit out[16];
-        bvh_.intersect_packets(std::span<const Ray3f>(r.data() + first, n), std::span<RayHit>(out, n), packet_size);
-        for (std::size_t i = 0; i < n; ++i) hits.set(first + i, out[i]);
-      }, 32);
+      std::vector<RayHit> out(r.size());
+      bvh_.intersect_packets(r, out, packet_size);
+      for (std::size_t i = 0; i < r.size(); ++i) hits.set(i, out[i]);
     }
     return hits.tuple();
   }
@@ -92,17 +87,13 @@ class PyBvh {
   py::array_t<bool> occluded_packets(const Rows<float>& origins, const Rows<float>& directions,
                                      const Rows<float>& tmax, int packet_size) const {
     const std::vector<Ray3f> r = rays_from_arrays(origins, directions, tmax, "TriangleBvh.occluded_packets");
-    if (packet_size != 8 && packet_size != 16) throw Error("TriangleBvh.occluded_packets: packet_size must be 8 or 16");
+    std::vector<std::uint8_t> o(r.size());
+    {
+      py::gil_scoped_release release;
+      bvh_.occluded_packets(r, o, packet_size);
+    }
     py::array_t<bool> out(py::ssize_t(r.size()));
-    bool* po = out.mutable_data();
-    py::gil_scoped_release release;
-    const std::size_t size = std::size_t(packet_size), packets = (r.size() + size - 1) / size;
-    parallel_for_each_index(0, packets, [&](std::size_t p) {
-      const std::size_t first = p * size, n = std::min(size, r.size() - first);
-      std::uint8_t o[16];
-      bvh_.occluded_packets(std::span<const Ray3f>(r.data() + first, n), std::span<std::uint8_t>(o, n), packet_size);
-      for (std::size_t i = 0; i < n; ++i) po[first + i] = o[i] != 0;
-    }, 32);
+    std::copy(o.begin(), o.end(), out.mutable_data());
     return out;
   }
 

@@ -16,6 +16,7 @@
 #include "geods/bvh/traversal.hpp"
 #include "geods/bvh/triangle_bvh.hpp"
 #include "geods/core/error.hpp"
+#include "geods/core/parallel.hpp"
 #include "geods/core/simd_level.hpp"
 
 #if defined(__SSE__)
@@ -552,28 +553,31 @@ RayPacket half(const RayPacket16& packet, int h) {
   return r;
 }
 
+// Every ray in packets of P consecutive ones, the packets in parallel.
 template <int P>
 void intersect_all(const TriangleBvh& bvh, std::span<const Ray3f> rays, std::span<RayHit> hits) {
-  for (std::size_t first = 0; first < rays.size(); first += P) {
+  parallel_for_each_index(0, (rays.size() + P - 1) / P, [&](std::size_t p) {
+    const std::size_t first = p * P;
     RayPacketN<P> packet;
     const std::size_t n = std::min<std::size_t>(P, rays.size() - first);
     for (std::size_t i = 0; i < n; ++i) packet.rays[i] = rays[first + i];
     packet.active = (1u << n) - 1;
     const HitPacketN<P> out = bvh.intersect(packet);
     for (std::size_t i = 0; i < n; ++i) hits[first + i] = out.hits[i];
-  }
+  }, 32);
 }
 
 template <int P>
 void occluded_all(const TriangleBvh& bvh, std::span<const Ray3f> rays, std::span<std::uint8_t> occluded_out) {
-  for (std::size_t first = 0; first < rays.size(); first += P) {
+  parallel_for_each_index(0, (rays.size() + P - 1) / P, [&](std::size_t p) {
+    const std::size_t first = p * P;
     RayPacketN<P> packet;
     const std::size_t n = std::min<std::size_t>(P, rays.size() - first);
     for (std::size_t i = 0; i < n; ++i) packet.rays[i] = rays[first + i];
     packet.active = (1u << n) - 1;
     const std::uint32_t mask = bvh.occluded(packet);
     for (std::size_t i = 0; i < n; ++i) occluded_out[first + i] = std::uint8_t(mask >> i & 1);
-  }
+  }, 32);
 }
 
 void check_packet_size(int packet_size, const char* what) {

@@ -17,7 +17,7 @@ namespace {
 constexpr int kTile = 16;  // a multiple of the 4 x 4 pixel blocks of a packet
 constexpr int kBlockX = 4, kBlockY = 4;
 using Packet = bvh::RayPacket16;  // 16 rays: faster than 8 (docs/ray.md)
-using Hits = bvh::HitPacket16;
+using Hits = bvh::HitPacketN<Packet::size>;
 constexpr int kBlock = Packet::size;
 static_assert(kBlockX * kBlockY == kBlock);
 

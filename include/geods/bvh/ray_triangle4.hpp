@@ -33,9 +33,12 @@ struct alignas(32) TriangleGroup {  // 160 bytes
 /// lanes for the scalar test's double-precision path. As vector masks, or as
 /// bit masks with a `bits` that turns each comparison into one (packets of
 /// 16: GCC scalarizes & and | of 16-lane comparisons inlined into AVX-512 code).
+// (Always inlined: the wide vectors below cross no call, so no ABI concern.)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpsabi"
 struct SameMask {
   template <typename M>
-  M operator()(M m) const {
+  [[gnu::always_inline]] M operator()(M m) const {
     return m;
   }
 };
@@ -59,6 +62,7 @@ template <typename VF, typename Bits = SameMask>
   e.inside = ~mixed & ~e.on_edge & bits(e.det != zero) & bits(e.det - e.det == zero);
   return e;
 }
+#pragma GCC diagnostic pop
 
 class RayTriangle4Test {
  public:

@@ -118,7 +118,8 @@ class TriangleBvh {
   HitPacket16 intersect(const RayPacket16& packet) const;
   std::uint32_t occluded(const RayPacket16& packet) const;
   /// Every ray, in packets of packet_size (8 or 16) consecutive rays (give
-  /// coherent rays in neighbouring order: pixels of 4 x 2 or 4 x 4 tiles);
+  /// coherent rays in neighbouring order: pixels of 4 x 2 or 4 x 4 tiles),
+  /// the packets in parallel;
   /// hits.size() and occluded.size() must be rays.size(), packet_size 8 or
   /// 16 (geods::Error otherwise).
   void intersect_packets(std::span<const Ray3f> rays, std::span<RayHit> hits, int packet_size = kPacketSize) const;
