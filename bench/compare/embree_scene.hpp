@@ -7,9 +7,14 @@
 
 #include "common.hpp"
 
-/// A committed scene of `mesh` on `device`; the caller releases it.
+/// A committed scene of `mesh` on `device`; the caller releases it. With
+/// GEODS_EMBREE_ROBUST the scene is RTC_SCENE_FLAG_ROBUST: conservative box tests
+/// and the watertight Pluecker triangle test, the like of geods' traversal.
 inline RTCScene embree_mesh_scene(RTCDevice device, const compare::PlyMesh& mesh) {
   RTCScene scene = rtcNewScene(device);
+#ifdef GEODS_EMBREE_ROBUST
+  rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST);
+#endif
   rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_MEDIUM);
   RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
   auto* v = static_cast<float*>(

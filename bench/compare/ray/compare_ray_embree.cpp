@@ -1,4 +1,5 @@
-// Embree 3 (RTC_BUILD_QUALITY_MEDIUM, rtcIntersect1 one ray at a time) on the ray comparison.
+// Embree 3 (RTC_BUILD_QUALITY_MEDIUM, rtcIntersect1 one ray at a time) on the ray comparison;
+// compiled a second time as compare_ray_embree_robust (RTC_SCENE_FLAG_ROBUST).
 #include <embree3/rtcore.h>
 
 #include "embree_scene.hpp"
@@ -7,7 +8,11 @@
 namespace {
 
 struct Embree {
+#ifdef GEODS_EMBREE_ROBUST
+  static constexpr const char* anchor = "embree_robust";
+#else
   static constexpr const char* anchor = "embree";
+#endif
   struct Index {
     RTCDevice device = nullptr;
     RTCScene scene = nullptr;
