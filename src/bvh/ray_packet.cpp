@@ -131,16 +131,36 @@ struct PacketEntry {
 };
 
 #if defined(GEODS_PACKET_SIMD_DISPATCH)
-// The 16 rays side by side (origin, direction, tmin, tmax: 8 floats a ray),
-// one gather per attribute.
+// The 16 rays side by side (origin, direction, tmin, tmax: 8 floats a ray):
+// the 8 x 8 transpose of AVX (unpack, shuffle, 128-bit lanes) on two halves
+// at once, the rows holding rays j and j + 4 (j < 4), 8 + j and 12 + j
+// (one gather per attribute cost twice as much).
 static_assert(sizeof(Ray3f) == 8 * sizeof(float), "a ray is 8 floats");
-__attribute__((target("avx512f"))) inline void gather_rays_avx512(const Ray3f* rays, Lanes<16>::vf (&attr)[8]) {
-  const __m512i first = _mm512_setr_epi32(0, 8, 16, 24, 32, 40, 48, 56, 64, 72, 80, 88, 96, 104, 112, 120);
-  const float* base = reinterpret_cast<const float*>(rays);
-  for (int a = 0; a < 8; ++a) {
-    const __m512i index = _mm512_add_epi32(first, _mm512_set1_epi32(a));
-    // (The masked gather: the plain one reads an uninitialized source in GCC 12's header.)
-    attr[a] = reinterpret_cast<Lanes<16>::vf>(_mm512_mask_i32gather_ps(_mm512_setzero_ps(), 0xffff, index, base, 4));
+__attribute__((target("avx512f,avx512dq"))) inline void transpose_rays_avx512(const Ray3f* rays,
+                                                                              Lanes<16>::vf (&attr)[8]) {
+  using v8 = Lanes<8>::vf;
+  using v16 = Lanes<16>::vf;
+  v16 row[8], t[8], s[8];
+  for (int j = 0; j < 8; ++j) {
+    const int lo = j < 4 ? j : j + 4;
+    v8 a, b;
+    std::memcpy(&a, &rays[lo], sizeof a);
+    std::memcpy(&b, &rays[lo + 4], sizeof b);
+    row[j] = __builtin_shufflevector(a, b, 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+  }
+  for (int j = 0; j < 8; j += 2) {  // unpacklo, unpackhi
+    t[j] = __builtin_shufflevector(row[j], row[j + 1], 0, 16, 1, 17, 4, 20, 5, 21, 8, 24, 9, 25, 12, 28, 13, 29);
+    t[j + 1] = __builtin_shufflevector(row[j], row[j + 1], 2, 18, 3, 19, 6, 22, 7, 23, 10, 26, 11, 27, 14, 30, 15, 31);
+  }
+  for (int j = 0; j < 8; j += 4) {  // shuffle 0x44, 0xee
+    for (int h = 0; h < 2; ++h) {
+      s[j + 2 * h] = __builtin_shufflevector(t[j + h], t[j + h + 2], 0, 1, 16, 17, 4, 5, 20, 21, 8, 9, 24, 25, 12, 13, 28, 29);
+      s[j + 2 * h + 1] = __builtin_shufflevector(t[j + h], t[j + h + 2], 2, 3, 18, 19, 6, 7, 22, 23, 10, 11, 26, 27, 14, 15, 30, 31);
+    }
+  }
+  for (int a = 0; a < 4; ++a) {  // 128-bit lanes 0, 2 and 1, 3 of each
+    attr[a] = __builtin_shufflevector(s[a], s[a + 4], 0, 1, 2, 3, 8, 9, 10, 11, 16, 17, 18, 19, 24, 25, 26, 27);
+    attr[a + 4] = __builtin_shufflevector(s[a], s[a + 4], 4, 5, 6, 7, 12, 13, 14, 15, 20, 21, 22, 23, 28, 29, 30, 31);
   }
 }
 #endif
@@ -162,7 +182,7 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
 #if defined(GEODS_PACKET_SIMD_DISPATCH)
   if constexpr (P == 16 && L == SimdLevel::avx512) {
     vf attr[8];
-    gather_rays_avx512(packet.rays, attr);
+    transpose_rays_avx512(packet.rays, attr);
     for (int a = 0; a < 3; ++a) org[a] = attr[a], dir[a] = attr[3 + a];
     tmin_v = attr[6];
     hit_t = attr[7];
