@@ -79,6 +79,37 @@ GEODS_BVH_INLINE unsigned lane_bits(M m) {
 #endif
 }
 
+#if defined(GEODS_PACKET_SIMD_DISPATCH)
+template <int Predicate>
+__attribute__((target("avx512f"))) inline unsigned compare_bits_avx512(Lanes<16>::vf a, Lanes<16>::vf b) {
+  return _mm512_cmp_ps_mask(reinterpret_cast<__m512>(a), reinterpret_cast<__m512>(b), Predicate);
+}
+#endif
+
+// lane_bits of a < b, a <= b, a == b; 16 lanes with AVX-512 compare straight
+// into a mask register (GCC turns the comparison into a vector and back).
+template <SimdLevel L, typename V>
+GEODS_BVH_INLINE unsigned lt_bits(V a, V b) {
+#if defined(GEODS_PACKET_SIMD_DISPATCH)
+  if constexpr (sizeof(V) == 64 && L == SimdLevel::avx512) return compare_bits_avx512<_CMP_LT_OS>(a, b);
+#endif
+  return lane_bits<L>(a < b);
+}
+template <SimdLevel L, typename V>
+GEODS_BVH_INLINE unsigned le_bits(V a, V b) {
+#if defined(GEODS_PACKET_SIMD_DISPATCH)
+  if constexpr (sizeof(V) == 64 && L == SimdLevel::avx512) return compare_bits_avx512<_CMP_LE_OS>(a, b);
+#endif
+  return lane_bits<L>(a <= b);
+}
+template <SimdLevel L, typename V>
+GEODS_BVH_INLINE unsigned eq_bits(V a, V b) {
+#if defined(GEODS_PACKET_SIMD_DISPATCH)
+  if constexpr (sizeof(V) == 64 && L == SimdLevel::avx512) return compare_bits_avx512<_CMP_EQ_OQ>(a, b);
+#endif
+  return lane_bits<L>(a == b);
+}
+
 // (A shuffle of lane 0 compiles to one broadcast; an initializer list or a
 // lane-by-lane loop to inserts, vector + scalar to an addition of zero too.)
 template <int N>
@@ -201,10 +232,9 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
     vf finite = splat<P>(0.0f);
     for (int a = 0; a < 3; ++a) finite += (org[a] - org[a]) + (dir[a] - dir[a]);
     const vf zero = splat<P>(0.0f);
-    const std::uint32_t zero_dir = lane_bits<L>(dir[0] == zero) & lane_bits<L>(dir[1] == zero) &
-                                   lane_bits<L>(dir[2] == zero);
-    const std::uint32_t taken = active & lane_bits<L>(finite == zero) & ~zero_dir & lane_bits<L>(tmin_v == tmin_v) &
-                                lane_bits<L>(hit_t == hit_t);
+    const std::uint32_t zero_dir = eq_bits<L>(dir[0], zero) & eq_bits<L>(dir[1], zero) & eq_bits<L>(dir[2], zero);
+    const std::uint32_t taken = active & eq_bits<L>(finite, zero) & ~zero_dir & eq_bits<L>(tmin_v, tmin_v) &
+                                eq_bits<L>(hit_t, hit_t);
     alone |= active & ~taken;
     active = taken;
   }
@@ -283,7 +313,7 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
   // of the single ray). Lanes that entered later are dropped by the tests below it.
   auto live = [&](const PacketEntry& e) GEODS_BVH_INLINE_LAMBDA {
     const vf slack = (hit_t < splat<P>(0.0f) ? -hit_t : hit_t) * splat<P>(4e-7f);
-    return e.mask & ~done & lane_bits<L>(splat<P>(e.key) <= hit_t + slack);
+    return e.mask & ~done & le_bits<L>(splat<P>(e.key), hit_t + slack);
   };
   // The children that some lane may enter, all W at once: a lane's entry
   // and exit distances along an axis are products of (bound - origin) and the
@@ -337,8 +367,7 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
         tn = near > tn ? near : tn;
         tf = far < tf ? far : tf;
       }
-      const vi enter = tn <= tf * splat<P>(widen);
-      const std::uint32_t m = lanes & lane_bits<L>(enter);
+      const std::uint32_t m = lanes & le_bits<L>(tn, tf * splat<P>(widen));
       if (m == 0) continue;
       child_mask[c] = m;
       if (!full_frustum) keys[c] = lane_min(lane_mask<P>(m) ? tn : inf);
@@ -364,8 +393,8 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
   auto record = [&](std::uint32_t hits, vf t, vi prim, vf u, vf v) GEODS_BVH_INLINE_LAMBDA {
     const vi m = lane_mask<P>(hits);
     const std::uint32_t had = hits & lane_bits<L>(hit_prim != (vi{} - 1));
-    alone &= ~(had & lane_bits<L>(t < hit_t));
-    alone |= had & lane_bits<L>(t == hit_t) & lane_bits<L>(prim != hit_prim);
+    alone &= ~(had & lt_bits<L>(t, hit_t));
+    alone |= had & eq_bits<L>(t, hit_t) & lane_bits<L>(prim != hit_prim);
     hit_t = m ? t : hit_t;
     hit_prim = m ? prim : hit_prim;
     hit_u = m ? u : hit_u;
@@ -405,7 +434,7 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
         vf t = scaled_t * inv_det, u = ed.ev * inv_det, v = ed.ew * inv_det;
         std::uint32_t hits;
         if constexpr (P == 16) {
-          hits = ed.inside & lane_bits<L>(t >= tmin_v) & lane_bits<L>(t <= hit_t) & lanes;
+          hits = ed.inside & le_bits<L>(tmin_v, t) & le_bits<L>(t, hit_t) & lanes;
         } else {
           hits = lane_bits<L>(ed.inside & (t >= tmin_v) & (t <= hit_t)) & lanes;
         }
