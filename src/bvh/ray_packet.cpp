@@ -165,7 +165,7 @@ struct PacketEntry {
 // The 16 rays side by side (origin, direction, tmin, tmax: 8 floats a ray):
 // the 8 x 8 transpose of AVX (unpack, shuffle, 128-bit lanes) on two halves
 // at once, the rows holding rays j and j + 4 (j < 4), 8 + j and 12 + j
-// (one gather per attribute cost twice as much).
+// (one gather per attribute cost more than the scalar loads it replaced).
 static_assert(sizeof(Ray3f) == 8 * sizeof(float), "a ray is 8 floats");
 __attribute__((target("avx512f,avx512dq"))) inline void transpose_rays_avx512(const Ray3f* rays,
                                                                               Lanes<16>::vf (&attr)[8]) {
