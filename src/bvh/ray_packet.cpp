@@ -79,6 +79,37 @@ GEODS_BVH_INLINE unsigned lane_bits(M m) {
 #endif
 }
 
+#if defined(GEODS_PACKET_SIMD_DISPATCH)
+template <int Predicate>
+__attribute__((target("avx512f"))) inline unsigned compare_bits_avx512(Lanes<16>::vf a, Lanes<16>::vf b) {
+  return _mm512_cmp_ps_mask(reinterpret_cast<__m512>(a), reinterpret_cast<__m512>(b), Predicate);
+}
+#endif
+
+// lane_bits of a < b, a <= b, a == b; 16 lanes with AVX-512 compare straight
+// into a mask register (GCC turns the comparison into a vector and back).
+template <SimdLevel L, typename V>
+GEODS_BVH_INLINE unsigned lt_bits(V a, V b) {
+#if defined(GEODS_PACKET_SIMD_DISPATCH)
+  if constexpr (sizeof(V) == 64 && L == SimdLevel::avx512) return compare_bits_avx512<_CMP_LT_OS>(a, b);
+#endif
+  return lane_bits<L>(a < b);
+}
+template <SimdLevel L, typename V>
+GEODS_BVH_INLINE unsigned le_bits(V a, V b) {
+#if defined(GEODS_PACKET_SIMD_DISPATCH)
+  if constexpr (sizeof(V) == 64 && L == SimdLevel::avx512) return compare_bits_avx512<_CMP_LE_OS>(a, b);
+#endif
+  return lane_bits<L>(a <= b);
+}
+template <SimdLevel L, typename V>
+GEODS_BVH_INLINE unsigned eq_bits(V a, V b) {
+#if defined(GEODS_PACKET_SIMD_DISPATCH)
+  if constexpr (sizeof(V) == 64 && L == SimdLevel::avx512) return compare_bits_avx512<_CMP_EQ_OQ>(a, b);
+#endif
+  return lane_bits<L>(a == b);
+}
+
 // (A shuffle of lane 0 compiles to one broadcast; an initializer list or a
 // lane-by-lane loop to inserts, vector + scalar to an addition of zero too.)
 template <int N>
@@ -130,29 +161,93 @@ struct PacketEntry {
   std::uint32_t mask;
 };
 
-// Rays that the packet does not take: they go through the single-ray query.
-bool alone(const Ray3f& r) {
-  return !r.origin.allFinite() || !r.direction.allFinite() || r.direction.isZero(0) || std::isnan(r.tmin) ||
-         std::isnan(r.tmax);
+#if defined(GEODS_PACKET_SIMD_DISPATCH)
+// The 16 rays side by side (origin, direction, tmin, tmax: 8 floats a ray):
+// the 8 x 8 transpose of AVX (unpack, shuffle, 128-bit lanes) on two halves
+// at once, the rows holding rays j and j + 4 (j < 4), 8 + j and 12 + j
+// (one gather per attribute cost more than the scalar loads it replaced).
+static_assert(sizeof(Ray3f) == 8 * sizeof(float), "a ray is 8 floats");
+__attribute__((target("avx512f,avx512dq"))) inline void transpose_rays_avx512(const Ray3f* rays,
+                                                                              Lanes<16>::vf (&attr)[8]) {
+  using v8 = Lanes<8>::vf;
+  using v16 = Lanes<16>::vf;
+  v16 row[8], t[8], s[8];
+  for (int j = 0; j < 8; ++j) {
+    const int lo = j < 4 ? j : j + 4;
+    v8 a, b;
+    std::memcpy(&a, &rays[lo], sizeof a);
+    std::memcpy(&b, &rays[lo + 4], sizeof b);
+    row[j] = __builtin_shufflevector(a, b, 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+  }
+  for (int j = 0; j < 8; j += 2) {  // unpacklo, unpackhi
+    t[j] = __builtin_shufflevector(row[j], row[j + 1], 0, 16, 1, 17, 4, 20, 5, 21, 8, 24, 9, 25, 12, 28, 13, 29);
+    t[j + 1] = __builtin_shufflevector(row[j], row[j + 1], 2, 18, 3, 19, 6, 22, 7, 23, 10, 26, 11, 27, 14, 30, 15, 31);
+  }
+  for (int j = 0; j < 8; j += 4) {  // shuffle 0x44, 0xee
+    for (int h = 0; h < 2; ++h) {
+      s[j + 2 * h] = __builtin_shufflevector(t[j + h], t[j + h + 2], 0, 1, 16, 17, 4, 5, 20, 21, 8, 9, 24, 25, 12, 13, 28, 29);
+      s[j + 2 * h + 1] = __builtin_shufflevector(t[j + h], t[j + h + 2], 2, 3, 18, 19, 6, 7, 22, 23, 10, 11, 26, 27, 14, 15, 30, 31);
+    }
+  }
+  for (int a = 0; a < 4; ++a) {  // 128-bit lanes 0, 2 and 1, 3 of each
+    attr[a] = __builtin_shufflevector(s[a], s[a + 4], 0, 1, 2, 3, 8, 9, 10, 11, 16, 17, 18, 19, 24, 25, 26, 27);
+    attr[a + 4] = __builtin_shufflevector(s[a], s[a + 4], 4, 5, 6, 7, 12, 13, 14, 15, 20, 21, 22, 23, 28, 29, 30, 31);
+  }
 }
+#endif
 
 // The traversal of the active lanes of `packet`; `any`: occlusion (a lane
-// stops at its first hit). Lanes in `ambiguous` found two different
-// triangles at their closest t: the caller shoots them alone.
+// stops at its first hit). The caller shoots the lanes in `alone` alone:
+// rays the packet does not take (a non-finite or zero direction, a
+// non-finite origin, a NaN interval; a single ray left), and rays that found
+// two different triangles at their closest t.
 template <int W, int P, SimdLevel L>
 GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const FlatArray<TriangleGroup>& groups,
                                       int depth, const RayPacketN<P>& packet, std::uint32_t active, bool any,
-                                      HitPacketN<P>& out, std::uint32_t& done, std::uint32_t& ambiguous) {
+                                      HitPacketN<P>& out, std::uint32_t& done, std::uint32_t& alone) {
   using vf = typename Lanes<P>::vf;
   using vi = typename Lanes<P>::vi;
-  // The rays side by side; inactive lanes repeat the first active ray.
+  // The rays side by side.
   vf org[3], dir[3], tmin_v;
   vf hit_t;  // the closest hit so far (ray.tmax before one): the lane's tmax
-  for (int i = 0; i < P; ++i) {
-    const Ray3f& r = packet.rays[(active >> i & 1) ? i : __builtin_ctz(active)];
-    for (int a = 0; a < 3; ++a) org[a][i] = r.origin[a], dir[a][i] = r.direction[a];
-    tmin_v[i] = r.tmin;
-    hit_t[i] = r.tmax;
+#if defined(GEODS_PACKET_SIMD_DISPATCH)
+  if constexpr (P == 16 && L == SimdLevel::avx512) {
+    vf attr[8];
+    transpose_rays_avx512(packet.rays, attr);
+    for (int a = 0; a < 3; ++a) org[a] = attr[a], dir[a] = attr[3 + a];
+    tmin_v = attr[6];
+    hit_t = attr[7];
+  } else
+#endif
+  {
+    for (int i = 0; i < P; ++i) {
+      const Ray3f& r = packet.rays[i];
+      for (int a = 0; a < 3; ++a) org[a][i] = r.origin[a], dir[a][i] = r.direction[a];
+      tmin_v[i] = r.tmin;
+      hit_t[i] = r.tmax;
+    }
+  }
+  {
+    // x - x is 0 for finite x, NaN for inf and NaN: one sum tests all six coordinates.
+    vf finite = splat<P>(0.0f);
+    for (int a = 0; a < 3; ++a) finite += (org[a] - org[a]) + (dir[a] - dir[a]);
+    const vf zero = splat<P>(0.0f);
+    const std::uint32_t zero_dir = eq_bits<L>(dir[0], zero) & eq_bits<L>(dir[1], zero) & eq_bits<L>(dir[2], zero);
+    const std::uint32_t taken = active & eq_bits<L>(finite, zero) & ~zero_dir & eq_bits<L>(tmin_v, tmin_v) &
+                                eq_bits<L>(hit_t, hit_t);
+    alone |= active & ~taken;
+    active = taken;
+  }
+  if (__builtin_popcount(active) < 2) {  // one ray is cheaper alone
+    alone |= active;
+    return;
+  }
+  // Lanes not shot repeat the first active ray.
+  for (std::uint32_t b = ~active & ((1u << P) - 1); b != 0; b &= b - 1) {
+    const int i = __builtin_ctz(b), first = __builtin_ctz(active);
+    for (int a = 0; a < 3; ++a) org[a][i] = org[a][first], dir[a][i] = dir[a][first];
+    tmin_v[i] = tmin_v[first];
+    hit_t[i] = hit_t[first];
   }
   vf inv[3];
   vi neg[3];
@@ -218,7 +313,7 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
   // of the single ray). Lanes that entered later are dropped by the tests below it.
   auto live = [&](const PacketEntry& e) GEODS_BVH_INLINE_LAMBDA {
     const vf slack = (hit_t < splat<P>(0.0f) ? -hit_t : hit_t) * splat<P>(4e-7f);
-    return e.mask & ~done & lane_bits<L>(splat<P>(e.key) <= hit_t + slack);
+    return e.mask & ~done & le_bits<L>(splat<P>(e.key), hit_t + slack);
   };
   // The children that some lane may enter, all W at once: a lane's entry
   // and exit distances along an axis are products of (bound - origin) and the
@@ -272,8 +367,7 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
         tn = near > tn ? near : tn;
         tf = far < tf ? far : tf;
       }
-      const vi enter = tn <= tf * splat<P>(widen);
-      const std::uint32_t m = lanes & lane_bits<L>(enter);
+      const std::uint32_t m = lanes & le_bits<L>(tn, tf * splat<P>(widen));
       if (m == 0) continue;
       child_mask[c] = m;
       if (!full_frustum) keys[c] = lane_min(lane_mask<P>(m) ? tn : inf);
@@ -299,8 +393,8 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
   auto record = [&](std::uint32_t hits, vf t, vi prim, vf u, vf v) GEODS_BVH_INLINE_LAMBDA {
     const vi m = lane_mask<P>(hits);
     const std::uint32_t had = hits & lane_bits<L>(hit_prim != (vi{} - 1));
-    ambiguous &= ~(had & lane_bits<L>(t < hit_t));
-    ambiguous |= had & lane_bits<L>(t == hit_t) & lane_bits<L>(prim != hit_prim);
+    alone &= ~(had & lt_bits<L>(t, hit_t));
+    alone |= had & eq_bits<L>(t, hit_t) & lane_bits<L>(prim != hit_prim);
     hit_t = m ? t : hit_t;
     hit_prim = m ? prim : hit_prim;
     hit_u = m ? u : hit_u;
@@ -340,7 +434,7 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
         vf t = scaled_t * inv_det, u = ed.ev * inv_det, v = ed.ew * inv_det;
         std::uint32_t hits;
         if constexpr (P == 16) {
-          hits = ed.inside & lane_bits<L>(t >= tmin_v) & lane_bits<L>(t <= hit_t) & lanes;
+          hits = ed.inside & le_bits<L>(tmin_v, t) & le_bits<L>(t, hit_t) & lanes;
         } else {
           hits = lane_bits<L>(ed.inside & (t >= tmin_v) & (t <= hit_t)) & lanes;
         }
@@ -380,7 +474,7 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
         bool tie = false;
         for (int k = 0; k < 4; ++k) tie |= (mask >> k & 1) && t[k] == t[best] && group.index[k] != prim;
         record(1u << i, splat<P>(t[best]), vi{} + std::int32_t(prim), splat<P>(u[best]), splat<P>(v[best]));
-        if (tie) ambiguous |= 1u << i;
+        if (tie) alone |= 1u << i;
       }
       lanes &= ~done;
     }
@@ -420,8 +514,8 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
 template <int W, int P>
 void packet_portable(const FlatArray<WideNode<W>>& nodes, const FlatArray<TriangleGroup>& groups, int depth,
     const RayPacketN<P>& packet, std::uint32_t active, bool any, HitPacketN<P>& out, std::uint32_t& done,
-    std::uint32_t& ambiguous) {
-  packet_traverse<W, P, SimdLevel::portable>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
+    std::uint32_t& alone) {
+  packet_traverse<W, P, SimdLevel::portable>(nodes, groups, depth, packet, active, any, out, done, alone);
 }
 
 #if defined(GEODS_PACKET_SIMD_DISPATCH)
@@ -429,98 +523,69 @@ template <int W, int P>
 __attribute__((target("avx"), flatten)) void packet_avx(
     const FlatArray<WideNode<W>>& nodes, const FlatArray<TriangleGroup>& groups, int depth,
     const RayPacketN<P>& packet, std::uint32_t active, bool any, HitPacketN<P>& out, std::uint32_t& done,
-    std::uint32_t& ambiguous) {
-  packet_traverse<W, P, SimdLevel::avx>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
+    std::uint32_t& alone) {
+  packet_traverse<W, P, SimdLevel::avx>(nodes, groups, depth, packet, active, any, out, done, alone);
 }
 template <int W, int P>
 __attribute__((target("avx2,bmi,bmi2,lzcnt,popcnt"), flatten)) void packet_avx2(
     const FlatArray<WideNode<W>>& nodes, const FlatArray<TriangleGroup>& groups, int depth,
     const RayPacketN<P>& packet, std::uint32_t active, bool any, HitPacketN<P>& out, std::uint32_t& done,
-    std::uint32_t& ambiguous) {
-  packet_traverse<W, P, SimdLevel::avx2>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
+    std::uint32_t& alone) {
+  packet_traverse<W, P, SimdLevel::avx2>(nodes, groups, depth, packet, active, any, out, done, alone);
 }
 template <int W, int P>
 __attribute__((target("avx512f,avx512vl,avx512bw,avx512dq,avx2,bmi,bmi2,lzcnt,popcnt"), flatten)) void packet_avx512(
     const FlatArray<WideNode<W>>& nodes, const FlatArray<TriangleGroup>& groups, int depth,
     const RayPacketN<P>& packet, std::uint32_t active, bool any, HitPacketN<P>& out, std::uint32_t& done,
-    std::uint32_t& ambiguous) {
-  packet_traverse<W, P, SimdLevel::avx512>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
+    std::uint32_t& alone) {
+  packet_traverse<W, P, SimdLevel::avx512>(nodes, groups, depth, packet, active, any, out, done, alone);
 }
 #endif
 
 template <int W, int P>
 void packet_best(const FlatArray<WideNode<W>>& nodes, const FlatArray<TriangleGroup>& groups, int depth,
     const RayPacketN<P>& packet, std::uint32_t active, bool any, HitPacketN<P>& out, std::uint32_t& done,
-    std::uint32_t& ambiguous) {
+    std::uint32_t& alone) {
 #if defined(GEODS_PACKET_SIMD_DISPATCH)
   if constexpr (P == 16) {  // only with AVX-512 (sixteen_wide)
-    packet_avx512<W, P>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
+    packet_avx512<W, P>(nodes, groups, depth, packet, active, any, out, done, alone);
   } else {
     switch (simd_level()) {
-      case SimdLevel::avx512: return packet_avx512<W, P>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
-      case SimdLevel::avx2: return packet_avx2<W, P>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
-      case SimdLevel::avx: return packet_avx<W, P>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
+      case SimdLevel::avx512: return packet_avx512<W, P>(nodes, groups, depth, packet, active, any, out, done, alone);
+      case SimdLevel::avx2: return packet_avx2<W, P>(nodes, groups, depth, packet, active, any, out, done, alone);
+      case SimdLevel::avx: return packet_avx<W, P>(nodes, groups, depth, packet, active, any, out, done, alone);
       case SimdLevel::portable: break;
     }
-    packet_portable<W, P>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
+    packet_portable<W, P>(nodes, groups, depth, packet, active, any, out, done, alone);
   }
 #else
-  packet_portable<W, P>(nodes, groups, depth, packet, active, any, out, done, ambiguous);
+  packet_portable<W, P>(nodes, groups, depth, packet, active, any, out, done, alone);
 #endif
 }
 
-// The lanes the packet traversal takes, and the others shot alone into `out`.
+// The lanes the packet traversal leaves to the single-ray query: all of them
+// without a wide layout.
 template <int P>
-std::uint32_t split_lanes(const TriangleBvh& bvh, const RayPacketN<P>& packet, bool any, HitPacketN<P>& out,
-                          std::uint32_t& occluded) {
+std::uint32_t trace_packet(const TriangleBvh& bvh, const RayPacketN<P>& packet, bool any, HitPacketN<P>& out,
+                           std::uint32_t& done) {
   const std::uint32_t active = packet.active & ((1u << P) - 1);
-  const bool wide = !bvh.wide4_nodes().empty() || !bvh.wide8_nodes().empty();
-  std::uint32_t lanes = 0;
-  for (int i = 0; i < P; ++i) {
-    if (!(active >> i & 1)) continue;
-    if (wide && !alone(packet.rays[i])) {
-      lanes |= 1u << i;
-    } else if (any) {
-      if (bvh.occluded(packet.rays[i])) occluded |= 1u << i;
-    } else {
-      out.hits[i] = bvh.intersect(packet.rays[i]);
-    }
-  }
-  // One ray is cheaper alone.
-  if (__builtin_popcount(lanes) == 1) {
-    const int i = __builtin_ctz(lanes);
-    if (any) {
-      if (bvh.occluded(packet.rays[i])) occluded |= 1u << i;
-    } else {
-      out.hits[i] = bvh.intersect(packet.rays[i]);
-    }
-    lanes = 0;
-  }
-  return lanes;
-}
-
-template <int P>
-void run_packet(const TriangleBvh& bvh, const RayPacketN<P>& packet, std::uint32_t lanes, bool any,
-                HitPacketN<P>& out, std::uint32_t& done, std::uint32_t& ambiguous) {
+  std::uint32_t alone = 0;
   if (!bvh.wide8_nodes().empty()) {
-    packet_best<8, P>(bvh.wide8_nodes(), bvh.triangle_groups(), bvh.depth(), packet, lanes, any, out, done,
-                      ambiguous);
+    packet_best<8, P>(bvh.wide8_nodes(), bvh.triangle_groups(), bvh.depth(), packet, active, any, out, done, alone);
+  } else if (!bvh.wide4_nodes().empty()) {
+    packet_best<4, P>(bvh.wide4_nodes(), bvh.triangle_groups(), bvh.depth(), packet, active, any, out, done, alone);
   } else {
-    packet_best<4, P>(bvh.wide4_nodes(), bvh.triangle_groups(), bvh.depth(), packet, lanes, any, out, done,
-                      ambiguous);
+    alone = active;
   }
+  return alone;
 }
 
 template <int P>
 HitPacketN<P> intersect_packet(const TriangleBvh& bvh, const RayPacketN<P>& packet) {
   HitPacketN<P> out;
-  std::uint32_t unused = 0;
-  const std::uint32_t lanes = split_lanes(bvh, packet, false, out, unused);
-  if (lanes == 0) return out;
-  std::uint32_t done = 0, ambiguous = 0;
-  run_packet(bvh, packet, lanes, false, out, done, ambiguous);
-  // Two triangles at a ray's closest t: the single ray's order decides.
-  for (std::uint32_t b = ambiguous & lanes; b != 0; b &= b - 1) {
+  std::uint32_t done = 0;
+  // Also rays with two triangles at their closest t: the single ray's order decides.
+  for (std::uint32_t b = trace_packet(bvh, packet, false, out, done); b != 0; b &= b - 1) {
     const int i = __builtin_ctz(b);
     out.hits[i] = bvh.intersect(packet.rays[i]);
   }
@@ -530,12 +595,13 @@ HitPacketN<P> intersect_packet(const TriangleBvh& bvh, const RayPacketN<P>& pack
 template <int P>
 std::uint32_t occluded_packet(const TriangleBvh& bvh, const RayPacketN<P>& packet) {
   HitPacketN<P> out;
-  std::uint32_t occluded = 0;
-  const std::uint32_t lanes = split_lanes(bvh, packet, true, out, occluded);
-  if (lanes == 0) return occluded;
-  std::uint32_t done = 0, ambiguous = 0;
-  run_packet(bvh, packet, lanes, true, out, done, ambiguous);
-  return occluded | (done & lanes);
+  std::uint32_t done = 0;
+  const std::uint32_t alone = trace_packet(bvh, packet, true, out, done) & ~done;
+  for (std::uint32_t b = alone; b != 0; b &= b - 1) {
+    const int i = __builtin_ctz(b);
+    if (bvh.occluded(packet.rays[i])) done |= 1u << i;
+  }
+  return done;
 }
 
 // Packets of 16 where the kernel runs 16 lanes wide (AVX-512), else as two of 8.
