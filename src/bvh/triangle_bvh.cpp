@@ -23,6 +23,9 @@
 #include "geods/core/triangle.hpp"
 #include "geods/core/triangle_box.hpp"
 
+// 8-lane vectors are passed between inlined helpers only (RayTriangle8Test).
+#pragma GCC diagnostic ignored "-Wpsabi"
+
 namespace geods::bvh {
 namespace {
 
@@ -462,7 +465,9 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray, 
   using vf = typename SimdTypes<W>::vf;
   RayHit hit;
   if (nodes.empty()) return hit;
-  const RayTriangle4Test test(ray);
+  constexpr int kGroups = Avx ? 2 : 1;  // triangle groups per test
+  using GroupTest = RayTriangleGroupTest<4 * kGroups>;
+  const GroupTest test(ray);
   // A zero direction component gives an infinite inverse; the 0 * inf NaN of
   // an origin on a slab plane is then skipped by the NaN-ignoring min/max
   // below, so a ray inside a (possibly flat) slab keeps the whole line. The
@@ -556,21 +561,32 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray, 
     prefetch(c);
     return c;
   };
+  // A leaf's groups two at a time at the AVX levels (one 8-lane test; an odd
+  // last group goes in both halves), one at a time otherwise. All the lanes
+  // of a test see the same tmax, and the nearest lane wins, ties to the last
+  // one: what testing the triangles one after the other, each against the
+  // shrinking tmax (t <= tmax: a later equal t wins), would keep.
   auto leaf = [&](const WideEntry& e) GEODS_BVH_INLINE_LAMBDA {
-    for (std::uint32_t g = e.child; g < e.child + e.count; ++g) {
-      RayTriangle4Test::vf t, u, v;
-      const int mask = test.intersect(groups_[g], tmin, tmax, t, u, v);
+    const std::uint32_t end = e.child + e.count;
+    for (std::uint32_t g = e.child; g < end; g += kGroups) {
+      const TriangleGroup& first = groups_[g];
+      const TriangleGroup& last = groups_[std::min<std::uint32_t>(g + kGroups, end) - 1];
+      typename GroupTest::vf t, u, v;
+      int mask;
+      if constexpr (kGroups == 2) {
+        mask = test.intersect(first, last, tmin, tmax, t, u, v);
+      } else {
+        mask = test.intersect(first, tmin, tmax, t, u, v);
+      }
       if (mask == 0) continue;
-      // The nearest lane, ties to the last one: what testing the triangles
-      // one after the other, each against the shrinking tmax, would keep.
       // Usually a single lane: no data-dependent branch per lane then.
       int best = __builtin_ctz(unsigned(mask));
       if (mask & (mask - 1)) {
-        for (int i = best + 1; i < 4; ++i)
+        for (int i = best + 1; i < 4 * kGroups; ++i)
           if ((mask >> i & 1) && t[i] <= t[best]) best = i;
       }
       tmax = t[best];
-      hit = {t[best], groups_[g].index[best], u[best], v[best]};
+      hit = {t[best], (best < 4 ? first : last).index[best % 4], u[best], v[best]};
       if (any) return false;
     }
     return true;
