@@ -465,8 +465,7 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray, 
   using vf = typename SimdTypes<W>::vf;
   RayHit hit;
   if (nodes.empty()) return hit;
-  constexpr int kGroups = Avx ? 2 : 1;  // triangle groups per test
-  using GroupTest = RayTriangleGroupTest<4 * kGroups>;
+  using GroupTest = RayTriangleGroupTest<Avx ? 8 : 4>;  // the AVX levels test two groups at once
   const GroupTest test(ray);
   // A zero direction component gives an infinite inverse; the 0 * inf NaN of
   // an origin on a slab plane is then skipped by the NaN-ignoring min/max
@@ -561,32 +560,43 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray, 
     prefetch(c);
     return c;
   };
-  // A leaf's groups two at a time at the AVX levels (one 8-lane test; an odd
-  // last group goes in both halves), one at a time otherwise. All the lanes
-  // of a test see the same tmax, and the nearest lane wins, ties to the last
-  // one: what testing the triangles one after the other, each against the
-  // shrinking tmax (t <= tmax: a later equal t wins), would keep.
+  // Keeps the nearest hit lane of a test, ties to the last one: what testing
+  // the triangles one after the other, each against the shrinking tmax,
+  // would keep (t <= tmax: a later equal t wins), also when all the lanes
+  // saw the same tmax. Usually a single lane: no data-dependent branch per lane then.
+  auto keep = [&](int mask, const auto& t, const auto& u, const auto& v, const TriangleGroup& first,
+                  const TriangleGroup& second) GEODS_BVH_INLINE_LAMBDA {
+    int best = __builtin_ctz(unsigned(mask));
+    if (mask & (mask - 1)) {
+      for (int i = best + 1; i < int(sizeof(t) / sizeof(float)); ++i)
+        if ((mask >> i & 1) && t[i] <= t[best]) best = i;
+    }
+    tmax = t[best];
+    hit = {t[best], (best < 4 ? first : second).index[best % 4], u[best], v[best]};
+  };
   auto leaf = [&](const WideEntry& e) GEODS_BVH_INLINE_LAMBDA {
     const std::uint32_t end = e.child + e.count;
-    for (std::uint32_t g = e.child; g < end; g += kGroups) {
-      const TriangleGroup& first = groups_[g];
-      const TriangleGroup& last = groups_[std::min<std::uint32_t>(g + kGroups, end) - 1];
-      typename GroupTest::vf t, u, v;
-      int mask;
-      if constexpr (kGroups == 2) {
-        mask = test.intersect(first, last, tmin, tmax, t, u, v);
-      } else {
-        mask = test.intersect(first, tmin, tmax, t, u, v);
+    if constexpr (Avx) {
+      // Closest hit: the groups two at a time (one 8-lane test; an odd last
+      // group fills both halves).
+      if (!any) {
+        for (std::uint32_t g = e.child; g < end; g += 2) {
+          const TriangleGroup& first = groups_[g];
+          const TriangleGroup& second = groups_[std::min(g + 2, end) - 1];
+          typename GroupTest::vf t, u, v;
+          const int mask = test.intersect(first, second, tmin, tmax, t, u, v);
+          if (mask != 0) keep(mask, t, u, v, first, second);
+        }
+        return true;
       }
+    }
+    // One group at a time: a hit in the first group of an any-hit ray ends
+    // the traversal without waiting for the second one's cache lines.
+    for (std::uint32_t g = e.child; g < end; ++g) {
+      typename GroupTest::v4 t, u, v;
+      const int mask = test.intersect(groups_[g], tmin, tmax, t, u, v);
       if (mask == 0) continue;
-      // Usually a single lane: no data-dependent branch per lane then.
-      int best = __builtin_ctz(unsigned(mask));
-      if (mask & (mask - 1)) {
-        for (int i = best + 1; i < 4 * kGroups; ++i)
-          if ((mask >> i & 1) && t[i] <= t[best]) best = i;
-      }
-      tmax = t[best];
-      hit = {t[best], (best < 4 ? first : last).index[best % 4], u[best], v[best]};
+      keep(mask, t, u, v, groups_[g], groups_[g]);
       if (any) return false;
     }
     return true;

@@ -2,10 +2,12 @@
 // Four triangles side by side (structure of arrays, Embree's "triangle4"
 // idea) and the watertight test of core/ray_triangle.hpp on all four at once
 // with 4-wide GCC/Clang vector extensions (SSE on x86, plain scalar code where
-// there is no SIMD). Every lane performs the scalar test's operations in the
-// same order, and a lane whose edge function rounds to zero is handed to the
-// scalar test itself (its double-precision recomputation), so t, u, v and the
-// hit decision are bit-identical to RayTriangleTest<float>.
+// there is no SIMD), or on two groups at once with 8-wide ones (AVX code: the
+// wide traversal's AVX kernels test a leaf's two groups so). Every lane
+// performs the scalar test's operations in the same order, and a lane whose
+// edge function rounds to zero is handed to the scalar test itself (its
+// double-precision recomputation), so t, u, v and the hit decision are
+// bit-identical to RayTriangleTest<float>.
 #include <cstdint>
 #include <limits>
 
@@ -35,7 +37,7 @@ struct alignas(32) TriangleGroup {  // 160 bytes
 /// lanes for the scalar test's double-precision path. As vector masks, or as
 /// bit masks with a `bits` that turns each comparison into one (packets of
 /// 16: GCC scalarizes & and | of 16-lane comparisons inlined into AVX-512 code).
-// (Always inlined: the wide vectors below cross no call, so no ABI concern.)
+// (Always inlined, as the 8-lane test below: its vectors cross no call, so no ABI concern.)
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wpsabi"
 struct SameMask {
@@ -65,10 +67,7 @@ template <typename VF, typename Bits = SameMask>
   return e;
 }
 
-/// The watertight test of one ray against the triangles of N / 4 triangle
-/// groups at once: N = 4 (SSE) or 8 (two groups in one AVX register, for
-/// code compiled for AVX: the traversal's AVX kernels). Lanes 4 to 7 are the
-/// second group's.
+// The lane vectors of RayTriangleGroupTest<N>.
 template <int N>
 struct GroupLanes;  // (GCC drops vector_size on a typedef that depends on a template parameter)
 template <>
@@ -82,14 +81,21 @@ struct GroupLanes<8> {
   typedef std::int32_t vi __attribute__((vector_size(32)));
 };
 
+/// The watertight test of one ray against the triangles of N / 4 triangle
+/// groups at once: N = 4 (SSE) or 8 (two groups in one AVX register, for
+/// code compiled for AVX: the traversal's AVX kernels). Lanes 4 to 7 are the
+/// second group's. With N = 8 a single group can also be tested alone (4 lanes).
 template <int N>
 class RayTriangleGroupTest {
   static_assert(N == 4 || N == 8, "groups of 4 triangles, one or two at a time");
-  using v4 = GroupLanes<4>::vf;
+  template <int M>
+  using lanes = typename GroupLanes<M>::vf;
+  template <int M>
+  using lane_mask = typename GroupLanes<M>::vi;
 
  public:
-  using vf = typename GroupLanes<N>::vf;
-  using vi = typename GroupLanes<N>::vi;
+  using v4 = lanes<4>;
+  using vf = lanes<N>;
 
   explicit RayTriangleGroupTest(const Ray3f& ray) : scalar_(ray) {
     const int k[3] = {scalar_.axis_x(), scalar_.axis_y(), scalar_.axis_z()};
@@ -104,11 +110,9 @@ class RayTriangleGroupTest {
 
   /// Bit i set: lane i's triangle is hit with t in [tmin, tmax], its t and
   /// barycentrics in t[i], u[i], v[i] (other lanes hold garbage).
-  [[gnu::always_inline]] int intersect(const TriangleGroup& g, float tmin, float tmax, vf& t, vf& u, vf& v) const
-    requires(N == 4)
-  {
+  [[gnu::always_inline]] int intersect(const TriangleGroup& g, float tmin, float tmax, v4& t, v4& u, v4& v) const {
     const TriangleGroup* groups[1] = {&g};
-    return intersect_lanes(groups, tmin, tmax, t, u, v);
+    return intersect_lanes<4>(groups, tmin, tmax, t, u, v);
   }
   /// The same for the 8 triangles of `first` (lanes 0-3) and `second` (4-7).
   [[gnu::always_inline]] int intersect(const TriangleGroup& first, const TriangleGroup& second, float tmin, float tmax,
@@ -116,39 +120,46 @@ class RayTriangleGroupTest {
     requires(N == 8)
   {
     const TriangleGroup* groups[2] = {&first, &second};
-    return intersect_lanes(groups, tmin, tmax, t, u, v);
+    return intersect_lanes<8>(groups, tmin, tmax, t, u, v);
   }
 
  private:
-  [[gnu::always_inline]] int intersect_lanes(const TriangleGroup* const (&groups)[N / 4], float tmin, float tmax,
-                                             vf& t, vf& u, vf& v) const {
+  template <int M>
+  [[gnu::always_inline]] int intersect_lanes(const TriangleGroup* const (&groups)[M / 4], float tmin, float tmax,
+                                             lanes<M>& t, lanes<M>& u, lanes<M>& v) const {
+    using V = lanes<M>;
+    V origin[3], shear_x, shear_y, shear_z;
+    for (int a = 0; a < 3; ++a) first_lanes(origin[a], origin_[a]);
+    first_lanes(shear_x, shear_x_);
+    first_lanes(shear_y, shear_y_);
+    first_lanes(shear_z, shear_z_);
     // Corner k relative to the origin, in the sheared frame (x, y; z unscaled).
-    vf px[3], py[3], pz[3];
+    V px[3], py[3], pz[3];
     for (int c = 0; c < 3; ++c) {
-      vf x, y, z;
+      V x, y, z;
       load(x, groups, c, axis_[0]);
       load(y, groups, c, axis_[1]);
       load(z, groups, c, axis_[2]);
-      pz[c] = z - origin_[2];
-      px[c] = (x - origin_[0]) - shear_x_ * pz[c];
-      py[c] = (y - origin_[1]) - shear_y_ * pz[c];
+      pz[c] = z - origin[2];
+      px[c] = (x - origin[0]) - shear_x * pz[c];
+      py[c] = (y - origin[1]) - shear_y * pz[c];
     }
-    const ShearedEdges<vf> e = sheared_edges(px, py);
+    const ShearedEdges<V> e = sheared_edges(px, py);
     const int edge_mask = movemask(e.on_edge);
     // Most groups a ray reaches are missed: skip the division then.
     if (movemask(e.inside) == 0 && edge_mask == 0) return 0;
-    const vf scaled_t = e.eu * (shear_z_ * pz[0]) + e.ev * (shear_z_ * pz[1]) + e.ew * (shear_z_ * pz[2]);
-    vf one, lo, hi;
+    const V scaled_t = e.eu * (shear_z * pz[0]) + e.ev * (shear_z * pz[1]) + e.ew * (shear_z * pz[2]);
+    V one, lo, hi;
     splat(one, 1.0f);
     splat(lo, tmin);
     splat(hi, tmax);
-    const vf inv_det = one / e.det;
+    const V inv_det = one / e.det;
     t = scaled_t * inv_det;
     u = e.ev * inv_det;
     v = e.ew * inv_det;
     int mask = movemask(e.inside & (t >= lo) & (t <= hi));
     if (edge_mask != 0) [[unlikely]] {
-      for (int i = 0; i < N; ++i) {
+      for (int i = 0; i < M; ++i) {
         if (!(edge_mask >> i & 1)) continue;
         float hit_t, hit_u, hit_v;
         const TriangleGroup& g = *groups[i / 4];
@@ -164,38 +175,51 @@ class RayTriangleGroupTest {
 
   // (Vectors written through references: an 8-lane vector passed by value
   // has another ABI with AVX than without.)
-  [[gnu::always_inline]] static void splat(vf& out, float x) {
+  template <typename V>
+  [[gnu::always_inline]] static void splat(V& out, float x) {
     const v4 s = {x, x, x, x};  // one broadcast (a lane-by-lane fill went through the stack)
-    if constexpr (N == 4) {
+    if constexpr (sizeof(V) == sizeof(v4)) {
       out = s;
     } else {
       out = __builtin_shufflevector(s, s, 0, 1, 2, 3, 0, 1, 2, 3);
     }
   }
+  // The first M lanes of a member (free: the low half of an AVX register).
+  template <typename V>
+  [[gnu::always_inline]] static void first_lanes(V& out, const vf& x) {
+    if constexpr (sizeof(V) == sizeof(vf)) {
+      out = x;
+    } else {
+      out = __builtin_shufflevector(x, x, 0, 1, 2, 3);
+    }
+  }
   // Row a of corner c of every group, side by side.
-  [[gnu::always_inline]] static void load(vf& out, const TriangleGroup* const (&groups)[N / 4], int c, int a) {
-    v4 row[N / 4];
-    for (int k = 0; k < N / 4; ++k) __builtin_memcpy(&row[k], groups[k]->corner[c][a], sizeof(v4));
-    if constexpr (N == 4) {
+  template <typename V, int G>
+  [[gnu::always_inline]] static void load(V& out, const TriangleGroup* const (&groups)[G], int c, int a) {
+    v4 row[G];
+    for (int k = 0; k < G; ++k) __builtin_memcpy(&row[k], groups[k]->corner[c][a], sizeof(v4));
+    if constexpr (G == 1) {
       out = row[0];
     } else {
       out = __builtin_shufflevector(row[0], row[1], 0, 1, 2, 3, 4, 5, 6, 7);
     }
   }
-  [[gnu::always_inline]] static int movemask(const vi& m) {
+  template <typename M>
+  [[gnu::always_inline]] static int movemask(const M& m) {
+    constexpr int n = int(sizeof(M) / 4);
 #if defined(__SSE__)
-    if constexpr (N == 4) return _mm_movemask_ps(reinterpret_cast<__m128>(m));
+    if constexpr (n == 4) return _mm_movemask_ps(reinterpret_cast<__m128>(m));
 #endif
 #if defined(__x86_64__) && defined(__GNUC__)
-    if constexpr (N == 8) return movemask_avx(m);
+    if constexpr (n == 8) return movemask_avx(m);
 #endif
     int bits = 0;
-    for (int i = 0; i < N; ++i) bits |= (m[i] & 1) << i;
+    for (int i = 0; i < n; ++i) bits |= (m[i] & 1) << i;
     return bits;
   }
 #if defined(__x86_64__) && defined(__GNUC__)
   // One instruction; inlined into the AVX kernels that use N = 8 (their flatten).
-  __attribute__((target("avx"))) static int movemask_avx(const vi& m) {
+  __attribute__((target("avx"))) static int movemask_avx(const lane_mask<8>& m) {
     __m256 r;
     __builtin_memcpy(&r, &m, sizeof r);
     return _mm256_movemask_ps(r);
