@@ -57,10 +57,10 @@ bool can_run_8_lanes() {
 #endif
 }
 
-// RayTriangle4Test on the group of `tri`, and RayTriangle8Test on it and a
-// second group of the same triangles in reverse order (lanes 4-7), against
-// the scalar test. Returns the number of lanes hit, for the callers to check
-// the inputs hit at all.
+// RayTriangle4Test on the group of `tri`, and RayTriangle8Test on it alone
+// and with a second group of the same triangles in reverse order (lanes 4-7),
+// against the scalar test. Returns the number of lanes hit, for the callers
+// to check the inputs hit at all.
 int expect_lanes_match_scalar(const TriMesh& mesh, const Ray3f& ray, const std::size_t (&tri)[4], float tmin,
                               float tmax, const std::string& what) {
   const TriangleGroup group = group_of(mesh, tri);
@@ -68,10 +68,14 @@ int expect_lanes_match_scalar(const TriMesh& mesh, const Ray3f& ray, const std::
   const int mask = RayTriangle4Test(ray).intersect(group, tmin, tmax, t, u, v);
   const int hits = expect_match_scalar<4>(mesh, ray, tri, mask, t, u, v, tmin, tmax, what);
   if (can_run_8_lanes()) {
+    const RayTriangle8Test test8(ray);
+    RayTriangle8Test::v4 t4, u4, v4;
+    const int mask4 = test8.intersect(group, tmin, tmax, t4, u4, v4);
+    EXPECT_EQ(expect_match_scalar<4>(mesh, ray, tri, mask4, t4, u4, v4, tmin, tmax, what + " (one group)"), hits);
     const std::size_t tri8[8] = {tri[0], tri[1], tri[2], tri[3], tri[3], tri[2], tri[1], tri[0]};
     const std::size_t reversed[4] = {tri[3], tri[2], tri[1], tri[0]};
     RayTriangle8Test::vf t8, u8, v8;
-    const int mask8 = RayTriangle8Test(ray).intersect(group, group_of(mesh, reversed), tmin, tmax, t8, u8, v8);
+    const int mask8 = test8.intersect(group, group_of(mesh, reversed), tmin, tmax, t8, u8, v8);
     EXPECT_EQ(expect_match_scalar<8>(mesh, ray, tri8, mask8, t8, u8, v8, tmin, tmax, what), 2 * hits) << what;
   }
   return hits;
