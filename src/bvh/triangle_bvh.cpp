@@ -23,9 +23,6 @@
 #include "geods/core/triangle.hpp"
 #include "geods/core/triangle_box.hpp"
 
-// 8-lane vectors are passed between inlined helpers only (RayTriangle8Test).
-#pragma GCC diagnostic ignored "-Wpsabi"
-
 namespace geods::bvh {
 namespace {
 
@@ -465,8 +462,7 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray, 
   using vf = typename SimdTypes<W>::vf;
   RayHit hit;
   if (nodes.empty()) return hit;
-  using GroupTest = RayTriangleGroupTest<Avx ? 8 : 4>;  // the AVX levels test two groups at once
-  const GroupTest test(ray);
+  const RayTriangle4Test test(ray);
   // A zero direction component gives an infinite inverse; the 0 * inf NaN of
   // an origin on a slab plane is then skipped by the NaN-ignoring min/max
   // below, so a ray inside a (possibly flat) slab keeps the whole line. The
@@ -560,43 +556,21 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray, 
     prefetch(c);
     return c;
   };
-  // Keeps the nearest hit lane of a test, ties to the last one: what testing
-  // the triangles one after the other, each against the shrinking tmax,
-  // would keep (t <= tmax: a later equal t wins), also when all the lanes
-  // saw the same tmax. Usually a single lane: no data-dependent branch per lane then.
-  auto keep = [&](int mask, const auto& t, const auto& u, const auto& v, const TriangleGroup& first,
-                  const TriangleGroup& second) GEODS_BVH_INLINE_LAMBDA {
-    int best = __builtin_ctz(unsigned(mask));
-    if (mask & (mask - 1)) {
-      for (int i = best + 1; i < int(sizeof(t) / sizeof(float)); ++i)
-        if ((mask >> i & 1) && t[i] <= t[best]) best = i;
-    }
-    tmax = t[best];
-    hit = {t[best], (best < 4 ? first : second).index[best % 4], u[best], v[best]};
-  };
   auto leaf = [&](const WideEntry& e) GEODS_BVH_INLINE_LAMBDA {
-    const std::uint32_t end = e.child + e.count;
-    if constexpr (Avx) {
-      // Closest hit: the groups two at a time (one 8-lane test; an odd last
-      // group fills both halves).
-      if (!any) {
-        for (std::uint32_t g = e.child; g < end; g += 2) {
-          const TriangleGroup& first = groups_[g];
-          const TriangleGroup& second = groups_[std::min(g + 2, end) - 1];
-          typename GroupTest::vf t, u, v;
-          const int mask = test.intersect(first, second, tmin, tmax, t, u, v);
-          if (mask != 0) keep(mask, t, u, v, first, second);
-        }
-        return true;
-      }
-    }
-    // One group at a time: a hit in the first group of an any-hit ray ends
-    // the traversal without waiting for the second one's cache lines.
-    for (std::uint32_t g = e.child; g < end; ++g) {
-      typename GroupTest::v4 t, u, v;
+    for (std::uint32_t g = e.child; g < e.child + e.count; ++g) {
+      RayTriangle4Test::vf t, u, v;
       const int mask = test.intersect(groups_[g], tmin, tmax, t, u, v);
       if (mask == 0) continue;
-      keep(mask, t, u, v, groups_[g], groups_[g]);
+      // The nearest lane, ties to the last one: what testing the triangles
+      // one after the other, each against the shrinking tmax, would keep.
+      // Usually a single lane: no data-dependent branch per lane then.
+      int best = __builtin_ctz(unsigned(mask));
+      if (mask & (mask - 1)) {
+        for (int i = best + 1; i < 4; ++i)
+          if ((mask >> i & 1) && t[i] <= t[best]) best = i;
+      }
+      tmax = t[best];
+      hit = {t[best], groups_[g].index[best], u[best], v[best]};
       if (any) return false;
     }
     return true;

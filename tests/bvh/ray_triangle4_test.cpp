@@ -1,5 +1,5 @@
-// RayTriangle4Test and RayTriangle8Test against the scalar watertight test
-// they vectorize: the same hit decisions and bit-identical t, u, v, lane by lane.
+// RayTriangle4Test against the scalar watertight test it vectorizes: the
+// same hit decisions and bit-identical t, u, v, lane by lane.
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -7,9 +7,6 @@
 
 #include "bvh_test_util.hpp"
 #include "geods/bvh/ray_triangle4.hpp"
-
-// 8-lane vectors are passed between inlined helpers only (RayTriangle8Test).
-#pragma GCC diagnostic ignored "-Wpsabi"
 
 namespace geods::bvh {
 namespace {
@@ -26,57 +23,24 @@ TriangleGroup group_of(const TriMesh& mesh, const std::size_t (&tri)[4]) {
   return g;
 }
 
-// Each lane of a 4- or 8-lane test against the scalar test on its triangle;
-// returns the number of lanes hit.
-template <int N>
-int expect_match_scalar(const TriMesh& mesh, const Ray3f& ray, const std::size_t (&tri)[N], int mask,
-                        const typename RayTriangleGroupTest<N>::vf& t, const typename RayTriangleGroupTest<N>::vf& u,
-                        const typename RayTriangleGroupTest<N>::vf& v, float tmin, float tmax, const std::string& what) {
+// Returns the number of lanes hit, for the callers to check the inputs hit at all.
+int expect_lanes_match_scalar(const TriMesh& mesh, const Ray3f& ray, const std::size_t (&tri)[4], float tmin,
+                              float tmax, const std::string& what) {
   const RayTriangleTest<float> scalar(ray);
+  const RayTriangle4Test wide(ray);
+  RayTriangle4Test::vf t, u, v;
+  const int mask = wide.intersect(group_of(mesh, tri), tmin, tmax, t, u, v);
   int hits = 0;
-  for (int lane = 0; lane < N; ++lane) {
+  for (int lane = 0; lane < 4; ++lane) {
     float st = 0, su = 0, sv = 0;
     const bool hit = scalar.intersect(test::corner(mesh, tri[lane], 0), test::corner(mesh, tri[lane], 1),
                                       test::corner(mesh, tri[lane], 2), tmin, tmax, st, su, sv);
-    EXPECT_EQ(bool(mask >> lane & 1), hit) << what << ", " << N << " lanes: lane " << lane;
+    EXPECT_EQ(bool(mask >> lane & 1), hit) << what << " lane " << lane;
     if (!hit || !(mask >> lane & 1)) continue;
     ++hits;
     EXPECT_TRUE(same_bits(t[lane], st) && same_bits(u[lane], su) && same_bits(v[lane], sv))
-        << what << ", " << N << " lanes: lane " << lane << ": " << t[lane] << " " << u[lane] << " " << v[lane]
-        << " vs " << st << " " << su << " " << sv;
-  }
-  return hits;
-}
-
-// The 8-lane test is compiled for (and used by) the AVX kernels only.
-bool can_run_8_lanes() {
-#if defined(__x86_64__) && defined(__GNUC__)
-  return __builtin_cpu_supports("avx");
-#else
-  return true;
-#endif
-}
-
-// RayTriangle4Test on the group of `tri`, and RayTriangle8Test on it alone
-// and with a second group of the same triangles in reverse order (lanes 4-7),
-// against the scalar test. Returns the number of lanes hit, for the callers
-// to check the inputs hit at all.
-int expect_lanes_match_scalar(const TriMesh& mesh, const Ray3f& ray, const std::size_t (&tri)[4], float tmin,
-                              float tmax, const std::string& what) {
-  const TriangleGroup group = group_of(mesh, tri);
-  RayTriangle4Test::vf t, u, v;
-  const int mask = RayTriangle4Test(ray).intersect(group, tmin, tmax, t, u, v);
-  const int hits = expect_match_scalar<4>(mesh, ray, tri, mask, t, u, v, tmin, tmax, what);
-  if (can_run_8_lanes()) {
-    const RayTriangle8Test test8(ray);
-    RayTriangle8Test::v4 t4, u4, v4;
-    const int mask4 = test8.intersect(group, tmin, tmax, t4, u4, v4);
-    EXPECT_EQ(expect_match_scalar<4>(mesh, ray, tri, mask4, t4, u4, v4, tmin, tmax, what + " (one group)"), hits);
-    const std::size_t tri8[8] = {tri[0], tri[1], tri[2], tri[3], tri[3], tri[2], tri[1], tri[0]};
-    const std::size_t reversed[4] = {tri[3], tri[2], tri[1], tri[0]};
-    RayTriangle8Test::vf t8, u8, v8;
-    const int mask8 = test8.intersect(group, group_of(mesh, reversed), tmin, tmax, t8, u8, v8);
-    EXPECT_EQ(expect_match_scalar<8>(mesh, ray, tri8, mask8, t8, u8, v8, tmin, tmax, what), 2 * hits) << what;
+        << what << " lane " << lane << ": " << t[lane] << " " << u[lane] << " " << v[lane] << " vs " << st << " "
+        << su << " " << sv;
   }
   return hits;
 }

@@ -2,20 +2,16 @@
 // Four triangles side by side (structure of arrays, Embree's "triangle4"
 // idea) and the watertight test of core/ray_triangle.hpp on all four at once
 // with 4-wide GCC/Clang vector extensions (SSE on x86, plain scalar code where
-// there is no SIMD), or on two groups at once with 8-wide ones (AVX code: the
-// wide traversal's AVX kernels test a leaf's two groups so). Every lane
-// performs the scalar test's operations in the same order, and a lane whose
-// edge function rounds to zero is handed to the scalar test itself (its
-// double-precision recomputation), so t, u, v and the hit decision are
-// bit-identical to RayTriangleTest<float>.
+// there is no SIMD). Every lane performs the scalar test's operations in the
+// same order, and a lane whose edge function rounds to zero is handed to the
+// scalar test itself (its double-precision recomputation), so t, u, v and the
+// hit decision are bit-identical to RayTriangleTest<float>.
 #include <cstdint>
 #include <limits>
 
 #include "geods/core/ray_triangle.hpp"
 
-#if defined(__x86_64__) && defined(__GNUC__)
-#include <immintrin.h>
-#elif defined(__SSE__)
+#if defined(__SSE__)
 #include <xmmintrin.h>
 #endif
 
@@ -37,7 +33,7 @@ struct alignas(32) TriangleGroup {  // 160 bytes
 /// lanes for the scalar test's double-precision path. As vector masks, or as
 /// bit masks with a `bits` that turns each comparison into one (packets of
 /// 16: GCC scalarizes & and | of 16-lane comparisons inlined into AVX-512 code).
-// (Always inlined, as the 8-lane test below: its vectors cross no call, so no ABI concern.)
+// (Always inlined: the wide vectors below cross no call, so no ABI concern.)
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wpsabi"
 struct SameMask {
@@ -66,105 +62,49 @@ template <typename VF, typename Bits = SameMask>
   e.inside = ~mixed & ~e.on_edge & bits(e.det != zero) & bits(e.det - e.det == zero);
   return e;
 }
+#pragma GCC diagnostic pop
 
-// The lane vectors of RayTriangleGroupTest<N>.
-template <int N>
-struct GroupLanes;  // (GCC drops vector_size on a typedef that depends on a template parameter)
-template <>
-struct GroupLanes<4> {
+class RayTriangle4Test {
+ public:
   typedef float vf __attribute__((vector_size(16)));
   typedef std::int32_t vi __attribute__((vector_size(16)));
-};
-template <>
-struct GroupLanes<8> {
-  typedef float vf __attribute__((vector_size(32)));
-  typedef std::int32_t vi __attribute__((vector_size(32)));
-};
 
-/// The watertight test of one ray against the triangles of N / 4 triangle
-/// groups at once: N = 4 (SSE) or 8 (two groups in one AVX register, for
-/// code compiled for AVX: the traversal's AVX kernels). Lanes 4 to 7 are the
-/// second group's. With N = 8 a single group can also be tested alone (4 lanes).
-template <int N>
-class RayTriangleGroupTest {
-  static_assert(N == 4 || N == 8, "groups of 4 triangles, one or two at a time");
-  template <int M>
-  using lanes = typename GroupLanes<M>::vf;
-  template <int M>
-  using lane_mask = typename GroupLanes<M>::vi;
-
- public:
-  using v4 = lanes<4>;
-  using vf = lanes<N>;
-
-  explicit RayTriangleGroupTest(const Ray3f& ray) : scalar_(ray) {
+  explicit RayTriangle4Test(const Ray3f& ray) : scalar_(ray) {
     const int k[3] = {scalar_.axis_x(), scalar_.axis_y(), scalar_.axis_z()};
     for (int a = 0; a < 3; ++a) {
       axis_[a] = k[a];
-      splat(origin_[a], scalar_.origin()[k[a]]);
+      origin_[a] = splat(scalar_.origin()[k[a]]);
     }
-    splat(shear_x_, scalar_.shear_x());
-    splat(shear_y_, scalar_.shear_y());
-    splat(shear_z_, scalar_.shear_z());
+    shear_x_ = splat(scalar_.shear_x());
+    shear_y_ = splat(scalar_.shear_y());
+    shear_z_ = splat(scalar_.shear_z());
   }
 
   /// Bit i set: lane i's triangle is hit with t in [tmin, tmax], its t and
   /// barycentrics in t[i], u[i], v[i] (other lanes hold garbage).
-  [[gnu::always_inline]] int intersect(const TriangleGroup& g, float tmin, float tmax, v4& t, v4& u, v4& v) const {
-    const TriangleGroup* groups[1] = {&g};
-    return intersect_lanes<4>(groups, tmin, tmax, t, u, v);
-  }
-  /// The same for the 8 triangles of `first` (lanes 0-3) and `second` (4-7).
-  [[gnu::always_inline]] int intersect(const TriangleGroup& first, const TriangleGroup& second, float tmin, float tmax,
-                                       vf& t, vf& u, vf& v) const
-    requires(N == 8)
-  {
-    const TriangleGroup* groups[2] = {&first, &second};
-    return intersect_lanes<8>(groups, tmin, tmax, t, u, v);
-  }
-
- private:
-  template <int M>
-  [[gnu::always_inline]] int intersect_lanes(const TriangleGroup* const (&groups)[M / 4], float tmin, float tmax,
-                                             lanes<M>& t, lanes<M>& u, lanes<M>& v) const {
-    using V = lanes<M>;
-    V origin[3], shear_x, shear_y, shear_z;
-    for (int a = 0; a < 3; ++a) first_lanes(origin[a], origin_[a]);
-    first_lanes(shear_x, shear_x_);
-    first_lanes(shear_y, shear_y_);
-    first_lanes(shear_z, shear_z_);
+  int intersect(const TriangleGroup& g, float tmin, float tmax, vf& t, vf& u, vf& v) const {
     // Corner k relative to the origin, in the sheared frame (x, y; z unscaled).
-    V px[3], py[3], pz[3];
+    vf px[3], py[3], pz[3];
     for (int c = 0; c < 3; ++c) {
-      V x, y, z;
-      load(x, groups, c, axis_[0]);
-      load(y, groups, c, axis_[1]);
-      load(z, groups, c, axis_[2]);
-      pz[c] = z - origin[2];
-      px[c] = (x - origin[0]) - shear_x * pz[c];
-      py[c] = (y - origin[1]) - shear_y * pz[c];
+      pz[c] = load(g.corner[c][axis_[2]]) - origin_[2];
+      px[c] = (load(g.corner[c][axis_[0]]) - origin_[0]) - shear_x_ * pz[c];
+      py[c] = (load(g.corner[c][axis_[1]]) - origin_[1]) - shear_y_ * pz[c];
     }
-    const ShearedEdges<V> e = sheared_edges(px, py);
+    const ShearedEdges<vf> e = sheared_edges(px, py);
     const int edge_mask = movemask(e.on_edge);
     // Most groups a ray reaches are missed: skip the division then.
     if (movemask(e.inside) == 0 && edge_mask == 0) return 0;
-    const V scaled_t = e.eu * (shear_z * pz[0]) + e.ev * (shear_z * pz[1]) + e.ew * (shear_z * pz[2]);
-    V one, lo, hi;
-    splat(one, 1.0f);
-    splat(lo, tmin);
-    splat(hi, tmax);
-    const V inv_det = one / e.det;
+    const vf scaled_t = e.eu * (shear_z_ * pz[0]) + e.ev * (shear_z_ * pz[1]) + e.ew * (shear_z_ * pz[2]);
+    const vf inv_det = splat(1.0f) / e.det;
     t = scaled_t * inv_det;
     u = e.ev * inv_det;
     v = e.ew * inv_det;
-    int mask = movemask(e.inside & (t >= lo) & (t <= hi));
+    int mask = movemask(e.inside & (t >= splat(tmin)) & (t <= splat(tmax)));
     if (edge_mask != 0) [[unlikely]] {
-      for (int i = 0; i < M; ++i) {
+      for (int i = 0; i < 4; ++i) {
         if (!(edge_mask >> i & 1)) continue;
         float hit_t, hit_u, hit_v;
-        const TriangleGroup& g = *groups[i / 4];
-        if (scalar_.intersect(corner(g, 0, i % 4), corner(g, 1, i % 4), corner(g, 2, i % 4), tmin, tmax, hit_t, hit_u,
-                              hit_v)) {
+        if (scalar_.intersect(corner(g, 0, i), corner(g, 1, i), corner(g, 2, i), tmin, tmax, hit_t, hit_u, hit_v)) {
           t[i] = hit_t, u[i] = hit_u, v[i] = hit_v;
           mask |= 1 << i;
         }
@@ -173,58 +113,20 @@ class RayTriangleGroupTest {
     return mask;
   }
 
-  // (Vectors written through references: an 8-lane vector passed by value
-  // has another ABI with AVX than without.)
-  template <typename V>
-  [[gnu::always_inline]] static void splat(V& out, float x) {
-    const v4 s = {x, x, x, x};  // one broadcast (a lane-by-lane fill went through the stack)
-    if constexpr (sizeof(V) == sizeof(v4)) {
-      out = s;
-    } else {
-      out = __builtin_shufflevector(s, s, 0, 1, 2, 3, 0, 1, 2, 3);
-    }
+ private:
+  static vf splat(float x) { return vf{x, x, x, x}; }
+  static vf load(const float* p) {
+    vf r;
+    __builtin_memcpy(&r, p, sizeof r);
+    return r;
   }
-  // The first M lanes of a member (free: the low half of an AVX register).
-  template <typename V>
-  [[gnu::always_inline]] static void first_lanes(V& out, const vf& x) {
-    if constexpr (sizeof(V) == sizeof(vf)) {
-      out = x;
-    } else {
-      out = __builtin_shufflevector(x, x, 0, 1, 2, 3);
-    }
-  }
-  // Row a of corner c of every group, side by side.
-  template <typename V, int G>
-  [[gnu::always_inline]] static void load(V& out, const TriangleGroup* const (&groups)[G], int c, int a) {
-    v4 row[G];
-    for (int k = 0; k < G; ++k) __builtin_memcpy(&row[k], groups[k]->corner[c][a], sizeof(v4));
-    if constexpr (G == 1) {
-      out = row[0];
-    } else {
-      out = __builtin_shufflevector(row[0], row[1], 0, 1, 2, 3, 4, 5, 6, 7);
-    }
-  }
-  template <typename M>
-  [[gnu::always_inline]] static int movemask(const M& m) {
-    constexpr int n = int(sizeof(M) / 4);
+  static int movemask(vi m) {
 #if defined(__SSE__)
-    if constexpr (n == 4) return _mm_movemask_ps(reinterpret_cast<__m128>(m));
+    return _mm_movemask_ps(reinterpret_cast<__m128>(m));
+#else
+    return (m[0] & 1) | (m[1] & 2) | (m[2] & 4) | (m[3] & 8);
 #endif
-#if defined(__x86_64__) && defined(__GNUC__)
-    if constexpr (n == 8) return movemask_avx(m);
-#endif
-    int bits = 0;
-    for (int i = 0; i < n; ++i) bits |= (m[i] & 1) << i;
-    return bits;
   }
-#if defined(__x86_64__) && defined(__GNUC__)
-  // One instruction; inlined into the AVX kernels that use N = 8 (their flatten).
-  __attribute__((target("avx"))) static int movemask_avx(const lane_mask<8>& m) {
-    __m256 r;
-    __builtin_memcpy(&r, &m, sizeof r);
-    return _mm256_movemask_ps(r);
-  }
-#endif
   static Vec3f corner(const TriangleGroup& g, int k, int lane) {
     return {g.corner[k][0][lane], g.corner[k][1][lane], g.corner[k][2][lane]};
   }
@@ -234,9 +136,5 @@ class RayTriangleGroupTest {
   vf origin_[3];  // origin coordinate along kx, ky, kz
   vf shear_x_, shear_y_, shear_z_;
 };
-#pragma GCC diagnostic pop
-
-using RayTriangle4Test = RayTriangleGroupTest<4>;
-using RayTriangle8Test = RayTriangleGroupTest<8>;
 
 }  // namespace geods::bvh
