@@ -48,9 +48,9 @@ int main(int argc, char** argv) {
   const compare::ThreadLimit limit(args.threads);
   if (!args.wants("100k_coherent") && !args.wants("100k_incoherent")) return 0;
   const compare::PlyMesh mesh = compare::read_ply(args.path("mesh_100k.ply"));
-  if (args.wants("100k_coherent")) compare::ray::run_variant<Accel>(args, mesh, "100k", "coherent");
+  if (args.wants("100k_coherent")) compare::ray::run_variant<Accel>(args, mesh, "100k", "coherent", false);
   compare::Args fewer = args;
   fewer.scale *= 0.1;
-  if (args.wants("100k_incoherent")) compare::ray::run_variant<Accel>(fewer, mesh, "100k", "incoherent");
+  if (args.wants("100k_incoherent")) compare::ray::run_variant<Accel>(fewer, mesh, "100k", "incoherent", false);
   return 0;
 }

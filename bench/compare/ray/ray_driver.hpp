@@ -13,11 +13,10 @@
 //   static bool wants_mesh(const std::string& mesh);  // e.g. CGAL: "100k" only
 //
 //   static bool occluded(const Index&, const float* ray);  // any hit with t in [0, inf)
-// With the environment variable ANCHORS_RAY_ANY=1 the programs that have
-// occluded time it instead of intersect (variants "<mesh>_<rays>_any"; the
-// check then compares hit or miss only).
 //
-// Variants: "1m_coherent", "1m_incoherent", "100k_coherent", "100k_incoherent".
+// Variants: "1m_coherent", "1m_incoherent", "100k_coherent", "100k_incoherent"
+// (closest hit) and, for the libraries with occluded, the same with "_any"
+// (any hit, rtcOccluded1's question; the check then compares hit or miss only).
 // Check: every 10000th ray against brute force (Möller-Trumbore in double):
 // same hit/miss and t within 1e-4, allowing one grazing disagreement per 100.
 // "hits" (number of rays that hit) must agree across libraries; "mean_t" too,
@@ -59,15 +58,12 @@ inline double brute_force_t(const PlyMesh& mesh, const float* r) {
   return best;
 }
 
-inline bool any_hit_mode() {
-  const char* e = std::getenv("ANCHORS_RAY_ANY");
-  return e && *e && std::string_view(e) != "0";
-}
+template <class Lib>
+constexpr bool has_occluded = requires(const typename Lib::Index& index, const float* r) { Lib::occluded(index, r); };
 
 template <class Lib>
-void run_variant(const Args& args, const PlyMesh& mesh, const std::string& mesh_name, const std::string& rays_name) {
-  constexpr bool has_occluded = requires(const typename Lib::Index& index, const float* r) { Lib::occluded(index, r); };
-  const bool any = has_occluded && any_hit_mode();
+void run_variant(const Args& args, const PlyMesh& mesh, const std::string& mesh_name, const std::string& rays_name,
+                 bool any) {
   std::vector<float> rays = read_raw<float>(args.path("rays_" + rays_name + ".f32"));
   const std::size_t m = std::min(rays.size() / 6, args.scaled(rays.size() / 6));
   rays.resize(6 * m);
@@ -80,7 +76,7 @@ void run_variant(const Args& args, const PlyMesh& mesh, const std::string& mesh_
   });
   auto trace_all = [&] {
     auto body = [&](std::size_t b, std::size_t e) {
-      if constexpr (has_occluded) {
+      if constexpr (has_occluded<Lib>) {
         if (any) {
           for (std::size_t i = b; i < e; ++i) hits[i] = Lib::occluded(*index, &rays[6 * i]) ? Hit{0.0f, 0} : Hit{};
           return;
@@ -128,10 +124,16 @@ int run(int argc, char** argv) {
     if constexpr (requires { Lib::wants_mesh(std::string()); }) {
       if (!Lib::wants_mesh(mesh_name)) continue;
     }
-    if (!args.wants(std::string(mesh_name) + "_coherent") && !args.wants(std::string(mesh_name) + "_incoherent")) continue;
+    // (rays, any hit) of the variants wanted on this mesh
+    std::vector<std::pair<std::string, bool>> wanted;
+    for (const char* rays_name : {"coherent", "incoherent"}) {
+      const std::string variant = std::string(mesh_name) + "_" + rays_name;
+      if (args.wants(variant)) wanted.emplace_back(rays_name, false);
+      if (has_occluded<Lib> && args.wants(variant + "_any")) wanted.emplace_back(rays_name, true);
+    }
+    if (wanted.empty()) continue;
     const PlyMesh mesh = read_ply(args.path(std::string("mesh_") + mesh_name + ".ply"));
-    for (const char* rays_name : {"coherent", "incoherent"})
-      if (args.wants(std::string(mesh_name) + "_" + rays_name)) run_variant<Lib>(args, mesh, mesh_name, rays_name);
+    for (const auto& [rays_name, any] : wanted) run_variant<Lib>(args, mesh, mesh_name, rays_name, any);
   }
   return 0;
 }
