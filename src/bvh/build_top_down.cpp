@@ -1,14 +1,16 @@
 // Top-down builders (§4.1.3): binned SAH, object median, PCA plane and
 // Zachmann's restricted boxtree criterion. Each recursion step splits a range
-// of the primitive array in place; large ranges recurse in parallel. Node ids
-// depend on scheduling, but finalize() renumbers depth first and every split
+// of the primitive array in place; large ranges recurse in parallel. Each
+// side of a parallel split numbers its nodes in its own range of ids (a
+// subtree of k primitives has at most 2 k - 1 nodes), so no counter is shared
+// between threads (one atomic per node made them fight over its cache line);
+// the ids leave gaps, finalize() renumbers depth first, and every split
 // decision depends only on the range's contents, so the tree is deterministic.
 #include <tbb/parallel_invoke.h>
 #include <tbb/parallel_reduce.h>
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <cstddef>
 #include <cstdlib>
@@ -143,10 +145,11 @@ class TopDown {
 
   Topology run() {
     const auto n = std::uint32_t(refs_.size());
-    const std::uint32_t root = build(0, n, bounds(0, n), 0);
+    std::uint32_t next = 0;  // one past the largest node id used
+    const std::uint32_t root = build(0, n, bounds(0, n), 0, next);
     UntouchedArray<std::uint32_t> prims(n);
     parallel_for_each_index(0, n, [&](std::size_t i) { prims[i] = refs_[i].id; });
-    return finalize({{nodes_.data(), next_.load()}, root, {prims.data(), n}, false}, options_.leaf_size,
+    return finalize({{nodes_.data(), next}, root, {prims.data(), n}, false}, options_.leaf_size,
                     options_.arity);
   }
 
@@ -176,8 +179,9 @@ class TopDown {
     return id;
   }
 
-  std::uint32_t build(std::uint32_t begin, std::uint32_t end, const RangeBounds& rb, int depth) {
-    const std::uint32_t id = next_.fetch_add(1);
+  // The subtree of [begin, end), its nodes numbered from `next` on (advanced past them).
+  std::uint32_t build(std::uint32_t begin, std::uint32_t end, const RangeBounds& rb, int depth, std::uint32_t& next) {
+    const std::uint32_t id = next++;
     BinaryNode& node = *std::construct_at(&nodes_[id]);
     node.box = rb.box;
     node.prim_count = end - begin;
@@ -204,12 +208,14 @@ class TopDown {
     if (count >= kParallelThreshold && num_threads() > 1) {
       if (!have_sides)
         tbb::parallel_invoke([&] { side[0] = bounds(begin, mid); }, [&] { side[1] = bounds(mid, end); });
-      tbb::parallel_invoke([&] { left = build(begin, mid, side[0], depth + 1); },
-                           [&] { right = build(mid, end, side[1], depth + 1); });
+      std::uint32_t next_left = next, next_right = next + 2 * (mid - begin) - 1;
+      tbb::parallel_invoke([&] { left = build(begin, mid, side[0], depth + 1, next_left); },
+                           [&] { right = build(mid, end, side[1], depth + 1, next_right); });
+      next = next_right;
     } else {
       if (!have_sides) side[0] = bounds(begin, mid), side[1] = bounds(mid, end);
-      left = build(begin, mid, side[0], depth + 1);
-      right = build(mid, end, side[1], depth + 1);
+      left = build(begin, mid, side[0], depth + 1, next);
+      right = build(mid, end, side[1], depth + 1, next);
     }
     nodes_[id].left = left;
     nodes_[id].right = right;
@@ -517,7 +523,6 @@ class TopDown {
   // The primitives move with the partitions, so every scan reads them in order.
   UntouchedArray<PrimRef> refs_;
   UntouchedArray<BinaryNode> nodes_;
-  std::atomic<std::uint32_t> next_{0};
 };
 
 }  // namespace
