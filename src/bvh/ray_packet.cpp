@@ -86,27 +86,17 @@ __attribute__((target("avx512f"))) inline unsigned compare_bits_avx512(Lanes<16>
 }
 #endif
 
-// lane_bits of a < b, a <= b, a == b; 16 lanes with AVX-512 compare straight
+// lane_bits of a < b, a <= b or a == b; 16 lanes with AVX-512 compare straight
 // into a mask register (GCC turns the comparison into a vector and back).
-template <SimdLevel L, typename V>
-GEODS_BVH_INLINE unsigned lt_bits(V a, V b) {
+enum class Cmp { lt, le, eq };
+template <SimdLevel L, Cmp C, typename V>
+GEODS_BVH_INLINE unsigned compare_bits(V a, V b) {
 #if defined(GEODS_PACKET_SIMD_DISPATCH)
-  if constexpr (sizeof(V) == 64 && L == SimdLevel::avx512) return compare_bits_avx512<_CMP_LT_OS>(a, b);
+  if constexpr (sizeof(V) == 64 && L == SimdLevel::avx512)
+    return compare_bits_avx512<C == Cmp::lt ? _CMP_LT_OS : C == Cmp::le ? _CMP_LE_OS : _CMP_EQ_OQ>(a, b);
 #endif
-  return lane_bits<L>(a < b);
-}
-template <SimdLevel L, typename V>
-GEODS_BVH_INLINE unsigned le_bits(V a, V b) {
-#if defined(GEODS_PACKET_SIMD_DISPATCH)
-  if constexpr (sizeof(V) == 64 && L == SimdLevel::avx512) return compare_bits_avx512<_CMP_LE_OS>(a, b);
-#endif
-  return lane_bits<L>(a <= b);
-}
-template <SimdLevel L, typename V>
-GEODS_BVH_INLINE unsigned eq_bits(V a, V b) {
-#if defined(GEODS_PACKET_SIMD_DISPATCH)
-  if constexpr (sizeof(V) == 64 && L == SimdLevel::avx512) return compare_bits_avx512<_CMP_EQ_OQ>(a, b);
-#endif
+  if constexpr (C == Cmp::lt) return lane_bits<L>(a < b);
+  if constexpr (C == Cmp::le) return lane_bits<L>(a <= b);
   return lane_bits<L>(a == b);
 }
 
@@ -232,9 +222,9 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
     vf finite = splat<P>(0.0f);
     for (int a = 0; a < 3; ++a) finite += (org[a] - org[a]) + (dir[a] - dir[a]);
     const vf zero = splat<P>(0.0f);
-    const std::uint32_t zero_dir = eq_bits<L>(dir[0], zero) & eq_bits<L>(dir[1], zero) & eq_bits<L>(dir[2], zero);
-    const std::uint32_t taken = active & eq_bits<L>(finite, zero) & ~zero_dir & eq_bits<L>(tmin_v, tmin_v) &
-                                eq_bits<L>(hit_t, hit_t);
+    const auto eq = [](vf a, vf b) GEODS_BVH_INLINE_LAMBDA { return compare_bits<L, Cmp::eq>(a, b); };
+    const std::uint32_t zero_dir = eq(dir[0], zero) & eq(dir[1], zero) & eq(dir[2], zero);
+    const std::uint32_t taken = active & eq(finite, zero) & ~zero_dir & eq(tmin_v, tmin_v) & eq(hit_t, hit_t);
     alone |= active & ~taken;
     active = taken;
   }
@@ -313,7 +303,7 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
   // of the single ray). Lanes that entered later are dropped by the tests below it.
   auto live = [&](const PacketEntry& e) GEODS_BVH_INLINE_LAMBDA {
     const vf slack = (hit_t < splat<P>(0.0f) ? -hit_t : hit_t) * splat<P>(4e-7f);
-    return e.mask & ~done & le_bits<L>(splat<P>(e.key), hit_t + slack);
+    return e.mask & ~done & compare_bits<L, Cmp::le>(splat<P>(e.key), hit_t + slack);
   };
   // The children that some lane may enter, all W at once: a lane's entry
   // and exit distances along an axis are products of (bound - origin) and the
@@ -367,7 +357,7 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
         tn = near > tn ? near : tn;
         tf = far < tf ? far : tf;
       }
-      const std::uint32_t m = lanes & le_bits<L>(tn, tf * splat<P>(widen));
+      const std::uint32_t m = lanes & compare_bits<L, Cmp::le>(tn, tf * splat<P>(widen));
       if (m == 0) continue;
       child_mask[c] = m;
       if (!full_frustum) keys[c] = lane_min(lane_mask<P>(m) ? tn : inf);
@@ -393,8 +383,8 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
   auto record = [&](std::uint32_t hits, vf t, vi prim, vf u, vf v) GEODS_BVH_INLINE_LAMBDA {
     const vi m = lane_mask<P>(hits);
     const std::uint32_t had = hits & lane_bits<L>(hit_prim != (vi{} - 1));
-    alone &= ~(had & lt_bits<L>(t, hit_t));
-    alone |= had & eq_bits<L>(t, hit_t) & lane_bits<L>(prim != hit_prim);
+    alone &= ~(had & compare_bits<L, Cmp::lt>(t, hit_t));
+    alone |= had & compare_bits<L, Cmp::eq>(t, hit_t) & lane_bits<L>(prim != hit_prim);
     hit_t = m ? t : hit_t;
     hit_prim = m ? prim : hit_prim;
     hit_u = m ? u : hit_u;
@@ -434,7 +424,7 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
         vf t = scaled_t * inv_det, u = ed.ev * inv_det, v = ed.ew * inv_det;
         std::uint32_t hits;
         if constexpr (P == 16) {
-          hits = ed.inside & le_bits<L>(tmin_v, t) & le_bits<L>(t, hit_t) & lanes;
+          hits = ed.inside & compare_bits<L, Cmp::le>(tmin_v, t) & compare_bits<L, Cmp::le>(t, hit_t) & lanes;
         } else {
           hits = lane_bits<L>(ed.inside & (t >= tmin_v) & (t <= hit_t)) & lanes;
         }
