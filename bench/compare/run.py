@@ -51,9 +51,9 @@ declares them with geods_compare_program(), and a compare.json read here:
   rounds      optional number of interleaved rounds when --rounds is not given (default 1)
   timeout_s   optional per-program time limit (default 1800)
   scaling     optional [{"anchor": "geods", "variant": "iso 1.8", "metric": "build_s", "note": "..."}]:
-              the measured reason for a geods program's speed-up on all cores (variant and metric: a
-              name or a list of names, left out to match all), shown in the "why" column of the
-              All-cores table
+              the measured reason for a geods program's speed-up on all cores (anchor: a name or a
+              list of names; variant and metric: the same, left out to match all), shown in the
+              "why" column of the All-cores table
 
 Every program takes --data DIR --threads N --reps N [--scale X] and prints one JSON line per
 measurement: {"workload","anchor","variant","threads","build_s","query_s","count","median_of",...,"ok"}.
@@ -450,7 +450,7 @@ def speedup_rows(c, records, labels, run):
         peers = [f"{labels.get(b, b)} {ps:.2f}" for b in labels if not b.startswith("geods")
                  for ps, _ in [speedup((b, v, m))] if ps]
         mark = f"**{s:.2f}**" if s >= 1.6 else f"{s:.2f} (< 1.6)"
-        why = next((n["note"] for n in c.get("scaling", []) if n.get("anchor") == a
+        why = next((n["note"] for n in c.get("scaling", []) if a in as_list(n.get("anchor"))
                     and v in as_list(n.get("variant", v)) and m in as_list(n.get("metric", m))), "")
         rows.append(f"| {c['workload']} | {md_escape(labels.get(a, a))} | `{v}` | {m} | {most} | {mark} | "
                     f"{md_escape(', '.join(peers)) or '–'} | {load} | {md_escape(why) or '–'} |")
