@@ -427,38 +427,38 @@ __attribute__((target("avx"))) inline unsigned lane_bits_avx(const Mask& m) {
 // instructions are not used to contract a * b + c), so the hits are identical.
 #if defined(__x86_64__) && defined(__GNUC__)
 #define GEODS_BVH_SIMD_DISPATCH 1
-template <int W>
+template <int W, bool Any>
 __attribute__((target("avx"), flatten)) RayHit TriangleBvh::intersect_wide_avx(const WideNodes<W>& nodes,
-                                                                               const Ray3f& ray, bool any) const {
-  return intersect_wide<W, true>(nodes, ray, any);
+                                                                               const Ray3f& ray) const {
+  return intersect_wide<W, Any, true>(nodes, ray);
 }
-template <int W>
+template <int W, bool Any>
 __attribute__((target("avx2,bmi,bmi2,lzcnt,popcnt"), flatten)) RayHit TriangleBvh::intersect_wide_avx2(
-    const WideNodes<W>& nodes, const Ray3f& ray, bool any) const {
-  return intersect_wide<W, true>(nodes, ray, any);
+    const WideNodes<W>& nodes, const Ray3f& ray) const {
+  return intersect_wide<W, Any, true>(nodes, ray);
 }
-template <int W>
+template <int W, bool Any>
 __attribute__((target("avx512f,avx512vl,avx512bw,avx512dq,avx2,bmi,bmi2,lzcnt,popcnt"), flatten)) RayHit
-TriangleBvh::intersect_wide_avx512(const WideNodes<W>& nodes, const Ray3f& ray, bool any) const {
-  return intersect_wide<W, true>(nodes, ray, any);
+TriangleBvh::intersect_wide_avx512(const WideNodes<W>& nodes, const Ray3f& ray) const {
+  return intersect_wide<W, Any, true>(nodes, ray);
 }
 #endif
 
-template <int W>
-RayHit TriangleBvh::intersect_wide_best(const WideNodes<W>& nodes, const Ray3f& ray, bool any) const {
+template <int W, bool Any>
+RayHit TriangleBvh::intersect_wide_best(const WideNodes<W>& nodes, const Ray3f& ray) const {
 #if defined(GEODS_BVH_SIMD_DISPATCH)
   switch (simd_level()) {
-    case SimdLevel::avx512: return intersect_wide_avx512(nodes, ray, any);
-    case SimdLevel::avx2: return intersect_wide_avx2(nodes, ray, any);
-    case SimdLevel::avx: return intersect_wide_avx(nodes, ray, any);
+    case SimdLevel::avx512: return intersect_wide_avx512<W, Any>(nodes, ray);
+    case SimdLevel::avx2: return intersect_wide_avx2<W, Any>(nodes, ray);
+    case SimdLevel::avx: return intersect_wide_avx<W, Any>(nodes, ray);
     case SimdLevel::portable: break;
   }
 #endif
-  return intersect_wide(nodes, ray, any);
+  return intersect_wide<W, Any>(nodes, ray);
 }
 
-template <int W, bool Avx>
-RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray, bool any) const {
+template <int W, bool Any, bool Avx>
+RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray) const {
   using vf = typename SimdTypes<W>::vf;
   RayHit hit;
   if (nodes.empty()) return hit;
@@ -467,14 +467,24 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray, 
   // an origin on a slab plane is then skipped by the NaN-ignoring min/max
   // below, so a ray inside a (possibly flat) slab keeps the whole line. The
   // near bound of each axis is chosen by the sign.
-  vf org[3], inv[3];
-  int near_row[3];
+  // The far bounds are scaled by inv_far = inv (1 + 4e-7): the widening of
+  // Ize (2013) that keeps a box hit rounding would lose, folded into the
+  // inverse so that it costs no operation per node (one rounding of inv x
+  // (1 + 4e-7) in place of one of t x (1 + 4e-7): the same bound; near and far
+  // share the rounding of inv itself).
+  constexpr float kWiden = 1.0f + 4e-7f;
+  vf org[3], inv[3], inv_far[3];
+  std::size_t near_offset[3];  // byte offset of the near bound's row in WideNode::bounds; the far row's is ^ sizeof(vf)
   for (int a = 0; a < 3; ++a) {
     const float inv_a = 1.0f / ray.direction[a];
-    near_row[a] = 2 * a + (inv_a < 0 ? 1 : 0);
+    near_offset[a] = (2 * a + (inv_a < 0 ? 1 : 0)) * sizeof(vf);
     splat(org[a], ray.origin[a]);
     splat(inv[a], inv_a);
+    splat(inv_far[a], inv_a * kWiden);
   }
+  // Plain pointers: through the containers GCC reloads them at every node.
+  const WideNode<W>* const node_at = nodes.data();
+  const TriangleGroup* const group_at = groups_.data();
   float tmax = ray.tmax;
   const float tmin = ray.tmin;
   vf tmin_v;
@@ -485,56 +495,51 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray, 
   // misses on nodes and triangles dominate incoherent rays.
   auto prefetch = [&](const WideEntry& e) GEODS_BVH_INLINE_LAMBDA {
     if (e.count == 0) {
-      const char* p = reinterpret_cast<const char*>(&nodes[e.child]);
+      const char* p = reinterpret_cast<const char*>(&node_at[e.child]);
       for (std::size_t k = 0; k < sizeof(WideNode<W>); k += 64) __builtin_prefetch(p + k);
       return;
     }
-    const std::uintptr_t first = reinterpret_cast<std::uintptr_t>(&groups_[e.child]) & ~std::uintptr_t(63);
-    const std::uintptr_t last = reinterpret_cast<std::uintptr_t>(&groups_[e.child] + e.count) - 1;
+    const std::uintptr_t first = reinterpret_cast<std::uintptr_t>(&group_at[e.child]) & ~std::uintptr_t(63);
+    const std::uintptr_t last = reinterpret_cast<std::uintptr_t>(&group_at[e.child] + e.count) - 1;
     for (std::uintptr_t p = first; p <= last; p += 64) __builtin_prefetch(reinterpret_cast<const void*>(p));
   };
   // Without a NaN among the slab distances (a finite origin, finite nonzero
   // inverse directions, tmin and tmax not NaN) the four-way max and min are
-  // taken as two levels of a tree instead of a chain, with the far bound
-  // widened per axis (x -> x (1 + 4e-7) rounds monotonically, so the minimum
-  // of the widened values is the widened minimum): the same values and mask
-  // as the chain, a shorter dependency chain from a node's bounds to its mask.
+  // taken as two levels of a tree instead of a chain: the same values and
+  // mask, a shorter dependency chain from a node's bounds to its mask.
   bool no_nan = !std::isnan(tmin) && !std::isnan(tmax);
-  for (int a = 0; a < 3; ++a) no_nan = no_nan && std::isfinite(ray.origin[a]) && std::isfinite(inv[a][0]) && inv[a][0] != 0.0f;
-  constexpr float kWiden = 1.0f + 4e-7f;
+  for (int a = 0; a < 3; ++a)
+    no_nan = no_nan && std::isfinite(ray.origin[a]) && std::isfinite(inv_far[a][0]) && inv[a][0] != 0.0f;
   auto mask_bits = [&](const auto& m) GEODS_BVH_INLINE_LAMBDA {
 #if defined(GEODS_BVH_SIMD_DISPATCH)
     if constexpr (Avx && W == 8) return lane_bits_avx(m);
 #endif
     return lane_bits(m);
   };
-  // The children whose boxes the ray enters before tmax, all W at once.
-  // The entry and exit distances of the ray at the slabs of axis a of the W children.
+  // The entry and (widened) exit distances of the ray at the slabs of axis a of the W children.
   auto slab = [&](const WideNode<W>& node, int a, vf& t0, vf& t1) GEODS_BVH_INLINE_LAMBDA {
+    const char* rows = reinterpret_cast<const char*>(node.bounds);
     vf lo, hi;
-    std::memcpy(&lo, node.bounds[near_row[a]], sizeof(vf));
-    std::memcpy(&hi, node.bounds[near_row[a] ^ 1], sizeof(vf));
+    std::memcpy(&lo, rows + near_offset[a], sizeof(vf));
+    std::memcpy(&hi, rows + (near_offset[a] ^ sizeof(vf)), sizeof(vf));
     t0 = (lo - org[a]) * inv[a];
-    t1 = (hi - org[a]) * inv[a];
+    t1 = (hi - org[a]) * inv_far[a];
   };
+  // The children whose boxes the ray enters before tmax, all W at once.
   auto children = [&](const WideEntry& e, float* keys) GEODS_BVH_INLINE_LAMBDA {
-    const WideNode<W>& node = nodes[e.child];
+    const WideNode<W>& node = node_at[e.child];
     vf tmax_v;
-    splat(tmax_v, tmax);
+    splat(tmax_v, tmax * kWiden);
     if (no_nan) [[likely]] {
       vf t0x, t1x, t0y, t1y, t0z, t1z;
       slab(node, 0, t0x, t1x);
       slab(node, 1, t0y, t1y);
       slab(node, 2, t0z, t1z);
-      t1x *= kWiden;
-      t1y *= kWiden;
-      t1z *= kWiden;
       const vf n01 = t0x > t0y ? t0x : t0y;
       const vf n2 = t0z > tmin_v ? t0z : tmin_v;
       const vf tn = n01 > n2 ? n01 : n2;
       const vf f01 = t1x < t1y ? t1x : t1y;
-      const vf tmw = tmax_v * kWiden;
-      const vf f2 = t1z < tmw ? t1z : tmw;
+      const vf f2 = t1z < tmax_v ? t1z : tmax_v;
       const vf tf = f01 < f2 ? f01 : f2;
       std::memcpy(keys, &tn, sizeof tn);
       return mask_bits(tn <= tf);
@@ -548,18 +553,17 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray, 
       tf = t1 < tf ? t1 : tf;
     }
     std::memcpy(keys, &tn, sizeof tn);
-    // Widened far bound: a box hit that rounding would lose is kept (Ize 2013).
-    return mask_bits(tn <= tf * kWiden);
+    return mask_bits(tn <= tf);
   };
   auto child = [&](const WideEntry& e, int i, float t) GEODS_BVH_INLINE_LAMBDA {
-    const WideEntry c{nodes[e.child].child[i], nodes[e.child].count[i], t};
+    const WideEntry c{node_at[e.child].child[i], node_at[e.child].count[i], t};
     prefetch(c);
     return c;
   };
   auto leaf = [&](const WideEntry& e) GEODS_BVH_INLINE_LAMBDA {
     for (std::uint32_t g = e.child; g < e.child + e.count; ++g) {
       RayTriangle4Test::vf t, u, v;
-      const int mask = test.intersect(groups_[g], tmin, tmax, t, u, v);
+      const int mask = test.intersect(group_at[g], tmin, tmax, t, u, v);
       if (mask == 0) continue;
       // The nearest lane, ties to the last one: what testing the triangles
       // one after the other, each against the shrinking tmax, would keep.
@@ -570,19 +574,15 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray, 
           if ((mask >> i & 1) && t[i] <= t[best]) best = i;
       }
       tmax = t[best];
-      hit = {t[best], groups_[g].index[best], u[best], v[best]};
-      if (any) return false;
+      hit = {t[best], group_at[g].index[best], u[best], v[best]};
+      if constexpr (Any) return false;
     }
     return true;
   };
   const auto is_leaf = [](const WideEntry& e) GEODS_BVH_INLINE_LAMBDA { return e.count != 0; };
   const auto still_needed = [&](const WideEntry& e) GEODS_BVH_INLINE_LAMBDA { return may_hit_before(e.key, tmax); };
   // Any hit ends the traversal, so the order of the children does not matter.
-  if (any) {
-    traverse<W, false>(WideEntry{0, 0, tmin}, stack, is_leaf, children, child, leaf, still_needed);
-  } else {
-    traverse<W, true>(WideEntry{0, 0, tmin}, stack, is_leaf, children, child, leaf, still_needed);
-  }
+  traverse<W, !Any>(WideEntry{0, 0, tmin}, stack, is_leaf, children, child, leaf, still_needed);
   return hit;
 }
 
@@ -617,14 +617,14 @@ RayHit TriangleBvh::intersect_generic(const FlatArray<BV>& volumes, const Ray3f&
 }
 
 RayHit TriangleBvh::intersect(const Ray3f& ray) const {
-  if (!wide4_.empty()) return intersect_wide_best(wide4_, ray, false);
-  if (!wide8_.empty()) return intersect_wide_best(wide8_, ray, false);
+  if (!wide4_.empty()) return intersect_wide_best<4, false>(wide4_, ray);
+  if (!wide8_.empty()) return intersect_wide_best<8, false>(wide8_, ray);
   return std::visit([&](const auto& vols) { return intersect_generic(vols, ray, false); }, volumes_);
 }
 
 bool TriangleBvh::occluded(const Ray3f& ray) const {
-  if (!wide4_.empty()) return intersect_wide_best(wide4_, ray, true).hit();
-  if (!wide8_.empty()) return intersect_wide_best(wide8_, ray, true).hit();
+  if (!wide4_.empty()) return intersect_wide_best<4, true>(wide4_, ray).hit();
+  if (!wide8_.empty()) return intersect_wide_best<8, true>(wide8_, ray).hit();
   return std::visit([&](const auto& vols) { return intersect_generic(vols, ray, true).hit(); }, volumes_);
 }
 

@@ -82,7 +82,8 @@ class RayTriangle4Test {
 
   /// Bit i set: lane i's triangle is hit with t in [tmin, tmax], its t and
   /// barycentrics in t[i], u[i], v[i] (other lanes hold garbage).
-  int intersect(const TriangleGroup& g, float tmin, float tmax, vf& t, vf& u, vf& v) const {
+  /// (Always inlined: the traversals' flatten alone left it out of line in some of them.)
+  [[gnu::always_inline]] int intersect(const TriangleGroup& g, float tmin, float tmax, vf& t, vf& u, vf& v) const {
     // Corner k relative to the origin, in the sheared frame (x, y; z unscaled).
     vf px[3], py[3], pz[3];
     for (int c = 0; c < 3; ++c) {

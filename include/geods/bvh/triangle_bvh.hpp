@@ -167,18 +167,20 @@ class TriangleBvh {
   template <int W>
   using WideNodes = FlatArray<WideNode<W>>;  // built in huge pages (HugePageAllocator)
   // Avx: compiled into an AVX (or later) function, 8-wide masks in one movemask.
-  template <int W, bool Avx = false>
-  RayHit intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray, bool any) const;
+  // Any: stop at the first hit (occluded); a separate function, so that the
+  // closest-hit loop carries none of the any-hit loop's state.
+  template <int W, bool Any, bool Avx = false>
+  RayHit intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray) const;
   // The same compiled for AVX, AVX2 and AVX-512, and the choice between them
   // by simd_level() (simd_level.hpp).
-  template <int W>
-  RayHit intersect_wide_avx(const WideNodes<W>& nodes, const Ray3f& ray, bool any) const;
-  template <int W>
-  RayHit intersect_wide_avx2(const WideNodes<W>& nodes, const Ray3f& ray, bool any) const;
-  template <int W>
-  RayHit intersect_wide_avx512(const WideNodes<W>& nodes, const Ray3f& ray, bool any) const;
-  template <int W>
-  RayHit intersect_wide_best(const WideNodes<W>& nodes, const Ray3f& ray, bool any) const;
+  template <int W, bool Any>
+  RayHit intersect_wide_avx(const WideNodes<W>& nodes, const Ray3f& ray) const;
+  template <int W, bool Any>
+  RayHit intersect_wide_avx2(const WideNodes<W>& nodes, const Ray3f& ray) const;
+  template <int W, bool Any>
+  RayHit intersect_wide_avx512(const WideNodes<W>& nodes, const Ray3f& ray) const;
+  template <int W, bool Any>
+  RayHit intersect_wide_best(const WideNodes<W>& nodes, const Ray3f& ray) const;
   template <typename BV>
   ClosestPoint closest_generic(const FlatArray<BV>& volumes, std::uint32_t start, const Vec3f& p,
                                float max_distance) const;
