@@ -577,10 +577,10 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray) 
         for (int i = best + 1; i < 4; ++i)
           if ((mask >> i & 1) && t[i] <= t[best]) best = i;
       }
+      hit = {t[best], group_at[g].index[best], u[best], v[best]};
+      if constexpr (Any) return false;  // the traversal ends here: no bound to tighten
       tmax = t[best];
       splat(tmax_far, tmax * kWiden);
-      hit = {t[best], group_at[g].index[best], u[best], v[best]};
-      if constexpr (Any) return false;
     }
     return true;
   };
