@@ -297,12 +297,12 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
   // The greatest tmax of the lanes still running: the frustum's far end.
   float tmax_hi = lane_max(active_v ? hit_t : -inf);
   TraversalStack<PacketEntry> stack(traversal_stack_size(depth, W));
-  const float widen = 1.0f + 4e-7f;
+  const float widen = 1.0f + kRayBoxSlack;
   // The lanes of entry e that may still hit something in it: the nearest
   // entry into its box is no later than their tmax allows (may_hit_before
   // of the single ray). Lanes that entered later are dropped by the tests below it.
   auto live = [&](const PacketEntry& e) GEODS_BVH_INLINE_LAMBDA {
-    const vf slack = (hit_t < splat<P>(0.0f) ? -hit_t : hit_t) * splat<P>(4e-7f);
+    const vf slack = (hit_t < splat<P>(0.0f) ? -hit_t : hit_t) * splat<P>(kRayBoxSlack);
     return e.mask & ~done & compare_bits<L, Cmp::le>(splat<P>(e.key), hit_t + slack);
   };
   // The children that some lane may enter, all W at once: a lane's entry

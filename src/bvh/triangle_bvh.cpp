@@ -54,11 +54,11 @@ std::pair<double, double> measures(const BV& bv) {
 // A bounding-volume interval test must never reject a box the exact
 // triangle test would hit: widen the far end by a few ulps (Ize 2013).
 inline bool interval_hit(std::pair<float, float> iv) {
-  return iv.first <= iv.second + std::abs(iv.second) * 4e-7f;
+  return iv.first <= iv.second + std::abs(iv.second) * kRayBoxSlack;
 }
 // A node entered at t_near may still hold a hit at tmax: the same slack as
 // interval_hit, since t_near carries the same rounding as the far bound.
-inline bool may_hit_before(float t_near, float tmax) { return t_near <= tmax + std::abs(tmax) * 4e-7f; }
+inline bool may_hit_before(float t_near, float tmax) { return t_near <= tmax + std::abs(tmax) * kRayBoxSlack; }
 
 // Directions whose components are far from any simple ratio, so that rays
 // from a point rarely pass exactly through edges or vertices.
@@ -472,7 +472,7 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray) 
   // inverse so that it costs no operation per node (one rounding of inv x
   // (1 + 4e-7) in place of one of t x (1 + 4e-7): the same bound; near and far
   // share the rounding of inv itself).
-  constexpr float kWiden = 1.0f + 4e-7f;
+  constexpr float kWiden = 1.0f + kRayBoxSlack;
   vf org[3], inv[3], inv_far[3];
   std::size_t near_offset[3];  // byte offset of the near bound's row in WideNode::bounds; the far row's is ^ sizeof(vf)
   for (int a = 0; a < 3; ++a) {

@@ -45,6 +45,13 @@ template <typename T>
 T surface_area(const AABB<T, 3>& a) {
   return a.surface_area();
 }
+/// The relative slack of the ray–box tests that must never reject a box the
+/// exact triangle test would hit (Ize 2013): a far distance t counts as
+/// t + |t| kRayBoxSlack, or is computed with the inverse direction scaled by
+/// 1 + kRayBoxSlack. The rounding of (bound - origin) x inverse needs less
+/// than 3.6e-7 (2 gamma_3).
+inline constexpr float kRayBoxSlack = 4e-7f;
+
 /// Parameter interval of the ray inside the box, clipped to [tmin, tmax];
 /// first > second on a miss. inv_dir = 1 / direction (infinities allowed).
 template <typename T>
