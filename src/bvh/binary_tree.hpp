@@ -18,10 +18,6 @@ struct BinaryNode {
   std::uint32_t left = kNone, right = kNone;  // kNone: a leaf
   std::uint32_t prim_first = 0;              // leaf: its primitives are prims[prim_first, +prim_count)
   std::uint32_t prim_count = 0;              // leaf: its primitives; inner node: all below it
-  /// Inner node the SAH would have made a leaf of more than one triangle
-  /// group, split for the collapse to a wide node (topology.cpp): opened there
-  /// while its wide node has room for more children, else one leaf.
-  bool leaf_unless_opened = false;
 
   bool leaf() const { return left == kNone; }
 };

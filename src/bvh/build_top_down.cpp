@@ -194,7 +194,7 @@ class TopDown {
     RangeBounds side[2];
     bool have_sides = false;
     switch (options_.builder) {
-      case Builder::sah: mid = split_sah(begin, end, rb, leaf, node.leaf_unless_opened, side, have_sides); break;
+      case Builder::sah: mid = split_sah(begin, end, rb, leaf, side, have_sides); break;
       case Builder::pca: mid = split_pca(begin, end); break;
       case Builder::boxtree: mid = depth < 48 ? split_boxtree(begin, end, rb.box) : begin; break;
       default: break;
@@ -236,9 +236,8 @@ class TopDown {
 
   // Binned SAH: bins on all three axes, the sweep of §4.1.4 over bin
   // boundaries, cost (7) with unit traversal and intersection costs.
-  // leaf_unless_opened: see BinaryNode.
   std::uint32_t split_sah(std::uint32_t begin, std::uint32_t end, const RangeBounds& rb, bool& leaf,
-                          bool& leaf_unless_opened, RangeBounds side[2], bool& have_sides) {
+                          RangeBounds side[2], bool& have_sides) {
     const std::uint32_t count = end - begin;
     // The wide AABB layout tests leaf triangles in groups of 4
     // (ray_triangle4.hpp): a leaf costs one test per started group.
@@ -325,16 +324,8 @@ class TopDown {
     const float split_cost =
         best_axis < 0 ? std::numeric_limits<float>::infinity() : 1.0f + best_cost / std::max(parent_area, 1e-30f);
     if (count <= std::uint32_t(options_.leaf_size) && leaf_cost <= split_cost) {
-      // A wide node has room for more children than a binary one's two, and
-      // a child in a free slot costs no node visit: a leaf of more than one
-      // group is split all the same, and the collapse keeps it whole only
-      // when its wide node is full (Embree's builder fills its nodes alike).
-      // The rays test fewer groups (100k mesh, incoherent: 1.6 per ray, not 2.2).
-      if (!grouped || best_axis < 0) {
-        leaf = true;
-        return begin;
-      }
-      leaf_unless_opened = true;
+      leaf = true;
+      return begin;
     }
     if (best_axis < 0) return begin;  // all centroids equal: median split by id
     // The boxes of both sides are the unions of their bins.

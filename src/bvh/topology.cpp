@@ -62,7 +62,7 @@ void number(const BinaryTreeView& tree, int leaf_size, int arity, std::uint32_t 
       skipped(b, t);
       continue;
     }
-    if (final_leaf(b) || tree.nodes[b].leaf_unless_opened) {  // (not opened by its parent)
+    if (final_leaf(b)) {
       gather_prims(tree, b, prim_order, scratch);
       continue;
     }
