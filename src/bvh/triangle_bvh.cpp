@@ -51,14 +51,12 @@ std::pair<double, double> measures(const BV& bv) {
   }
 }
 
-// A bounding-volume interval test must never reject a box the exact
-// triangle test would hit: widen the far end by a few ulps (Ize 2013).
-inline bool interval_hit(std::pair<float, float> iv) {
-  return iv.first <= iv.second + std::abs(iv.second) * kRayBoxSlack;
-}
-// A node entered at t_near may still hold a hit at tmax: the same slack as
-// interval_hit, since t_near carries the same rounding as the far bound.
-inline bool may_hit_before(float t_near, float tmax) { return t_near <= tmax + std::abs(tmax) * kRayBoxSlack; }
+// A box entered at t_near may still hold a hit at t_far (its exit, or the
+// ray's tmax): the test must never reject a box the exact triangle test
+// would hit, so the far end is widened by a few ulps (Ize 2013).
+inline bool may_hit_before(float t_near, float t_far) { return t_near <= t_far + std::abs(t_far) * kRayBoxSlack; }
+// A bounding-volume interval that a hit may lie in.
+inline bool interval_hit(std::pair<float, float> iv) { return may_hit_before(iv.first, iv.second); }
 
 // Directions whose components are far from any simple ratio, so that rays
 // from a point rarely pass exactly through edges or vertices.
@@ -467,11 +465,11 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray) 
   // an origin on a slab plane is then skipped by the NaN-ignoring min/max
   // below, so a ray inside a (possibly flat) slab keeps the whole line. The
   // near bound of each axis is chosen by the sign.
-  // The far bounds are scaled by inv_far = inv (1 + 4e-7): the widening of
-  // Ize (2013) that keeps a box hit rounding would lose, folded into the
-  // inverse so that it costs no operation per node (one rounding of inv x
-  // (1 + 4e-7) in place of one of t x (1 + 4e-7): the same bound; near and far
-  // share the rounding of inv itself).
+  // The far bounds are scaled by inv_far = inv (1 + kRayBoxSlack): the
+  // widening of Ize (2013) that keeps a box hit rounding would lose, folded
+  // into the inverse so that it costs no operation per node (one rounding of
+  // inv x (1 + slack) in place of one of t x (1 + slack): the same bound; near
+  // and far share the rounding of inv itself).
   constexpr float kWiden = 1.0f + kRayBoxSlack;
   vf org[3], inv[3], inv_far[3];
   std::size_t near_offset[3];  // byte offset of the near bound's row in WideNode::bounds; the far row's is ^ sizeof(vf)
@@ -487,7 +485,7 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray) 
   const TriangleGroup* const group_at = groups_.data();
   float tmax = ray.tmax;
   const float tmin = ray.tmin;
-  vf tmin_v, tmax_far;  // tmax_far: tmax (1 + 4e-7), the widened far bound of every box, kept with tmax
+  vf tmin_v, tmax_far;  // tmax_far: tmax (1 + kRayBoxSlack), the widened far bound of every box, kept with tmax
   splat(tmin_v, tmin);
   splat(tmax_far, tmax * kWiden);
   TraversalStack<WideEntry> stack(traversal_stack_size(depth_, W));
