@@ -297,7 +297,17 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
   // The greatest tmax of the lanes still running: the frustum's far end.
   float tmax_hi = lane_max(active_v ? hit_t : -inf);
   TraversalStack<PacketEntry> stack(traversal_stack_size(depth, W));
-  const float widen = 1.0f + kRayBoxSlack;
+  // An exit distance tf widened by kRayBoxSlack: scaled by 1 + kRayBoxSlack
+  // where no lane starts behind its origin (tmin >= 0: a box whose scaled,
+  // so narrowed, negative exit is missed holds no hit then), else
+  // tf + |tf| kRayBoxSlack, as the single ray's may_hit_before.
+  const bool scaled_widening = tmin_lo >= 0;
+  auto widened = [&](auto tf) GEODS_BVH_INLINE_LAMBDA {
+    constexpr int N = sizeof(tf) / sizeof(float);
+    if (scaled_widening) [[likely]]
+      return tf * splat<N>(1.0f + kRayBoxSlack);
+    return tf + (tf < splat<N>(0.0f) ? -tf : tf) * splat<N>(kRayBoxSlack);
+  };
   // The lanes of entry e that may still hit something in it: the nearest
   // entry into its box is no later than their tmax allows (may_hit_before
   // of the single ray). Lanes that entered later are dropped by the tests below it.
@@ -325,7 +335,7 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
       tf = far < tf ? far : tf;
     }
     std::memcpy(near_out, &tn, sizeof tn);
-    return lane_bits<L>(tn <= tf * splat<W>(widen));
+    return lane_bits<L>(tn <= widened(tf));
   };
   // Per child of the node being opened: the lanes that enter it. With all
   // three axes in the frustum, its entry distance (a lower bound of every
@@ -357,7 +367,7 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
         tn = near > tn ? near : tn;
         tf = far < tf ? far : tf;
       }
-      const std::uint32_t m = lanes & compare_bits<L, Cmp::le>(tn, tf * splat<P>(widen));
+      const std::uint32_t m = lanes & compare_bits<L, Cmp::le>(tn, widened(tf));
       if (m == 0) continue;
       child_mask[c] = m;
       if (!full_frustum) keys[c] = lane_min(lane_mask<P>(m) ? tn : inf);

@@ -507,36 +507,41 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray) 
     for (std::uintptr_t k = 0; k < 6; ++k)
       __builtin_prefetch(reinterpret_cast<const void*>(std::min(first + 64 * k, last)));
   };
-  // Without a NaN among the slab distances (a finite origin, finite nonzero
-  // inverse directions, tmin and tmax not NaN) the four-way max and min are
-  // taken as two levels of a tree instead of a chain: the same values and
-  // mask, a shorter dependency chain from a node's bounds to its mask.
-  bool no_nan = !std::isnan(tmin) && !std::isnan(tmax);
+  // The usual case takes the fast box test: no NaN among the slab distances
+  // (a finite origin, finite nonzero inverse directions, tmin and tmax not
+  // NaN), so the four-way max and min are two levels of a tree instead of a
+  // chain (the same values and mask, a shorter dependency chain from a
+  // node's bounds to its mask); and tmin >= 0, so the widening by inv_far
+  // may scale: it narrows a negative exit distance, but a box left behind
+  // the origin holds no hit then. Lines and rays with tmin < 0 take the
+  // chain with the widening t + |t| kRayBoxSlack of may_hit_before.
+  bool fast_box_test = tmin >= 0 && !std::isnan(tmax);
   for (int a = 0; a < 3; ++a)
-    no_nan = no_nan && std::isfinite(ray.origin[a]) && std::isfinite(inv_far[a][0]) && inv[a][0] != 0.0f;
+    fast_box_test = fast_box_test && std::isfinite(ray.origin[a]) && std::isfinite(inv_far[a][0]) && inv[a][0] != 0.0f;
   auto mask_bits = [&](const auto& m) GEODS_BVH_INLINE_LAMBDA {
 #if defined(GEODS_BVH_SIMD_DISPATCH)
     if constexpr (Avx && W == 8) return lane_bits_avx(m);
 #endif
     return lane_bits(m);
   };
-  // The entry and (widened) exit distances of the ray at the slabs of axis a of the W children.
-  auto slab = [&](const WideNode<W>& node, int a, vf& t0, vf& t1) GEODS_BVH_INLINE_LAMBDA {
+  // The entry and exit distances of the ray at the slabs of axis a of the W
+  // children, the exit's computed with far_inv (inv_far: widened).
+  auto slab = [&](const WideNode<W>& node, int a, const vf& far_inv, vf& t0, vf& t1) GEODS_BVH_INLINE_LAMBDA {
     const char* rows = reinterpret_cast<const char*>(node.bounds);
     vf lo, hi;
     std::memcpy(&lo, rows + near_offset[a], sizeof(vf));
     std::memcpy(&hi, rows + (near_offset[a] ^ sizeof(vf)), sizeof(vf));
     t0 = (lo - org[a]) * inv[a];
-    t1 = (hi - org[a]) * inv_far[a];
+    t1 = (hi - org[a]) * far_inv;
   };
   // The children whose boxes the ray enters before tmax, all W at once.
   auto children = [&](const WideEntry& e, float* keys) GEODS_BVH_INLINE_LAMBDA {
     const WideNode<W>& node = node_at[e.child];
-    if (no_nan) [[likely]] {
+    if (fast_box_test) [[likely]] {
       vf t0x, t1x, t0y, t1y, t0z, t1z;
-      slab(node, 0, t0x, t1x);
-      slab(node, 1, t0y, t1y);
-      slab(node, 2, t0z, t1z);
+      slab(node, 0, inv_far[0], t0x, t1x);
+      slab(node, 1, inv_far[1], t0y, t1y);
+      slab(node, 2, inv_far[2], t0z, t1z);
       const vf n01 = t0x > t0y ? t0x : t0y;
       const vf n2 = t0z > tmin_v ? t0z : tmin_v;
       const vf tn = n01 > n2 ? n01 : n2;
@@ -546,16 +551,20 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray) 
       std::memcpy(keys, &tn, sizeof tn);
       return mask_bits(tn <= tf);
     }
-    vf tn = tmin_v, tf = tmax_far;
+    vf tn = tmin_v, tf;
+    splat(tf, tmax);
     for (int a = 0; a < 3; ++a) {
       vf t0, t1;
-      slab(node, a, t0, t1);
+      slab(node, a, inv[a], t0, t1);
       // Written so that a NaN t0 or t1 leaves the interval unchanged.
       tn = t0 > tn ? t0 : tn;
       tf = t1 < tf ? t1 : tf;
     }
+    vf slack;
+    splat(slack, kRayBoxSlack);
     std::memcpy(keys, &tn, sizeof tn);
-    return mask_bits(tn <= tf);
+    const vf zero{};
+    return mask_bits(tn <= tf + (tf < zero ? -tf : tf) * slack);
   };
   auto child = [&](const WideEntry& e, int i, float t) GEODS_BVH_INLINE_LAMBDA {
     const WideEntry c{node_at[e.child].child[i], node_at[e.child].count[i], t};

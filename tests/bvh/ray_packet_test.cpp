@@ -210,6 +210,24 @@ TEST(RayPacket, TiesAtSharedEdgesKeepTheSingleRayTriangle) {
   expect_layouts_match(grid, rays, "grid");
 }
 
+TEST(RayPacket, LinesWithNegativeTminSeeHitsBehindTheirOrigins) {
+  // Parallel lines (tmin < 0) through a flat grid from above it: every hit
+  // lies behind the origin, in boxes flat along the direction's main axis.
+  const TriMesh grid = test::flat_grid(6);
+  std::vector<Ray3f> rays;
+  for (int i = 0; i < 256; ++i) {
+    Ray3f r;
+    r.origin = Vec3f(0.25f + 0.02f * float(i % 16), 0.25f + 0.02f * float(i / 16), 0.5f + 0.01f * float(i % 7));
+    r.origin *= 6.0f;
+    r.direction = Vec3f(0.125f, -0.0625f, 1.0f);
+    r.tmin = i % 3 ? -100.0f : -std::numeric_limits<float>::infinity();
+    rays.push_back(r);
+  }
+  for (std::size_t i = 0; i < rays.size(); i += 37)
+    ASSERT_TRUE(test::brute_intersect(grid, rays[i]).hit()) << "the lines must cross the grid behind their origins";
+  expect_layouts_match(grid, rays, "lines");
+}
+
 TEST(RayPacket, EveryLevelGivesThePortableSingleRayHits) {
   const LevelGuard guard;
   const TriMesh bunny = test::data_mesh("bunny.ply");

@@ -159,6 +159,33 @@ TEST(TriangleBvh, TmaxAndTminBoundTheHits) {
   }
 }
 
+TEST(TriangleBvh, NegativeTminFindsHitsBehindTheOrigin) {
+  // Lines (tmin < 0) through a grid of flat, axis-aligned squares: the boxes
+  // are flat and the hits lie behind the origin, where the box test's
+  // widening must still widen (a relative slack applied to a negative exit
+  // distance would narrow it).
+  const TriMesh grid = test::flat_grid(6);
+  Rng rng(23);
+  for (int arity : {2, 4, 8}) {
+    BuildOptions options;
+    options.arity = arity;
+    const TriangleBvh bvh = TriangleBvh::build(grid, options);
+    for (int i = 0; i < 400; ++i) {
+      Ray3f ray;
+      ray.origin = Vec3f(float(rng.uniform() * 6), float(rng.uniform() * 6), float(0.1 + rng.uniform() * 10));
+      ray.direction = Vec3f(float(rng.uniform() - 0.5), float(rng.uniform() - 0.5), 1.0f);
+      ray.tmin = i % 2 ? -1000.0f : -std::numeric_limits<float>::infinity();
+      const RayHit want = brute_intersect(grid, ray);
+      ASSERT_TRUE(want.hit() || ray.origin.x() - ray.origin.z() * ray.direction.x() < 0 ||
+                  ray.origin.x() - ray.origin.z() * ray.direction.x() > 6 ||
+                  ray.origin.y() - ray.origin.z() * ray.direction.y() < 0 ||
+                  ray.origin.y() - ray.origin.z() * ray.direction.y() > 6);
+      expect_same_hit(grid, ray, bvh.intersect(ray), want, "arity " + std::to_string(arity) + " ray " + std::to_string(i));
+      ASSERT_EQ(bvh.occluded(ray), want.hit()) << arity << " " << i;
+    }
+  }
+}
+
 TEST(TriangleBvh, ContainsAgreesWithTheWindingNumber) {
   const TriMesh bunny = test::data_mesh("bunny.ply");
   Rng rng(7);

@@ -242,6 +242,27 @@ TEST(Accelerators, UglySoupMatchesBruteForce) {
   }
 }
 
+TEST(Accelerators, LinesWithNegativeTminMatchBruteForce) {
+  // Lines (tmin < 0): the hits behind the origin count too, on a soup and on
+  // a grid of flat squares in the plane z = 0.5 (flat boxes, whose entry and
+  // exit distances are equal).
+  TriMesh mesh = ugly_soup(5, 40);
+  for (int i = 0; i < 8; ++i)
+    for (int j = 0; j < 8; ++j) {
+      const auto base = std::uint32_t(mesh.vertices.size());
+      for (int k = 0; k < 4; ++k) mesh.vertices.push_back({0.25f * float(i + k % 2) - 1, 0.25f * float(j + k / 2) - 1, 0.5f});
+      mesh.triangles.push_back({base, base + 1, base + 3});
+      mesh.triangles.push_back({base, base + 3, base + 2});
+    }
+  std::vector<Ray3f> rays = test_rays(mesh, 15, 900);
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    Ray3f& r = rays[i];  // from the line's point nearest the mesh's centre: hits on both sides
+    r.origin += r.direction * ((mesh.bounds().center() - r.origin).dot(r.direction) / r.direction.squaredNorm());
+    r.tmin = i % 2 ? -50.0f : -std::numeric_limits<float>::infinity();
+  }
+  expect_same_as_brute_force(mesh, rays, "lines");
+}
+
 // A closed cube of 2 x 2 quads per face on a grid, shot through its shared edges
 // and vertices along the axes and diagonals: watertight, so every ray from
 // outside through the cube's interior hits.

@@ -48,8 +48,9 @@ T surface_area(const AABB<T, 3>& a) {
 /// The relative slack of the ray–box tests that must never reject a box the
 /// exact triangle test would hit (Ize 2013): a far distance t counts as
 /// t + |t| kRayBoxSlack, or is computed with the inverse direction scaled by
-/// 1 + kRayBoxSlack. The rounding of (bound - origin) x inverse needs less
-/// than 3.6e-7 (2 gamma_3).
+/// 1 + kRayBoxSlack (which narrows a negative t: only for rays with tmin >= 0,
+/// where a box behind the origin holds no hit). The rounding of
+/// (bound - origin) x inverse needs less than 3.6e-7 (2 gamma_3).
 inline constexpr float kRayBoxSlack = 4e-7f;
 
 /// Parameter interval of the ray inside the box, clipped to [tmin, tmax];
