@@ -54,7 +54,8 @@ std::pair<double, double> measures(const BV& bv) {
 // A box entered at t_near may still hold a hit at t_far (its exit, or the
 // ray's tmax): the test must never reject a box the exact triangle test
 // would hit, so the far end is widened by a few ulps (Ize 2013).
-inline bool may_hit_before(float t_near, float t_far) { return t_near <= t_far + std::abs(t_far) * kRayBoxSlack; }
+inline float widened(float t_far) { return t_far + std::abs(t_far) * kRayBoxSlack; }
+inline bool may_hit_before(float t_near, float t_far) { return t_near <= widened(t_far); }
 // A bounding-volume interval that a hit may lie in.
 inline bool interval_hit(std::pair<float, float> iv) { return may_hit_before(iv.first, iv.second); }
 
@@ -379,7 +380,7 @@ GEODS_BVH_INLINE void splat(V& v, float x) {
     v = s;
   } else {
     static_assert(sizeof(V) == 32);
-    v = __builtin_shufflevector(s, s, 0, 0, 0, 0, 0, 0, 0, 0);  // one broadcast instruction with AVX2
+    v = __builtin_shufflevector(s, s, 0, 0, 0, 0, 0, 0, 0, 0);
   }
 }
 
@@ -413,6 +414,14 @@ __attribute__((target("avx"))) inline unsigned lane_bits_avx(const Mask& m) {
   __m256 v;
   std::memcpy(&v, &m, sizeof v);
   return unsigned(_mm256_movemask_ps(v));
+}
+// splat of an 8-wide vector in one vbroadcastss, for the same code (splat's
+// generic form takes three instructions: GCC builds the 4-lane vector first).
+template <typename V>
+__attribute__((target("avx"))) inline void splat_avx(V& v, float x) {
+  static_assert(sizeof(V) == 32);
+  const __m256 r = _mm256_set1_ps(x);
+  std::memcpy(&v, &r, sizeof v);
 }
 #endif
 
@@ -471,23 +480,30 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray) 
   // inv x (1 + slack) in place of one of t x (1 + slack): the same bound; near
   // and far share the rounding of inv itself).
   constexpr float kWiden = 1.0f + kRayBoxSlack;
+  auto broadcast = [](vf& v, float x) GEODS_BVH_INLINE_LAMBDA {
+#if defined(GEODS_BVH_SIMD_DISPATCH)
+    if constexpr (Avx && W == 8) return splat_avx(v, x);
+#endif
+    splat(v, x);
+  };
   vf org[3], inv[3], inv_far[3];
   std::size_t near_offset[3];  // byte offset of the near bound's row in WideNode::bounds; the far row's is ^ sizeof(vf)
   for (int a = 0; a < 3; ++a) {
     const float inv_a = 1.0f / ray.direction[a];
     near_offset[a] = (2 * a + (inv_a < 0 ? 1 : 0)) * sizeof(vf);
-    splat(org[a], ray.origin[a]);
-    splat(inv[a], inv_a);
-    splat(inv_far[a], inv_a * kWiden);
+    broadcast(org[a], ray.origin[a]);
+    broadcast(inv[a], inv_a);
+    broadcast(inv_far[a], inv_a * kWiden);
   }
   // Plain pointers: through the containers GCC reloads them at every node.
   const WideNode<W>* const node_at = nodes.data();
   const TriangleGroup* const group_at = groups_.data();
   float tmax = ray.tmax;
+  float tmax_widened = widened(tmax);  // kept with tmax: may_hit_before(key, tmax) is key <= tmax_widened
   const float tmin = ray.tmin;
   vf tmin_v, tmax_far;  // tmax_far: tmax (1 + kRayBoxSlack), the widened far bound of every box, kept with tmax
-  splat(tmin_v, tmin);
-  splat(tmax_far, tmax * kWiden);
+  broadcast(tmin_v, tmin);
+  broadcast(tmax_far, tmax * kWiden);
   TraversalStack<WideEntry> stack(traversal_stack_size(depth_, W));
   // Start fetching what a child needs, every cache line of it (a node: 2 or
   // 4 lines; a leaf: its groups of 160 bytes, which straddle lines); the cache
@@ -552,7 +568,7 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray) 
       return mask_bits(tn <= tf);
     }
     vf tn = tmin_v, tf;
-    splat(tf, tmax);
+    broadcast(tf, tmax);
     for (int a = 0; a < 3; ++a) {
       vf t0, t1;
       slab(node, a, inv[a], t0, t1);
@@ -561,7 +577,7 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray) 
       tf = t1 < tf ? t1 : tf;
     }
     vf slack;
-    splat(slack, kRayBoxSlack);
+    broadcast(slack, kRayBoxSlack);
     std::memcpy(keys, &tn, sizeof tn);
     const vf zero{};
     return mask_bits(tn <= tf + (tf < zero ? -tf : tf) * slack);
@@ -587,12 +603,13 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray) 
       hit = {t[best], group_at[g].index[best], u[best], v[best]};
       if constexpr (Any) return false;  // the traversal ends here: no bound to tighten
       tmax = t[best];
-      splat(tmax_far, tmax * kWiden);
+      tmax_widened = widened(tmax);
+      broadcast(tmax_far, tmax * kWiden);
     }
     return true;
   };
   const auto is_leaf = [](const WideEntry& e) GEODS_BVH_INLINE_LAMBDA { return e.count != 0; };
-  const auto still_needed = [&](const WideEntry& e) GEODS_BVH_INLINE_LAMBDA { return may_hit_before(e.key, tmax); };
+  const auto still_needed = [&](const WideEntry& e) GEODS_BVH_INLINE_LAMBDA { return e.key <= tmax_widened; };
   // Any hit ends the traversal, so the order of the children does not matter.
   traverse<W, !Any>(WideEntry{0, 0, tmin}, stack, is_leaf, children, child, leaf, still_needed);
   return hit;

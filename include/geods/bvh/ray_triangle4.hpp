@@ -6,6 +6,7 @@
 // same order, and a lane whose edge function rounds to zero is handed to the
 // scalar test itself (its double-precision recomputation), so t, u, v and the
 // hit decision are bit-identical to RayTriangleTest<float>.
+#include <cstddef>
 #include <cstdint>
 #include <limits>
 
@@ -55,11 +56,15 @@ template <typename VF, typename Bits = SameMask>
   e.ew = px[1] * py[0] - py[1] * px[0];
   const VF zero{};
   e.on_edge = bits(e.eu == zero) | bits(e.ev == zero) | bits(e.ew == zero);
-  const auto mixed = (bits(e.eu < zero) | bits(e.ev < zero) | bits(e.ew < zero)) &
-                     (bits(e.eu > zero) | bits(e.ev > zero) | bits(e.ew > zero));
+  // Signs mixed: the sign bits differ. (Decides as the scalar test's < 0 and
+  // > 0 wherever it matters: a zero is on_edge, a NaN makes det NaN.)
+  using VI = decltype(VF{} < VF{});
+  const VI eu = __builtin_bit_cast(VI, e.eu);
+  const auto mixed = bits(((eu ^ __builtin_bit_cast(VI, e.ev)) | (eu ^ __builtin_bit_cast(VI, e.ew))) < VI{});
   e.det = e.eu + e.ev + e.ew;
-  // det - det is 0 exactly for a finite det (NaN for inf and NaN).
-  e.inside = ~mixed & ~e.on_edge & bits(e.det != zero) & bits(e.det - e.det == zero);
+  // det - det is 0 exactly for a finite det (NaN for inf and NaN). (det of
+  // three nonzero values of one sign is not 0.)
+  e.inside = ~mixed & ~e.on_edge & bits(e.det - e.det == zero);
   return e;
 }
 #pragma GCC diagnostic pop
@@ -72,7 +77,7 @@ class RayTriangle4Test {
   explicit RayTriangle4Test(const Ray3f& ray) : scalar_(ray) {
     const int k[3] = {scalar_.axis_x(), scalar_.axis_y(), scalar_.axis_z()};
     for (int a = 0; a < 3; ++a) {
-      axis_[a] = k[a];
+      axis_offset_[a] = k[a] * std::ptrdiff_t(sizeof(vf));
       origin_[a] = splat(scalar_.origin()[k[a]]);
     }
     shear_x_ = splat(scalar_.shear_x());
@@ -86,10 +91,12 @@ class RayTriangle4Test {
   [[gnu::always_inline]] int intersect(const TriangleGroup& g, float tmin, float tmax, vf& t, vf& u, vf& v) const {
     // Corner k relative to the origin, in the sheared frame (x, y; z unscaled).
     vf px[3], py[3], pz[3];
+    const char* base = reinterpret_cast<const char*>(&g);
     for (int c = 0; c < 3; ++c) {
-      pz[c] = load(g.corner[c][axis_[2]]) - origin_[2];
-      px[c] = (load(g.corner[c][axis_[0]]) - origin_[0]) - shear_x_ * pz[c];
-      py[c] = (load(g.corner[c][axis_[1]]) - origin_[1]) - shear_y_ * pz[c];
+      const char* corner = base + c * sizeof(g.corner[c]);
+      pz[c] = load(corner + axis_offset_[2]) - origin_[2];
+      px[c] = (load(corner + axis_offset_[0]) - origin_[0]) - shear_x_ * pz[c];
+      py[c] = (load(corner + axis_offset_[1]) - origin_[1]) - shear_y_ * pz[c];
     }
     const ShearedEdges<vf> e = sheared_edges(px, py);
     const int edge_mask = movemask(e.on_edge);
@@ -116,7 +123,7 @@ class RayTriangle4Test {
 
  private:
   static vf splat(float x) { return vf{x, x, x, x}; }
-  static vf load(const float* p) {
+  static vf load(const char* p) {
     vf r;
     __builtin_memcpy(&r, p, sizeof r);
     return r;
@@ -133,8 +140,8 @@ class RayTriangle4Test {
   }
 
   RayTriangleTest<float> scalar_;
-  int axis_[3];
-  vf origin_[3];  // origin coordinate along kx, ky, kz
+  std::ptrdiff_t axis_offset_[3];  // byte offset of the kx, ky, kz rows in a corner (3 registers, not one per corner)
+  vf origin_[3];                  // origin coordinate along kx, ky, kz
   vf shear_x_, shear_y_, shear_z_;
 };
 
