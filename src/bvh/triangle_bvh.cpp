@@ -464,6 +464,11 @@ RayHit TriangleBvh::intersect_wide_best(const WideNodes<W>& nodes, const Ray3f& 
   return intersect_wide<W, Any>(nodes, ray);
 }
 
+template <int W, bool Any>
+RayHit TriangleBvh::intersect_wide_portable(const WideNodes<W>& nodes, const Ray3f& ray) const {
+  return intersect_wide<W, Any>(nodes, ray);
+}
+
 template <int W, bool Any, bool Avx>
 RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray) const {
   using vf = typename SimdTypes<W>::vf;
@@ -504,6 +509,26 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray) 
   vf tmin_v, tmax_far;  // tmax_far: tmax (1 + kRayBoxSlack), the widened far bound of every box, kept with tmax
   broadcast(tmin_v, tmin);
   broadcast(tmax_far, tmax * kWiden);
+  // The usual case takes the fast box test: no NaN among the slab distances
+  // (a finite origin and finite inverse directions, tmin and tmax not NaN), so the four-way max and min are two levels of a tree instead of a
+  // chain (the same values and mask, a shorter dependency chain from a
+  // node's bounds to its mask); and tmin >= 0, so the widening by inv_far
+  // may scale: it narrows a negative exit distance, but a box left behind
+  // the origin holds no hit then. Lines and rays with tmin < 0 take the
+  // chain with the widening t + |t| kRayBoxSlack of may_hit_before.
+  // (x - x is 0 for a finite x, NaN for inf and NaN: one sum tests all six
+  // without a branch each. A zero inverse gives no NaN with a finite origin.)
+  float non_finite = 0.0f;
+  for (int a = 0; a < 3; ++a)
+    non_finite += (ray.origin[a] - ray.origin[a]) + (inv_far[a][0] - inv_far[a][0]);
+  const bool fast_box_test = (non_finite == 0.0f) & (tmin >= 0) & (tmax == tmax);
+  if constexpr (Avx) {
+    // The SIMD kernels keep only the fast test in their loop (fewer values
+    // live across it, no branch per node); the other rays take the portable
+    // kernel, whose hits are the same, bit for bit.
+    if (!fast_box_test) [[unlikely]]
+      return intersect_wide_portable<W, Any>(nodes, ray);
+  }
   TraversalStack<WideEntry> stack(traversal_stack_size(depth_, W));
   // Start fetching what a child needs, every cache line of it (a node: 2 or
   // 4 lines; a leaf: its groups of 160 bytes, which straddle lines); the cache
@@ -523,17 +548,6 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray) 
     for (std::uintptr_t k = 0; k < 6; ++k)
       __builtin_prefetch(reinterpret_cast<const void*>(std::min(first + 64 * k, last)));
   };
-  // The usual case takes the fast box test: no NaN among the slab distances
-  // (a finite origin, finite nonzero inverse directions, tmin and tmax not
-  // NaN), so the four-way max and min are two levels of a tree instead of a
-  // chain (the same values and mask, a shorter dependency chain from a
-  // node's bounds to its mask); and tmin >= 0, so the widening by inv_far
-  // may scale: it narrows a negative exit distance, but a box left behind
-  // the origin holds no hit then. Lines and rays with tmin < 0 take the
-  // chain with the widening t + |t| kRayBoxSlack of may_hit_before.
-  bool fast_box_test = tmin >= 0 && !std::isnan(tmax);
-  for (int a = 0; a < 3; ++a)
-    fast_box_test = fast_box_test && std::isfinite(ray.origin[a]) && std::isfinite(inv_far[a][0]) && inv[a][0] != 0.0f;
   auto mask_bits = [&](const auto& m) GEODS_BVH_INLINE_LAMBDA {
 #if defined(GEODS_BVH_SIMD_DISPATCH)
     if constexpr (Avx && W == 8) return lane_bits_avx(m);
@@ -553,7 +567,7 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray) 
   // The children whose boxes the ray enters before tmax, all W at once.
   auto children = [&](const WideEntry& e, float* keys) GEODS_BVH_INLINE_LAMBDA {
     const WideNode<W>& node = node_at[e.child];
-    if (fast_box_test) [[likely]] {
+    if (Avx || fast_box_test) [[likely]] {
       vf t0x, t1x, t0y, t1y, t0z, t1z;
       slab(node, 0, inv_far[0], t0x, t1x);
       slab(node, 1, inv_far[1], t0y, t1y);

@@ -181,6 +181,10 @@ class TriangleBvh {
   RayHit intersect_wide_avx512(const WideNodes<W>& nodes, const Ray3f& ray) const;
   template <int W, bool Any>
   RayHit intersect_wide_best(const WideNodes<W>& nodes, const Ray3f& ray) const;
+  // The portable kernel out of line: the SIMD kernels hand it the rare rays
+  // they do not take (inlined, it shared their registers and stack).
+  template <int W, bool Any>
+  [[gnu::noinline]] RayHit intersect_wide_portable(const WideNodes<W>& nodes, const Ray3f& ray) const;
   template <typename BV>
   ClosestPoint closest_generic(const FlatArray<BV>& volumes, std::uint32_t start, const Vec3f& p,
                                float max_distance) const;
