@@ -510,12 +510,13 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray) 
   broadcast(tmin_v, tmin);
   broadcast(tmax_far, tmax * kWiden);
   // The usual case takes the fast box test: no NaN among the slab distances
-  // (a finite origin and finite inverse directions, tmin and tmax not NaN), so the four-way max and min are two levels of a tree instead of a
-  // chain (the same values and mask, a shorter dependency chain from a
-  // node's bounds to its mask); and tmin >= 0, so the widening by inv_far
-  // may scale: it narrows a negative exit distance, but a box left behind
-  // the origin holds no hit then. Lines and rays with tmin < 0 take the
-  // chain with the widening t + |t| kRayBoxSlack of may_hit_before.
+  // (a finite origin and finite inverse directions, tmin and tmax not NaN),
+  // so the four-way max and min are two levels of a tree instead of a chain
+  // (the same values and mask, a shorter dependency chain from a node's
+  // bounds to its mask); and tmin >= 0, so the widening by inv_far may
+  // scale: it narrows a negative exit distance, but a box left behind the
+  // origin holds no hit then. Lines and rays with tmin < 0 take the chain
+  // with the widening t + |t| kRayBoxSlack of may_hit_before.
   // (x - x is 0 for a finite x, NaN for inf and NaN: one sum tests all six
   // without a branch each. A zero inverse gives no NaN with a finite origin.)
   float non_finite = 0.0f;
