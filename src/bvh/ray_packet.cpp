@@ -302,18 +302,16 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
   // so narrowed, negative exit is missed holds no hit then), else
   // tf + |tf| kRayBoxSlack, as the single ray's may_hit_before.
   const bool scaled_widening = tmin_lo >= 0;
-  auto widened = [&](auto tf) GEODS_BVH_INLINE_LAMBDA {
-    constexpr int N = sizeof(tf) / sizeof(float);
+  auto widen_exit = [&](auto tf) GEODS_BVH_INLINE_LAMBDA {
     if (scaled_widening) [[likely]]
-      return tf * splat<N>(1.0f + kRayBoxSlack);
-    return tf + (tf < splat<N>(0.0f) ? -tf : tf) * splat<N>(kRayBoxSlack);
+      return tf * splat<sizeof(tf) / sizeof(float)>(1.0f + kRayBoxSlack);
+    return widen_far(tf);
   };
   // The lanes of entry e that may still hit something in it: the nearest
   // entry into its box is no later than their tmax allows (may_hit_before
   // of the single ray). Lanes that entered later are dropped by the tests below it.
   auto live = [&](const PacketEntry& e) GEODS_BVH_INLINE_LAMBDA {
-    const vf slack = (hit_t < splat<P>(0.0f) ? -hit_t : hit_t) * splat<P>(kRayBoxSlack);
-    return e.mask & ~done & compare_bits<L, Cmp::le>(splat<P>(e.key), hit_t + slack);
+    return e.mask & ~done & compare_bits<L, Cmp::le>(splat<P>(e.key), widen_far(hit_t));
   };
   // The children that some lane may enter, all W at once: a lane's entry
   // and exit distances along an axis are products of (bound - origin) and the
@@ -335,7 +333,7 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
       tf = far < tf ? far : tf;
     }
     std::memcpy(near_out, &tn, sizeof tn);
-    return lane_bits<L>(tn <= widened(tf));
+    return lane_bits<L>(tn <= widen_exit(tf));
   };
   // Per child of the node being opened: the lanes that enter it. With all
   // three axes in the frustum, its entry distance (a lower bound of every
@@ -367,7 +365,7 @@ GEODS_BVH_INLINE void packet_traverse(const FlatArray<WideNode<W>>& nodes, const
         tn = near > tn ? near : tn;
         tf = far < tf ? far : tf;
       }
-      const std::uint32_t m = lanes & compare_bits<L, Cmp::le>(tn, widened(tf));
+      const std::uint32_t m = lanes & compare_bits<L, Cmp::le>(tn, widen_exit(tf));
       if (m == 0) continue;
       child_mask[c] = m;
       if (!full_frustum) keys[c] = lane_min(lane_mask<P>(m) ? tn : inf);

@@ -23,6 +23,9 @@
 #include "geods/core/triangle.hpp"
 #include "geods/core/triangle_box.hpp"
 
+// Lane vectors are passed between always-inlined helpers only (widen_far).
+#pragma GCC diagnostic ignored "-Wpsabi"
+
 namespace geods::bvh {
 namespace {
 
@@ -54,8 +57,7 @@ std::pair<double, double> measures(const BV& bv) {
 // A box entered at t_near may still hold a hit at t_far (its exit, or the
 // ray's tmax): the test must never reject a box the exact triangle test
 // would hit, so the far end is widened by a few ulps (Ize 2013).
-inline float widened(float t_far) { return t_far + std::abs(t_far) * kRayBoxSlack; }
-inline bool may_hit_before(float t_near, float t_far) { return t_near <= widened(t_far); }
+inline bool may_hit_before(float t_near, float t_far) { return t_near <= widen_far(t_far); }
 // A bounding-volume interval that a hit may lie in.
 inline bool interval_hit(std::pair<float, float> iv) { return may_hit_before(iv.first, iv.second); }
 
@@ -504,7 +506,7 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray) 
   const WideNode<W>* const node_at = nodes.data();
   const TriangleGroup* const group_at = groups_.data();
   float tmax = ray.tmax;
-  float tmax_widened = widened(tmax);  // kept with tmax: may_hit_before(key, tmax) is key <= tmax_widened
+  float tmax_widened = widen_far(tmax);  // kept with tmax: may_hit_before(key, tmax) is key <= tmax_widened
   const float tmin = ray.tmin;
   vf tmin_v, tmax_far;  // tmax_far: tmax (1 + kRayBoxSlack), the widened far bound of every box, kept with tmax
   broadcast(tmin_v, tmin);
@@ -591,11 +593,8 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray) 
       tn = t0 > tn ? t0 : tn;
       tf = t1 < tf ? t1 : tf;
     }
-    vf slack;
-    broadcast(slack, kRayBoxSlack);
     std::memcpy(keys, &tn, sizeof tn);
-    const vf zero{};
-    return mask_bits(tn <= tf + (tf < zero ? -tf : tf) * slack);
+    return mask_bits(tn <= widen_far(tf));
   };
   auto child = [&](const WideEntry& e, int i, float t) GEODS_BVH_INLINE_LAMBDA {
     const WideEntry c{node_at[e.child].child[i], node_at[e.child].count[i], t};
@@ -618,7 +617,7 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray) 
       hit = {t[best], group_at[g].index[best], u[best], v[best]};
       if constexpr (Any) return false;  // the traversal ends here: no bound to tighten
       tmax = t[best];
-      tmax_widened = widened(tmax);
+      tmax_widened = widen_far(tmax);
       broadcast(tmax_far, tmax * kWiden);
     }
     return true;

@@ -52,6 +52,16 @@ T surface_area(const AABB<T, 3>& a) {
 /// where a box behind the origin holds no hit). The rounding of
 /// (bound - origin) x inverse needs less than 3.6e-7 (2 gamma_3).
 inline constexpr float kRayBoxSlack = 4e-7f;
+/// A far distance t widened by the slack, t + |t| kRayBoxSlack: for a float
+/// or double, or lane by lane for a GCC vector of floats.
+// (Always inlined: a wide vector then crosses no call, so no ABI concern.)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpsabi"
+template <typename T>
+[[gnu::always_inline]] inline T widen_far(T t) {
+  return t + (t < T{} ? -t : t) * kRayBoxSlack;
+}
+#pragma GCC diagnostic pop
 
 /// Parameter interval of the ray inside the box, clipped to [tmin, tmax];
 /// first > second on a miss. inv_dir = 1 / direction (infinities allowed).

@@ -173,7 +173,7 @@ std::pair<T, T> ray_interval(const Kdop<T, K>& a, const Ray<T>& ray, const Vec<T
   }
   // The slack of the AABB traversal: a triangle whose float t rounded below
   // t1 may lie in a box whose exact interval starts a few ulps above it.
-  if (t0 > t1 + std::abs(t1) * kRayBoxSlack) return {T(1), T(0)};
+  if (t0 > widen_far(t1)) return {T(1), T(0)};
   // Round outwards to T.
   T near = T(t0), far = T(t1);
   if (double(near) > t0) near = std::nextafter(near, -std::numeric_limits<T>::infinity());
