@@ -370,7 +370,7 @@ struct SimdTypes<8> {
   typedef float vf __attribute__((vector_size(32)));
 };
 
-// Every lane x (one broadcast; filling the lanes one by one in a loop made
+// Every lane x (a broadcast; filling the lanes one by one in a loop made
 // GCC assemble the vectors lane by lane through the stack).
 // (Written through a reference: a 32-byte vector passed by value has another
 // ABI with AVX than without.)
