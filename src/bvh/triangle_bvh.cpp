@@ -493,14 +493,19 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray) 
 #endif
     splat(v, x);
   };
+  // The three inverses in one division, and the finiteness of the origin and
+  // of them in one comparison (4 lanes, the last one 1 / 1).
+  typedef float v4 __attribute__((vector_size(16)));
+  const v4 origin4 = {ray.origin[0], ray.origin[1], ray.origin[2], 0.0f};
+  const v4 inv4 = v4{1.0f, 1.0f, 1.0f, 1.0f} / v4{ray.direction[0], ray.direction[1], ray.direction[2], 1.0f};
+  const v4 inv_far4 = inv4 * kWiden;
   vf org[3], inv[3], inv_far[3];
   std::size_t near_offset[3];  // byte offset of the near bound's row in WideNode::bounds; the far row's is ^ sizeof(vf)
   for (int a = 0; a < 3; ++a) {
-    const float inv_a = 1.0f / ray.direction[a];
-    near_offset[a] = (2 * a + (inv_a < 0 ? 1 : 0)) * sizeof(vf);
-    broadcast(org[a], ray.origin[a]);
-    broadcast(inv[a], inv_a);
-    broadcast(inv_far[a], inv_a * kWiden);
+    near_offset[a] = (2 * a + (inv4[a] < 0 ? 1 : 0)) * sizeof(vf);
+    broadcast(org[a], origin4[a]);
+    broadcast(inv[a], inv4[a]);
+    broadcast(inv_far[a], inv_far4[a]);
   }
   // Plain pointers: through the containers GCC reloads them at every node.
   const WideNode<W>* const node_at = nodes.data();
@@ -519,12 +524,10 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray) 
   // scale: it narrows a negative exit distance, but a box left behind the
   // origin holds no hit then. Lines and rays with tmin < 0 take the chain
   // with the widening t + |t| kRayBoxSlack of may_hit_before.
-  // (x - x is 0 for a finite x, NaN for inf and NaN: one sum tests all six
-  // without a branch each. A zero inverse gives no NaN with a finite origin.)
-  float non_finite = 0.0f;
-  for (int a = 0; a < 3; ++a)
-    non_finite += (ray.origin[a] - ray.origin[a]) + (inv_far[a][0] - inv_far[a][0]);
-  const bool fast_box_test = (non_finite == 0.0f) & (tmin >= 0) & (tmax == tmax);
+  // (x - x is 0 for a finite x, NaN for inf and NaN: one sum per axis tests
+  // both without a branch each. A zero inverse gives no NaN with a finite origin.)
+  const v4 non_finite = (origin4 - origin4) + (inv_far4 - inv_far4);
+  const bool fast_box_test = (lane_bits(non_finite == v4{}) == 0xF) & (tmin >= 0) & (tmax == tmax);
   if constexpr (Avx) {
     // The SIMD kernels keep only the fast test in their loop (fewer values
     // live across it, no branch per node); the other rays take the portable
@@ -537,19 +540,24 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray) 
   // 4 lines; a leaf: its groups of 160 bytes, which straddle lines); the cache
   // misses on nodes and triangles dominate incoherent rays. A leaf's lines are
   // fetched without a loop over its size, whose exit mispredicted about once
-  // per ray: the 6 lines that two groups (leaves of up to 8 triangles) can
-  // span, those past the leaf's end replaced by its last; the groups of larger
-  // leaves past the second are left to the hardware prefetcher.
+  // per ray: the 3 lines a group spans (groups start at multiples of 32
+  // bytes), then the next 3 for a leaf of more than one group, the same 3
+  // again for a leaf of one (a second prefetch of a line costs no traffic;
+  // clamping each address to the leaf cost 4 instructions a line). The groups
+  // of larger leaves past the second are left to the hardware prefetcher.
   auto prefetch = [&](const WideEntry& e) GEODS_BVH_INLINE_LAMBDA {
     if (e.count == 0) {
       const char* p = reinterpret_cast<const char*>(&node_at[e.child]);
       for (std::size_t k = 0; k < sizeof(WideNode<W>); k += 64) __builtin_prefetch(p + k);
       return;
     }
-    const std::uintptr_t first = reinterpret_cast<std::uintptr_t>(&group_at[e.child]) & ~std::uintptr_t(63);
-    const std::uintptr_t last = reinterpret_cast<std::uintptr_t>(&group_at[e.child] + e.count) - 1;
-    for (std::uintptr_t k = 0; k < 6; ++k)
-      __builtin_prefetch(reinterpret_cast<const void*>(std::min(first + 64 * k, last)));
+    static_assert(sizeof(TriangleGroup) <= 3 * 64 - 32 && alignof(TriangleGroup) >= 32);
+    const char* first = reinterpret_cast<const char*>(
+        reinterpret_cast<std::uintptr_t>(&group_at[e.child]) & ~std::uintptr_t(63));
+    // (A mask, not ?:: GCC turned the choice into a cmov for each line.)
+    const char* second = first + (-std::uintptr_t(e.count > 1) & (3 * 64));
+    for (int k = 0; k < 3; ++k) __builtin_prefetch(first + 64 * k);
+    for (int k = 0; k < 3; ++k) __builtin_prefetch(second + 64 * k);
   };
   auto mask_bits = [&](const auto& m) GEODS_BVH_INLINE_LAMBDA {
 #if defined(GEODS_BVH_SIMD_DISPATCH)

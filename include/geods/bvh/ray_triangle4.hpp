@@ -74,15 +74,16 @@ class RayTriangle4Test {
   typedef float vf __attribute__((vector_size(16)));
   typedef std::int32_t vi __attribute__((vector_size(16)));
 
-  explicit RayTriangle4Test(const Ray3f& ray) : scalar_(ray) {
-    const int k[3] = {scalar_.axis_x(), scalar_.axis_y(), scalar_.axis_z()};
+  explicit RayTriangle4Test(const Ray3f& ray) : ray_(&ray) {
+    const RayTriangleTest<float> scalar(ray);
+    const int k[3] = {scalar.axis_x(), scalar.axis_y(), scalar.axis_z()};
     for (int a = 0; a < 3; ++a) {
       axis_offset_[a] = k[a] * std::ptrdiff_t(sizeof(vf));
-      origin_[a] = splat(scalar_.origin()[k[a]]);
+      origin_[a] = splat(ray.origin[k[a]]);
     }
-    shear_x_ = splat(scalar_.shear_x());
-    shear_y_ = splat(scalar_.shear_y());
-    shear_z_ = splat(scalar_.shear_z());
+    shear_x_ = splat(scalar.shear_x());
+    shear_y_ = splat(scalar.shear_y());
+    shear_z_ = splat(scalar.shear_z());
   }
 
   /// Bit i set: lane i's triangle is hit with t in [tmin, tmax], its t and
@@ -109,10 +110,11 @@ class RayTriangle4Test {
     v = e.ew * inv_det;
     int mask = movemask(e.inside & (t >= splat(tmin)) & (t <= splat(tmax)));
     if (edge_mask != 0) [[unlikely]] {
+      const RayTriangleTest<float> scalar(*ray_);
       for (int i = 0; i < 4; ++i) {
         if (!(edge_mask >> i & 1)) continue;
         float hit_t, hit_u, hit_v;
-        if (scalar_.intersect(corner(g, 0, i), corner(g, 1, i), corner(g, 2, i), tmin, tmax, hit_t, hit_u, hit_v)) {
+        if (scalar.intersect(corner(g, 0, i), corner(g, 1, i), corner(g, 2, i), tmin, tmax, hit_t, hit_u, hit_v)) {
           t[i] = hit_t, u[i] = hit_u, v[i] = hit_v;
           mask |= 1 << i;
         }
@@ -139,7 +141,9 @@ class RayTriangle4Test {
     return {g.corner[k][0][lane], g.corner[k][1][lane], g.corner[k][2][lane]};
   }
 
-  RayTriangleTest<float> scalar_;
+  // The ray, for the scalar test of on-edge lanes: built there, where it is
+  // rare, rather than kept (GCC kept its fields in memory, stored per ray).
+  const Ray3f* ray_;
   std::ptrdiff_t axis_offset_[3];  // byte offset of the kx, ky, kz rows in a corner (3 registers, not one per corner)
   vf origin_[3];                  // origin coordinate along kx, ky, kz
   vf shear_x_, shear_y_, shear_z_;
