@@ -41,16 +41,15 @@ class TraversalStack {
   }
   TraversalStack(const TraversalStack&) = delete;
   TraversalStack& operator=(const TraversalStack&) = delete;
-  void push(const Entry& e) { data_[size_++] = e; }
-  Entry pop() { return data_[--size_]; }
-  bool empty() const { return size_ == 0; }
-  void clear() { size_ = 0; }
+  /// The bottom of the stack; `traverse` keeps its top in a local pointer
+  /// (kept in the object, GCC stored and reloaded it at every push: an
+  /// entry's store might alias it).
+  Entry* data() { return data_; }
 
  private:
   std::array<Entry, 256> inline_;
   std::vector<Entry> heap_;
   Entry* data_ = inline_.data();
-  std::size_t size_ = 0;
 };
 
 namespace detail {
@@ -66,8 +65,8 @@ GEODS_BVH_INLINE bool keep_going(Fn& fn, Args&&... args) {
 }
 }  // namespace detail
 
-/// Depth-first traversal from `root` (already accepted), on `stack` (cleared
-/// first: a stopped traversal leaves entries behind), over any node layout
+/// Depth-first traversal from `root` (already accepted), on `stack` (its
+/// storage: it starts empty), over any node layout
 /// whose entries (the nodes waiting to be visited) have a float `key`:
 /// - is_leaf(e): whether entry e is a leaf;
 /// - children(e, keys): the children of inner node e to visit, as a bit mask
@@ -87,7 +86,8 @@ template <int MaxChildren, bool Ordered, typename Entry, typename IsLeaf, typena
 GEODS_BVH_INLINE bool traverse(Entry root, TraversalStack<Entry>& stack, IsLeaf&& is_leaf, Children&& children,
                                Child&& child, Leaf&& leaf, StillNeeded&& still_needed) {
   static_assert(MaxChildren >= 2 && MaxChildren <= 32, "children are reported as 32-bit masks");
-  stack.clear();
+  Entry* const bottom = stack.data();
+  Entry* top = bottom;  // one past the last waiting entry
   Entry cur = root;
   for (;;) {
     if (!is_leaf(cur)) {
@@ -106,10 +106,10 @@ GEODS_BVH_INLINE bool traverse(Entry root, TraversalStack<Entry>& stack, IsLeaf&
           const Entry b = child(cur, second, keys[second]);
           // As the general case below: farthest first, equal keys the later child first.
           if (Ordered && a.key < b.key) {
-            stack.push(b);
+            *top++ = b;
             cur = a;
           } else {
-            stack.push(a);
+            *top++ = a;
             cur = b;
           }
           continue;
@@ -129,7 +129,7 @@ GEODS_BVH_INLINE bool traverse(Entry root, TraversalStack<Entry>& stack, IsLeaf&
           }
           visit[k] = e;
         }
-        for (int i = 0; i + 1 < n; ++i) stack.push(visit[i]);
+        for (int i = 0; i + 1 < n; ++i) *top++ = visit[i];
         cur = visit[n - 1];
         continue;
       }
@@ -137,8 +137,8 @@ GEODS_BVH_INLINE bool traverse(Entry root, TraversalStack<Entry>& stack, IsLeaf&
       return false;
     }
     bool more = false;
-    while (!more && !stack.empty()) {
-      cur = stack.pop();
+    while (!more && top != bottom) {
+      cur = *--top;
       more = still_needed(cur);
     }
     if (!more) return true;
