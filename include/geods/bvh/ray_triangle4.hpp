@@ -74,6 +74,7 @@ class RayTriangle4Test {
   typedef float vf __attribute__((vector_size(16)));
   typedef std::int32_t vi __attribute__((vector_size(16)));
 
+  /// `ray` must outlive the test (the on-edge lanes read it).
   explicit RayTriangle4Test(const Ray3f& ray) : ray_(&ray) {
     const RayTriangleTest<float> scalar(ray);
     const int k[3] = {scalar.axis_x(), scalar.axis_y(), scalar.axis_z()};
