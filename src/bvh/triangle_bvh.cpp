@@ -517,7 +517,9 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray) 
   broadcast(tmin_v, tmin);
   broadcast(tmax_far, tmax * kWiden);
   // The usual case takes the fast box test: no NaN among the slab distances
-  // (a finite origin and finite inverse directions, tmin and tmax not NaN),
+  // (a finite origin, finite nonzero inverse directions, tmin and tmax not
+  // NaN; a zero inverse, of an infinite direction, makes NaN of the empty
+  // slots' infinite bounds),
   // so the four-way max and min are two levels of a tree instead of a chain
   // (the same values and mask, a shorter dependency chain from a node's
   // bounds to its mask); and tmin >= 0, so the widening by inv_far may
@@ -525,9 +527,10 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray) 
   // origin holds no hit then. Lines and rays with tmin < 0 take the chain
   // with the widening t + |t| kRayBoxSlack of may_hit_before.
   // (x - x is 0 for a finite x, NaN for inf and NaN: one sum per axis tests
-  // both without a branch each. A zero inverse gives no NaN with a finite origin.)
+  // both without a branch each.)
   const v4 non_finite = (origin4 - origin4) + (inv_far4 - inv_far4);
-  const bool fast_box_test = (lane_bits(non_finite == v4{}) == 0xF) & (tmin >= 0) & (tmax == tmax);
+  const bool fast_box_test =
+      (lane_bits((non_finite == v4{}) & (inv4 != v4{})) == 0xF) & (tmin >= 0) & (tmax == tmax);
   if constexpr (Avx) {
     // The SIMD kernels keep only the fast test in their loop (fewer values
     // live across it, no branch per node); the other rays take the portable
@@ -602,7 +605,14 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray) 
       tf = t1 < tf ? t1 : tf;
     }
     std::memcpy(keys, &tn, sizeof tn);
-    return mask_bits(tn <= widen_far(tf));
+    // An empty slot's slab distances are all NaN for a NaN origin or a ray
+    // with no finite nonzero inverse, and the chain keeps the interval then:
+    // such slots are dropped by their child index instead.
+    static_assert(WideNode<W>::kEmpty == ~std::uint32_t(0));
+    using vi = decltype(tn < tf);
+    vi child;
+    std::memcpy(&child, node.child, sizeof child);
+    return mask_bits((tn <= widen_far(tf)) & (child != ~vi{}));
   };
   auto child = [&](const WideEntry& e, int i, float t) GEODS_BVH_INLINE_LAMBDA {
     const WideEntry c{node_at[e.child].child[i], node_at[e.child].count[i], t};

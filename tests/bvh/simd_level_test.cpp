@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <limits>
 
 #include "bvh/bvh_test_util.hpp"
 #include "geods/core/simd_level.hpp"
@@ -115,6 +116,43 @@ TEST(SimdLevel, EveryLevelGivesThePortableHitsOnAGridThroughItsEdges) {
       rays.push_back(r);
     }
   expect_levels_agree(grid, rays, "grid");
+}
+
+TEST(SimdLevel, RaysWithInfiniteDirectionsOrNaNOriginsMatchBruteForceAtEveryLevel) {
+  // Slab distances that are all NaN for a node's empty slots (a zero inverse
+  // on every axis, or a NaN origin): the traversal once took such a slot's
+  // child index (kEmpty) for a node and read far outside the nodes.
+  const TriMesh soup = test::random_soup(500, 41);
+  std::vector<Ray3f> rays = test::test_rays(soup, 600, 42);
+  const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
+  for (std::size_t i = 0; i < rays.size(); i += 5) {
+    Ray3f& r = rays[i];
+    switch (i / 5 % 3) {
+      case 0: r.direction = Vec3f(inf, -inf, inf); break;
+      case 1: r.origin = Vec3f(nan, nan, nan); break;
+      default: r.origin[2] = nan, r.direction[1] = -inf; break;
+    }
+    if (i % 2) r.tmin = -inf;
+  }
+  const LevelGuard guard;
+  for (int arity : {4, 8}) {
+    BuildOptions options;
+    options.arity = arity;
+    const TriangleBvh bvh = TriangleBvh::build(soup, options);
+    std::vector<SimdLevel> levels = levels_to_test();
+    levels.insert(levels.begin(), SimdLevel::portable);
+    for (SimdLevel level : levels) {
+      set_simd_level(level);
+      for (std::size_t i = 0; i < rays.size(); ++i) {
+        const RayHit want = test::brute_intersect(soup, rays[i]), got = bvh.intersect(rays[i]);
+        const std::string what = "arity " + std::to_string(arity) + " " + simd_level_name(level) + " ray " +
+                                 std::to_string(i);
+        ASSERT_EQ(got.hit(), want.hit()) << what;
+        ASSERT_TRUE(!want.hit() || got.t == want.t) << what << ": t " << got.t << " vs " << want.t;
+        ASSERT_EQ(bvh.occluded(rays[i]), want.hit()) << what;
+      }
+    }
+  }
 }
 
 }  // namespace

@@ -263,6 +263,26 @@ TEST(Accelerators, LinesWithNegativeTminMatchBruteForce) {
   expect_same_as_brute_force(mesh, rays, "lines");
 }
 
+TEST(Accelerators, RaysWithInfiniteDirectionsOrNaNOriginsMatchBruteForce) {
+  // Slab and cell distances that are NaN on every axis: no accelerator may
+  // walk outside its structure or hang on them, and none of these rays hits.
+  // (A direction infinite on some axes only is left out: the watertight test
+  // then reports hits at t = 0 that no accelerator's boxes contain.)
+  const TriMesh mesh = ugly_soup(6, 500);
+  std::vector<Ray3f> rays = test_rays(mesh, 16, 1500);
+  const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
+  for (std::size_t i = 0; i < rays.size(); i += 4) {
+    Ray3f& r = rays[i];
+    switch (i / 4 % 3) {
+      case 0: r.direction = Vec3f(inf, -inf, inf); break;
+      case 1: r.origin = Vec3f(nan, nan, nan); break;
+      default: r.origin[2] = nan, r.direction[1] = -inf; break;
+    }
+    if (i % 8 == 0) r.tmin = -inf;
+  }
+  expect_same_as_brute_force(mesh, rays, "infinite and NaN rays");
+}
+
 // A closed cube of 2 x 2 quads per face on a grid, shot through its shared edges
 // and vertices along the axes and diagonals: watertight, so every ray from
 // outside through the cube's interior hits.
