@@ -124,16 +124,7 @@ TEST(SimdLevel, RaysWithInfiniteDirectionsOrNaNOriginsMatchBruteForceAtEveryLeve
   // child index (kEmpty) for a node and read far outside the nodes.
   const TriMesh soup = test::random_soup(500, 41);
   std::vector<Ray3f> rays = test::test_rays(soup, 600, 42);
-  const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
-  for (std::size_t i = 0; i < rays.size(); i += 5) {
-    Ray3f& r = rays[i];
-    switch (i / 5 % 3) {
-      case 0: r.direction = Vec3f(inf, -inf, inf); break;
-      case 1: r.origin = Vec3f(nan, nan, nan); break;
-      default: r.origin[2] = nan, r.direction[1] = -inf; break;
-    }
-    if (i % 2) r.tmin = -inf;
-  }
+  test::make_nan_slab_rays(rays, 5);
   const LevelGuard guard;
   for (int arity : {4, 8}) {
     BuildOptions options;

@@ -12,6 +12,7 @@
 #include <limits>
 #include <vector>
 
+#include "bvh/bvh_test_util.hpp"
 #include "common/archive_files.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"
@@ -270,16 +271,7 @@ TEST(Accelerators, RaysWithInfiniteDirectionsOrNaNOriginsMatchBruteForce) {
   // then reports hits at t = 0 that no accelerator's boxes contain.)
   const TriMesh mesh = ugly_soup(6, 500);
   std::vector<Ray3f> rays = test_rays(mesh, 16, 1500);
-  const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
-  for (std::size_t i = 0; i < rays.size(); i += 4) {
-    Ray3f& r = rays[i];
-    switch (i / 4 % 3) {
-      case 0: r.direction = Vec3f(inf, -inf, inf); break;
-      case 1: r.origin = Vec3f(nan, nan, nan); break;
-      default: r.origin[2] = nan, r.direction[1] = -inf; break;
-    }
-    if (i % 8 == 0) r.tmin = -inf;
-  }
+  bvh::test::make_nan_slab_rays(rays, 4);
   expect_same_as_brute_force(mesh, rays, "infinite and NaN rays");
 }
 
