@@ -1,35 +1,4 @@
-// geods::bvh::TriangleBvh (binned SAH, AABB: the defaults; 8 wide, as the ray module's
-// accelerator builds it) on the ray comparison.
-#include "geods/bvh/triangle_bvh.hpp"
-#include "geods_mesh.hpp"
-#include "ray_driver.hpp"
+// geods' BVH on the ray comparison (geods_bvh_ray.hpp).
+#include "geods_bvh_ray.hpp"
 
-namespace {
-
-struct Geods {
-  static constexpr const char* anchor = "geods";
-  using Index = geods::bvh::TriangleBvh;
-  static std::unique_ptr<Index> build(const compare::PlyMesh& ply) {
-    const geods::TriMesh& mesh = compare::ray::geods_mesh(ply);
-    geods::bvh::BuildOptions options;
-    options.arity = 8;
-    return std::make_unique<Index>(Index::build(mesh, options));
-  }
-  static compare::ray::Hit intersect(const Index& bvh, const float* r) {
-    geods::Ray3f ray;
-    ray.origin = {r[0], r[1], r[2]};
-    ray.direction = {r[3], r[4], r[5]};
-    const geods::RayHit hit = bvh.intersect(ray);
-    return {hit.t, hit.prim};
-  }
-  static bool occluded(const Index& bvh, const float* r) {
-    geods::Ray3f ray;
-    ray.origin = {r[0], r[1], r[2]};
-    ray.direction = {r[3], r[4], r[5]};
-    return bvh.occluded(ray);
-  }
-};
-
-}  // namespace
-
-int main(int argc, char** argv) { return compare::ray::run<Geods>(argc, argv); }
+int main(int argc, char** argv) { return compare::ray::run<compare::ray::Geods>(argc, argv); }

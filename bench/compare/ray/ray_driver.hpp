@@ -116,25 +116,35 @@ void run_variant(const Args& args, const PlyMesh& mesh, const std::string& mesh_
       .print(disagreements * 100 <= checked);
 }
 
-template <class Lib>
-int run(int argc, char** argv) {
-  const Args args = parse_args(argc, argv);
-  const ThreadLimit limit(args.threads);
+/// Calls fn(mesh, mesh_name, rays_name, any) for every variant --only selects,
+/// "_any" ones only if with_any; each mesh is read once.
+template <class Fn>
+void for_each_variant(const Args& args, bool with_any, bool (*wants_mesh)(const std::string&), Fn&& fn) {
   for (const char* mesh_name : {"1m", "100k"}) {
-    if constexpr (requires { Lib::wants_mesh(std::string()); }) {
-      if (!Lib::wants_mesh(mesh_name)) continue;
-    }
+    if (wants_mesh && !wants_mesh(mesh_name)) continue;
     // (rays, any hit) of the variants wanted on this mesh
     std::vector<std::pair<std::string, bool>> wanted;
     for (const char* rays_name : {"coherent", "incoherent"}) {
       const std::string variant = std::string(mesh_name) + "_" + rays_name;
       if (args.wants(variant)) wanted.emplace_back(rays_name, false);
-      if (has_occluded<Lib> && args.wants(variant + "_any")) wanted.emplace_back(rays_name, true);
+      if (with_any && args.wants(variant + "_any")) wanted.emplace_back(rays_name, true);
     }
     if (wanted.empty()) continue;
     const PlyMesh mesh = read_ply(args.path(std::string("mesh_") + mesh_name + ".ply"));
-    for (const auto& [rays_name, any] : wanted) run_variant<Lib>(args, mesh, mesh_name, rays_name, any);
+    for (const auto& [rays_name, any] : wanted) fn(mesh, mesh_name, rays_name, any);
   }
+}
+
+template <class Lib>
+int run(int argc, char** argv) {
+  const Args args = parse_args(argc, argv);
+  const ThreadLimit limit(args.threads);
+  bool (*wants_mesh)(const std::string&) = nullptr;
+  if constexpr (requires { Lib::wants_mesh(std::string()); }) wants_mesh = &Lib::wants_mesh;
+  for_each_variant(args, has_occluded<Lib>, wants_mesh,
+                   [&](const PlyMesh& mesh, const std::string& mesh_name, const std::string& rays_name, bool any) {
+                     run_variant<Lib>(args, mesh, mesh_name, rays_name, any);
+                   });
   return 0;
 }
 
