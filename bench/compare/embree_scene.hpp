@@ -1,9 +1,12 @@
 #pragma once
-// The Embree 3 scene of one triangle mesh (RTC_BUILD_QUALITY_MEDIUM), shared by
-// the single-ray and the packet programs of bench/compare so both time the same build.
+// The Embree 3 scene of one triangle mesh (RTC_BUILD_QUALITY_MEDIUM) and the device
+// holding it, shared by the single-ray and the packet programs of bench/compare so
+// both time the same build.
 #include <embree3/rtcore.h>
 
 #include <algorithm>
+#include <memory>
+#include <string>
 
 #include "common.hpp"
 
@@ -30,3 +33,19 @@ inline RTCScene embree_mesh_scene(RTCDevice device, const compare::PlyMesh& mesh
   rtcCommitScene(scene);
   return scene;
 }
+
+/// An Embree device of `threads` threads and its scene, released together.
+struct EmbreeIndex {
+  RTCDevice device = nullptr;
+  RTCScene scene = nullptr;
+  explicit EmbreeIndex(int threads) {
+    const std::string config = "threads=" + std::to_string(threads);
+    device = rtcNewDevice(config.c_str());
+  }
+  EmbreeIndex(const EmbreeIndex&) = delete;
+  EmbreeIndex& operator=(const EmbreeIndex&) = delete;
+  ~EmbreeIndex() {
+    if (scene) rtcReleaseScene(scene);
+    if (device) rtcReleaseDevice(device);
+  }
+};

@@ -6,7 +6,6 @@
 
 #include <limits>
 #include <memory>
-#include <string>
 
 #include "embree_scene.hpp"
 #include "ray_driver.hpp"
@@ -19,19 +18,10 @@ struct Embree {
 #else
   static constexpr const char* anchor = "embree";
 #endif
-  struct Index {
-    RTCDevice device = nullptr;
-    RTCScene scene = nullptr;
-    ~Index() {
-      if (scene) rtcReleaseScene(scene);
-      if (device) rtcReleaseDevice(device);
-    }
-  };
+  using Index = EmbreeIndex;
   static inline int threads = 1;
   static std::unique_ptr<Index> build(const PlyMesh& mesh) {
-    auto index = std::make_unique<Index>();
-    const std::string config = "threads=" + std::to_string(threads);
-    index->device = rtcNewDevice(config.c_str());
+    auto index = std::make_unique<Index>(threads);
     index->scene = embree_mesh_scene(index->device, mesh);
     return index;
   }

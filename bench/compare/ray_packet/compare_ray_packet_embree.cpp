@@ -37,19 +37,10 @@ struct Embree {
   static constexpr int N = GEODS_EMBREE_PACKET;
   static constexpr const char* anchor = N == 16 ? "embree16" : "embree8";
   static constexpr int kTileW = 4, kTileH = N / 4;
-  struct Index {
-    RTCDevice device = nullptr;
-    RTCScene scene = nullptr;
-    ~Index() {
-      if (scene) rtcReleaseScene(scene);
-      if (device) rtcReleaseDevice(device);
-    }
-  };
+  using Index = EmbreeIndex;
   static inline int threads = 1;
   static std::unique_ptr<Index> build(const compare::PlyMesh& mesh) {
-    auto index = std::make_unique<Index>();
-    const std::string config = "threads=" + std::to_string(threads);
-    index->device = rtcNewDevice(config.c_str());
+    auto index = std::make_unique<Index>(threads);
     const int property = N == 16 ? RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED : RTC_DEVICE_PROPERTY_NATIVE_RAY8_SUPPORTED;
     if (!rtcGetDeviceProperty(index->device, RTCDeviceProperty(property)))
       throw std::runtime_error("Embree: this CPU or build does not support packets of " + std::to_string(N));
