@@ -192,20 +192,23 @@ inline std::vector<Ray3f> test_rays(const TriMesh& mesh, std::size_t n, std::uin
   return rays;
 }
 
-/// Makes every stride-th ray one whose slab distances are NaN on every axis,
-/// in turn: a direction infinite on every axis, a NaN origin, a NaN origin
-/// coordinate with an infinite direction component; every second of them a
-/// line (tmin = -inf). None of them hits anything.
-inline void make_nan_slab_rays(std::vector<Ray3f>& rays, std::size_t stride) {
+/// Makes every stride-th ray one with a non-finite direction or origin, in
+/// turn: a direction infinite on every axis and a NaN origin (slab distances
+/// NaN on every axis, at a node's empty slots too), a NaN origin coordinate
+/// with an infinite direction component, a direction infinite on one axis
+/// only; every second of them a line (tmin = -inf). None of them hits
+/// anything.
+inline void make_non_finite_rays(std::vector<Ray3f>& rays, std::size_t stride) {
   const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
   for (std::size_t k = 0, i = 0; i < rays.size(); ++k, i += stride) {
     Ray3f& r = rays[i];
-    switch (k % 3) {
+    switch (k % 4) {
       case 0: r.direction = Vec3f(inf, -inf, inf); break;
       case 1: r.origin = Vec3f(nan, nan, nan); break;
-      default: r.origin[2] = nan, r.direction[1] = -inf; break;
+      case 2: r.origin[2] = nan, r.direction[1] = -inf; break;
+      default: r.direction[k / 4 % 3] = k / 4 % 2 ? -inf : inf; break;
     }
-    if (k % 2) r.tmin = -inf;
+    if ((k + k / 4) % 2) r.tmin = -inf;
   }
 }
 

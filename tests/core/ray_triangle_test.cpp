@@ -2,6 +2,7 @@
 // its defining property: rays through shared edges and vertices never miss.
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <vector>
 
 #include "geods/core/ray_triangle.hpp"
@@ -76,6 +77,17 @@ TEST(RayTriangle, RejectsDegenerateInputs) {
   EXPECT_FALSE(RayTriangleTest<float>(r).intersect(a, b, c, 0, 10, t, u, v));
   r.direction = {0, 0, 0};
   EXPECT_FALSE(RayTriangleTest<float>(r).intersect(a, b, Vec3f(0, 1, 0), 0, 10, t, u, v));
+  // A direction infinite or NaN on any axis: no hit (sheared by an infinite
+  // component, the triangle around the origin's projection came out at t = 0).
+  const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
+  r.origin = {0.2f, 0.2f, -1.0f};
+  for (const Vec3f& d : {Vec3f(0, 0, inf), Vec3f(0.1f, 0, -inf), Vec3f(inf, 0, 1), Vec3f(0, -inf, 1),
+                         Vec3f(inf, inf, inf), Vec3f(0, 0, nan), Vec3f(nan, 0, 1), Vec3f(0, nan, 1)}) {
+    r.direction = d;
+    EXPECT_FALSE(RayTriangleTest<float>(r).intersect(a, b, Vec3f(0, 1, 0), 0, 10, t, u, v))
+        << d[0] << " " << d[1] << " " << d[2];
+    EXPECT_FALSE(RayTriangleTest<float>(r).intersect(a, b, Vec3f(0, 1, 0), -inf, inf, t, u, v));
+  }
   // A ray in the triangle's plane does not hit it (zero determinant).
   r.origin = {-1, 0.1f, 0};
   r.direction = {1, 0, 0};

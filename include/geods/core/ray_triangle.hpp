@@ -49,12 +49,16 @@ class RayTriangleTest {
     ky_ = after ^ ((next ^ after) & swap);
     shear_x_ = d[kx_] / d[kz_];
     shear_y_ = d[ky_] / d[kz_];
-    shear_z_ = T(1) / d[kz_];
+    // A direction with an infinite component (then d[kz] is one) hits
+    // nothing: its shear would put every triangle around the origin's
+    // projection at t = 0. A NaN t rejects them all (and a NaN component
+    // already makes the edge functions NaN).
+    shear_z_ = std::isfinite(d[kz_]) ? T(1) / d[kz_] : std::numeric_limits<T>::quiet_NaN();
   }
 
   /// Parameter t and barycentrics (u, v) of the hit with triangle (a, b, c)
   /// if t lies in [tmin, tmax]; false otherwise (also for degenerate triangles
-  /// and a zero direction).
+  /// and a zero or non-finite direction).
   bool intersect(const Vec<T, 3>& a, const Vec<T, 3>& b, const Vec<T, 3>& c, T tmin, T tmax, T& t,
                  T& u, T& v) const {
     const Vec<T, 3> pa = a - origin_, pb = b - origin_, pc = c - origin_;
