@@ -3,7 +3,7 @@
 several processes, and prints per variant the median and range of the ratio
 Embree's time / geods' over the processes (> 1: geods faster). The ratio of a
 single process moves by a few per cent with where its memory lands; the median
-of 10 or more is steady to about 1 %.
+of 10 or more moved by 1-3 % between runs on a shared 2-core VM.
 
 With several programs (compare_ray_paired built from different geods trees),
 their processes alternate, so that the drift of the machine is shared by
