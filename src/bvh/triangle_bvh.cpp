@@ -476,6 +476,13 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray) 
   using vf = typename SimdTypes<W>::vf;
   RayHit hit;
   if (nodes.empty()) return hit;
+  if constexpr (!Avx) {
+    // A direction with an infinite component hits nothing, as in the scalar
+    // test (RayTriangle4Test takes the direction to be finite). The SIMD
+    // kernels send such rays here: their zero inverse fails the fast test.
+    const Vec3f& d = ray.direction;
+    if (!(std::isfinite(d[0]) && std::isfinite(d[1]) && std::isfinite(d[2]))) return hit;
+  }
   const RayTriangle4Test test(ray);
   // A zero direction component gives an infinite inverse; the 0 * inf NaN of
   // an origin on a slab plane is then skipped by the NaN-ignoring min/max
