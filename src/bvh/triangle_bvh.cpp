@@ -476,13 +476,6 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray) 
   using vf = typename SimdTypes<W>::vf;
   RayHit hit;
   if (nodes.empty()) return hit;
-  if constexpr (!Avx) {
-    // A direction with an infinite component hits nothing, as in the scalar
-    // test (RayTriangle4Test takes the direction to be finite). The SIMD
-    // kernels send such rays here: their zero inverse fails the fast test.
-    const Vec3f& d = ray.direction;
-    if (!(std::isfinite(d[0]) && std::isfinite(d[1]) && std::isfinite(d[2]))) return hit;
-  }
   const RayTriangle4Test test(ray);
   // A zero direction component gives an infinite inverse; the 0 * inf NaN of
   // an origin on a slab plane is then skipped by the NaN-ignoring min/max
@@ -538,6 +531,13 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray) 
   const v4 non_finite = (origin4 - origin4) + (inv_far4 - inv_far4);
   const bool fast_box_test =
       (lane_bits((non_finite == v4{}) & (inv4 != v4{})) == 0xF) & (tmin >= 0) & (tmax == tmax);
+  if constexpr (!Avx) {
+    // A direction with an infinite or NaN component (a zero or NaN inverse)
+    // hits nothing, as in the scalar test; RayTriangle4Test takes the
+    // direction to be finite. The SIMD kernels send such rays here: they
+    // fail the fast test.
+    if (lane_bits((inv4 == v4{}) | (inv4 != inv4)) != 0) return hit;
+  }
   if constexpr (Avx) {
     // The SIMD kernels keep only the fast test in their loop (fewer values
     // live across it, no branch per node); the other rays take the portable

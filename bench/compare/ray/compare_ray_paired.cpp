@@ -13,9 +13,6 @@
 // from the median builds. Threads > 1 split each chunk with tbb::parallel_for.
 //
 //   compare_ray_paired --data build/anchors-data --threads 1 --reps 4 --only 100k_incoherent
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <cmath>
 #include <vector>
@@ -26,18 +23,6 @@
 
 namespace compare::ray {
 namespace {
-
-template <class Lib>
-void trace(const typename Lib::Index& index, const std::vector<float>& rays, std::size_t begin, std::size_t end,
-           bool any, std::vector<Hit>& hits, int threads) {
-  auto body = [&](std::size_t b, std::size_t e) {
-    for (std::size_t i = b; i < e; ++i)
-      hits[i] = any ? (Lib::occluded(index, &rays[6 * i]) ? Hit{0.0f, 0} : Hit{}) : Lib::intersect(index, &rays[6 * i]);
-  };
-  if (threads == 1) return body(begin, end);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(begin, end, 1024),
-                    [&](const tbb::blocked_range<std::size_t>& r) { body(r.begin(), r.end()); });
-}
 
 void run_paired(const Args& args, const PlyMesh& mesh, const std::string& mesh_name, const std::string& rays_name,
                 bool any) {

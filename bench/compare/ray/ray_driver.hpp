@@ -61,6 +61,25 @@ inline double brute_force_t(const PlyMesh& mesh, const float* r) {
 template <class Lib>
 constexpr bool has_occluded = requires(const typename Lib::Index& index, const float* r) { Lib::occluded(index, r); };
 
+/// hits[i] for the rays [begin, end): the closest hit, or with `any` a hit at
+/// t = 0 if anything is hit; threads > 1 split them with tbb::parallel_for.
+template <class Lib>
+void trace(const typename Lib::Index& index, const std::vector<float>& rays, std::size_t begin, std::size_t end,
+           bool any, std::vector<Hit>& hits, int threads) {
+  auto body = [&](std::size_t b, std::size_t e) {
+    if constexpr (has_occluded<Lib>) {
+      if (any) {
+        for (std::size_t i = b; i < e; ++i) hits[i] = Lib::occluded(index, &rays[6 * i]) ? Hit{0.0f, 0} : Hit{};
+        return;
+      }
+    }
+    for (std::size_t i = b; i < e; ++i) hits[i] = Lib::intersect(index, &rays[6 * i]);
+  };
+  if (threads == 1) return body(begin, end);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(begin, end, 1024),
+                    [&](const tbb::blocked_range<std::size_t>& r) { body(r.begin(), r.end()); });
+}
+
 template <class Lib>
 void run_variant(const Args& args, const PlyMesh& mesh, const std::string& mesh_name, const std::string& rays_name,
                  bool any) {
@@ -74,23 +93,7 @@ void run_variant(const Args& args, const PlyMesh& mesh, const std::string& mesh_
     index.reset();
     index = Lib::build(mesh);
   });
-  auto trace_all = [&] {
-    auto body = [&](std::size_t b, std::size_t e) {
-      if constexpr (has_occluded<Lib>) {
-        if (any) {
-          for (std::size_t i = b; i < e; ++i) hits[i] = Lib::occluded(*index, &rays[6 * i]) ? Hit{0.0f, 0} : Hit{};
-          return;
-        }
-      }
-      for (std::size_t i = b; i < e; ++i) hits[i] = Lib::intersect(*index, &rays[6 * i]);
-    };
-    if (args.threads == 1) {
-      body(0, m);
-    } else {
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m, 1024),
-                        [&](const tbb::blocked_range<std::size_t>& r) { body(r.begin(), r.end()); });
-    }
-  };
+  auto trace_all = [&] { trace<Lib>(*index, rays, 0, m, any, hits, args.threads); };
   const double query_s = median_time_s(args.reps, trace_all);
 
   std::size_t hit_count = 0;
