@@ -571,7 +571,7 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray) 
   };
   auto mask_bits = [&](const auto& m) GEODS_BVH_INLINE_LAMBDA {
 #if defined(GEODS_BVH_SIMD_DISPATCH)
-    if constexpr (Avx && W == 8) return lane_bits_avx(m);
+    if constexpr (Avx && sizeof(m) == 32) return lane_bits_avx(m);
 #endif
     return lane_bits(m);
   };
@@ -626,20 +626,27 @@ RayHit TriangleBvh::intersect_wide(const WideNodes<W>& nodes, const Ray3f& ray) 
     prefetch(c);
     return c;
   };
+  // Two groups at a time, 8 lanes wide: a leaf of the default size (8
+  // triangles, at most 2 groups) in one test, without a loop whose exit
+  // mispredicted about once a ray; a last group alone takes lanes 0-3 only.
   auto leaf = [&](const WideEntry& e) GEODS_BVH_INLINE_LAMBDA {
-    for (std::uint32_t g = e.child; g < e.child + e.count; ++g) {
-      RayTriangle4Test::vf t, u, v;
-      const int mask = test.intersect(group_at[g], tmin, tmax, t, u, v);
+    const std::uint32_t end = e.child + e.count;
+    for (std::uint32_t g = e.child; g < end; g += 2) {
+      // (Arithmetic, not ?:: GCC branched on it, mispredicting half a time a ray.)
+      const std::uint32_t pair = std::uint32_t(g + 1 < end);
+      RayTriangle4Test::vf8 t, u, v;
+      const int mask = test.intersect(group_at[g], group_at[g + pair], int(0x0F | (0xF0 & -pair)), tmin, tmax, t, u, v,
+                                      [&](const auto& m) GEODS_BVH_INLINE_LAMBDA { return mask_bits(m); });
       if (mask == 0) continue;
       // The nearest lane, ties to the last one: what testing the triangles
       // one after the other, each against the shrinking tmax, would keep.
       // Usually a single lane: no data-dependent branch per lane then.
       int best = __builtin_ctz(unsigned(mask));
       if (mask & (mask - 1)) {
-        for (int i = best + 1; i < 4; ++i)
+        for (int i = best + 1; i < 8; ++i)
           if ((mask >> i & 1) && t[i] <= t[best]) best = i;
       }
-      hit = {t[best], group_at[g].index[best], u[best], v[best]};
+      hit = {t[best], group_at[g + (best >> 2)].index[best & 3], u[best], v[best]};
       if constexpr (Any) return false;  // the traversal ends here: no bound to tighten
       tmax = t[best];
       tmax_widened = widen_far(tmax);

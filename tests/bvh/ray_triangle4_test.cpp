@@ -1,5 +1,5 @@
 // RayTriangle4Test against the scalar watertight test it vectorizes: the
-// same hit decisions and bit-identical t, u, v, lane by lane.
+// same hit decisions and bit-identical t, u, v, lane by lane, 4 and 8 wide.
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -7,6 +7,9 @@
 
 #include "bvh_test_util.hpp"
 #include "geods/bvh/ray_triangle4.hpp"
+
+// (The 8-wide vectors of the two-group form cross no call: no ABI concern.)
+#pragma GCC diagnostic ignored "-Wpsabi"
 
 namespace geods::bvh {
 namespace {
@@ -41,6 +44,27 @@ int expect_lanes_match_scalar(const TriMesh& mesh, const Ray3f& ray, const std::
     EXPECT_TRUE(same_bits(t[lane], st) && same_bits(u[lane], su) && same_bits(v[lane], sv))
         << what << " lane " << lane << ": " << t[lane] << " " << u[lane] << " " << v[lane] << " vs " << st << " "
         << su << " " << sv;
+  }
+  // The two-group form: lanes 0-3 the group above, lanes 4-7 its lanes in
+  // reverse; and with lanes 4-7 masked off, as a leaf's last group alone.
+  const std::size_t reversed[4] = {tri[3], tri[2], tri[1], tri[0]};
+  const TriangleGroup g0 = group_of(mesh, tri), g1 = group_of(mesh, reversed);
+  const auto bits = [](const auto& m) {
+    int b = 0;
+    for (int lane = 0; lane < 8; ++lane) b |= (m[lane] & 1) << lane;
+    return b;
+  };
+  for (int lanes : {0xFF, 0x0F}) {
+    RayTriangle4Test::vf8 t8, u8, v8;
+    const int mask8 = wide.intersect(g0, g1, lanes, tmin, tmax, t8, u8, v8, bits);
+    EXPECT_EQ(mask8 & ~lanes, 0) << what;
+    for (int lane = 0; lane < 8; ++lane) {
+      const int k = lane < 4 ? lane : 7 - lane;  // the lane of the 4-wide test with the same triangle
+      EXPECT_EQ(bool(mask8 >> lane & 1), (lanes >> lane & 1) && (mask >> k & 1)) << what << " lane " << lane;
+      if (!(mask8 >> lane & 1) || !(mask >> k & 1)) continue;
+      EXPECT_TRUE(same_bits(t8[lane], t[k]) && same_bits(u8[lane], u[k]) && same_bits(v8[lane], v[k]))
+          << what << " 8-wide lane " << lane;
+    }
   }
   return hits;
 }

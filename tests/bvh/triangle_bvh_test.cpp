@@ -144,6 +144,31 @@ TEST(TriangleBvh, RaysFromInsideAClosedMeshThroughEveryVertexNeverSlipThrough) {
   }
 }
 
+TEST(TriangleBvh, TiedTrianglesOfALeafGoToTheLastInLeafOrder) {
+  // n copies of one triangle make one leaf; every copy is hit at the same t,
+  // and the one kept is the last in leaf order, as testing them one after
+  // the other against the shrinking tmax keeps it (the wide layout tests
+  // 4 or 8 at once: 1 to 4 groups, pairs and a group alone).
+  for (int arity : {2, 4, 8})
+    for (int n = 1; n <= 16; ++n) {
+      TriMesh mesh;
+      mesh.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+      mesh.triangles.assign(std::size_t(n), {0, 1, 2});
+      BuildOptions options;
+      options.arity = arity;
+      options.leaf_size = 16;
+      const TriangleBvh bvh = TriangleBvh::build(mesh, options);
+      const std::string what = "arity " + std::to_string(arity) + ", " + std::to_string(n) + " copies";
+      ASSERT_EQ(bvh.topology().nodes.size(), 1u) << what;
+      Ray3f ray;
+      ray.origin = Vec3f(0.25f, 0.25f, -1.0f);
+      const RayHit hit = bvh.intersect(ray);
+      ASSERT_TRUE(hit.hit()) << what;
+      EXPECT_EQ(hit.t, 1.0f) << what;
+      EXPECT_EQ(hit.prim, bvh.triangle_ids()[std::size_t(n) - 1]) << what;
+    }
+}
+
 TEST(TriangleBvh, TmaxAndTminBoundTheHits) {
   const TriMesh bunny = test::data_mesh("bunny.ply");
   const TriangleBvh bvh = TriangleBvh::build(bunny);

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <limits>
 
+#include "geods/bvh/traversal.hpp"  // GEODS_BVH_INLINE_LAMBDA
 #include "geods/core/ray_triangle.hpp"
 
 #if defined(__SSE__)
@@ -67,12 +68,11 @@ template <typename VF, typename Bits = SameMask>
   e.inside = ~mixed & ~e.on_edge & bits(e.det - e.det == zero);
   return e;
 }
-#pragma GCC diagnostic pop
-
 class RayTriangle4Test {
  public:
   typedef float vf __attribute__((vector_size(16)));
   typedef std::int32_t vi __attribute__((vector_size(16)));
+  typedef float vf8 __attribute__((vector_size(32)));
 
   /// `ray` must outlive the test (the on-edge lanes read it).
   explicit RayTriangle4Test(const Ray3f& ray) : ray_(&ray) {
@@ -80,46 +80,78 @@ class RayTriangle4Test {
     const int k[3] = {scalar.axis_x(), scalar.axis_y(), scalar.axis_z()};
     for (int a = 0; a < 3; ++a) {
       axis_offset_[a] = k[a] * std::ptrdiff_t(sizeof(vf));
-      origin_[a] = splat(ray.origin[k[a]]);
+      origin_[a] = vf8{} + ray.origin[k[a]];
     }
-    shear_x_ = splat(scalar.shear_x());
-    shear_y_ = splat(scalar.shear_y());
+    shear_x_ = vf8{} + scalar.shear_x();
+    shear_y_ = vf8{} + scalar.shear_y();
     // The scalar test's shear_z for a finite direction (the only kind the
     // traversals test triangles with), computed here: with the scalar test's
     // check for an infinite one inlined, GCC scheduled the AVX-512 kernel
     // worse (4-5 % slower on 100k incoherent rays, paired with Embree).
-    shear_z_ = splat(1.0f / ray.direction[k[2]]);
+    shear_z_ = vf8{} + 1.0f / ray.direction[k[2]];
   }
 
   /// Bit i set: lane i's triangle is hit with t in [tmin, tmax], its t and
   /// barycentrics in t[i], u[i], v[i] (other lanes hold garbage).
   /// (Always inlined: the traversals' flatten alone left it out of line in some of them.)
   [[gnu::always_inline]] int intersect(const TriangleGroup& g, float tmin, float tmax, vf& t, vf& u, vf& v) const {
-    // Corner k relative to the origin, in the sheared frame (x, y; z unscaled).
-    vf px[3], py[3], pz[3];
     const char* base = reinterpret_cast<const char*>(&g);
+    return test<vf>(
+        [&](std::size_t offset) GEODS_BVH_INLINE_LAMBDA { return load(base + offset); }, 0xF, tmin, tmax, t, u, v,
+        [](vi m) GEODS_BVH_INLINE_LAMBDA { return movemask(m); },
+        [&](int) GEODS_BVH_INLINE_LAMBDA -> const TriangleGroup& { return g; });
+  }
+
+  /// intersect for the triangles of two groups at once, 8 wide (one AVX
+  /// operation a step where the caller is compiled for it): lanes 0-3 are
+  /// g0's, lanes 4-7 g1's, and only the lanes set in `lanes` are tested.
+  /// bits(m): the bit mask of an 8-lane comparison (one vmovmskps with AVX).
+  template <typename Bits>
+  [[gnu::always_inline]] int intersect(const TriangleGroup& g0, const TriangleGroup& g1, int lanes, float tmin,
+                                       float tmax, vf8& t, vf8& u, vf8& v, Bits bits) const {
+    const char* base0 = reinterpret_cast<const char*>(&g0);
+    const char* base1 = reinterpret_cast<const char*>(&g1);
+    return test<vf8>(
+        [&](std::size_t offset) GEODS_BVH_INLINE_LAMBDA {
+          return __builtin_shufflevector(load(base0 + offset), load(base1 + offset), 0, 1, 2, 3, 4, 5, 6, 7);
+        },
+        lanes, tmin, tmax, t, u, v, bits,
+        [&](int lane) GEODS_BVH_INLINE_LAMBDA -> const TriangleGroup& { return lane < 4 ? g0 : g1; });
+  }
+
+ private:
+  // The test on the lanes of V (4 or 8): load(offset) gives the row at that
+  // byte offset of the group(s), group(i) the group of lane i (lane i % 4 in it).
+  template <typename V, typename Load, typename Bits, typename Group>
+  [[gnu::always_inline]] int test(Load load, int lanes, float tmin, float tmax, V& t, V& u, V& v, Bits bits,
+                                  Group group) const {
+    // Corner k relative to the origin, in the sheared frame (x, y; z unscaled).
+    V px[3], py[3], pz[3];
     for (int c = 0; c < 3; ++c) {
-      const char* corner = base + c * sizeof(g.corner[c]);
-      pz[c] = load(corner + axis_offset_[2]) - origin_[2];
-      px[c] = (load(corner + axis_offset_[0]) - origin_[0]) - shear_x_ * pz[c];
-      py[c] = (load(corner + axis_offset_[1]) - origin_[1]) - shear_y_ * pz[c];
+      const std::size_t corner = c * sizeof(TriangleGroup::corner[c]);
+      pz[c] = load(corner + axis_offset_[2]) - lanes_of<V>(origin_[2]);
+      px[c] = (load(corner + axis_offset_[0]) - lanes_of<V>(origin_[0])) - lanes_of<V>(shear_x_) * pz[c];
+      py[c] = (load(corner + axis_offset_[1]) - lanes_of<V>(origin_[1])) - lanes_of<V>(shear_y_) * pz[c];
     }
-    const ShearedEdges<vf> e = sheared_edges(px, py);
-    const int edge_mask = movemask(e.on_edge);
+    const ShearedEdges<V> e = sheared_edges(px, py);
+    const int edge_mask = bits(e.on_edge) & lanes;
     // Most groups a ray reaches are missed: skip the division then.
-    if (movemask(e.inside) == 0 && edge_mask == 0) return 0;
-    const vf scaled_t = e.eu * (shear_z_ * pz[0]) + e.ev * (shear_z_ * pz[1]) + e.ew * (shear_z_ * pz[2]);
-    const vf inv_det = splat(1.0f) / e.det;
+    if ((bits(e.inside) & lanes) == 0 && edge_mask == 0) return 0;
+    const V shear_z = lanes_of<V>(shear_z_);
+    const V scaled_t = e.eu * (shear_z * pz[0]) + e.ev * (shear_z * pz[1]) + e.ew * (shear_z * pz[2]);
+    const V inv_det = 1.0f / e.det;
     t = scaled_t * inv_det;
     u = e.ev * inv_det;
     v = e.ew * inv_det;
-    int mask = movemask(e.inside & (t >= splat(tmin)) & (t <= splat(tmax)));
+    int mask = bits(e.inside & (t >= tmin) & (t <= tmax)) & lanes;
     if (edge_mask != 0) [[unlikely]] {
       const RayTriangleTest<float> scalar(*ray_);
-      for (int i = 0; i < 4; ++i) {
+      for (int i = 0; i < int(sizeof(V) / sizeof(float)); ++i) {
         if (!(edge_mask >> i & 1)) continue;
+        const TriangleGroup& g = group(i);
         float hit_t, hit_u, hit_v;
-        if (scalar.intersect(corner(g, 0, i), corner(g, 1, i), corner(g, 2, i), tmin, tmax, hit_t, hit_u, hit_v)) {
+        if (scalar.intersect(corner(g, 0, i % 4), corner(g, 1, i % 4), corner(g, 2, i % 4), tmin, tmax, hit_t, hit_u,
+                             hit_v)) {
           t[i] = hit_t, u[i] = hit_u, v[i] = hit_v;
           mask |= 1 << i;
         }
@@ -127,9 +159,15 @@ class RayTriangle4Test {
     }
     return mask;
   }
-
- private:
-  static vf splat(float x) { return vf{x, x, x, x}; }
+  // The first 4 lanes of a splat, or all 8.
+  template <typename V>
+  [[gnu::always_inline]] static V lanes_of(const vf8& x) {
+    if constexpr (sizeof(V) == sizeof(vf8)) {
+      return x;
+    } else {
+      return __builtin_shufflevector(x, x, 0, 1, 2, 3);
+    }
+  }
   static vf load(const char* p) {
     vf r;
     __builtin_memcpy(&r, p, sizeof r);
@@ -150,8 +188,9 @@ class RayTriangle4Test {
   // rare, rather than kept (GCC kept its fields in memory, stored per ray).
   const Ray3f* ray_;
   std::ptrdiff_t axis_offset_[3];  // byte offset of the kx, ky, kz rows in a corner (3 registers, not one per corner)
-  vf origin_[3];                  // origin coordinate along kx, ky, kz
-  vf shear_x_, shear_y_, shear_z_;
+  vf8 origin_[3];                 // origin coordinate along kx, ky, kz, in every lane
+  vf8 shear_x_, shear_y_, shear_z_;
 };
+#pragma GCC diagnostic pop
 
 }  // namespace geods::bvh
