@@ -7,7 +7,9 @@ of 10 or more moved by 1-3 % between runs on a shared 2-core VM.
 
 With several programs (compare_ray_paired built from different geods trees),
 their processes alternate, so that the drift of the machine is shared by
-them too: an A/B of two versions of geods, each against Embree.
+them too: an A/B of two versions of geods, each against Embree. It then
+also prints, per program after the first, the median over rounds of its
+ratio / the first program's in the same round.
 
   bench/compare/ray/paired.py --runs 10 --threads 1 --only 100k_incoherent \\
       build/compare/bin/compare_ray_paired [/tmp/compare_ray_paired_other ...]
@@ -46,6 +48,15 @@ def main():
     print("variant\tprogram\tmedian\tmin\tmax\t(Embree's time / geods', one value per process)")
     for (prog, variant), r in sorted(ratios.items(), key=lambda kv: (kv[0][1], args.programs.index(kv[0][0]))):
         print(f"{variant}\t{prog}\t{statistics.median(r):.3f}\t{min(r):.3f}\t{max(r):.3f}")
+    if len(args.programs) > 1:
+        # Each round's processes ran back to back: their quotient cancels the
+        # drift of the machine between rounds, which the medians above keep.
+        print("variant\tprogram\tmedian\tmin\tmax\t(its ratio / the first program's, one value per round)")
+        for variant in sorted({v for _, v in ratios}):
+            first = ratios[(args.programs[0], variant)]
+            for prog in args.programs[1:]:
+                q = [a / b for a, b in zip(ratios[(prog, variant)], first)]
+                print(f"{variant}\t{prog}\t{statistics.median(q):.3f}\t{min(q):.3f}\t{max(q):.3f}")
 
 
 if __name__ == "__main__":

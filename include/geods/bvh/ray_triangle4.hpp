@@ -80,15 +80,15 @@ class RayTriangle4Test {
     const int k[3] = {scalar.axis_x(), scalar.axis_y(), scalar.axis_z()};
     for (int a = 0; a < 3; ++a) {
       axis_offset_[a] = k[a] * std::ptrdiff_t(sizeof(vf));
-      origin_[a] = vf8{} + ray.origin[k[a]];
+      origin_[a] = vf{} + ray.origin[k[a]];
     }
-    shear_x_ = vf8{} + scalar.shear_x();
-    shear_y_ = vf8{} + scalar.shear_y();
+    shear_x_ = vf{} + scalar.shear_x();
+    shear_y_ = vf{} + scalar.shear_y();
     // The scalar test's shear_z for a finite direction (the only kind the
     // traversals test triangles with), computed here: with the scalar test's
     // check for an infinite one inlined, GCC scheduled the AVX-512 kernel
     // worse (4-5 % slower on 100k incoherent rays, paired with Embree).
-    shear_z_ = vf8{} + 1.0f / ray.direction[k[2]];
+    shear_z_ = vf{} + 1.0f / ray.direction[k[2]];
   }
 
   /// Bit i set: lane i's triangle is hit with t in [tmin, tmax], its t and
@@ -159,13 +159,13 @@ class RayTriangle4Test {
     }
     return mask;
   }
-  // The first 4 lanes of a splat, or all 8.
+  // A splat of 4 lanes as V: itself, or twice (one vbroadcastf128).
   template <typename V>
-  [[gnu::always_inline]] static V lanes_of(const vf8& x) {
-    if constexpr (sizeof(V) == sizeof(vf8)) {
+  [[gnu::always_inline]] static V lanes_of(const vf& x) {
+    if constexpr (sizeof(V) == sizeof(vf)) {
       return x;
     } else {
-      return __builtin_shufflevector(x, x, 0, 1, 2, 3);
+      return __builtin_shufflevector(x, x, 0, 1, 2, 3, 0, 1, 2, 3);
     }
   }
   static vf load(const char* p) {
@@ -188,8 +188,8 @@ class RayTriangle4Test {
   // rare, rather than kept (GCC kept its fields in memory, stored per ray).
   const Ray3f* ray_;
   std::ptrdiff_t axis_offset_[3];  // byte offset of the kx, ky, kz rows in a corner (3 registers, not one per corner)
-  vf8 origin_[3];                 // origin coordinate along kx, ky, kz, in every lane
-  vf8 shear_x_, shear_y_, shear_z_;
+  vf origin_[3];                  // origin coordinate along kx, ky, kz, in every lane
+  vf shear_x_, shear_y_, shear_z_;
 };
 #pragma GCC diagnostic pop
 
