@@ -116,7 +116,8 @@ class UntouchedArray {
  public:
   explicit UntouchedArray(std::size_t n)
       : data_(static_cast<T*>(geods::detail::allocate_huge_pages(std::max<std::size_t>(n, 1) * sizeof(T), alignof(T),
-                                                                  /*touched=*/false))),
+                                                                  /*touched=*/false)),
+              Free{std::max<std::size_t>(n, 1) * sizeof(T)}),
         size_(n) {
     static_assert(std::is_trivially_destructible_v<T>);  // freeing the memory ends them
   }
@@ -128,7 +129,8 @@ class UntouchedArray {
 
  private:
   struct Free {
-    void operator()(T* p) const { std::free(p); }
+    std::size_t bytes;
+    void operator()(T* p) const { geods::detail::free_huge_pages(p, bytes); }
   };
   std::unique_ptr<T[], Free> data_;
   std::size_t size_;

@@ -4,7 +4,9 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <mutex>
 #include <utility>
+#include <vector>
 
 #if defined(__linux__)
 #include <sys/mman.h>
@@ -20,6 +22,26 @@ namespace {
   const auto first = (reinterpret_cast<std::uintptr_t>(p) + kPage - 1) & ~(kPage - 1);
   const auto last = (reinterpret_cast<std::uintptr_t>(p) + bytes) & ~(kPage - 1);
   return {reinterpret_cast<void*>(first), last > first ? last - first : 0};
+}
+
+// Blocks of 1 MiB or more are rounded to whole huge pages: their size as allocated.
+std::size_t rounded_size(std::size_t bytes) { return (bytes + kHugePage - 1) / kHugePage * kHugePage; }
+bool is_huge(std::size_t bytes) { return bytes >= kHugePage / 2; }  // rounding up wastes less than half
+
+// Freed huge blocks kept for the next allocation of the same size, most recent
+// last, up to kCacheBytes in all. Returned to the system, they would be faulted
+// in again by the next build: on a virtual machine that reports free memory to
+// its host, the host takes the pages back within seconds, and refaulting them
+// doubled the time of the later builds in one process (docs/bvh.md).
+struct BlockCache {
+  static constexpr std::size_t kCacheBytes = std::size_t(256) << 20;
+  std::mutex mutex;
+  std::vector<std::pair<void*, std::size_t>> blocks;
+  std::size_t bytes = 0;
+};
+BlockCache& block_cache() {
+  static BlockCache* cache = new BlockCache;  // never destroyed: frees may come from static destructors
+  return *cache;
 }
 
 }  // namespace
@@ -46,9 +68,20 @@ void prefault(const void* p, std::size_t bytes) {
 
 void* allocate_huge_pages(std::size_t bytes, std::size_t alignment, bool touched) {
   constexpr std::size_t kPage = 4096;
-  const bool huge = bytes >= kHugePage / 2;  // rounding up wastes less than half
+  const bool huge = is_huge(bytes);
   const std::size_t align = huge ? kHugePage : std::max<std::size_t>(alignment, sizeof(void*));
   bytes = (bytes + align - 1) / align * align;  // aligned_alloc wants a multiple of the alignment
+  if (huge) {
+    BlockCache& cache = block_cache();
+    const std::lock_guard lock(cache.mutex);
+    for (auto b = cache.blocks.rbegin(); b != cache.blocks.rend(); ++b) {
+      if (b->second != bytes) continue;
+      void* p = b->first;  // already advised and faulted in
+      cache.bytes -= bytes;
+      cache.blocks.erase(std::next(b).base());
+      return p;
+    }
+  }
   void* p = std::aligned_alloc(align, bytes);
   if (!p) throw std::bad_alloc();
   if (!huge) return p;
@@ -61,6 +94,29 @@ void* allocate_huge_pages(std::size_t bytes, std::size_t alignment, bool touched
     for (std::size_t i = b; i < e; ++i) bytes_of[i * kPage] = 0;
   });
   return p;
+}
+
+void free_huge_pages(void* p, std::size_t bytes) {
+  if (!p) return;
+  if (!is_huge(bytes)) {
+    std::free(p);
+    return;
+  }
+  bytes = rounded_size(bytes);
+  BlockCache& cache = block_cache();
+  std::vector<void*> evicted;
+  {
+    const std::lock_guard lock(cache.mutex);
+    cache.blocks.emplace_back(p, bytes);
+    cache.bytes += bytes;
+    std::size_t n = 0;  // the oldest blocks go first
+    while (cache.bytes > BlockCache::kCacheBytes) {
+      cache.bytes -= cache.blocks[n].second;
+      evicted.push_back(cache.blocks[n++].first);
+    }
+    cache.blocks.erase(cache.blocks.begin(), cache.blocks.begin() + std::ptrdiff_t(n));
+  }
+  for (void* q : evicted) std::free(q);
 }
 
 }  // namespace geods::detail

@@ -776,7 +776,9 @@ class GridSolver {
     // every entry, its threads touching the fresh pages (a serial zeroing cost more than the fill).
     if (wide_ && n > 0 && n < std::size_t(std::numeric_limits<std::int32_t>::max()) / kRow) {
       // 16 floats of padding: gather_rows() reads 32 floats from a row's start.
-      rows_.reset(static_cast<float*>(detail::allocate_huge_pages((n * kRow + 16) * sizeof(float), alignof(float))));
+      const std::size_t bytes = (n * kRow + 16) * sizeof(float);
+      rows_ = std::unique_ptr<float[], Free>(static_cast<float*>(detail::allocate_huge_pages(bytes, alignof(float))),
+                                             Free{bytes});
     } else {
       all_.reserve(n);
       all_.size = n;
@@ -1270,7 +1272,8 @@ class GridSolver {
   const std::uint32_t* ids_;
   bool wide_ = simd_level() == SimdLevel::avx512;  // the AVX-512 kernels
   struct Free {
-    void operator()(float* p) const { std::free(p); }
+    std::size_t bytes;  // (no initializer: one would keep unique_ptr from default-constructing it here)
+    void operator()(float* p) const { detail::free_huge_pages(p, bytes); }
   };
   Packed all_;                          // every triangle, in leaf order (without rows_)
   std::unique_ptr<float[], Free> rows_;  // with AVX-512: the first k0 quantities and face, entry by entry

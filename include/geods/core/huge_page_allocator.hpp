@@ -21,6 +21,10 @@ inline constexpr std::size_t kHugePage = std::size_t(2) << 20;
 /// the pages are left for the caller's first writes to fault in (for arrays whose
 /// elements are written in parallel, or of which only a part is ever written).
 void* allocate_huge_pages(std::size_t bytes, std::size_t alignment, bool touched = true);
+/// Frees a block of allocate_huge_pages(bytes, ...). Blocks of 1 MiB or more are
+/// kept (256 MiB in all, the oldest freed first) for the next allocation of the
+/// same size, which then finds its pages already faulted in.
+void free_huge_pages(void* p, std::size_t bytes);
 /// Advises transparent huge pages for the whole small pages of [p, p + bytes) (2 MiB or more).
 void advise_huge_pages(void* p, std::size_t bytes);
 /// Maps the whole small pages of [p, p + bytes) writable before they are written, if they
@@ -52,7 +56,7 @@ class HugePageAllocator {
     if (n > std::size_t(-1) / sizeof(T)) throw std::bad_array_new_length();
     return static_cast<T*>(detail::allocate_huge_pages(n * sizeof(T), alignof(T)));
   }
-  void deallocate(T* p, std::size_t) { std::free(p); }
+  void deallocate(T* p, std::size_t n) { detail::free_huge_pages(p, n * sizeof(T)); }
 
   template <typename U>
   bool operator==(const HugePageAllocator<U>&) const {
