@@ -11,6 +11,12 @@
 #if defined(__linux__)
 #include <sys/mman.h>
 #endif
+#if defined(__SANITIZE_ADDRESS__)
+#include <sanitizer/asan_interface.h>
+#else
+#define ASAN_POISON_MEMORY_REGION(p, n) ((void)(p), (void)(n))
+#define ASAN_UNPOISON_MEMORY_REGION(p, n) ((void)(p), (void)(n))
+#endif
 
 namespace geods::detail {
 
@@ -32,7 +38,8 @@ bool is_huge(std::size_t bytes) { return bytes >= kHugePage / 2; }  // rounding 
 // last, up to kCacheBytes in all. Returned to the system, they would be faulted
 // in again by the next build: on a virtual machine that reports free memory to
 // its host, the host takes the pages back within seconds, and refaulting them
-// doubled the time of the later builds in one process (docs/bvh.md).
+// doubled the time of the later builds in one process (docs/bvh.md). Under
+// AddressSanitizer a kept block is poisoned, so a use after free is still caught.
 struct BlockCache {
   static constexpr std::size_t kCacheBytes = std::size_t(256) << 20;
   std::mutex mutex;
@@ -76,9 +83,10 @@ void* allocate_huge_pages(std::size_t bytes, std::size_t alignment, bool touched
     const std::lock_guard lock(cache.mutex);
     for (auto b = cache.blocks.rbegin(); b != cache.blocks.rend(); ++b) {
       if (b->second != bytes) continue;
-      void* p = b->first;  // already advised and faulted in
+      void* p = b->first;  // already advised, and faulted in where it was written
       cache.bytes -= bytes;
       cache.blocks.erase(std::next(b).base());
+      ASAN_UNPOISON_MEMORY_REGION(p, bytes);
       return p;
     }
   }
@@ -103,8 +111,9 @@ void free_huge_pages(void* p, std::size_t bytes) {
     return;
   }
   bytes = rounded_size(bytes);
+  ASAN_POISON_MEMORY_REGION(p, bytes);
   BlockCache& cache = block_cache();
-  std::vector<void*> evicted;
+  std::vector<std::pair<void*, std::size_t>> evicted;
   {
     const std::lock_guard lock(cache.mutex);
     cache.blocks.emplace_back(p, bytes);
@@ -112,11 +121,14 @@ void free_huge_pages(void* p, std::size_t bytes) {
     std::size_t n = 0;  // the oldest blocks go first
     while (cache.bytes > BlockCache::kCacheBytes) {
       cache.bytes -= cache.blocks[n].second;
-      evicted.push_back(cache.blocks[n++].first);
+      evicted.push_back(cache.blocks[n++]);
     }
     cache.blocks.erase(cache.blocks.begin(), cache.blocks.begin() + std::ptrdiff_t(n));
   }
-  for (void* q : evicted) std::free(q);
+  for (const auto& [q, size] : evicted) {
+    ASAN_UNPOISON_MEMORY_REGION(q, size);
+    std::free(q);
+  }
 }
 
 }  // namespace geods::detail
