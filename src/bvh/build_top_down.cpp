@@ -24,7 +24,7 @@
 #endif
 
 #include "binary_tree.hpp"
-#include "geods/core/huge_page_allocator.hpp"
+#include "geods/core/huge_page_array.hpp"
 #include "geods/core/parallel.hpp"
 
 namespace geods::bvh::detail {
@@ -115,10 +115,7 @@ template <typename T>
 class UntouchedArray {
  public:
   explicit UntouchedArray(std::size_t n)
-      : data_(static_cast<T*>(geods::detail::allocate_huge_pages(std::max<std::size_t>(n, 1) * sizeof(T), alignof(T),
-                                                                  /*touched=*/false)),
-              Free{std::max<std::size_t>(n, 1) * sizeof(T)}),
-        size_(n) {
+      : data_(make_huge_page_array<T>(n, /*touched=*/false)), size_(n) {
     static_assert(std::is_trivially_destructible_v<T>);  // freeing the memory ends them
   }
   std::size_t size() const { return size_; }
@@ -128,11 +125,7 @@ class UntouchedArray {
   const T& operator[](std::size_t i) const { return data_[i]; }
 
  private:
-  struct Free {
-    std::size_t bytes;
-    void operator()(T* p) const { geods::detail::free_huge_pages(p, bytes); }
-  };
-  std::unique_ptr<T[], Free> data_;
+  HugePageArray<T> data_;
   std::size_t size_;
 };
 

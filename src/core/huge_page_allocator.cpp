@@ -30,7 +30,7 @@ namespace {
   return {reinterpret_cast<void*>(first), last > first ? last - first : 0};
 }
 
-// Blocks of 1 MiB or more are rounded to whole huge pages: their size as allocated.
+// Blocks of 1 MiB or more are rounded to whole huge pages: their size as allocated (and kept).
 std::size_t rounded_size(std::size_t bytes) { return (bytes + kHugePage - 1) / kHugePage * kHugePage; }
 bool is_huge(std::size_t bytes) { return bytes >= kHugePage / 2; }  // rounding up wastes less than half
 
@@ -77,7 +77,7 @@ void* allocate_huge_pages(std::size_t bytes, std::size_t alignment, bool touched
   constexpr std::size_t kPage = 4096;
   const bool huge = is_huge(bytes);
   const std::size_t align = huge ? kHugePage : std::max<std::size_t>(alignment, sizeof(void*));
-  bytes = (bytes + align - 1) / align * align;  // aligned_alloc wants a multiple of the alignment
+  bytes = huge ? rounded_size(bytes) : (bytes + align - 1) / align * align;  // aligned_alloc: a multiple of align
   if (huge) {
     BlockCache& cache = block_cache();
     const std::lock_guard lock(cache.mutex);

@@ -23,7 +23,7 @@
 #include "../core/prefault.hpp"
 #include "geods/bvh/traversal.hpp"
 #include "geods/core/error.hpp"
-#include "geods/core/huge_page_allocator.hpp"
+#include "geods/core/huge_page_array.hpp"
 #include "geods/core/morton.hpp"
 #include "geods/core/parallel.hpp"
 #include "geods/core/simd_level.hpp"
@@ -776,9 +776,7 @@ class GridSolver {
     // every entry, its threads touching the fresh pages (a serial zeroing cost more than the fill).
     if (wide_ && n > 0 && n < std::size_t(std::numeric_limits<std::int32_t>::max()) / kRow) {
       // 16 floats of padding: gather_rows() reads 32 floats from a row's start.
-      const std::size_t bytes = (n * kRow + 16) * sizeof(float);
-      rows_ = std::unique_ptr<float[], Free>(static_cast<float*>(detail::allocate_huge_pages(bytes, alignof(float))),
-                                             Free{bytes});
+      rows_ = make_huge_page_array<float>(n * kRow + 16, /*touched=*/true);
     } else {
       all_.reserve(n);
       all_.size = n;
@@ -1271,12 +1269,8 @@ class GridSolver {
   const BvhTriangle* tris_;
   const std::uint32_t* ids_;
   bool wide_ = simd_level() == SimdLevel::avx512;  // the AVX-512 kernels
-  struct Free {
-    std::size_t bytes;  // (no initializer: one would keep unique_ptr from default-constructing it here)
-    void operator()(float* p) const { detail::free_huge_pages(p, bytes); }
-  };
   Packed all_;                          // every triangle, in leaf order (without rows_)
-  std::unique_ptr<float[], Free> rows_;  // with AVX-512: the first k0 quantities and face, entry by entry
+  HugePageArray<float> rows_;  // with AVX-512: the first k0 quantities and face, entry by entry
   float margin_ = 0;
   float slack_ = 0;
   float band_ = kInf;
