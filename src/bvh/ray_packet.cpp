@@ -27,9 +27,6 @@
 #define GEODS_PACKET_SIMD_DISPATCH 1
 #endif
 
-// Lane vectors are passed between inlined helpers only.
-#pragma GCC diagnostic ignored "-Wpsabi"
-
 namespace geods::bvh {
 
 namespace {

@@ -23,9 +23,6 @@
 #include "geods/core/triangle.hpp"
 #include "geods/core/triangle_box.hpp"
 
-// Lane vectors are passed between always-inlined helpers only (widen_far).
-#pragma GCC diagnostic ignored "-Wpsabi"
-
 namespace geods::bvh {
 namespace {
 

@@ -96,7 +96,6 @@ struct Packed {
 // nearest of the three edges. Eight entries at a time, without branches
 // (GCC vector extensions: AVX2 where the CPU has it, picked at run time,
 // else two SSE halves).
-#pragma GCC diagnostic ignored "-Wpsabi"  // 32-byte vectors in inlined helpers, never across a call
 using V8 = float __attribute__((vector_size(32)));
 
 __attribute__((always_inline)) inline V8 load8(const float* p) {

@@ -8,9 +8,6 @@
 #include "bvh_test_util.hpp"
 #include "geods/bvh/ray_triangle4.hpp"
 
-// (The 8-wide vectors of the two-group form cross no call: no ABI concern.)
-#pragma GCC diagnostic ignored "-Wpsabi"
-
 namespace geods::bvh {
 namespace {
 

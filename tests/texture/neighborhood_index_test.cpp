@@ -152,9 +152,13 @@ TEST(NeighborhoodIndex, TheScheduleOfTheApproximateSearch) {
           }
         }
       }
-      if (n > 4096) EXPECT_GT(tight, 100u) << "dim " << dim;
+      if (n > 4096) {
+        EXPECT_GT(tight, 100u) << "dim " << dim;
+      }
       EXPECT_GT(start + tight, 100u) << "n " << n << " dim " << dim;
-      if (dim == 65) EXPECT_GT(beyond, 0u) << "n " << n;  // neighbourhoods use up the schedule on some queries
+      if (dim == 65) {
+        EXPECT_GT(beyond, 0u) << "n " << n;  // neighbourhoods use up the schedule on some queries
+      }
     }
   }
   EXPECT_EQ(NeighborhoodIndex(clustered(4096, 65, 33), 65, 8).tight_budget(), 0u);
