@@ -21,9 +21,17 @@ struct Face {
   std::uint32_t label;
 };
 
+// Whether x and y are one point up to rounding: within 1e-12 of the box's
+// extent on every axis. (Per axis: a coordinate's rounding scales with the
+// box's extent along its own axis; a box thin along one axis is thinner than
+// a tolerance scaled by its diagonal, and its two sides would merge.)
+bool same_point(const Vec3d& x, const Vec3d& y, const Vec3d& extent) {
+  return ((x - y).cwiseAbs().array() <= 1e-12 * extent.array()).all();
+}
+
 // Keeps the part of the convex polyhedron where normal . x <= offset; the cut
-// becomes a face labelled `label`. `tolerance` merges cut points closer than it.
-void clip(std::vector<Face>& faces, const Vec3d& normal, double offset, std::uint32_t label, double tolerance) {
+// becomes a face labelled `label`. `extent`: the box's (same_point).
+void clip(std::vector<Face>& faces, const Vec3d& normal, double offset, std::uint32_t label, const Vec3d& extent) {
   std::vector<Vec3d> cut;
   std::vector<Face> kept;
   kept.reserve(faces.size() + 1);
@@ -64,24 +72,46 @@ void clip(std::vector<Face>& faces, const Vec3d& normal, double offset, std::uin
   }
   faces.swap(kept);
   if (!any_outside || faces.empty()) return;
-  // The cap: the cut points, merged and ordered counter-clockwise around the outward normal.
+  // The cap: the cut points, merged and ordered counter-clockwise around the
+  // outward normal, in coordinates where the box is a unit cube (on a box far
+  // thinner along one axis than the others, the corners of a cap's two long
+  // sides would differ by less than a rounding in the angles around its
+  // centre). Merged before the sort, so that no two copies of a corner sort
+  // apart.
+  std::vector<Vec3d> corners;
+  for (const Vec3d& x : cut)
+    if (std::none_of(corners.begin(), corners.end(), [&](const Vec3d& y) { return same_point(x, y, extent); }))
+      corners.push_back(x);
   Vec3d centre = Vec3d::Zero();
-  for (const Vec3d& x : cut) centre += x;
-  centre /= double(cut.size());
-  const Vec3d n = normal.normalized();
+  for (const Vec3d& x : corners) centre += x;
+  centre /= double(corners.size());
+  // The normal in the unit cube's coordinates (each factor at most 1: no
+  // overflow or underflow in the product at extreme scales).
+  const Vec3d n = normal.normalized().cwiseProduct(extent / extent.maxCoeff()).normalized();
   const Vec3d u = (std::abs(n[0]) < 0.9 ? Vec3d(1, 0, 0) : Vec3d(0, 1, 0)).cross(n).normalized();
   const Vec3d v = n.cross(u);
-  std::vector<std::pair<double, Vec3d>> around;
-  for (const Vec3d& x : cut) around.push_back({std::atan2((x - centre).dot(v), (x - centre).dot(u)), x});
-  std::sort(around.begin(), around.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  struct Around {
+    double u, v;  // the corner's offset from the centre in the plane
+    Vec3d x;
+    int half() const { return v > 0 || (v == 0 && u > 0) ? 0 : 1; }  // angle in [0, pi) or [pi, 2 pi)
+  };
+  std::vector<Around> around;
+  for (const Vec3d& x : corners) {
+    const Vec3d d = (x - centre).cwiseQuotient(extent);
+    around.push_back({d.dot(u), d.dot(v), x});
+  }
+  // By angle, without atan2 (whose roundings tie angles a few ulps apart):
+  // the half-plane, then the sign of the cross product.
+  std::sort(around.begin(), around.end(), [](const Around& a, const Around& b) {
+    if (a.half() != b.half()) return a.half() < b.half();
+    return a.u * b.v - a.v * b.u > 0;
+  });
   Face cap{{}, label};
-  for (const auto& [angle, x] : around)
-    if (cap.loop.empty() || (x - cap.loop.back()).norm() > tolerance) cap.loop.push_back(x);
-  while (cap.loop.size() > 1 && (cap.loop.front() - cap.loop.back()).norm() <= tolerance) cap.loop.pop_back();
+  for (const Around& a : around) cap.loop.push_back(a.x);
   if (cap.loop.size() >= 3) faces.push_back(std::move(cap));
 }
 
-Voronoi3Cell make_cell(std::uint32_t site, const std::vector<Face>& faces, double tolerance) {
+Voronoi3Cell make_cell(std::uint32_t site, const std::vector<Face>& faces, const Vec3d& extent) {
   Voronoi3Cell cell;
   cell.site = site;
   cell.face_offsets.push_back(0);
@@ -89,7 +119,7 @@ Voronoi3Cell make_cell(std::uint32_t site, const std::vector<Face>& faces, doubl
     for (const Vec3d& x : face.loop) {
       // the corners shared by faces: equal, or within rounding of each other
       auto it = std::find_if(cell.vertices.begin(), cell.vertices.end(),
-                             [&](const Vec3d& y) { return (x - y).norm() <= tolerance; });
+                             [&](const Vec3d& y) { return same_point(x, y, extent); });
       if (it == cell.vertices.end()) {
         cell.vertices.push_back(x);
         it = cell.vertices.end() - 1;
@@ -175,8 +205,7 @@ void Voronoi3::build(const Delaunay3& dt, std::span<const Plane> hull) {
       if (outside[t])
         for (int k = 0; k < 4; ++k) crosses_hull[tets[4 * t + k]] = 1;
   }
-  const double size = (box.hi - box.lo).norm();
-  const double tolerance = 1e-12 * size;
+  const Vec3d extent = box.hi - box.lo;
   std::vector<Face> initial;
   const Vec3d& lo = box.lo;
   const Vec3d& hi = box.hi;
@@ -205,7 +234,7 @@ void Voronoi3::build(const Delaunay3& dt, std::span<const Plane> hull) {
         for (const std::uint32_t w : neighbors) {
           if (w == s) continue;
           const Vec3d normal = points[w] - p;
-          clip(faces, normal, normal.dot((points[w] + p) * 0.5), w, tolerance);
+          clip(faces, normal, normal.dot((points[w] + p) * 0.5), w, extent);
           if (faces.empty()) break;
         }
         if (!hull.empty() && crosses_hull[s]) {
@@ -217,10 +246,10 @@ void Voronoi3::build(const Delaunay3& dt, std::span<const Plane> hull) {
             const Vec3d& n = hull[h].normal;
             double reach = 0;
             for (int a = 0; a < 3; ++a) reach += n[a] * (n[a] > 0 ? bounds.hi[a] : bounds.lo[a]);
-            if (reach > hull[h].offset) clip(faces, n, hull[h].offset, hull_face(h), tolerance);
+            if (reach > hull[h].offset) clip(faces, n, hull[h].offset, hull_face(h), extent);
           }
         }
-        cells_[k] = make_cell(s, faces, tolerance);
+        cells_[k] = make_cell(s, faces, extent);
       },
       16);
 }

@@ -180,5 +180,42 @@ TEST(Voronoi3, ExtremeScalesAreScaledOrRefused) {
   EXPECT_THROW(Voronoi3(unit, AABB3d(Vec3d(-1e200, 0, 0), Vec3d(1, 1, 1))), Error);
 }
 
+// A box far thinner along one axis than along the others (a slab for
+// coplanar sites, as the CLI makes for them): the cells are the prisms of the
+// sites' 2D cells, whatever the slab's thickness. Rounding along the long
+// axes once merged the slab's two sides (a tolerance scaled by the box's
+// diagonal), and atan2 tied the angles of a cap's corners.
+TEST(Voronoi3, BoxesThinAlongOneAxisGiveTheCellsOfAnyOtherThickness) {
+  Rng rng(47);
+  std::vector<Vec3d> unit;
+  for (int i = 0; i < 30; ++i) unit.emplace_back(rng.uniform(), rng.uniform(), 0.0);
+  const Voronoi3 reference(unit, AABB3d(Vec3d(0, 0, -0.5), Vec3d(1, 1, 0.5)));
+  for (const double s : {1e3, 1e17, 1e20, 1e38}) {
+    for (const double thickness : {1.0, 1e-3}) {
+      std::vector<Vec3d> p = unit;
+      for (Vec3d& x : p) x *= s;
+      const AABB3d box(Vec3d(0, 0, -thickness / 2), Vec3d(s, s, thickness / 2));
+      const Voronoi3 v(p, box);
+      EXPECT_NEAR(v.volume_total() / (s * s * thickness), 1.0, 1e-12) << s << " " << thickness;
+      ASSERT_EQ(v.cells().size(), reference.cells().size());
+      for (std::size_t i = 0; i < unit.size(); ++i) {
+        EXPECT_NEAR(v.cells()[i].volume / (s * s * thickness), reference.cells()[i].volume, 1e-12) << s;
+        EXPECT_EQ(v.cells()[i].face_count(), reference.cells()[i].face_count()) << s;
+        EXPECT_EQ(v.cells()[i].vertices.size(), reference.cells()[i].vertices.size()) << s;
+      }
+    }
+  }
+  // The same sites turned to lie in a plane of each axis: the thin axis may be any.
+  for (int axis = 0; axis < 2; ++axis) {
+    std::vector<Vec3d> p = unit;
+    for (Vec3d& x : p) x = axis == 0 ? Vec3d(0, x[0], x[1]) * 1e20 : Vec3d(x[0], 0, x[1]) * 1e20;
+    Vec3d lo(0, 0, 0), hi(1e20, 1e20, 1e20);
+    lo[axis] = -0.5, hi[axis] = 0.5;
+    const Voronoi3 v(p, AABB3d(lo, hi));
+    for (std::size_t i = 0; i < unit.size(); ++i)
+      EXPECT_NEAR(v.cells()[i].volume / 1e40, reference.cells()[i].volume, 1e-12) << axis;
+  }
+}
+
 }  // namespace
 }  // namespace geods::voronoi
