@@ -647,11 +647,18 @@ void check_packet_size(int packet_size, const char* what) {
 
 }  // namespace
 
-HitPacket TriangleBvh::intersect(const RayPacket& packet) const { return intersect_packet(*this, packet); }
+HitPacket TriangleBvh::intersect(const RayPacket& packet) const {
+  check_rays(packet);
+  return intersect_packet(*this, packet);
+}
 
-std::uint32_t TriangleBvh::occluded(const RayPacket& packet) const { return occluded_packet(*this, packet); }
+std::uint32_t TriangleBvh::occluded(const RayPacket& packet) const {
+  check_rays(packet);
+  return occluded_packet(*this, packet);
+}
 
 HitPacket16 TriangleBvh::intersect(const RayPacket16& packet) const {
+  check_rays(packet);
   if (sixteen_wide()) return intersect_packet(*this, packet);
   HitPacket16 out;
   for (int h = 0; h < 2; ++h) std::copy_n(intersect(half(packet, h)).hits, 8, out.hits + 8 * h);
@@ -659,6 +666,7 @@ HitPacket16 TriangleBvh::intersect(const RayPacket16& packet) const {
 }
 
 std::uint32_t TriangleBvh::occluded(const RayPacket16& packet) const {
+  check_rays(packet);
   if (sixteen_wide()) return occluded_packet(*this, packet);
   return occluded(half(packet, 0)) | occluded(half(packet, 1)) << 8;
 }

@@ -98,6 +98,7 @@ TriangleBvh TriangleBvh::build(const TriMesh& mesh, const BuildOptions& options)
     triangles[i] = {mesh.vertices[t[0]], mesh.vertices[t[1]], mesh.vertices[t[2]]};
   });
   bvh.triangles_ = std::move(triangles);
+  bvh.set_ray_range();
   switch (options.bv) {
     case BoundingVolume::aabb: bvh.fit_volumes<AABB3f>(); break;
     case BoundingVolume::sphere: bvh.fit_volumes<Sphere3f>(); break;
@@ -329,6 +330,7 @@ TriangleBvh TriangleBvh::from_sections(const Archive& in) {
   const std::size_t nodes = bvh.topology_.nodes.size();
   bvh.topology_.prim_order = in.array<std::uint32_t>("triangle_ids");
   bvh.triangles_ = in.array<Triangle>("triangles", bvh.topology_.prim_order.size());
+  bvh.set_ray_range();
   // The volume type the file says it holds; a section of another type is refused by its element size.
   with_volume_type(bvh.options_.bv, [&]<typename BV>(BV) { bvh.volumes_ = in.array<BV>("volumes", nodes); });
   const bool wide = bvh.options_.bv == BoundingVolume::aabb && bvh.options_.arity >= 4 && nodes > 0;
@@ -688,13 +690,24 @@ RayHit TriangleBvh::intersect_generic(const FlatArray<BV>& volumes, const Ray3f&
   return hit;
 }
 
+void TriangleBvh::set_ray_range() {
+  const AABB3f bounds = parallel_bounds<AABB3f>(triangles_.size(), [&](AABB3f& box, std::size_t i) {
+    box.extend(triangles_[i].a);
+    box.extend(triangles_[i].b);
+    box.extend(triangles_[i].c);
+  });
+  ray_range_problem_ = ray_range_problem(bounds, "TriangleBvh");
+}
+
 RayHit TriangleBvh::intersect(const Ray3f& ray) const {
+  check_ray(ray);
   if (!wide4_.empty()) return intersect_wide_best<4, false>(wide4_, ray);
   if (!wide8_.empty()) return intersect_wide_best<8, false>(wide8_, ray);
   return std::visit([&](const auto& vols) { return intersect_generic(vols, ray, false); }, volumes_);
 }
 
 bool TriangleBvh::occluded(const Ray3f& ray) const {
+  check_ray(ray);
   if (!wide4_.empty()) return intersect_wide_best<4, true>(wide4_, ray).hit();
   if (!wide8_.empty()) return intersect_wide_best<8, true>(wide8_, ray).hit();
   return std::visit([&](const auto& vols) { return intersect_generic(vols, ray, true).hit(); }, volumes_);

@@ -4,8 +4,6 @@
 #include <atomic>
 #include <cmath>
 
-#include <tbb/parallel_reduce.h>
-
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"
 #include "geods/ray/bvh_accelerator.hpp"
@@ -91,17 +89,8 @@ void Accelerator::add_sections(ArchiveWriter& out) const {
 }
 
 void Accelerator::set_bounds() {
-  // Minima and maxima: the same box in any order, so in parallel.
-  bounds_ = tbb::parallel_reduce(
-      tbb::blocked_range<std::size_t>(0, corners_.size(), 65536), AABB3f(),
-      [&](const tbb::blocked_range<std::size_t>& r, AABB3f box) {
-        for (std::size_t i = r.begin(); i < r.end(); ++i) box.extend(corners_[i]);
-        return box;
-      },
-      [](AABB3f a, const AABB3f& b) {
-        a.extend(b);
-        return a;
-      });
+  bounds_ = parallel_bounds<AABB3f>(corners_.size(), [&](AABB3f& box, std::size_t i) { box.extend(corners_[i]); });
+  ray_range_problem_ = ray_range_problem(bounds_, "ray accelerator");
   // Float rounding of the traversal is relative to the coordinates (about 1e-7
   // of them); 1e-5 of the scene's size and largest coordinate covers rays
   // starting up to a hundred scene sizes away.
@@ -123,6 +112,7 @@ RayHit Accelerator::intersect(const Ray3f& ray) const {
 }
 
 RayHit Accelerator::intersect(const Ray3f& ray, RayCache& cache) const {
+  check_range(ray);
   if (!shootable(ray) || corners_.empty()) return {};
   if (cache.owner != id_) cache = RayCache{id_};
   const RayHit hit = closest_hit(ray, cache);
@@ -135,6 +125,7 @@ bool Accelerator::occluded(const Ray3f& ray) const {
 }
 
 bool Accelerator::occluded(const Ray3f& ray, RayCache& cache) const {
+  check_range(ray);
   if (!shootable(ray) || corners_.empty()) return false;
   if (cache.owner != id_) cache = RayCache{id_};
   // The occluder cache (seed §2.5.2): any occluder will do, and the one that
@@ -152,13 +143,13 @@ bool Accelerator::occluded(const Ray3f& ray, RayCache& cache) const {
 
 namespace {
 
-// The packet with only its active rays that can hit anything (Accelerator::shootable).
+// The packet with only its active rays that can hit anything (shootable(ray)).
 template <int N, typename Shootable>
 bvh::RayPacketN<N> shootable_lanes(const bvh::RayPacketN<N>& packet, Shootable&& shootable) {
   bvh::RayPacketN<N> shot = packet;
   shot.active &= (1u << N) - 1;
-  for (int i = 0; i < N; ++i)
-    if (!shootable(packet.rays[i])) shot.active &= ~(1u << i);
+  for (std::uint32_t b = shot.active; b != 0; b &= b - 1)
+    if (!shootable(packet.rays[__builtin_ctz(b)])) shot.active &= ~(1u << __builtin_ctz(b));
   return shot;
 }
 
@@ -166,7 +157,10 @@ bvh::RayPacketN<N> shootable_lanes(const bvh::RayPacketN<N>& packet, Shootable&&
 
 template <int N>
 bvh::HitPacketN<N> Accelerator::intersect_packet(const bvh::RayPacketN<N>& packet, RayCache& cache) const {
-  const bvh::RayPacketN<N> shot = shootable_lanes(packet, shootable);
+  const bvh::RayPacketN<N> shot = shootable_lanes(packet, [&](const Ray3f& ray) {
+    check_range(ray);
+    return shootable(ray);
+  });
   if (shot.active == 0 || corners_.empty()) return {};
   if (cache.owner != id_) cache = RayCache{id_};
   bvh::HitPacketN<N> out = closest_hits(shot, cache);
@@ -177,7 +171,10 @@ bvh::HitPacketN<N> Accelerator::intersect_packet(const bvh::RayPacketN<N>& packe
 
 template <int N>
 std::uint32_t Accelerator::occluded_packet(const bvh::RayPacketN<N>& packet, RayCache& cache) const {
-  const bvh::RayPacketN<N> shot = shootable_lanes(packet, shootable);
+  const bvh::RayPacketN<N> shot = shootable_lanes(packet, [&](const Ray3f& ray) {
+    check_range(ray);
+    return shootable(ray);
+  });
   if (shot.active == 0 || corners_.empty()) return 0;
   if (cache.owner != id_) cache = RayCache{id_};
   return any_hits(shot, cache) & shot.active;

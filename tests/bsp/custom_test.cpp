@@ -71,13 +71,17 @@ TEST(CustomBsp, RayDistribution) {
   EXPECT_EQ(rc.stats.hits, ro.stats.hits);
   for (std::size_t i = 0; i < rc.t.size(); ++i) {
     EXPECT_EQ(std::isinf(rc.t[i]), std::isinf(ro.t[i])) << i;
-    if (!std::isinf(rc.t[i])) EXPECT_NEAR(rc.t[i], ro.t[i], 1e-9 * (1 + rc.t[i])) << i;
+    if (!std::isinf(rc.t[i])) {
+      EXPECT_NEAR(rc.t[i], ro.t[i], 1e-9 * (1 + rc.t[i])) << i;
+    }
   }
   const Triangles fm = c.fragment_mesh();
   for (std::size_t i = 0; i < 150; ++i) {
     const double b = brute_t(fm, rays.origins[i], rays.directions[i]);
     EXPECT_EQ(std::isinf(b), std::isinf(rc.t[i])) << i;
-    if (!std::isinf(b)) EXPECT_NEAR(rc.t[i], b, 1e-7 * (1 + b)) << i;
+    if (!std::isinf(b)) {
+      EXPECT_NEAR(rc.t[i], b, 1e-7 * (1 + b)) << i;
+    }
   }
   std::printf("custom: %zu nodes, %zu fragments, %.1f nodes and %.1f tests per ray, %.4f s; "
               "oblivious (cost): %zu nodes, %zu fragments, %.1f nodes and %.1f tests per ray, %.4f s\n",

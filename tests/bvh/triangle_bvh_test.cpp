@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <tuple>
 
 #include "bvh_test_util.hpp"
@@ -323,6 +324,72 @@ TEST(TriangleBvh, BadInputRaisesErrors) {
   EXPECT_THROW(parse_bounding_volume("cone"), Error);
   const TriangleBvh bvh = TriangleBvh::build(test::random_soup(10, 1));
   EXPECT_THROW(bvh.closest_point(Vec3f(0, INFINITY, 0)), Error);
+}
+
+// Within the range of the float watertight test (core/ray_triangle.hpp:
+// |coordinate| <= 2^35, an extent of at least 2^-34) the hits of a mesh and
+// rays scaled by a power of two are those at unit scale, t scaled; beyond it
+// every ray query refuses the mesh or the ray. (They once answered t = inf,
+// the wrong triangle or no hit at all, silently: the test's degree-3 terms
+// overflowed from about 2^45 and lost precision below about 2^-35.)
+TEST(TriangleBvh, RaysAtPowerOfTwoScalesHitAsAtUnitScaleOrAreRefused) {
+  const TriMesh bunny = test::data_mesh("bunny.ply");  // coordinates up to 10, extent 10
+  const std::vector<Ray3f> rays = test::test_rays(bunny, 700, 61);
+  auto scaled_mesh = [&](int e) {
+    TriMesh m = bunny;
+    for (Vec3f& v : m.vertices) v = Vec3f(std::ldexp(v[0], e), std::ldexp(v[1], e), std::ldexp(v[2], e));
+    return m;
+  };
+  auto scaled_ray = [](Ray3f r, int e) {
+    r.origin = Vec3f(std::ldexp(r.origin[0], e), std::ldexp(r.origin[1], e), std::ldexp(r.origin[2], e));
+    r.tmin = std::ldexp(r.tmin, e), r.tmax = std::ldexp(r.tmax, e);
+    return r;
+  };
+  for (int arity : {4, 8}) {
+    BuildOptions options;
+    options.arity = arity;
+    const TriangleBvh unit = TriangleBvh::build(bunny, options);
+    for (int e : {-30, -12, 12, 30}) {
+      const TriangleBvh bvh = TriangleBvh::build(scaled_mesh(e), options);
+      for (std::size_t i = 0; i < rays.size(); ++i) {
+        const RayHit want = unit.intersect(rays[i]);
+        const RayHit got = bvh.intersect(scaled_ray(rays[i], e));
+        ASSERT_EQ(got.prim, want.prim) << "scale 2^" << e << " ray " << i;
+        if (!want.hit()) continue;
+        ASSERT_EQ(got.t, std::ldexp(want.t, e)) << "scale 2^" << e << " ray " << i;
+        ASSERT_EQ(got.u, want.u) << i;
+        ASSERT_EQ(got.v, want.v) << i;
+      }
+    }
+  }
+  Ray3f ray = rays[0];
+  RayPacket packet;
+  packet.rays[0] = ray;
+  packet.active = 1;
+  for (int e : {40, -40}) {  // 2^40 x 10 is beyond 2^35; 2^-40 x 10 spans less than 2^-34
+    const TriangleBvh bvh = TriangleBvh::build(scaled_mesh(e));
+    const Ray3f far = scaled_ray(ray, e);
+    RayPacket far_packet = packet;
+    far_packet.rays[0] = far;
+    EXPECT_THROW(bvh.intersect(far), Error) << e;
+    EXPECT_THROW(bvh.occluded(far), Error) << e;
+    EXPECT_THROW(bvh.intersect(far_packet), Error) << e;
+    EXPECT_THROW(bvh.occluded(far_packet), Error) << e;
+    std::vector<RayHit> hits(1);
+    EXPECT_THROW(bvh.intersect_packets(std::span<const Ray3f>(&far, 1), hits), Error) << e;
+    EXPECT_NO_THROW(bvh.closest_point(far.origin)) << e;  // distances have their own range
+  }
+  // A ray from beyond the range towards a mesh inside it; a NaN origin still hits nothing.
+  const TriangleBvh bvh = TriangleBvh::build(bunny);
+  ray.origin = {std::ldexp(1.0f, 36), 0, 0};
+  ray.direction = {-1, 0, 0};
+  EXPECT_THROW(bvh.intersect(ray), Error);
+  packet.rays[0] = ray;
+  EXPECT_THROW(bvh.occluded(packet), Error);
+  packet.active = 0;  // an inactive lane is not looked at
+  EXPECT_NO_THROW(bvh.occluded(packet));
+  ray.origin = {std::nanf(""), 0, 0};
+  EXPECT_FALSE(bvh.intersect(ray).hit());
 }
 
 TEST(TriangleBvh, EmptyAndSingleTriangleMeshes) {

@@ -43,7 +43,9 @@ TEST(Grid3, ViewReadsTheSamplesInPlaceWithTheSameGeometry) {
     EXPECT_EQ(v.size(), g.size());
     EXPECT_EQ(v.dims, g.dims);
     EXPECT_EQ(v.bounds(), g.bounds());
-    if (g.size() == 0) EXPECT_TRUE(v.bounds().empty());
+    if (g.size() == 0) {
+      EXPECT_TRUE(v.bounds().empty());
+    }
     std::size_t n = 0;
     for (std::size_t k = 0; k < dims[2]; ++k)
       for (std::size_t j = 0; j < dims[1]; ++j)
@@ -74,7 +76,9 @@ TEST(Grid3, PaddedKeepsEverySampleInPlaceInsideABorder) {
         for (std::size_t i = 0; i < p.dims[0]; ++i) {
           const bool inside = i >= 1 && i <= dims[0] && j >= 1 && j <= dims[1] && k >= 1 && k <= dims[2];
           EXPECT_EQ(p(i, j, k), inside ? g(i - 1, j - 1, k - 1) : -7) << i << " " << j << " " << k;
-          if (inside) EXPECT_EQ(p.position(i, j, k), g.position(i - 1, j - 1, k - 1));
+          if (inside) {
+            EXPECT_EQ(p.position(i, j, k), g.position(i - 1, j - 1, k - 1));
+          }
         }
   }
 }

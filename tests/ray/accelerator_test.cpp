@@ -393,6 +393,42 @@ TEST(Accelerators, EmptyFlatAndBadInput) {
   EXPECT_FALSE(grid->occluded(r));
 }
 
+// Every kind refuses what the float ray-triangle test cannot answer
+// (core/ray_triangle.hpp): a mesh beyond +-2^35 or spanning less than 2^-34,
+// and rays from beyond +-2^35, in single and packet queries alike.
+TEST(Accelerators, MeshesAndRaysBeyondTheTriangleTestsRangeAreRefused) {
+  const TriMesh bunny = load("bunny.ply");
+  for (int e : {40, -40}) {
+    TriMesh m = bunny;
+    for (Vec3f& v : m.vertices) v = Vec3f(std::ldexp(v[0], e), std::ldexp(v[1], e), std::ldexp(v[2], e));
+    Ray3f r;
+    r.origin = Vec3f(0, std::ldexp(20.0f, e), 0);
+    r.direction = {0, -1, 0};
+    for (AcceleratorKind kind : all_accelerator_kinds()) {
+      const auto accel = make_accelerator(m, kind);
+      RayCache cache;
+      bvh::RayPacket packet;
+      packet.rays[0] = r;
+      packet.active = 1;
+      EXPECT_THROW(accel->intersect(r), Error) << to_string(kind) << " 2^" << e;
+      EXPECT_THROW(accel->occluded(r), Error) << to_string(kind);
+      EXPECT_THROW(accel->intersect(packet, cache), Error) << to_string(kind);
+      EXPECT_THROW(accel->occluded(packet, cache), Error) << to_string(kind);
+    }
+  }
+  Ray3f far, near;
+  far.origin = {0, std::ldexp(1.0f, 36), 0};
+  far.direction = {0, -1, 0};
+  near.origin = {0, 30, 0};  // towards the centre of triangle 0: answered
+  near.direction = (bvh::test::corner(bunny, 0, 0) + bvh::test::corner(bunny, 0, 1) + bvh::test::corner(bunny, 0, 2)) / 3 - near.origin;
+  for (AcceleratorKind kind : all_accelerator_kinds()) {
+    const auto accel = make_accelerator(bunny, kind);
+    EXPECT_THROW(accel->intersect(far), Error) << to_string(kind);
+    EXPECT_THROW(accel->occluded(far), Error) << to_string(kind);
+    EXPECT_TRUE(accel->intersect(near).hit()) << to_string(kind);
+  }
+}
+
 TEST(Accelerators, ParallelQueriesGiveTheSameAnswers) {
   const TriMesh mesh = load("bunny.ply");
   const std::vector<Ray3f> rays = test_rays(mesh, 21, 2000);

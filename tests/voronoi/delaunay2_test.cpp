@@ -425,7 +425,9 @@ TEST(Delaunay2, InserterMatchesInsertAndReportsTheStar) {
           ASSERT_EQ(listed, star) << "point " << i;
         }
         for (const auto& [h, t] : before)
-          if (!listed.count(h)) ASSERT_TRUE(ins.is_triangle(h) && ins.triangle(h) == t) << "handle " << h;
+          if (!listed.count(h)) {
+            ASSERT_TRUE(ins.is_triangle(h) && ins.triangle(h) == t) << "handle " << h;
+          }
         before.clear();
         for (std::uint32_t h = 0; h < ins.handle_count(); ++h)
           if (ins.is_triangle(h)) before[h] = ins.triangle(h);

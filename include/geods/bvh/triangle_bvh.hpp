@@ -16,6 +16,7 @@
 #include <filesystem>
 #include <limits>
 #include <span>
+#include <string>
 #include <variant>
 #include <vector>
 
@@ -190,6 +191,14 @@ class TriangleBvh {
                                float max_distance) const;
   template <typename Fn>
   void for_each_crossing(const Ray3f& ray, Fn&& fn) const;
+  // Throws geods::Error for a mesh or ray origin outside the range of the float
+  // ray-triangle test (core/ray_triangle.hpp); every ray query starts here.
+  void check_ray(const Ray3f& ray) const { check_ray_range(ray_range_problem_, ray.origin, "TriangleBvh"); }
+  template <typename Packet>
+  void check_rays(const Packet& packet) const {
+    for (std::uint32_t b = packet.active; b != 0; b &= b - 1) check_ray(packet.rays[__builtin_ctz(b)]);
+  }
+  void set_ray_range();
   // triangle(leaf-order index) for every triangle in a leaf whose volumes
   // (the root's too) all pass accept(volume), in no particular order.
   template <typename Accept, typename OnTriangle>
@@ -204,6 +213,7 @@ class TriangleBvh {
   int depth_ = 0;  // of topology_, sizes the traversal stacks
   VolumeArray volumes_;
   FlatArray<Triangle> triangles_;
+  std::string ray_range_problem_;  // ray_range_problem of the triangles: ray queries refuse them when set
   WideNodes<4> wide4_;
   WideNodes<8> wide8_;
   // The triangles of the wide leaves in groups of 4, in leaf order (huge pages when built).

@@ -2,6 +2,7 @@
 // Parallel helpers over oneTBB, and the global thread limit.
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 
 #include <cstddef>
 
@@ -32,6 +33,22 @@ void parallel_for_each_index(std::size_t first, std::size_t last, const Fn& fn, 
   parallel_for(first, last, grain, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) fn(i);
   });
+}
+
+/// The box of n items in parallel: extend(box, i) adds item i to a Box (an
+/// AABB); the extents' minima and maxima are the same in any order.
+template <typename Box, typename Extend>
+Box parallel_bounds(std::size_t n, const Extend& extend) {
+  return tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, n, 65536), Box(),
+      [&](const tbb::blocked_range<std::size_t>& r, Box box) {
+        for (std::size_t i = r.begin(); i < r.end(); ++i) extend(box, i);
+        return box;
+      },
+      [](Box a, const Box& b) {
+        a.extend(b);
+        return a;
+      });
 }
 
 }  // namespace geods

@@ -9,8 +9,11 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <string>
 #include <utility>
 
+#include "geods/core/coordinate_range.hpp"
+#include "geods/core/error.hpp"
 #include "geods/core/ray.hpp"
 
 namespace geods {
@@ -27,6 +30,45 @@ struct RayHit {
 
   bool hit() const { return prim != no_hit; }
 };
+
+/// The coordinates at which RayTriangleTest<float> answers as at unit scale
+/// (the hits of an input scaled by a power of two are those of the unit-scale
+/// input, t scaled): its terms are of degree 3 in corner - origin, which
+/// overflow beyond |coordinate| 2^35 (coordinate_limit<float>(3), 3.4e10)
+/// and lose precision when the cube of a mesh's extent nears the smallest
+/// normal float, below 2^-34 (5.8e-11). The ray queries refuse meshes and ray
+/// origins outside (geods::Error) rather than answer them wrongly.
+inline constexpr float kRayCoordinateLimit = coordinate_limit<float>(3);
+inline constexpr float kRayExtentFloor =
+    power_of_two<float>((std::numeric_limits<float>::min_exponent - 1 + std::numeric_limits<float>::digits) / 3);
+
+/// Empty if triangles within `bounds` (empty: no triangles) are in the range
+/// above (an extent of 0 is: every triangle is one point); else why not, as a
+/// message "<what>: ...".
+inline std::string ray_range_problem(const AABB3f& bounds, const std::string& what) {
+  if (bounds.empty()) return {};
+  const float reach = std::max(bounds.lo.cwiseAbs().maxCoeff(), bounds.hi.cwiseAbs().maxCoeff());
+  const float extent = (bounds.hi - bounds.lo).maxCoeff();
+  if (!(reach <= kRayCoordinateLimit))
+    return what + ": a coordinate of " + format_number(reach) + " is beyond +-" + format_number(kRayCoordinateLimit) +
+           ", where the ray-triangle test would overflow; scale the mesh for ray queries";
+  if (extent > 0 && extent < kRayExtentFloor)  // (0: points only, which no ray hits)
+    return what + ": the triangles span only " + format_number(extent) + " (below " +
+           format_number(kRayExtentFloor) + "), where the ray-triangle test loses precision; scale the mesh for ray queries";
+  return {};
+}
+
+/// Throws `problem` (ray_range_problem of the mesh) if it is not empty, or an
+/// error if the ray's origin lies beyond kRayCoordinateLimit. (A NaN origin
+/// passes: such a ray hits nothing.)
+inline void check_ray_range(const std::string& problem, const Vec3f& origin, const char* what) {
+  if (!problem.empty()) [[unlikely]]
+    throw Error(problem);
+  if (origin.cwiseAbs().maxCoeff() > kRayCoordinateLimit) [[unlikely]]
+    throw Error(std::string(what) + ": ray origin (" + format_number(origin[0]) + ", " + format_number(origin[1]) +
+                ", " + format_number(origin[2]) + ") is beyond +-" + format_number(kRayCoordinateLimit) +
+                ", where the ray-triangle test would overflow");
+}
 
 /// Per-ray precomputation of the watertight test; build once per ray, then
 /// call intersect() on every candidate triangle. Triangles are two-sided.

@@ -169,9 +169,13 @@ class Accelerator {
   /// Rays with a non-finite or zero direction, a non-finite origin or an empty
   /// interval hit nothing (as in the triangle test itself).
   static bool shootable(const Ray3f& ray);
+  /// Throws geods::Error for a mesh or ray origin outside the range of the
+  /// float ray-triangle test (core/ray_triangle.hpp).
+  void check_range(const Ray3f& ray) const { check_ray_range(ray_range_problem_, ray.origin, "ray accelerator"); }
 
   FlatArray<Vec3f> corners_;    // triangle i: corners_[3i..3i+2]
   AABB3f bounds_;               // of all triangles
+  std::string ray_range_problem_;  // ray_range_problem(bounds_): ray queries refuse the mesh when set
   // Cells and beams are widened by this much when triangles are assigned to
   // them, so that float rounding in the traversal never loses a triangle.
   float margin_ = 0;
