@@ -41,11 +41,21 @@ BV fit_points(std::span<const Vec3f> points) {
   }
 }
 
+// A volume in double, for its measures: in float, areas and volumes of
+// meshes far from unit scale overflow (a sphere's volume from a radius of
+// 4e12) and made the statistics inf or NaN.
+AABB<double, 3> in_double(const AABB3f& a) { return {a.lo.cast<double>(), a.hi.cast<double>()}; }
+Sphere<double> in_double(const Sphere3f& a) { return {a.center.cast<double>(), double(a.radius)}; }
+Obb<double> in_double(const Obb3f& a) { return {a.center.cast<double>(), a.axes.cast<double>(), a.half.cast<double>()}; }
+Rss<double> in_double(const Rss3f& a) {
+  return {a.center.cast<double>(), a.axes.cast<double>(), a.half.cast<double>(), double(a.radius)};
+}
+
 template <typename BV>
 std::pair<double, double> measures(const BV& bv) {
   if constexpr (std::is_same_v<BV, AABB3f> || std::is_same_v<BV, Sphere3f> || std::is_same_v<BV, Obb3f> ||
                 std::is_same_v<BV, Rss3f>) {
-    return {double(volume(bv)), double(surface_area(bv))};
+    return {volume(in_double(bv)), surface_area(in_double(bv))};
   } else {
     return kdop_measures(bv);
   }
