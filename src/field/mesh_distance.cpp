@@ -10,6 +10,7 @@
 
 #include "../core/prefault.hpp"
 #include "geods/bvh/traversal.hpp"
+#include "geods/core/coordinate_range.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"
 #include "geods/core/weld.hpp"
@@ -81,6 +82,8 @@ std::string_view to_string(Feature feature) {
 MeshDistance MeshDistance::build(const TriMesh& mesh, const bvh::BuildOptions& options) {
   if (mesh.num_triangles() == 0) throw Error("signed distance: the mesh has no faces");
   mesh.require_valid("signed distance");
+  check_coordinate_range(mesh.vertices.front().data(), mesh.num_vertices(), 3, 3, kDistanceCoordinateLimit,
+                         kDistanceExtentFloor, "signed distance");
   MeshDistance md;
   detail::reserve_prefaulted(md.faces_, mesh.num_triangles());  // mapped at once: cheaper than a fault per page
   md.faces_.assign(mesh.triangles.begin(), mesh.triangles.end());
@@ -295,6 +298,9 @@ bool MeshDistance::inside_by_pseudonormal(const Vec3f& p, const MeshPointDistanc
 
 MeshPointDistance MeshDistance::query(const Vec3f& p, SignMethod sign, float max_distance) const {
   if (!p.allFinite()) throw Error("signed distance: the query point is not finite");
+  if (p.cwiseAbs().maxCoeff() > kDistanceCoordinateLimit)
+    throw Error("signed distance: query point coordinate " + format_number(p.cwiseAbs().maxCoeff()) + " is beyond +-" +
+                format_number(kDistanceCoordinateLimit) + ", where its distances would overflow");
   MeshPointDistance out;
   float best_d2 = max_distance * max_distance;
   std::uint32_t best = kNoIndex;  // leaf-order index

@@ -65,12 +65,15 @@ struct Closest {
 
 // Triangles prepared for squared distances to many points, one array per
 // quantity (structure of arrays) so that the loop over them vectorizes: the
-// corner a, the edges ab and ac, the normal n, the terms of the projection's
-// barycentric coordinates, and the reciprocal squared lengths (0 for a
-// degenerate edge or face, which then never claims a point).
+// corner a, the edges ab and ac, the unit normal n, the terms of the
+// projection's barycentric coordinates, the reciprocal squared lengths (0 for a
+// degenerate edge, which then never claims a point) and has_face (1, or 0 for a
+// degenerate face). (A unit normal: the plane distance squared as (n . q)^2 /
+// |n|^2 with the cross product n, of degree 6 in the coordinates, overflowed
+// from differences of about 2^21 and underflowed below about 2^-21.)
 struct Packed {
   // k0..k7: in a block's list, the squared distances from the block's 8 corners.
-  enum Field { ax, ay, az, bx, by, bz, cx, cy, cz, nx, ny, nz, d00, d01, d11, inv_den, inv_nn, inv_ab, inv_ac, inv_bc,
+  enum Field { ax, ay, az, bx, by, bz, cx, cy, cz, nx, ny, nz, d00, d01, d11, inv_den, has_face, inv_ab, inv_ac, inv_bc,
                k0, k1, k2, k3, k4, k5, k6, k7, kFields };
   using Arrays = std::array<std::vector<float>, kFields>;
   Arrays f;
@@ -123,12 +126,12 @@ __attribute__((always_inline)) inline void distance8(const Packed::Arrays& f, st
   const V8 qx = px - at(Packed::ax), qy = py - at(Packed::ay), qz = pz - at(Packed::az);  // p - a
   const V8 e1 = bx * qx + by * qy + bz * qz;  // ab . (p - a)
   const V8 e2 = cx * qx + cy * qy + cz * qz;  // ac . (p - a)
-  const V8 d01 = at(Packed::d01), inv_den = at(Packed::inv_den), inv_nn = at(Packed::inv_nn);
+  const V8 d01 = at(Packed::d01), inv_den = at(Packed::inv_den), has_face = at(Packed::has_face);
   const V8 v = (at(Packed::d11) * e1 - d01 * e2) * inv_den;
   const V8 w = (at(Packed::d00) * e2 - d01 * e1) * inv_den;
   const V8 h = at(Packed::nx) * qx + at(Packed::ny) * qy + at(Packed::nz) * qz;
-  const V8 face = h * h * inv_nn;
-  const auto inside = (v >= zero) & (w >= zero) & (v + w <= one) & (inv_nn > zero);
+  const V8 face = h * h;
+  const auto inside = (v >= zero) & (w >= zero) & (v + w <= one) & (has_face > zero);
   // Edge ab from a, edge ac from a, edge bc from b.
   V8 s = clamp01(e1 * at(Packed::inv_ab));
   V8 rx = qx - s * bx, ry = qy - s * by, rz = qz - s * bz;
@@ -436,14 +439,14 @@ GEODS_AVX512_INLINE __m512 distance16(const Packed::Arrays& f, std::size_t i, __
                qz = _mm512_sub_ps(pz, at(f, Packed::az, i));
   const __m512 e1 = dot(bx, by, bz, qx, qy, qz);
   const __m512 e2 = dot(cx, cy, cz, qx, qy, qz);
-  const __m512 d01 = at(f, Packed::d01, i), inv_den = at(f, Packed::inv_den, i), inv_nn = at(f, Packed::inv_nn, i);
+  const __m512 d01 = at(f, Packed::d01, i), inv_den = at(f, Packed::inv_den, i), has_face = at(f, Packed::has_face, i);
   const __m512 v = _mm512_mul_ps(_mm512_sub_ps(_mm512_mul_ps(at(f, Packed::d11, i), e1), _mm512_mul_ps(d01, e2)), inv_den);
   const __m512 w = _mm512_mul_ps(_mm512_sub_ps(_mm512_mul_ps(at(f, Packed::d00, i), e2), _mm512_mul_ps(d01, e1)), inv_den);
   const __m512 h = dot(at(f, Packed::nx, i), at(f, Packed::ny, i), at(f, Packed::nz, i), qx, qy, qz);
-  const __m512 face = _mm512_mul_ps(_mm512_mul_ps(h, h), inv_nn);
+  const __m512 face = _mm512_mul_ps(h, h);
   const __mmask16 inside = _mm512_cmp_ps_mask(v, zero, _CMP_GE_OQ) & _mm512_cmp_ps_mask(w, zero, _CMP_GE_OQ) &
                            _mm512_cmp_ps_mask(_mm512_add_ps(v, w), one, _CMP_LE_OQ) &
-                           _mm512_cmp_ps_mask(inv_nn, zero, _CMP_GT_OQ);
+                           _mm512_cmp_ps_mask(has_face, zero, _CMP_GT_OQ);
   __m512 s = clamp01(_mm512_mul_ps(e1, at(f, Packed::inv_ab, i)));
   const __m512 dab = sq(_mm512_sub_ps(qx, _mm512_mul_ps(s, bx)), _mm512_sub_ps(qy, _mm512_mul_ps(s, by)),
                         _mm512_sub_ps(qz, _mm512_mul_ps(s, bz)));
@@ -782,12 +785,15 @@ class GridSolver {
     }
     parallel_for_each_index(0, n, [&](std::size_t i) {
       const BvhTriangle& t = tris_[i];
-      const Vec3f ab = t.b - t.a, ac = t.c - t.a, bc = t.c - t.b, nn = ab.cross(ac);
+      const Vec3f ab = t.b - t.a, ac = t.c - t.a, bc = t.c - t.b;
       const float d00 = ab.dot(ab), d01 = ab.dot(ac), d11 = ac.dot(ac), den = d00 * d11 - d01 * d01;
-      const float nn2 = nn.squaredNorm();
+      // The unit normal in double: the cross product's squared length is of degree 4.
+      const Vec3d nd = ab.cast<double>().cross(ac.cast<double>());
+      const double nd_norm = nd.norm();
+      const Vec3f n = nd_norm > 0 ? Vec3f((nd / nd_norm).cast<float>()) : Vec3f::Zero();
       const float values[Packed::kFields] = {
-          t.a.x(), t.a.y(), t.a.z(), ab.x(), ab.y(), ab.z(), ac.x(), ac.y(), ac.z(), nn.x(), nn.y(), nn.z(), d00, d01,
-          d11, den > 0 ? 1 / den : 0.0f, nn2 > 0 && den > 0 ? 1 / nn2 : 0.0f, d00 > 0 ? 1 / d00 : 0.0f,
+          t.a.x(), t.a.y(), t.a.z(), ab.x(), ab.y(), ab.z(), ac.x(), ac.y(), ac.z(), n.x(), n.y(), n.z(), d00, d01,
+          d11, den > 0 ? 1 / den : 0.0f, nd_norm > 0 && den > 0 && std::isfinite(den) ? 1.0f : 0.0f, d00 > 0 ? 1 / d00 : 0.0f,
           d11 > 0 ? 1 / d11 : 0.0f, bc.squaredNorm() > 0 ? 1 / bc.squaredNorm() : 0.0f};
       const auto face = std::int32_t(ids_[i]);
       if (rows_) {
@@ -1406,6 +1412,10 @@ SdfGrid sdf_grid(const MeshDistance& mesh, const Grid3Geometry& grid, const SdfG
   if (std::isnan(options.band) || !(options.band >= 0))
     throw Error(fmt::format("sdf grid: the band must be >= 0 samples, got {}", options.band));
   if (!grid.bounds().hi.allFinite()) throw Error("sdf grid: the grid reaches beyond float range");
+  const AABB3f box = grid.bounds();
+  if (std::max(box.lo.cwiseAbs().maxCoeff(), box.hi.cwiseAbs().maxCoeff()) > kDistanceCoordinateLimit)
+    throw Error("sdf grid: the grid reaches beyond +-" + format_number(kDistanceCoordinateLimit) +
+                ", where its distances would overflow");
   const std::size_t n = Grid3<float>::checked_size(grid.dims[0], grid.dims[1], grid.dims[2]);
   // Refuse before allocating what the machine cannot hold.
   const double bytes = double(n) * (options.faces ? 8.0 : 4.0);

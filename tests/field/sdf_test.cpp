@@ -389,6 +389,44 @@ TEST(SdfGrid, GeometryFromResolutionOrSpacing) {
   EXPECT_EQ(s.dims[2], 5u);  // ceil(2.5 + 2)
 }
 
+// Within the module's float range (mesh_distance.hpp: coordinates within
+// +-2^30, a mesh spanning at least 2^-24) the field of a mesh and grid scaled
+// by a power of two is the unit-scale field, scaled, bit for bit; outside,
+// meshes, query points and grids are refused. (The plane distance of the grid
+// kernels squared a term of degree 3 and gave wrong distances and 2 % wrong
+// signs from 2^24 and below 2^-20, silently.)
+TEST(SdfGrid, PowerOfTwoScalesGiveTheUnitScaleFieldOrAreRefused) {
+  const TriMesh bunny = data_mesh("bunny.ply");  // coordinates up to 10
+  const Grid3Geometry unit_grid = sdf_grid_geometry(bunny.bounds(), 20, 0, 2);
+  for (const SignMethod sign : {SignMethod::winding, SignMethod::pseudonormal}) {
+    SdfGridOptions options;
+    options.sign = sign;
+    const SdfGrid unit = sdf_grid(MeshDistance::build(bunny), unit_grid, options);
+    for (int e : {-20, -8, 8, 24}) {
+      TriMesh m = bunny;
+      for (Vec3f& v : m.vertices) v = Vec3f(std::ldexp(v[0], e), std::ldexp(v[1], e), std::ldexp(v[2], e));
+      Grid3Geometry grid = unit_grid;
+      for (int a = 0; a < 3; ++a) {
+        grid.origin[a] = std::ldexp(grid.origin[a], e);
+        grid.spacing[a] = std::ldexp(grid.spacing[a], e);
+      }
+      const SdfGrid scaled = sdf_grid(MeshDistance::build(m), grid, options);
+      for (std::size_t i = 0; i < unit.distance.size(); ++i)
+        ASSERT_EQ(scaled.distance.data[i], std::ldexp(unit.distance.data[i], e)) << "2^" << e << " sample " << i;
+    }
+  }
+  for (int e : {28, -28}) {  // 10 x 2^28 is beyond 2^30; 10 x 2^-28 spans less than 2^-24
+    TriMesh m = bunny;
+    for (Vec3f& v : m.vertices) v = Vec3f(std::ldexp(v[0], e), std::ldexp(v[1], e), std::ldexp(v[2], e));
+    EXPECT_THROW(MeshDistance::build(m), Error) << e;
+  }
+  const MeshDistance md = MeshDistance::build(bunny);
+  EXPECT_THROW(md.query(Vec3f(0, std::ldexp(1.0f, 31), 0)), Error);
+  Grid3Geometry far = unit_grid;
+  far.origin[0] = std::ldexp(1.0f, 31);
+  EXPECT_THROW(sdf_grid(md, far), Error);
+}
+
 TEST(SdfGrid, BadInputIsRefused) {
   const TriMesh c = cube();
   EXPECT_THROW(MeshDistance::build(TriMesh{}), Error);

@@ -45,15 +45,13 @@ constexpr T extent_floor(int degree) {
 }
 
 /// Checks that n points of `dim` coordinates (row i at coords[i * stride])
-/// fit the range of polynomials of `degree` in T: every |coordinate| at most
-/// coordinate_limit, and the bounding box's largest extent zero or at least
-/// extent_floor. Throws geods::Error "<what>: ..." saying which and why.
+/// lie within +-limit and that their bounding box's largest extent is zero or
+/// at least `floor`. Throws geods::Error "<what>: ..." saying which and why.
 /// Non-finite coordinates are the caller's to refuse (with their own message).
 template <typename T>
-void check_coordinate_range(const T* coords, std::size_t n, std::size_t dim, std::size_t stride, int degree,
+void check_coordinate_range(const T* coords, std::size_t n, std::size_t dim, std::size_t stride, T limit, T floor,
                             const std::string& what) {
   if (n == 0 || dim == 0) return;
-  const T limit = coordinate_limit<T>(degree);
   T extent = 0;
   for (std::size_t a = 0; a < dim; ++a) {
     T lo = coords[a], hi = coords[a];
@@ -68,9 +66,17 @@ void check_coordinate_range(const T* coords, std::size_t n, std::size_t dim, std
     }
     extent = hi - lo > extent ? hi - lo : extent;
   }
-  if (extent > 0 && extent < extent_floor<T>(degree))
+  if (extent > 0 && extent < floor)
     throw Error(what + ": the points span only " + format_number(double(extent)) + " (below " +
-                format_number(double(extent_floor<T>(degree))) + "), where their distances underflow; scale the input");
+                format_number(double(floor)) + "), where their distances underflow; scale the input");
+}
+
+/// check_coordinate_range for polynomials of `degree` in T: coordinate_limit
+/// and extent_floor.
+template <typename T>
+void check_coordinate_range(const T* coords, std::size_t n, std::size_t dim, std::size_t stride, int degree,
+                            const std::string& what) {
+  check_coordinate_range(coords, n, dim, stride, coordinate_limit<T>(degree), extent_floor<T>(degree), what);
 }
 
 /// Checks one query point against coordinate_limit (a far query's distances

@@ -60,6 +60,17 @@ struct MeshPointDistance {
   std::uint32_t feature_index = kNoIndex;
 };
 
+/// The coordinates at which the module's float distances answer as at unit
+/// scale (the fields of an input scaled by a power of two are those of the
+/// unit-scale input, scaled; measured on the bunny from 2^-28 to 2^32): the
+/// closest point's barycentric terms are of degree 4 in coordinate
+/// differences, which overflow from 2^32 (coordinates within +-2^30 differ by
+/// at most 2^31), and the mesh must span at least 2^-24 for its triangles'
+/// terms to stay normal floats. Meshes, query points and grids outside are
+/// refused (geods::Error).
+inline constexpr float kDistanceCoordinateLimit = 1u << 30;
+inline constexpr float kDistanceExtentFloor = 1.0f / float(1u << 24);
+
 /// Everything the signed distance of one mesh needs, built once: the
 /// hierarchy, the pseudonormals and the winding-number moments of its nodes.
 /// Queries are const and thread-safe.
@@ -69,12 +80,14 @@ class MeshDistance {
 
   /// Builds over `mesh` (its own TriangleBvh with `options`). Throws
   /// geods::Error for an invalid mesh (indices out of range, NaN or infinite
-  /// coordinates) or a mesh without faces. Degenerate faces are kept: they are
+  /// coordinates, coordinates beyond kDistanceCoordinateLimit or a span below
+  /// kDistanceExtentFloor) or a mesh without faces. Degenerate faces are kept: they are
   /// points or segments of the surface, with no area and no normal.
   /// Time O(n log n).
   static MeshDistance build(const TriMesh& mesh, const bvh::BuildOptions& options = {});
 
-  /// Distance, closest point, face and feature of p (finite, else geods::Error).
+  /// Distance, closest point, face and feature of p (finite and within
+  /// kDistanceCoordinateLimit, else geods::Error).
   /// max_distance bounds the search: a point farther than that from the mesh
   /// gets distance +-infinity and no face. The sign costs a winding-number
   /// traversal with SignMethod::winding.
