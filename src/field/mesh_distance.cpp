@@ -298,9 +298,7 @@ bool MeshDistance::inside_by_pseudonormal(const Vec3f& p, const MeshPointDistanc
 
 MeshPointDistance MeshDistance::query(const Vec3f& p, SignMethod sign, float max_distance) const {
   if (!p.allFinite()) throw Error("signed distance: the query point is not finite");
-  if (p.cwiseAbs().maxCoeff() > kDistanceCoordinateLimit)
-    throw Error("signed distance: query point coordinate " + format_number(p.cwiseAbs().maxCoeff()) + " is beyond +-" +
-                format_number(kDistanceCoordinateLimit) + ", where its distances would overflow");
+  check_query_range(std::span<const float>(p.data(), 3), kDistanceCoordinateLimit, "signed distance");
   MeshPointDistance out;
   float best_d2 = max_distance * max_distance;
   std::uint32_t best = kNoIndex;  // leaf-order index

@@ -1411,11 +1411,10 @@ SdfGrid sdf_grid(const MeshDistance& mesh, const Grid3Geometry& grid, const SdfG
   }
   if (std::isnan(options.band) || !(options.band >= 0))
     throw Error(fmt::format("sdf grid: the band must be >= 0 samples, got {}", options.band));
-  if (!grid.bounds().hi.allFinite()) throw Error("sdf grid: the grid reaches beyond float range");
   const AABB3f box = grid.bounds();
-  if (std::max(box.lo.cwiseAbs().maxCoeff(), box.hi.cwiseAbs().maxCoeff()) > kDistanceCoordinateLimit)
-    throw Error("sdf grid: the grid reaches beyond +-" + format_number(kDistanceCoordinateLimit) +
-                ", where its distances would overflow");
+  if (!box.hi.allFinite()) throw Error("sdf grid: the grid reaches beyond float range");
+  for (const Vec3f& corner : {box.lo, box.hi})
+    check_query_range(std::span<const float>(corner.data(), 3), kDistanceCoordinateLimit, "sdf grid");
   const std::size_t n = Grid3<float>::checked_size(grid.dims[0], grid.dims[1], grid.dims[2]);
   // Refuse before allocating what the machine cannot hold.
   const double bytes = double(n) * (options.faces ? 8.0 : 4.0);

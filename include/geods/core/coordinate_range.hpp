@@ -79,15 +79,21 @@ void check_coordinate_range(const T* coords, std::size_t n, std::size_t dim, std
   check_coordinate_range(coords, n, dim, stride, coordinate_limit<T>(degree), extent_floor<T>(degree), what);
 }
 
-/// Checks one query point against coordinate_limit (a far query's distances
-/// overflow like a far point's). On the query path: the limit is a constant.
+/// Checks one query point against +-limit (a far query's distances overflow
+/// like a far point's). NaN coordinates pass: they are the caller's to refuse.
+template <typename T>
+void check_query_range(std::span<const T> q, T limit, const char* what) {
+  for (T x : q)
+    if (std::abs(x) > limit) [[unlikely]]
+      throw Error(std::string(what) + ": query coordinate " + format_number(double(x)) + " is beyond +-" +
+                  format_number(double(limit)) + ", where its distances would overflow");
+}
+
+/// check_query_range against coordinate_limit. On the query path: the limit is a constant.
 template <int Degree, typename T>
 void check_query_range(std::span<const T> q, const char* what) {
   constexpr T limit = coordinate_limit<T>(Degree);
-  for (T x : q)
-    if (std::abs(x) > limit)
-      throw Error(std::string(what) + ": query coordinate " + format_number(double(x)) + " is beyond +-" +
-                  format_number(double(limit)) + ", where its distances would overflow");
+  check_query_range(q, limit, what);
 }
 
 }  // namespace geods

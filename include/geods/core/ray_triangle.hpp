@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <span>
 #include <string>
 #include <utility>
 
@@ -64,10 +65,7 @@ inline std::string ray_range_problem(const AABB3f& bounds, const std::string& wh
 inline void check_ray_range(const std::string& problem, const Vec3f& origin, const char* what) {
   if (!problem.empty()) [[unlikely]]
     throw Error(problem);
-  if (origin.cwiseAbs().maxCoeff() > kRayCoordinateLimit) [[unlikely]]
-    throw Error(std::string(what) + ": ray origin (" + format_number(origin[0]) + ", " + format_number(origin[1]) +
-                ", " + format_number(origin[2]) + ") is beyond +-" + format_number(kRayCoordinateLimit) +
-                ", where the ray-triangle test would overflow");
+  check_query_range(std::span<const float>(origin.data(), 3), kRayCoordinateLimit, what);
 }
 
 /// Per-ray precomputation of the watertight test; build once per ray, then

@@ -31,6 +31,7 @@
 
 #include "geods/bvh/traversal.hpp"
 #include "geods/bvh/triangle_bvh.hpp"
+#include "geods/core/coordinate_range.hpp"
 #include "geods/core/tri_mesh.hpp"
 #include "geods/core/triangle.hpp"
 
@@ -68,8 +69,8 @@ struct MeshPointDistance {
 /// at most 2^31), and the mesh must span at least 2^-24 for its triangles'
 /// terms to stay normal floats. Meshes, query points and grids outside are
 /// refused (geods::Error).
-inline constexpr float kDistanceCoordinateLimit = 1u << 30;
-inline constexpr float kDistanceExtentFloor = 1.0f / float(1u << 24);
+inline constexpr float kDistanceCoordinateLimit = power_of_two<float>(30);
+inline constexpr float kDistanceExtentFloor = power_of_two<float>(-24);
 
 /// Everything the signed distance of one mesh needs, built once: the
 /// hierarchy, the pseudonormals and the winding-number moments of its nodes.
