@@ -79,14 +79,31 @@ void check_coordinate_range(const T* coords, std::size_t n, std::size_t dim, std
   check_coordinate_range(coords, n, dim, stride, coordinate_limit<T>(degree), extent_floor<T>(degree), what);
 }
 
+namespace detail {
+// The error of check_query_range, out of line: the check itself runs on every
+// query (every ray), and with the message built inline GCC called it instead
+// of inlining it.
+template <typename T>
+[[noreturn, gnu::cold, gnu::noinline]] void throw_query_beyond(std::span<const T> q, T limit, const char* what) {
+  T x = 0;
+  for (T c : q)
+    if (std::abs(c) > limit) {
+      x = c;
+      break;
+    }
+  throw Error(std::string(what) + ": query coordinate " + format_number(double(x)) + " is beyond +-" +
+              format_number(double(limit)) + ", where its distances would overflow");
+}
+}  // namespace detail
+
 /// Checks one query point against +-limit (a far query's distances overflow
 /// like a far point's). NaN coordinates pass: they are the caller's to refuse.
 template <typename T>
-void check_query_range(std::span<const T> q, T limit, const char* what) {
-  for (T x : q)
-    if (std::abs(x) > limit) [[unlikely]]
-      throw Error(std::string(what) + ": query coordinate " + format_number(double(x)) + " is beyond +-" +
-                  format_number(double(limit)) + ", where its distances would overflow");
+inline void check_query_range(std::span<const T> q, T limit, const char* what) {
+  bool beyond = false;
+  for (T x : q) beyond |= std::abs(x) > limit;
+  if (beyond) [[unlikely]]
+    detail::throw_query_beyond(q, limit, what);
 }
 
 /// check_query_range against coordinate_limit. On the query path: the limit is a constant.
