@@ -109,6 +109,7 @@ def discover():
 
 
 BEFORE = "@before"  # anchor suffix of a program run from an older build (--before)
+UNAVAILABLE = 77  # exit status of a program that cannot run on this machine (common.hpp: kUnavailable)
 
 
 def add_before(comps, bin_dir, label):
@@ -239,7 +240,11 @@ def run_comparison(c, bin_dir, data_dir, threads_list, rounds, reps, scale, stat
                     records.append(rec)
                     n += 1
                 log(f"  {n} measurements in {time.time() - t0:.1f} s" + (f", exit {rc}" if rc else ""))
-                if rc:
+                if rc == UNAVAILABLE and "program" in p:  # cannot run on this machine: skipped from now on
+                    with open(errlog) as ef:
+                        lines = [l.strip() for l in ef if l.strip()]
+                    status[prog] = lines[-1] if lines else "unavailable on this machine"
+                elif rc:
                     problems.append(f"`{prog} --threads {threads}` exited with {rc} (stderr: {rel(errlog)})")
     return records, raw, problems
 

@@ -2,7 +2,8 @@
 // rtcIntersect8/rtcOccluded8 on 4 x 2 pixel tiles, or with
 // GEODS_EMBREE_PACKET=16 rtcIntersect16/rtcOccluded16 on 4 x 4 tiles where the
 // CPU and the library support 16-wide packets
-// (RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED; else 8 and 4 x 2 tiles).
+// (RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED; elsewhere the program exits
+// with compare::kUnavailable).
 #include <embree3/rtcore.h>
 
 #include "embree_scene.hpp"
@@ -42,8 +43,10 @@ struct Embree {
   static std::unique_ptr<Index> build(const compare::PlyMesh& mesh) {
     auto index = std::make_unique<Index>(threads);
     const int property = N == 16 ? RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED : RTC_DEVICE_PROPERTY_NATIVE_RAY8_SUPPORTED;
-    if (!rtcGetDeviceProperty(index->device, RTCDeviceProperty(property)))
-      throw std::runtime_error("Embree: this CPU or build does not support packets of " + std::to_string(N));
+    if (!rtcGetDeviceProperty(index->device, RTCDeviceProperty(property))) {
+      std::fprintf(stderr, "Embree %s has no native packets of %d on this CPU\n", RTC_VERSION_STRING, N);
+      std::exit(compare::kUnavailable);
+    }
     index->scene = embree_mesh_scene(index->device, mesh);
     return index;
   }
