@@ -2,7 +2,6 @@
 // The command framework of the geods CLI: one Command subclass per
 // cmd_<name>.cpp, registered in one line with register_command<T>().
 #include <CLI/CLI.hpp>
-#include <nlohmann/json.hpp>
 
 #include <memory>
 #include <string>
@@ -10,17 +9,9 @@
 
 #include "geods/core/progress.hpp"
 #include "geods/io/output.hpp"
+#include "report.hpp"
 
 namespace geods::cli {
-
-using Json = nlohmann::ordered_json;
-
-/// What a command reports: `json` is printed with --json (inputs, parameters,
-/// counts, timings in keys ending in _s), `lines` otherwise.
-struct Report {
-  Json json = Json::object();
-  std::vector<std::string> lines;
-};
 
 /// Options every command shares, filled in before run().
 struct RunContext {

@@ -14,7 +14,7 @@
 #include "geods/io/image_io.hpp"
 #include "geods/io/mesh_io.hpp"
 #include "geods/ray/render.hpp"
-#include "stats_json.hpp"
+#include "stats_text.hpp"
 
 namespace geods::cli {
 namespace {

@@ -14,7 +14,7 @@
 #include "geods/voronoi/delaunay3.hpp"
 #include "geods/voronoi/stats_fields.hpp"
 #include "geods/voronoi/voronoi3.hpp"
-#include "stats_json.hpp"
+#include "stats_text.hpp"
 #include "stopwatch.hpp"
 
 namespace geods::cli {

@@ -14,7 +14,7 @@
 #include "geods/io/point_io.hpp"
 #include "geods/io/svg.hpp"
 #include "geods/spatial/kd_tree.hpp"
-#include "stats_json.hpp"
+#include "stats_text.hpp"
 #include "stopwatch.hpp"
 
 namespace geods::cli {

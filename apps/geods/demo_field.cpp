@@ -13,7 +13,7 @@
 #include "geods/io/mesh_io.hpp"
 #include "geods/io/image_io.hpp"
 #include "geods/io/volume_io.hpp"
-#include "stats_json.hpp"
+#include "stats_text.hpp"
 #include "stopwatch.hpp"
 
 namespace geods::cli {

@@ -16,7 +16,7 @@
 #include "geods/io/image_io.hpp"
 #include "geods/io/mesh_io.hpp"
 #include "geods/ray/render.hpp"
-#include "stats_json.hpp"
+#include "stats_text.hpp"
 #include "stopwatch.hpp"
 
 namespace geods::cli {

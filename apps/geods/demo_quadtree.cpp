@@ -9,7 +9,7 @@
 #include "geods/io/svg.hpp"
 #include "geods/spatial/quadtree.hpp"
 #include "geods/spatial/stats_fields.hpp"
-#include "stats_json.hpp"
+#include "stats_text.hpp"
 #include "stopwatch.hpp"
 
 namespace geods::cli {

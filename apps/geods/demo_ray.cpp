@@ -7,7 +7,7 @@
 #include "geods/io/mesh_io.hpp"
 #include "geods/ray/render.hpp"
 #include "geods/ray/stats_fields.hpp"
-#include "stats_json.hpp"
+#include "stats_text.hpp"
 
 namespace geods::cli {
 namespace {

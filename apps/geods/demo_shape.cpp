@@ -16,7 +16,7 @@
 #include "geods/shape/collection.hpp"
 #include "geods/shape/retrieval.hpp"
 #include "geods/shape/stats_fields.hpp"
-#include "stats_json.hpp"
+#include "stats_text.hpp"
 #include "stopwatch.hpp"
 
 namespace geods::cli {

@@ -15,7 +15,7 @@
 #include "geods/ray/render.hpp"
 #include "geods/terrain/stats_fields.hpp"
 #include "geods/terrain/terrain.hpp"
-#include "stats_json.hpp"
+#include "stats_text.hpp"
 #include "stopwatch.hpp"
 
 namespace geods::cli {

@@ -19,7 +19,7 @@
 #include "geods/voronoi/proximity.hpp"
 #include "geods/voronoi/stats_fields.hpp"
 #include "geods/voronoi/voronoi2.hpp"
-#include "stats_json.hpp"
+#include "stats_text.hpp"
 #include "stopwatch.hpp"
 #include "voronoi_cli.hpp"
 

@@ -4,8 +4,8 @@
 #include <filesystem>
 #include <optional>
 
-#include "command.hpp"
 #include "geods/core/dtype.hpp"
+#include "report.hpp"
 
 namespace geods::cli {
 

@@ -111,7 +111,7 @@ TEST(Csg, LocalMatchesMerge) {
   const double size = (hi - lo).maxCoeff();
   const Triangles ball = sphere(0.3 * size, 8, 12, 0.5 * (lo + hi) + Vec3d{0.3 * size, 0.1 * size, 0});
   Triangles three = transformed(sphere(0.8, 6, 10), 0.2, {0.9, 0.1, 0.2});
-  for (const Vec3d c : {Vec3d{0, 0, 0}, Vec3d{-1, 0, 0}}) {
+  for (const Vec3d& c : {Vec3d{0, 0, 0}, Vec3d{-1, 0, 0}}) {
     const Triangles s = sphere(0.1, 4, 6, c);
     const auto base = static_cast<std::uint32_t>(three.vertices.size());
     three.vertices.insert(three.vertices.end(), s.vertices.begin(), s.vertices.end());

@@ -231,7 +231,7 @@ TEST(MeshIo, WriterRejectsBadMeshes) {
   // Meshes read_mesh would refuse are refused before anything is written, in every format.
   const float inf = std::numeric_limits<float>::infinity();
   for (const char* name : {"x.ply", "x.obj", "x.stl"}) {
-    for (const Vec3f bad : {Vec3f(0, std::nanf(""), 0), Vec3f(inf, 0, 0), Vec3f(0, 0, -inf)}) {
+    for (const Vec3f& bad : {Vec3f(0, std::nanf(""), 0), Vec3f(inf, 0, 0), Vec3f(0, 0, -inf)}) {
       TriMesh nan = cube();
       nan.vertices[5] = bad;
       expect_error(dir / name, [&] { write_mesh(dir / name, nan); }, "vertex 5 has a non-finite coordinate");

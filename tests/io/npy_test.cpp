@@ -95,7 +95,7 @@ TEST(Npy, ReadsBigEndianVersionsTwoThreeAndBool) {
 // The oracle builds the Fortran bytes from that formula; read_npy must give the C-order values.
 TEST(Npy, ReadsFortranOrderAsCOrder) {
   TempDir dir;
-  for (const std::vector<std::size_t> shape : {std::vector<std::size_t>{3, 4}, {2, 3, 4}, {5, 1, 2}, {1, 6}, {7}, {2, 2, 2, 3}}) {
+  for (const std::vector<std::size_t>& shape : {std::vector<std::size_t>{3, 4}, {2, 3, 4}, {5, 1, 2}, {1, 6}, {7}, {2, 2, 2, 3}}) {
     std::size_t n = 1;
     for (std::size_t d : shape) n *= d;
     std::vector<std::int16_t> c_order(n), fortran(n);

@@ -467,7 +467,7 @@ TEST(SegmentVoronoiExact, SquareWithSplitDiagonals) {
   // Inside each of the four triangles, the incentre is a vertex equidistant to
   // its three sides: r = 20 / (1 + sqrt(2)).
   const double r = 20 / (1 + std::sqrt(2.0));
-  for (const Vec2d c : {Vec2d(20, r), Vec2d(20, 40 - r), Vec2d(r, 20), Vec2d(40 - r, 20)}) {
+  for (const Vec2d& c : {Vec2d(20, r), Vec2d(20, 40 - r), Vec2d(r, 20), Vec2d(40 - r, 20)}) {
     bool found = false;
     for (const auto& vx : v.vertices()) found = found || ((vx.position - c).norm() <= 1e-9 * 40 && std::abs(vx.clearance - r) <= 1e-9 * 40);
     EXPECT_TRUE(found) << "incentre " << c.transpose();
