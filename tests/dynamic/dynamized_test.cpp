@@ -195,21 +195,39 @@ TEST(Locator, FindsEveryEntryAcrossGenerations) {
   EXPECT_EQ(locator.find(50000), nullptr);
 }
 
-TEST(Locator, ShrinksInStepsAfterMassDeletion) {
+TEST(Locator, ReturnsMemoryAsEntriesDie) {
   Locator locator;
-  for (Id id = 0; id < 20000; ++id) locator.set(id, {0, 0, std::uint32_t(id)});
-  for (Id id = 0; id < 19800; ++id) locator.erase(id);
+  constexpr Id n = 40960;  // ten pages
+  for (Id id = 0; id < n; ++id) locator.set(id, {0, 0, std::uint32_t(id)});
+  const std::size_t full = locator.bytes();
+  EXPECT_LT(full, n * 16) << "about 12 bytes an entry";
+  for (Id id = 0; id < n; ++id)
+    if (id % 16 != 0) locator.erase(id);
+  EXPECT_EQ(locator.size(), n / 16);
+  EXPECT_EQ(locator.spilled(), n / 16) << "a page an eighth full hands its entries to the map";
+  EXPECT_LT(locator.bytes(), full / 3);
+  for (Id id = 0; id < n - 1600; id += 16) locator.erase(id);
   const std::size_t before = locator.bytes();
   locator.shrink();
-  EXPECT_EQ(locator.migrating(), 200u) << "entries move over in steps";
+  EXPECT_EQ(locator.migrating(), 100u) << "the map's entries move to one of the right size in steps";
   std::size_t steps = 0;
   while (locator.migrate(16) > 0) ++steps;
-  EXPECT_EQ(steps, 200u / 16 + 1);
+  EXPECT_EQ(steps, 100u / 16 + 1);
   EXPECT_LT(locator.bytes(), before / 10);
-  for (Id id = 0; id < 20000; ++id) ASSERT_EQ(locator.find(id) != nullptr, id >= 19800) << id;
-  EXPECT_EQ(locator.find(19900)->slot, 19900u);
+  for (Id id = 0; id < n; ++id) ASSERT_EQ(locator.find(id) != nullptr, id % 16 == 0 && id >= n - 1600) << id;
+  EXPECT_EQ(locator.find(n - 16)->slot, std::uint32_t(n - 16));
   locator.shrink();
-  EXPECT_EQ(locator.migrating(), 0u) << "a table of the right size stays";
+  EXPECT_EQ(locator.migrating(), 0u) << "a map of the right size stays";
+  locator.set(n + 5, {1, 2, 3});  // a fresh page
+  locator.set(n - 16, {4, 5, 6});  // moves an entry of a spilled page
+  EXPECT_EQ(locator.find(n + 5)->slot, 3u);
+  EXPECT_EQ(locator.find(n - 16)->level, 4u);
+  EXPECT_EQ(locator.spilled(), 100u);
+  EXPECT_EQ(locator.size(), 101u);
+  for (Id id = n - 1600; id < n; id += 16) locator.erase(id);
+  locator.erase(n + 5);
+  EXPECT_EQ(locator.size(), 0u);
+  EXPECT_EQ(locator.find(n + 5), nullptr);
 }
 
 }  // namespace
