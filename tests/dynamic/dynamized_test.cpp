@@ -195,6 +195,46 @@ TEST(Locator, FindsEveryEntryAcrossGenerations) {
   EXPECT_EQ(locator.find(50000), nullptr);
 }
 
+TEST(Locator, FarAndSparseIdsGoToTheMap) {
+  Locator locator;
+  for (Id id = 0; id < 5000; ++id) locator.set(id, {0, 0, std::uint32_t(id)});
+  const Id far = Id(1) << 50;  // e.g. from a corrupt file: no page table up to it
+  locator.set(far, {1, 1, 1});
+  EXPECT_EQ(locator.spilled(), 1u);
+  EXPECT_LT(locator.bytes(), std::size_t(1) << 20);
+  EXPECT_EQ(locator.find(far)->slot, 1u);
+  EXPECT_EQ(locator.find(far + 1), nullptr);
+  for (Id id = 5000; id < 20000; ++id) locator.set(id, {0, 0, std::uint32_t(id)});  // in order: pages
+  EXPECT_EQ(locator.spilled(), 1u);
+  EXPECT_EQ(locator.size(), 20001u);
+  locator.erase(far);
+  EXPECT_EQ(locator.find(far), nullptr);
+  EXPECT_EQ(locator.size(), 20000u);
+
+  // 100 entries of ids below 10^6 (too sparse for pages), then ids from there on in order.
+  Locator sparse(100, 1000000);
+  for (Id id = 0; id < 1000000; id += 10000) sparse.set(id, {2, 0, std::uint32_t(id)});
+  EXPECT_EQ(sparse.spilled(), 100u);
+  for (Id id = 1000000; id < 1010000; ++id) sparse.set(id, {3, 0, 0});
+  EXPECT_EQ(sparse.spilled(), 100u);
+  EXPECT_EQ(sparse.size(), 10100u);
+  EXPECT_EQ(sparse.find(990000)->level, 2u);
+  EXPECT_EQ(sparse.find(1005000)->level, 3u);
+  EXPECT_EQ(sparse.find(990001), nullptr);
+  std::size_t visited = 0;
+  sparse.for_each([&](Id id, const Location& at) {
+    ++visited;
+    EXPECT_EQ(at.level, id < 1000000 ? 2u : 3u);
+  });
+  EXPECT_EQ(visited, 10100u);
+
+  // Dense ids below the bound: one page table for all of them at once.
+  Locator dense(500000, 1000000);
+  for (Id id = 1; id < 1000000; id += 2) dense.set(id, {4, 0, 0});
+  EXPECT_EQ(dense.spilled(), 0u);
+  EXPECT_EQ(dense.size(), 500000u);
+}
+
 TEST(Locator, ReturnsMemoryAsEntriesDie) {
   Locator locator;
   constexpr Id n = 40960;  // ten pages

@@ -145,7 +145,7 @@ class Dynamized {
     d.next_id_ = next_id;
     std::size_t slots = 0;
     for (const auto& part : parts) slots += part.second.size();
-    d.locator_ = Locator(slots);
+    d.locator_ = Locator(slots, next_id);
     for (auto& [structure, ids] : parts) {
       const std::size_t n = ids.size();
       if (n == 0 || (n & (n - 1)) != 0 || structure.size() != n)
@@ -219,9 +219,11 @@ class Dynamized {
   void remove(std::span<const Id> ids)
     requires WeakDeletable<S>
   {
-    for (Id id : ids)
-      if (!contains(id))
-        throw Error("remove: id " + std::to_string(id) + " is not stored (never inserted, or removed already)");
+    for (Id id : ids) {
+      const Location* at = locator_.find(id);
+      if (!at) throw Error("remove: id " + std::to_string(id) + " is not stored (never inserted, or removed already)");
+      __builtin_prefetch(at);  // read below: the misses of a batch overlap here instead of one by one there
+    }
     std::vector<Id> sorted(ids.begin(), ids.end());
     std::sort(sorted.begin(), sorted.end());
     if (const auto twice = std::adjacent_find(sorted.begin(), sorted.end()); twice != sorted.end())
@@ -622,7 +624,7 @@ class Dynamized {
     building_.clear();
     base_.clear();
     recon_.reset();
-    locator_ = Locator(items.size());
+    locator_ = Locator(items.size(), next_id_);
     dead_ = 0;
     std::size_t offset = 0;
     for (std::size_t i = 64; i-- > 0;) {

@@ -35,21 +35,36 @@ struct Location {
 // the entry of every item it moves). A page whose live entries fall below an
 // eighth of those it ever held hands them to a hash map and frees itself, so
 // the space stays O(live entries) however the deletions fall; later entries
-// of its ids go to the map too. The map has two generations, so that growing
-// never rehashes every entry in one call (a std::unordered_map rehash would be
-// the slowest single insert of the worst-case variant): when `current_` is
-// full it becomes `old_`, a map reserved for twice as many starts, and every
-// entry added moves two over.
+// of its ids go to the map too. The page table covers the ids from
+// `first_page_` on and grows as ids come in order. Ids below it (a locator set
+// up for sparse ids) or far beyond its end (which would make it large for few
+// entries, e.g. an id read from a corrupt file) go to the map as well, so the
+// table holds O(ids handed out in order / kPageSize) slots.
+// The map has two generations, so that growing never rehashes every entry in
+// one call (a std::unordered_map rehash would be the slowest single insert of
+// the worst-case variant): when `current_` is full it becomes `old_`, a map
+// reserved for twice as many starts, and every entry added moves two over.
 class Locator {
  public:
   Locator() = default;
-  explicit Locator(std::size_t expected) { pages_.reserve(expected / kPageSize + 1); }
+  /// A locator for about `expected` entries of ids below `id_bound`, and later
+  /// ids. If at least an eighth of those ids will have an entry, the page
+  /// table covers them at once; else (sparse ids) their entries go to the map
+  /// and the pages start at id_bound.
+  Locator(std::size_t expected, Id id_bound) {
+    const Id pages = id_bound / kPageSize + 1;
+    if (id_bound / 8 <= Id(expected)) {
+      pages_.resize(std::size_t(pages));
+    } else {
+      first_page_ = pages - 1;
+      current_.reserve(expected);
+    }
+  }
 
   std::size_t size() const { return paged_ + current_.size() + old_.size(); }
   const Location* find(Id id) const {
-    const std::size_t p = std::size_t(id >> kPageBits);
-    if (p < pages_.size() && pages_[p].page) {
-      const Page& page = *pages_[p].page;
+    if (const PageSlot* slot = page_slot(id); slot && slot->page) {
+      const Page& page = *slot->page;
       const std::size_t i = std::size_t(id) & kPageMask;
       return page.holds(i) ? &page.at[i] : nullptr;
     }
@@ -59,12 +74,18 @@ class Locator {
     return nullptr;
   }
   void set(Id id, Location location) {
-    const std::size_t p = std::size_t(id >> kPageBits);
-    if (p >= pages_.size()) pages_.resize(p + 1);
-    PageSlot& slot = pages_[p];
-    if (!slot.page && !slot.spilled) slot.page = std::make_unique<Page>();
-    if (!slot.page) return map_set(id, location);
-    Page& page = *slot.page;
+    const Id p = id >> kPageBits;
+    if (p - first_page_ >= pages_.size() && p >= first_page_ && p < far_page_) [[unlikely]] {
+      if (p - first_page_ < 2 * Id(pages_.size()) + kPageTableSlack) {
+        pages_.resize(std::size_t(p - first_page_ + 1));
+      } else {
+        far_page_ = p;  // and every page after it: the map
+      }
+    }
+    PageSlot* slot = page_slot(id);
+    if (slot && !slot->page && !slot->spilled) slot->page = std::make_unique<Page>();
+    if (!slot || !slot->page) return map_set(id, location);
+    Page& page = *slot->page;
     const std::size_t i = std::size_t(id) & kPageMask;
     if (!page.holds(i)) {
       page.used[i / 64] |= std::uint64_t(1) << (i % 64);
@@ -75,15 +96,14 @@ class Locator {
     page.at[i] = location;
   }
   void erase(Id id) {
-    const std::size_t p = std::size_t(id >> kPageBits);
-    if (p < pages_.size() && pages_[p].page) {
-      Page& page = *pages_[p].page;
+    if (PageSlot* slot = page_slot(id); slot && slot->page) {
+      Page& page = *slot->page;
       const std::size_t i = std::size_t(id) & kPageMask;
       if (!page.holds(i)) return;
       page.used[i / 64] &= ~(std::uint64_t(1) << (i % 64));
       --page.live;
       --paged_;
-      if (8 * page.live < page.held) spill(p);
+      if (8 * page.live < page.held) spill(*slot, id >> kPageBits);
       return;
     }
     if (current_.erase(id) == 0) old_.erase(id);
@@ -118,7 +138,7 @@ class Locator {
       if (!pages_[p].page) continue;
       const Page& page = *pages_[p].page;
       for (std::size_t i = 0; i < kPageSize; ++i)
-        if (page.holds(i)) f(Id(p) * kPageSize + i, page.at[i]);
+        if (page.holds(i)) f((first_page_ + p) * kPageSize + i, page.at[i]);
     }
     for (const auto& [id, location] : current_) f(id, location);
     for (const auto& [id, location] : old_) f(id, location);
@@ -137,6 +157,8 @@ class Locator {
   static constexpr std::size_t kPageBits = 12;
   static constexpr std::size_t kPageSize = std::size_t(1) << kPageBits;
   static constexpr std::size_t kPageMask = kPageSize - 1;
+  // An id this many pages past twice the table's end is far: to the map.
+  static constexpr Id kPageTableSlack = 64;
   struct Page {
     std::array<Location, kPageSize> at;
     std::array<std::uint64_t, kPageSize / 64> used{};  // which ids have an entry
@@ -150,15 +172,24 @@ class Locator {
   };
   using Map = std::unordered_map<Id, Location>;
 
-  // Moves the live entries of page p to the map and frees the page.
-  void spill(std::size_t p) {
-    std::unique_ptr<Page> page = std::move(pages_[p].page);
-    pages_[p].spilled = true;
+  // The table's slot of id's page, or nullptr if the page table does not cover
+  // it. (Below first_page_ the difference wraps around to a large number; the
+  // table never reaches far_page_.)
+  const PageSlot* page_slot(Id id) const {
+    const Id k = (id >> kPageBits) - first_page_;
+    return k < pages_.size() ? &pages_[std::size_t(k)] : nullptr;
+  }
+  PageSlot* page_slot(Id id) { return const_cast<PageSlot*>(std::as_const(*this).page_slot(id)); }
+
+  // Moves the live entries of page p (in `slot`) to the map and frees the page.
+  void spill(PageSlot& slot, Id p) {
+    std::unique_ptr<Page> page = std::move(slot.page);
+    slot.spilled = true;
     paged_ -= page->live;
     for (std::size_t w = 0; w < page->used.size(); ++w)
       for (std::uint64_t bits = page->used[w]; bits != 0; bits &= bits - 1) {
         const std::size_t i = w * 64 + std::size_t(std::countr_zero(bits));
-        map_set(Id(p) * kPageSize + i, page->at[i]);
+        map_set(p * kPageSize + i, page->at[i]);
       }
   }
 
@@ -178,8 +209,10 @@ class Locator {
     current_.reserve(2 * (old_.size() + 1));
   }
 
-  std::vector<PageSlot> pages_;  // page p holds ids [p * kPageSize, (p + 1) * kPageSize)
-  std::size_t paged_ = 0;        // entries in pages
+  std::vector<PageSlot> pages_;  // pages_[k]: page first_page_ + k, ids [p * kPageSize, (p + 1) * kPageSize)
+  Id first_page_ = 0;
+  Id far_page_ = std::numeric_limits<Id>::max();  // pages from here on: the map
+  std::size_t paged_ = 0;                         // entries in pages
   Map current_, old_;
 };
 
