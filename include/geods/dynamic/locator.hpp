@@ -209,7 +209,7 @@ class Locator {
     current_.reserve(2 * (old_.size() + 1));
   }
 
-  std::vector<PageSlot> pages_;  // pages_[k]: page first_page_ + k, ids [p * kPageSize, (p + 1) * kPageSize)
+  std::vector<PageSlot> pages_;  // pages_[k]: page p = first_page_ + k, ids [p * kPageSize, (p + 1) * kPageSize)
   Id first_page_ = 0;
   Id far_page_ = std::numeric_limits<Id>::max();  // pages from here on: the map
   std::size_t paged_ = 0;                         // entries in pages
