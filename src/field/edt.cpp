@@ -4,9 +4,9 @@
 #include <cmath>
 #include <string>
 
+#include "../core/prefault.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"
-#include "../core/prefault.hpp"
 
 namespace geods::field {
 namespace {
