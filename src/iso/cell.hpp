@@ -138,9 +138,11 @@ class VertexPlacer {
 
   bool normals() const { return normals_; }
 
-  /// Appends the vertex on the edge from sample (i, j, k) one step along `axis`.
-  void place(std::size_t i, std::size_t j, std::size_t k, int axis, std::vector<Vec3f>& out_positions,
-             std::vector<Vec3f>& out_normals) const {
+  /// Appends the vertex on the edge from sample (i, j, k) one step along `axis`
+  /// (to std::vectors of Vec3f, any allocator).
+  template <class Vertices>
+  void place(std::size_t i, std::size_t j, std::size_t k, int axis, Vertices& out_positions,
+             Vertices& out_normals) const {
     Vec3f position, normal;
     place(i, j, k, axis, position, normal);
     out_positions.push_back(position);

@@ -5,11 +5,14 @@
 
 #include <algorithm>
 #include <bit>
-#include <memory>
 #include <cstdint>
+#include <memory>
+#include <mutex>
 #include <vector>
 
 #include "cell.hpp"
+#include "geods/core/huge_page_allocator.hpp"
+#include "geods/core/huge_page_array.hpp"
 #include "geods/core/parallel.hpp"
 #include "geods/core/progress.hpp"
 
@@ -29,51 +32,99 @@ struct RowTrim {
 // cell's (i, j) entry.
 constexpr std::uint8_t kEdgeArray[12] = {0, 0, 1, 1, 2, 2, 3, 3, 4, 4, 4, 4};
 
+// The arrays a slab scan works in and appends its output to, used by one slab
+// at a time and kept for the next: the vertex ids of two planes and a layer, the
+// row trims of two planes, and the vertices and triangles of all its slabs. As
+// many as slabs run at once, so that the output arrays grow large enough for
+// the huge-page allocator, which keeps freed blocks for the next call: a fresh
+// 4 KiB page costs microseconds to fault in on a virtual machine, and the faults
+// of two threads at once slow each other down (docs/iso.md).
+struct ScanArrays {
+  template <class U>
+  using Buffer = std::vector<U, HugePageAllocator<U>>;
+  HugePageArray<std::uint32_t> ids;  // x edges of planes k and k+1, y edges of both, z edges of layer k
+  std::vector<RowTrim> trims[2];
+  Buffer<Vec3f> positions, normals, centre_positions, centre_normals;
+  Buffer<TriMesh::Triangle> triangles;
+};
+
+// Hands out ScanArrays, creating one when all are in use.
+class ScanArraysPool {
+ public:
+  ScanArrays* take() {
+    const std::lock_guard lock(mutex_);
+    if (free_.empty()) return all_.emplace_back(std::make_unique<ScanArrays>()).get();
+    ScanArrays* a = free_.back();
+    free_.pop_back();
+    return a;
+  }
+  void give_back(ScanArrays* a) {
+    const std::lock_guard lock(mutex_);
+    free_.push_back(a);
+  }
+
+ private:
+  std::mutex mutex_;
+  std::vector<std::unique_ptr<ScanArrays>> all_;
+  std::vector<ScanArrays*> free_;
+};
+
 template <typename T>
 class SlabScan {
  public:
-  SlabScan(const Grid3View<T>& g, double iso, const IsoOptions& options, bool flip)
-      : g_(g), iso_(iso), thr_(iso), placer_(g, iso, options.positions, options.normals), flip_(flip),
-        table_(detail::case_table_view()), nx_(g.dims[0]), ny_(g.dims[1]) {
+  SlabScan(const Grid3View<T>& g, double iso, const IsoOptions& options, bool flip, ScanArrays& arrays)
+      : arrays(arrays), positions(arrays.positions), normals(arrays.normals), centre_positions(arrays.centre_positions),
+        centre_normals(arrays.centre_normals), triangles(arrays.triangles), first_vertex(positions.size()),
+        first_centre(centre_positions.size()), first_triangle(triangles.size()), g_(g), iso_(iso), thr_(iso),
+        placer_(g, iso, options.positions, options.normals), flip_(flip), table_(detail::case_table_view()),
+        nx_(g.dims[0]), ny_(g.dims[1]) {
     // Left uninitialized: an id is read only for a crossed edge, which was written first.
     const std::size_t plane = nx_ * ny_;
-    for (auto& ids : xid_) ids = std::make_unique_for_overwrite<std::uint32_t[]>(plane);
-    for (auto& ids : yid_) ids = std::make_unique_for_overwrite<std::uint32_t[]>(plane);
-    zid_ = std::make_unique_for_overwrite<std::uint32_t[]>(plane);
-    for (auto& t : trims_) t.resize(ny_);
+    if (!arrays.ids) arrays.ids = make_huge_page_array<std::uint32_t>(5 * plane, /*touched=*/false);
+    xid_[0] = arrays.ids.get(), xid_[1] = xid_[0] + plane, yid_[0] = xid_[1] + plane, yid_[1] = yid_[0] + plane;
+    zid_ = yid_[1] + plane;
+    for (auto& t : arrays.trims) t.resize(ny_);
     const std::ptrdiff_t nx = std::ptrdiff_t(nx_);
     const std::ptrdiff_t delta[12] = {0, nx, 0, nx, 0, 1, 0, 1, 0, 1, nx, nx + 1};
     std::copy(delta, delta + 12, edge_delta_);
   }
 
-  // Triangle corners with this bit refer to centre_positions.
+  // Triangle corners with this bit refer to centre vertices.
   static constexpr std::uint32_t kCentreFlag = 0x80000000u;
 
-  // Edge vertices: the bottom plane's x/y edges first (bottom_count of them),
-  // the top plane's x/y edges last (from top_begin on). Cell-centre vertices
-  // apart, so that the top plane stays last.
-  std::vector<Vec3f> positions, normals, centre_positions, centre_normals;
-  std::vector<TriMesh::Triangle> triangles;
+  // The slab's output is what it appended to its arrays: edge vertices from
+  // first_vertex on, centre vertices (apart, so that the top plane stays last)
+  // from first_centre on, triangles from first_triangle on, their corners
+  // counted from first_vertex or, with kCentreFlag, from first_centre. Of the
+  // edge vertices, the bottom plane's x/y edges come first (bottom_count of
+  // them), the top plane's x/y edges last (from top_begin on, also counted from
+  // first_vertex).
+  ScanArrays& arrays;
+  ScanArrays::Buffer<Vec3f>&positions, &normals, &centre_positions, &centre_normals;
+  ScanArrays::Buffer<TriMesh::Triangle>& triangles;
+  const std::size_t first_vertex, first_centre, first_triangle;
+  std::size_t end_vertex = 0, end_centre = 0, end_triangle = 0;
   std::size_t bottom_count = 0, top_begin = 0;
   std::size_t cells_visited = 0;
 
   void run(std::size_t k0, std::size_t k1) {
     compute_trims(k0);
     create_xy_vertices(k0);
-    bottom_count = positions.size();
+    bottom_count = positions.size() - first_vertex;
     for (std::size_t k = k0; k < k1; ++k) {
       compute_trims(k + 1);
       create_z_vertices(k);
-      top_begin = positions.size();
+      top_begin = positions.size() - first_vertex;
       create_xy_vertices(k + 1);
       march_layer(k);
     }
+    end_vertex = positions.size(), end_centre = centre_positions.size(), end_triangle = triangles.size();
   }
 
  private:
   bool inside(std::size_t i) const { return thr_.inside(g_.data[i]); }
   const T* row(std::size_t j, std::size_t k) const { return g_.data.data() + g_.index(0, j, k); }
-  std::vector<RowTrim>& trims(std::size_t k) { return trims_[k & 1]; }
+  std::vector<RowTrim>& trims(std::size_t k) { return arrays.trims[k & 1]; }
 
   void compute_trims(std::size_t k) {
     std::vector<RowTrim>& out = trims(k);
@@ -117,8 +168,8 @@ class SlabScan {
   }
 
   void create_xy_vertices(std::size_t k) {
-    std::uint32_t* xid = xid_[k & 1].get();
-    std::uint32_t* yid = yid_[k & 1].get();
+    std::uint32_t* xid = xid_[k & 1];
+    std::uint32_t* yid = yid_[k & 1];
     const std::vector<RowTrim>& t = trims(k);
     for (std::size_t j = 0; j < ny_; ++j) {
       if (t[j].uniform()) continue;
@@ -150,7 +201,7 @@ class SlabScan {
   }
 
   std::uint32_t add_vertex(std::size_t i, std::size_t j, std::size_t k, int axis) {
-    const std::size_t id = positions.size();
+    const std::size_t id = positions.size() - first_vertex;
     if (id >= std::size_t(kCentreFlag)) throw Error("isosurface: more than 2^32 - 1 vertices");
     placer_.place(i, j, k, axis, positions, normals);
     return std::uint32_t(id);
@@ -159,8 +210,7 @@ class SlabScan {
   void march_layer(std::size_t k) {
     const std::vector<RowTrim>& t0 = trims(k);
     const std::vector<RowTrim>& t1 = trims(k + 1);
-    const std::uint32_t* arrays[5] = {xid_[k & 1].get(), xid_[(k + 1) & 1].get(), yid_[k & 1].get(),
-                                      yid_[(k + 1) & 1].get(), zid_.get()};
+    const std::uint32_t* arrays[5] = {xid_[k & 1], xid_[(k + 1) & 1], yid_[k & 1], yid_[(k + 1) & 1], zid_};
     for (std::size_t j = 0; j + 1 < ny_; ++j) {
       // Corner bit c = x + 2y + 4z: rows (y, z) = (0,0), (1,0), (0,1), (1,1).
       const T* const rows[4] = {row(j, k), row(j + 1, k), row(j, k + 1), row(j + 1, k + 1)};
@@ -192,9 +242,12 @@ class SlabScan {
           ids[e] = arrays[kEdgeArray[e]][base + edge_delta_[e]];
         }
         for (std::size_t n = 0; n < kMaxCentres && table_.centres[entry * kMaxCentres + n] != 0; ++n) {
-          ids[12 + n] = kCentreFlag | std::uint32_t(centre_positions.size());
-          detail::place_centre(table_.centres[entry * kMaxCentres + n], ids, positions, normals, centre_positions,
-                               centre_normals);
+          ids[12 + n] = kCentreFlag | std::uint32_t(centre_positions.size() - first_centre);
+          Vec3f position, normal;
+          detail::centre_vertex(table_.centres[entry * kMaxCentres + n], ids, positions.data() + first_vertex,
+                                placer_.normals() ? normals.data() + first_vertex : nullptr, position, normal);
+          centre_positions.push_back(position);
+          if (placer_.normals()) centre_normals.push_back(normal);
         }
         const std::uint8_t* e = table_.edges + table_.offsets[entry];
         const std::uint8_t* end = table_.edges + table_.offsets[entry + 1];
@@ -213,9 +266,24 @@ class SlabScan {
   detail::CaseTableView table_;
   std::size_t nx_, ny_;
   std::ptrdiff_t edge_delta_[12];
-  std::unique_ptr<std::uint32_t[]> xid_[2], yid_[2], zid_;
-  std::vector<RowTrim> trims_[2];
+  std::uint32_t *xid_[2], *yid_[2], *zid_;  // in arrays.ids
 };
+
+// 0, ..., n-1 in bit-reversed order (0, 4, 2, 6, 1, 5, 3, 7 for 8). tbb gives
+// a thread half of a range first and splits it in halves again: taken in this
+// order, every such part spans the whole height of the volume, so that the
+// slabs of a surface that fills only some layers are shared out, not left to one.
+std::vector<std::size_t> bit_reversed_order(std::size_t n) {
+  const int bits = std::bit_width(n - 1);
+  std::vector<std::size_t> order;
+  order.reserve(n);
+  for (std::size_t i = 0; i < std::size_t(1) << bits; ++i) {
+    std::size_t r = 0;
+    for (int b = 0; b < bits; ++b) r |= (i >> b & 1) << (bits - 1 - b);
+    if (r < n) order.push_back(r);
+  }
+  return order;
+}
 
 }  // namespace
 
@@ -241,65 +309,64 @@ TriMesh isosurface(const Grid3View<T>& volume, double iso, const IsoOptions& opt
   if (options.progress) slabs = std::max(slabs, std::min<std::size_t>(layers, 32));
   const std::size_t batch = options.progress ? threads : slabs;
   Progress progress(options.progress, "isosurface", double(slabs));
+  ScanArraysPool pool;
   std::vector<std::unique_ptr<SlabScan<T>>> scans(slabs);
+  const std::vector<std::size_t> order = bit_reversed_order(slabs);
   for (std::size_t first = 0; first < slabs; first += batch) {
     const std::size_t last = std::min(slabs, first + batch);
-    parallel_for_each_index(first, last, [&](std::size_t s) {
-      scans[s] = std::make_unique<SlabScan<T>>(volume, iso, options, flip);
+    parallel_for_each_index(first, last, [&](std::size_t i) {
+      const std::size_t s = order[i];
+      ScanArrays* arrays = pool.take();
+      scans[s] = std::make_unique<SlabScan<T>>(volume, iso, options, flip, *arrays);
       scans[s]->run(layers * s / slabs, layers * (s + 1) / slabs);
+      pool.give_back(arrays);
     }, 1);
     progress.update(double(last));
-  }
-
-  if (slabs == 1 && scans[0]->centre_positions.empty()) {  // nothing to merge
-    SlabScan<T>& scan = *scans[0];
-    if (cells_visited) *cells_visited = scan.cells_visited;
-    mesh.vertices = std::move(scan.positions);
-    mesh.normals = std::move(scan.normals);
-    mesh.triangles = std::move(scan.triangles);
-    progress.finish();
-    return mesh;
   }
 
   // Slab s's top plane is slab s+1's bottom plane, made in the same order:
   // keep the latter, so that the result equals one slab over everything.
   // Edge vertices of all slabs first, then the centre vertices of all slabs.
+  // A single slab is copied out as well: the mesh's arrays are plain std::vectors.
   std::vector<std::size_t> base(slabs + 1, 0), centre_base(slabs + 1, 0);
   for (std::size_t s = 0; s < slabs; ++s) {
     const SlabScan<T>& scan = *scans[s];
     const bool last = s + 1 == slabs;
-    if (!last && scan.positions.size() - scan.top_begin != scans[s + 1]->bottom_count)
+    const std::size_t count = scan.end_vertex - scan.first_vertex;
+    if (!last && count - scan.top_begin != scans[s + 1]->bottom_count)
       throw Error("isosurface: internal error: slab planes disagree");
-    base[s + 1] = base[s] + (last ? scan.positions.size() : scan.top_begin);
+    base[s + 1] = base[s] + (last ? count : scan.top_begin);
   }
   centre_base[0] = base[slabs];
-  for (std::size_t s = 0; s < slabs; ++s) centre_base[s + 1] = centre_base[s] + scans[s]->centre_positions.size();
+  for (std::size_t s = 0; s < slabs; ++s)
+    centre_base[s + 1] = centre_base[s] + (scans[s]->end_centre - scans[s]->first_centre);
   const std::size_t vertices = centre_base[slabs];
   if (vertices >= std::size_t(UINT32_MAX)) throw Error("isosurface: more than 2^32 - 1 vertices");
   if (cells_visited)
     for (const auto& scan : scans) *cells_visited += scan->cells_visited;
   std::vector<std::size_t> tri_base(slabs + 1, 0);
-  for (std::size_t s = 0; s < slabs; ++s) tri_base[s + 1] = tri_base[s] + scans[s]->triangles.size();
+  for (std::size_t s = 0; s < slabs; ++s)
+    tri_base[s + 1] = tri_base[s] + (scans[s]->end_triangle - scans[s]->first_triangle);
   mesh.vertices.resize(vertices);
   if (options.normals) mesh.normals.resize(vertices);
   mesh.triangles.resize(tri_base[slabs]);
   parallel_for_each_index(0, slabs, [&](std::size_t s) {
-    SlabScan<T>& scan = *scans[s];
-    const std::size_t keep = base[s + 1] - base[s];
-    std::copy_n(scan.positions.begin(), keep, mesh.vertices.begin() + std::ptrdiff_t(base[s]));
-    if (options.normals) std::copy_n(scan.normals.begin(), keep, mesh.normals.begin() + std::ptrdiff_t(base[s]));
-    std::copy(scan.centre_positions.begin(), scan.centre_positions.end(),
-              mesh.vertices.begin() + std::ptrdiff_t(centre_base[s]));
-    if (options.normals)
-      std::copy(scan.centre_normals.begin(), scan.centre_normals.end(),
-                mesh.normals.begin() + std::ptrdiff_t(centre_base[s]));
+    const SlabScan<T>& scan = *scans[s];
+    const std::size_t keep = base[s + 1] - base[s], centres_kept = centre_base[s + 1] - centre_base[s];
+    std::copy_n(scan.positions.data() + scan.first_vertex, keep, mesh.vertices.data() + base[s]);
+    std::copy_n(scan.centre_positions.data() + scan.first_centre, centres_kept, mesh.vertices.data() + centre_base[s]);
+    if (options.normals) {
+      std::copy_n(scan.normals.data() + scan.first_vertex, keep, mesh.normals.data() + base[s]);
+      std::copy_n(scan.centre_normals.data() + scan.first_centre, centres_kept, mesh.normals.data() + centre_base[s]);
+    }
     const std::uint32_t own = std::uint32_t(base[s]);
     const std::uint32_t centres = std::uint32_t(centre_base[s]);
     const std::uint32_t next = std::uint32_t(base[s + 1]);
     const std::uint32_t top = std::uint32_t(scan.top_begin);
     const bool last = s + 1 == slabs;
     TriMesh::Triangle* out = mesh.triangles.data() + tri_base[s];
-    for (const TriMesh::Triangle& t : scan.triangles) {
+    for (std::size_t n = scan.first_triangle; n < scan.end_triangle; ++n) {
+      const TriMesh::Triangle& t = scan.triangles[n];
       TriMesh::Triangle r;
       for (int c = 0; c < 3; ++c) {
         if (t[c] & SlabScan<T>::kCentreFlag) r[c] = centres + (t[c] & ~SlabScan<T>::kCentreFlag);
@@ -307,7 +374,6 @@ TriMesh isosurface(const Grid3View<T>& volume, double iso, const IsoOptions& opt
       }
       *out++ = r;
     }
-    scans[s].reset();
   }, 1);
   progress.finish();
   return mesh;

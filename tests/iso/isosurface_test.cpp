@@ -255,13 +255,20 @@ TEST(Isosurface, ThreadsGiveTheSameOutputAsOneThread) {
   ThreadGuard guard;
   const Field a = sphere(20, 22, 18, 9), b = torus(30, 25, 30, 10, 3);
   const auto g = sample(48, 47, 49, [&](double x, double y, double z) { return std::max(a(x, y, z), b(x, y, z)); });
+  // Noise: many ambiguous cells, so cell-centre vertices in every slab.
+  const Grid3<float> n = noise<float>(30, 1000, 7, -1.0f);
   set_num_threads(1);
-  const TriMesh one = isosurface(g, 0.0);
+  const TriMesh one = isosurface(g, 0.0), noisy = isosurface(n, 500.0);
   for (int threads : {2, 3, 8}) {
     set_num_threads(threads);
     expect_same_mesh(isosurface(g, 0.0), one, std::to_string(threads) + " threads");
+    expect_same_mesh(isosurface(n, 500.0), noisy, std::to_string(threads) + " threads, noise");
   }
   expect_closed_surface(one, "sphere and torus");
+  expect_closed_surface(noisy, "noise");
+  // A vertex off the grid's edges (two or more coordinates not whole) is a cell centre.
+  const auto off_edges = [](const Vec3f& v) { return (v.array() != v.array().round()).count() >= 2; };
+  EXPECT_GT(std::count_if(noisy.vertices.begin(), noisy.vertices.end(), off_edges), 100);
 }
 
 TEST(Isosurface, CurvilinearGridPlacesVerticesInPhysicalSpace) {
