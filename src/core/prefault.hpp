@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "geods/core/huge_page_allocator.hpp"
+#include "geods/core/parallel.hpp"
 
 namespace geods::detail {
 
@@ -16,6 +17,26 @@ template <class T>
 void reserve_prefaulted(std::vector<T>& v, std::size_t size) {
   v.reserve(size);
   prefault(v.data(), v.capacity() * sizeof(T));
+}
+
+/// prefault() by all threads, each a run of whole 2 MiB pieces: for memory that
+/// the calling thread alone would otherwise fault in, page by page.
+inline void prefault_in_parallel(const void* p, std::size_t bytes) {
+  const auto begin = reinterpret_cast<std::uintptr_t>(p), end = begin + bytes;
+  const std::uintptr_t first = begin & ~(kHugePage - 1);
+  parallel_for(0, (end - first + kHugePage - 1) / kHugePage, 1, [&](std::size_t a, std::size_t b) {
+    const std::uintptr_t lo = std::max<std::uintptr_t>(begin, first + a * kHugePage);
+    const std::uintptr_t hi = std::min<std::uintptr_t>(end, first + b * kHugePage);
+    prefault(reinterpret_cast<const void*>(lo), hi - lo);
+  });
+}
+
+/// v.reserve(size), its storage prefaulted by all threads (prefault_in_parallel): for
+/// an array that resize() is about to write on one thread, or threads to fill at once.
+template <class T>
+void reserve_prefaulted_in_parallel(std::vector<T>& v, std::size_t size) {
+  v.reserve(size);
+  prefault_in_parallel(v.data(), v.capacity() * sizeof(T));
 }
 
 /// v.reserve(size) for an array that fills from the front to a size not known in advance: its

@@ -10,6 +10,7 @@
 #include <mutex>
 #include <vector>
 
+#include "../core/prefault.hpp"
 #include "cell.hpp"
 #include "geods/core/huge_page_allocator.hpp"
 #include "geods/core/huge_page_array.hpp"
@@ -80,7 +81,14 @@ class SlabScan {
         nx_(g.dims[0]), ny_(g.dims[1]) {
     // Left uninitialized: an id is read only for a crossed edge, which was written first.
     const std::size_t plane = nx_ * ny_;
-    if (!arrays.ids) arrays.ids = make_huge_page_array<std::uint32_t>(5 * plane, /*touched=*/false);
+    if (!arrays.ids) {
+      arrays.ids = make_huge_page_array<std::uint32_t>(5 * plane, /*touched=*/false);
+      // Room for a surface that crosses the volume about twice (two vertices, four
+      // triangles per column); for a large volume that is a kept block from the start.
+      arrays.positions.reserve(2 * plane);
+      if (options.normals) arrays.normals.reserve(2 * plane);
+      arrays.triangles.reserve(4 * plane);
+    }
     xid_[0] = arrays.ids.get(), xid_[1] = xid_[0] + plane, yid_[0] = xid_[1] + plane, yid_[1] = yid_[0] + plane;
     zid_ = yid_[1] + plane;
     for (auto& t : arrays.trims) t.resize(ny_);
@@ -347,6 +355,11 @@ TriMesh isosurface(const Grid3View<T>& volume, double iso, const IsoOptions& opt
   std::vector<std::size_t> tri_base(slabs + 1, 0);
   for (std::size_t s = 0; s < slabs; ++s)
     tri_base[s + 1] = tri_base[s] + (scans[s]->end_triangle - scans[s]->first_triangle);
+  // Mapped by all threads at once (the fresh pages of a first call cost microseconds each),
+  // then sized: resize() writes the triangles on this thread.
+  geods::detail::reserve_prefaulted_in_parallel(mesh.vertices, vertices);
+  if (options.normals) geods::detail::reserve_prefaulted_in_parallel(mesh.normals, vertices);
+  geods::detail::reserve_prefaulted_in_parallel(mesh.triangles, tri_base[slabs]);
   mesh.vertices.resize(vertices);
   if (options.normals) mesh.normals.resize(vertices);
   mesh.triangles.resize(tri_base[slabs]);
