@@ -7,6 +7,7 @@
 #include <memory>
 #include <string>
 
+#include "../core/prefault.hpp"
 #include "cell.hpp"
 #include "geods/core/parallel.hpp"
 #include "geods/core/progress.hpp"
@@ -738,6 +739,9 @@ OctreeIsoResult MinMaxOctree<T>::block_isosurface(double iso, const IsoOptions& 
     mesh.vertices = std::move(chunk[0].positions);
     mesh.normals = std::move(chunk[0].normals);
   } else {
+    // Mapped by all threads at once, as the scan's output (marching_cubes.cpp).
+    geods::detail::reserve_prefaulted_in_parallel(mesh.vertices, q.vertex_first[n]);
+    if (options.normals) geods::detail::reserve_prefaulted_in_parallel(mesh.normals, q.vertex_first[n]);
     mesh.vertices.resize(q.vertex_first[n]);
     if (options.normals) mesh.normals.resize(q.vertex_first[n]);
     parallel_for_each_index(0, chunks, [&](std::size_t c) {
@@ -745,6 +749,7 @@ OctreeIsoResult MinMaxOctree<T>::block_isosurface(double iso, const IsoOptions& 
       std::copy(chunk[c].normals.begin(), chunk[c].normals.end(), mesh.normals.begin() + std::ptrdiff_t(chunk_first[c]));
     }, 1);
   }
+  geods::detail::reserve_prefaulted_in_parallel(mesh.triangles, q.triangle_first[n]);
   mesh.triangles.resize(q.triangle_first[n]);
   for_each_in_batches(n, bool(options.progress), progress, double(chunks), 16, [&](std::size_t s) { q.march(s, mesh); });
   progress.finish();
