@@ -38,8 +38,7 @@ constexpr std::uint8_t kEdgeArray[12] = {0, 0, 1, 1, 2, 2, 3, 3, 4, 4, 4, 4};
 // row trims of two planes, and the vertices and triangles of all its slabs. As
 // many as slabs run at once, so that the output arrays grow large enough for
 // the huge-page allocator, which keeps freed blocks for the next call: a fresh
-// 4 KiB page costs microseconds to fault in on a virtual machine, and the faults
-// of two threads at once slow each other down (docs/iso.md).
+// 4 KiB page costs microseconds to fault in on a virtual machine (docs/iso.md).
 struct ScanArrays {
   template <class U>
   using Buffer = std::vector<U, HugePageAllocator<U>>;
@@ -84,10 +83,12 @@ class SlabScan {
     if (!arrays.ids) {
       arrays.ids = make_huge_page_array<std::uint32_t>(5 * plane, /*touched=*/false);
       // Room for a surface that crosses the volume about twice (two vertices, four
-      // triangles per column); for a large volume that is a kept block from the start.
-      arrays.positions.reserve(2 * plane);
-      if (options.normals) arrays.normals.reserve(2 * plane);
-      arrays.triangles.reserve(4 * plane);
+      // triangles per column), up to 8 MiB an array: for a large volume, a kept
+      // block from the start.
+      const std::size_t most = 4 * geods::detail::kHugePage / 12;  // 12 bytes: a vertex or a triangle
+      arrays.positions.reserve(std::min(2 * plane, most));
+      if (options.normals) arrays.normals.reserve(std::min(2 * plane, most));
+      arrays.triangles.reserve(std::min(4 * plane, most));
     }
     xid_[0] = arrays.ids.get(), xid_[1] = xid_[0] + plane, yid_[0] = xid_[1] + plane, yid_[1] = yid_[0] + plane;
     zid_ = yid_[1] + plane;
