@@ -73,9 +73,8 @@ template <typename T>
 class SlabScan {
  public:
   SlabScan(const Grid3View<T>& g, double iso, const IsoOptions& options, bool flip, ScanArrays& arrays)
-      : arrays(arrays), positions(arrays.positions), normals(arrays.normals), centre_positions(arrays.centre_positions),
-        centre_normals(arrays.centre_normals), triangles(arrays.triangles), first_vertex(positions.size()),
-        first_centre(centre_positions.size()), first_triangle(triangles.size()), g_(g), iso_(iso), thr_(iso),
+      : arrays(arrays), first_vertex(arrays.positions.size()), first_centre(arrays.centre_positions.size()),
+        first_triangle(arrays.triangles.size()), g_(g), iso_(iso), thr_(iso),
         placer_(g, iso, options.positions, options.normals), flip_(flip), table_(detail::case_table_view()),
         nx_(g.dims[0]), ny_(g.dims[1]) {
     // Left uninitialized: an id is read only for a crossed edge, which was written first.
@@ -109,8 +108,6 @@ class SlabScan {
   // them), the top plane's x/y edges last (from top_begin on, also counted from
   // first_vertex).
   ScanArrays& arrays;
-  ScanArrays::Buffer<Vec3f>&positions, &normals, &centre_positions, &centre_normals;
-  ScanArrays::Buffer<TriMesh::Triangle>& triangles;
   const std::size_t first_vertex, first_centre, first_triangle;
   std::size_t end_vertex = 0, end_centre = 0, end_triangle = 0;
   std::size_t bottom_count = 0, top_begin = 0;
@@ -119,15 +116,16 @@ class SlabScan {
   void run(std::size_t k0, std::size_t k1) {
     compute_trims(k0);
     create_xy_vertices(k0);
-    bottom_count = positions.size() - first_vertex;
+    bottom_count = arrays.positions.size() - first_vertex;
     for (std::size_t k = k0; k < k1; ++k) {
       compute_trims(k + 1);
       create_z_vertices(k);
-      top_begin = positions.size() - first_vertex;
+      top_begin = arrays.positions.size() - first_vertex;
       create_xy_vertices(k + 1);
       march_layer(k);
     }
-    end_vertex = positions.size(), end_centre = centre_positions.size(), end_triangle = triangles.size();
+    end_vertex = arrays.positions.size(), end_centre = arrays.centre_positions.size();
+    end_triangle = arrays.triangles.size();
   }
 
  private:
@@ -210,16 +208,16 @@ class SlabScan {
   }
 
   std::uint32_t add_vertex(std::size_t i, std::size_t j, std::size_t k, int axis) {
-    const std::size_t id = positions.size() - first_vertex;
+    const std::size_t id = arrays.positions.size() - first_vertex;
     if (id >= std::size_t(kCentreFlag)) throw Error("isosurface: more than 2^32 - 1 vertices");
-    placer_.place(i, j, k, axis, positions, normals);
+    placer_.place(i, j, k, axis, arrays.positions, arrays.normals);
     return std::uint32_t(id);
   }
 
   void march_layer(std::size_t k) {
     const std::vector<RowTrim>& t0 = trims(k);
     const std::vector<RowTrim>& t1 = trims(k + 1);
-    const std::uint32_t* arrays[5] = {xid_[k & 1], xid_[(k + 1) & 1], yid_[k & 1], yid_[(k + 1) & 1], zid_};
+    const std::uint32_t* id_arrays[5] = {xid_[k & 1], xid_[(k + 1) & 1], yid_[k & 1], yid_[(k + 1) & 1], zid_};
     for (std::size_t j = 0; j + 1 < ny_; ++j) {
       // Corner bit c = x + 2y + 4z: rows (y, z) = (0,0), (1,0), (0,1), (1,1).
       const T* const rows[4] = {row(j, k), row(j + 1, k), row(j, k + 1), row(j + 1, k + 1)};
@@ -248,20 +246,20 @@ class SlabScan {
         std::uint32_t ids[12 + kMaxCentres];
         for (unsigned crossed = detail::kCrossedEdges[c]; crossed != 0; crossed &= crossed - 1) {
           const int e = std::countr_zero(crossed);
-          ids[e] = arrays[kEdgeArray[e]][base + edge_delta_[e]];
+          ids[e] = id_arrays[kEdgeArray[e]][base + edge_delta_[e]];
         }
         for (std::size_t n = 0; n < kMaxCentres && table_.centres[entry * kMaxCentres + n] != 0; ++n) {
-          ids[12 + n] = kCentreFlag | std::uint32_t(centre_positions.size() - first_centre);
+          ids[12 + n] = kCentreFlag | std::uint32_t(arrays.centre_positions.size() - first_centre);
           Vec3f position, normal;
-          detail::centre_vertex(table_.centres[entry * kMaxCentres + n], ids, positions.data() + first_vertex,
-                                placer_.normals() ? normals.data() + first_vertex : nullptr, position, normal);
-          centre_positions.push_back(position);
-          if (placer_.normals()) centre_normals.push_back(normal);
+          detail::centre_vertex(table_.centres[entry * kMaxCentres + n], ids, arrays.positions.data() + first_vertex,
+                                placer_.normals() ? arrays.normals.data() + first_vertex : nullptr, position, normal);
+          arrays.centre_positions.push_back(position);
+          if (placer_.normals()) arrays.centre_normals.push_back(normal);
         }
         const std::uint8_t* e = table_.edges + table_.offsets[entry];
         const std::uint8_t* end = table_.edges + table_.offsets[entry + 1];
         for (; e != end; e += 3)
-          triangles.push_back(flip_ ? TriMesh::Triangle{ids[e[0]], ids[e[2]], ids[e[1]]}
+          arrays.triangles.push_back(flip_ ? TriMesh::Triangle{ids[e[0]], ids[e[2]], ids[e[1]]}
                                     : TriMesh::Triangle{ids[e[0]], ids[e[1]], ids[e[2]]});
       }
     }
@@ -366,12 +364,13 @@ TriMesh isosurface(const Grid3View<T>& volume, double iso, const IsoOptions& opt
   mesh.triangles.resize(tri_base[slabs]);
   parallel_for_each_index(0, slabs, [&](std::size_t s) {
     const SlabScan<T>& scan = *scans[s];
+    const ScanArrays& from = scan.arrays;
     const std::size_t keep = base[s + 1] - base[s], centres_kept = centre_base[s + 1] - centre_base[s];
-    std::copy_n(scan.positions.data() + scan.first_vertex, keep, mesh.vertices.data() + base[s]);
-    std::copy_n(scan.centre_positions.data() + scan.first_centre, centres_kept, mesh.vertices.data() + centre_base[s]);
+    std::copy_n(from.positions.data() + scan.first_vertex, keep, mesh.vertices.data() + base[s]);
+    std::copy_n(from.centre_positions.data() + scan.first_centre, centres_kept, mesh.vertices.data() + centre_base[s]);
     if (options.normals) {
-      std::copy_n(scan.normals.data() + scan.first_vertex, keep, mesh.normals.data() + base[s]);
-      std::copy_n(scan.centre_normals.data() + scan.first_centre, centres_kept, mesh.normals.data() + centre_base[s]);
+      std::copy_n(from.normals.data() + scan.first_vertex, keep, mesh.normals.data() + base[s]);
+      std::copy_n(from.centre_normals.data() + scan.first_centre, centres_kept, mesh.normals.data() + centre_base[s]);
     }
     const std::uint32_t own = std::uint32_t(base[s]);
     const std::uint32_t centres = std::uint32_t(centre_base[s]);
@@ -380,7 +379,7 @@ TriMesh isosurface(const Grid3View<T>& volume, double iso, const IsoOptions& opt
     const bool last = s + 1 == slabs;
     TriMesh::Triangle* out = mesh.triangles.data() + tri_base[s];
     for (std::size_t n = scan.first_triangle; n < scan.end_triangle; ++n) {
-      const TriMesh::Triangle& t = scan.triangles[n];
+      const TriMesh::Triangle& t = from.triangles[n];
       TriMesh::Triangle r;
       for (int c = 0; c < 3; ++c) {
         if (t[c] & SlabScan<T>::kCentreFlag) r[c] = centres + (t[c] & ~SlabScan<T>::kCentreFlag);
