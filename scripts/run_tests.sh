@@ -19,8 +19,10 @@ PYTHONPATH=build/release/python GEODS_CLI=build/release/bin/geods \
   /usr/bin/python3 -m pytest python/tests -q -p no:cacheprovider >build/pytest.log 2>&1 &
 pytest_pid=$!
 
-# The asan preset compiles at -O1 -g1 (line tables are enough for the reports):
-# half the compile time of -O2 -g, and compiling is most of this stage.
+# The asan preset compiles at -Og -g1 (line tables are enough for the reports):
+# compiling is most of this stage, and -Og takes about 40 % less of it than -O1
+# (side by side: triangle_bvh.cpp 134 -> 84 s, kd_tree_test.cpp 99 -> 59 s) for
+# 10 % more test time (ctest 445 against 404 s, back to back).
 asan_built=0
 { [[ -f build/asan/build.ninja ]] || cmake --preset asan >/dev/null; } &&
   cmake --build build/asan -j"$jobs" && asan_built=1
