@@ -3,8 +3,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <algorithm>
 #include <limits>
+#include <random>
 #include <vector>
+
+#include "geods/core/parallel.hpp"
 
 #include "geods/core/coordinate_range.hpp"
 
@@ -66,6 +70,60 @@ TEST(CoordinateRange, RefusesPointsBeyondTheRangeAndNothingElse) {
   const std::vector<double> q{3e200, 0};
   EXPECT_THROW(check_query_range<2>(std::span<const double>(q), "test"), Error);
   EXPECT_NO_THROW(check_query_range<2>(std::span<const double>(q).subspan(1), "test"));
+}
+
+// The one-pass scan is split over threads in chunks of rows: its extent and
+// its verdict must be those of looking at every coordinate, wherever the
+// outlier lies (first row, a chunk boundary, last row) and on any thread count.
+TEST(CoordinateRange, ParallelScanMatchesBruteForce) {
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> normal(0, 1e3);
+  for (std::size_t dim : {1, 2, 3, 5})
+    for (std::size_t stride : {dim, dim + 2})
+      for (std::size_t n : {std::size_t(1), std::size_t(1000), std::size_t(200003)}) {
+        std::vector<double> coords(n * stride);
+        for (double& x : coords) x = normal(rng);
+        double extent = 0;
+        for (std::size_t a = 0; a < dim; ++a) {
+          double lo = coords[a], hi = coords[a];
+          for (std::size_t i = 0; i < n; ++i) {
+            lo = std::min(lo, coords[i * stride + a]);
+            hi = std::max(hi, coords[i * stride + a]);
+          }
+          extent = std::max(extent, hi - lo);
+        }
+        const double limit = coordinate_limit<double>(2);
+        for (int threads : {1, 2, 3}) {
+          set_num_threads(threads);
+          const CoordinateScan<double> scan = scan_coordinates(coords.data(), n, dim, stride, limit);
+          EXPECT_TRUE(scan.finite_within);
+          EXPECT_EQ(scan.extent, extent) << dim << " " << n;
+          for (std::size_t row : {std::size_t(0), std::min(n - 1, std::size_t(65536)), n - 1})
+            for (double bad : {std::numeric_limits<double>::quiet_NaN(), -std::numeric_limits<double>::infinity(),
+                               2 * limit}) {
+              std::vector<double> spoiled = coords;
+              spoiled[row * stride + dim - 1] = bad;
+              EXPECT_FALSE(scan_coordinates(spoiled.data(), n, dim, stride, limit).finite_within) << row << " " << bad;
+            }
+          // A value between the rows (stride) is not a coordinate.
+          if (stride > dim) {
+            std::vector<double> between = coords;
+            between[(n - 1) * stride + dim] = std::numeric_limits<double>::quiet_NaN();
+            EXPECT_TRUE(scan_coordinates(between.data(), n, dim, stride, limit).finite_within);
+          }
+        }
+        set_num_threads(0);
+      }
+  // Many points: the error still names the first coordinate beyond, axis by axis.
+  std::vector<float> many(3 * 300000, 1.0f);
+  many[3 * 250000 + 0] = 1e20f;
+  many[3 * 100000 + 1] = 2e20f;
+  try {
+    check_coordinate_range(many.data(), 300000, 3, 3, 2, "KdTree");
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("KdTree: coordinate 1e+20 of point 250000", 0), 0u) << e.what();
+  }
 }
 
 }  // namespace

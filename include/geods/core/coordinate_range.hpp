@@ -7,13 +7,17 @@
 // compute such polynomials in T check their input here and refuse, with a
 // clear geods::Error, what they would otherwise answer wrongly (points scaled
 // by 1e300 or 1e-300). The exact predicates need no such range.
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <limits>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "geods/core/error.hpp"
+#include "geods/core/parallel.hpp"
 
 namespace geods {
 
@@ -44,6 +48,94 @@ constexpr T extent_floor(int degree) {
   return power_of_two<T>(-(-min_exponent / degree) + std::numeric_limits<T>::digits);
 }
 
+/// What one pass over n points of `dim` coordinates (row i at coords[i *
+/// stride]) finds: whether every coordinate is finite and within +-limit, and
+/// the largest extent of the points' bounding box (meaningful when they are).
+template <typename T>
+struct CoordinateScan {
+  bool finite_within = true;
+  T extent = 0;
+};
+
+namespace detail {
+// Widens lo/hi (dim values each) by the rows [begin, end); false if one of
+// their coordinates is not finite or lies beyond +-limit. No early exit and no
+// throw inside the loop, so it compiles to straight compare and min/max code
+// (D > 0: the dimension, fixed). NaN fails the comparison and leaves lo/hi.
+template <int D, typename T>
+bool scan_rows(const T* coords, std::size_t begin, std::size_t end, std::size_t dim, std::size_t stride, T limit,
+               T* lo, T* hi) {
+  bool within = true;
+  auto rows = [&](std::size_t d, T* l, T* h) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const T* p = coords + i * stride;
+      for (std::size_t a = 0; a < d; ++a) {
+        const T x = p[a];
+        within &= std::abs(x) <= limit;
+        l[a] = std::min(l[a], x);
+        h[a] = std::max(h[a], x);
+      }
+    }
+  };
+  if constexpr (D > 0) {  // in registers: lo and hi could alias coords
+    std::array<T, D> l, h;
+    std::copy_n(lo, D, l.begin());
+    std::copy_n(hi, D, h.begin());
+    rows(D, l.data(), h.data());
+    std::copy_n(l.begin(), D, lo);
+    std::copy_n(h.begin(), D, hi);
+  } else {
+    rows(dim, lo, hi);
+  }
+  return within;
+}
+}  // namespace detail
+
+/// The pass of CoordinateScan, split over the threads for many points.
+template <typename T>
+CoordinateScan<T> scan_coordinates(const T* coords, std::size_t n, std::size_t dim, std::size_t stride, T limit) {
+  CoordinateScan<T> scan;
+  if (n == 0 || dim == 0) return scan;
+  constexpr std::size_t kRows = 65536;  // rows per chunk
+  const std::size_t chunks = (n + kRows - 1) / kRows;
+  std::vector<T> lo(chunks * dim), hi(chunks * dim);
+  std::vector<char> within(chunks);
+  parallel_for(0, chunks, 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t c = b; c < e; ++c) {
+      const std::size_t first = c * kRows, last = std::min(n, first + kRows);
+      T* l = lo.data() + c * dim;
+      T* h = hi.data() + c * dim;
+      std::copy_n(coords + first * stride, dim, l);
+      std::copy_n(coords + first * stride, dim, h);
+      if (dim == 2)
+        within[c] = detail::scan_rows<2>(coords, first, last, dim, stride, limit, l, h);
+      else if (dim == 3)
+        within[c] = detail::scan_rows<3>(coords, first, last, dim, stride, limit, l, h);
+      else
+        within[c] = detail::scan_rows<0>(coords, first, last, dim, stride, limit, l, h);
+    }
+  });
+  for (std::size_t c = 0; c < chunks; ++c) scan.finite_within &= bool(within[c]);
+  for (std::size_t a = 0; a < dim; ++a) {
+    T l = lo[a], h = hi[a];
+    for (std::size_t c = 1; c < chunks; ++c) {
+      l = std::min(l, lo[c * dim + a]);
+      h = std::max(h, hi[c * dim + a]);
+    }
+    scan.extent = std::max(scan.extent, h - l);
+  }
+  return scan;
+}
+
+/// Throws geods::Error "<what>: ..." if a point set's largest extent is above
+/// zero but below `floor` (its distances would underflow).
+template <typename T>
+void check_coordinate_extent(T extent, T floor, const std::string& what) {
+  if (extent > 0 && extent < floor)
+    throw Error(what + ": the points span only " + format_number(double(extent)) + " (below " +
+                format_number(double(floor)) + "), where their distances underflow; scale the input");
+}
+
 /// Checks that n points of `dim` coordinates (row i at coords[i * stride])
 /// lie within +-limit and that their bounding box's largest extent is zero or
 /// at least `floor`. Throws geods::Error "<what>: ..." saying which and why.
@@ -52,23 +144,24 @@ template <typename T>
 void check_coordinate_range(const T* coords, std::size_t n, std::size_t dim, std::size_t stride, T limit, T floor,
                             const std::string& what) {
   if (n == 0 || dim == 0) return;
-  T extent = 0;
-  for (std::size_t a = 0; a < dim; ++a) {
-    T lo = coords[a], hi = coords[a];
-    for (std::size_t i = 0; i < n; ++i) {
-      const T x = coords[i * stride + a];
-      if (std::abs(x) > limit)
-        throw Error(what + ": coordinate " + format_number(double(x)) + " of point " + std::to_string(i) +
-                    " is beyond +-" + format_number(double(limit)) + ", where its distances would overflow; " +
-                    "scale the input");
-      lo = x < lo ? x : lo;
-      hi = x > hi ? x : hi;
+  CoordinateScan<T> scan = scan_coordinates(coords, n, dim, stride, limit);
+  if (!scan.finite_within) {  // name the first coordinate beyond the limit, axis by axis; NaN passes here
+    scan.extent = 0;
+    for (std::size_t a = 0; a < dim; ++a) {
+      T lo = coords[a], hi = coords[a];
+      for (std::size_t i = 0; i < n; ++i) {
+        const T x = coords[i * stride + a];
+        if (std::abs(x) > limit)
+          throw Error(what + ": coordinate " + format_number(double(x)) + " of point " + std::to_string(i) +
+                      " is beyond +-" + format_number(double(limit)) + ", where its distances would overflow; " +
+                      "scale the input");
+        lo = x < lo ? x : lo;
+        hi = x > hi ? x : hi;
+      }
+      scan.extent = hi - lo > scan.extent ? hi - lo : scan.extent;
     }
-    extent = hi - lo > extent ? hi - lo : extent;
   }
-  if (extent > 0 && extent < floor)
-    throw Error(what + ": the points span only " + format_number(double(extent)) + " (below " +
-                format_number(double(floor)) + "), where their distances underflow; scale the input");
+  check_coordinate_extent(scan.extent, floor, what);
 }
 
 /// check_coordinate_range for polynomials of `degree` in T: coordinate_limit

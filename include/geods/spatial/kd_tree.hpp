@@ -607,14 +607,19 @@ class KdTree {
     if (view_.count > 0 && view_.data == nullptr) throw Error("KdTree: null point array");
     leaf_size_ = leaf_size;
     const std::size_t n = view_.count;
-    for (std::size_t i = 0; i < n; ++i) {
-      const T* p = view_[i];
-      for (std::size_t a = 0; a < dim(); ++a)
-        if (!std::isfinite(p[a]))
-          throw Error("KdTree: point " + std::to_string(i) + " has a non-finite coordinate (axis " +
-                      std::to_string(a) + ")");
+    // One pass in parallel; the checks one by one only run to name a bad point.
+    const CoordinateScan<T> scan = scan_coordinates(view_.data, n, dim(), view_.stride, coordinate_limit<T>(2));
+    if (!scan.finite_within) {
+      for (std::size_t i = 0; i < n; ++i) {
+        const T* p = view_[i];
+        for (std::size_t a = 0; a < dim(); ++a)
+          if (!std::isfinite(p[a]))
+            throw Error("KdTree: point " + std::to_string(i) + " has a non-finite coordinate (axis " +
+                        std::to_string(a) + ")");
+      }
+      check_coordinate_range(view_.data, n, dim(), view_.stride, 2, "KdTree");
     }
-    check_coordinate_range(view_.data, n, dim(), view_.stride, 2, "KdTree");
+    check_coordinate_extent(scan.extent, extent_floor<T>(2), "KdTree");
     std::vector<std::uint32_t> perm(n);
     if (n == 0) return;
     // The size of every subtree depends only on its point count, so each one
