@@ -260,7 +260,7 @@ class SlabScan {
         const std::uint8_t* end = table_.edges + table_.offsets[entry + 1];
         for (; e != end; e += 3)
           arrays.triangles.push_back(flip_ ? TriMesh::Triangle{ids[e[0]], ids[e[2]], ids[e[1]]}
-                                    : TriMesh::Triangle{ids[e[0]], ids[e[1]], ids[e[2]]});
+                                           : TriMesh::Triangle{ids[e[0]], ids[e[1]], ids[e[2]]});
       }
     }
   }

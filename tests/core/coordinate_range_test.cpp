@@ -2,15 +2,14 @@
 // polynomials really overflow or underflow, and the checks refuse just that.
 #include <gtest/gtest.h>
 
-#include <cmath>
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <random>
 #include <vector>
 
-#include "geods/core/parallel.hpp"
-
 #include "geods/core/coordinate_range.hpp"
+#include "geods/core/parallel.hpp"
 
 namespace geods {
 namespace {
