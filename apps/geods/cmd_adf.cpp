@@ -112,7 +112,7 @@ class AdfCommand : public Command {
   double offset_ = 0;
 };
 
-const bool registered = register_command<AdfCommand>();
+const bool registered_adf = register_command<AdfCommand>();
 
 }  // namespace
 }  // namespace geods::cli

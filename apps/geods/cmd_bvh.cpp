@@ -138,7 +138,7 @@ class BvhCommand : public Command {
   int packet_size_ = 0;  // 0: one ray at a time
 };
 
-const bool registered = register_command<BvhCommand>();
+const bool registered_bvh = register_command<BvhCommand>();
 
 }  // namespace
 }  // namespace geods::cli

@@ -106,7 +106,7 @@ class CirclesCommand : public Command {
   std::string points_, colors_, svg_;
 };
 
-const bool registered = register_command<CirclesCommand>();
+const bool registered_circles = register_command<CirclesCommand>();
 
 }  // namespace
 }  // namespace geods::cli

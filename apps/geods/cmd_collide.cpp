@@ -143,7 +143,7 @@ class CollideCommand : public Command {
   double within_ = -1;
 };
 
-const bool registered = register_command<CollideCommand>();
+const bool registered_collide = register_command<CollideCommand>();
 
 }  // namespace
 }  // namespace geods::cli

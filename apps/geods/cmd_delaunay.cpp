@@ -134,7 +134,7 @@ class DelaunayCommand : public Command {
   std::string points_, segments_, output_, svg_, save_;
 };
 
-const bool registered = register_command<DelaunayCommand>();
+const bool registered_delaunay = register_command<DelaunayCommand>();
 
 }  // namespace
 }  // namespace geods::cli

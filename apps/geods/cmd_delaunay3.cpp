@@ -98,7 +98,7 @@ class Delaunay3Command : public Command {
   std::string points_, output_, neighbors_, hull_, save_, insertion_ = "cavity";
 };
 
-const bool registered = register_command<Delaunay3Command>();
+const bool registered_delaunay3 = register_command<Delaunay3Command>();
 
 }  // namespace
 }  // namespace geods::cli

@@ -89,7 +89,7 @@ class DemoCommand : public Command {
   std::vector<std::string> only_;
 };
 
-const bool registered = register_command<DemoCommand>();
+const bool registered_demo = register_command<DemoCommand>();
 
 }  // namespace
 }  // namespace geods::cli

@@ -140,7 +140,7 @@ class EdtCommand : public Command {
   bool squared_ = false;
 };
 
-const bool registered = register_command<EdtCommand>();
+const bool registered_edt = register_command<EdtCommand>();
 
 }  // namespace
 }  // namespace geods::cli

@@ -35,7 +35,7 @@ class InfoCommand : public Command {
   std::string dtype_;
 };
 
-const bool registered = register_command<InfoCommand>();
+const bool registered_info = register_command<InfoCommand>();
 
 }  // namespace
 }  // namespace geods::cli

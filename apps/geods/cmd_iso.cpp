@@ -141,7 +141,7 @@ class IsoCommand : public Command {
   std::size_t leaf_cells_ = iso::MinMaxOctree<float>::kDefaultLeafCells;
 };
 
-const bool registered = register_command<IsoCommand>();
+const bool registered_iso = register_command<IsoCommand>();
 
 }  // namespace
 }  // namespace geods::cli

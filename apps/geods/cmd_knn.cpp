@@ -114,7 +114,7 @@ class KnnCommand : public Command {
   double eps_ = 0;
 };
 
-const bool registered = register_command<KnnCommand>();
+const bool registered_knn = register_command<KnnCommand>();
 
 }  // namespace
 }  // namespace geods::cli

@@ -114,7 +114,7 @@ class MorphCommand : public Command {
   std::size_t steps_ = 0, res_ = field::MorphOptions{}.res;
 };
 
-const bool registered = register_command<MorphCommand>();
+const bool registered_morph = register_command<MorphCommand>();
 
 }  // namespace
 }  // namespace geods::cli

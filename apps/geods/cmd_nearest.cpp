@@ -89,7 +89,7 @@ class NearestCommand : public Command {
   std::string sites_, queries_, output_, method_ = "walk";
 };
 
-const bool registered = register_command<NearestCommand>();
+const bool registered_nearest = register_command<NearestCommand>();
 
 }  // namespace
 }  // namespace geods::cli

@@ -116,7 +116,7 @@ class PlanCommand : public Command {
   double radius_ = 0, margin_ = 0.25;
 };
 
-const bool registered = register_command<PlanCommand>();
+const bool registered_plan = register_command<PlanCommand>();
 
 }  // namespace
 }  // namespace geods::cli

@@ -102,7 +102,7 @@ class ProjectCommand : public Command {
   std::optional<double> max_distance_;
 };
 
-const bool registered = register_command<ProjectCommand>();
+const bool registered_project = register_command<ProjectCommand>();
 
 }  // namespace
 }  // namespace geods::cli

@@ -69,7 +69,7 @@ class RangeCommand : public Command {
   std::string boxes_, output_;
 };
 
-const bool registered = register_command<RangeCommand>();
+const bool registered_range = register_command<RangeCommand>();
 
 }  // namespace
 }  // namespace geods::cli

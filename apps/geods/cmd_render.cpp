@@ -125,7 +125,7 @@ class RenderCommand : public Command {
   bool packets_ = true;
 };
 
-const bool registered = register_command<RenderCommand>();
+const bool registered_render = register_command<RenderCommand>();
 
 }  // namespace
 }  // namespace geods::cli

@@ -115,7 +115,7 @@ class SdfCommand : public Command {
   std::optional<double> band_;
 };
 
-const bool registered = register_command<SdfCommand>();
+const bool registered_sdf = register_command<SdfCommand>();
 
 }  // namespace
 }  // namespace geods::cli

@@ -100,7 +100,7 @@ class SegVoronoiCommand : public Command {
   bool medial_ = false;
 };
 
-const bool registered = register_command<SegVoronoiCommand>();
+const bool registered_segvoronoi = register_command<SegVoronoiCommand>();
 
 }  // namespace
 }  // namespace geods::cli

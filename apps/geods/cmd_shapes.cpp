@@ -250,7 +250,7 @@ class ShapesCommand : public Command {
   DescriptorArgs descriptor_;
 };
 
-const bool registered = register_command<ShapesCommand>();
+const bool registered_shapes = register_command<ShapesCommand>();
 
 }  // namespace
 }  // namespace geods::cli

@@ -153,7 +153,7 @@ class TerrainCommand : public Command {
   std::uint32_t tiles_ = 1;
 };
 
-const bool registered = register_command<TerrainCommand>();
+const bool registered_terrain = register_command<TerrainCommand>();
 
 }  // namespace
 }  // namespace geods::cli

@@ -100,7 +100,7 @@ class TextureCommand : public Command {
   bool tile_ = false;
 };
 
-const bool registered = register_command<TextureCommand>();
+const bool registered_texture = register_command<TextureCommand>();
 
 }  // namespace
 }  // namespace geods::cli

@@ -155,7 +155,7 @@ class VoronoiCommand : public Command {
   std::size_t order_ = 0;
 };
 
-const bool registered = register_command<VoronoiCommand>();
+const bool registered_voronoi = register_command<VoronoiCommand>();
 
 }  // namespace
 }  // namespace geods::cli

@@ -98,7 +98,7 @@ class Voronoi3Command : public Command {
   bool hull_ = false;
 };
 
-const bool registered = register_command<Voronoi3Command>();
+const bool registered_voronoi3 = register_command<Voronoi3Command>();
 
 }  // namespace
 }  // namespace geods::cli

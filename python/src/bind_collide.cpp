@@ -10,6 +10,7 @@
 #include "bindings.hpp"
 #include "geods/collide/collide.hpp"
 #include "geods/collide/stats_fields.hpp"
+#include "stats_dict.hpp"
 #include "without_gil.hpp"
 
 namespace geods::python {
@@ -34,12 +35,6 @@ Posed pose_of(const py::handle& x, const std::string& what) {
     return p;
   }
   throw Error(what + ": a pose is None, 7 numbers (qw, qx, qy, qz, tx, ty, tz) or a 4 x 4 matrix");
-}
-
-py::dict stats_dict(const collide::CollideStats& s) {
-  py::dict d;
-  collide::for_each_field(s, [&](const char* name, const auto& v) { d[name] = v; });
-  return d;
 }
 
 }  // namespace

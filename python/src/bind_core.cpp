@@ -28,7 +28,7 @@ using DoubleArray = Rows<double>;
 
 // Calls of a predicate with N points of dimension Dim, one row per call.
 template <int Dim, std::size_t N>
-struct PointRows {
+struct PredicateArgs {
   std::array<DoubleArray, N> arrays;
   std::array<const double*, N> data{};
   py::ssize_t count = 0;  // rows
@@ -36,9 +36,9 @@ struct PointRows {
 };
 
 template <int Dim, std::size_t N>
-PointRows<Dim, N> to_rows(const char* name, const std::array<py::object, N>& args) {
+PredicateArgs<Dim, N> to_rows(const char* name, const std::array<py::object, N>& args) {
   static constexpr const char* kLetters = "abcde";
-  PointRows<Dim, N> rows;
+  PredicateArgs<Dim, N> rows;
   for (std::size_t i = 0; i < N; ++i) {
     DoubleArray a = DoubleArray::ensure(args[i]);  // null if not convertible
     auto arg = [&] { return std::string(name).append(": argument '").append(1, kLetters[i]).append("'"); };
@@ -68,7 +68,7 @@ PointRows<Dim, N> to_rows(const char* name, const std::array<py::object, N>& arg
 // else a float64 array of length n (computed in parallel without the GIL).
 template <int Dim, std::size_t N, typename Predicate>
 py::object evaluate(const char* name, const std::array<py::object, N>& args, Predicate predicate) {
-  const PointRows<Dim, N> rows = to_rows<Dim, N>(name, args);
+  const PredicateArgs<Dim, N> rows = to_rows<Dim, N>(name, args);
   auto row = [&](py::ssize_t r) {
     std::array<const double*, N> p;
     for (std::size_t i = 0; i < N; ++i) p[i] = rows.data[i] + r * Dim;
