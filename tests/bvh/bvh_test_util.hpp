@@ -1,16 +1,30 @@
 #pragma once
 // Meshes, triangle soups, rays and brute-force oracles for the bvh tests.
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <string>
 #include <vector>
 
 #include "geods/bvh/triangle_bvh.hpp"
 #include "geods/core/rng.hpp"
+#include "geods/core/simd_level.hpp"
 #include "geods/core/triangle.hpp"
 #include "geods/io/mesh_io.hpp"
 
 namespace geods::bvh::test {
+
+/// Restores the SIMD level a test started with.
+struct LevelGuard {
+  SimdLevel saved = simd_level();
+  ~LevelGuard() { set_simd_level(saved); }
+};
+
+/// The same hit to the bit: t, u, v and the triangle.
+inline bool same_bits(const RayHit& a, const RayHit& b) {
+  return std::memcmp(&a.t, &b.t, sizeof(float)) == 0 && std::memcmp(&a.u, &b.u, sizeof(float)) == 0 &&
+         std::memcmp(&a.v, &b.v, sizeof(float)) == 0 && a.prim == b.prim;
+}
 
 inline TriMesh data_mesh(const std::string& name) { return io::read_mesh(std::string(GEODS_DATA_DIR) + "/" + name); }
 

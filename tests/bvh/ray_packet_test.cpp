@@ -6,7 +6,6 @@
 // checks the t.
 #include <gtest/gtest.h>
 
-#include <cstring>
 #include <limits>
 
 #include "bvh/bvh_test_util.hpp"
@@ -15,16 +14,6 @@
 
 namespace geods::bvh {
 namespace {
-
-bool same_bits(const RayHit& a, const RayHit& b) {
-  return std::memcmp(&a.t, &b.t, sizeof(float)) == 0 && std::memcmp(&a.u, &b.u, sizeof(float)) == 0 &&
-         std::memcmp(&a.v, &b.v, sizeof(float)) == 0 && a.prim == b.prim;
-}
-
-struct LevelGuard {
-  SimdLevel saved = simd_level();
-  ~LevelGuard() { set_simd_level(saved); }
-};
 
 // Packets of N consecutive rays with the given active masks (cycled; empty:
 // all rays) against one ray at a time; returns the number of hits.
@@ -46,7 +35,7 @@ std::size_t expect_packets_match(const TriangleBvh& bvh, const std::vector<Ray3f
         continue;
       }
       const RayHit single = bvh.intersect(rays[first + i]);
-      EXPECT_TRUE(same_bits(out.hits[i], single))
+      EXPECT_TRUE(test::same_bits(out.hits[i], single))
           << what << " packet of " << N << " ray " << first + i << ": packet t " << out.hits[i].t << " prim " << out.hits[i].prim
           << ", single t " << single.t << " prim " << single.prim;
       EXPECT_EQ(bool(blocked >> i & 1), bvh.occluded(rays[first + i])) << what << " packet of " << N << " ray " << first + i;
@@ -229,7 +218,7 @@ TEST(RayPacket, LinesWithNegativeTminSeeHitsBehindTheirOrigins) {
 }
 
 TEST(RayPacket, EveryLevelGivesThePortableSingleRayHits) {
-  const LevelGuard guard;
+  const test::LevelGuard guard;
   const TriMesh bunny = test::data_mesh("bunny.ply");
   const AABB3f box = bunny.bounds();
   std::vector<Ray3f> rays = camera_rays(box, box.center() + 1.5f * box.extent(), 32, 16);
@@ -253,7 +242,8 @@ TEST(RayPacket, EveryLevelGivesThePortableSingleRayHits) {
       bvh.intersect_packets(rays, hits, size);
       bvh.occluded_packets(rays, occ, size);
       for (std::size_t i = 0; i < rays.size(); ++i) {
-        ASSERT_TRUE(same_bits(hits[i], expected[i])) << simd_level_name(level) << " packets of " << size << " ray " << i;
+        ASSERT_TRUE(test::same_bits(hits[i], expected[i]))
+            << simd_level_name(level) << " packets of " << size << " ray " << i;
         ASSERT_EQ(occ[i], blocked[i]) << simd_level_name(level) << " packets of " << size << " ray " << i;
       }
     }

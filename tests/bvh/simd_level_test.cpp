@@ -3,7 +3,6 @@
 // triangle) and occlusion, 4 and 8 wide; and the level switch itself.
 #include <gtest/gtest.h>
 
-#include <cstring>
 #include <limits>
 
 #include "bvh/bvh_test_util.hpp"
@@ -13,12 +12,6 @@
 namespace geods::bvh {
 namespace {
 
-// Restores the level a test started with.
-struct LevelGuard {
-  SimdLevel saved = simd_level();
-  ~LevelGuard() { set_simd_level(saved); }
-};
-
 std::vector<SimdLevel> levels_to_test() {
   std::vector<SimdLevel> out;
   for (SimdLevel l : {SimdLevel::avx, SimdLevel::avx2, SimdLevel::avx512})
@@ -26,13 +19,8 @@ std::vector<SimdLevel> levels_to_test() {
   return out;
 }
 
-bool same_bits(const RayHit& a, const RayHit& b) {
-  return std::memcmp(&a.t, &b.t, sizeof(float)) == 0 && std::memcmp(&a.u, &b.u, sizeof(float)) == 0 &&
-         std::memcmp(&a.v, &b.v, sizeof(float)) == 0 && a.prim == b.prim;
-}
-
 void expect_levels_agree(const TriMesh& mesh, const std::vector<Ray3f>& rays, const std::string& what) {
-  const LevelGuard guard;
+  const test::LevelGuard guard;
   for (int arity : {4, 8}) {
     BuildOptions options;
     options.arity = arity;
@@ -52,7 +40,7 @@ void expect_levels_agree(const TriMesh& mesh, const std::vector<Ray3f>& rays, co
       set_simd_level(level);
       for (std::size_t i = 0; i < rays.size(); ++i) {
         const RayHit hit = bvh.intersect(rays[i]);
-        ASSERT_TRUE(same_bits(hit, expected[i])) << what << " arity " << arity << " " << simd_level_name(level)
+        ASSERT_TRUE(test::same_bits(hit, expected[i])) << what << " arity " << arity << " " << simd_level_name(level)
                                                  << " ray " << i << ": t " << hit.t << " vs " << expected[i].t;
         ASSERT_EQ(bvh.occluded(rays[i]), bool(blocked[i])) << what << " " << simd_level_name(level) << " ray " << i;
       }
@@ -68,7 +56,7 @@ TEST(SimdLevel, NamesRoundTripAndUnknownNamesAreErrors) {
 }
 
 TEST(SimdLevel, SetRefusesLevelsTheCpuLacksAndKeepsTheCurrentOne) {
-  const LevelGuard guard;
+  const test::LevelGuard guard;
   set_simd_level(SimdLevel::portable);
   EXPECT_EQ(simd_level(), SimdLevel::portable);
   if (best_simd_level() < SimdLevel::avx512) {
@@ -126,7 +114,7 @@ TEST(SimdLevel, RaysWithInfiniteDirectionsOrNaNOriginsMatchBruteForceAtEveryLeve
   const TriMesh soup = test::random_soup(500, 41);
   std::vector<Ray3f> rays = test::test_rays(soup, 600, 42);
   test::make_non_finite_rays(rays, 5);
-  const LevelGuard guard;
+  const test::LevelGuard guard;
   for (int arity : {4, 8}) {
     BuildOptions options;
     options.arity = arity;

@@ -162,11 +162,12 @@ const Predicate kInsphere{
     [](const Point* p) { return insphere(p[0].data(), p[1].data(), p[2].data(), p[3].data(), p[4].data()); },
     [](const Point* p) { return insphere_fast(p[0].data(), p[1].data(), p[2].data(), p[3].data(), p[4].data()); }};
 
-using Points = std::array<Point, 5>;
+// The points of one predicate call (up to 5).
+using PredicateArgs = std::array<Point, 5>;
 
 int sign(double x) { return (x > 0) - (x < 0); }
 
-std::string describe(const Points& p, int count) {
+std::string describe(const PredicateArgs& p, int count) {
   std::ostringstream s;
   s << std::hexfloat;
   for (int i = 0; i < count; ++i) s << " (" << p[i][0] << ", " << p[i][1] << ", " << p[i][2] << ")";
@@ -177,18 +178,18 @@ std::string describe(const Points& p, int count) {
 // the signs must agree, an exactly degenerate input must give exactly 0, and
 // swapping two points must flip the sign.
 void expect_exact_signs(const Predicate& pred, std::uint64_t seed, int cases,
-                        const std::function<Points(Rng&)>& generate, const char* what) {
+                        const std::function<PredicateArgs(Rng&)>& generate, const char* what) {
   Rng rng(seed);
   int failures = 0, zeros = 0;
   for (int n = 0; n < cases; ++n) {
-    Points p = generate(rng);
+    PredicateArgs p = generate(rng);
     const int want = oracle(p.data(), pred.count, pred.dim, pred.lifted);
     const double got = pred.exact(p.data());
     zeros += want == 0;
     bool ok = std::isfinite(got) && sign(got) == want && (want != 0 || got == 0.0);
     const int i = int(rng.below(std::uint64_t(pred.count)));
     const int j = (i + 1 + int(rng.below(std::uint64_t(pred.count - 1)))) % pred.count;
-    Points swapped = p;
+    PredicateArgs swapped = p;
     std::swap(swapped[i], swapped[j]);
     const double got_swapped = pred.exact(swapped.data());
     ok = ok && sign(got_swapped) == -want;
@@ -276,8 +277,8 @@ void nudge_point(Point& p, Rng& rng, int ulps) {
 // Integer points on a grid of one-ulp spacing far from the origin (the
 // coordinates o + k ulp(o) are exact): exactly degenerate when the integer
 // configuration is, then half of the time nudged by one ulp.
-Points offset_grid(Rng& rng, const Points& integer_points, int count, int dim) {
-  Points p{};
+PredicateArgs offset_grid(Rng& rng, const PredicateArgs& integer_points, int count, int dim) {
+  PredicateArgs p{};
   for (int k = 0; k < dim; ++k) {
     const int e = int(rng.below(80)) - 20;
     const double origin = random_sign(rng) * 1.5 * std::ldexp(1.0, e), ulp = std::ldexp(1.0, e - 52);
@@ -289,8 +290,8 @@ Points offset_grid(Rng& rng, const Points& integer_points, int count, int dim) {
   return p;
 }
 
-Points random_integer_flat(Rng& rng, int dim) {
-  Points u{};
+PredicateArgs random_integer_flat(Rng& rng, int dim) {
+  PredicateArgs u{};
   auto coordinate = [&] { return double(int(rng.below(2049)) - 1024); };
   for (int i = 0; i < dim; ++i) u[i] = {coordinate(), coordinate(), coordinate()};
   const double s = double(int(rng.below(5)) - 2), t = double(int(rng.below(5)) - 2);
@@ -299,20 +300,20 @@ Points random_integer_flat(Rng& rng, int dim) {
   return u;
 }
 
-Points random_lattice_round(Rng& rng, int dim);
+PredicateArgs random_lattice_round(Rng& rng, int dim);
 
 // c on the line ab (orient2d) / d on the plane abc (orient3d), then placed.
-Points near_flat(Scale scale, Rng& rng, int dim) {
+PredicateArgs near_flat(Scale scale, Rng& rng, int dim) {
   if (scale == Scale::Offset) return offset_grid(rng, random_integer_flat(rng, dim), dim + 1, dim);
   const Frame f = random_frame(scale, rng, false);
-  Points u;
+  PredicateArgs u;
   for (auto& p : u) p = random_unit_point(rng);
   const int last = dim;  // index of the dependent point
   Point& q = u[last];
   const double s = rng.uniform(-1, 2), t = rng.uniform(-1, 2);
   for (int k = 0; k < 3; ++k)
     q[k] = dim == 2 ? u[0][k] + s * (u[1][k] - u[0][k]) : u[0][k] + s * (u[1][k] - u[0][k]) + t * (u[2][k] - u[0][k]);
-  Points p;
+  PredicateArgs p;
   for (int i = 0; i < 5; ++i) p[i] = f.apply(u[i]);
   if (dim == 2)
     for (auto& x : p) x[2] = 0.0;
@@ -321,11 +322,11 @@ Points near_flat(Scale scale, Rng& rng, int dim) {
   return p;
 }
 
-// Points on a circle (dim 2) or sphere (dim 3), the last one nudged.
-Points near_round(Scale scale, Rng& rng, int dim) {
+// PredicateArgs on a circle (dim 2) or sphere (dim 3), the last one nudged.
+PredicateArgs near_round(Scale scale, Rng& rng, int dim) {
   const int count = dim + 2;
   if (scale == Scale::Offset) return offset_grid(rng, random_lattice_round(rng, dim), count, dim);
-  Points p{};
+  PredicateArgs p{};
   if (scale == Scale::Mixed) {
     // Radius 2^k around the origin, points a tiny angle away from the axes:
     // coordinates of wildly different magnitudes in one call.
@@ -361,8 +362,8 @@ Points near_round(Scale scale, Rng& rng, int dim) {
   return p;
 }
 
-Points random_uniform(Rng& rng, int dim) {
-  Points p{};
+PredicateArgs random_uniform(Rng& rng, int dim) {
+  PredicateArgs p{};
   for (auto& q : p) {
     q = random_unit_point(rng);
     if (dim == 2) q[2] = 0.0;
@@ -372,8 +373,8 @@ Points random_uniform(Rng& rng, int dim) {
 
 // Small integer grids: many exactly degenerate sets. Translated by an integer
 // and scaled by a power of two, both exact while in range.
-Points integer_grid(Rng& rng, int dim, int half_width) {
-  Points p{};
+PredicateArgs integer_grid(Rng& rng, int dim, int half_width) {
+  PredicateArgs p{};
   const double scale = std::ldexp(1.0, int(rng.below(1960)) - 1000);
   const double shift = double(int(rng.below(2001)) - 1000) * (rng.below(2) ? 1.0 : std::ldexp(1.0, 20));
   for (auto& q : p)
@@ -398,8 +399,8 @@ std::vector<Point> lattice_sphere(int r, int dim) {
 
 // Distinct exactly co-circular / co-spherical lattice points, translated by an
 // integer and scaled by a power of two.
-Points on_lattice_sphere(Rng& rng, const std::vector<Point>& sphere, int dim) {
-  Points p{};
+PredicateArgs on_lattice_sphere(Rng& rng, const std::vector<Point>& sphere, int dim) {
+  PredicateArgs p{};
   const double scale = std::ldexp(1.0, int(rng.below(1400)) - 700);
   Point shift{};
   for (int k = 0; k < dim; ++k) shift[k] = double(int(rng.below(201)) - 100);
@@ -416,18 +417,18 @@ Points on_lattice_sphere(Rng& rng, const std::vector<Point>& sphere, int dim) {
   return p;
 }
 
-Points random_lattice_round(Rng& rng, int dim) {
+PredicateArgs random_lattice_round(Rng& rng, int dim) {
   static const std::vector<Point> circle = lattice_sphere(65, 2), sphere = lattice_sphere(9, 3);
-  Points p{};
+  PredicateArgs p{};
   const std::vector<Point>& round = dim == 2 ? circle : sphere;
   for (int i = 0; i < dim + 2; ++i) p[i] = round[rng.below(round.size())];
   return p;
 }
 
-// Points on a line / plane through the origin with power-of-two multiples:
+// PredicateArgs on a line / plane through the origin with power-of-two multiples:
 // exactly degenerate with arbitrary significands and mixed magnitudes.
-Points flat_through_origin(Rng& rng, int dim) {
-  Points p{};
+PredicateArgs flat_through_origin(Rng& rng, int dim) {
+  PredicateArgs p{};
   auto any_double = [&] { return random_sign(rng) * log_uniform(rng, -300, 300); };
   Point a{any_double(), any_double(), dim == 3 ? any_double() : 0.0};
   Point b{any_double(), any_double(), dim == 3 ? any_double() : 0.0};
@@ -559,8 +560,8 @@ TEST(Predicates, IncircleExactOnLatticeCircles) {
 // incircle) and up to 8 times beyond (where the adaptive stages take over):
 // random, collinear or co-circular (lattice circles of radius 1105 and 5525,
 // scaled by up to 2), or those moved by one unit.
-Points integer_differences_near_limit(Rng& rng, int bits, const std::vector<std::vector<Point>>& circles) {
-  Points p{};
+PredicateArgs integer_differences_near_limit(Rng& rng, int bits, const std::vector<std::vector<Point>>& circles) {
+  PredicateArgs p{};
   const double origin = double(std::int64_t(rng.below(std::uint64_t(1) << 50)) - (std::int64_t(1) << 49));
   const double limit = std::ldexp(1.0, bits + int(rng.below(4)));
   const auto coordinate = [&] { return std::floor(rng.uniform(-limit, limit)); };
@@ -606,10 +607,10 @@ TEST(Predicates, InsphereExactOnLatticeSpheres) {
 // on one line / plane through the origin or on one circle / sphere around it.
 // Nothing short of the last exact stage can call these 0; nudged by an ulp,
 // they exercise the stage with the first-order tail terms (C) and the last.
-Points inexact_differences(Rng& rng, int dim, bool round, bool nudged) {
+PredicateArgs inexact_differences(Rng& rng, int dim, bool round, bool nudged) {
   const double x = 1.0 + rng.uniform(0, 1), y = std::ldexp(rng.uniform(1, 2), -int(rng.below(40)) - 1);
   const double z = std::ldexp(rng.uniform(1, 2), -int(rng.below(40)) - 1);
-  Points p{};
+  PredicateArgs p{};
   const int count = dim + (round ? 2 : 1);
   for (int i = 0; i < count; ++i) {
     double v[3] = {x, y, z};
@@ -644,7 +645,7 @@ TEST(Predicates, FastDeterminantsAgreeAwayFromDegeneracy) {
   Rng rng(99);
   for (const Predicate* pred : {&kOrient2d, &kOrient3d, &kIncircle, &kInsphere}) {
     for (int n = 0; n < 2000; ++n) {
-      const Points p = random_uniform(rng, pred->dim);
+      const PredicateArgs p = random_uniform(rng, pred->dim);
       const double fast = pred->fast(p.data()), exact = pred->exact(p.data());
       if (std::abs(fast) > 1e-9) {
         EXPECT_EQ(sign(fast), sign(exact)) << pred->name;

@@ -13,23 +13,24 @@
 namespace geods::field {
 namespace {
 
-Grid3<std::uint8_t> random_mask(std::size_t nx, std::size_t ny, std::size_t nz, double foreground, std::uint64_t seed) {
+Grid3<std::uint8_t> random_labelled_mask(std::size_t nx, std::size_t ny, std::size_t nz, double foreground,
+                                         std::uint64_t seed) {
   Rng rng(seed);
   Grid3<std::uint8_t> m(nx, ny, nz);
   for (auto& v : m.data) v = rng.uniform() < foreground ? std::uint8_t(1 + rng.below(255)) : 0;
   return m;
 }
 
-struct Brute {
+struct BruteTransform {
   std::vector<double> squared;
   std::vector<std::uint64_t> feature;
 };
 
 // The oracle: for each sample, the nearest background sample by
 // ((sx dx)^2 + (sy dy)^2) + (sz dz)^2; ties to the smallest flat index.
-Brute brute_force(const Grid3<std::uint8_t>& m, std::array<double, 3> s) {
+BruteTransform brute_force(const Grid3<std::uint8_t>& m, std::array<double, 3> s) {
   const auto [nx, ny, nz] = m.dims;
-  Brute b{std::vector<double>(m.size(), std::numeric_limits<double>::infinity()),
+  BruteTransform b{std::vector<double>(m.size(), std::numeric_limits<double>::infinity()),
           std::vector<std::uint64_t>(m.size(), EdtResult::kNoFeature)};
   std::vector<std::size_t> background;
   for (std::size_t i = 0; i < m.size(); ++i)
@@ -49,7 +50,7 @@ Brute brute_force(const Grid3<std::uint8_t>& m, std::array<double, 3> s) {
 }
 
 void expect_exact(const Grid3<std::uint8_t>& m, std::array<double, 3> s, const std::string& what) {
-  const Brute b = brute_force(m, s);
+  const BruteTransform b = brute_force(m, s);
   const EdtResult squared = edt(m.view(), {s, true, true});
   const EdtResult plain = edt(m.view(), {s, false, false});
   ASSERT_EQ(squared.distance.size(), m.size()) << what;
@@ -66,7 +67,7 @@ TEST(Edt, EqualsBruteForceBitForBitWithIntegerSpacings) {
   for (const double foreground : {0.02, 0.3, 0.7, 0.97})
     for (const auto& dims : {std::array<std::size_t, 3>{13, 11, 9}, {1, 1, 40}, {37, 1, 1}, {24, 19, 1}, {2, 3, 17}})
       for (const auto& s : {std::array<double, 3>{1, 1, 1}, {1, 2, 3}, {5, 1, 2}}) {
-        const auto m = random_mask(dims[0], dims[1], dims[2], foreground, seed++);
+        const auto m = random_labelled_mask(dims[0], dims[1], dims[2], foreground, seed++);
         expect_exact(m, s, "mask " + std::to_string(seed));
       }
 }
@@ -102,8 +103,8 @@ TEST(Edt, OtherSpacingsAgreeWithBruteForceWithinRounding) {
   std::uint64_t seed = 100;
   for (const double foreground : {0.1, 0.6, 0.95})
     for (const auto& s : {std::array<double, 3>{0.7, 1.3, 2.1}, {0.1, 0.1, 0.35}, {3.7, 0.2, 1}}) {
-      const auto m = random_mask(12, 10, 8, foreground, seed++);
-      const Brute b = brute_force(m, s);
+      const auto m = random_labelled_mask(12, 10, 8, foreground, seed++);
+      const BruteTransform b = brute_force(m, s);
       const EdtResult r = edt(m.view(), {s, true, true});
       for (std::size_t q = 0; q < m.size(); ++q) {
         ASSERT_NEAR(r.distance.data[q], b.squared[q], 1e-14 * b.squared[q]) << "sample " << q;
@@ -113,7 +114,7 @@ TEST(Edt, OtherSpacingsAgreeWithBruteForceWithinRounding) {
 }
 
 TEST(Edt, UsesTheMaskSpacingUnlessTheRequestSetsOne) {
-  auto m = random_mask(10, 9, 8, 0.8, 7);
+  auto m = random_labelled_mask(10, 9, 8, 0.8, 7);
   m.spacing = Vec3f(2, 1, 3);
   m.origin = Vec3f(-1, 5, 2);
   const EdtResult own = edt(m.view());
@@ -121,12 +122,12 @@ TEST(Edt, UsesTheMaskSpacingUnlessTheRequestSetsOne) {
   EXPECT_EQ(own.distance.data, given.distance.data);
   EXPECT_EQ(own.distance.origin, m.origin);
   EXPECT_EQ(own.distance.spacing, m.spacing);
-  const Brute b = brute_force(m, {2, 1, 3});
+  const BruteTransform b = brute_force(m, {2, 1, 3});
   for (std::size_t q = 0; q < m.size(); ++q) ASSERT_EQ(own.distance.data[q], std::sqrt(b.squared[q]));
 }
 
 TEST(Edt, SameResultOnAnyThreadCount) {
-  const auto m = random_mask(70, 60, 50, 0.9, 11);
+  const auto m = random_labelled_mask(70, 60, 50, 0.9, 11);
   const EdtResult all = edt(m.view(), {std::array<double, 3>{0.9, 1.1, 1.7}, false, true});
   set_num_threads(1);
   const EdtResult one = edt(m.view(), {std::array<double, 3>{0.9, 1.1, 1.7}, false, true});
@@ -136,7 +137,7 @@ TEST(Edt, SameResultOnAnyThreadCount) {
 }
 
 TEST(Edt, RefusesBadSpacingsAndInconsistentViews) {
-  const auto m = random_mask(4, 4, 4, 0.5, 3);
+  const auto m = random_labelled_mask(4, 4, 4, 0.5, 3);
   const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
   for (const auto& s : {std::array<double, 3>{0, 1, 1}, {1, -1, 1}, {1, 1, nan}, {inf, 1, 1}, {1e200, 1, 1}, {1, 1e-200, 1}})
     EXPECT_THROW(edt(m.view(), {s}), Error);
@@ -149,7 +150,7 @@ TEST(Edt, RefusesBadSpacingsAndInconsistentViews) {
 TEST(Edt, PassesInAnyAxisOrderEqualTheTransform) {
   const double inf = std::numeric_limits<double>::infinity();
   for (const auto& dims : {std::array<std::size_t, 3>{9, 7, 6}, {1, 8, 5}, {6, 1, 1}}) {
-    const auto m = random_mask(dims[0], dims[1], dims[2], 0.8, 21);
+    const auto m = random_labelled_mask(dims[0], dims[1], dims[2], 0.8, 21);
     const std::array<double, 3> s{1, 2, 3};
     const EdtResult r = edt(m.view(), {s, true, false});
     for (const auto& order : {std::array<int, 3>{0, 1, 2}, {2, 1, 0}, {1, 2, 0}}) {

@@ -6,7 +6,6 @@
 #include <array>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <cstring>
 #include <string>
 #include <vector>
@@ -446,24 +445,16 @@ TEST(KdTree, LoadedTreesAnswerLikeTheOriginal) {
   expect_same_answers(strided, copy, qs, 30, 5);
 }
 
-std::vector<char> read_all(const std::filesystem::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), {}};
-}
-void write_all(const std::filesystem::path& p, const std::vector<char>& bytes) {
-  std::ofstream(p, std::ios::binary).write(bytes.data(), std::streamsize(bytes.size()));
-}
-
 TEST(KdTree, CorruptedFilesThrow) {
   const std::size_t n = 500;
   const auto pts = make_points<double>(Shape::uniform, n, 2, 8);
   const KdTree<double, 2> tree(PointView<double>(pts.data(), n, 2));
   const auto path = temp_file("good.geods"), bad = temp_file("bad.geods");
   tree.save(path);
-  const std::vector<char> good = read_all(path);
+  const std::vector<char> good = test::read_bytes(path);
   // Checked by the container (checksums on) and, with the checksums skipped, by validate().
   auto expect_error = [&](std::vector<char> bytes, const std::string& what) {
-    write_all(bad, bytes);
+    test::write_bytes(bad, bytes);
     EXPECT_THROW((KdTree<double, 2>::load(bad)), Error) << what;
     EXPECT_THROW((KdTree<double, 2>::load(bad, Archive::Verify::structure_only)), Error) << what;
   };
@@ -519,7 +510,7 @@ TEST(KdTree, CorruptedFilesThrow) {
   EXPECT_THROW((KdTree<double, 2>::load(temp_file("missing.geods"))), Error);
   // Every truncation is an error, never a crash.
   for (std::size_t size = 0; size < good.size(); size += 1 + size / 8) {
-    write_all(bad, std::vector<char>(good.begin(), good.begin() + std::ptrdiff_t(size)));
+    test::write_bytes(bad, std::vector<char>(good.begin(), good.begin() + std::ptrdiff_t(size)));
     EXPECT_THROW((KdTree<double, 2>::load(bad, Archive::Verify::structure_only)), Error) << size;
   }
   std::filesystem::remove(path);

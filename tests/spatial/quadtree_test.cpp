@@ -9,7 +9,6 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <map>
 #include <string>
@@ -24,17 +23,17 @@
 namespace geods::spatial {
 namespace {
 
-enum class Shape { uniform, clustered, duplicated, line, identical, grid };
-const Shape kShapes[] = {Shape::uniform, Shape::clustered, Shape::duplicated,
-                         Shape::line,    Shape::identical, Shape::grid};
+enum class Shape2 { uniform, clustered, duplicated, line, identical, grid };
+const Shape2 kShapes2[] = {Shape2::uniform, Shape2::clustered, Shape2::duplicated,
+                           Shape2::line,    Shape2::identical, Shape2::grid};
 
-std::string name(Shape s) {
+std::string name(Shape2 s) {
   const char* names[] = {"uniform", "clustered", "duplicated", "line", "identical", "grid"};
   return names[int(s)];
 }
 
 template <typename T, int D>
-std::vector<Vec<T, D>> make_points(Shape shape, std::size_t n, std::uint64_t seed) {
+std::vector<Vec<T, D>> make_points(Shape2 shape, std::size_t n, std::uint64_t seed) {
   Rng rng(seed);
   std::vector<Vec<double, D>> centers(6), distinct(15);
   for (auto& c : centers) for (int a = 0; a < D; ++a) c[a] = rng.uniform(-5, 5);
@@ -49,12 +48,12 @@ std::vector<Vec<T, D>> make_points(Shape shape, std::size_t n, std::uint64_t see
     const double spread = std::pow(10.0, -1.0 - double(c));
     for (int a = 0; a < D; ++a) {
       switch (shape) {
-        case Shape::uniform: p[a] = T(rng.uniform(-3, 7)); break;
-        case Shape::clustered: p[a] = T(centers[c][a] + spread * rng.normal()); break;
-        case Shape::duplicated: p[a] = T(distinct[e][a]); break;
-        case Shape::line: p[a] = T(origin[a] + s * dir[a]); break;
-        case Shape::identical: p[a] = T(0.25); break;
-        case Shape::grid: p[a] = T(rng.below(6)); break;
+        case Shape2::uniform: p[a] = T(rng.uniform(-3, 7)); break;
+        case Shape2::clustered: p[a] = T(centers[c][a] + spread * rng.normal()); break;
+        case Shape2::duplicated: p[a] = T(distinct[e][a]); break;
+        case Shape2::line: p[a] = T(origin[a] + s * dir[a]); break;
+        case Shape2::identical: p[a] = T(0.25); break;
+        case Shape2::grid: p[a] = T(rng.below(6)); break;
       }
     }
   }
@@ -212,7 +211,7 @@ double smallest_distance(const std::vector<Vec<T, D>>& points) {
 }
 
 template <typename T, int D>
-void check_shape(Shape shape, std::size_t n, std::size_t bucket, bool all_checks) {
+void check_shape(Shape2 shape, std::size_t n, std::size_t bucket, bool all_checks) {
   SCOPED_TRACE(name(shape) + " n=" + std::to_string(n) + " bucket=" + std::to_string(bucket) + " D=" +
                std::to_string(D) + (sizeof(T) == 4 ? " float" : " double"));
   const auto points = make_points<T, D>(shape, n, 7 * n + int(shape) + 100 * D);
@@ -244,7 +243,7 @@ void check_shape(Shape shape, std::size_t n, std::size_t bucket, bool all_checks
   ASSERT_TRUE(balanced.is_balanced());
   balanced.validate();
   EXPECT_TRUE(balanced_oracle(balanced));
-  if (shape == Shape::clustered) {
+  if (shape == Shape2::clustered) {
     EXPECT_FALSE(balanced_oracle(tree));  // so balancing had work to do
     EXPECT_GT(balanced.nodes().size(), tree.nodes().size());
   }
@@ -260,7 +259,7 @@ void check_shape(Shape shape, std::size_t n, std::size_t bucket, bool all_checks
 }
 
 TEST(Quadtree, ShapesAgainstOracles) {
-  for (Shape shape : kShapes) {
+  for (Shape2 shape : kShapes2) {
     check_shape<double, 2>(shape, 300, 1, true);
     check_shape<float, 2>(shape, 300, 3, true);
     check_shape<double, 2>(shape, 3000, 1, false);
@@ -268,7 +267,7 @@ TEST(Quadtree, ShapesAgainstOracles) {
 }
 
 TEST(Octree, ShapesAgainstOracles) {
-  for (Shape shape : kShapes) {
+  for (Shape2 shape : kShapes2) {
     check_shape<double, 3>(shape, 150, 1, true);
     check_shape<float, 3>(shape, 200, 4, true);
     check_shape<double, 3>(shape, 3000, 2, false);
@@ -323,7 +322,7 @@ TEST(Quadtree, CoincidentPointsAndDepthLimit) {
 }
 
 TEST(Quadtree, ParallelBuildMatchesSequential) {
-  const auto points = make_points<double, 2>(Shape::clustered, 200000, 5);
+  const auto points = make_points<double, 2>(Shape2::clustered, 200000, 5);
   const Quadtree<> parallel_td(points, {.bucket = 8});
   const Quadtree<> parallel_morton(points, {.bucket = 8, .build = OrthtreeBuild::morton});
   set_num_threads(1);
@@ -336,7 +335,7 @@ TEST(Quadtree, ParallelBuildMatchesSequential) {
 }
 
 TEST(Octree, BalancingLargeClusteredTree) {
-  const auto points = make_points<float, 3>(Shape::clustered, 20000, 9);
+  const auto points = make_points<float, 3>(Shape2::clustered, 20000, 9);
   const Octree<float> tree(points);
   const Octree<float> balanced = tree.balanced();
   balanced.validate();
@@ -344,18 +343,10 @@ TEST(Octree, BalancingLargeClusteredTree) {
   EXPECT_LE(balanced.nodes().size(), 16 * tree.nodes().size());  // O(m) nodes
 }
 
-std::vector<char> read_all(const std::filesystem::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), {}};
-}
-void write_all(const std::filesystem::path& p, const std::vector<char>& bytes) {
-  std::ofstream(p, std::ios::binary).write(bytes.data(), std::streamsize(bytes.size()));
-}
-
 TEST(Orthtree, SaveLoad) {
   const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("geods_qt_" + std::to_string(getpid()));
   std::filesystem::create_directories(dir);
-  const auto points = make_points<float, 3>(Shape::clustered, 500, 3);
+  const auto points = make_points<float, 3>(Shape2::clustered, 500, 3);
   const Octree<float> tree(points, {.bucket = 2, .max_depth = 12});
   const Octree<float> balanced = tree.balanced();
   for (const Octree<float>* t : {&tree, &balanced}) {
@@ -374,14 +365,14 @@ TEST(Orthtree, SaveLoad) {
   EXPECT_THROW(Octree<float>::load(dir / "missing.geods"), Error);
   // Truncated, and single corrupted bytes: an Error or a tree that validates, never a crash
   // (with the checksums skipped, so that validate() sees the corruption).
-  const std::vector<char> bytes = read_all(dir / "t.geods");
-  write_all(dir / "short.geods", std::vector<char>(bytes.begin(), bytes.end() - 5));
+  const std::vector<char> bytes = test::read_bytes(dir / "t.geods");
+  test::write_bytes(dir / "short.geods", std::vector<char>(bytes.begin(), bytes.end() - 5));
   EXPECT_THROW(Octree<float>::load(dir / "short.geods"), Error);
   Rng rng(1);
   for (int t = 0; t < 200; ++t) {
     std::vector<char> bad = bytes;
     bad[rng.below(bad.size())] ^= char(1 + rng.below(255));
-    write_all(dir / "bad.geods", bad);
+    test::write_bytes(dir / "bad.geods", bad);
     for (auto verify : {Archive::Verify::checksums, Archive::Verify::structure_only}) {
       try {
         Octree<float>::load(dir / "bad.geods", verify).validate();
@@ -392,9 +383,9 @@ TEST(Orthtree, SaveLoad) {
   // validate() checks the 2:1 condition of trees that claim it: mark an unbalanced tree balanced.
   ASSERT_FALSE(balanced_oracle(tree));
   tree.save(dir / "t.geods");
-  std::vector<char> claim = read_all(dir / "t.geods");
+  std::vector<char> claim = test::read_bytes(dir / "t.geods");
   claim[test::archive_section_offset(claim, "balanced")] = 1;
-  write_all(dir / "claim.geods", claim);
+  test::write_bytes(dir / "claim.geods", claim);
   EXPECT_THROW(Octree<float>::load(dir / "claim.geods"), Error);  // the checksum sees it
   try {
     Octree<float>::load(dir / "claim.geods", Archive::Verify::structure_only);
@@ -437,27 +428,27 @@ void expect_round_trip(const Orthtree<T, D>& tree, const std::vector<Vec<T, D>>&
 
 TEST(Orthtree, LoadedTreesAnswerLikeTheOriginal) {
   const auto path = std::filesystem::temp_directory_path() / ("geods_qt_rt_" + std::to_string(getpid()));
-  for (Shape shape : kShapes) {
+  for (Shape2 shape : kShapes2) {
     for (std::size_t n : {1, 2, 9, 400}) {
       SCOPED_TRACE(name(shape) + " n=" + std::to_string(n));
       const auto p2 = make_points<double, 2>(shape, n, n + 1);
-      const auto q2 = make_points<double, 2>(Shape::uniform, 20, n + 2);
+      const auto q2 = make_points<double, 2>(Shape2::uniform, 20, n + 2);
       expect_round_trip(Quadtree<double>(p2, {.bucket = 3}), q2, path);
       expect_round_trip(Quadtree<double>(p2).balanced(), q2, path);
       const auto p3 = make_points<float, 3>(shape, n, n + 3);
-      const auto q3 = make_points<float, 3>(Shape::uniform, 20, n + 4);
+      const auto q3 = make_points<float, 3>(Shape2::uniform, 20, n + 4);
       expect_round_trip(Octree<float>(p3, {.bucket = 2, .max_depth = 8, .build = OrthtreeBuild::morton}), q3, path);
     }
   }
   // A non-finite point, a bad parameter, another structure's archive.
-  const auto pts = make_points<double, 2>(Shape::uniform, 50, 5);
+  const auto pts = make_points<double, 2>(Shape2::uniform, 50, 5);
   Quadtree<double>(pts).save(path);
-  const std::vector<char> good = read_all(path);
+  const std::vector<char> good = test::read_bytes(path);
   for (const char* section : {"points", "bucket", "max_depth", "root_side"}) {
     std::vector<char> bad = good;
     const double nan = std::nan("");
     std::memcpy(&bad[test::archive_section_offset(bad, section)], &nan, sizeof nan);
-    write_all(path, bad);
+    test::write_bytes(path, bad);
     EXPECT_THROW(Quadtree<double>::load(path, Archive::Verify::structure_only), Error) << section;
     EXPECT_THROW(Quadtree<double>::load(path), Error) << section;
   }

@@ -23,36 +23,36 @@
 namespace geods::voronoi {
 namespace {
 
-enum class Shape { uniform, clustered, sphere, lattice, coplanar, duplicates, tiny, huge, mixed };
+enum class Shape3 { uniform, clustered, sphere, lattice, coplanar, duplicates, tiny, huge, mixed };
 
-std::vector<Vec3d> make_points(Shape shape, std::size_t n, std::uint64_t seed) {
+std::vector<Vec3d> make_points(Shape3 shape, std::size_t n, std::uint64_t seed) {
   Rng rng(seed);
   std::vector<Vec3d> p;
   switch (shape) {
-    case Shape::uniform:
+    case Shape3::uniform:
       for (std::size_t i = 0; i < n; ++i) p.emplace_back(rng.uniform(), rng.uniform(), rng.uniform());
       break;
-    case Shape::clustered:
+    case Shape3::clustered:
       for (std::size_t i = 0; i < n; ++i) {
         const double s = i % 10 == 0 ? 1.0 : 1e-4;
         const double c = double(rng.below(5));
         p.emplace_back(c + s * rng.normal(), c * 0.5 + s * rng.normal(), s * rng.normal());
       }
       break;
-    case Shape::sphere:  // every integer point on the sphere of radius 15: cospherical, coplanar and cocircular sets
+    case Shape3::sphere:  // every integer point on the sphere of radius 15: cospherical, coplanar and cocircular sets
       for (int x = -15; x <= 15; ++x)
         for (int y = -15; y <= 15; ++y)
           for (int z = -15; z <= 15; ++z)
             if (x * x + y * y + z * z == 225) p.emplace_back(x, y, z);
       p.emplace_back(0, 0, 0);
       break;
-    case Shape::lattice:  // 6 x 7 x 8 integer grid, shuffled: degenerate everywhere
+    case Shape3::lattice:  // 6 x 7 x 8 integer grid, shuffled: degenerate everywhere
       for (int x = 0; x < 6; ++x)
         for (int y = 0; y < 7; ++y)
           for (int z = 0; z < 8; ++z) p.emplace_back(x, y, z);
       for (std::size_t i = p.size(); i > 1; --i) std::swap(p[i - 1], p[rng.below(i)]);
       break;
-    case Shape::coplanar:  // most points on three planes (two axis-aligned, one skew), a few off them
+    case Shape3::coplanar:  // most points on three planes (two axis-aligned, one skew), a few off them
       for (std::size_t i = 0; i < n; ++i) {
         const double a = double(rng.below(20)), b = double(rng.below(20));
         switch (i % 4) {
@@ -63,20 +63,20 @@ std::vector<Vec3d> make_points(Shape shape, std::size_t n, std::uint64_t seed) {
         }
       }
       break;
-    case Shape::duplicates: {
+    case Shape3::duplicates: {
       std::vector<Vec3d> base;
       for (int i = 0; i < 60; ++i) base.emplace_back(rng.uniform(), rng.uniform(), rng.uniform());
       for (std::size_t i = 0; i < n; ++i) p.push_back(base[rng.below(base.size())]);
       break;
     }
-    case Shape::tiny:
+    case Shape3::tiny:
       for (std::size_t i = 0; i < n; ++i) p.emplace_back(1e-300 * rng.uniform(), 1e-300 * rng.uniform(), 1e-300 * rng.uniform());
       break;
-    case Shape::huge:
+    case Shape3::huge:
       for (std::size_t i = 0; i < n; ++i)
         p.emplace_back(1e300 * rng.uniform(-1, 1), 1e300 * rng.uniform(-1, 1), 1e300 * rng.uniform(-1, 1));
       break;
-    case Shape::mixed:
+    case Shape3::mixed:
       for (std::size_t i = 0; i < n; ++i) {
         const double s = std::ldexp(1.0, int(rng.below(200)) - 100);
         p.emplace_back(s * rng.uniform(-1, 1), s * rng.uniform(-1, 1), s * rng.uniform(-1, 1));
@@ -86,8 +86,8 @@ std::vector<Vec3d> make_points(Shape shape, std::size_t n, std::uint64_t seed) {
   return p;
 }
 
-const Shape kShapes[] = {Shape::uniform, Shape::clustered, Shape::sphere, Shape::lattice, Shape::coplanar,
-                         Shape::duplicates, Shape::tiny, Shape::huge, Shape::mixed};
+const Shape3 kShapes3[] = {Shape3::uniform, Shape3::clustered, Shape3::sphere, Shape3::lattice, Shape3::coplanar,
+                           Shape3::duplicates, Shape3::tiny, Shape3::huge, Shape3::mixed};
 
 double signed_volume(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& d) {
   return (b - a).dot((c - a).cross(d - a)) / 6.0;
@@ -201,11 +201,11 @@ std::vector<std::array<std::uint32_t, 4>> sorted_tets(const Delaunay3& dt) {
 }
 
 TEST(Delaunay3, EmptySphereOnEveryShape) {
-  for (Shape shape : kShapes)
+  for (Shape3 shape : kShapes3)
     for (std::uint64_t seed : {1, 2}) {
       SCOPED_TRACE("shape " + std::to_string(int(shape)) + " seed " + std::to_string(seed));
       // Far from unit size every predicate takes core's big-integer path: fewer points there.
-      const bool extreme = shape == Shape::tiny || shape == Shape::huge || shape == Shape::mixed;
+      const bool extreme = shape == Shape3::tiny || shape == Shape3::huge || shape == Shape3::mixed;
       const auto p = make_points(shape, extreme ? 50 : 400, seed);
       const Delaunay3 dt(p);
       check_solid(p, dt);
@@ -216,7 +216,7 @@ TEST(Delaunay3, EmptySphereOnEveryShape) {
 TEST(Delaunay3, UniqueWhateverTheInsertionOrder) {
   // The perturbation makes the tetrahedralization of degenerate sets unique:
   // other seeds (other BRIO orders) give the same tetrahedra.
-  for (Shape shape : {Shape::sphere, Shape::lattice, Shape::coplanar, Shape::duplicates}) {
+  for (Shape3 shape : {Shape3::sphere, Shape3::lattice, Shape3::coplanar, Shape3::duplicates}) {
     SCOPED_TRACE("shape " + std::to_string(int(shape)));
     const auto p = make_points(shape, 300, 7);
     const auto reference = sorted_tets(Delaunay3(p));
@@ -225,12 +225,12 @@ TEST(Delaunay3, UniqueWhateverTheInsertionOrder) {
 }
 
 TEST(Delaunay3, LargerUniformAndClusteredValidate) {
-  for (Shape shape : {Shape::uniform, Shape::clustered}) {
+  for (Shape3 shape : {Shape3::uniform, Shape3::clustered}) {
     const auto p = make_points(shape, 6000, 3);
     const Delaunay3 dt(p);
     check_solid(p, dt);
     // about 6.5 tetrahedra per point for uniform points
-    if (shape == Shape::uniform) {
+    if (shape == Shape3::uniform) {
       EXPECT_GT(dt.tetrahedron_count(), 6 * p.size());
       EXPECT_LT(dt.tetrahedron_count(), 7 * p.size());
     }
@@ -275,7 +275,7 @@ TEST(Delaunay3, RejectsNonFinitePoints) {
 }
 
 TEST(Delaunay3, StatsCountWhatIsThere) {
-  const auto p = make_points(Shape::duplicates, 500, 5);
+  const auto p = make_points(Shape3::duplicates, 500, 5);
   const Delaunay3 dt(p);
   const Delaunay3Stats s = dt.stats();
   EXPECT_EQ(s.points, p.size());
@@ -288,14 +288,14 @@ TEST(Delaunay3, StatsCountWhatIsThere) {
 }
 
 TEST(Delaunay3, LocateAndNearestVertexAgreeWithBruteForce) {
-  for (Shape shape : {Shape::uniform, Shape::lattice, Shape::duplicates}) {
+  for (Shape3 shape : {Shape3::uniform, Shape3::lattice, Shape3::duplicates}) {
     const auto p = make_points(shape, 500, 9);
     const Delaunay3 dt(p);
     Rng rng(4);
     const auto& tets = dt.tetrahedra();
     for (int k = 0; k < 200; ++k) {
       const Vec3d q(rng.uniform(-0.2, 1.2) * 7, rng.uniform(-0.2, 1.2) * 7, rng.uniform(-0.2, 1.2) * 7);
-      const Vec3d scaled = shape == Shape::lattice ? q : q / 7.0;
+      const Vec3d scaled = shape == Shape3::lattice ? q : q / 7.0;
       // locate: the tetrahedron holds q (exact orientations), or q is outside the hull
       const std::uint32_t t = dt.locate(scaled);
       bool inside_hull = true;
@@ -322,7 +322,7 @@ TEST(Delaunay3, LocateAndNearestVertexAgreeWithBruteForce) {
 }
 
 TEST(Delaunay3, InsertAndRemoveGiveTheTetrahedralizationOfTheSet) {
-  auto p = make_points(Shape::lattice, 0, 21);
+  auto p = make_points(Shape3::lattice, 0, 21);
   std::vector<Vec3d> first(p.begin(), p.begin() + 150), rest(p.begin() + 150, p.end());
   Delaunay3 dt(first);
   for (const Vec3d& x : rest) dt.insert(x);
@@ -361,7 +361,7 @@ TEST(Delaunay3, InsertAndRemoveGiveTheTetrahedralizationOfTheSet) {
 // after every step the result is the fresh tetrahedralization of the points
 // left, compared by original point indices, on every shape.
 TEST(Delaunay3, LocalRemovalEqualsAFreshBuildOnEveryShape) {
-  for (Shape shape : kShapes) {
+  for (Shape3 shape : kShapes3) {
     SCOPED_TRACE("shape " + std::to_string(int(shape)));
     const auto p = make_points(shape, 240, 7);
     Delaunay3 dt(p);
@@ -393,7 +393,7 @@ TEST(Delaunay3, LocalRemovalEqualsAFreshBuildOnEveryShape) {
         EXPECT_EQ(dt.representative(original[k]), original[fresh.representative(k)]);
     }
     // Only a hull vertex with coplanar neighbours (the integer sphere has some) needs a rebuild.
-    if (shape != Shape::sphere) {
+    if (shape != Shape3::sphere) {
       EXPECT_EQ(dt.stats().rebuilds, 0u);
     }
   }
@@ -404,9 +404,9 @@ TEST(Delaunay3, LocalRemovalEqualsAFreshBuildOnEveryShape) {
 // Coordinates whose squares leave double range (1e300, 1e-300) build sequentially.
 TEST(Delaunay3, ParallelBuildEqualsTheSequentialOne) {
   const int threads = num_threads();
-  for (Shape shape : kShapes) {
+  for (Shape3 shape : kShapes3) {
     SCOPED_TRACE("shape " + std::to_string(int(shape)));
-    const bool extreme = shape == Shape::tiny || shape == Shape::huge;
+    const bool extreme = shape == Shape3::tiny || shape == Shape3::huge;
     const auto p = make_points(shape, extreme ? 300 : 2000, 9);
     set_num_threads(1);
     const Delaunay3 sequential(p);
@@ -439,7 +439,7 @@ TEST(Delaunay3, ParallelBuildEqualsTheSequentialOne) {
 TEST(Delaunay3, SaveLoadRoundTripAndBadFiles) {
   const std::filesystem::path dir = std::filesystem::temp_directory_path() / "geods_delaunay3_test";
   std::filesystem::create_directories(dir);
-  auto p = make_points(Shape::duplicates, 300, 4);
+  auto p = make_points(Shape3::duplicates, 300, 4);
   Delaunay3 dt(p);
   dt.remove(5);
   dt.save(dir / "dt.geods");
@@ -465,7 +465,7 @@ TEST(Delaunay3, SaveLoadRoundTripAndBadFiles) {
 }
 
 TEST(Delaunay3, VertexNeighborsAreTheEdges) {
-  const auto p = make_points(Shape::uniform, 300, 2);
+  const auto p = make_points(Shape3::uniform, 300, 2);
   const Delaunay3 dt(p);
   std::set<std::pair<std::uint32_t, std::uint32_t>> edges;
   const auto& tets = dt.tetrahedra();
@@ -488,10 +488,10 @@ TEST(Delaunay3, VertexNeighborsAreTheEdges) {
 TEST(Delaunay3, FlipInsertionEqualsTheCavityInsertionOnEveryShape) {
   const int threads = num_threads();
   set_num_threads(1);
-  for (Shape shape : kShapes)
+  for (Shape3 shape : kShapes3)
     for (std::uint64_t seed : {1, 2}) {
       SCOPED_TRACE("shape " + std::to_string(int(shape)) + " seed " + std::to_string(seed));
-      const bool extreme = shape == Shape::tiny || shape == Shape::huge || shape == Shape::mixed;
+      const bool extreme = shape == Shape3::tiny || shape == Shape3::huge || shape == Shape3::mixed;
       const auto p = make_points(shape, extreme ? 50 : 400, seed);
       const Delaunay3 cavity(p, {.seed = seed});
       const Delaunay3 flips(p, {.insertion = Delaunay3Insertion::flips, .seed = seed});
@@ -505,11 +505,11 @@ TEST(Delaunay3, FlipInsertionEqualsTheCavityInsertionOnEveryShape) {
       EXPECT_EQ(s.duplicates, c.duplicates);
       EXPECT_EQ(c.flips_14 + c.flips_23 + c.flips_32 + c.splits + c.hull_inserts, 0u);
       EXPECT_EQ(s.flip_repairs, 0u);
-      if (shape == Shape::uniform) {
+      if (shape == Shape3::uniform) {
         EXPECT_GT(s.flips_23, s.vertices);
         EXPECT_GT(s.flips_32, 0u);
       }
-      if (shape == Shape::lattice || shape == Shape::coplanar) {
+      if (shape == Shape3::lattice || shape == Shape3::coplanar) {
         EXPECT_GT(s.splits + s.flips_44, 0u);
       }
     }
@@ -525,7 +525,7 @@ TEST(Delaunay3, FlipInsertionEqualsTheCavityInsertionOnEveryShape) {
 // with it, and the repair must end at the same tetrahedralization as the
 // cavity insertion (compared as sets of oriented tetrahedra).
 TEST(Delaunay3, FlipRepairFinishesFromAnyStateOfTheFlips) {
-  for (Shape shape : {Shape::uniform, Shape::sphere, Shape::lattice, Shape::coplanar})
+  for (Shape3 shape : {Shape3::uniform, Shape3::sphere, Shape3::lattice, Shape3::coplanar})
     for (std::size_t budget : {0, 1, 3}) {
       SCOPED_TRACE("shape " + std::to_string(int(shape)) + " budget " + std::to_string(budget));
       const auto p = make_points(shape, 200, 5);
@@ -577,7 +577,7 @@ TEST(Delaunay3, FlipRepairFinishesFromAnyStateOfTheFlips) {
 
 // Single-point insert() by flips, and the parallel build's halves and seam by flips.
 TEST(Delaunay3, FlipInsertOneByOneAndInParallel) {
-  for (Shape shape : {Shape::uniform, Shape::lattice, Shape::sphere, Shape::duplicates}) {
+  for (Shape3 shape : {Shape3::uniform, Shape3::lattice, Shape3::sphere, Shape3::duplicates}) {
     SCOPED_TRACE("shape " + std::to_string(int(shape)));
     const auto p = make_points(shape, 300, 5);
     const std::size_t half = p.size() / 2;
