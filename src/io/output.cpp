@@ -50,7 +50,9 @@ void check_output_extension(const fs::path& path, OutputKind kind) {
   std::string accepted;
   for (const std::string& e : output_extensions(kind)) accepted += (accepted.empty() ? "" : ", ") + e;
   if (standard_output_allowed(kind)) accepted += "; - for standard output";
-  const std::string ext = detail::is_standard_stream(path) ? std::string("standard output") : "'" + detail::extension(path) + "'";
+  // Appended, not "'" + extension: GCC 12 at -O3 warns falsely (-Wstringop-overflow) on that insert at the front.
+  std::string ext = "standard output";
+  if (!detail::is_standard_stream(path)) ext = std::string("'").append(detail::extension(path)).append("'");
   detail::fail(path, std::string("cannot write ") + kind_name(kind) + " as " + (ext == "''" ? "a file without extension" : ext) +
                          " (accepted: " + accepted + ")");
 }

@@ -2,6 +2,7 @@
 // Meshes, triangle soups, rays and brute-force oracles for the bvh tests.
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <limits>
 #include <string>
 #include <vector>
@@ -26,7 +27,7 @@ inline bool same_bits(const RayHit& a, const RayHit& b) {
          std::memcmp(&a.v, &b.v, sizeof(float)) == 0 && a.prim == b.prim;
 }
 
-inline TriMesh data_mesh(const std::string& name) { return io::read_mesh(std::string(GEODS_DATA_DIR) + "/" + name); }
+inline TriMesh data_mesh(const std::string& name) { return io::read_mesh(std::filesystem::path(GEODS_DATA_DIR) / name); }
 
 inline Vec3f random_point(Rng& rng, float lo, float hi) {
   return {float(rng.uniform(lo, hi)), float(rng.uniform(lo, hi)), float(rng.uniform(lo, hi))};

@@ -94,6 +94,6 @@ inline void expect_truncations_fail(const fs::path& dir, const std::string& name
   }
 }
 
-inline std::string data_file(const std::string& name) { return std::string(GEODS_DATA_DIR) + "/" + name; }
+inline std::string data_file(const std::string& name) { return (std::filesystem::path(GEODS_DATA_DIR) / name).string(); }
 
 }  // namespace geods::io::test
