@@ -41,7 +41,7 @@ void expect_levels_agree(const TriMesh& mesh, const std::vector<Ray3f>& rays, co
       for (std::size_t i = 0; i < rays.size(); ++i) {
         const RayHit hit = bvh.intersect(rays[i]);
         ASSERT_TRUE(test::same_bits(hit, expected[i])) << what << " arity " << arity << " " << simd_level_name(level)
-                                                 << " ray " << i << ": t " << hit.t << " vs " << expected[i].t;
+                                                       << " ray " << i << ": t " << hit.t << " vs " << expected[i].t;
         ASSERT_EQ(bvh.occluded(rays[i]), bool(blocked[i])) << what << " " << simd_level_name(level) << " ray " << i;
       }
     }

@@ -31,7 +31,7 @@ struct BruteTransform {
 BruteTransform brute_force(const Grid3<std::uint8_t>& m, std::array<double, 3> s) {
   const auto [nx, ny, nz] = m.dims;
   BruteTransform b{std::vector<double>(m.size(), std::numeric_limits<double>::infinity()),
-          std::vector<std::uint64_t>(m.size(), EdtResult::kNoFeature)};
+                   std::vector<std::uint64_t>(m.size(), EdtResult::kNoFeature)};
   std::vector<std::size_t> background;
   for (std::size_t i = 0; i < m.size(); ++i)
     if (!m.data[i]) background.push_back(i);
