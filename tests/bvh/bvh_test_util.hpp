@@ -7,19 +7,15 @@
 #include <string>
 #include <vector>
 
+#include "common/simd_level_guard.hpp"
 #include "geods/bvh/triangle_bvh.hpp"
 #include "geods/core/rng.hpp"
-#include "geods/core/simd_level.hpp"
 #include "geods/core/triangle.hpp"
 #include "geods/io/mesh_io.hpp"
 
 namespace geods::bvh::test {
 
-/// Restores the SIMD level a test started with.
-struct LevelGuard {
-  SimdLevel saved = simd_level();
-  ~LevelGuard() { set_simd_level(saved); }
-};
+using geods::test::LevelGuard;
 
 /// The same hit to the bit: t, u, v and the triangle.
 inline bool same_bits(const RayHit& a, const RayHit& b) {

@@ -9,6 +9,7 @@
 #include <limits>
 #include <string>
 
+#include "common/simd_level_guard.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"
 #include "geods/core/rng.hpp"
@@ -164,7 +165,7 @@ TEST(SdfGrid, SameBitsAtEverySimdLevel) {
   const TriMesh bunny = data_mesh("bunny.ply");
   const MeshDistance md = MeshDistance::build(bunny);
   const Grid3Geometry grid = sdf_grid_geometry(bunny.bounds(), 40, 0, 3);
-  const SimdLevel saved = simd_level();
+  const test::LevelGuard guard;
   for (const double band : {std::numeric_limits<double>::infinity(), 2.0}) {
     SdfGridOptions options;
     options.faces = true;
@@ -180,7 +181,6 @@ TEST(SdfGrid, SameBitsAtEverySimdLevel) {
       EXPECT_EQ(r.stats.in_band, portable.stats.in_band);
     }
   }
-  set_simd_level(saved);
 }
 
 TEST(SdfGrid, NarrowBandEqualsTheWholeGridInside) {

@@ -16,6 +16,7 @@
 #include <random>
 #include <set>
 
+#include "common/simd_level_guard.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/simd_level.hpp"
 #include "geods/io/npy.hpp"
@@ -582,6 +583,7 @@ TEST(Terrain, GreedyTinsWithinTheBoundAndTiled) {
 // mesh at every SIMD level: the same errors, the same worst samples.
 TEST(Terrain, GreedyTinTheSameAtEverySimdLevel) {
   const Terrain t(real_field());
+  const test::LevelGuard guard;
   const SimdLevel level = simd_level();
   set_simd_level(SimdLevel::portable);
   const TerrainMesh portable = t.tin(1.0), portable_tiles = t.tin(3.0, 2);
@@ -603,6 +605,7 @@ TEST(Terrain, RecordsTheSameAtEverySimdLevel) {
   const std::vector<std::pair<HeightField, double>> fields = {
       {noise(257, 257, 21), 1}, {noise(300, 170, 22, 1000), 1e-3}, {noise(129, 400, 23), 1e30}, {noise(1025, 600, 24), 1},
       {real_field(), 1}};
+  const test::LevelGuard guard;
   const SimdLevel level = simd_level();
   for (const auto& [f, scale] : fields)
     for (const Layout layout : {Layout::interleaved, Layout::matrix}) {
@@ -615,7 +618,6 @@ TEST(Terrain, RecordsTheSameAtEverySimdLevel) {
         ASSERT_EQ(t.records().size(), portable.records().size());
         EXPECT_EQ(std::memcmp(t.records().data(), portable.records().data(), t.records().size() * sizeof(VertexRecord)), 0);
       }
-      set_simd_level(level);
     }
 }
 
