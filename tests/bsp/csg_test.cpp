@@ -1,3 +1,4 @@
+#include "common/data_files.hpp"
 #include "geods/bsp/csg.hpp"
 
 #include <gtest/gtest.h>
@@ -7,7 +8,6 @@
 
 #include "bsp/meshes.hpp"
 #include "geods/core/error.hpp"
-#include "geods/io/mesh_io.hpp"
 
 using namespace geods;
 using namespace geods::bsp;
@@ -105,7 +105,7 @@ TEST(Csg, CurvedSolids) {
 // sphere plus two small spheres far from the torus's surface, one inside the torus and one
 // in its hole (components labelled by the whole-operand fallback).
 TEST(Csg, LocalMatchesMerge) {
-  const Triangles bunny = from_tri_mesh(io::read_mesh(std::string(GEODS_DATA_DIR) + "/bunny.ply"));
+  const Triangles bunny = from_tri_mesh(test::data_mesh("bunny.ply"));
   Vec3d lo = bunny.vertices[0], hi = lo;
   for (const auto& v : bunny.vertices) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
   const double size = (hi - lo).maxCoeff();

@@ -4,10 +4,10 @@
 #include <cstdio>
 #include <random>
 
+#include "common/data_files.hpp"
 #include "bsp/meshes.hpp"
 #include "geods/bsp/bsp_tree.hpp"
 #include "geods/core/error.hpp"
-#include "geods/io/mesh_io.hpp"
 
 using namespace geods;
 using namespace geods::bsp;
@@ -57,7 +57,7 @@ double brute_t(const Triangles& f, const Vec3d& o, const Vec3d& d) {
 // Answers equal brute force and the oblivious (cost heuristic) tree's; on a skewed ray
 // distribution the customized tree tests fewer polygons per ray.
 TEST(CustomBsp, RayDistribution) {
-  const Triangles bunny = from_tri_mesh(io::read_mesh(std::string(GEODS_DATA_DIR) + "/bunny.ply"));
+  const Triangles bunny = from_tri_mesh(test::data_mesh("bunny.ply"));
   const RayQuery sample = skewed_rays(bunny, 1000, 1), rays = skewed_rays(bunny, 2000, 2);
   BuildOptions custom;
   custom.heuristic = Heuristic::custom;

@@ -1,3 +1,4 @@
+#include "common/data_files.hpp"
 #include "geods/bsp/deferred.hpp"
 
 #include <gtest/gtest.h>
@@ -6,7 +7,6 @@
 
 #include "bsp/meshes.hpp"
 #include "geods/core/predicates.hpp"
-#include "geods/io/mesh_io.hpp"
 
 using namespace geods;
 using namespace geods::bsp;
@@ -33,7 +33,7 @@ bool brute(const Triangles& m, const Vec3d& p, const Vec3d& q) {
 // of the bunny) the self-organizing tree tests fewer triangles per query than the
 // oblivious one, after building only part of it.
 TEST(DeferredBsp, ExactAndAdaptive) {
-  const Triangles bunny = from_tri_mesh(io::read_mesh(std::string(GEODS_DATA_DIR) + "/bunny.ply"));
+  const Triangles bunny = from_tri_mesh(test::data_mesh("bunny.ply"));
   DeferredBsp lazy(bunny, 4, 8), oblivious(bunny, 0, 8);
   std::mt19937_64 rng(9);
   std::normal_distribution<double> g;

@@ -2,19 +2,18 @@
 // Meshes, triangle soups, rays and brute-force oracles for the bvh tests.
 #include <cmath>
 #include <cstring>
-#include <filesystem>
 #include <limits>
-#include <string>
 #include <vector>
 
+#include "common/data_files.hpp"
 #include "common/simd_level_guard.hpp"
 #include "geods/bvh/triangle_bvh.hpp"
 #include "geods/core/rng.hpp"
 #include "geods/core/triangle.hpp"
-#include "geods/io/mesh_io.hpp"
 
 namespace geods::bvh::test {
 
+using geods::test::data_mesh;
 using geods::test::LevelGuard;
 
 /// The same hit to the bit: t, u, v and the triangle.
@@ -22,8 +21,6 @@ inline bool same_bits(const RayHit& a, const RayHit& b) {
   return std::memcmp(&a.t, &b.t, sizeof(float)) == 0 && std::memcmp(&a.u, &b.u, sizeof(float)) == 0 &&
          std::memcmp(&a.v, &b.v, sizeof(float)) == 0 && a.prim == b.prim;
 }
-
-inline TriMesh data_mesh(const std::string& name) { return io::read_mesh(std::filesystem::path(GEODS_DATA_DIR) / name); }
 
 inline Vec3f random_point(Rng& rng, float lo, float hi) {
   return {float(rng.uniform(lo, hi)), float(rng.uniform(lo, hi)), float(rng.uniform(lo, hi))};

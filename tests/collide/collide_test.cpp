@@ -8,11 +8,11 @@
 #include <cmath>
 #include <limits>
 
+#include "common/data_files.hpp"
 #include "geods/collide/collide.hpp"
 #include "geods/collide/triangle_pair.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/rng.hpp"
-#include "geods/io/mesh_io.hpp"
 
 namespace geods::collide {
 namespace {
@@ -181,8 +181,8 @@ TEST(Collide, TouchingAndCoplanarMeshes) {
 }
 
 TEST(Collide, DataMeshesUnderRandomPoses) {
-  const TriMesh bunny = io::read_mesh(std::string(GEODS_DATA_DIR) + "/bunny.ply");
-  const TriMesh teapot = io::read_mesh(std::string(GEODS_DATA_DIR) + "/teapot.obj");
+  const TriMesh bunny = test::data_mesh("bunny.ply");
+  const TriMesh teapot = test::data_mesh("teapot.obj");
   // Scale the teapot to the bunny's size.
   TriMesh pot = teapot;
   const AABB3f bb = bunny.bounds(), tb = teapot.bounds();

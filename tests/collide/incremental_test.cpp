@@ -2,10 +2,10 @@
 // of smooth motions, and the broad phase equals the narrow phase on all pairs.
 #include <gtest/gtest.h>
 
+#include "common/data_files.hpp"
 #include "geods/collide/incremental.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/rng.hpp"
-#include "geods/io/mesh_io.hpp"
 
 namespace geods::collide {
 namespace {
@@ -23,8 +23,8 @@ struct Scene {
   AABB3f bb;
   double size;
   Scene()
-      : bunny(io::read_mesh(std::string(GEODS_DATA_DIR) + "/bunny.ply")),
-        pot(io::read_mesh(std::string(GEODS_DATA_DIR) + "/teapot.obj")) {
+      : bunny(test::data_mesh("bunny.ply")),
+        pot(test::data_mesh("teapot.obj")) {
     bb = bunny.bounds();
     const AABB3f tb = pot.bounds();
     const float scale = 0.8f * (bb.hi - bb.lo).maxCoeff() / (tb.hi - tb.lo).maxCoeff();

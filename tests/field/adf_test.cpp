@@ -13,18 +13,18 @@
 #include <string>
 #include <vector>
 
+#include "common/data_files.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"
 #include "geods/core/rng.hpp"
 #include "geods/field/adf.hpp"
-#include "geods/io/mesh_io.hpp"
 #include "geods/shape/analytic_shapes.hpp"
 #include "mesh_oracle.hpp"
 
 namespace geods::field {
 namespace {
 
-TriMesh bunny() { return io::read_mesh(std::string(GEODS_DATA_DIR) + "/bunny.ply"); }
+TriMesh bunny() { return test::data_mesh("bunny.ply"); }
 
 // The exact signed distance (clamped to the band) by brute force and ray
 // parity; NaN where the parity is undecided.
@@ -336,8 +336,8 @@ TEST(Adf, DeepSparseTreesAndOldFiles) {
 // geods d5116bf (`geods adf data/bunny.ply --error 0.3 -o adf_bunny_v2.geodsadf`),
 // is read and gives exactly the answers of the ADF this version builds.
 TEST(Adf, SameAnswersAsThePreviousLayout) {
-  const Adf old = Adf::load(std::string(GEODS_DATA_DIR) + "/adf_bunny_v2.geodsadf");
-  EXPECT_EQ(Archive::peek(std::string(GEODS_DATA_DIR) + "/adf_bunny_v2.geodsadf").version, 2u);
+  const Adf old = Adf::load(test::data_path("adf_bunny_v2.geodsadf"));
+  EXPECT_EQ(Archive::peek(test::data_path("adf_bunny_v2.geodsadf")).version, 2u);
   const TriMesh b = bunny();
   const Adf adf = Adf::build(b, old.options());
   ASSERT_EQ(adf.num_cells(), old.num_cells());
@@ -363,7 +363,7 @@ TEST(Adf, SameAnswersAsThePreviousLayout) {
 // Single-byte corruptions of a saved ADF, loaded without checksums: a
 // geods::Error or an ADF that answers (the structure's checks keep queries in bounds).
 TEST(Adf, CorruptFilesAreRefusedOrConsistent) {
-  const Adf adf = Adf::load(std::string(GEODS_DATA_DIR) + "/adf_bunny_v2.geodsadf");
+  const Adf adf = Adf::load(test::data_path("adf_bunny_v2.geodsadf"));
   const auto dir = std::filesystem::temp_directory_path() / ("geods_adf_corrupt_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   adf.save(dir / "a.geodsadf");

@@ -6,11 +6,11 @@
 
 #include <cmath>
 
+#include "common/data_files.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/rng.hpp"
 #include "geods/field/modeling.hpp"
 #include "geods/field/sdf_grid.hpp"
-#include "geods/io/mesh_io.hpp"
 
 namespace geods::field {
 namespace {
@@ -42,7 +42,7 @@ TEST(Modeling, CsgAgreesWithMembershipOfTheMeshes) {
   // The bunny and a sphere through it, their exact fields on one grid; at random points
   // farther than a cell's diagonal from both surfaces, the sign of the interpolated
   // result is the Boolean of the meshes' own insides (exact signed distances, not the grids).
-  const TriMesh bunny = io::read_mesh(std::string(GEODS_DATA_DIR) + "/bunny.ply");
+  const TriMesh bunny = test::data_mesh("bunny.ply");
   const MeshDistance md = MeshDistance::build(bunny);
   const Grid3Geometry g = sdf_grid_geometry(bunny.bounds(), 28);
   const Grid3<float> object = sdf_grid(md, g).distance;

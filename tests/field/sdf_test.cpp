@@ -9,19 +9,18 @@
 #include <limits>
 #include <string>
 
+#include "common/data_files.hpp"
 #include "common/simd_level_guard.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"
 #include "geods/core/rng.hpp"
 #include "geods/core/simd_level.hpp"
 #include "geods/field/sdf_grid.hpp"
-#include "geods/io/mesh_io.hpp"
 #include "mesh_oracle.hpp"
 
 namespace geods::field {
 namespace {
 
-TriMesh data_mesh(const std::string& name) { return io::read_mesh(std::string(GEODS_DATA_DIR) + "/" + name); }
 
 double mesh_size(const TriMesh& m) { return m.bounds().extent().maxCoeff(); }
 
@@ -99,7 +98,7 @@ TEST(MeshDistance, CubeIsClosedWithUnitWinding) {
 }
 
 TEST(SdfGrid, BunnyEverySampleOfASmallGrid) {
-  const TriMesh bunny = data_mesh("bunny.ply");
+  const TriMesh bunny = test::data_mesh("bunny.ply");
   // Not a multiple of the tiles, anisotropic, shifted off the mesh's centre.
   Grid3Geometry grid = sdf_grid_geometry(bunny.bounds(), 11, 0, 2);
   grid.spacing = grid.spacing.cwiseProduct(Vec3f(1.0f, 1.15f, 0.9f));
@@ -111,7 +110,7 @@ TEST(SdfGrid, BunnyEverySampleOfThinGrids) {
   // Grids one or a few samples thick along some axes: tiles and blocks of
   // 1 to 3 samples, boxes without extent along an axis (the block lists'
   // interpolated bounds then rest on coincident corners).
-  const TriMesh bunny = data_mesh("bunny.ply");
+  const TriMesh bunny = test::data_mesh("bunny.ply");
   const Grid3Geometry base = sdf_grid_geometry(bunny.bounds(), 14, 0, 1);
   for (const std::array<std::size_t, 3> dims : {std::array<std::size_t, 3>{1, 14, 11}, {13, 1, 2}, {3, 6, 1}}) {
     Grid3Geometry grid = base;
@@ -123,7 +122,7 @@ TEST(SdfGrid, BunnyEverySampleOfThinGrids) {
 }
 
 TEST(SdfGrid, BunnyRandomSamplesOfALargerGrid) {
-  const TriMesh bunny = data_mesh("bunny.ply");
+  const TriMesh bunny = test::data_mesh("bunny.ply");
   const Grid3Geometry grid = sdf_grid_geometry(bunny.bounds(), 56, 0, 4);
   const SdfGrid r = sdf_grid(bunny, grid);
   EXPECT_EQ(r.stats.in_band, r.distance.size());
@@ -146,7 +145,7 @@ TEST(SdfGrid, BunnyRandomSamplesOfALargerGrid) {
 }
 
 TEST(SdfGrid, SameBitsForAnyThreadCount) {
-  const TriMesh bunny = data_mesh("bunny.ply");
+  const TriMesh bunny = test::data_mesh("bunny.ply");
   const Grid3Geometry grid = sdf_grid_geometry(bunny.bounds(), 40, 0, 3);
   SdfGridOptions options;
   options.faces = true;
@@ -162,7 +161,7 @@ TEST(SdfGrid, SameBitsForAnyThreadCount) {
 // same bits and faces, whole grid and band (portable alone where the CPU has
 // no AVX-512; ctest field_portable_simd runs the brute-force tests there too).
 TEST(SdfGrid, SameBitsAtEverySimdLevel) {
-  const TriMesh bunny = data_mesh("bunny.ply");
+  const TriMesh bunny = test::data_mesh("bunny.ply");
   const MeshDistance md = MeshDistance::build(bunny);
   const Grid3Geometry grid = sdf_grid_geometry(bunny.bounds(), 40, 0, 3);
   const test::LevelGuard guard;
@@ -184,7 +183,7 @@ TEST(SdfGrid, SameBitsAtEverySimdLevel) {
 }
 
 TEST(SdfGrid, NarrowBandEqualsTheWholeGridInside) {
-  const TriMesh bunny = data_mesh("bunny.ply");
+  const TriMesh bunny = test::data_mesh("bunny.ply");
   const Grid3Geometry grid = sdf_grid_geometry(bunny.bounds(), 48, 0, 3);
   const SdfGrid whole = sdf_grid(bunny, grid);
   SdfGridOptions options;
@@ -207,7 +206,7 @@ TEST(SdfGrid, NarrowBandEqualsTheWholeGridInside) {
 }
 
 TEST(SdfGrid, PropagationIsAnUpperBoundExactOnTheShell) {
-  const TriMesh bunny = data_mesh("bunny.ply");
+  const TriMesh bunny = test::data_mesh("bunny.ply");
   const MeshDistance md = MeshDistance::build(bunny);
   const Grid3Geometry grid = sdf_grid_geometry(bunny.bounds(), 48, 0, 4);
   SdfGridOptions options;
@@ -238,7 +237,7 @@ TEST(SdfGrid, PropagationIsAnUpperBoundExactOnTheShell) {
 }
 
 TEST(SignedDistance, PointsMatchBruteForceWithFeatures) {
-  const TriMesh bunny = data_mesh("bunny.ply");
+  const TriMesh bunny = test::data_mesh("bunny.ply");
   Rng rng(7);
   const AABB3f box = bunny.bounds();
   std::vector<Vec3f> points;
@@ -291,7 +290,7 @@ TEST(SignedDistance, PointsMatchBruteForceWithFeatures) {
 TEST(SignedDistance, OpenMeshHasASensibleInside) {
   // The bunny with a hole: winding numbers still call its deep inside inside,
   // and far outside outside.
-  TriMesh open = data_mesh("bunny.ply");
+  TriMesh open = test::data_mesh("bunny.ply");
   const TriMesh closed = open;
   open.triangles.erase(open.triangles.begin() + 100, open.triangles.begin() + 130);
   const MeshDistance md = MeshDistance::build(open);
@@ -320,7 +319,7 @@ TEST(MeshDistance, InsideByWindingIsTheWindingNumbersSide) {
   // Its polynomial arctangent must never change the side: on grids over the closed bunny
   // and the bunny with a hole, and at the centroids of the hole's missing faces (winding
   // numbers near 1/2, where the exact sum decides).
-  TriMesh open = data_mesh("bunny.ply");
+  TriMesh open = test::data_mesh("bunny.ply");
   const TriMesh closed = open;
   std::vector<Vec3f> points;
   for (std::size_t t = 100; t < 130; ++t) {
@@ -396,7 +395,7 @@ TEST(SdfGrid, GeometryFromResolutionOrSpacing) {
 // kernels squared a term of degree 3 and gave wrong distances and 2 % wrong
 // signs from 2^24 and below 2^-20, silently.)
 TEST(SdfGrid, PowerOfTwoScalesGiveTheUnitScaleFieldOrAreRefused) {
-  const TriMesh bunny = data_mesh("bunny.ply");  // coordinates up to 10
+  const TriMesh bunny = test::data_mesh("bunny.ply");  // coordinates up to 10
   const Grid3Geometry unit_grid = sdf_grid_geometry(bunny.bounds(), 20, 0, 2);
   for (const SignMethod sign : {SignMethod::winding, SignMethod::pseudonormal}) {
     SdfGridOptions options;

@@ -108,7 +108,7 @@ TEST(ImageIo, ReadsSixteenBitPngAndRealFile) {
   EXPECT_EQ(im.data, (std::vector<std::uint16_t>{0x1234, 0xfedc}));
   EXPECT_EQ(read_image(dir / "g16.png").data, (std::vector<std::uint8_t>{0x12, 0xfe}));
 
-  const auto brick = read_image(test::data_file("brick.png"));
+  const auto brick = read_image(test::data_path("brick.png"));
   EXPECT_EQ(brick.width, 512u);
   EXPECT_EQ(brick.height, 512u);
   EXPECT_EQ(brick.channels, 1u);

@@ -12,9 +12,12 @@
 #include <unistd.h>
 #include <vector>
 
+#include "common/data_files.hpp"
 #include "geods/core/error.hpp"
 
 namespace geods::io::test {
+
+using geods::test::data_path;
 
 namespace fs = std::filesystem;
 
@@ -93,7 +96,5 @@ inline void expect_truncations_fail(const fs::path& dir, const std::string& name
     }
   }
 }
-
-inline std::string data_file(const std::string& name) { return (std::filesystem::path(GEODS_DATA_DIR) / name).string(); }
 
 }  // namespace geods::io::test

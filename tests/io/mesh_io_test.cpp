@@ -62,11 +62,11 @@ TEST(MeshIo, WritesAndReadsNormals) {
 }
 
 TEST(MeshIo, ReadsRealFiles) {
-  const TriMesh bunny = read_mesh(test::data_file("bunny.ply"));
+  const TriMesh bunny = read_mesh(test::data_path("bunny.ply"));
   EXPECT_EQ(bunny.num_vertices(), 1839u);
   EXPECT_EQ(bunny.num_triangles(), 3674u);
   EXPECT_TRUE(bunny.validate().valid());
-  const TriMesh teapot = read_mesh(test::data_file("teapot.obj"));
+  const TriMesh teapot = read_mesh(test::data_path("teapot.obj"));
   EXPECT_EQ(teapot.num_triangles(), 992u);
   EXPECT_TRUE(teapot.validate().valid());
 }
@@ -216,7 +216,7 @@ TEST(MeshIo, MalformedFilesThrowNamingTheFile) {
   auto ascii = test::read_bytes(dir / "ca.ply");
   ascii.resize(ascii.size() - 20);  // strictly: cut inside the faces
   test::expect_truncations_fail(dir.path(), "cuta.ply", ascii, read);
-  test::expect_truncations_fail(dir.path(), "cutbunny.ply", test::read_bytes(test::data_file("bunny.ply")), read);
+  test::expect_truncations_fail(dir.path(), "cutbunny.ply", test::read_bytes(test::data_path("bunny.ply")), read);
   write_mesh(dir / "c.obj", cube());
   test::expect_truncations_fail(dir.path(), "cut.obj", test::read_bytes(dir / "c.obj"), read, false);
 }

@@ -122,7 +122,7 @@ TEST(Npy, ReadsFortranOrderAsCOrder) {
 }
 
 TEST(Npy, ReadsRealFile) {
-  const NpyArray a = read_npy(test::data_file("jacksboro_dem.npy"));
+  const NpyArray a = read_npy(test::data_path("jacksboro_dem.npy"));
   EXPECT_EQ(a.dtype, DType::i16);
   EXPECT_EQ(a.shape, (std::vector<std::size_t>{344, 403}));
   const auto v = a.to_vector<double>();

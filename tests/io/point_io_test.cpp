@@ -31,10 +31,10 @@ TEST(PointIo, RoundTripEveryFormat) {
 }
 
 TEST(PointIo, ReadsRealFilesAndVariants) {
-  const PointMatrix land = read_points(test::data_file("land_points.npy"));
+  const PointMatrix land = read_points(test::data_path("land_points.npy"));
   EXPECT_EQ(land.rows(), 4996);
   EXPECT_EQ(land.cols(), 2);
-  const SegmentMatrix seg = read_segments(test::data_file("land_segments.npy"));
+  const SegmentMatrix seg = read_segments(test::data_path("land_segments.npy"));
   EXPECT_EQ(seg.rows(), 4999);
 
   TempDir dir;

@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "common/data_files.hpp"
 #include "geods/core/error.hpp"
 #include "geods/io/polygon_io.hpp"
 
@@ -43,7 +44,7 @@ TEST(PolygonIo, CinAndSvg) {
 }
 
 TEST(PolygonIo, Shapefile) {
-  const PolygonSet s = read_polygons(std::filesystem::path(GEODS_DATA_DIR) / "nc_counties.shp");
+  const PolygonSet s = read_polygons(test::data_path("nc_counties.shp"));
   EXPECT_GE(s.rings.size(), 100u);  // 100 counties, some of several parts
   for (const auto& r : s.rings)
     for (const Vec2d& p : r) {

@@ -59,7 +59,7 @@ TEST(VolumeIo, RoundTripEveryTypeAndFormat) {
 }
 
 TEST(VolumeIo, ReadsRealNifti) {
-  const AnyGrid3 v = read_volume(test::data_file("t1_head.nii.gz"));
+  const AnyGrid3 v = read_volume(test::data_path("t1_head.nii.gz"));
   const auto dims = std::visit([](const auto& g) { return g.dims; }, v);
   EXPECT_EQ(dims, (std::array<std::size_t, 3>{128, 128, 62}));
   const Grid3<float> f = to_float(v);

@@ -19,6 +19,7 @@
 #include <utility>
 #include <vector>
 
+#include "common/data_files.hpp"
 #include "common/archive_files.hpp"
 #include "geods/core/archive.hpp"
 #include "geods/core/error.hpp"
@@ -577,7 +578,7 @@ TEST(MinMaxOctree, SmallSurfacesVisitFewCells) {
 }
 
 TEST(Isosurface, DemoHeadVolumePaddedIsClosed) {
-  const Grid3<float> head = io::to_float(io::read_volume(std::string(GEODS_DATA_DIR) + "/t1_head.nii.gz"));
+  const Grid3<float> head = io::to_float(io::read_volume(test::data_path("t1_head.nii.gz")));
   // Pad with the minimum so that the surface closes at the border.
   const float low = *std::min_element(head.data.begin(), head.data.end());
   const float high = *std::max_element(head.data.begin(), head.data.end());

@@ -12,12 +12,12 @@
 #include <limits>
 #include <vector>
 
+#include "common/data_files.hpp"
 #include "bvh/bvh_test_util.hpp"
 #include "common/archive_files.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"
 #include "geods/core/rng.hpp"
-#include "geods/io/mesh_io.hpp"
 #include "geods/ray/accelerator.hpp"
 #include "geods/ray/bvh_accelerator.hpp"
 #include "geods/ray/ray_classifier.hpp"
@@ -187,15 +187,14 @@ void expect_same_as_brute_force(const TriMesh& mesh, const std::vector<Ray3f>& r
   }
 }
 
-TriMesh load(const char* name) { return io::read_mesh(std::string(GEODS_DATA_DIR) + "/" + name); }
 
 TEST(Accelerators, BunnyMatchesBruteForce) {
-  const TriMesh mesh = load("bunny.ply");
+  const TriMesh mesh = test::data_mesh("bunny.ply");
   expect_same_as_brute_force(mesh, test_rays(mesh, 1, 1800), "bunny");
 }
 
 TEST(Accelerators, TeapotMatchesBruteForce) {
-  const TriMesh mesh = load("teapot.obj");
+  const TriMesh mesh = test::data_mesh("teapot.obj");
   expect_same_as_brute_force(mesh, test_rays(mesh, 2, 1800), "teapot");
 }
 
@@ -326,7 +325,7 @@ TEST(Accelerators, ClosedGridCubeNeverLeaks) {
 }
 
 TEST(Accelerators, SmallLeavesDeepTreesAndCutoffMatchBruteForce) {
-  const TriMesh mesh = load("bunny.ply");
+  const TriMesh mesh = test::data_mesh("bunny.ply");
   AcceleratorOptions options;
   options.grid_density = 0.3f;  // coarse grid: many triangles per cell
   options.octree_leaf_size = 1;
@@ -397,7 +396,7 @@ TEST(Accelerators, EmptyFlatAndBadInput) {
 // (core/ray_triangle.hpp): a mesh beyond +-2^35 or spanning less than 2^-34,
 // and rays from beyond +-2^35, in single and packet queries alike.
 TEST(Accelerators, MeshesAndRaysBeyondTheTriangleTestsRangeAreRefused) {
-  const TriMesh bunny = load("bunny.ply");
+  const TriMesh bunny = test::data_mesh("bunny.ply");
   for (int e : {40, -40}) {
     TriMesh m = bunny;
     for (Vec3f& v : m.vertices) v = Vec3f(std::ldexp(v[0], e), std::ldexp(v[1], e), std::ldexp(v[2], e));
@@ -430,7 +429,7 @@ TEST(Accelerators, MeshesAndRaysBeyondTheTriangleTestsRangeAreRefused) {
 }
 
 TEST(Accelerators, ParallelQueriesGiveTheSameAnswers) {
-  const TriMesh mesh = load("bunny.ply");
+  const TriMesh mesh = test::data_mesh("bunny.ply");
   const std::vector<Ray3f> rays = test_rays(mesh, 21, 2000);
   for (AcceleratorKind kind : all_accelerator_kinds()) {
     const auto accel = make_accelerator(mesh, kind);
@@ -490,7 +489,7 @@ TEST(Accelerators, GridAndOctreeBuildsAreTheSameOnAnyThreadCount) {
 }
 
 TEST(Accelerators, CachesHelpCoherentRays) {
-  const TriMesh mesh = load("bunny.ply");
+  const TriMesh mesh = test::data_mesh("bunny.ply");
   const auto accel = make_accelerator(mesh, AcceleratorKind::rays5d);
   const AABB3f box = mesh.bounds();
   // A fan of coherent rays from one eye, then shadow rays towards one light.
@@ -524,7 +523,7 @@ TEST(Accelerators, CachesHelpCoherentRays) {
 }
 
 TEST(Accelerators, StatsDescribeTheStructures) {
-  const TriMesh mesh = load("bunny.ply");
+  const TriMesh mesh = test::data_mesh("bunny.ply");
   const auto grid = UniformGrid::build(mesh);
   const AcceleratorStats g = grid->stats();
   EXPECT_EQ(g.kind, "grid");
@@ -552,7 +551,7 @@ TEST(AcceleratorArchive, EveryKindRoundTripsBitForBit) {
   TriMesh flat = ugly_soup(31, 400);
   for (Vec3f& v : flat.vertices) v.y() = -0.5f;
   const std::pair<const char*, TriMesh> meshes[] = {
-      {"bunny", load("bunny.ply")}, {"one", one}, {"flat", flat}, {"soup", ugly_soup(32, 1500)}};
+      {"bunny", test::data_mesh("bunny.ply")}, {"one", one}, {"flat", flat}, {"soup", ugly_soup(32, 1500)}};
   for (const auto& [name, mesh] : meshes)
     for (AcceleratorKind kind : all_accelerator_kinds()) {
       SCOPED_TRACE(std::string(name) + " " + std::string(to_string(kind)));
@@ -583,7 +582,7 @@ TEST(AcceleratorArchive, EveryKindRoundTripsBitForBit) {
 }
 
 TEST(AcceleratorArchive, OctreeArraysAreMappedAndEqual) {
-  const TriMesh mesh = load("teapot.obj");
+  const TriMesh mesh = test::data_mesh("teapot.obj");
   const auto built = RayOctree::build(mesh);
   const auto path = geods::test::temp_archive("octree_arrays");
   built->save(path);
@@ -736,7 +735,7 @@ std::size_t expect_packets_answer_as_single_rays(const Accelerator& accel, Accel
 // time gives (the BVH traverses the packet together; the others loop), bad
 // rays and partial masks included.
 TEST(Accelerators, PacketsAnswerAsSingleRays) {
-  const TriMesh mesh = load("bunny.ply");
+  const TriMesh mesh = test::data_mesh("bunny.ply");
   std::vector<Ray3f> rays = test_rays(mesh, 17, 400);
   rays[3].direction = Vec3f::Zero();
   rays[12].origin.x() = std::numeric_limits<float>::quiet_NaN();

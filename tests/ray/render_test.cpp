@@ -4,15 +4,15 @@
 
 #include <cmath>
 
+#include "common/data_files.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"
-#include "geods/io/mesh_io.hpp"
 #include "geods/ray/render.hpp"
 
 namespace geods::ray {
 namespace {
 
-TriMesh bunny() { return io::read_mesh(std::string(GEODS_DATA_DIR) + "/bunny.ply"); }
+TriMesh bunny() { return test::data_mesh("bunny.ply"); }
 
 bool is_background(const Image<std::uint8_t>& image, std::size_t x, std::size_t y) {
   // The background is a bluish-grey gradient: blue above red; the surface is warm: red above blue.

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <map>
 
+#include "common/data_files.hpp"
 #include "geods/core/error.hpp"
 #include "geods/io/mesh_io.hpp"
 #include "geods/shape/collection.hpp"
@@ -129,7 +130,7 @@ TEST(ShapeCollection, ZipArchiveReadsMembersInMemory) {
 }
 
 TEST(ShapeCollection, SweetHome3DLibraryLabelsByCategory) {
-  const ShapeCollection c = ShapeCollection::open(GEODS_DATA_DIR "/furniture.sh3f");
+  const ShapeCollection c = ShapeCollection::open(test::data_path("furniture.sh3f"));
   EXPECT_EQ(c.kind(), CollectionKind::sh3f);
   ASSERT_EQ(c.size(), 14u);
   EXPECT_TRUE(c.warnings().empty());
@@ -148,7 +149,7 @@ TEST(ShapeCollection, SweetHome3DLibraryLabelsByCategory) {
   // A CSV overrides the catalog.
   TempDir dir;
   write_text(dir.path / "l.csv", "blendswap-cc-0/rock1/rock1.obj,stone\n");
-  const ShapeCollection relabelled = ShapeCollection::open(GEODS_DATA_DIR "/furniture.sh3f", dir.path / "l.csv");
+  const ShapeCollection relabelled = ShapeCollection::open(test::data_path("furniture.sh3f"), dir.path / "l.csv");
   for (const auto& e : relabelled.entries())
     EXPECT_EQ(e.label == "stone", e.name == "blendswap-cc-0/rock1/rock1.obj") << e.name;
 }

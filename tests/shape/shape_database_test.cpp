@@ -9,9 +9,9 @@
 #include <map>
 #include <random>
 
+#include "common/data_files.hpp"
 #include "geods/core/archive.hpp"
 #include "geods/core/error.hpp"
-#include "geods/io/mesh_io.hpp"
 #include "geods/shape/retrieval.hpp"
 #include "geods/shape/shape_database.hpp"
 #include "shape/test_meshes.hpp"
@@ -102,8 +102,8 @@ TEST(ShapeDatabase, ExactAndApproximateKnnMatchBruteForceAcrossAdds) {
 }
 
 TEST(ShapeDatabase, RetrievesTransformedCopiesAtPrecisionOne) {
-  const TriMesh bunny = io::read_mesh(GEODS_DATA_DIR "/bunny.ply");
-  const TriMesh teapot = io::read_mesh(GEODS_DATA_DIR "/teapot.obj");
+  const TriMesh bunny = test::data_mesh("bunny.ply");
+  const TriMesh teapot = test::data_mesh("teapot.obj");
   const std::vector<std::pair<std::string, TriMesh>> originals = {
       {"bunny", bunny}, {"teapot", teapot}, {"sphere", testing::icosphere(3)},
       {"cube", testing::cube()}, {"cylinder", testing::cylinder(48, 1, 4)}};
@@ -146,7 +146,7 @@ TEST(ShapeDatabase, SaveLoadRoundTripMapsAndKeepsAdding) {
   std::vector<std::string> labels;
   for (std::size_t i = 0; i < 300; ++i) labels.push_back(i % 3 ? "chair" : "");
   db.add_descriptors(numbered(300), random_descriptors(300, dim, 4), labels);
-  db.add("bunny", io::read_mesh(GEODS_DATA_DIR "/bunny.ply"), "animal");
+  db.add("bunny", test::data_mesh("bunny.ply"), "animal");
   const fs::path path = temp_file("db.geodsshapes");
   db.save(path);
   ShapeDatabase loaded = ShapeDatabase::load(path);
@@ -165,7 +165,7 @@ TEST(ShapeDatabase, SaveLoadRoundTripMapsAndKeepsAdding) {
     }
   }
   // Adding to a loaded database continues the ids and answers like adding to the original.
-  const TriMesh teapot = io::read_mesh(GEODS_DATA_DIR "/teapot.obj");
+  const TriMesh teapot = test::data_mesh("teapot.obj");
   EXPECT_EQ(loaded.add("teapot", teapot, "kitchen"), 301u);
   EXPECT_EQ(loaded.query(teapot, 1).front().name, "teapot");
   EXPECT_EQ(loaded.query(teapot, 1).front().distance, 0.0);

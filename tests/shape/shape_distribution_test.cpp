@@ -10,9 +10,9 @@
 #include <numbers>
 #include <random>
 
+#include "common/data_files.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"
-#include "geods/io/mesh_io.hpp"
 #include "geods/shape/shape_distribution.hpp"
 #include "shape/test_meshes.hpp"
 
@@ -201,7 +201,7 @@ TEST(SurfaceSampler, PicksTrianglesByAreaAndNeverZeroArea) {
 }
 
 TEST(ShapeDistribution, DeterministicPerSeedAndThreadCount) {
-  const TriMesh bunny = io::read_mesh(GEODS_DATA_DIR "/bunny.ply");
+  const TriMesh bunny = test::data_mesh("bunny.ply");
   DistributionOptions o;
   o.samples = 50000;
   const auto a = shape_distribution(bunny, ShapeFunction::d2, o);
@@ -217,8 +217,8 @@ TEST(ShapeDistribution, DeterministicPerSeedAndThreadCount) {
 
 // ---------------------------------------------------------------- invariance
 TEST(ShapeDistribution, InvariantToRigidMotionScaleAndTessellation) {
-  const TriMesh bunny = io::read_mesh(GEODS_DATA_DIR "/bunny.ply");
-  const TriMesh teapot = io::read_mesh(GEODS_DATA_DIR "/teapot.obj");
+  const TriMesh bunny = test::data_mesh("bunny.ply");
+  const TriMesh teapot = test::data_mesh("teapot.obj");
   const float size = bunny.bounds().extent().maxCoeff();
   const std::vector<std::pair<const char*, TriMesh>> copies = {
       {"rotated", testing::transformed(bunny, testing::rotation(1.1f, {1, 2, 3}), Vec3f::Zero(), 1)},
@@ -318,7 +318,7 @@ TEST(Descriptor, ParseAndCombine) {
   DescriptorOptions o = w;
   o.distribution.samples = 20000;
   o.distribution.bins = 16;
-  const TriMesh teapot = io::read_mesh(GEODS_DATA_DIR "/teapot.obj");
+  const TriMesh teapot = test::data_mesh("teapot.obj");
   const std::vector<float> d = describe(teapot, o);
   ASSERT_EQ(d.size(), 32u);
   DistributionOptions one = o.distribution;

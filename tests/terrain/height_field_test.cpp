@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "common/data_files.hpp"
 #include "geods/core/error.hpp"
 #include "geods/io/image_io.hpp"
 #include "geods/io/npy.hpp"
@@ -40,10 +41,10 @@ TEST(HeightField, ImagesAndArrays) {
   // Real data: the Jacksboro DEM, and a 24-bit BMP (grey in all channels; the first
   // one is read) written from its top-left 128 x 96 samples as (z - 236) / 4
   // (integer division): sample for sample the same field, rows in the same order.
-  const HeightField dem = read_height_field(std::filesystem::path(GEODS_DATA_DIR) / "jacksboro_dem.npy");
+  const HeightField dem = read_height_field(test::data_path("jacksboro_dem.npy"));
   EXPECT_EQ(dem.width, 403u);
   EXPECT_EQ(dem.height, 344u);
-  const HeightField bmp = read_height_field(std::filesystem::path(GEODS_DATA_DIR) / "jacksboro_dem_crop.bmp");
+  const HeightField bmp = read_height_field(test::data_path("jacksboro_dem_crop.bmp"));
   ASSERT_EQ(bmp.width, 128u);
   ASSERT_EQ(bmp.height, 96u);
   for (std::size_t y = 0; y < bmp.height; ++y)
@@ -52,7 +53,7 @@ TEST(HeightField, ImagesAndArrays) {
 }
 
 TEST(HeightField, GeoTiffThroughGdal) {
-  const HeightField f = read_height_field(std::filesystem::path(GEODS_DATA_DIR) / "terra_lux_elev.tif");
+  const HeightField f = read_height_field(test::data_path("terra_lux_elev.tif"));
   EXPECT_EQ(f.width, 95u);
   EXPECT_EQ(f.height, 90u);
   // Geotransform: 0.00833 degrees per sample, rows going south.
@@ -121,7 +122,7 @@ TEST(HeightField, BadFiles) {
   }
   EXPECT_THROW(read_height_field(temp("junk.tif")), Error);
   // A truncated GeoTIFF.
-  const auto src = std::filesystem::path(GEODS_DATA_DIR) / "terra_lux_elev.tif";
+  const auto src = test::data_path("terra_lux_elev.tif");
   std::filesystem::copy_file(src, temp("cut.tif"), std::filesystem::copy_options::overwrite_existing);
   std::filesystem::permissions(temp("cut.tif"), std::filesystem::perms::owner_write, std::filesystem::perm_options::add);
   std::filesystem::resize_file(temp("cut.tif"), 3000);

@@ -16,6 +16,7 @@
 #include <random>
 #include <set>
 
+#include "common/data_files.hpp"
 #include "common/simd_level_guard.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/simd_level.hpp"
@@ -42,7 +43,7 @@ HeightField noise(std::size_t w, std::size_t h, unsigned seed, double amplitude 
 }
 
 HeightField real_field() {
-  const io::NpyArray a = io::read_npy(std::filesystem::path(GEODS_DATA_DIR) / "jacksboro_dem.npy");
+  const io::NpyArray a = io::read_npy(test::data_path("jacksboro_dem.npy"));
   const std::vector<double> v = a.to_vector<double>();
   // A 70 x 45 corner keeps the oracle fast (it is quadratic).
   return field_of(70, 45, [&](double x, double y) { return v[std::size_t(y) * a.shape[1] + std::size_t(x)]; });
