@@ -16,6 +16,10 @@ ndimage = pytest.importorskip("scipy.ndimage")
 da = pytest.importorskip("dask.array")
 gd = pytest.importorskip("geods.dask")
 
+# Debian 12's dask.distributed (2022.12) starts tornado's (6.2) IO loop the
+# way tornado deprecated: a warning about those two packages, not about geods.
+pytestmark = pytest.mark.filterwarnings("ignore:make_current is deprecated:DeprecationWarning:tornado")
+
 
 @pytest.fixture(scope="module")
 def client():
