@@ -21,7 +21,6 @@
 namespace geods::field {
 namespace {
 
-
 double mesh_size(const TriMesh& m) { return m.bounds().extent().maxCoeff(); }
 
 // Checks one sample of a field against brute force: the distance, and on a

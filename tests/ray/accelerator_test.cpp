@@ -187,7 +187,6 @@ void expect_same_as_brute_force(const TriMesh& mesh, const std::vector<Ray3f>& r
   }
 }
 
-
 TEST(Accelerators, BunnyMatchesBruteForce) {
   const TriMesh mesh = test::data_mesh("bunny.ply");
   expect_same_as_brute_force(mesh, test_rays(mesh, 1, 1800), "bunny");
