@@ -24,8 +24,6 @@
 namespace geods::field {
 namespace {
 
-TriMesh bunny() { return test::data_mesh("bunny.ply"); }
-
 // The exact signed distance (clamped to the band) by brute force and ray
 // parity; NaN where the parity is undecided.
 double exact(const TriMesh& m, const Vec3f& p, double band = INFINITY) {
@@ -155,7 +153,7 @@ TEST(Adf, RandomPointsWithinTheBound) {
     EXPECT_LE(max_random_error(coarse, *m, 2000, 8), 2 * o.error);
   }
   // The bunny (3,674 faces) in a band: the clamped field.
-  const TriMesh b = bunny();
+  const TriMesh b = test::data_mesh("bunny.ply");
   AdfOptions o;
   o.error = 0.1;
   o.band = 0.6;
@@ -221,7 +219,7 @@ TEST(Adf, GradientMatchesFiniteDifferencesAwayFromTheMedialAxis) {
 }
 
 TEST(Adf, ClosestPointIsOnTheSurfaceAtTheDistance) {
-  const TriMesh m = bunny();
+  const TriMesh m = test::data_mesh("bunny.ply");
   AdfOptions o;
   o.error = 0.05;
   o.band = 0.5;
@@ -338,7 +336,7 @@ TEST(Adf, DeepSparseTreesAndOldFiles) {
 TEST(Adf, SameAnswersAsThePreviousLayout) {
   const Adf old = Adf::load(test::data_path("adf_bunny_v2.geodsadf"));
   EXPECT_EQ(Archive::peek(test::data_path("adf_bunny_v2.geodsadf")).version, 2u);
-  const TriMesh b = bunny();
+  const TriMesh b = test::data_mesh("bunny.ply");
   const Adf adf = Adf::build(b, old.options());
   ASSERT_EQ(adf.num_cells(), old.num_cells());
   ASSERT_TRUE(std::equal(adf.inner_bits().begin(), adf.inner_bits().end(), old.inner_bits().begin()));

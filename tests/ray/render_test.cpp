@@ -12,15 +12,13 @@
 namespace geods::ray {
 namespace {
 
-TriMesh bunny() { return test::data_mesh("bunny.ply"); }
-
 bool is_background(const Image<std::uint8_t>& image, std::size_t x, std::size_t y) {
   // The background is a bluish-grey gradient: blue above red; the surface is warm: red above blue.
   return image(x, y, 2) > image(x, y, 0);
 }
 
 TEST(Render, EveryAcceleratorAndThreadCountGivesTheSamePicture) {
-  const TriMesh mesh = bunny();
+  const TriMesh mesh = test::data_mesh("bunny.ply");
   RenderOptions options;
   options.width = 96;
   options.height = 64;
@@ -48,7 +46,7 @@ TEST(Render, EveryAcceleratorAndThreadCountGivesTheSamePicture) {
 }
 
 TEST(Render, FramingShowsTheWholeMesh) {
-  const TriMesh mesh = bunny();
+  const TriMesh mesh = test::data_mesh("bunny.ply");
   RenderOptions options;
   options.width = options.height = 80;
   const RenderResult result = render(mesh, options);
@@ -89,7 +87,7 @@ TEST(Render, PrimaryRaysSpanTheFieldOfView) {
 }
 
 TEST(Render, ShadowsDarkenAndUseTheOccluderCache) {
-  const TriMesh mesh = bunny();
+  const TriMesh mesh = test::data_mesh("bunny.ply");
   RenderOptions options;
   options.width = options.height = 160;  // neighbouring shadow rays often meet the same triangle
   const RenderResult lit = render(mesh, options);
@@ -116,7 +114,7 @@ TEST(Render, ShadowsDarkenAndUseTheOccluderCache) {
 TEST(Render, PacketsGiveTheSamePictureAsSingleRays) {
   // Sizes that are not multiples of the 4 x 4 pixel packets; 4 and 8 wide
   // BVHs (packet traversal) and the octree (ray by ray behind the interface).
-  const TriMesh mesh = bunny();
+  const TriMesh mesh = test::data_mesh("bunny.ply");
   RenderOptions options;
   options.width = 75;
   options.height = 41;
@@ -139,7 +137,7 @@ TEST(Render, PacketsGiveTheSamePictureAsSingleRays) {
 }
 
 TEST(Render, BadOptionsRaise) {
-  const TriMesh mesh = bunny();
+  const TriMesh mesh = test::data_mesh("bunny.ply");
   RenderOptions options;
   options.width = 0;
   EXPECT_THROW(render(mesh, options), Error);

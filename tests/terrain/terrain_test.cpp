@@ -585,10 +585,9 @@ TEST(Terrain, GreedyTinsWithinTheBoundAndTiled) {
 TEST(Terrain, GreedyTinTheSameAtEverySimdLevel) {
   const Terrain t(real_field());
   const test::LevelGuard guard;
-  const SimdLevel level = simd_level();
   set_simd_level(SimdLevel::portable);
   const TerrainMesh portable = t.tin(1.0), portable_tiles = t.tin(3.0, 2);
-  set_simd_level(level);
+  set_simd_level(guard.saved);
   const TerrainMesh best = t.tin(1.0), best_tiles = t.tin(3.0, 2);
   EXPECT_EQ(best.samples, portable.samples);
   EXPECT_EQ(best.triangles, portable.triangles);
@@ -607,13 +606,12 @@ TEST(Terrain, RecordsTheSameAtEverySimdLevel) {
       {noise(257, 257, 21), 1}, {noise(300, 170, 22, 1000), 1e-3}, {noise(129, 400, 23), 1e30}, {noise(1025, 600, 24), 1},
       {real_field(), 1}};
   const test::LevelGuard guard;
-  const SimdLevel level = simd_level();
   for (const auto& [f, scale] : fields)
     for (const Layout layout : {Layout::interleaved, Layout::matrix}) {
       SCOPED_TRACE(std::to_string(f.width) + " x " + std::to_string(f.height));
       set_simd_level(SimdLevel::portable);
       const Terrain portable(f, {.z_scale = scale, .layout = layout});
-      for (const SimdLevel l : {std::min(level, SimdLevel::avx2), level}) {
+      for (const SimdLevel l : {std::min(guard.saved, SimdLevel::avx2), guard.saved}) {
         set_simd_level(l);
         const Terrain t(f, {.z_scale = scale, .layout = layout});
         ASSERT_EQ(t.records().size(), portable.records().size());
