@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <string>
 #include <utility>
 
@@ -23,6 +24,39 @@ void check_query(const Vec2d& q) {
   if (!std::isfinite(q[0]) || !std::isfinite(q[1]))
     throw Error("nearest site: non-finite query point (" + format_number(q[0]) + ", " + format_number(q[1]) + ")");
   check_query_range<2>(std::span<const double>(q.data(), 2), "nearest site");
+}
+
+// An edge the slabs store, as its half-edge with the higher site on its left (going up
+// crosses the bisector towards the site with the larger y), its direction's slope and
+// its x range (an infinite end at -inf or +inf).
+struct SlabEdge {
+  std::uint32_t half_edge;
+  double slope, from, to;
+};
+
+// The undirected edge {e, twin} as the slabs store it; nothing for a vertical bisector
+// (sites at equal y) or a direction that rounding made vertical, or an edge of no width.
+std::optional<SlabEdge> slab_edge(const Voronoi2& diagram, std::uint32_t e) {
+  const auto& edges = diagram.edges();
+  const std::uint32_t t = edges[e].twin;
+  const double ya = diagram.points()[edges[e].site][1], yb = diagram.points()[edges[t].site][1];
+  if (ya == yb) return std::nullopt;
+  const std::uint32_t up = ya > yb ? e : t;
+  const Vec2d d = diagram.direction(up);
+  if (d[0] == 0) return std::nullopt;
+  const auto& vertices = diagram.vertices();
+  const Voronoi2::Edge& edge = edges[up];
+  const double from = edge.origin != Voronoi2::kInfinity ? vertices[edge.origin][0] : (d[0] > 0 ? -kInf : kInf);
+  const double to = edge.target != Voronoi2::kInfinity ? vertices[edge.target][0] : (d[0] > 0 ? kInf : -kInf);
+  if (from == to) return std::nullopt;
+  return SlabEdge{up, d[1] / d[0], std::min(from, to), std::max(from, to)};
+}
+
+// The first and last slab between the slab boundaries xs (sorted, distinct) that an edge
+// spanning x in [from, to] crosses: from the one right of `from` to the one left of `to`.
+std::array<std::uint32_t, 2> crossed_slabs(const std::vector<double>& xs, double from, double to) {
+  const auto at = [&](double x) { return std::uint32_t(std::lower_bound(xs.begin(), xs.end(), x) - xs.begin()); };
+  return {from == -kInf ? 0 : at(from) + 1, to == kInf ? std::uint32_t(xs.size()) : at(to)};
 }
 
 }  // namespace
@@ -61,110 +95,112 @@ SlabLocator::SlabLocator(const Voronoi2& diagram) : diagram_(&diagram) {
   const auto& vertices = diagram.vertices();
   const std::span<const Vec2d> points = diagram.points();
 
-  // Each undirected edge that is not vertical, as its half-edge with the higher site
-  // on its left (going up crosses a bisector towards the site with the larger y).
-  struct Span {
-    std::uint32_t edge;
-    double x0, x1;
-  };
-  std::vector<Span> spans;
+  std::vector<SlabEdge> spans;
   lines_.resize(edges.size());
   xs_.reserve(vertices.size());
   for (const Vec2d& v : vertices) xs_.push_back(v[0]);
   for (std::uint32_t e = 0; e < edges.size(); ++e) {
-    const std::uint32_t t = edges[e].twin;
-    if (t < e) continue;
-    const double ya = points[edges[e].site][1], yb = points[edges[t].site][1];
-    if (ya == yb) {  // a vertical bisector: a slab boundary when it is a whole line
-      if (edges[e].origin == Voronoi2::kInfinity && edges[e].target == Voronoi2::kInfinity)
-        xs_.push_back(diagram.line_point(e)[0]);
-      continue;
-    }
-    const std::uint32_t up = ya > yb ? e : t;
-    const Vec2d d = diagram.direction(up);
-    if (d[0] == 0) continue;  // rounding made a steep direction vertical: it spans no slab
-    const Voronoi2::Edge& edge = edges[up];
-    double x_from = edge.origin != Voronoi2::kInfinity ? vertices[edge.origin][0] : (d[0] > 0 ? -kInf : kInf);
-    double x_to = edge.target != Voronoi2::kInfinity ? vertices[edge.target][0] : (d[0] > 0 ? kInf : -kInf);
-    if (x_from > x_to) std::swap(x_from, x_to);
-    if (x_from < x_to) spans.push_back({up, x_from, x_to});
-    const Vec2d p = diagram.line_point(up);
-    lines_[up] = {p[0], p[1], d[1] / d[0]};
+    if (edges[e].twin < e) continue;
+    // A vertical bisector that is a whole line is a slab boundary.
+    if (points[edges[e].site][1] == points[edges[edges[e].twin].site][1] && edges[e].origin == Voronoi2::kInfinity &&
+        edges[e].target == Voronoi2::kInfinity)
+      xs_.push_back(diagram.line_point(e)[0]);
+    const std::optional<SlabEdge> span = slab_edge(diagram, e);
+    if (!span) continue;
+    spans.push_back(*span);
+    const Vec2d p = diagram.line_point(span->half_edge);
+    lines_[span->half_edge] = {p[0], p[1], span->slope};
   }
   std::sort(xs_.begin(), xs_.end());
   xs_.erase(std::unique(xs_.begin(), xs_.end()), xs_.end());
   const std::size_t slabs = xs_.size() + 1;
 
-  // Count the crossings per slab (a difference array), then fill.
-  const auto first_slab = [&](double x0) {
-    return x0 == -kInf ? std::size_t(0) : std::size_t(std::lower_bound(xs_.begin(), xs_.end(), x0) - xs_.begin()) + 1;
-  };
-  const auto last_slab = [&](double x1) {
-    return x1 == kInf ? xs_.size() : std::size_t(std::lower_bound(xs_.begin(), xs_.end(), x1) - xs_.begin());
-  };
-  // The spans in consecutive blocks, counted and filled block by block in parallel: each slab
-  // gets its edges in the order of the spans whatever the number of blocks (the sort below
-  // then sees the same input on any number of threads).
   std::vector<std::array<std::uint32_t, 2>> span_slabs(spans.size());  // first and last slab
   parallel_for(0, spans.size(), 4096, [&](std::size_t b, std::size_t e) {
-    for (std::size_t i = b; i < e; ++i)
-      span_slabs[i] = {std::uint32_t(first_slab(spans[i].x0)), std::uint32_t(last_slab(spans[i].x1))};
+    for (std::size_t i = b; i < e; ++i) span_slabs[i] = crossed_slabs(xs_, spans[i].from, spans[i].to);
   });
-  const std::size_t threads = std::size_t(num_threads());
-  const std::size_t blocks =
-      threads == 1 ? 1 : std::max<std::size_t>(1, std::min<std::size_t>(2 * threads, spans.size() / 4096));
-  const auto block_begin = [&](std::size_t b) { return b * spans.size() / blocks; };
-  // Per block and slab: how many of the block's spans cross the slab (from a difference
-  // array; unsigned wrap-around is exact since every count fits), later where they go.
-  std::vector<std::vector<std::uint32_t>> place(blocks);
-  parallel_for_each_index(0, blocks, [&](std::size_t b) {
-    std::vector<std::uint32_t>& c = place[b];
-    c.assign(slabs + 1, 0);
-    for (std::size_t i = block_begin(b); i < block_begin(b + 1); ++i) {
-      ++c[span_slabs[i][0]];
-      --c[span_slabs[i][1] + 1];
-    }
-    std::uint32_t running = 0;
-    for (std::size_t s = 0; s < slabs; ++s) c[s] = running += c[s];
-  }, 1);
-  std::size_t total = 0;
+  // Crossings per slab from a difference array (unsigned wrap-around is exact: every count fits).
   offsets_.assign(slabs + 1, 0);
-  for (std::size_t s = 0; s < slabs; ++s) {
-    for (std::size_t b = 0; b < blocks; ++b) total += place[b][s];
+  for (const auto& [first, last] : span_slabs) {
+    ++offsets_[first];
+    --offsets_[last + 1];
+  }
+  std::size_t total = 0;
+  for (std::uint32_t s = 0, crossing = 0; s < slabs; ++s) {
+    crossing += offsets_[s];
+    offsets_[s] = std::uint32_t(total);
+    total += crossing;
     if (total >= std::numeric_limits<std::uint32_t>::max())
       throw Error("SlabLocator: more than 2^32 edge-slab crossings (" + std::to_string(diagram.stats().distinct) +
                   " sites); use WalkLocator for this many sites");
-    offsets_[s + 1] = std::uint32_t(total);
   }
-  parallel_for(0, slabs, 1024, [&](std::size_t first, std::size_t last) {
-    for (std::size_t s = first; s < last; ++s)
-      for (std::uint32_t b = 0, at = offsets_[s]; b < blocks; ++b) at += std::exchange(place[b][s], at);
-  });
+  offsets_[slabs] = std::uint32_t(total);
   edge_.resize(total);
   below_.resize(total);
-  parallel_for_each_index(0, blocks, [&](std::size_t b) {
-    std::vector<std::uint32_t>& fill = place[b];
-    for (std::size_t i = block_begin(b); i < block_begin(b + 1); ++i)
-      for (std::size_t slab = span_slabs[i][0], last = span_slabs[i][1]; slab <= last; ++slab)
-        edge_[fill[slab]++] = spans[i].edge;
-  }, 1);
-
-  // Sort each slab bottom to top at its middle; edges do not cross inside a slab.
   top_.assign(slabs, 0);
-  const auto middle = [&](std::size_t s) { return slab_middle(s); };
-  parallel_for(0, slabs, 64, [&](std::size_t b, std::size_t e) {
-    for (std::size_t s = b; s < e; ++s) {
-      const double x = middle(s);
-      std::sort(edge_.begin() + offsets_[s], edge_.begin() + offsets_[s + 1],
-                [&](std::uint32_t a, std::uint32_t c) { return edge_y(a, x) < edge_y(c, x); });
+
+  // Each slab's edges sorted bottom to top at its middle; edges do not cross inside a slab.
+  // Slab s differs from slab s - 1 only by the edges that end or start at the line between
+  // them, so it is derived from it: the edges that go on, in their order, merged with the
+  // few that start (O(size) instead of a sort's O(size log size) comparisons, each reading
+  // two lines). Runs of kRun slabs are derived in parallel, each from a sort of its first
+  // slab: the runs do not depend on the number of threads, so neither do the slabs.
+  constexpr std::size_t kRun = 1024;
+  const std::size_t runs = (slabs + kRun - 1) / kRun;
+  std::vector<std::vector<std::uint32_t>> run_first(runs);  // the edges of each run's first slab
+  std::vector<std::uint32_t> last_slab_of(edges.size());
+  std::vector<std::uint32_t> start_at(slabs + 1, 0);  // slab s's starting edges: starting[start_at[s], start_at[s + 1])
+  for (std::size_t i = 0; i < spans.size(); ++i) {
+    const auto [first, last] = span_slabs[i];
+    last_slab_of[spans[i].half_edge] = last;
+    ++start_at[first + 1];
+    for (std::size_t r = (first + kRun - 1) / kRun; r * kRun <= last; ++r) run_first[r].push_back(spans[i].half_edge);
+  }
+  for (std::size_t s = 0; s < slabs; ++s) start_at[s + 1] += start_at[s];
+  std::vector<std::uint32_t> starting(spans.size());
+  {
+    std::vector<std::uint32_t> next(start_at.begin(), start_at.end() - 1);
+    for (std::size_t i = 0; i < spans.size(); ++i) starting[next[span_slabs[i][0]]++] = spans[i].half_edge;
+  }
+  parallel_for_each_index(0, runs, [&](std::size_t r) {
+    std::vector<std::pair<double, std::uint32_t>> fresh;  // the starting edges of a slab, by height
+    for (std::size_t s = r * kRun; s < std::min(slabs, (r + 1) * kRun); ++s) {
+      const double x = slab_middle(s);
+      const auto by_height = [&](std::uint32_t a, std::uint32_t c) { return edge_y(a, x) < edge_y(c, x); };
+      std::uint32_t* const out = edge_.data() + offsets_[s];
+      if (s == r * kRun) {
+        std::copy(run_first[r].begin(), run_first[r].end(), out);
+        std::sort(out, out + run_first[r].size(), by_height);
+      } else {
+        fresh.clear();
+        for (std::uint32_t k = start_at[s]; k < start_at[s + 1]; ++k)
+          fresh.push_back({edge_y(starting[k], x), starting[k]});
+        std::sort(fresh.begin(), fresh.end());
+        std::uint32_t* w = out;
+        auto next_fresh = fresh.begin();
+        double last_y = -kInf;
+        bool sorted = true;  // false where rounding at this x reorders edges that go on
+        for (std::uint32_t k = offsets_[s - 1]; k < offsets_[s]; ++k) {
+          const std::uint32_t e = edge_[k];
+          if (last_slab_of[e] < s) continue;  // ends at the line before this slab
+          const double y = edge_y(e, x);
+          for (; next_fresh != fresh.end() && next_fresh->first < y; ++next_fresh) *w++ = next_fresh->second;
+          sorted = sorted && last_y <= y;
+          last_y = y;
+          *w++ = e;
+        }
+        for (; next_fresh != fresh.end(); ++next_fresh) *w++ = next_fresh->second;
+        if (!sorted) std::sort(out, w, by_height);
+      }
       for (std::uint32_t k = offsets_[s]; k < offsets_[s + 1]; ++k) below_[k] = diagram.opposite_site(edge_[k]);
       if (offsets_[s + 1] > offsets_[s]) top_[s] = edges[edge_[offsets_[s + 1] - 1]].site;
     }
-  });
+  }, 1);
   // Slabs without edges lie inside one cell (several sites only when they are all on a horizontal line).
   std::uint32_t previous = diagram.representative(0);
   for (std::size_t s = 0; s < slabs; ++s)
-    if (offsets_[s + 1] == offsets_[s]) previous = top_[s] = descend_to_nearest(diagram, Vec2d(middle(s), 0), previous);
+    if (offsets_[s + 1] == offsets_[s])
+      previous = top_[s] = descend_to_nearest(diagram, Vec2d(slab_middle(s), 0), previous);
 }
 
 double SlabLocator::slab_middle(std::size_t s) const {
@@ -200,15 +236,38 @@ SlabLocatorStats SlabLocator::stats() const {
 }
 
 void SlabLocator::validate() const {
+  // Each slab holds the edges that cross it (counted as the constructor counts them) sorted
+  // bottom to top at its middle, each with the sites on either side. (That the site above one
+  // edge is the site below the next holds only up to the rounding of the Voronoi vertices:
+  // slabs narrower than that hold edges of both sides of a vertex computed twice.)
   const auto& edges = diagram_->edges();
-  for (std::size_t s = 0; s + 1 < offsets_.size(); ++s) {
-    const double x = slab_middle(s);
-    for (std::uint32_t k = offsets_[s]; k + 1 < offsets_[s + 1]; ++k) {
-      if (edge_y(edge_[k], x) > edge_y(edge_[k + 1], x))
-        throw Error("SlabLocator::validate: slab " + std::to_string(s) + " is not sorted");
-      if (edges[edge_[k]].site != below_[k + 1])
-        throw Error("SlabLocator::validate: slab " + std::to_string(s) + ": the cell between two edges differs");
+  std::vector<std::uint32_t> crossing(offsets_.size(), 0);  // a difference array, as in the constructor
+  for (std::uint32_t e = 0; e < edges.size(); ++e) {
+    if (edges[e].twin < e) continue;
+    if (const std::optional<SlabEdge> span = slab_edge(*diagram_, e)) {
+      const auto [first, last] = crossed_slabs(xs_, span->from, span->to);
+      ++crossing[first];
+      --crossing[last + 1];
     }
+  }
+  std::uint32_t count = 0;
+  for (std::size_t s = 0; s + 1 < offsets_.size(); ++s) {
+    const auto fail = [&](const std::string& what) {
+      throw Error("SlabLocator::validate: slab " + std::to_string(s) + " " + what);
+    };
+    count += crossing[s];
+    if (offsets_[s + 1] - offsets_[s] != count)
+      fail("holds " + std::to_string(offsets_[s + 1] - offsets_[s]) + " edges, " + std::to_string(count) + " cross it");
+    const double x = slab_middle(s);
+    for (std::uint32_t k = offsets_[s]; k < offsets_[s + 1]; ++k) {
+      const std::optional<SlabEdge> span = slab_edge(*diagram_, edge_[k]);
+      if (!span || span->half_edge != edge_[k] || !(span->from <= x && x <= span->to))
+        fail("holds an edge that does not cross it");
+      if (k + 1 < offsets_[s + 1] && edge_y(edge_[k], x) > edge_y(edge_[k + 1], x)) fail("is not sorted");
+      if (below_[k] != diagram_->opposite_site(edge_[k])) fail("has a wrong site below an edge");
+    }
+    if (offsets_[s + 1] > offsets_[s] && top_[s] != edges[edge_[offsets_[s + 1] - 1]].site)
+      fail("has a wrong site above its top edge");
   }
 }
 

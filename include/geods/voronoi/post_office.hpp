@@ -57,8 +57,8 @@ class SlabLocator {
   std::uint32_t locate(const Vec2d& q) const;
 
   SlabLocatorStats stats() const;
-  /// Checks that every slab's edges are sorted and that the cells between them
-  /// are consistent with the edges' sites. Throws geods::Error.
+  /// Checks that every slab holds the Voronoi edges that cross it, sorted bottom
+  /// to top, each with the sites on its two sides. Throws geods::Error.
   void validate() const;
 
  private:
