@@ -68,15 +68,23 @@ std::uint32_t descend_to_nearest(const Voronoi2& diagram, const Vec2d& q, std::u
   // Steepest descent on rounded distances first (strictly decreasing, so it ends),
   // then exact comparisons settle the last step.
   double current_d = (points[current] - q).squaredNorm();
+  double neighbour_d;  // after the loop: the least rounded distance of a neighbour of current
   for (;;) {
     std::uint32_t best = current;
+    neighbour_d = kInf;
     for (std::uint32_t nb : diagram.neighbors(current)) {
       const double d = (points[nb] - q).squaredNorm();
+      neighbour_d = std::min(neighbour_d, d);
       if (d < current_d) current_d = d, best = nb;
     }
     if (best == current) break;
     current = best;
   }
+  // A rounded squared distance is within 4u (relative) of the exact one, or a few subnormal
+  // units where it underflows: neighbours farther than that are farther exactly, and the
+  // exact comparisons below could not move. (Overflow or NaN fails the test.)
+  constexpr double kRounding = 1 + 10 * std::numeric_limits<double>::epsilon();
+  if (neighbour_d > current_d * kRounding + 8 * std::numeric_limits<double>::denorm_min()) return current;
   for (bool moved = true; moved;) {
     moved = false;
     for (std::uint32_t nb : diagram.neighbors(current))
