@@ -3,8 +3,11 @@
 // duplicated sites; clipping; bad input.
 #include <gtest/gtest.h>
 
+#include <gmpxx.h>
+
 #include <cmath>
 
+#include "../../src/voronoi/exact_compare.hpp"
 #include "brute_delaunay.hpp"
 #include "geods/core/error.hpp"
 #include "geods/voronoi/polygon_clip.hpp"
@@ -139,6 +142,52 @@ TEST(Voronoi2, CollinearSitesHaveParallelLines) {
   // Horizontal sites give vertical lines.
   const auto h = brute_delaunay({{0, 1}, {2, 1}, {5, 1}});
   expect_cells_match_brute_force(h.voronoi(), AABB2d({-1, -1}, {6, 3}), 10);
+}
+
+// The circumcentre of nearly flat triangles (a corner 1e-9 off the line of the other
+// two, two corners 1e-12 apart; at scales 1 and 1e12) against rational arithmetic:
+// within 2^-38 of its offset from a and of a. (The rounded formula alone was off
+// by up to 1e-5 of the distance.)
+TEST(Voronoi2, CircumcentresOfNearlyFlatTrianglesAreAccurate) {
+  Rng rng(41);
+  for (int i = 0; i < 3000; ++i) {
+    const double scale = i % 2 ? 1 : 1e12;
+    Vec2d a(rng.uniform(-1, 1), rng.uniform(-1, 1)), b(rng.uniform(-1, 1), rng.uniform(-1, 1)), c;
+    if (i % 3 == 0) {
+      c = a + 1e-12 * Vec2d(rng.uniform(-1, 1), rng.uniform(-1, 1));
+    } else {
+      const double t = rng.uniform(-2, 2);
+      c = a + t * (b - a) + 1e-9 * Vec2d(rng.uniform(-1, 1), rng.uniform(-1, 1));
+    }
+    a *= scale, b *= scale, c *= scale;
+    if (orient2d(a, b, c) == 0) continue;
+    const mpq_class ax(a[0]), ay(a[1]), bx = mpq_class(b[0]) - ax, by = mpq_class(b[1]) - ay;
+    const mpq_class cx = mpq_class(c[0]) - ax, cy = mpq_class(c[1]) - ay;
+    const mpq_class d = 2 * (bx * cy - by * cx), b2 = bx * bx + by * by, c2 = cx * cx + cy * cy;
+    const mpq_class ux = (cy * b2 - by * c2) / d, uy = (bx * c2 - cx * b2) / d;
+    const Vec2d got = detail::circumcentre(a, b, c);
+    const double error = std::max(std::abs(mpq_class(mpq_class(got[0]) - ax - ux).get_d()),
+                                  std::abs(mpq_class(mpq_class(got[1]) - ay - uy).get_d()));
+    const double size = std::max(std::abs(ux.get_d()), std::abs(uy.get_d())) + a.cwiseAbs().maxCoeff();
+    EXPECT_LE(error, std::ldexp(size, -38)) << i << ": " << a.transpose() << " / " << b.transpose() << " / "
+                                            << c.transpose();
+  }
+}
+
+// Sites on a line with a few 1e-10 off it, and lattice sites moved by 1e-12: the
+// vertices of their nearly flat triangles are equidistant from their sites
+// (validate() threw here before the circumcentre above).
+TEST(Voronoi2, NearlyCollinearAndNearlyCoincidentSites) {
+  Rng rng(43);
+  std::vector<Vec2d> line, lattice;
+  for (int i = 0; i < 400; ++i) {
+    const double x = std::floor(rng.uniform(0, 21));
+    line.push_back({x, 2 * x + 1 + (i % 5 == 0 ? rng.uniform(-1e-10, 1e-10) : 0.0)});
+    lattice.push_back({std::floor(rng.uniform(0, 21)) + rng.uniform(-1e-12, 1e-12),
+                       std::floor(rng.uniform(0, 21)) + rng.uniform(-1e-12, 1e-12)});
+  }
+  Voronoi2(line).validate();
+  Voronoi2(lattice).validate();
 }
 
 TEST(Voronoi2, DuplicatesShareTheCellOfTheirFirstOccurrence) {
