@@ -11,6 +11,7 @@
 #include "geods/core/error.hpp"
 #include "geods/core/vec.hpp"
 #include "geods/voronoi/delaunay2.hpp"
+#include "geods/voronoi/polygon_clip.hpp"
 
 namespace geods::voronoi::detail {
 
@@ -72,15 +73,10 @@ inline std::vector<Vec2d> convex_polygon_of(std::vector<Vec2d> pts) {
 inline void check_cell(const std::vector<Vec2d>& cell, const AABB2d& box, const std::string& what) {
   if (cell.empty()) return;
   const double side = std::max(box.hi[0] - box.lo[0], box.hi[1] - box.lo[1]);
-  double twice = 0;
-  for (std::size_t k = 0; k < cell.size(); ++k) {
-    const Vec2d& a = cell[k];
-    const Vec2d& b = cell[(k + 1) % cell.size()];
-    twice += a[0] * b[1] - b[0] * a[1];
+  for (const Vec2d& a : cell)
     if (((a - box.lo).array() < -1e-9 * side).any() || ((a - box.hi).array() > 1e-9 * side).any())
       throw Error(what + " leaves the box");
-  }
-  if (twice < 0) throw Error(what + " is clockwise");
+  if (polygon_area(cell) < 0) throw Error(what + " is clockwise");
 }
 
 }  // namespace geods::voronoi::detail

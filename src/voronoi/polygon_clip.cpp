@@ -66,9 +66,13 @@ bool point_in_polygon(const Vec2d& p, const std::vector<Vec2d>& polygon) {
 }
 
 double polygon_area(const std::vector<Vec2d>& polygon) {
+  // A fan about the first corner: far from the origin, the products of absolute
+  // coordinates cancel the area away (a cell of side 1 at 1e15 lost it and its sign).
   double twice = 0;
-  for (std::size_t i = 0, j = polygon.size() - 1; i < polygon.size(); j = i++)
-    twice += polygon[j][0] * polygon[i][1] - polygon[i][0] * polygon[j][1];
+  for (std::size_t i = 1; i + 1 < polygon.size(); ++i) {
+    const Vec2d a = polygon[i] - polygon[0], b = polygon[i + 1] - polygon[0];
+    twice += a[0] * b[1] - b[0] * a[1];
+  }
   return twice / 2;
 }
 

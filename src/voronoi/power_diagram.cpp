@@ -506,7 +506,9 @@ void PowerDiagram::validate() const {
     const double wa = weights()[e.a], wb = weights()[e.b];
     for (const Vec2d& x : {e.p0, e.p1}) {
       const double da = power_distance(x, pa, wa), db = power_distance(x, pb, wb);
-      const double scale = (x - pa).squaredNorm() + (x - pb).squaredNorm() + std::abs(wa) + std::abs(wb) + side * side;
+      // (|x|: far from the origin a corner is only as exact as its coordinates' own rounding.)
+      const double reach = (x - pa).norm() + (x - pb).norm() + side;
+      const double scale = reach * (reach + x.cwiseAbs().maxCoeff()) + std::abs(wa) + std::abs(wb);
       if (std::abs(da - db) > 1e-9 * scale) fail("an edge end has unequal powers for its sites");
     }
   }

@@ -116,6 +116,20 @@ TEST(FarthestVoronoi, CocircularGridDuplicatesCollinear) {
   EXPECT_NEAR(polygon_area(o.cells()[0]), 4, 1e-12);
 }
 
+// Sites on a grid 1e15 from the origin (coordinates exact, corners rounded to 1/8):
+// validate() allows the corners their own rounding, and the cells still tile the box.
+TEST(FarthestVoronoi, FarFromTheOrigin) {
+  std::vector<Vec2d> grid;
+  for (int i = 0; i < 60; ++i) grid.push_back({1e15 + double(i % 9), 1e15 + 0.5 * double((i * 7) % 13)});
+  const AABB2d box = frame_around(grid);
+  const FarthestVoronoi v(grid, box);
+  v.validate();
+  double area = 0;
+  for (const auto& cell : v.cells()) area += polygon_area(cell);
+  const double box_area = (box.hi[0] - box.lo[0]) * (box.hi[1] - box.lo[1]);
+  EXPECT_NEAR(area, box_area, 1e-3 * box_area);
+}
+
 TEST(KthOrderVoronoi, FirstOrderIsTheVoronoiDiagram) {
   const auto p = uniform_points(80, 7);
   const AABB2d box = frame_around(p);

@@ -82,6 +82,21 @@ TEST(PowerDiagram, RandomWeightedPointsMatchBruteForce) {
   }
 }
 
+// Weighted sites on a grid 1e15 from the origin (coordinates exact, corners rounded
+// to 1/8): validate() allows the corners their own rounding, and the cells tile the box.
+TEST(PowerDiagram, FarFromTheOrigin) {
+  std::vector<Vec2d> grid;
+  for (int i = 0; i < 200; ++i) grid.push_back({1e15 + double(i % 17), 1e15 + 0.5 * double((i * 7) % 23)});
+  const PowerDiagram d(grid, random_weights(grid.size(), 12, 0.01), frame_around(grid));
+  d.validate();
+  double area = 0;
+  for (std::uint32_t i = 0; i < d.cells().size(); ++i)
+    if (d.triangulation().representative(i) == i) area += polygon_area(d.cells()[i]);
+  const AABB2d& box = d.box();
+  const double box_area = (box.hi[0] - box.lo[0]) * (box.hi[1] - box.lo[1]);
+  EXPECT_NEAR(area, box_area, 1e-3 * box_area);
+}
+
 TEST(PowerDiagram, HeavyWeightsMakeRedundantPoints) {
   const auto p = uniform_points(200, 7);
   const auto w = random_weights(p.size(), 8, 0.2);  // big circles swallow small ones

@@ -190,6 +190,15 @@ TEST(Voronoi2, NearlyCollinearAndNearlyCoincidentSites) {
   Voronoi2(lattice).validate();
 }
 
+// polygon_area sums a fan about the first corner: a unit square 1e15 from the origin
+// has area 1 (about the origin its products cancelled it away).
+TEST(Voronoi2, PolygonAreaFarFromTheOrigin) {
+  const std::vector<Vec2d> square = {{1e15, 1e15}, {1e15 + 1, 1e15}, {1e15 + 1, 1e15 + 1}, {1e15, 1e15 + 1}};
+  EXPECT_EQ(polygon_area(square), 1.0);
+  EXPECT_EQ(polygon_area(std::vector<Vec2d>(square.rbegin(), square.rend())), -1.0);
+  EXPECT_EQ(polygon_area({}), 0.0);
+}
+
 TEST(Voronoi2, DuplicatesShareTheCellOfTheirFirstOccurrence) {
   std::vector<Vec2d> p = uniform_points(25, 11);
   p.push_back(p[3]);
