@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <deque>
+#include <utility>
 
 #include "geods/core/error.hpp"
 
@@ -85,11 +87,12 @@ std::optional<ConstrainedDelaunay::Crossing> ConstrainedDelaunay::insert_segment
   } while (h != start);
   if (crossing == kNone) throw Error("Delaunay2: internal error, segment leaves no triangle");
 
-  // Walk along the segment, collecting the triangles it crosses and the
-  // vertices left and right of it.
-  std::vector<std::uint32_t> cavity{crossing / 3}, left{vert[next(crossing)]}, right{vert[crossing]};
+  // Walk along the segment, collecting the edges and triangles it crosses and
+  // the vertices left and right of it.
+  std::vector<std::uint32_t> crossed, cavity{crossing / 3}, left{vert[next(crossing)]}, right{vert[crossing]};
   for (;;) {
     if ((*marks_)[crossing]) return split_crossing(a, b, crossing);
+    crossed.push_back(crossing);
     const std::uint32_t t = twin[crossing], x = vert[prev(t)];
     cavity.push_back(t / 3);
     if (x == b) break;
@@ -107,8 +110,69 @@ std::optional<ConstrainedDelaunay::Crossing> ConstrainedDelaunay::insert_segment
       right.push_back(x);
     }
   }
+  // A vertex twice in a chain: the crossed triangles surround a vertex of that
+  // side (all of its triangles are crossed), which the chains cannot describe
+  // (the edges to it, constrained ones too, would be lost). Flips then.
+  const auto repeats = [](std::vector<std::uint32_t> chain) {
+    std::sort(chain.begin(), chain.end());
+    return std::adjacent_find(chain.begin(), chain.end()) != chain.end();
+  };
+  if (repeats(left) || repeats(right)) {
+    flip_in(a, b, crossed);
+    return std::nullopt;
+  }
   fill_cavity(a, b, std::move(cavity), std::move(left), std::move(right));
   return std::nullopt;
+}
+
+std::uint32_t ConstrainedDelaunay::find_edge(std::uint32_t u, std::uint32_t w) const {
+  const std::uint32_t start = core_->vertex_edge[u];
+  std::uint32_t h = start;
+  do {
+    if (core_->vert[next(h)] == w) return h;
+    h = core_->twin[prev(h)];
+  } while (h != start);
+  return kNone;
+}
+
+void ConstrainedDelaunay::flip_in(std::uint32_t a, std::uint32_t b, const std::vector<std::uint32_t>& crossed) {
+  // Sloan's recovery: flip each edge crossing a-b whose two triangles form a
+  // strictly convex quadrilateral (one always does), until none crosses; then
+  // Lawson's flips make the new edges Delaunay again, a-b held fixed.
+  DelaunayCore& core = *core_;
+  const Vec2d pa = core.at(a), pb = core.at(b);
+  const auto sides = [&](const Vec2d& p, const Vec2d& q, std::uint32_t u, std::uint32_t w) {
+    return orient2d(p, q, core.at(u)) * orient2d(p, q, core.at(w));
+  };
+  const auto crosses = [&](std::uint32_t u, std::uint32_t w) {
+    return u != a && u != b && w != a && w != b && sides(pa, pb, u, w) < 0 && sides(core.at(u), core.at(w), a, b) < 0;
+  };
+  std::deque<std::pair<std::uint32_t, std::uint32_t>> queue;
+  for (std::uint32_t h : crossed) queue.push_back({core.vert[h], core.vert[next(h)]});
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> created;
+  for (std::size_t stalled = 0; !queue.empty();) {
+    const auto [u, w] = queue.front();
+    queue.pop_front();
+    const std::uint32_t e = find_edge(u, w);
+    if (e == kNone) throw Error("Delaunay2: internal error, a crossed edge vanished");
+    const std::uint32_t p = core.vert[prev(e)], x = core.vert[prev(core.twin[e])];
+    if (sides(core.at(p), core.at(x), u, w) >= 0) {  // not strictly convex: later
+      if (++stalled > queue.size()) throw Error("Delaunay2: internal error, segment recovery by flips stalled");
+      queue.push_back({u, w});
+      continue;
+    }
+    stalled = 0;
+    core.flip(e, *this);
+    if (crosses(p, x))
+      queue.push_back({p, x});
+    else
+      created.push_back({p, x});
+  }
+  const std::uint32_t segment = find_edge(a, b);
+  if (segment == kNone) throw Error("Delaunay2: internal error, segment not recovered by flips");
+  mark(segment);
+  for (const auto& [u, w] : created)
+    if (const std::uint32_t h = find_edge(u, w); h != kNone) core.restore_delaunay(h, *this);
 }
 
 void ConstrainedDelaunay::fill_cavity(std::uint32_t a, std::uint32_t b, std::vector<std::uint32_t> cavity,

@@ -50,6 +50,8 @@ class ConstrainedDelaunay {
   Crossing split_crossing(std::uint32_t a, std::uint32_t b, std::uint32_t crossing);
   void fill_cavity(std::uint32_t a, std::uint32_t b, std::vector<std::uint32_t> cavity, std::vector<std::uint32_t> left,
                    std::vector<std::uint32_t> right);
+  void flip_in(std::uint32_t a, std::uint32_t b, const std::vector<std::uint32_t>& crossed);
+  std::uint32_t find_edge(std::uint32_t u, std::uint32_t w) const;  // the half-edge u -> w, or none
 
   DelaunayCore* core_;
   std::vector<std::uint8_t>* marks_;

@@ -305,6 +305,9 @@ void Delaunay2::Editor::insert_constraints() {
     const auto crossing = constraints.insert_segment(a, b, pending);
     if (!crossing) continue;
     // Both are split at the crossing, a new point; the four pieces are then segments of their own.
+    // The crossed edge, no longer fixed, is made Delaunay first: the point, rounded, may fall
+    // outside its two triangles (next to a sliver along it) and leave it in place otherwise.
+    core.restore_delaunay(crossing->edge, constraints);
     const std::uint32_t i = std::uint32_t(points.size());
     if (i + 1 >= (std::uint32_t(1) << 30)) throw Error("Delaunay2: too many points");
     points.push_back(crossing->point);
@@ -835,13 +838,25 @@ void Delaunay2::validate() const {
   if (has_constraints_) {
     for (std::uint32_t e = 0; e < half_edges; ++e)
       if (vert_[e] != kNone && fixed_[e] != fixed_[twin_[e]]) fail("constraint flags of twins differ");
-    // Every input segment is a path of constrained edges through vertices on
-    // it or through intersection points (rounded, so slightly off it).
-    std::vector<std::uint32_t> crossings = intersections_;
-    std::sort(crossings.begin(), crossings.end());
+    // Every input segment is a path of constrained edges through intersection
+    // points (rounded, so slightly off it, and possibly onto another point,
+    // whose vertex then stands for both) and through vertices on it or on its
+    // pieces between them (so within that rounding of it).
+    std::vector<char> crossing(coords_.size(), 0);
+    for (std::uint32_t c : intersections_)
+      if (c < rep_.size() && rep_[c] < internal_of_.size() && internal_of_[rep_[c]] != kNone)
+        crossing[internal_of_[rep_[c]]] = 1;
     for (const Segment& seg : segments_) {
       const std::uint32_t a = internal_of_[rep_[seg[0]]], b = internal_of_[rep_[seg[1]]];
       if (a == kNone || b == kNone) fail("a segment end point is not a vertex");
+      const Vec2d &pa = coords_[a], &pb = coords_[b];
+      // The rounding of an intersection point: a few units in the last place of the segment's coordinates.
+      const double off = 16 * std::numeric_limits<double>::epsilon() *
+                         std::max(pa.cwiseAbs().maxCoeff(), pb.cwiseAbs().maxCoeff()) * (pb - pa).norm();
+      const auto on_segment = [&](const Vec2d& p) {
+        const double along = (p - pa).dot(pb - pa);
+        return std::abs(orient2d(pa, pb, p)) <= off && along > 0 && along < (pb - pa).squaredNorm();
+      };
       std::vector<std::uint32_t> queue{a};
       std::vector<char> seen(coords_.size(), 0);
       seen[a] = 1;
@@ -851,8 +866,7 @@ void Delaunay2::validate() const {
         do {
           const std::uint32_t w = vert_[next(h)];
           if (fixed_[h] && w != kGhost && !seen[w] &&
-              (w == b || std::binary_search(crossings.begin(), crossings.end(), original_of_[w]) ||
-               (orient2d(coords_[a], coords_[b], coords_[w]) == 0 && DelaunayCore::strictly_between(coords_[a], coords_[b], coords_[w])))) {
+              (w == b || crossing[w] || on_segment(coords_[w]))) {
             seen[w] = 1;
             queue.push_back(w);
           }

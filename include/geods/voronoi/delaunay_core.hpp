@@ -122,6 +122,11 @@ class DelaunayCore : public DelaunayHalfEdges {
   /// Flips the edges opposite p on the flip stack until every one is locally Delaunay (Lawson).
   template <class Hooks>
   void legalize(std::uint32_t p, Hooks& hooks);
+  /// Flips edge e if it is not fixed and not locally Delaunay, then the edges
+  /// around each flip the same way, until none is left (Lawson): for an edge
+  /// that was held fixed and is freed. Hull edges stay (no point is added).
+  template <class Hooks>
+  void restore_delaunay(std::uint32_t e, Hooks& hooks);
 
  private:
   std::vector<std::uint32_t> flip_stack_;  // half-edges opposite the new vertex, still to check
@@ -235,6 +240,23 @@ void DelaunayCore::legalize(std::uint32_t p, Hooks& hooks) {
     flip(e, hooks);
     flip_stack_.push_back(e);
     flip_stack_.push_back(f2);
+  }
+}
+
+template <class Hooks>
+void DelaunayCore::restore_delaunay(std::uint32_t e, Hooks& hooks) {
+  flip_stack_.push_back(e);
+  while (!flip_stack_.empty()) {
+    const std::uint32_t h = flip_stack_.back();
+    flip_stack_.pop_back();
+    const std::uint32_t f = twin[h];
+    if (hooks.fixed(h) || is_ghost_triangle(h / 3) || is_ghost_triangle(f / 3) ||
+        !in_conflict(f / 3, at(vert[prev(h)])))
+      continue;
+    // (u, w, p) and (w, u, x) become (u, x, p) and (w, p, x): their outer edges next.
+    const std::uint32_t f2 = prev(f);
+    flip(h, hooks);
+    for (std::uint32_t outer : {h, prev(h), f, f2}) flip_stack_.push_back(outer);
   }
 }
 
