@@ -516,7 +516,9 @@ void SegmentVoronoi::validate() const {
       const Vertex& v = vertices_[ed.vertex[k]];
       for (int j = 0; j < 2; ++j) {
         const double d = site_distance(ed.site[j], v.position);
-        if (std::abs(d - v.clearance) > 1e-7 * extent)
+        // (|position|: far from the origin a vertex is only as exact as its coordinates' own rounding.)
+        if (std::abs(d - v.clearance) >
+            1e-7 * extent + 16 * std::numeric_limits<double>::epsilon() * v.position.cwiseAbs().maxCoeff())
           throw Error("segment voronoi: vertex " + std::to_string(ed.vertex[k]) + " is not equidistant to the sites of edge " +
                       std::to_string(e));
       }

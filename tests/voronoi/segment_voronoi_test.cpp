@@ -296,6 +296,21 @@ TEST(SegmentVoronoi, IntegerGrid) {
   expect_cells_complete(v, 15);
 }
 
+// The same lattice 1e15 from the origin, where doubles are 1/8 apart: its vertices
+// (at half units) round by up to 1/16, which validate() allows them.
+TEST(SegmentVoronoi, IntegerGridFarFromTheOrigin) {
+  std::vector<double> segs;
+  for (int i = 0; i <= 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      segs.insert(segs.end(), {1e15 + j, 1e15 + i, 1e15 + j + 1, 1e15 + i});
+      segs.insert(segs.end(), {1e15 + i, 1e15 + j, 1e15 + i, 1e15 + j + 1});
+    }
+  const std::vector<double> pts{1e15 + 0.5, 1e15 + 0.25, 1e15 + 2.5, 1e15 + 1.625};
+  SegmentVoronoi v(pts, segs);
+  v.validate();
+  EXPECT_EQ(v.num_segments(), 24u);
+}
+
 TEST(SegmentVoronoi, CrossingSegmentsAreSplit) {
   const std::vector<double> segs{0, 0, 10, 10, 0, 10, 10, 0, 20, 0, 30, 0, 25, 0, 25, 8};
   SegmentVoronoi v({}, segs);
