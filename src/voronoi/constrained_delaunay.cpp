@@ -141,11 +141,14 @@ void ConstrainedDelaunay::flip_in(std::uint32_t a, std::uint32_t b, const std::v
   // Lawson's flips make the new edges Delaunay again, a-b held fixed.
   DelaunayCore& core = *core_;
   const Vec2d pa = core.at(a), pb = core.at(b);
-  const auto sides = [&](const Vec2d& p, const Vec2d& q, std::uint32_t u, std::uint32_t w) {
-    return orient2d(p, q, core.at(u)) * orient2d(p, q, core.at(w));
+  // Vertices u and w strictly on either side of the line pq. (Signs, not their
+  // product: at 1e-300 the product of two orientations underflows to zero.)
+  const auto apart = [&](const Vec2d& p, const Vec2d& q, std::uint32_t u, std::uint32_t w) {
+    const double su = orient2d(p, q, core.at(u)), sw = orient2d(p, q, core.at(w));
+    return (su > 0 && sw < 0) || (su < 0 && sw > 0);
   };
   const auto crosses = [&](std::uint32_t u, std::uint32_t w) {
-    return u != a && u != b && w != a && w != b && sides(pa, pb, u, w) < 0 && sides(core.at(u), core.at(w), a, b) < 0;
+    return u != a && u != b && w != a && w != b && apart(pa, pb, u, w) && apart(core.at(u), core.at(w), a, b);
   };
   std::deque<std::pair<std::uint32_t, std::uint32_t>> queue;
   for (std::uint32_t h : crossed) queue.push_back({core.vert[h], core.vert[next(h)]});
@@ -156,7 +159,7 @@ void ConstrainedDelaunay::flip_in(std::uint32_t a, std::uint32_t b, const std::v
     const std::uint32_t e = find_edge(u, w);
     if (e == kNone) throw Error("Delaunay2: internal error, a crossed edge vanished");
     const std::uint32_t p = core.vert[prev(e)], x = core.vert[prev(core.twin[e])];
-    if (sides(core.at(p), core.at(x), u, w) >= 0) {  // not strictly convex: later
+    if (!apart(core.at(p), core.at(x), u, w)) {  // not strictly convex: later
       if (++stalled > queue.size()) throw Error("Delaunay2: internal error, segment recovery by flips stalled");
       queue.push_back({u, w});
       continue;

@@ -849,13 +849,25 @@ void Delaunay2::validate() const {
     for (const Segment& seg : segments_) {
       const std::uint32_t a = internal_of_[rep_[seg[0]]], b = internal_of_[rep_[seg[1]]];
       if (a == kNone || b == kNone) fail("a segment end point is not a vertex");
+      // Within the rounding of an intersection point (a few units in the last
+      // place of the segment's coordinates) of the segment, and along it. In a
+      // frame scaled by a power of two to the segment's length: products of
+      // coordinates near 1e300 or 1e-300 would overflow or underflow.
       const Vec2d &pa = coords_[a], &pb = coords_[b];
-      // The rounding of an intersection point: a few units in the last place of the segment's coordinates.
-      const double off = 16 * std::numeric_limits<double>::epsilon() *
-                         std::max(pa.cwiseAbs().maxCoeff(), pb.cwiseAbs().maxCoeff()) * (pb - pa).norm();
+      int exponent = 0;
+      std::frexp((pb - pa).cwiseAbs().maxCoeff(), &exponent);
+      const auto scaled = [&](const Vec2d& v) {
+        return Vec2d(std::ldexp(v[0], -exponent), std::ldexp(v[1], -exponent));
+      };
+      const Vec2d d = scaled(pb - pa);
+      const double off = std::ldexp(16 * std::numeric_limits<double>::epsilon() *
+                                        std::max(pa.cwiseAbs().maxCoeff(), pb.cwiseAbs().maxCoeff()),
+                                    -exponent) *
+                         d.norm();
       const auto on_segment = [&](const Vec2d& p) {
-        const double along = (p - pa).dot(pb - pa);
-        return std::abs(orient2d(pa, pb, p)) <= off && along > 0 && along < (pb - pa).squaredNorm();
+        const Vec2d q = scaled(p - pa);
+        const double along = d.dot(q);
+        return std::abs(d[0] * q[1] - d[1] * q[0]) <= off && along > 0 && along < d.squaredNorm();
       };
       std::vector<std::uint32_t> queue{a};
       std::vector<char> seen(coords_.size(), 0);

@@ -682,11 +682,15 @@ TEST(Delaunay2Constrained, CrossingsAtExtremeScales) {
 // segments, crossing points rounded next to other points. A crossing point
 // rounded outside the two triangles of the edge it splits (beside a sliver
 // along that edge) used to leave that edge, no longer constrained, not Delaunay.
+// Also scaled by 2^-1000 and 2^1000, where products of coordinates underflow
+// or overflow.
 TEST(Delaunay2Constrained, RandomSegmentsOnACoarseGrid) {
-  for (std::uint64_t seed = 0; seed < 300; ++seed) {
+  for (std::uint64_t seed = 0; seed < 360; ++seed) {  // the extreme scales take the predicates' slow paths: fewer
     Rng rng(seed);
+    const int exponent = seed < 300 ? 0 : seed % 2 ? -1000 : 1000;
     std::vector<Vec2d> p;
-    for (int i = 0; i < 30; ++i) p.emplace_back(double(rng.below(7)), double(rng.below(7)));
+    for (int i = 0; i < 30; ++i)
+      p.emplace_back(std::ldexp(double(rng.below(7)), exponent), std::ldexp(double(rng.below(7)), exponent));
     std::vector<Delaunay2::Segment> segments;
     for (int k = 0; k < 12; ++k) segments.push_back({std::uint32_t(rng.below(30)), std::uint32_t(rng.below(30))});
     std::erase_if(segments, [](const auto& s) { return s[0] == s[1]; });
