@@ -52,12 +52,47 @@ inline Vec2d circumcentre(const Vec2d& a, const Vec2d& b, const Vec2d& c) {
                  (2 * o_exact);
 }
 
-/// The centre of the sphere through a, b, c, d (not coplanar): the rounded formula,
-/// the exact orientation keeping its denominator non-zero.
+/// The centre of the sphere through a, b, c, d (not coplanar), the same way as
+/// the circle's: the rounded formula where its error bound allows 2^-40, else
+/// the numerators and the orientation summed exactly (a sliver's rounded
+/// centre was off by up to a tenth of its distance).
 inline Vec3d circumcentre(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& d) {
   const Vec3d ab = b - a, ac = c - a, ad = d - a;
-  const double det = -2 * orient3d(a.data(), b.data(), c.data(), d.data());  // 2 det(ab, ac, ad)
-  return a + (ab.squaredNorm() * ac.cross(ad) + ac.squaredNorm() * ad.cross(ab) + ad.squaredNorm() * ab.cross(ac)) / det;
+  const double o = orient3d(a.data(), b.data(), c.data(), d.data());
+  const double det = -2 * o;  // 2 det(ab, ac, ad)
+  const double ab2 = ab.squaredNorm(), ac2 = ac.squaredNorm(), ad2 = ad.squaredNorm();
+  const Vec3d n = ab2 * ac.cross(ad) + ac2 * ad.cross(ab) + ad2 * ab.cross(ac);
+  const Vec3d offset = n / det;
+  // Forward error bounds as in 2D: the numerators from the magnitudes of their
+  // terms, orient3d's value from its stage A bound (about 7u of its permanent, about d).
+  constexpr double u = std::numeric_limits<double>::epsilon() / 2;
+  const auto magnitudes = [](const Vec3d& x, const Vec3d& y) {
+    return Vec3d(std::abs(x[1] * y[2]) + std::abs(x[2] * y[1]), std::abs(x[2] * y[0]) + std::abs(x[0] * y[2]),
+                 std::abs(x[0] * y[1]) + std::abs(x[1] * y[0]));
+  };
+  const double n_error =
+      16 * u * (ab2 * magnitudes(ac, ad) + ac2 * magnitudes(ad, ab) + ad2 * magnitudes(ab, ac)).maxCoeff();
+  const Vec3d da = a - d, db = b - d, dc = c - d;
+  const double o_error = 8 * u * da.cwiseAbs().dot(magnitudes(db, dc));
+  const double offset_error = (n_error + n.cwiseAbs().maxCoeff() * (o_error / std::abs(o))) / std::abs(det);
+  if (o_error < 0x1p-20 * std::abs(o) &&
+      offset_error <= 0x1p-40 * (offset.cwiseAbs().maxCoeff() + a.cwiseAbs().maxCoeff()))
+    return a + offset;
+  const auto abx = exact_diff(b[0], a[0]), aby = exact_diff(b[1], a[1]), abz = exact_diff(b[2], a[2]);
+  const auto acx = exact_diff(c[0], a[0]), acy = exact_diff(c[1], a[1]), acz = exact_diff(c[2], a[2]);
+  const auto adx = exact_diff(d[0], a[0]), ady = exact_diff(d[1], a[1]), adz = exact_diff(d[2], a[2]);
+  const auto ab2_exact = abx * abx + aby * aby + abz * abz;
+  const auto ac2_exact = acx * acx + acy * acy + acz * acz;
+  const auto ad2_exact = adx * adx + ady * ady + adz * adz;
+  // The cross products' components, then each numerator component and the determinant.
+  const auto cd_x = acy * adz - acz * ady, cd_y = acz * adx - acx * adz, cd_z = acx * ady - acy * adx;  // ac x ad
+  const auto db_x = ady * abz - adz * aby, db_y = adz * abx - adx * abz, db_z = adx * aby - ady * abx;  // ad x ab
+  const auto bc_x = aby * acz - abz * acy, bc_y = abz * acx - abx * acz, bc_z = abx * acy - aby * acx;  // ab x ac
+  const double det_exact = 2 * (abx * cd_x + aby * cd_y + abz * cd_z).estimate();
+  const auto numerator = [&](const auto& cd, const auto& db, const auto& bc) {
+    return (ab2_exact * cd + ac2_exact * db + ad2_exact * bc).estimate();
+  };
+  return a + Vec3d(numerator(cd_x, db_x, bc_x), numerator(cd_y, db_y, bc_y), numerator(cd_z, db_z, bc_z)) / det_exact;
 }
 
 /// Sign of (a0 - b0)(c0 - d0) + (a1 - b1)(c1 - d1) - (e0 - f0)(g0 - h0) - (e1 - f1)(g1 - h1),
