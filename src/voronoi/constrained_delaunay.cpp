@@ -256,13 +256,16 @@ ConstrainedDelaunay::Crossing ConstrainedDelaunay::split_crossing(std::uint32_t 
   for (const Vec2d& p : {core.at(a), core.at(b), pu, pw}) largest = std::max(largest, p.cwiseAbs().maxCoeff());
   int exponent = 0;
   std::frexp(largest, &exponent);
-  const auto scaled = [&](const Vec2d& p) { return Vec2d(std::ldexp(p[0], -exponent), std::ldexp(p[1], -exponent)); };
-  const Vec2d sa = scaled(core.at(a)), sb = scaled(core.at(b)), su = scaled(pu), sw = scaled(pw);
+  const Vec2d sa = DelaunayCore::scaled(core.at(a), -exponent), sb = DelaunayCore::scaled(core.at(b), -exponent);
+  const Vec2d su = DelaunayCore::scaled(pu, -exponent), sw = DelaunayCore::scaled(pw, -exponent);
   const double du = orient2d(sa, sb, su), dw = orient2d(sa, sb, sw);
-  const Vec2d sx = (su * dw - sw * du) / (dw - du);
-  Vec2d x(std::ldexp(sx[0], exponent), std::ldexp(sx[1], exponent));
+  Vec2d x = DelaunayCore::scaled((su * dw - sw * du) / (dw - du), exponent);
   for (int k = 0; k < 2; ++k) x[k] = std::clamp(x[k], std::min(pu[k], pw[k]), std::max(pu[k], pw[k]));
+  // The edge, no longer fixed, is made Delaunay at once: x, rounded, may fall
+  // outside its two triangles (beside a sliver along it), and inserting x would
+  // then leave the edge in place, not Delaunay.
   (*marks_)[crossing] = (*marks_)[core.twin[crossing]] = 0;
+  core_->restore_delaunay(crossing, *this);
   return {crossing, u, w, x};
 }
 

@@ -34,7 +34,8 @@ class ConstrainedDelaunay {
 
   /// Makes segment a-b (internal vertices) a path of constrained edges. A vertex
   /// on the segment splits it: the rest is pushed to `pending`. Returns the
-  /// crossing when a-b crosses a constrained edge (that edge is then unmarked).
+  /// crossing when a-b crosses a constrained edge (that edge is then unmarked,
+  /// and flipped as Delaunay asks).
   std::optional<Crossing> insert_segment(std::uint32_t a, std::uint32_t b, Pending& pending);
 
   // Hooks.

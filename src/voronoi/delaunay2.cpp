@@ -305,9 +305,6 @@ void Delaunay2::Editor::insert_constraints() {
     const auto crossing = constraints.insert_segment(a, b, pending);
     if (!crossing) continue;
     // Both are split at the crossing, a new point; the four pieces are then segments of their own.
-    // The crossed edge, no longer fixed, is made Delaunay first: the point, rounded, may fall
-    // outside its two triangles (next to a sliver along it) and leave it in place otherwise.
-    core.restore_delaunay(crossing->edge, constraints);
     const std::uint32_t i = std::uint32_t(points.size());
     if (i + 1 >= (std::uint32_t(1) << 30)) throw Error("Delaunay2: too many points");
     points.push_back(crossing->point);
@@ -856,16 +853,13 @@ void Delaunay2::validate() const {
       const Vec2d &pa = coords_[a], &pb = coords_[b];
       int exponent = 0;
       std::frexp((pb - pa).cwiseAbs().maxCoeff(), &exponent);
-      const auto scaled = [&](const Vec2d& v) {
-        return Vec2d(std::ldexp(v[0], -exponent), std::ldexp(v[1], -exponent));
-      };
-      const Vec2d d = scaled(pb - pa);
+      const Vec2d d = DelaunayCore::scaled(pb - pa, -exponent);
       const double off = std::ldexp(16 * std::numeric_limits<double>::epsilon() *
                                         std::max(pa.cwiseAbs().maxCoeff(), pb.cwiseAbs().maxCoeff()),
                                     -exponent) *
                          d.norm();
       const auto on_segment = [&](const Vec2d& p) {
-        const Vec2d q = scaled(p - pa);
+        const Vec2d q = DelaunayCore::scaled(p - pa, -exponent);
         const double along = d.dot(q);
         return std::abs(d[0] * q[1] - d[1] * q[0]) <= off && along > 0 && along < d.squaredNorm();
       };

@@ -18,6 +18,19 @@ inline ::geods::exact::Expansion<2> exact_diff(double a, double b) {
   return ::geods::exact::from_two_term(::geods::exact::two_diff(a, b));
 }
 
+constexpr double kUnitRoundoff = std::numeric_limits<double>::epsilon() / 2;
+
+// Whether a rounded circumcentre a + n / (2 o) (up to sign) is within 2^-40 of
+// the exact one, relative to its offset from a and to a, given bounds on the
+// errors of the numerator n (largest component n_max) and of the orientation o.
+// (Ordered so that no intermediate overflows where the result does not: the
+// test takes the same branch at any power-of-two scale of the input.)
+inline bool rounded_centre_is_accurate(double n_error, double n_max, double o, double o_error, double offset_max,
+                                       double a_max) {
+  const double offset_error = (n_error + n_max * (o_error / std::abs(o))) / std::abs(2 * o);
+  return o_error < 0x1p-20 * std::abs(o) && offset_error <= 0x1p-40 * (offset_max + a_max);
+}
+
 /// The centre of the circle through a, b, c (not collinear), accurate to about
 /// 2^-40 of its offset from a and of a however flat the triangle: the rounded
 /// formula where its error bound allows that, else its numerators and the
@@ -33,16 +46,12 @@ inline Vec2d circumcentre(const Vec2d& a, const Vec2d& b, const Vec2d& c) {
   // Forward error bounds: each rounded difference, product and sum adds at most
   // u = eps / 2 relative to its magnitude; orient2d's value is within its stage
   // A bound, about 3u of its terms' magnitudes (here taken about c, as it does).
-  constexpr double u = std::numeric_limits<double>::epsilon() / 2;
   const Vec2d ca = a - c, cb = b - c;
-  const double o_error = 4 * u * (std::abs(ca[0] * cb[1]) + std::abs(ca[1] * cb[0]));
-  const double n_error = 8 * u * std::max(std::abs(ac[1]) * ab2 + std::abs(ab[1]) * ac2,
-                                          std::abs(ab[0]) * ac2 + std::abs(ac[0]) * ab2);
-  // (Ordered so that no intermediate overflows where the result does not: the test
-  // then takes the same branch at any power-of-two scale of the input.)
-  const double offset_error = (n_error + n.cwiseAbs().maxCoeff() * (o_error / std::abs(o))) / std::abs(2 * o);
-  if (o_error < 0x1p-20 * std::abs(o) &&
-      offset_error <= 0x1p-40 * (offset.cwiseAbs().maxCoeff() + a.cwiseAbs().maxCoeff()))
+  const double o_error = 4 * kUnitRoundoff * (std::abs(ca[0] * cb[1]) + std::abs(ca[1] * cb[0]));
+  const double n_error = 8 * kUnitRoundoff * std::max(std::abs(ac[1]) * ab2 + std::abs(ab[1]) * ac2,
+                                                      std::abs(ab[0]) * ac2 + std::abs(ac[0]) * ab2);
+  if (rounded_centre_is_accurate(n_error, n.cwiseAbs().maxCoeff(), o, o_error, offset.cwiseAbs().maxCoeff(),
+                                 a.cwiseAbs().maxCoeff()))
     return a + offset;
   const auto abx = exact_diff(b[0], a[0]), aby = exact_diff(b[1], a[1]);
   const auto acx = exact_diff(c[0], a[0]), acy = exact_diff(c[1], a[1]);
@@ -65,18 +74,16 @@ inline Vec3d circumcentre(const Vec3d& a, const Vec3d& b, const Vec3d& c, const 
   const Vec3d offset = n / det;
   // Forward error bounds as in 2D: the numerators from the magnitudes of their
   // terms, orient3d's value from its stage A bound (about 7u of its permanent, about d).
-  constexpr double u = std::numeric_limits<double>::epsilon() / 2;
   const auto magnitudes = [](const Vec3d& x, const Vec3d& y) {
     return Vec3d(std::abs(x[1] * y[2]) + std::abs(x[2] * y[1]), std::abs(x[2] * y[0]) + std::abs(x[0] * y[2]),
                  std::abs(x[0] * y[1]) + std::abs(x[1] * y[0]));
   };
   const double n_error =
-      16 * u * (ab2 * magnitudes(ac, ad) + ac2 * magnitudes(ad, ab) + ad2 * magnitudes(ab, ac)).maxCoeff();
+      16 * kUnitRoundoff * (ab2 * magnitudes(ac, ad) + ac2 * magnitudes(ad, ab) + ad2 * magnitudes(ab, ac)).maxCoeff();
   const Vec3d da = a - d, db = b - d, dc = c - d;
-  const double o_error = 8 * u * da.cwiseAbs().dot(magnitudes(db, dc));
-  const double offset_error = (n_error + n.cwiseAbs().maxCoeff() * (o_error / std::abs(o))) / std::abs(det);
-  if (o_error < 0x1p-20 * std::abs(o) &&
-      offset_error <= 0x1p-40 * (offset.cwiseAbs().maxCoeff() + a.cwiseAbs().maxCoeff()))
+  const double o_error = 8 * kUnitRoundoff * da.cwiseAbs().dot(magnitudes(db, dc));
+  if (rounded_centre_is_accurate(n_error, n.cwiseAbs().maxCoeff(), o, o_error, offset.cwiseAbs().maxCoeff(),
+                                 a.cwiseAbs().maxCoeff()))
     return a + offset;
   const auto abx = exact_diff(b[0], a[0]), aby = exact_diff(b[1], a[1]), abz = exact_diff(b[2], a[2]);
   const auto acx = exact_diff(c[0], a[0]), acy = exact_diff(c[1], a[1]), acz = exact_diff(c[2], a[2]);

@@ -15,6 +15,7 @@
 // marks) follow its changes through Hooks: after each split and flip the core
 // calls them, and legalize() asks them which edges must not flip. NoHooks is
 // the plain path; the calls compile away.
+#include <cmath>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -45,6 +46,11 @@ struct DelaunayHalfEdges {
   static bool strictly_between(const Vec2d& a, const Vec2d& b, const Vec2d& p) {
     if (a[0] != b[0]) return (a[0] < p[0] && p[0] < b[0]) || (b[0] < p[0] && p[0] < a[0]);
     return (a[1] < p[1] && p[1] < b[1]) || (b[1] < p[1] && p[1] < a[1]);
+  }
+  /// p times 2^exponent, exactly (short of overflow or underflow): a frame in
+  /// which products of coordinates near 1e300 or 1e-300 stay in range.
+  static Vec2d scaled(const Vec2d& p, int exponent) {
+    return {std::ldexp(p[0], exponent), std::ldexp(p[1], exponent)};
   }
 
   enum class Where { inside, on_edge, on_vertex, outside };
