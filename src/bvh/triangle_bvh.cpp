@@ -230,12 +230,7 @@ void TriangleBvh::build_wide() {
         for (std::uint32_t lane = 0; lane < 4; ++lane) {
           const std::uint32_t t = nodes[i].prim_first + std::min(k + lane, nodes[i].prim_count - 1);
           const Triangle& tri = triangles_[t];
-          for (int a = 0; a < 3; ++a) {
-            g.corner[0][a][lane] = tri.a[a];
-            g.corner[1][a][lane] = tri.b[a];
-            g.corner[2][a][lane] = tri.c[a];
-          }
-          g.index[lane] = topology_.prim_order[t];
+          set_lane(g, int(lane), tri.a, tri.b, tri.c, topology_.prim_order[t]);
         }
       }
     }
@@ -1022,10 +1017,7 @@ void TriangleBvh::validate() const {
             if (covered[t]) fail("wide leaves do not cover each triangle once");
             covered[t] = 1;
             const Triangle& tri = triangles_[leaf_position[t]];
-            for (int a = 0; a < 3; ++a)
-              if (group.corner[0][a][lane] != tri.a[a] || group.corner[1][a][lane] != tri.b[a] ||
-                  group.corner[2][a][lane] != tri.c[a])
-                fail("a triangle group differs from its triangle");
+            if (!lane_holds(group, lane, tri.a, tri.b, tri.c)) fail("a triangle group differs from its triangle");
             if (!box.contains(tri.a) || !box.contains(tri.b) || !box.contains(tri.c))
               fail("a wide leaf box does not hold its triangle");
           }

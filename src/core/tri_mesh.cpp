@@ -79,9 +79,7 @@ MeshReport TriMesh::validate() const {
     const Vec3f& a = vertices[t[0]];
     const Vec3f& b = vertices[t[1]];
     const Vec3f& c = vertices[t[2]];
-    // Zero area in double so that tiny but valid float triangles are not flagged.
-    const bool zero_area = !repeated && triangle_normal<double>(a.cast<double>(), b.cast<double>(),
-                                                                c.cast<double>()).squaredNorm() == 0.0;
+    const bool zero_area = !repeated && has_zero_area(a, b, c);  // exactly: tiny valid triangles are not
     if (repeated || zero_area) {
       ++report.degenerate_faces;
       note(report, "face " + std::to_string(f) + ": degenerate");

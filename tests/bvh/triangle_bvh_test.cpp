@@ -6,6 +6,7 @@
 #include <tuple>
 
 #include "bvh_test_util.hpp"
+#include "common/collinear_triangles.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"
 #include "geods/core/triangle_box.hpp"
@@ -112,6 +113,35 @@ TEST(TriangleBvh, RandomSoupsWithDegenerateTinyHugeAndAxisAlignedTriangles) {
         check_rays(soup, bvh, rays, expected, what);
       }
   }
+}
+
+TEST(TriangleBvh, TrianglesOfZeroAreaAreNeverHitByAnyLayout) {
+  // Rounded, the triangle test "hit" some collinear triangles off the
+  // triangle, and tight volumes (k-DOPs, OBB, RSS) skipped a few of those.
+  const TriMesh soup = geods::test::collinear_soup(600, 41);
+  const auto rays = geods::test::rays_along_triangles(soup, 1200, 42);
+  std::vector<RayHit> expected;
+  for (const auto& r : rays) expected.push_back(brute_intersect(soup, r));
+  for (BoundingVolume bv : kVolumes)
+    for (int arity : {2, 4, 8}) {
+      if (arity > 2 && bv != BoundingVolume::aabb) continue;
+      BuildOptions options;
+      options.bv = bv;
+      options.arity = arity;
+      const TriangleBvh bvh = TriangleBvh::build(soup, options);
+      const std::string what = std::string(to_string(bv)) + " arity " + std::to_string(arity);
+      ASSERT_NO_THROW(bvh.validate()) << what;
+      check_rays(soup, bvh, rays, expected, what);
+      std::vector<RayHit> packed(rays.size());
+      bvh.intersect_packets(rays, packed);
+      for (std::size_t i = 0; i < rays.size(); ++i) {
+        ASSERT_EQ(packed[i].t, expected[i].t) << what << " packet ray " << i;
+        if (!packed[i].hit()) continue;
+        ASSERT_FALSE(has_zero_area(test::corner(soup, packed[i].prim, 0), test::corner(soup, packed[i].prim, 1),
+                                   test::corner(soup, packed[i].prim, 2)))
+            << what << " ray " << i;
+      }
+    }
 }
 
 TEST(TriangleBvh, RaysFromInsideAClosedMeshThroughEveryVertexNeverSlipThrough) {

@@ -78,6 +78,46 @@ TEST(Triangle, AreaNormalBarycentric) {
   EXPECT_EQ(triangle_bounds(a, b, c), AABB3d(Vec3d(0, 0, 0), Vec3d(2, 2, 0)));
 }
 
+TEST(Triangle, HasZeroAreaIsExact) {
+  // Corners on a lattice of step 2^-20 (exact in float): collinear ones
+  // (a + j d, a + k d) and ones with c moved off the line by one step, against
+  // the cross product in integers; scaled by 2^-100 and 2^100 alike.
+  Rng rng(5);
+  const auto lattice = [&](std::int64_t range) { return std::int64_t(rng.below(std::uint64_t(2 * range + 1))) - range; };
+  int zero = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    std::int64_t p[3][3], d[3];
+    for (int x = 0; x < 3; ++x) {
+      p[0][x] = lattice(1 << 20);
+      d[x] = lattice(7) << 12;
+    }
+    const std::int64_t j = lattice(8), k = lattice(8);
+    for (int x = 0; x < 3; ++x) {
+      p[1][x] = p[0][x] + j * d[x];
+      p[2][x] = p[0][x] + k * d[x];
+    }
+    if (rng.below(2)) p[2][rng.below(3)] += rng.below(2) ? 1 : -1;
+    std::int64_t e[2][3];
+    for (int x = 0; x < 3; ++x) {
+      e[0][x] = p[1][x] - p[0][x];
+      e[1][x] = p[2][x] - p[0][x];
+    }
+    bool expected = true;
+    for (int x = 0; x < 3; ++x)
+      expected &= e[0][(x + 1) % 3] * e[1][(x + 2) % 3] == e[0][(x + 2) % 3] * e[1][(x + 1) % 3];
+    zero += expected;
+    for (float scale : {0x1p-20f, 0x1p-120f, 0x1p80f}) {
+      Vec3f c[3];
+      for (int i = 0; i < 3; ++i)
+        for (int x = 0; x < 3; ++x) c[i][x] = float(p[i][x]) * scale;
+      ASSERT_EQ(has_zero_area(c[0], c[1], c[2]), expected) << "trial " << trial << " scale " << scale;
+      ASSERT_EQ(has_zero_area<double>(c[0].cast<double>(), c[1].cast<double>(), c[2].cast<double>()), expected);
+    }
+  }
+  EXPECT_GT(zero, 10000);  // the collinear half, and moves along d's own line
+  EXPECT_LT(zero, 15000);
+}
+
 // Brute force: the closest of many sampled points of the triangle.
 Vec3d sampled_closest(const Vec3d& p, const Vec3d& a, const Vec3d& b, const Vec3d& c) {
   Vec3d best = a;

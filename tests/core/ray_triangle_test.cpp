@@ -5,6 +5,7 @@
 #include <limits>
 #include <vector>
 
+#include "common/collinear_triangles.hpp"
 #include "geods/core/ray_triangle.hpp"
 #include "geods/core/rng.hpp"
 
@@ -92,6 +93,28 @@ TEST(RayTriangle, RejectsDegenerateInputs) {
   r.origin = {-1, 0.1f, 0};
   r.direction = {1, 0, 0};
   EXPECT_FALSE(RayTriangleTest<float>(r).intersect(a, b, Vec3f(0, 1, 0), 0, 10, t, u, v));
+}
+
+TEST(RayTriangle, TrianglesOfZeroAreaAreNeverHit) {
+  // Rounded, about one in twelve of these rays "hit" its collinear triangle
+  // at a point off it; the ordinary ones, aimed at on an edge, are hit often.
+  const TriMesh soup = test::collinear_soup(4000, 7);
+  const auto rays = test::rays_along_triangles(soup, 40000, 8);
+  int zero_area = 0, ordinary_hits = 0;
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    const auto& f = soup.triangles[i % soup.num_triangles()];
+    const Vec3f &a = soup.vertices[f[0]], &b = soup.vertices[f[1]], &c = soup.vertices[f[2]];
+    float t, u, v;
+    const bool hit = RayTriangleTest<float>(rays[i]).intersect(a, b, c, 0, 1e30f, t, u, v);
+    if (has_zero_area(a, b, c)) {
+      ++zero_area;
+      EXPECT_FALSE(hit) << "ray " << i << " hits a triangle of zero area at t = " << t;
+    } else {
+      ordinary_hits += hit;
+    }
+  }
+  EXPECT_GE(zero_area, 20000);  // the collinear half, and a few ordinary ones by chance
+  EXPECT_GT(ordinary_hits, (40000 - zero_area) / 3);  // aimed at an edge: rounded inside about half the time
 }
 
 // A closed cube whose faces are n x n grids of triangle pairs with shared vertices.

@@ -6,6 +6,7 @@
 // same order, and a lane whose edge function rounds to zero is handed to the
 // scalar test itself (its double-precision recomputation), so t, u, v and the
 // hit decision are bit-identical to RayTriangleTest<float>.
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <limits>
@@ -26,6 +27,30 @@ struct alignas(32) TriangleGroup {  // 160 bytes
   /// 1 to 4 triangles; unused lanes repeat the last one (same result, same index).
   std::uint32_t index[4];
 };
+
+/// Puts triangle (a, b, c), number `index`, in lane `lane` of g. A triangle
+/// of zero area gets NaN corners: no lane test ever hits it, as the scalar
+/// test never does (has_zero_area), without a per-ray cost.
+inline void set_lane(TriangleGroup& g, int lane, const Vec3f& a, const Vec3f& b, const Vec3f& c,
+                     std::uint32_t index) {
+  const bool zero = has_zero_area(a, b, c);
+  const Vec3f* corners[3] = {&a, &b, &c};
+  for (int k = 0; k < 3; ++k)
+    for (int x = 0; x < 3; ++x) g.corner[k][x][lane] = zero ? std::numeric_limits<float>::quiet_NaN() : (*corners[k])[x];
+  g.index[lane] = index;
+}
+
+/// Whether lane `lane` of g holds (a, b, c) as set_lane puts it there.
+inline bool lane_holds(const TriangleGroup& g, int lane, const Vec3f& a, const Vec3f& b, const Vec3f& c) {
+  const bool zero = has_zero_area(a, b, c);
+  const Vec3f* corners[3] = {&a, &b, &c};
+  for (int k = 0; k < 3; ++k)
+    for (int x = 0; x < 3; ++x) {
+      const float stored = g.corner[k][x][lane];
+      if (zero ? !std::isnan(stored) : stored != (*corners[k])[x]) return false;
+    }
+  return true;
+}
 
 /// The watertight test's edge functions of a triangle whose corners, relative to
 /// the ray's origin in its sheared frame, are (px, py): RayTriangleTest's

@@ -87,12 +87,14 @@ class TriangleBvh {
 
   /// Builds over the mesh's triangles (deterministic for any thread count).
   /// Throws geods::Error for invalid meshes (see TriMesh::require_valid) and bad
-  /// options. Degenerate triangles are kept (rays never hit them).
+  /// options. Triangles of zero area are kept: rays never hit them
+  /// (has_zero_area, core/triangle.hpp), the other queries see them.
   static TriangleBvh build(const TriMesh& mesh, const BuildOptions& options = {});
 
-  /// Archive kind and layout version of save().
+  /// Archive kind and layout version of save() (2: zero-area triangles'
+  /// group lanes hold NaN corners, bvh/ray_triangle4.hpp).
   static constexpr const char* kArchiveKind = "bvh.TriangleBvh";
-  static constexpr std::uint32_t kArchiveVersion = 1;
+  static constexpr std::uint32_t kArchiveVersion = 2;
   /// Writes the hierarchy (options, nodes, volumes, triangles, wide nodes) to
   /// `path`; throws geods::Error naming the file if it cannot be written.
   void save(const std::filesystem::path& path) const;

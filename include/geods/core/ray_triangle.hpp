@@ -16,6 +16,7 @@
 #include "geods/core/coordinate_range.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/ray.hpp"
+#include "geods/core/triangle.hpp"
 
 namespace geods {
 
@@ -97,8 +98,8 @@ class RayTriangleTest {
   }
 
   /// Parameter t and barycentrics (u, v) of the hit with triangle (a, b, c)
-  /// if t lies in [tmin, tmax]; false otherwise (also for degenerate triangles
-  /// and a zero or non-finite direction).
+  /// if t lies in [tmin, tmax]; false otherwise (also for triangles of zero
+  /// area, has_zero_area, and a zero or non-finite direction).
   bool intersect(const Vec<T, 3>& a, const Vec<T, 3>& b, const Vec<T, 3>& c, T tmin, T tmax, T& t,
                  T& u, T& v) const {
     const Vec<T, 3> pa = a - origin_, pb = b - origin_, pc = c - origin_;
@@ -125,6 +126,12 @@ class RayTriangleTest {
     const T inv_det = T(1) / det;
     const T hit_t = scaled_t * inv_det;
     if (!(hit_t >= tmin && hit_t <= tmax)) return false;
+    // Exactly, a triangle with collinear corners is never hit (its edge
+    // functions sum to zero); rounded, its sheared projection can get a
+    // sliver of area around the ray and a "hit" off the triangle. Decided
+    // exactly, on hits only.
+    if (has_zero_area(a, b, c)) [[unlikely]]
+      return false;
     t = hit_t;
     u = ev * inv_det;
     v = ew * inv_det;

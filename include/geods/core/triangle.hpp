@@ -5,6 +5,7 @@
 #include <cstdint>
 
 #include "geods/core/aabb.hpp"
+#include "geods/core/predicates.hpp"
 
 namespace geods {
 
@@ -12,6 +13,21 @@ namespace geods {
 template <typename T>
 Vec<T, 3> triangle_normal(const Vec<T, 3>& a, const Vec<T, 3>& b, const Vec<T, 3>& c) {
   return (b - a).cross(c - a);
+}
+
+/// Whether the corners are collinear (a repeated corner included), decided
+/// exactly: the normal's three components are the orientations of the
+/// triangle's projections onto the coordinate planes. For float and double
+/// corners (floats convert to double exactly).
+template <typename T>
+bool has_zero_area(const Vec<T, 3>& a, const Vec<T, 3>& b, const Vec<T, 3>& c) {
+  const Vec3d p[3] = {a.template cast<double>(), b.template cast<double>(), c.template cast<double>()};
+  for (int x = 0; x < 3; ++x) {
+    const int y = (x + 1) % 3;
+    const double q[3][2] = {{p[0][x], p[0][y]}, {p[1][x], p[1][y]}, {p[2][x], p[2][y]}};
+    if (orient2d(q[0], q[1], q[2]) != 0) return false;
+  }
+  return true;
 }
 
 template <typename T>

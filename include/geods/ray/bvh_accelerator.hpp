@@ -13,7 +13,7 @@ class BvhAccelerator final : public Accelerator {
   static std::unique_ptr<BvhAccelerator> build(const TriMesh& mesh, const AcceleratorOptions& options = {});
 
   static constexpr const char* kArchiveKind = "ray.BvhAccelerator";
-  static constexpr std::uint32_t kArchiveVersion = 1;
+  static constexpr std::uint32_t kArchiveVersion = 2;
   /// The corners and the hierarchy's sections (bvh::TriangleBvh::save's).
   void save(const std::filesystem::path& path) const override;
   /// Maps a file written by save(); throws geods::Error naming the file if it is bad.
