@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <initializer_list>
 #include <limits>
 #include <numeric>
 
@@ -18,9 +19,11 @@ namespace {
 constexpr std::uint32_t kFrameSide = 0xffffffffu;  // a piece of the frame, not of a bisector
 constexpr double kTieBreak = 1e-9;
 
+// A piece of a cell's boundary; `inward` is its unit normal into the cell.
 struct Piece {
   Vec2d a, b;
   std::uint32_t neighbor;
+  Vec2d inward;
 };
 
 // Disjoint increasing parameter intervals of a piece, without allocation.
@@ -74,6 +77,15 @@ std::vector<std::pair<Vec2d, Vec2d>> l1_bisector(const Vec2d& p, const Vec2d& q,
   return out;
 }
 
+// The bisector of p and q under the distance w |dx| + |dy| (w >= 1): the L1
+// bisector with x stretched by w.
+std::vector<std::pair<Vec2d, Vec2d>> stretched_l1_bisector(const Vec2d& p, const Vec2d& q, double w, double far) {
+  const Vec2d d = q - p;
+  auto pieces = l1_bisector(Vec2d::Zero(), Vec2d(w * d[0], d[1]), w * far);
+  for (auto& [a, b] : pieces) a = p + Vec2d(a[0] / w, a[1]), b = p + Vec2d(b[0] / w, b[1]);
+  return pieces;
+}
+
 class CellBuilder {
  public:
   CellBuilder(std::span<const Vec2d> points, Metric metric, const AABB2d& frame)
@@ -83,36 +95,95 @@ class CellBuilder {
   // The whole frame: the cell of a site before any other site is considered.
   std::vector<Piece> frame_pieces() const {
     std::vector<Piece> out;
-    for (int k = 0; k < 4; ++k) out.push_back({corner(k), corner(k + 1), kFrameSide});
+    for (int k = 0; k < 4; ++k) out.push_back({corner(k), corner(k + 1), kFrameSide, left_normal(corner(k), corner(k + 1))});
     return out;
   }
 
   // Cuts site q's part out of the cell of p given by its boundary pieces and the
   // sites that made it (`active`): the pieces keep what is not nearer to q, and
   // the bisector of p and q adds what is not nearer to an active site.
+  //
+  // Where a piece runs along the bisector of the site and another (three
+  // sites tie on a line, as lattice sites do under L-infinity), the line
+  // itself goes to one of them by the tie-break and its two sides to the
+  // others: deciding on the line kept a zero-width spike in one cell and
+  // dropped the boundary of the other two. There it is decided a tiny step
+  // off the piece, inside the cell (allowed()).
   void cut(std::uint32_t p, std::uint32_t q, std::span<const std::uint32_t> active, std::vector<Piece>& pieces) const {
+    const Vec2d &site = points_[p], &other = points_[q];
     std::vector<Piece> kept;
     const auto keep = [&](const Piece& piece, const Intervals& intervals) {
       for (int k = 0; k < intervals.size; ++k) {
         const Vec2d d = piece.b - piece.a;
         const Vec2d a = piece.a + intervals.v[k][0] * d, b = piece.a + intervals.v[k][1] * d;
-        if ((b - a).norm() > 1e-12 * scale_) kept.push_back({a, b, piece.neighbor});
+        // (Shorter pieces are the tie-break's slivers, or rounding's.)
+        if ((b - a).norm() > std::max(1e-12 * scale_, 4 * kTieBreak * (a - site).norm()))
+          kept.push_back({a, b, piece.neighbor, piece.inward});
       }
     };
-    for (const Piece& piece : pieces) keep(piece, allowed(piece, points_[p], points_[q]));
-    for (const auto& [a, b] : bisector(points_[p], points_[q])) {
+    for (const Piece& piece : pieces) keep(piece, allowed(piece, site, other));
+    for (const auto& [a, b] : bisector(site, other)) {
       const auto clipped = clip_segment_to_box(a, b, frame_);
       if (!clipped || clipped->first == clipped->second) continue;
-      const Piece piece{clipped->first, clipped->second, q};
+      Piece piece{clipped->first, clipped->second, q, left_normal(clipped->first, clipped->second)};
+      // The cell's side: where the site is the nearer of the two.
+      const Vec2d m = (piece.a + piece.b) / 2, step = probe_step(m, site, other) * piece.inward;
+      if (farther(m + step, site, other) > farther(m - step, site, other))
+        piece.inward = -piece.inward;
       Intervals intervals;
       intervals.add(0, 1);
       for (std::uint32_t r : active) {
-        intervals = intersect(intervals, allowed(piece, points_[p], points_[r]));
+        intervals = intersect(intervals, allowed(piece, site, points_[r]));
         if (intervals.size == 0) break;
       }
       keep(piece, intervals);
     }
     pieces = std::move(kept);
+  }
+
+  // After the last cut: where pieces overlap on one line (the bisectors of
+  // the site and two others can share a line, and a piece kept from an early
+  // cut then runs along a later one), the overlap is kept once, with the
+  // neighbour nearer just outside it.
+  void settle(std::vector<Piece>& pieces) const {
+    const auto resolve_one = [&] {
+      for (std::size_t i = 0; i < pieces.size(); ++i)
+        for (std::size_t j = i + 1; j < pieces.size(); ++j) {
+          const Piece x = pieces[i], y = pieces[j];
+          if (x.neighbor == kFrameSide || y.neighbor == kFrameSide) continue;
+          const Vec2d d = x.b - x.a;
+          const double length2 = d.squaredNorm();
+          const auto off_line = [&](const Vec2d& v) {
+            return std::abs(cross(d, v - x.a)) > 1e-12 * scale_ * std::sqrt(length2);
+          };
+          if (off_line(y.a) || off_line(y.b)) continue;
+          const double ta = d.dot(y.a - x.a) / length2, tb = d.dot(y.b - x.a) / length2;
+          const double y0 = std::min(ta, tb), y1 = std::max(ta, tb), lo = std::max(0.0, y0), hi = std::min(1.0, y1);
+          if (!((hi - lo) * std::sqrt(length2) > 1e-12 * scale_)) continue;  // apart, or touching
+          pieces.erase(pieces.begin() + std::ptrdiff_t(j));
+          pieces.erase(pieces.begin() + std::ptrdiff_t(i));
+          const auto add = [&](const Piece& like, double t0, double t1) {
+            if ((t1 - t0) * std::sqrt(length2) > 1e-12 * scale_)
+              pieces.push_back({x.a + t0 * d, x.a + t1 * d, like.neighbor, like.inward});
+          };
+          if (x.neighbor == y.neighbor) {
+            add(x, std::min(0.0, y0), std::max(1.0, y1));
+            return true;
+          }
+          const Vec2d middle = x.a + (lo + hi) / 2 * d;
+          const Vec2d out = middle - probe_step(middle, points_[x.neighbor], points_[y.neighbor]) * x.inward;
+          const bool x_nearer = farther(out, points_[x.neighbor], points_[y.neighbor]) <= 0;
+          const Piece &kept = x_nearer ? x : y, &cut = x_nearer ? y : x;
+          const double c0 = x_nearer ? y0 : 0.0, c1 = x_nearer ? y1 : 1.0;
+          add(kept, x_nearer ? 0.0 : y0, x_nearer ? 1.0 : y1);
+          add(cut, c0, lo);
+          add(cut, hi, c1);
+          return true;
+        }
+      return false;
+    };
+    while (resolve_one()) {
+    }
   }
 
   // Joins the pieces around the site into a counter-clockwise polygon.
@@ -138,16 +209,32 @@ class CellBuilder {
 
   double distance(const Vec2d& x, const Vec2d& p) const { return metric_distance(metric_, x, p); }
 
-  // Whether site r takes part of the cell `polygon` of site p.
+  // Whether site r takes part of the cell `polygon` of site p (its boundary,
+  // or just inside it: the cell is on the left of its counter-clockwise edges).
   bool takes_part(const std::vector<Vec2d>& polygon, const Vec2d& p, const Vec2d& r) const {
     if (point_in_polygon(r, polygon)) return true;
     for (std::size_t k = 0; k < polygon.size(); ++k) {
-      if (!allowed({polygon[k], polygon[(k + 1) % polygon.size()], kFrameSide}, p, r).whole()) return true;
+      const Vec2d &a = polygon[k], &b = polygon[(k + 1) % polygon.size()];
+      if (!allowed({a, b, kFrameSide, left_normal(a, b)}, p, r).whole()) return true;
     }
     return false;
   }
 
  private:
+  static double cross(const Vec2d& u, const Vec2d& v) { return u[0] * v[1] - u[1] * v[0]; }
+  // The unit normal to the left of a -> b.
+  static Vec2d left_normal(const Vec2d& a, const Vec2d& b) {
+    const Vec2d d = b - a;
+    const double length = d.norm();
+    return length > 0 ? Vec2d(Vec2d(-d[1], d[0]) / length) : Vec2d(Vec2d::Zero());
+  }
+  // How far off a piece at x membership is decided where p and r tie along
+  // it: far enough that their distances differ by more than the tie-break
+  // there, and no farther (boundaries move by about that much).
+  double probe_step(const Vec2d& x, const Vec2d& p, const Vec2d& r) const {
+    return 16 * kTieBreak * ((x - p).cwiseAbs().sum() + (x - r).cwiseAbs().sum()) + 0x1p-40 * scale_;
+  }
+
   Vec2d corner(int k) const {
     switch (k % 4) {
       case 0: return frame_.lo;
@@ -159,10 +246,14 @@ class CellBuilder {
 
   std::vector<std::pair<Vec2d, Vec2d>> bisector(const Vec2d& p, const Vec2d& q) const {
     switch (metric_) {
-      case Metric::l1: return l1_bisector(p, q, far_);
+      // The bisectors of the distances farther() compares, tie-break included
+      // (so that they agree where two sites nearly tie too).
+      case Metric::l1: return stretched_l1_bisector(p, q, 1 + kTieBreak, far_);
       case Metric::linf: {
-        auto pieces = l1_bisector(turn(p), turn(q), 2 * far_);
-        for (auto& [a, b] : pieces) a = unturn(a), b = unturn(b);
+        // Turned about p: turning absolute coordinates would round a small
+        // offset in y to the resolution of a large x (and the other way).
+        auto pieces = stretched_l1_bisector(Vec2d::Zero(), turn(q - p), 1 + 2 * kTieBreak, 2 * far_);
+        for (auto& [a, b] : pieces) a = p + unturn(a), b = p + unturn(b);
         return pieces;
       }
       default: {
@@ -173,14 +264,24 @@ class CellBuilder {
     }
   }
 
-  // The distance of x from p as the diagram sees it: L2 squared (so that the
-  // difference of two is linear), L1 and L-infinity with the tie-breaking term.
-  double biased(const Vec2d& x, const Vec2d& p) const {
-    const Vec2d d = x - p;
+  // The distance of x from p as the diagram sees it, minus that from r: > 0
+  // where r is nearer. L2 squared (so that it is linear); L1 and L-infinity
+  // with a tie-breaking term, the main terms' difference taken first (in a
+  // tie it is 0, and the tie-break's difference survives the rounding).
+  // With the tie-break L1 is the L1 distance with x stretched by
+  // 1 + kTieBreak, and L-infinity half the L1 distance of the turned
+  // coordinates (x + y, x - y) with x + y stretched by 1 + 2 kTieBreak:
+  // bisector() builds theirs.
+  double farther(const Vec2d& x, const Vec2d& p, const Vec2d& r) const {
+    const Vec2d d = x - p, e = x - r;
     switch (metric_) {
-      case Metric::l1: return std::abs(d[0]) + std::abs(d[1]) + kTieBreak * std::abs(d[0]);
-      case Metric::linf: return std::max(std::abs(d[0]), std::abs(d[1])) + kTieBreak * std::abs(d[0] + d[1]);
-      default: return d.squaredNorm();
+      case Metric::l1:
+        return (std::abs(d[0]) - std::abs(e[0])) + (std::abs(d[1]) - std::abs(e[1])) +
+               kTieBreak * (std::abs(d[0]) - std::abs(e[0]));
+      case Metric::linf:
+        return (std::max(std::abs(d[0]), std::abs(d[1])) - std::max(std::abs(e[0]), std::abs(e[1]))) +
+               kTieBreak * (std::abs(d[0] + d[1]) - std::abs(e[0] + e[1]));
+      default: return d.squaredNorm() - e.squaredNorm();
     }
   }
 
@@ -206,7 +307,14 @@ class CellBuilder {
     Intervals out;
     const auto f = [&](double t) {
       const Vec2d x = piece.a + t * d;
-      return biased(x, p) - biased(x, r);
+      return farther(x, p, r);
+    };
+    // |f| within the tie-break and rounding: the piece is on the bisector of
+    // p and r there (L1 and L-infinity, whose bisectors can share lines).
+    const auto on_bisector = [&](double t, double ft) {
+      const Vec2d x = piece.a + t * d;
+      return metric_ != Metric::l2 &&
+             std::abs(ft) <= 4 * kTieBreak * ((x - p).cwiseAbs().sum() + (x - r).cwiseAbs().sum()) + 0x1p-46 * scale_;
     };
     const auto add = [&](double t0, double t1) { out.add(t0, t1); };
     double f0 = f(ts[0]);
@@ -214,7 +322,12 @@ class CellBuilder {
       const double t0 = ts[k], t1 = ts[k + 1];
       if (t1 <= t0) continue;
       const double f1 = f(t1);
-      if (f0 <= 0 && f1 <= 0) {
+      const Vec2d middle = piece.a + (t0 + t1) / 2 * d;
+      const double step = probe_step(middle, p, r);
+      // (Only along: a short stretch near 0 at both ends crosses a bisector.)
+      if (on_bisector(t0, f0) && on_bisector(t1, f1) && (t1 - t0) * d.norm() > 4 * step) {
+        if (farther(middle + step * piece.inward, p, r) <= 0) add(t0, t1);
+      } else if (f0 <= 0 && f1 <= 0) {
         add(t0, t1);
       } else if (f0 <= 0 || f1 <= 0) {
         const double root = std::clamp(t0 + (t1 - t0) * f0 / (f0 - f1), t0, t1);
@@ -273,6 +386,16 @@ MetricVoronoi::MetricVoronoi(std::span<const Vec2d> points, Metric metric, const
   const double margin = 0.05 * std::max(frame.hi[0] - frame.lo[0], frame.hi[1] - frame.lo[1]);
   frame.lo.array() -= margin;
   frame.hi.array() += margin;
+  // The cells are computed relative to `origin`: on each axis the frame's
+  // centre where the frame lies far from 0 (else 0). There the subtraction is
+  // exact (Sterbenz), and the arithmetic rounds at the frame's size rather than
+  // at its distance from 0 (sites 1e-7 apart at 2e7 got cells with spikes).
+  Vec2d origin = Vec2d::Zero();
+  for (int a = 0; a < 2; ++a) {
+    const double centre = frame.lo[a] / 2 + frame.hi[a] / 2;
+    if (std::abs(centre) >= 2 * (frame.hi[a] - frame.lo[a])) origin[a] = centre;
+  }
+  const AABB2d local_frame(frame.lo - origin, frame.hi - origin), local_box(box.lo - origin, box.hi - origin);
 
   // Duplicates: the first occurrence of equal points.
   std::vector<std::uint32_t> order(n);
@@ -286,10 +409,10 @@ MetricVoronoi::MetricVoronoi(std::span<const Vec2d> points, Metric metric, const
   for (std::uint32_t i = 0; i < n; ++i)
     if (representative_[i] == i) sites.push_back(i);
   std::vector<Vec2d> site_points(sites.size());
-  for (std::size_t k = 0; k < sites.size(); ++k) site_points[k] = points[sites[k]];
+  for (std::size_t k = 0; k < sites.size(); ++k) site_points[k] = points[sites[k]] - origin;
 
   const spatial::KdTree<double, 2> tree{spatial::PointView<double>(std::span<const Vec2d>(site_points))};
-  const CellBuilder builder(site_points, metric, frame);
+  const CellBuilder builder(site_points, metric, local_frame);
 
   std::vector<std::vector<Vec2d>> site_cells(sites.size());
   std::vector<std::vector<Piece>> site_pieces(sites.size());
@@ -305,7 +428,7 @@ MetricVoronoi::MetricVoronoi(std::span<const Vec2d> points, Metric metric, const
     std::vector<Piece> pieces = builder.frame_pieces();
     std::vector<Vec2d> polygon = builder.polygon(p, pieces);
     double reach = std::numeric_limits<double>::infinity();
-    AABB2d bounds = frame;
+    AABB2d bounds = local_frame;
     // A site farther from the cell's bounding box than the cell's reach cannot take any of it.
     const auto near_cell = [&](std::uint32_t q) {
       const Vec2d gap = (bounds.lo - site_points[q]).cwiseMax(site_points[q] - bounds.hi).cwiseMax(0.0);
@@ -336,9 +459,12 @@ MetricVoronoi::MetricVoronoi(std::span<const Vec2d> points, Metric metric, const
       for (const auto& [d, q] : more)
         if (std::find(active.begin(), active.end(), q) == active.end()) offer(q);
     }
+    builder.settle(pieces);
+    polygon = builder.polygon(p, pieces);
     consulted[s] = active.size();
     site_pieces[s] = std::move(pieces);
-    site_cells[s] = clip_polygon_to_box(polygon, box);
+    site_cells[s] = clip_polygon_to_box(polygon, local_box);
+    for (Vec2d& v : site_cells[s]) v += origin;
   });
 
   cells_.resize(n);
@@ -346,8 +472,8 @@ MetricVoronoi::MetricVoronoi(std::span<const Vec2d> points, Metric metric, const
     max_candidates_ = std::max(max_candidates_, consulted[s]);
     for (const Piece& piece : site_pieces[s]) {
       if (piece.neighbor == kFrameSide || sites[piece.neighbor] < sites[s]) continue;
-      if (const auto clipped = clip_segment_to_box(piece.a, piece.b, box); clipped && clipped->first != clipped->second)
-        edges_.push_back({sites[s], sites[piece.neighbor], clipped->first, clipped->second});
+      if (const auto clipped = clip_segment_to_box(piece.a, piece.b, local_box); clipped && clipped->first != clipped->second)
+        edges_.push_back({sites[s], sites[piece.neighbor], clipped->first + origin, clipped->second + origin});
     }
   }
   for (std::uint32_t i = 0; i < n; ++i) {
@@ -374,16 +500,37 @@ void MetricVoronoi::validate() const {
   AABB2d grown = box_;
   grown.lo.array() -= 1e-9 * scale;
   grown.hi.array() += 1e-9 * scale;
+  // Vertices are rounded to their coordinates' precision: by up to u |v|.
+  constexpr double u = std::numeric_limits<double>::epsilon() / 2;
+  const auto reach = [](std::initializer_list<Vec2d> vs) {
+    double r = 0;
+    for (const Vec2d& v : vs) r = std::max(r, v.cwiseAbs().maxCoeff());
+    return r;
+  };
+  double covered = 0, slack = 0;  // the distinct sites' cells tile the box
   for (std::size_t i = 0; i < cells_.size(); ++i) {
     if (cells_[i].empty()) continue;
-    if (polygon_area(cells_[i]) <= 0) throw Error("MetricVoronoi::validate: cell " + std::to_string(i) + " is not counter-clockwise");
+    // A cell thinner than that resolution may round to zero area, not below.
+    double perimeter = 0, far = 0;
+    for (std::size_t k = 0; k < cells_[i].size(); ++k) {
+      perimeter += (cells_[i][(k + 1) % cells_[i].size()] - cells_[i][k]).norm();
+      far = std::max(far, reach({cells_[i][k]}));
+    }
+    const double area = polygon_area(cells_[i]);
+    if (area <= -4 * u * far * perimeter)
+      throw Error("MetricVoronoi::validate: cell " + std::to_string(i) + " is not counter-clockwise");
+    if (representative_[i] == i) covered += area, slack += 4 * u * far * perimeter;
     for (const Vec2d& v : cells_[i])
       if (!grown.contains(v)) throw Error("MetricVoronoi::validate: cell " + std::to_string(i) + " leaves the box");
   }
+  const double box_area = (box_.hi[0] - box_.lo[0]) * (box_.hi[1] - box_.lo[1]);
+  if (std::abs(covered - box_area) > 1e-9 * box_area + slack)
+    throw Error("MetricVoronoi::validate: the cells cover " + format_number(covered) + " of the box's area " +
+                format_number(box_area));
   for (const Edge& e : edges_)
     for (const Vec2d& x : {e.p0, e.p1}) {
       const double da = metric_distance(metric_, x, points_[e.a]), db = metric_distance(metric_, x, points_[e.b]);
-      if (std::abs(da - db) > 1e-6 * (da + db) + 1e-12 * scale)
+      if (std::abs(da - db) > 1e-6 * (da + db) + 1e-12 * scale + 8 * u * reach({x, points_[e.a], points_[e.b]}))
         throw Error("MetricVoronoi::validate: an edge of sites " + std::to_string(e.a) + " and " + std::to_string(e.b) +
                     " is not on their bisector");
     }
