@@ -128,9 +128,15 @@ class RayTriangleTest {
     if (!(hit_t >= tmin && hit_t <= tmax)) return false;
     // Exactly, a triangle with collinear corners is never hit (its edge
     // functions sum to zero); rounded, its sheared projection can get a
-    // sliver of area around the ray and a "hit" off the triangle. Decided
-    // exactly, on hits only.
-    if (has_zero_area(a, b, c)) [[unlikely]]
+    // sliver of area around the ray and a "hit" off the triangle. On hits
+    // only: a det beyond the rounding of the sheared corners and of the edge
+    // functions (about 20 units of u times the sizes of their terms) shows
+    // area at once, else zero area is decided exactly.
+    const T mx = std::abs(pa[kx_]) + std::abs(pb[kx_]) + std::abs(pc[kx_]) +
+                 std::abs(shear_x_) * (std::abs(pa[kz_]) + std::abs(pb[kz_]) + std::abs(pc[kz_]));
+    const T my = std::abs(pa[ky_]) + std::abs(pb[ky_]) + std::abs(pc[ky_]) +
+                 std::abs(shear_y_) * (std::abs(pa[kz_]) + std::abs(pb[kz_]) + std::abs(pc[kz_]));
+    if (!(std::abs(det) > T(16) * std::numeric_limits<T>::epsilon() * mx * my) && has_zero_area(a, b, c)) [[unlikely]]
       return false;
     t = hit_t;
     u = ev * inv_det;

@@ -2,6 +2,7 @@
 // Small helpers on a single triangle (a, b, c).
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 
 #include "geods/core/aabb.hpp"
@@ -21,10 +22,18 @@ Vec<T, 3> triangle_normal(const Vec<T, 3>& a, const Vec<T, 3>& b, const Vec<T, 3
 /// corners (floats convert to double exactly).
 template <typename T>
 bool has_zero_area(const Vec<T, 3>& a, const Vec<T, 3>& b, const Vec<T, 3>& c) {
-  const Vec3d p[3] = {a.template cast<double>(), b.template cast<double>(), c.template cast<double>()};
+  // Filter: a normal component nonzero beyond its rounding (each edge and
+  // product off by at most a few units of 2^-53) decides at once.
+  const double e[3] = {double(b[0]) - double(a[0]), double(b[1]) - double(a[1]), double(b[2]) - double(a[2])};
+  const double f[3] = {double(c[0]) - double(a[0]), double(c[1]) - double(a[1]), double(c[2]) - double(a[2])};
   for (int x = 0; x < 3; ++x) {
-    const int y = (x + 1) % 3;
-    const double q[3][2] = {{p[0][x], p[0][y]}, {p[1][x], p[1][y]}, {p[2][x], p[2][y]}};
+    const int y = x == 2 ? 0 : x + 1, z = y == 2 ? 0 : y + 1;
+    const double u = e[y] * f[z], v = e[z] * f[y];
+    if (std::abs(u - v) > 0x1p-49 * (std::abs(u) + std::abs(v))) return false;
+  }
+  for (int x = 0; x < 3; ++x) {
+    const int y = x == 2 ? 0 : x + 1;
+    const double q[3][2] = {{double(a[x]), double(a[y])}, {double(b[x]), double(b[y])}, {double(c[x]), double(c[y])}};
     if (orient2d(q[0], q[1], q[2]) != 0) return false;
   }
   return true;
