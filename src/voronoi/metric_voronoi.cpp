@@ -195,10 +195,11 @@ class CellBuilder {
     std::sort(pieces.begin(), pieces.end(), [&](const Piece& x, const Piece& y) { return angle(x) < angle(y); });
     std::vector<Vec2d> out;
     for (Piece& s : pieces) {
-      const double cross = (s.a - site)[0] * (s.b - site)[1] - (s.a - site)[1] * (s.b - site)[0];
+      const double turn_sense = cross(s.a - site, s.b - site);
       // Pieces on a ray from the site (possible at the degenerate quadrants) have no
       // turning sense: they start where the previous piece ended.
-      if (out.empty() ? cross < 0 : (cross < 0 || (cross == 0 && (s.b - out.back()).norm() < (s.a - out.back()).norm())))
+      if (out.empty() ? turn_sense < 0
+                      : (turn_sense < 0 || (turn_sense == 0 && (s.b - out.back()).norm() < (s.a - out.back()).norm())))
         std::swap(s.a, s.b);
       for (const Vec2d& v : {s.a, s.b})
         if (out.empty() || (v - out.back()).norm() > 1e-12 * scale_) out.push_back(v);
@@ -221,7 +222,6 @@ class CellBuilder {
   }
 
  private:
-  static double cross(const Vec2d& u, const Vec2d& v) { return u[0] * v[1] - u[1] * v[0]; }
   // The unit normal to the left of a -> b.
   static Vec2d left_normal(const Vec2d& a, const Vec2d& b) {
     const Vec2d d = b - a;

@@ -6,6 +6,7 @@
 #include <unordered_map>
 
 #include "geods/core/error.hpp"
+#include "geods/voronoi/polygon_clip.hpp"
 #include "even_odd.hpp"
 #include "segment_voronoi_sweep.hpp"
 
@@ -38,7 +39,6 @@ bool strictly_between(const IntPoint& a, const IntPoint& b, const IntPoint& c) {
 }
 
 Vec2d perp_cw(const Vec2d& w) { return Vec2d(w[1], -w[0]); }
-double cross(const Vec2d& a, const Vec2d& b) { return a[0] * b[1] - a[1] * b[0]; }
 
 double point_segment_distance(const Vec2d& x, const Vec2d& a, const Vec2d& b) {
   const Vec2d ab = b - a;

@@ -20,6 +20,10 @@ std::optional<std::pair<Vec2d, Vec2d>> clip_segment_to_box(const Vec2d& a, const
 /// Whether p lies inside the simple polygon (even-odd rule; points on the boundary may go either way).
 bool point_in_polygon(const Vec2d& p, const std::vector<Vec2d>& polygon);
 
+/// The z component of the cross product of a and b: twice the signed area of
+/// the triangle (0, a, b).
+inline double cross(const Vec2d& a, const Vec2d& b) { return a[0] * b[1] - a[1] * b[0]; }
+
 /// Signed area, positive for counter-clockwise polygons.
 double polygon_area(const std::vector<Vec2d>& polygon);
 
