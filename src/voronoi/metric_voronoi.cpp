@@ -1,4 +1,5 @@
-// Voronoi diagrams under L1, L-infinity and L2: cells cut out by bisector pieces.
+// Voronoi diagrams under L1 and L-infinity, cells cut out by bisector pieces;
+// under L2, Voronoi2 clipped to the box.
 #include "geods/voronoi/metric_voronoi.hpp"
 
 #include <algorithm>
@@ -12,12 +13,14 @@
 #include "geods/core/parallel.hpp"
 #include "geods/spatial/kd_tree.hpp"
 #include "geods/voronoi/polygon_clip.hpp"
+#include "geods/voronoi/voronoi2.hpp"
 
 namespace geods::voronoi {
 namespace {
 
 constexpr std::uint32_t kFrameSide = 0xffffffffu;  // a piece of the frame, not of a bisector
 constexpr double kTieBreak = 1e-9;
+constexpr double kResolution = 1e-6;  // L1 and L-infinity: the closest distinct sites, relative to the frame
 
 // A piece of a cell's boundary; `inward` is its unit normal into the cell.
 struct Piece {
@@ -244,45 +247,32 @@ class CellBuilder {
     }
   }
 
+  // The bisectors of the distances farther() compares, tie-break included
+  // (so that they agree where two sites nearly tie too).
   std::vector<std::pair<Vec2d, Vec2d>> bisector(const Vec2d& p, const Vec2d& q) const {
-    switch (metric_) {
-      // The bisectors of the distances farther() compares, tie-break included
-      // (so that they agree where two sites nearly tie too).
-      case Metric::l1: return stretched_l1_bisector(p, q, 1 + kTieBreak, far_);
-      case Metric::linf: {
-        // Turned about p: turning absolute coordinates would round a small
-        // offset in y to the resolution of a large x (and the other way).
-        auto pieces = stretched_l1_bisector(Vec2d::Zero(), turn(q - p), 1 + 2 * kTieBreak, 2 * far_);
-        for (auto& [a, b] : pieces) a = p + unturn(a), b = p + unturn(b);
-        return pieces;
-      }
-      default: {
-        const Vec2d m = (p + q) / 2, d = q - p;
-        const Vec2d u = Vec2d(-d[1], d[0]).normalized() * far_;
-        return {{m - u, m + u}};
-      }
-    }
+    if (metric_ == Metric::l1) return stretched_l1_bisector(p, q, 1 + kTieBreak, far_);
+    // L-infinity, turned about p: turning absolute coordinates would round a
+    // small offset in y to the resolution of a large x (and the other way).
+    auto pieces = stretched_l1_bisector(Vec2d::Zero(), turn(q - p), 1 + 2 * kTieBreak, 2 * far_);
+    for (auto& [a, b] : pieces) a = p + unturn(a), b = p + unturn(b);
+    return pieces;
   }
 
   // The distance of x from p as the diagram sees it, minus that from r: > 0
-  // where r is nearer. L2 squared (so that it is linear); L1 and L-infinity
-  // with a tie-breaking term, the main terms' difference taken first (in a
-  // tie it is 0, and the tie-break's difference survives the rounding).
+  // where r is nearer, with a tie-breaking term, the main terms' difference
+  // taken first (in a tie it is 0, and the tie-break's difference survives
+  // the rounding).
   // With the tie-break L1 is the L1 distance with x stretched by
   // 1 + kTieBreak, and L-infinity half the L1 distance of the turned
   // coordinates (x + y, x - y) with x + y stretched by 1 + 2 kTieBreak:
   // bisector() builds theirs.
   double farther(const Vec2d& x, const Vec2d& p, const Vec2d& r) const {
     const Vec2d d = x - p, e = x - r;
-    switch (metric_) {
-      case Metric::l1:
-        return (std::abs(d[0]) - std::abs(e[0])) + (std::abs(d[1]) - std::abs(e[1])) +
-               kTieBreak * (std::abs(d[0]) - std::abs(e[0]));
-      case Metric::linf:
-        return (std::max(std::abs(d[0]), std::abs(d[1])) - std::max(std::abs(e[0]), std::abs(e[1]))) +
-               kTieBreak * (std::abs(d[0] + d[1]) - std::abs(e[0] + e[1]));
-      default: return d.squaredNorm() - e.squaredNorm();
-    }
+    if (metric_ == Metric::l1)
+      return (std::abs(d[0]) - std::abs(e[0])) + (std::abs(d[1]) - std::abs(e[1])) +
+             kTieBreak * (std::abs(d[0]) - std::abs(e[0]));
+    return (std::max(std::abs(d[0]), std::abs(d[1])) - std::max(std::abs(e[0]), std::abs(e[1]))) +
+           kTieBreak * (std::abs(d[0] + d[1]) - std::abs(e[0] + e[1]));
   }
 
   // The parameters t in [0, 1] where piece.a + t (piece.b - piece.a) is not nearer to r than to p.
@@ -294,13 +284,11 @@ class CellBuilder {
     ts[count++] = 0;
     ts[count++] = 1;
     const Vec2d d = piece.b - piece.a;
-    if (metric_ != Metric::l2) {
-      for (const Vec2d* s : {&p, &r}) {
-        const Vec2d o = *s - piece.a;
-        const double crossings[4][2] = {{o[0], d[0]}, {o[1], d[1]}, {o[0] + o[1], d[0] + d[1]}, {o[0] - o[1], d[0] - d[1]}};
-        for (const auto& [num, den] : crossings)
-          if (den != 0 && num / den > 0 && num / den < 1) ts[count++] = num / den;
-      }
+    for (const Vec2d* s : {&p, &r}) {
+      const Vec2d o = *s - piece.a;
+      const double crossings[4][2] = {{o[0], d[0]}, {o[1], d[1]}, {o[0] + o[1], d[0] + d[1]}, {o[0] - o[1], d[0] - d[1]}};
+      for (const auto& [num, den] : crossings)
+        if (den != 0 && num / den > 0 && num / den < 1) ts[count++] = num / den;
     }
     for (std::size_t i = 1; i < count; ++i)  // insertion sort of at most 10 values
       for (std::size_t j = i; j > 0 && ts[j] < ts[j - 1]; --j) std::swap(ts[j], ts[j - 1]);
@@ -310,11 +298,10 @@ class CellBuilder {
       return farther(x, p, r);
     };
     // |f| within the tie-break and rounding: the piece is on the bisector of
-    // p and r there (L1 and L-infinity, whose bisectors can share lines).
+    // p and r there (bisectors under L1 and L-infinity can share lines).
     const auto on_bisector = [&](double t, double ft) {
       const Vec2d x = piece.a + t * d;
-      return metric_ != Metric::l2 &&
-             std::abs(ft) <= 4 * kTieBreak * ((x - p).cwiseAbs().sum() + (x - r).cwiseAbs().sum()) + 0x1p-46 * scale_;
+      return std::abs(ft) <= 4 * kTieBreak * ((x - p).cwiseAbs().sum() + (x - r).cwiseAbs().sum()) + 0x1p-46 * scale_;
     };
     const auto add = [&](double t0, double t1) { out.add(t0, t1); };
     double f0 = f(ts[0]);
@@ -382,6 +369,25 @@ MetricVoronoi::MetricVoronoi(std::span<const Vec2d> points, Metric metric, const
     if (!points[i].allFinite()) throw Error("MetricVoronoi: non-finite coordinates at point " + std::to_string(i));
     frame.extend(points[i]);
   }
+  if (metric == Metric::l2) {
+    // The library's Euclidean diagram: the dual of the Delaunay triangulation,
+    // whose exact predicates keep cells of sites 1e-12 apart right, where
+    // cutting cells by bisectors in floating point fails near 1e-8.
+    const Voronoi2 diagram(points_);
+    cells_ = diagram.cell_polygons(box_);
+    representative_.resize(n);
+    for (std::uint32_t i = 0; i < n; ++i) {
+      representative_[i] = diagram.representative(i);
+      if (representative_[i] == i) max_candidates_ = std::max(max_candidates_, diagram.neighbors(i).size());
+    }
+    for (std::uint32_t e = 0; e < diagram.edges().size(); ++e) {
+      const std::uint32_t a = diagram.edges()[e].site, b = diagram.opposite_site(e);
+      if (a > b) continue;  // the twin gives this edge
+      if (const auto clipped = diagram.clipped_edge(e, box_); clipped && clipped->first != clipped->second)
+        edges_.push_back({a, b, clipped->first, clipped->second});
+    }
+    return;
+  }
   // The frame holds every site strictly inside, so every cell is star-shaped within it.
   const double margin = 0.05 * std::max(frame.hi[0] - frame.lo[0], frame.hi[1] - frame.lo[1]);
   frame.lo.array() -= margin;
@@ -412,6 +418,18 @@ MetricVoronoi::MetricVoronoi(std::span<const Vec2d> points, Metric metric, const
   for (std::size_t k = 0; k < sites.size(); ++k) site_points[k] = points[sites[k]] - origin;
 
   const spatial::KdTree<double, 2> tree{spatial::PointView<double>(std::span<const Vec2d>(site_points))};
+  // Sites nearer than this are beyond the construction's resolution (a
+  // fuzz of lattice subsets: 0 of 150 wrong 3e-7 of the frame apart, 1 of
+  // 150 at 1e-7, most at 1e-9): refused rather than given wrong cells.
+  const double resolution = kResolution * std::max(frame.hi[0] - frame.lo[0], frame.hi[1] - frame.lo[1]);
+  for (std::size_t k = 0; k < sites.size() && sites.size() > 1; ++k) {
+    const auto nearest = tree.query(site_points[k], 2);
+    const auto& other = nearest[0].index == k ? nearest[1] : nearest[0];
+    if ((site_points[other.index] - site_points[k]).norm() < resolution)
+      throw Error("MetricVoronoi: points " + std::to_string(sites[k]) + " and " + std::to_string(sites[other.index]) +
+                  " are closer than " + format_number(resolution) + " (1e-6 of the box and points' extent), which " +
+                  metric_name(metric) + " cells cannot resolve (l2 can)");
+  }
   const CellBuilder builder(site_points, metric, local_frame);
 
   std::vector<std::vector<Vec2d>> site_cells(sites.size());
@@ -507,21 +525,47 @@ void MetricVoronoi::validate() const {
     for (const Vec2d& v : vs) r = std::max(r, v.cwiseAbs().maxCoeff());
     return r;
   };
+  // Under L1 and L-infinity the tie-break moves a boundary by up to 1e-9 of
+  // its distance to the sites, and neighbours may round it either way.
+  const double tie_break = metric_ == Metric::l2 ? 0.0 : 4 * kTieBreak;
   double covered = 0, slack = 0;  // the distinct sites' cells tile the box
   for (std::size_t i = 0; i < cells_.size(); ++i) {
     if (cells_[i].empty()) continue;
     // A cell thinner than that resolution may round to zero area, not below.
-    double perimeter = 0, far = 0;
+    double perimeter = 0, far = 0, from_site = 0;
     for (std::size_t k = 0; k < cells_[i].size(); ++k) {
       perimeter += (cells_[i][(k + 1) % cells_[i].size()] - cells_[i][k]).norm();
       far = std::max(far, reach({cells_[i][k]}));
+      from_site = std::max(from_site, metric_distance(metric_, cells_[i][k], points_[i]));
     }
     const double area = polygon_area(cells_[i]);
     if (area <= -4 * u * far * perimeter)
       throw Error("MetricVoronoi::validate: cell " + std::to_string(i) + " is not counter-clockwise");
-    if (representative_[i] == i) covered += area, slack += 4 * u * far * perimeter;
+    if (representative_[i] == i) covered += area, slack += (4 * u * far + tie_break * from_site) * perimeter;
     for (const Vec2d& v : cells_[i])
       if (!grown.contains(v)) throw Error("MetricVoronoi::validate: cell " + std::to_string(i) + " leaves the box");
+  }
+  // A site strictly inside the box lies inside its cell (its boundary is
+  // about half the distance to the nearest other site away), or within the
+  // rounding of the cell's corners: cells of sites an ulp apart are an ulp wide.
+  const auto distance_to_segment = [](const Vec2d& p, const Vec2d& a, const Vec2d& b) {
+    const Vec2d d = b - a;
+    const double length2 = d.squaredNorm();
+    const double t = length2 > 0 ? std::clamp(d.dot(p - a) / length2, 0.0, 1.0) : 0.0;
+    return (a + t * d - p).norm();
+  };
+  for (std::uint32_t i = 0; i < cells_.size(); ++i) {
+    const Vec2d& p = points_[i];
+    const std::vector<Vec2d>& cell = cells_[i];
+    if (representative_[i] != i || !(p.array() > box_.lo.array()).all() || !(p.array() < box_.hi.array()).all() ||
+        point_in_polygon(p, cell))
+      continue;
+    double gap = std::numeric_limits<double>::infinity(), far = reach({p});
+    for (std::size_t k = 0; k < cell.size(); ++k) {
+      gap = std::min(gap, distance_to_segment(p, cell[k], cell[(k + 1) % cell.size()]));
+      far = std::max(far, reach({cell[k]}));
+    }
+    if (!(gap <= 8 * u * far)) throw Error("MetricVoronoi::validate: site " + std::to_string(i) + " is not inside its cell");
   }
   const double box_area = (box_.hi[0] - box_.lo[0]) * (box_.hi[1] - box_.lo[1]);
   if (std::abs(covered - box_area) > 1e-9 * box_area + slack)

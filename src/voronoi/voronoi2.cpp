@@ -295,36 +295,45 @@ std::vector<Vec2d> Voronoi2::cell_polygon(std::uint32_t i, const AABB2d& box) co
   const std::uint32_t start = cell_edge(i);
   if (start == kNoEdge) return {box_corner(box, 0), box_corner(box, 1), box_corner(box, 2), box_corner(box, 3)};
 
-  // First the cell within a frame around everything (sites, vertices, box), where
-  // the rays end; the ends are joined along the frame, counter-clockwise.
+  // First the cell within a frame around the sites and the box, each edge cut
+  // to it along its bisector (as clipped_edge does: exact sites, not a far
+  // vertex, give the crossing, the same one from both cells; clipping
+  // polygons whose corners reached 1e10 left gaps of 1e-7 between cells).
+  // Where an edge leaves the frame, the frame's corners lead, counter-clockwise,
+  // to where the next edge comes back in.
   AABB2d frame = box;
   for (const Vec2d& p : points_) frame.extend(p);
-  for (const Vec2d& v : vertices_) frame.extend(v);
   const double side = std::max({frame.hi[0] - frame.lo[0], frame.hi[1] - frame.lo[1], 1e-300});
   frame.lo.array() -= side;
   frame.hi.array() += side;
 
-  std::vector<Vec2d> polygon;
+  struct Piece {
+    Vec2d a, b;
+    bool enters, leaves;  // a, b on the frame (the edge goes on beyond it)
+  };
+  std::vector<Piece> pieces;
   std::uint32_t e = start;
   do {
     const Edge& edge = edges_[e];
-    const Vec2d p = line_point(e), d = direction(e);
-    const auto [t_in, t_out] = line_box_interval(p, d, frame);
-    polygon.push_back(edge.origin != kInfinity ? vertices_[edge.origin] : Vec2d(p + t_in * d));
-    if (edge.target == kInfinity) {
-      const Vec2d exit = p + t_out * d;
-      polygon.push_back(exit);
-      const std::uint32_t n = edge.next;
-      const auto [next_in, next_out] = line_box_interval(line_point(n), direction(n), frame);
-      (void)next_out;
-      const Vec2d entry = line_point(n) + next_in * direction(n);
-      const double from = perimeter_position(exit, frame);
-      double to = perimeter_position(entry, frame);
+    if (const auto clipped = clipped_edge(e, frame))
+      pieces.push_back({clipped->first, clipped->second,
+                        edge.origin == kInfinity || clipped->first != vertices_[edge.origin],
+                        edge.target == kInfinity || clipped->second != vertices_[edge.target]});
+    e = edge.next;
+  } while (e != start);
+  std::vector<Vec2d> polygon;
+  for (std::size_t k = 0; k < pieces.size(); ++k) {
+    const Piece &piece = pieces[k], &next = pieces[(k + 1) % pieces.size()];
+    for (const Vec2d& v : {piece.a, piece.b})
+      if (polygon.empty() || polygon.back() != v) polygon.push_back(v);
+    if (piece.leaves && next.enters) {
+      const double from = perimeter_position(piece.b, frame);
+      double to = perimeter_position(next.a, frame);
       if (to <= from) to += 4;
       for (int corner = int(std::floor(from)) + 1; corner < to; ++corner) polygon.push_back(box_corner(frame, corner));
     }
-    e = edge.next;
-  } while (e != start);
+  }
+  if (polygon.size() > 1 && polygon.front() == polygon.back()) polygon.pop_back();
   return clip_polygon_to_box(polygon, box);
 }
 
@@ -400,8 +409,10 @@ void Voronoi2::validate() const {
   for (std::uint32_t e = 0; e < edges_.size(); ++e) {
     const Edge& edge = edges_[e];
     const auto name = [e] { return "half-edge " + std::to_string(e); };
-    // The site lies strictly left of its edge's line.
-    const Vec2d d = direction(e), s = points_[edge.site] - line_point(e);
+    // The site lies strictly left of its edge's line. (Its offset from the
+    // line is half its difference from the other site, exactly; the
+    // midpoint of sites an ulp apart rounds onto one of them.)
+    const Vec2d d = direction(e), s = (points_[edge.site] - points_[edges_[edge.twin].site]) / 2;
     if (!(d[0] * s[1] - d[1] * s[0] > 0)) fail(name() + ": its site is not on its left");
     for (std::uint32_t v : {edge.origin, edge.target}) {
       if (v == kInfinity) continue;

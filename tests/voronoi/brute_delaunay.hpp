@@ -31,6 +31,16 @@ inline std::vector<Vec2d> uniform_points(std::size_t n, std::uint64_t seed, doub
   return p;
 }
 
+// 4 to 15 sites of the 6 x 6 integer lattice (duplicates likely); with
+// moved_rows, each raised by 0, 0.01 or 0.02 (nearly co-circular quadruples).
+inline std::vector<Vec2d> lattice_subset(std::uint64_t seed, bool moved_rows) {
+  Rng rng(seed);
+  std::vector<Vec2d> sites(4 + rng.below(12));
+  for (Vec2d& s : sites)
+    s = Vec2d(double(rng.below(6)), double(rng.below(6)) + (moved_rows ? 0.01 * double(rng.below(3)) : 0.0));
+  return sites;
+}
+
 inline void link_halfedges(Triangulation& t) {
   std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> directed;
   for (std::uint32_t e = 0; e < t.triangles.size(); ++e)

@@ -13,6 +13,7 @@
 namespace geods::voronoi {
 namespace {
 
+using testing::lattice_subset;
 using testing::uniform_points;
 
 void expect_cells_match_brute_force(const MetricVoronoi& v, std::uint64_t seed, int samples = 1500) {
@@ -82,14 +83,6 @@ TEST(MetricVoronoi, DegenerateDiagonalPairsAndDuplicates) {
 // Random subsets of a 6 x 6 lattice, some rows moved up by 0.01 or 0.02:
 // pairs with dx = 0 or dy = 0 tie under L-infinity (|dx| = |dy| under L1) on
 // two-dimensional regions, and three sites can share a bisector line.
-std::vector<Vec2d> lattice_subset(std::uint64_t seed, bool moved_rows) {
-  Rng rng(seed);
-  std::vector<Vec2d> sites(4 + rng.below(12));
-  for (Vec2d& s : sites)
-    s = Vec2d(double(rng.below(6)), double(rng.below(6)) + (moved_rows ? 0.01 * double(rng.below(3)) : 0.0));
-  return sites;
-}
-
 TEST(MetricVoronoi, LatticeSubsetsUnderEveryMetric) {
   // Before the cells were decided off the shared lines, about half of these
   // failed under L-infinity (cells missing a boundary, zero-width spikes).
@@ -111,6 +104,34 @@ TEST(MetricVoronoi, SitesFarFromTheOrigin) {
       for (Vec2d& s : sites) s = Vec2d(2e7 + 1e-3 * s[0], -7e6 + 1e-3 * s[1]);
       const MetricVoronoi v(sites, m, AABB2d({2e7 - 1, -7e6 - 1}, {2e7 + 1, -7e6 + 1}));
       expect_cells_match_brute_force(v, seed, 300);
+    }
+}
+
+TEST(MetricVoronoi, EuclideanCellsOfSitesFarCloserThanTheBox) {
+  // Lattices 1e-9 and 1e-12 apart in a unit box: cut out by bisectors in
+  // floating point, every one of these got wrong cells (empty, or not holding
+  // their site); now they are Voronoi2's. Sampled among the sites, where the
+  // cells are.
+  for (double spacing : {1e-9, 1e-12})
+    for (std::uint64_t seed = 1; seed < 200; seed += 7) {
+      SCOPED_TRACE("spacing " + std::to_string(spacing) + " seed " + std::to_string(seed));
+      std::vector<Vec2d> sites = lattice_subset(seed, true);
+      for (Vec2d& s : sites) s = Vec2d(0.5, 0.5) + spacing * s;
+      const MetricVoronoi v(sites, Metric::l2, AABB2d({0, 0}, {1, 1}));
+      v.validate();
+      Rng rng(seed);
+      for (int k = 0; k < 300; ++k) {
+        const Vec2d q = Vec2d(0.5, 0.5) + spacing * Vec2d(rng.uniform(-3, 9), rng.uniform(-3, 9));
+        double best = std::numeric_limits<double>::infinity();
+        for (const Vec2d& p : sites) best = std::min(best, (q - p).norm());
+        int containing = 0;
+        for (std::uint32_t i = 0; i < sites.size(); ++i) {
+          if (v.representative(i) != i || !point_in_polygon(q, v.cells()[i])) continue;
+          ++containing;
+          EXPECT_LE((q - sites[i]).norm(), best + 1e-6 * spacing + 1e-15) << "sample in the cell of " << i;
+        }
+        EXPECT_GE(containing, 1) << "sample " << k << " in no cell";
+      }
     }
 }
 
@@ -163,6 +184,20 @@ TEST(MetricVoronoi, BadInput) {
   const MetricVoronoi one(std::vector<Vec2d>{{0.5, 0.5}}, Metric::linf, AABB2d({0, 0}, {1, 1}));
   EXPECT_NEAR(polygon_area(one.cells()[0]), 1, 1e-12);
   EXPECT_TRUE(one.edges().empty());
+  // Distinct sites closer than 1e-6 of the frame: refused under L1 and
+  // L-infinity (their cells were wrong from about 1e-7), resolved under L2.
+  const std::vector<Vec2d> close = {{0.5, 0.5}, {0.5 + 1e-7, 0.5}, {0.2, 0.7}, {0.2, 0.7}};
+  for (Metric m : {Metric::l1, Metric::linf}) {
+    try {
+      MetricVoronoi(close, m, AABB2d({0, 0}, {1, 1}));
+      ADD_FAILURE() << metric_name(m) << ": no error";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("points 0 and 1 are closer than"), std::string::npos) << e.what();
+    }
+  }
+  MetricVoronoi(close, Metric::l2, AABB2d({0, 0}, {1, 1})).validate();
+  const std::vector<Vec2d> apart = {{0.5, 0.5}, {0.5 + 2e-6, 0.5}, {0.2, 0.7}, {0.2, 0.7}};
+  expect_cells_match_brute_force(MetricVoronoi(apart, Metric::linf, AABB2d({0, 0}, {1, 1})), 7, 300);
 }
 
 }  // namespace

@@ -190,6 +190,29 @@ TEST(Voronoi2, NearlyCollinearAndNearlyCoincidentSites) {
   Voronoi2(lattice).validate();
 }
 
+// Nearly co-circular lattice sites 1e-3 apart in a unit box: some hull
+// triangles are nearly flat, their circumcentres 1e10 away. The clipped
+// cells tile the box (clipped as polygons reaching that far, neighbours
+// disagreed on their shared edge's exit and left a gap of 1.8e-7); and sites
+// an ulp apart at 2e7 pass validate() (their rounded midpoint fell on one of
+// them, which read as a site not left of its edge).
+TEST(Voronoi2, CellsOfNearlyCoCircularSitesTileTheBox) {
+  for (const double at : {0.0, 2e7})
+    for (const double spacing : {1e-3, 1e-9})
+      for (std::uint64_t seed = 1; seed < 400; seed += 7) {
+        SCOPED_TRACE("at " + std::to_string(at) + " spacing " + std::to_string(spacing) + " seed " + std::to_string(seed));
+        std::vector<Vec2d> sites = testing::lattice_subset(seed, true);
+        for (Vec2d& p : sites) p = Vec2d(at + 0.5 + spacing * p[0], 0.5 + spacing * p[1]);
+        const Voronoi2 v(sites);
+        v.validate();
+        const AABB2d box({at, 0}, {at + 1, 1});
+        double area = 0;
+        for (std::uint32_t i = 0; i < sites.size(); ++i)
+          if (v.representative(i) == i) area += polygon_area(v.cell_polygon(i, box));
+        EXPECT_NEAR(area, 1.0, 1e-12);
+      }
+}
+
 // polygon_area sums a fan about the first corner: a unit square 1e15 from the origin
 // has area 1 (about the origin its products cancelled it away).
 TEST(Voronoi2, PolygonAreaFarFromTheOrigin) {

@@ -17,7 +17,9 @@
 // 1e-9 * |x - site_x| (L1; |(x - site_x) + (y - site_y)| for L-infinity) to the
 // distances, which moves no boundary by more than 1e-9 of its distance to the sites.
 //
-// Construction: each cell is cut out of a frame around the box and the sites
+// Under L2 the diagram is Voronoi2's (the dual of the Delaunay triangulation,
+// exact predicates) clipped to the box. Under L1 and L-infinity each cell is
+// cut out of a frame around the box and the sites
 // by the bisectors of its site and its 16 nearest sites; farther sites are then
 // offered nearest first and join only if they take part of the current cell
 // (some point of its boundary is nearer to them; a site's region is star-shaped
@@ -52,7 +54,7 @@ struct MetricVoronoiStats {
   std::size_t sites = 0, distinct = 0;
   std::size_t edges = 0;           // bisector pieces in the box
   std::size_t cell_vertices = 0;   // summed over the cells
-  std::size_t max_candidates = 0;  // most sites consulted for one cell
+  std::size_t max_candidates = 0;  // most sites consulted for one cell (L2: most Delaunay neighbours of a site)
 };
 
 class MetricVoronoi {
@@ -60,7 +62,9 @@ class MetricVoronoi {
   /// A piece of the diagram inside the box: part of the bisector of sites a < b (representatives).
   using Edge = BisectorEdge;
 
-  /// Throws geods::Error for no points, non-finite coordinates or an empty box.
+  /// Throws geods::Error for no points, non-finite coordinates, an empty box,
+  /// or (L1, L-infinity) distinct points closer than 1e-6 of the extent of the
+  /// box and the points, which the construction cannot resolve (docs/voronoi.md).
   MetricVoronoi(std::span<const Vec2d> points, Metric metric, const AABB2d& box);
 
   Metric metric() const { return metric_; }
@@ -73,8 +77,10 @@ class MetricVoronoi {
   const std::vector<Edge>& edges() const { return edges_; }
 
   MetricVoronoiStats stats() const;
-  /// Checks that every cell is a counter-clockwise polygon inside the box and
-  /// that both ends of every edge are equidistant from its two sites. Throws geods::Error.
+  /// Checks that every cell is a counter-clockwise polygon inside the box,
+  /// that the cells cover the box, that every site inside the box is inside
+  /// its cell, and that both ends of every edge are equidistant from its two
+  /// sites. Throws geods::Error.
   void validate() const;
 
  private:
