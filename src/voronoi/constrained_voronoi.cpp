@@ -99,8 +99,6 @@ ConstrainedVoronoi::ConstrainedVoronoi(std::span<const Vec2d> points, std::span<
   }
   spatial::KdTree<double, 2> segment_tree;
   if (!middles.empty()) segment_tree = spatial::KdTree<double, 2>{spatial::PointView<double>(std::span<const Vec2d>(middles))};
-  const double box_area = (box.hi[0] - box.lo[0]) * (box.hi[1] - box.lo[1]);
-  const double min_area = 1e-15 * box_area;
 
   std::vector<std::vector<Piece>> found(regions.size());
   std::vector<std::size_t> cell_count(regions.size()), candidate_count(regions.size());
@@ -176,7 +174,7 @@ ConstrainedVoronoi::ConstrainedVoronoi(std::span<const Vec2d> points, std::span<
     cell_count[r] = cells.size();
     // In each cell the same candidates are visible: split it by their bisectors.
     for (const auto& cell : cells) {
-      if (polygon_area(cell.points) <= min_area) continue;
+      if (detail::negligible_area(cell.points)) continue;
       const Vec2d x = vertex_mean(cell.points);
       std::vector<std::uint32_t> seen;
       for (std::size_t c = 0; c < candidates.size(); ++c) {
@@ -194,7 +192,7 @@ ConstrainedVoronoi::ConstrainedVoronoi(std::span<const Vec2d> points, std::span<
           detail::clip_halfplane(piece, p, 2 * d, d.squaredNorm(), o);
           if (piece.points.empty()) break;
         }
-        if (!piece.points.empty() && polygon_area(piece.points) > min_area) found[r].push_back({q, std::move(piece.points)});
+        if (!piece.points.empty() && !detail::negligible_area(piece.points)) found[r].push_back({q, std::move(piece.points)});
       }
     }
   }, 4);

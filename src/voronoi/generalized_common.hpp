@@ -2,6 +2,7 @@
 // Checks and small geometry shared by the farthest-point and k-th order diagrams.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <span>
 #include <string>
 #include <vector>
@@ -67,6 +68,19 @@ inline std::vector<Vec2d> convex_polygon_of(std::vector<Vec2d> pts) {
   while (out.size() > 1 && (out.front() - out.back()).cwiseAbs().maxCoeff() <= 1e-12 * extent) out.pop_back();
   if (out.size() < 3) out.clear();
   return out;
+}
+
+/// Whether a polygon is no more than the rounding of its corners (u |corner|
+/// each, across its perimeter): a sliver that cutting by lines left, not a
+/// region. (Relative to the polygon, not the box: regions of sites 1e-7 of the
+/// box apart are 1e-14 of its area.)
+inline bool negligible_area(const std::vector<Vec2d>& polygon) {
+  double perimeter = 0, far = 0;
+  for (std::size_t k = 0; k < polygon.size(); ++k) {
+    perimeter += (polygon[(k + 1) % polygon.size()] - polygon[k]).norm();
+    far = std::max(far, polygon[k].cwiseAbs().maxCoeff());
+  }
+  return polygon_area(polygon) <= 8 * std::numeric_limits<double>::epsilon() * far * perimeter;
 }
 
 /// Checks a counter-clockwise polygon inside the box (to 1e-9 of its side).

@@ -25,7 +25,6 @@ KthOrderVoronoi::KthOrderVoronoi(std::span<const Vec2d> points, std::size_t k, c
   if (k == 0 || k > distinct_)
     throw Error("KthOrderVoronoi: k = " + std::to_string(k) + " must be between 1 and the " +
                 std::to_string(distinct_) + " distinct points");
-  const double min_area = 1e-14 * (box.hi[0] - box.lo[0]) * (box.hi[1] - box.lo[1]);
   std::vector<std::vector<std::uint32_t>> neighbors(points.size());
   for (std::uint32_t s : sites) neighbors[s] = dt.neighbors(s);
 
@@ -34,7 +33,7 @@ KthOrderVoronoi::KthOrderVoronoi(std::span<const Vec2d> points, std::size_t k, c
   regions_.clear();
   for (std::uint32_t s : sites) {
     std::vector<Vec2d> cell = vd.cell_polygon(s, box);
-    if (!cell.empty() && polygon_area(cell) > min_area) regions_.push_back({{s}, std::move(cell)});
+    if (!cell.empty() && !detail::negligible_area(cell)) regions_.push_back({{s}, std::move(cell)});
   }
   for (std::size_t order = 1; order < k; ++order) {
     // Each region's pieces, in parallel: (set, corners).
@@ -56,7 +55,7 @@ KthOrderVoronoi::KthOrderVoronoi(std::span<const Vec2d> points, std::size_t k, c
           detail::clip_halfplane(poly, p, 2 * d, d.squaredNorm(), o);
           if (poly.points.empty()) break;
         }
-        if (poly.points.empty() || polygon_area(poly.points) <= min_area) continue;
+        if (poly.points.empty() || detail::negligible_area(poly.points)) continue;
         std::vector<std::uint32_t> set = region.sites;
         set.insert(std::upper_bound(set.begin(), set.end(), s), s);
         pieces[r].push_back({std::move(set), std::move(poly.points)});
@@ -72,7 +71,7 @@ KthOrderVoronoi::KthOrderVoronoi(std::span<const Vec2d> points, std::size_t k, c
     regions_.clear();
     for (auto& [set, corners] : merged) {
       std::vector<Vec2d> polygon = detail::convex_polygon_of(std::move(corners));
-      if (!polygon.empty() && polygon_area(polygon) > min_area) regions_.push_back({set, std::move(polygon)});
+      if (!polygon.empty() && !detail::negligible_area(polygon)) regions_.push_back({set, std::move(polygon)});
     }
   }
   std::sort(regions_.begin(), regions_.end(), [](const Region& a, const Region& b) { return a.sites < b.sites; });
