@@ -233,7 +233,9 @@ void Voronoi3::build(const Delaunay3& dt, std::span<const Plane> hull) {
         std::vector<Face> faces = initial;
         for (const std::uint32_t w : neighbors) {
           if (w == s) continue;
-          const Vec3d normal = points[w] - p;
+          // A unit normal: with the sites' difference itself, sites 1e-300
+          // apart made products that underflowed to 0, and cells vanished.
+          const Vec3d normal = (points[w] - p).stableNormalized();
           clip(faces, normal, normal.dot((points[w] + p) * 0.5), w, extent);
           if (faces.empty()) break;
         }

@@ -223,6 +223,21 @@ TEST(Voronoi3, ExtremeScalesAreScaledOrRefused) {
   EXPECT_THROW(Voronoi3(unit, AABB3d(Vec3d(-1e200, 0, 0), Vec3d(1, 1, 1))), Error);
 }
 
+// Sites 1e-300 apart beside one at (1, 1, 1): the bisector planes were
+// the sites' differences, whose products with coordinates near 1e-300
+// underflowed to 0; a cell vanished and the others covered 0.77 of the box.
+TEST(Voronoi3, SitesCloserThanTheSquareRootOfTheSmallestNormal) {
+  for (double gap : {1e-300, 1e-307}) {
+    const std::vector<Vec3d> p = {{0, 0, 0}, {gap, 0, 0}, {0, gap, 0}, {0, 0, gap}, {1, 1, 1}};
+    const Voronoi3 v(p, AABB3d(Vec3d(0, 0, 0), Vec3d(1, 1, 1)));
+    EXPECT_NEAR(v.volume_total(), 1.0, 1e-12) << gap;
+    // By symmetry the three cells beside the origin are equal: each holds the
+    // points nearer to it than to (1, 1, 1) where its axis's coordinate is largest.
+    for (int k = 1; k <= 3; ++k) EXPECT_NEAR(v.cells()[k].volume, v.cells()[1].volume, 1e-12) << gap;
+    EXPECT_EQ(v.stats().empty, 0u) << gap;
+  }
+}
+
 // A box far thinner along one axis than along the others (a slab for
 // coplanar sites, as the CLI makes for them): the cells are the prisms of the
 // sites' 2D cells, whatever the slab's thickness. Rounding along the long
