@@ -14,6 +14,7 @@
 #include "geods/spatial/kd_tree.hpp"
 #include "geods/voronoi/polygon_clip.hpp"
 #include "geods/voronoi/voronoi2.hpp"
+#include "generalized_common.hpp"
 
 namespace geods::voronoi {
 namespace {
@@ -359,16 +360,12 @@ double metric_distance(Metric metric, const Vec2d& a, const Vec2d& b) {
 
 MetricVoronoi::MetricVoronoi(std::span<const Vec2d> points, Metric metric, const AABB2d& box)
     : points_(points.begin(), points.end()), metric_(metric), box_(box) {
+  // The points first (finite, within the range where distances stay finite),
+  // then the box: a box made around points at 1e308 is infinite.
+  detail::check_sites_and_box(points, box, "MetricVoronoi");
   const std::size_t n = points.size();
-  if (n == 0) throw Error("MetricVoronoi: no points");
-  if (n >= kFrameSide) throw Error("MetricVoronoi: 2^32 - 1 points or more");
-  if (box.empty() || !box.lo.allFinite() || !box.hi.allFinite() || box.lo[0] == box.hi[0] || box.lo[1] == box.hi[1])
-    throw Error("MetricVoronoi: the box must be finite with positive width and height");
   AABB2d frame = box;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (!points[i].allFinite()) throw Error("MetricVoronoi: non-finite coordinates at point " + std::to_string(i));
-    frame.extend(points[i]);
-  }
+  for (const Vec2d& p : points) frame.extend(p);
   if (metric == Metric::l2) {
     // The library's Euclidean diagram: the dual of the Delaunay triangulation,
     // whose exact predicates keep cells of sites 1e-12 apart right, where

@@ -178,6 +178,17 @@ TEST(MetricVoronoi, BadInput) {
   EXPECT_THROW(MetricVoronoi(p, Metric::l1, AABB2d()), Error);
   EXPECT_THROW(MetricVoronoi(p, Metric::l1, AABB2d({0, 0}, {0, 1})), Error);
   EXPECT_THROW(MetricVoronoi(std::vector<Vec2d>{{0, std::nan("")}}, Metric::l1, AABB2d({0, 0}, {1, 1})), Error);
+  // Coordinates whose distances would overflow are named before the box
+  // made around them (infinite) is.
+  const std::vector<Vec2d> huge = {{1e308, 1}, {-1e308, 3}, {4, 5}};
+  for (Metric m : {Metric::l1, Metric::linf, Metric::l2}) {
+    try {
+      MetricVoronoi(huge, m, AABB2d({-INFINITY, -INFINITY}, {INFINITY, INFINITY}));
+      ADD_FAILURE() << metric_name(m) << ": no error";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("MetricVoronoi: coordinate 1e+308 of point 0"), std::string::npos) << e.what();
+    }
+  }
   EXPECT_THROW(parse_metric("l3"), Error);
   EXPECT_EQ(parse_metric("linf"), Metric::linf);
   EXPECT_EQ(metric_name(Metric::l1), "l1");

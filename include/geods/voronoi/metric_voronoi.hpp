@@ -62,8 +62,9 @@ class MetricVoronoi {
   /// A piece of the diagram inside the box: part of the bisector of sites a < b (representatives).
   using Edge = BisectorEdge;
 
-  /// Throws geods::Error for no points, non-finite coordinates, an empty box,
-  /// or (L1, L-infinity) distinct points closer than 1e-6 of the extent of the
+  /// Throws geods::Error for no points, 2^30 or more, non-finite coordinates or
+  /// ones beyond +-3.5e100 (core/coordinate_range.hpp), an empty box, or
+  /// (L1, L-infinity) distinct points closer than 1e-6 of the extent of the
   /// box and the points, which the construction cannot resolve (docs/voronoi.md).
   MetricVoronoi(std::span<const Vec2d> points, Metric metric, const AABB2d& box);
 
