@@ -1,5 +1,6 @@
 #pragma once
-// Checks and small geometry shared by the farthest-point and k-th order diagrams.
+// Checks and small geometry shared by the generalized diagrams (farthest-point,
+// k-th order, constrained, other metrics).
 #include <algorithm>
 #include <cmath>
 #include <limits>

@@ -364,8 +364,6 @@ MetricVoronoi::MetricVoronoi(std::span<const Vec2d> points, Metric metric, const
   // then the box: a box made around points at 1e308 is infinite.
   detail::check_sites_and_box(points, box, "MetricVoronoi");
   const std::size_t n = points.size();
-  AABB2d frame = box;
-  for (const Vec2d& p : points) frame.extend(p);
   if (metric == Metric::l2) {
     // The library's Euclidean diagram: the dual of the Delaunay triangulation,
     // whose exact predicates keep cells of sites 1e-12 apart right, where
@@ -386,6 +384,8 @@ MetricVoronoi::MetricVoronoi(std::span<const Vec2d> points, Metric metric, const
     return;
   }
   // The frame holds every site strictly inside, so every cell is star-shaped within it.
+  AABB2d frame = box;
+  for (const Vec2d& p : points) frame.extend(p);
   const double margin = 0.05 * std::max(frame.hi[0] - frame.lo[0], frame.hi[1] - frame.lo[1]);
   frame.lo.array() -= margin;
   frame.hi.array() += margin;
@@ -526,43 +526,34 @@ void MetricVoronoi::validate() const {
   // its distance to the sites, and neighbours may round it either way.
   const double tie_break = metric_ == Metric::l2 ? 0.0 : 4 * kTieBreak;
   double covered = 0, slack = 0;  // the distinct sites' cells tile the box
-  for (std::size_t i = 0; i < cells_.size(); ++i) {
-    if (cells_[i].empty()) continue;
+  for (std::uint32_t i = 0; i < cells_.size(); ++i) {
+    const std::vector<Vec2d>& cell = cells_[i];
+    if (cell.empty()) continue;
     // A cell thinner than that resolution may round to zero area, not below.
     double perimeter = 0, far = 0, from_site = 0;
-    for (std::size_t k = 0; k < cells_[i].size(); ++k) {
-      perimeter += (cells_[i][(k + 1) % cells_[i].size()] - cells_[i][k]).norm();
-      far = std::max(far, reach({cells_[i][k]}));
-      from_site = std::max(from_site, metric_distance(metric_, cells_[i][k], points_[i]));
+    for (std::size_t k = 0; k < cell.size(); ++k) {
+      perimeter += (cell[(k + 1) % cell.size()] - cell[k]).norm();
+      far = std::max(far, reach({cell[k]}));
+      from_site = std::max(from_site, metric_distance(metric_, cell[k], points_[i]));
     }
-    const double area = polygon_area(cells_[i]);
+    const double area = polygon_area(cell);
     if (area <= -4 * u * far * perimeter)
       throw Error("MetricVoronoi::validate: cell " + std::to_string(i) + " is not counter-clockwise");
-    if (representative_[i] == i) covered += area, slack += (4 * u * far + tie_break * from_site) * perimeter;
-    for (const Vec2d& v : cells_[i])
+    for (const Vec2d& v : cell)
       if (!grown.contains(v)) throw Error("MetricVoronoi::validate: cell " + std::to_string(i) + " leaves the box");
-  }
-  // A site strictly inside the box lies inside its cell (its boundary is
-  // about half the distance to the nearest other site away), or within the
-  // rounding of the cell's corners: cells of sites an ulp apart are an ulp wide.
-  const auto distance_to_segment = [](const Vec2d& p, const Vec2d& a, const Vec2d& b) {
-    const Vec2d d = b - a;
-    const double length2 = d.squaredNorm();
-    const double t = length2 > 0 ? std::clamp(d.dot(p - a) / length2, 0.0, 1.0) : 0.0;
-    return (a + t * d - p).norm();
-  };
-  for (std::uint32_t i = 0; i < cells_.size(); ++i) {
+    if (representative_[i] != i) continue;
+    covered += area, slack += (4 * u * far + tie_break * from_site) * perimeter;
+    // A site strictly inside the box lies inside its cell (its boundary is
+    // about half the distance to the nearest other site away), or within the
+    // rounding of the cell's corners: cells of sites an ulp apart are an ulp wide.
     const Vec2d& p = points_[i];
-    const std::vector<Vec2d>& cell = cells_[i];
-    if (representative_[i] != i || !(p.array() > box_.lo.array()).all() || !(p.array() < box_.hi.array()).all() ||
-        point_in_polygon(p, cell))
+    if (!(p.array() > box_.lo.array()).all() || !(p.array() < box_.hi.array()).all() || point_in_polygon(p, cell))
       continue;
-    double gap = std::numeric_limits<double>::infinity(), far = reach({p});
-    for (std::size_t k = 0; k < cell.size(); ++k) {
-      gap = std::min(gap, distance_to_segment(p, cell[k], cell[(k + 1) % cell.size()]));
-      far = std::max(far, reach({cell[k]}));
-    }
-    if (!(gap <= 8 * u * far)) throw Error("MetricVoronoi::validate: site " + std::to_string(i) + " is not inside its cell");
+    double gap = std::numeric_limits<double>::infinity();
+    for (std::size_t k = 0; k < cell.size(); ++k)
+      gap = std::min(gap, point_segment_distance(p, cell[k], cell[(k + 1) % cell.size()]));
+    if (!(gap <= 8 * u * std::max(far, reach({p}))))
+      throw Error("MetricVoronoi::validate: site " + std::to_string(i) + " is not inside its cell");
   }
   const double box_area = (box_.hi[0] - box_.lo[0]) * (box_.hi[1] - box_.lo[1]);
   if (std::abs(covered - box_area) > 1e-9 * box_area + slack)

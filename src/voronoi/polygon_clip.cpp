@@ -1,4 +1,4 @@
-// Polygon clipping and point-in-polygon for the voronoi module.
+// Polygon clipping, point-in-polygon and point-segment distance for the voronoi module.
 #include "geods/voronoi/polygon_clip.hpp"
 
 #include <algorithm>
@@ -63,6 +63,13 @@ bool point_in_polygon(const Vec2d& p, const std::vector<Vec2d>& polygon) {
       inside = !inside;
   }
   return inside;
+}
+
+double point_segment_distance(const Vec2d& x, const Vec2d& a, const Vec2d& b) {
+  const Vec2d ab = b - a;
+  const double len2 = ab.squaredNorm();
+  const double t = len2 > 0 ? std::clamp((x - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+  return (x - (a + t * ab)).norm();
 }
 
 double polygon_area(const std::vector<Vec2d>& polygon) {

@@ -40,14 +40,6 @@ bool strictly_between(const IntPoint& a, const IntPoint& b, const IntPoint& c) {
 
 Vec2d perp_cw(const Vec2d& w) { return Vec2d(w[1], -w[0]); }
 
-double point_segment_distance(const Vec2d& x, const Vec2d& a, const Vec2d& b) {
-  const Vec2d ab = b - a;
-  const double len2 = ab.squaredNorm();
-  double t = len2 > 0 ? (x - a).dot(ab) / len2 : 0;
-  t = std::clamp(t, 0.0, 1.0);
-  return (x - (a + t * ab)).norm();
-}
-
 }  // namespace
 
 Vec2d SegmentVoronoi::EdgeCurve::point(double t) const {

@@ -412,8 +412,8 @@ void Voronoi2::validate() const {
     // The site lies strictly left of its edge's line. (Its offset from the
     // line is half its difference from the other site, exactly; the
     // midpoint of sites an ulp apart rounds onto one of them.)
-    const Vec2d d = direction(e), s = (points_[edge.site] - points_[edges_[edge.twin].site]) / 2;
-    if (!(d[0] * s[1] - d[1] * s[0] > 0)) fail(name() + ": its site is not on its left");
+    const Vec2d s = (points_[edge.site] - points_[opposite_site(e)]) / 2;
+    if (!(cross(direction(e), s) > 0)) fail(name() + ": its site is not on its left");
     for (std::uint32_t v : {edge.origin, edge.target}) {
       if (v == kInfinity) continue;
       const double da = (vertices_[v] - points_[edge.site]).norm(), db = (vertices_[v] - points_[edges_[edge.twin].site]).norm();

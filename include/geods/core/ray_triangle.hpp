@@ -132,10 +132,9 @@ class RayTriangleTest {
     // only: a det beyond the rounding of the sheared corners and of the edge
     // functions (about 20 units of u times the sizes of their terms) shows
     // area at once, else zero area is decided exactly.
-    const T mx = std::abs(pa[kx_]) + std::abs(pb[kx_]) + std::abs(pc[kx_]) +
-                 std::abs(shear_x_) * (std::abs(pa[kz_]) + std::abs(pb[kz_]) + std::abs(pc[kz_]));
-    const T my = std::abs(pa[ky_]) + std::abs(pb[ky_]) + std::abs(pc[ky_]) +
-                 std::abs(shear_y_) * (std::abs(pa[kz_]) + std::abs(pb[kz_]) + std::abs(pc[kz_]));
+    const T mz = std::abs(pa[kz_]) + std::abs(pb[kz_]) + std::abs(pc[kz_]);
+    const T mx = std::abs(pa[kx_]) + std::abs(pb[kx_]) + std::abs(pc[kx_]) + std::abs(shear_x_) * mz;
+    const T my = std::abs(pa[ky_]) + std::abs(pb[ky_]) + std::abs(pc[ky_]) + std::abs(shear_y_) * mz;
     if (!(std::abs(det) > T(16) * std::numeric_limits<T>::epsilon() * mx * my) && has_zero_area(a, b, c)) [[unlikely]]
       return false;
     t = hit_t;

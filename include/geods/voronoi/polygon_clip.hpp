@@ -24,6 +24,9 @@ bool point_in_polygon(const Vec2d& p, const std::vector<Vec2d>& polygon);
 /// the triangle (0, a, b).
 inline double cross(const Vec2d& a, const Vec2d& b) { return a[0] * b[1] - a[1] * b[0]; }
 
+/// The distance from x to the segment ab (to a if a == b).
+double point_segment_distance(const Vec2d& x, const Vec2d& a, const Vec2d& b);
+
 /// Signed area, positive for counter-clockwise polygons.
 double polygon_area(const std::vector<Vec2d>& polygon);
 
