@@ -5,10 +5,15 @@
 
 #include <gmpxx.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <string>
 #include <vector>
 
 #include "../../src/voronoi/exact_compare.hpp"
+#include "common/archive_files.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/rng.hpp"
 #include "geods/voronoi/voronoi3.hpp"
@@ -31,6 +36,7 @@ bool in_cell(const Voronoi3Cell& cell, const Vec3d& q, double slack) {
 
 void check_partition(const std::vector<Vec3d>& sites, const AABB3d& box, std::uint64_t seed) {
   const Voronoi3 vd(sites, box);
+  vd.validate();
   const double box_volume = (box.hi - box.lo).prod();
   EXPECT_NEAR(vd.volume_total(), box_volume, 1e-9 * box_volume);
   Rng rng(seed);
@@ -158,6 +164,7 @@ TEST(Voronoi3, CellsClippedToTheHullPartitionIt) {
   for (const auto& sites : sets) {
     const Delaunay3 dt(sites);
     const Voronoi3 vd(dt);
+    vd.validate();
     double hull_volume = 0;
     for (std::size_t t = 0; t < dt.tetrahedron_count(); ++t) {
       const std::uint32_t* v = &dt.tetrahedra()[4 * t];
@@ -202,6 +209,39 @@ TEST(Voronoi3, CellsClippedToTheHullPartitionIt) {
 }
 
 
+// Lattice points whose hull has coplanar triangles: the second triangle's
+// plane, cut in rounding, left a second face on the first (the cell was not closed).
+TEST(Voronoi3, CoplanarHullTrianglesCutOnce) {
+  const std::vector<Vec3d> p = {{0, 1, 2}, {0, 0, 0}, {1, 1, 0}, {1, 0, 0}, {0, 2, 0},
+                                {2, 0, 0}, {1, 0, 2}, {0, 0, 1}, {0, 1, 1}, {0, 2, 2}};
+  const Voronoi3 vd{Delaunay3(p)};
+  vd.validate();
+}
+
+// Sites 1e-10 of the box apart, nearly cospherical (lattice subsets, rows
+// raised by 1 % of the spacing): Voronoi vertices closer than the corners'
+// resolution (1e-12 of the box) are refused with an error, never given as
+// cells that are not closed; what is given passes validate().
+TEST(Voronoi3, VerticesCloserThanTheResolutionAreRefused) {
+  int refused = 0;
+  for (int trial = 0; trial < 20; ++trial) {
+    Rng rng(std::uint64_t(trial) * 7 + 1);
+    std::vector<Vec3d> p;
+    const int n = 5 + int(rng.below(25));
+    for (int i = 0; i < n; ++i)
+      p.emplace_back(0.5 + 1e-10 * double(rng.below(4)), 0.5 + 1e-10 * (double(rng.below(4)) + 0.01 * double(rng.below(3))),
+                     0.5 + 1e-10 * double(rng.below(4)));
+    try {
+      const Voronoi3 vd(p, AABB3d(Vec3d(0, 0, 0), Vec3d(1, 1, 1)));
+      vd.validate();
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("closer than the clipping resolves"), std::string::npos) << e.what();
+      ++refused;
+    }
+  }
+  EXPECT_GT(refused, 0);
+}
+
 // Cell volumes are cubic in the coordinates: a power-of-two copy inside that
 // range has the volumes scaled exactly (to rounding), 1e300 sites or boxes are refused.
 TEST(Voronoi3, ExtremeScalesAreScaledOrRefused) {
@@ -214,8 +254,12 @@ TEST(Voronoi3, ExtremeScalesAreScaledOrRefused) {
     for (Vec3d& x : p) x = Vec3d(std::ldexp(x[0], e), std::ldexp(x[1], e), std::ldexp(x[2], e));
     const double s = std::ldexp(1.0, e);
     const Voronoi3 v(p, AABB3d(Vec3d(0, 0, 0), Vec3d(s, s, s)));
-    for (std::size_t i = 0; i < unit.size(); ++i)
+    v.validate();
+    for (std::size_t i = 0; i < unit.size(); ++i) {
       EXPECT_NEAR(v.cells()[i].volume / (s * s * s), reference.cells()[i].volume, 1e-12) << e;
+      // (the centroids' moments, quartic in the coordinates, overflowed at 2^330)
+      EXPECT_NEAR((v.cells()[i].centroid / s - reference.cells()[i].centroid).norm(), 0, 1e-12) << e;
+    }
   }
   std::vector<Vec3d> far = unit;
   for (Vec3d& x : far) x *= 1e300;
@@ -230,11 +274,15 @@ TEST(Voronoi3, SitesCloserThanTheSquareRootOfTheSmallestNormal) {
   for (double gap : {1e-300, 1e-307}) {
     const std::vector<Vec3d> p = {{0, 0, 0}, {gap, 0, 0}, {0, gap, 0}, {0, 0, gap}, {1, 1, 1}};
     const Voronoi3 v(p, AABB3d(Vec3d(0, 0, 0), Vec3d(1, 1, 1)));
+    v.validate();
     EXPECT_NEAR(v.volume_total(), 1.0, 1e-12) << gap;
     // By symmetry the three cells beside the origin are equal: each holds the
     // points nearer to it than to (1, 1, 1) where its axis's coordinate is largest.
     for (int k = 1; k <= 3; ++k) EXPECT_NEAR(v.cells()[k].volume, v.cells()[1].volume, 1e-12) << gap;
-    EXPECT_EQ(v.stats().empty, 0u) << gap;
+    // The origin's own cell is gap-sized: below the corners' resolution, it
+    // merges into a point (no faces, volume 0); the other four have faces.
+    EXPECT_EQ(v.cells()[0].volume, 0) << gap;
+    for (int k = 1; k <= 4; ++k) EXPECT_GT(v.cells()[k].face_count(), 0u) << gap;
   }
 }
 
@@ -254,6 +302,7 @@ TEST(Voronoi3, BoxesThinAlongOneAxisGiveTheCellsOfAnyOtherThickness) {
       for (Vec3d& x : p) x *= s;
       const AABB3d box(Vec3d(0, 0, -thickness / 2), Vec3d(s, s, thickness / 2));
       const Voronoi3 v(p, box);
+      v.validate();
       EXPECT_NEAR(v.volume_total() / (s * s * thickness), 1.0, 1e-12) << s << " " << thickness;
       ASSERT_EQ(v.cells().size(), reference.cells().size());
       for (std::size_t i = 0; i < unit.size(); ++i) {
@@ -270,9 +319,85 @@ TEST(Voronoi3, BoxesThinAlongOneAxisGiveTheCellsOfAnyOtherThickness) {
     Vec3d lo(0, 0, 0), hi(1e20, 1e20, 1e20);
     lo[axis] = -0.5, hi[axis] = 0.5;
     const Voronoi3 v(p, AABB3d(lo, hi));
+    v.validate();
     for (std::size_t i = 0; i < unit.size(); ++i)
       EXPECT_NEAR(v.cells()[i].volume / 1e40, reference.cells()[i].volume, 1e-12) << axis;
   }
+}
+
+
+void expect_same(const Voronoi3& a, const Voronoi3& b) {
+  EXPECT_EQ(a.points(), b.points());
+  EXPECT_EQ(a.box().lo, b.box().lo);
+  EXPECT_EQ(a.box().hi, b.box().hi);
+  EXPECT_EQ(a.hull(), b.hull());
+  ASSERT_EQ(a.cells().size(), b.cells().size());
+  for (std::size_t c = 0; c < a.cells().size(); ++c) {
+    const Voronoi3Cell &x = a.cells()[c], &y = b.cells()[c];
+    EXPECT_EQ(x.site, y.site);
+    EXPECT_EQ(x.vertices, y.vertices);
+    EXPECT_EQ(x.face_offsets, y.face_offsets);
+    EXPECT_EQ(x.face_vertices, y.face_vertices);
+    EXPECT_EQ(x.face_neighbors, y.face_neighbors);
+    EXPECT_EQ(x.volume, y.volume);
+    EXPECT_EQ(x.centroid, y.centroid);
+  }
+}
+
+// Saved and loaded, the cells are the same (clipped to a box, with sites
+// outside it, and to the hull); truncated, flipped and wrong-kind files are refused.
+TEST(Voronoi3Archive, RoundTripAndBadFiles) {
+  Rng rng(61);
+  std::vector<Vec3d> sites;
+  for (int i = 0; i < 200; ++i) sites.emplace_back(rng.uniform(), rng.uniform(), rng.uniform());
+  const Delaunay3 dt(sites);
+  const std::filesystem::path path = test::temp_archive("voronoi3");
+  for (const Voronoi3& original : {Voronoi3(dt, AABB3d(Vec3d(0.2, -0.5, 0.3), Vec3d(0.7, 0.5, 1.5))), Voronoi3(dt)}) {
+    original.save(path);
+    expect_same(original, Voronoi3::load(path));
+    expect_same(original, Voronoi3::load(path, Archive::Verify::full));
+  }
+  test::expect_bad_copies_refused(path, [](const std::filesystem::path& p) { Voronoi3::load(p); });
+  EXPECT_THROW(Delaunay3::load(path), Error);  // another kind
+  std::filesystem::remove(path);
+}
+
+// What validate() sees that the checksums do not: a file whose sections were
+// changed after saving, loaded without checksums (Verify::structure_only).
+// Each change is one number: a corner moved, a label or corner index changed,
+// a volume, a site moved.
+TEST(Voronoi3Archive, ChangedCellsAreRefusedByValidate) {
+  Rng rng(62);
+  std::vector<Vec3d> sites;
+  for (int i = 0; i < 100; ++i) sites.emplace_back(rng.uniform(), rng.uniform(), rng.uniform());
+  const Voronoi3 original(sites, AABB3d(Vec3d(0, 0, 0), Vec3d(1, 1, 1)));
+  const std::filesystem::path good = test::temp_archive("voronoi3_good"), bad = test::temp_archive("voronoi3_bad");
+  original.save(good);
+  const std::vector<char> bytes = test::read_bytes(good);
+  const Voronoi3Cell& first = original.cells()[0];
+  std::uint32_t other_site = 0;  // a site that is not across any face of the first cell
+  while (other_site == first.site || std::count(first.face_neighbors.begin(), first.face_neighbors.end(), other_site))
+    ++other_site;
+  const auto changed = [&](const char* section, std::size_t at, auto value) {
+    std::vector<char> copy = bytes;
+    std::memcpy(copy.data() + test::archive_section_offset(bytes, section) + at * sizeof(value), &value, sizeof(value));
+    test::write_bytes(bad, copy);
+    return bad;
+  };
+  const auto load = [](const std::filesystem::path& p) { Voronoi3::load(p, Archive::Verify::structure_only); };
+  load(changed("volumes", 0, first.volume));  // unchanged: the rewrite itself loads
+  EXPECT_THROW(load(changed("vertices", 0, first.vertices[0][0] + 1e-3)), Error) << "a corner moved by 1e-3";
+  EXPECT_THROW(load(changed("face_neighbors", 0, other_site)), Error) << "a face's label another site";
+  EXPECT_THROW(load(changed("face_neighbors", 0, first.site)), Error) << "a face's label its own site";
+  EXPECT_THROW(load(changed("face_vertices", 0, first.face_vertices[1])), Error) << "a corner index changed";
+  EXPECT_THROW(load(changed("volumes", 0, 2 * first.volume)), Error) << "a volume doubled";
+  EXPECT_THROW(load(changed("centroids", 0, first.centroid[0] + 1e-3)), Error) << "a centroid moved";
+  EXPECT_THROW(load(changed("points", 3 * first.site, sites[first.site][0] + 0.05)), Error) << "a site moved";
+  EXPECT_THROW(load(changed("box", 3, 1.01)), Error) << "a box side moved";
+  // With the checksums, a change is refused before any check.
+  EXPECT_THROW(Voronoi3::load(changed("volumes", 0, 2 * first.volume)), Error);
+  std::filesystem::remove(good);
+  std::filesystem::remove(bad);
 }
 
 }  // namespace

@@ -10,11 +10,14 @@
 // (counter-clockwise seen from outside), and per face the site across it, a
 // box side (Voronoi3::box_side(k), k = 0..5 for -x, +x, -y, +y, -z, +z) or a
 // hull triangle (Voronoi3::hull_face(k), k indexing Delaunay3::hull()).
+#include <array>
 #include <cstdint>
+#include <filesystem>
 #include <span>
 #include <vector>
 
 #include "geods/core/aabb.hpp"
+#include "geods/core/archive.hpp"
 #include "geods/core/tri_mesh.hpp"
 #include "geods/core/vec.hpp"
 #include "geods/voronoi/delaunay3.hpp"
@@ -65,6 +68,11 @@ class Voronoi3 {
 
   const std::vector<Voronoi3Cell>& cells() const { return cells_; }
   const AABB3d& box() const { return box_; }
+  /// The points the cells belong to (Voronoi3Cell::site indexes them), duplicates included.
+  const std::vector<Vec3d>& points() const { return points_; }
+  /// The hull triangles the cells were clipped to (Delaunay3::hull(), its
+  /// hull_face(k) labels), empty for cells clipped to a box.
+  const std::vector<std::array<std::uint32_t, 3>>& hull() const { return hull_; }
   /// The sum of the cell volumes: the box's (or the hull's) volume up to rounding.
   double volume_total() const;
   Voronoi3Stats stats() const;
@@ -75,13 +83,41 @@ class Voronoi3 {
   /// given) holds c.
   TriMesh mesh(double explode = 0, std::vector<std::uint32_t>* cell_of_triangle = nullptr) const;
 
+  /// Writes the cells, their points, the box and the hull to `path` as a geods
+  /// archive (core/archive.hpp, kind "voronoi.Voronoi3", version 1). Throws
+  /// geods::Error naming the file if it cannot be written.
+  void save(const std::filesystem::path& path) const;
+  /// The cells save()d to `path`. Every index and label is checked before use
+  /// and every cell is a closed surface; with Verify::structure_only or full
+  /// (no checksums to vouch for the geometry) all of validate() runs. Throws
+  /// geods::Error naming the file if it is missing, truncated, corrupt, of
+  /// another kind or version, or fails those checks.
+  static Voronoi3 load(const std::filesystem::path& path, Archive::Verify verify = Archive::Verify::checksums);
+
+  /// Checks, with a tolerance for the clipping's roundings (1e-9 of the box's
+  /// diagonal and the coordinates' rounding), what the cells promise; throws
+  /// geods::Error naming the first violation. Independent of Delaunay3,
+  /// O(size log n), and O(size h) more for h hull triangles:
+  /// - every cell's faces are index loops into its vertices, each edge used
+  ///   once in each direction (a closed, oriented surface);
+  /// - every face label is another site's, a box side, or (clipped to the
+  ///   hull) a hull triangle, and every corner of the face lies on that
+  ///   bisector, box side or hull plane; no corner is outside another face's
+  ///   plane (the cell is convex);
+  /// - no corner is nearer to another site than to its own (a k-d tree over
+  ///   the sites), so the cells do not overlap, and their volumes add up to
+  ///   the box's (or the hull's): together they cover it;
+  /// - a site inside the box has a cell with a positive volume that holds it,
+  ///   and each cell's volume and centroid are those of its faces.
+  void validate() const;
+
  private:
-  struct Plane {
-    Vec3d normal;
-    double offset;  // the half-space normal . x <= offset
-  };
-  void build(const Delaunay3& dt, std::span<const Plane> hull);
+  Voronoi3() = default;  // for load()
+  void build(const Delaunay3& dt);
+  void check_cells() const;  // validate()'s checks of indices and labels: what makes the cells safe to walk
+  std::vector<Vec3d> points_;
   AABB3d box_;
+  std::vector<std::array<std::uint32_t, 3>> hull_;
   std::vector<Voronoi3Cell> cells_;
 };
 
