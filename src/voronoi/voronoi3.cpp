@@ -190,13 +190,16 @@ bool is_closed(const Voronoi3Cell& cell, std::vector<std::pair<std::uint32_t, st
   return true;
 }
 
-Voronoi3Cell make_cell(std::uint32_t site, const std::vector<Face>& faces, const Vec3d& extent) {
+// The cell of `site` from its faces; corners within `snap_radius` of `snap_to` become it.
+Voronoi3Cell make_cell(std::uint32_t site, const std::vector<Face>& faces, const Vec3d& extent, const Vec3d& snap_to,
+                       double snap_radius) {
   Voronoi3Cell cell;
   cell.site = site;
   cell.face_offsets.push_back(0);
   for (const Face& face : faces) {
     const std::size_t begin = cell.face_vertices.size();
-    for (const Vec3d& x : face.loop) {
+    for (Vec3d x : face.loop) {
+      if ((x - snap_to).stableNorm() <= snap_radius) x = snap_to;
       // the corners shared by faces: equal, or within rounding of each other
       auto it = std::find_if(cell.vertices.begin(), cell.vertices.end(),
                              [&](const Vec3d& y) { return same_point(x, y, extent); });
@@ -275,11 +278,12 @@ void Voronoi3::build(const Delaunay3& dt) {
     if (dt.representative(i) == i) sites.push_back(i);
   // With a hull: the sites whose cells may cross it, those on it and those
   // with a Voronoi vertex (a circumcentre) outside it.
-  std::vector<std::uint8_t> crosses_hull;
+  std::vector<std::uint8_t> crosses_hull, hull_vertex;
   if (!hull.empty()) {
     crosses_hull.assign(points.size(), 0);
+    hull_vertex.assign(points.size(), 0);
     for (const auto& t : hull_)
-      for (const std::uint32_t v : t) crosses_hull[v] = 1;
+      for (const std::uint32_t v : t) crosses_hull[v] = hull_vertex[v] = 1;
     const auto& tets = dt.tetrahedra();
     std::vector<std::uint8_t> outside(dt.tetrahedron_count());
     parallel_for(0, outside.size(), 1 << 12, [&](std::size_t begin, std::size_t end) {
@@ -341,8 +345,19 @@ void Voronoi3::build(const Delaunay3& dt) {
             if (reach_h > hull[h].offset) clip(faces, n, hull[h].offset, hull_face(h), extent, reach);
           }
         }
-        const Voronoi3Cell& cell = cells_[k] = make_cell(s, faces, extent);
-        if (!hull.empty()) return;  // (see below)
+        // A hull vertex is a corner of its own cell, where hull planes meet
+        // that can be nearly coplanar: their cuts put that corner a few 1e-12
+        // apart (enough to leave the cell open), and it is the site itself.
+        // The cell's other corners are at least half the nearest site's
+        // distance away (on a bisector).
+        double snap_radius = 0;
+        if (!hull.empty() && hull_vertex[s])
+          for (const std::uint32_t w : neighbors)
+            if (w != s) {
+              snap_radius = std::min(1e-9 * extent.norm(), 0.25 * (points[w] - p).stableNorm());
+              break;
+            }
+        const Voronoi3Cell& cell = cells_[k] = make_cell(s, faces, extent, p, snap_radius);
         std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
         open[k] = !is_closed(cell, edges);
         for (std::size_t f = 0; f < cell.face_count() && !open[k]; ++f) {  // and every face turned outwards
@@ -360,15 +375,15 @@ void Voronoi3::build(const Delaunay3& dt) {
   // Corners merged within 1e-12 of the box that are not one Voronoi vertex
   // leave a cell open or a face turned inwards: refused rather than given.
   // (A fuzz of nearly cospherical lattice subsets, 40 at each spacing: none
-  // down to sites 1e-8 of the box apart, 1 to 21 from 1e-9 to 1e-11.) Not
-  // clipped to the hull: there nearly coplanar hull triangles meet at a hull
-  // site in corners a few 1e-12 apart (20,000 uniform random points: 2 cells
-  // open), which validate() reports; refused, they would refuse ordinary input.
+  // down to sites 1e-8 of the box apart, 1 to 21 from 1e-9 to 1e-11; and
+  // every set of 2,000 to 17,000 points on a sphere, where all cells meet
+  // near its centre.) Corners by the identity of what they come from (the
+  // tetrahedra's circumcentres, edges cut by planes) would not need merging.
   const auto first_open = std::find(open.begin(), open.end(), 1);
   if (first_open != open.end())
     throw Error("Voronoi3: the cell of site " + std::to_string(sites[std::size_t(first_open - open.begin())]) +
                 " has Voronoi vertices closer than the clipping resolves (1e-12 of the box's extent), as sites "
-                "about 1e-9 of it apart or nearly cospherical at that scale make; clip to a smaller box");
+                "about 1e-9 of the box apart (a smaller box resolves them) or many sites on one sphere make");
 }
 
 double Voronoi3::volume_total() const {

@@ -240,6 +240,12 @@ TEST(Voronoi3, VerticesCloserThanTheResolutionAreRefused) {
     }
   }
   EXPECT_GT(refused, 0);
+  // Points on a sphere: every cell meets the others near its centre, at
+  // corners the clipping does not resolve.
+  Rng rng(5);
+  std::vector<Vec3d> sphere;
+  for (int i = 0; i < 300; ++i) sphere.push_back(Vec3d(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1)).normalized());
+  EXPECT_THROW(Voronoi3(sphere, AABB3d(Vec3d(-2, -2, -2), Vec3d(2, 2, 2))), Error);
 }
 
 // Cell volumes are cubic in the coordinates: a power-of-two copy inside that
