@@ -1,6 +1,7 @@
 // Voronoi3: each cell is the box clipped by the bisectors of its site and the
 // site's Delaunay neighbours (Sutherland-Hodgman on every face, the cut closed
-// by a cap polygon ordered around its centre).
+// by a cap made of the edges left without a twin), its corners joined by
+// identity, not by coordinates.
 #include "geods/voronoi/voronoi3.hpp"
 
 #include <algorithm>
@@ -24,110 +25,119 @@ struct Plane {
   double offset;  // the half-space normal . x <= offset
 };
 
+// A corner of a cell being clipped, with its identity: the box's corners are
+// 0..7, and each cut of an edge by a plane gets the next number, the same in
+// both faces of the edge. Faces and caps are joined by these numbers, never
+// by coordinates, so that a cell stays closed however close its corners lie.
+struct Corner {
+  Vec3d x;
+  std::uint32_t id;
+};
+
 struct Face {
-  std::vector<Vec3d> loop;  // counter-clockwise seen from outside
+  std::vector<Corner> loop;  // counter-clockwise seen from outside
   std::uint32_t label;
 };
 
-// Whether x and y are one point up to rounding: within 1e-12 of the box's
-// extent on every axis. (Per axis: a coordinate's rounding scales with the
-// box's extent along its own axis; a box thin along one axis is thinner than
-// a tolerance scaled by its diagonal, and its two sides would merge.)
-bool same_point(const Vec3d& x, const Vec3d& y, const Vec3d& extent) {
-  return ((x - y).cwiseAbs().array() <= 1e-12 * extent.array()).all();
-}
-
 // Keeps the part of the convex polyhedron where normal . x <= offset; the cut
-// becomes a face labelled `label`. `extent`: the box's (same_point); `reach`:
-// per axis, the largest magnitude of the box's coordinates.
-void clip(std::vector<Face>& faces, const Vec3d& normal, double offset, std::uint32_t label, const Vec3d& extent,
+// becomes a face labelled `label` (one per loop of the cut). `next_id`: the
+// number of the next corner. `reach`: per axis, the largest magnitude of the
+// box's coordinates.
+void clip(std::vector<Face>& faces, const Vec3d& normal, double offset, std::uint32_t label, std::uint32_t& next_id,
           const Vec3d& reach) {
   // A plane the polyhedron lies within, up to the rounding of its corners
   // (another of coplanar hull triangles, a face already cut by it) cuts
-  // nothing: cut in rounding, it left a second face on the first, and the
-  // cell was not closed.
+  // nothing: cut in rounding, it would leave slivers of no width.
   const double rounding = 16 * std::numeric_limits<double>::epsilon() * (normal.cwiseAbs().dot(reach) + std::abs(offset));
   bool beyond_rounding = false;
   for (const Face& face : faces)
-    for (const Vec3d& x : face.loop) beyond_rounding |= normal.dot(x) - offset > rounding;
+    for (const Corner& c : face.loop) beyond_rounding |= normal.dot(c.x) - offset > rounding;
   if (!beyond_rounding) return;
-  std::vector<Vec3d> cut;
+  std::vector<std::uint32_t> on_plane;                                  // corners on the plane or cut into it
+  std::vector<std::pair<std::array<std::uint32_t, 2>, Corner>> cuts;  // this plane's cuts, by their edge
   std::vector<Face> kept;
   kept.reserve(faces.size() + 1);
-  bool any_outside = false;
   for (Face& face : faces) {
     const std::size_t m = face.loop.size();
     std::vector<double> side(m);
     bool inside = false, outside = false;
     for (std::size_t k = 0; k < m; ++k) {
-      side[k] = normal.dot(face.loop[k]) - offset;
+      side[k] = normal.dot(face.loop[k].x) - offset;
       inside |= side[k] <= 0;
       outside |= side[k] > 0;
+      if (side[k] == 0) on_plane.push_back(face.loop[k].id);
     }
-    any_outside |= outside;
     if (!outside) {
-      for (std::size_t k = 0; k < m; ++k)
-        if (side[k] == 0) cut.push_back(face.loop[k]);
       kept.push_back(std::move(face));
       continue;
     }
     if (!inside) continue;
     Face out{{}, face.label};
     for (std::size_t k = 0; k < m; ++k) {
-      const Vec3d& a = face.loop[k];
-      const Vec3d& b = face.loop[(k + 1) % m];
+      const Corner& a = face.loop[k];
+      const Corner& b = face.loop[(k + 1) % m];
       const double sa = side[k], sb = side[(k + 1) % m];
       if (sa <= 0) out.loop.push_back(a);
-      if (sa == 0) cut.push_back(a);
       if ((sa < 0 && sb > 0) || (sa > 0 && sb < 0)) {
-        // computed from the lexicographically smaller end, so that the two faces of the edge agree bit for bit
-        const bool forward = std::lexicographical_compare(a.data(), a.data() + 3, b.data(), b.data() + 3);
-        const Vec3d x = forward ? Vec3d(a + (b - a) * (sa / (sa - sb))) : Vec3d(b + (a - b) * (sb / (sb - sa)));
-        out.loop.push_back(x);
-        cut.push_back(x);
+        const std::array<std::uint32_t, 2> edge{std::min(a.id, b.id), std::max(a.id, b.id)};
+        auto it = std::find_if(cuts.begin(), cuts.end(), [&](const auto& c) { return c.first == edge; });
+        if (it == cuts.end()) {
+          // computed from the end with the smaller number, as the other face of the edge would
+          const bool forward = a.id < b.id;
+          const Vec3d x = forward ? Vec3d(a.x + (b.x - a.x) * (sa / (sa - sb))) : Vec3d(b.x + (a.x - b.x) * (sb / (sb - sa)));
+          cuts.push_back({edge, {x, next_id++}});
+          on_plane.push_back(cuts.back().second.id);
+          it = cuts.end() - 1;
+        }
+        out.loop.push_back(it->second);
       }
     }
     if (out.loop.size() >= 3) kept.push_back(std::move(out));
   }
   faces.swap(kept);
-  if (!any_outside || faces.empty()) return;
-  // The cap: the cut points, merged and ordered counter-clockwise around the
-  // outward normal, in coordinates where the box is a unit cube (on a box far
-  // thinner along one axis than the others, the corners of a cap's two long
-  // sides would differ by less than a rounding in the angles around its
-  // centre). Merged before the sort, so that no two copies of a corner sort
-  // apart.
-  std::vector<Vec3d> corners;
-  for (const Vec3d& x : cut)
-    if (std::none_of(corners.begin(), corners.end(), [&](const Vec3d& y) { return same_point(x, y, extent); }))
-      corners.push_back(x);
-  Vec3d centre = Vec3d::Zero();
-  for (const Vec3d& x : corners) centre += x;
-  centre /= double(corners.size());
-  // The normal in the unit cube's coordinates (each factor at most 1: no
-  // overflow or underflow in the product at extreme scales).
-  const Vec3d n = normal.normalized().cwiseProduct(extent / extent.maxCoeff()).normalized();
-  const Vec3d u = (std::abs(n[0]) < 0.9 ? Vec3d(1, 0, 0) : Vec3d(0, 1, 0)).cross(n).normalized();
-  const Vec3d v = n.cross(u);
-  struct Around {
-    double u, v;  // the corner's offset from the centre in the plane
-    Vec3d x;
-    int half() const { return v > 0 || (v == 0 && u > 0) ? 0 : 1; }  // angle in [0, pi) or [pi, 2 pi)
-  };
-  std::vector<Around> around;
-  for (const Vec3d& x : corners) {
-    const Vec3d d = (x - centre).cwiseQuotient(extent);
-    around.push_back({d.dot(u), d.dot(v), x});
+  // The cap: the edges on the plane that no face has the other way round
+  // (their other face was cut away), reversed and chained into loops.
+  std::sort(on_plane.begin(), on_plane.end());
+  const auto on = [&](std::uint32_t id) { return std::binary_search(on_plane.begin(), on_plane.end(), id); };
+  std::vector<std::pair<Corner, Corner>> edges;  // on the plane, as the faces run
+  for (const Face& face : faces)
+    for (std::size_t k = 0; k < face.loop.size(); ++k) {
+      const Corner& a = face.loop[k];
+      const Corner& b = face.loop[(k + 1) % face.loop.size()];
+      if (on(a.id) && on(b.id)) edges.push_back({a, b});
+    }
+  std::vector<std::pair<Corner, Corner>> open;  // the cap's edges
+  for (const auto& [a, b] : edges)
+    if (std::none_of(edges.begin(), edges.end(), [&](const auto& e) { return e.first.id == b.id && e.second.id == a.id; }))
+      open.push_back({b, a});
+  // Each loop ends where it started: at a corner where the cut touches
+  // itself, the next edge is any unused one leaving it.
+  std::vector<std::uint8_t> used(open.size(), 0);
+  for (std::size_t start = 0; start < open.size(); ++start) {
+    if (used[start]) continue;
+    Face cap{{}, label};
+    for (std::size_t e = start;;) {
+      used[e] = 1;
+      cap.loop.push_back(open[e].first);
+      const std::uint32_t to = open[e].second.id;
+      if (to == open[start].first.id) break;
+      std::size_t next = 0;
+      while (next < open.size() && (used[next] || open[next].first.id != to)) ++next;
+      if (next == open.size()) break;
+      e = next;
+    }
+    // A loop through a corner twice is two loops.
+    for (std::size_t k = 1; k < cap.loop.size(); ++k)
+      for (std::size_t j = 0; j < k; ++j)
+        if (cap.loop[j].id == cap.loop[k].id) {
+          Face part{{cap.loop.begin() + std::ptrdiff_t(j), cap.loop.begin() + std::ptrdiff_t(k)}, label};
+          if (part.loop.size() >= 3) faces.push_back(std::move(part));
+          cap.loop.erase(cap.loop.begin() + std::ptrdiff_t(j), cap.loop.begin() + std::ptrdiff_t(k));
+          k = j;
+          break;
+        }
+    if (cap.loop.size() >= 3) faces.push_back(std::move(cap));
   }
-  // By angle, without atan2 (whose roundings tie angles a few ulps apart):
-  // the half-plane, then the sign of the cross product.
-  std::sort(around.begin(), around.end(), [](const Around& a, const Around& b) {
-    if (a.half() != b.half()) return a.half() < b.half();
-    return a.u * b.v - a.v * b.u > 0;
-  });
-  Face cap{{}, label};
-  for (const Around& a : around) cap.loop.push_back(a.x);
-  if (cap.loop.size() >= 3) faces.push_back(std::move(cap));
 }
 
 // The cell's volume and centroid: tetrahedra from a point inside to the fan of each face.
@@ -190,44 +200,24 @@ bool is_closed(const Voronoi3Cell& cell, std::vector<std::pair<std::uint32_t, st
   return true;
 }
 
-// The cell of `site` from its faces; corners within `snap_radius` of `snap_to` become it.
-Voronoi3Cell make_cell(std::uint32_t site, const std::vector<Face>& faces, const Vec3d& extent, const Vec3d& snap_to,
-                       double snap_radius) {
+// The cell of `site` from its faces: their corners numbered by identity, in the order met.
+Voronoi3Cell make_cell(std::uint32_t site, const std::vector<Face>& faces, std::uint32_t corner_ids) {
   Voronoi3Cell cell;
   cell.site = site;
   cell.face_offsets.push_back(0);
+  constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+  std::vector<std::uint32_t> index(corner_ids, kNone);
   for (const Face& face : faces) {
-    const std::size_t begin = cell.face_vertices.size();
-    for (Vec3d x : face.loop) {
-      if ((x - snap_to).stableNorm() <= snap_radius) x = snap_to;
-      // the corners shared by faces: equal, or within rounding of each other
-      auto it = std::find_if(cell.vertices.begin(), cell.vertices.end(),
-                             [&](const Vec3d& y) { return same_point(x, y, extent); });
-      if (it == cell.vertices.end()) {
-        cell.vertices.push_back(x);
-        it = cell.vertices.end() - 1;
+    for (const Corner& c : face.loop) {
+      if (index[c.id] == kNone) {
+        index[c.id] = std::uint32_t(cell.vertices.size());
+        cell.vertices.push_back(c.x);
       }
-      const std::uint32_t v = std::uint32_t(it - cell.vertices.begin());
-      // Corners that merged leave an edge of no length, in this face and its neighbour across it: gone from both.
-      if (cell.face_vertices.size() == begin || cell.face_vertices.back() != v) cell.face_vertices.push_back(v);
-    }
-    while (cell.face_vertices.size() > begin + 1 && cell.face_vertices.back() == cell.face_vertices[begin])
-      cell.face_vertices.pop_back();
-    if (cell.face_vertices.size() < begin + 3) {  // a face merged into an edge or a corner
-      cell.face_vertices.resize(begin);
-      continue;
+      cell.face_vertices.push_back(index[c.id]);
     }
     cell.face_offsets.push_back(std::uint32_t(cell.face_vertices.size()));
     cell.face_neighbors.push_back(face.label);
   }
-  // Only the corners of the faces left (none if every face merged away: a cell below the resolution).
-  std::vector<std::uint32_t> renumbered(cell.vertices.size(), 0);
-  for (const std::uint32_t v : cell.face_vertices) renumbered[v] = 1;
-  std::uint32_t kept = 0;
-  for (std::uint32_t v = 0; v < cell.vertices.size(); ++v)
-    if (renumbered[v]) cell.vertices[kept] = cell.vertices[v], renumbered[v] = kept++;
-  cell.vertices.resize(kept);
-  for (std::uint32_t& v : cell.face_vertices) v = renumbered[v];
   measure(cell);
   return cell;
 }
@@ -278,12 +268,11 @@ void Voronoi3::build(const Delaunay3& dt) {
     if (dt.representative(i) == i) sites.push_back(i);
   // With a hull: the sites whose cells may cross it, those on it and those
   // with a Voronoi vertex (a circumcentre) outside it.
-  std::vector<std::uint8_t> crosses_hull, hull_vertex;
+  std::vector<std::uint8_t> crosses_hull;
   if (!hull.empty()) {
     crosses_hull.assign(points.size(), 0);
-    hull_vertex.assign(points.size(), 0);
     for (const auto& t : hull_)
-      for (const std::uint32_t v : t) crosses_hull[v] = hull_vertex[v] = 1;
+      for (const std::uint32_t v : t) crosses_hull[v] = 1;
     const auto& tets = dt.tetrahedra();
     std::vector<std::uint8_t> outside(dt.tetrahedron_count());
     parallel_for(0, outside.size(), 1 << 12, [&](std::size_t begin, std::size_t end) {
@@ -297,13 +286,13 @@ void Voronoi3::build(const Delaunay3& dt) {
       if (outside[t])
         for (int k = 0; k < 4; ++k) crosses_hull[tets[4 * t + k]] = 1;
   }
-  const Vec3d extent = box.hi - box.lo;
   const Vec3d reach = box.lo.cwiseAbs().cwiseMax(box.hi.cwiseAbs());
   std::vector<Face> initial;
   const Vec3d& lo = box.lo;
   const Vec3d& hi = box.hi;
-  const Vec3d c[8] = {{lo[0], lo[1], lo[2]}, {hi[0], lo[1], lo[2]}, {lo[0], hi[1], lo[2]}, {hi[0], hi[1], lo[2]},
-                      {lo[0], lo[1], hi[2]}, {hi[0], lo[1], hi[2]}, {lo[0], hi[1], hi[2]}, {hi[0], hi[1], hi[2]}};
+  const Corner c[8] = {{{lo[0], lo[1], lo[2]}, 0}, {{hi[0], lo[1], lo[2]}, 1}, {{lo[0], hi[1], lo[2]}, 2},
+                       {{hi[0], hi[1], lo[2]}, 3}, {{lo[0], lo[1], hi[2]}, 4}, {{hi[0], lo[1], hi[2]}, 5},
+                       {{lo[0], hi[1], hi[2]}, 6}, {{hi[0], hi[1], hi[2]}, 7}};
   initial.push_back({{c[0], c[4], c[6], c[2]}, box_side(0)});
   initial.push_back({{c[1], c[3], c[7], c[5]}, box_side(1)});
   initial.push_back({{c[0], c[1], c[5], c[4]}, box_side(2)});
@@ -311,7 +300,6 @@ void Voronoi3::build(const Delaunay3& dt) {
   initial.push_back({{c[0], c[2], c[3], c[1]}, box_side(4)});
   initial.push_back({{c[4], c[5], c[7], c[6]}, box_side(5)});
   cells_.resize(sites.size());
-  std::vector<std::uint8_t> open(sites.size());
   parallel_for_each_index(
       0, sites.size(),
       [&](std::size_t k) {
@@ -325,12 +313,13 @@ void Voronoi3::build(const Delaunay3& dt) {
                  ((points[a] - p).squaredNorm() == (points[b] - p).squaredNorm() && a < b);
         });
         std::vector<Face> faces = initial;
+        std::uint32_t corner_ids = 8;
         for (const std::uint32_t w : neighbors) {
           if (w == s) continue;
           // A unit normal: with the sites' difference itself, sites 1e-300
           // apart made products that underflowed to 0, and cells vanished.
           const Vec3d normal = (points[w] - p).stableNormalized();
-          clip(faces, normal, normal.dot((points[w] + p) * 0.5), w, extent, reach);
+          clip(faces, normal, normal.dot((points[w] + p) * 0.5), w, corner_ids, reach);
           if (faces.empty()) break;
         }
         if (!hull.empty() && crosses_hull[s]) {
@@ -338,52 +327,16 @@ void Voronoi3::build(const Delaunay3& dt) {
             // skip the planes the cell's bounding box lies within
             AABB3d bounds;
             for (const Face& f : faces)
-              for (const Vec3d& x : f.loop) bounds.extend(x);
+              for (const Corner& c : f.loop) bounds.extend(c.x);
             const Vec3d& n = hull[h].normal;
             double reach_h = 0;
             for (int a = 0; a < 3; ++a) reach_h += n[a] * (n[a] > 0 ? bounds.hi[a] : bounds.lo[a]);
-            if (reach_h > hull[h].offset) clip(faces, n, hull[h].offset, hull_face(h), extent, reach);
+            if (reach_h > hull[h].offset) clip(faces, n, hull[h].offset, hull_face(h), corner_ids, reach);
           }
         }
-        // A hull vertex is a corner of its own cell, where hull planes meet
-        // that can be nearly coplanar: their cuts put that corner a few 1e-12
-        // apart (enough to leave the cell open), and it is the site itself.
-        // The cell's other corners are at least half the nearest site's
-        // distance away (on a bisector).
-        double snap_radius = 0;
-        if (!hull.empty() && hull_vertex[s])
-          for (const std::uint32_t w : neighbors)
-            if (w != s) {
-              snap_radius = std::min(1e-9 * extent.norm(), 0.25 * (points[w] - p).stableNorm());
-              break;
-            }
-        const Voronoi3Cell& cell = cells_[k] = make_cell(s, faces, extent, p, snap_radius);
-        std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
-        open[k] = !is_closed(cell, edges);
-        for (std::size_t f = 0; f < cell.face_count() && !open[k]; ++f) {  // and every face turned outwards
-          const std::uint32_t label = cell.face_neighbors[f];
-          Vec3d outward = Vec3d::Zero();
-          if (is_box_side(label))
-            outward[(box_side(0) - label) / 2] = (box_side(0) - label) % 2 ? 1 : -1;
-          else
-            outward = is_hull_face(label) ? hull[label & 0x7fffffffu].normal : Vec3d(points[label] - p);
-          const auto [area, perimeter] = face_extent(cell, f);
-          open[k] = !(area.dot(outward.stableNormalized()) >= -2 * perimeter * 1e-11 * extent.norm());
-        }
+        cells_[k] = make_cell(s, faces, corner_ids);
       },
       16);
-  // Corners merged within 1e-12 of the box that are not one Voronoi vertex
-  // leave a cell open or a face turned inwards: refused rather than given.
-  // (A fuzz of nearly cospherical lattice subsets, 40 at each spacing: none
-  // down to sites 1e-8 of the box apart, 1 to 21 from 1e-9 to 1e-11; and
-  // every set of 2,000 to 17,000 points on a sphere, where all cells meet
-  // near its centre.) Corners by the identity of what they come from (the
-  // tetrahedra's circumcentres, edges cut by planes) would not need merging.
-  const auto first_open = std::find(open.begin(), open.end(), 1);
-  if (first_open != open.end())
-    throw Error("Voronoi3: the cell of site " + std::to_string(sites[std::size_t(first_open - open.begin())]) +
-                " has Voronoi vertices closer than the clipping resolves (1e-12 of the box's extent), as sites "
-                "about 1e-9 of the box apart (a smaller box resolves them) or many sites on one sphere make");
 }
 
 double Voronoi3::volume_total() const {
@@ -481,11 +434,11 @@ void Voronoi3::check_cells() const {
 void Voronoi3::validate() const {
   check_cells();
   constexpr double u = std::numeric_limits<double>::epsilon() / 2;
-  // How far a corner may be from where it belongs, per axis: corners within
-  // 1e-12 of the box's extent on every axis merge (same_point), and each cut
-  // rounds. (In a fuzz of nearly cospherical lattice subsets, 40 at each
-  // spacing from 1e-2 to 1e-11 of the box, no diagram failed at 1e-11.) Per axis, so that a box thin along one axis is checked as closely
-  // along it as any other.
+  // How far a corner may be from where it belongs, per axis: each cut rounds
+  // (in a fuzz of nearly cospherical lattice subsets, 40 at each spacing
+  // from 1e-2 to 1e-11 of the box, and of points on a sphere, none was off
+  // by more). Per axis, so that a box thin along one axis is checked as
+  // closely along it as any other.
   const Vec3d tolerance = 1e-11 * (box_.hi - box_.lo) + 64 * u * box_.lo.cwiseAbs().cwiseMax(box_.hi.cwiseAbs());
   const auto across = [&](const Vec3d& normal) { return normal.cwiseAbs().dot(tolerance); };  // off a plane
   const auto rounding = [&](const Vec3d& normal, const Vec3d& x) { return 64 * u * normal.cwiseAbs().dot(x.cwiseAbs()); };
