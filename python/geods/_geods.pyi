@@ -1067,6 +1067,46 @@ class Voronoi2:
         """(v, 2) Voronoi vertices (circumcentres; co-circular ones merged).
         """
 
+class Voronoi3:
+    """
+    The Voronoi cells of 3D points clipped to a box (x0, y0, z0, x1, y1, z1), or with
+    box=None to the points' convex hull, as closed convex polyhedra.
+
+    """
+    def __init__(self, points: Any, box: Any = ...) -> None:
+        """points: float64 (n, 3); box: 6 numbers or None (the hull)
+        """
+    @property
+    def box(self) -> NDArray[numpy.float64]:
+        """(6,) float64: the box, or the hull's bounding box
+        """
+    @property
+    def cells(self) -> list[Any]:
+        """One dict per distinct point: "site" (its index), "volume", "centroid",
+        "vertices" (k, 3), "faces" (index loops into vertices, counter-clockwise seen from
+        outside) and "neighbors" (per face the site across, -2 - k for box side k: -x, +x,
+        -y, +y, -z, +z, or -1000 - k for hull triangle k).
+        """
+    @staticmethod
+    def load(path: str | os.PathLike[str]) -> Voronoi3:
+        """reads cells written by save() (indices and closedness checked)
+        """
+    def mesh(self, explode: float = ...) -> tuple[Any, ...]:
+        """(V float32 (n, 3), F (m, 3)): every cell a closed surface, moved from the box's centre by explode
+        """
+    def save(self, path: str | os.PathLike[str]) -> None:
+        """writes the cells, points, box and hull to a geods archive
+        """
+    def stats(self) -> dict[str, Any]:
+        """dict: sites, faces, vertices, empty, bytes
+        """
+    def validate(self) -> None:
+        """Checks every invariant (closed convex cells on their bisectors, none overlapping, volumes adding up); raises geods.Error if one fails.
+        """
+    def volume_total(self) -> float:
+        """the sum of the cells' volumes: the box's or the hull's
+        """
+
 class WalkLocator:
     """Nearest sites by walking in the Delaunay graph of a Voronoi2.
     """
@@ -1422,13 +1462,8 @@ def tin_tile(heights: Any, max_error: float, border_limit: float | None = ...) -
     by (x0, y0) (geods.dask.terrain_tiles).
     """
 
-def voronoi3(points: Any, box: Any = ...) -> list[Any]:
-    """The Voronoi cells of 3D points clipped to a box (x0, y0, z0, x1, y1, z1), or with
-    box=None to the points' convex hull: one dict per distinct point with "site" (its
-    index), "volume", "centroid", "vertices" (k, 3), "faces" (index loops into vertices,
-    counter-clockwise seen from outside) and "neighbors" (per face the site across, -2 - k
-    for box side k: -x, +x, -y, +y, -z, +z, or -1000 - k for Delaunay3.hull triangle k).
-    The cells partition the box (or the hull).
+def voronoi3(points: Any, box: Any = ...) -> Voronoi3:
+    """The Voronoi cells of 3D points (n, 3) clipped to box (x0, y0, z0, x1, y1, z1), or to their convex hull when box is None: a Voronoi3.
     """
 
 def write_mesh(path: str | os.PathLike[str], V: ArrayLike, F: ArrayLike, binary: bool = ...) -> None:

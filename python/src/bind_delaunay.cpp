@@ -31,6 +31,18 @@ Vec2d as_point(const py::handle& h, const char* what) { return point_of<double, 
 
 std::int64_t as_index(std::uint32_t i) { return index_value(i); }
 
+// Voronoi3(points, box): clipped to the box (6 numbers), or to the hull for None.
+voronoi::Voronoi3 make_voronoi3(const py::handle& points_in, const py::handle& box_in) {
+  const std::vector<Vec3d> points = points_of<double, 3>(points_in, "Voronoi3");
+  if (box_in.is_none()) return without_gil([&] { return voronoi::Voronoi3(voronoi::Delaunay3(points)); });
+  const py::array_t<double, py::array::c_style | py::array::forcecast> box =
+      py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(box_in);
+  if (!box || box.size() != 6) throw Error("Voronoi3: box must be 6 numbers x0, y0, z0, x1, y1, z1, or None");
+  const double* b = box.data();
+  const AABB3d aabb(Vec3d(b[0], b[1], b[2]), Vec3d(b[3], b[4], b[5]));
+  return without_gil([&] { return voronoi::Voronoi3(points, aabb); });
+}
+
 std::uint32_t vertex_index(std::int64_t i, const Delaunay2& dt, const char* what) {
   if (i < 0 || std::size_t(i) >= dt.points().size())
     throw Error(std::string(what) + ": point " + std::to_string(i) + " does not exist");
@@ -168,50 +180,68 @@ insertion="flips" inserts each point (here and in insert()) by 1-4, 2-3, 3-2
       .def("validate", &Delaunay3::validate, "checks every invariant (exact); raises geods.Error on a violation")
       .def("stats", [](const Delaunay3& dt) { return stats_dict(dt.stats()); }, "dict of the DelaunayStats fields");
 
-  m.def(
-      "voronoi3",
-      [](const py::handle& points_in, const py::handle& box_in) {
-        const std::vector<Vec3d> points = points_of<double, 3>(points_in, "voronoi3");
-        std::vector<voronoi::Voronoi3Cell> cells;
-        if (box_in.is_none()) {
-          py::gil_scoped_release release;
-          cells = voronoi::Voronoi3(voronoi::Delaunay3(points)).cells();
-        } else {
-          const py::array_t<double, py::array::c_style | py::array::forcecast> box =
-              py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(box_in);
-          if (!box || box.size() != 6) throw Error("voronoi3: box must be 6 numbers x0, y0, z0, x1, y1, z1, or None");
-          const double* b = box.data();
-          py::gil_scoped_release release;
-          cells = voronoi::Voronoi3(points, AABB3d(Vec3d(b[0], b[1], b[2]), Vec3d(b[3], b[4], b[5]))).cells();
-        }
-        py::list out;
-        for (const auto& cell : cells) {
-          py::dict d;
-          d["site"] = std::int64_t(cell.site);
-          d["volume"] = cell.volume;
-          d["centroid"] = copy_array(cell.centroid.data(), {3});
-          d["vertices"] = points_array(cell.vertices);
-          py::list faces;
-          for (std::size_t f = 0; f < cell.face_count(); ++f)
-            faces.append(index_array(std::span<const std::uint32_t>(
-                cell.face_vertices.data() + cell.face_offsets[f], cell.face_offsets[f + 1] - cell.face_offsets[f])));
-          d["faces"] = faces;
-          std::vector<std::int64_t> labels;
-          for (const std::uint32_t l : cell.face_neighbors)  // box side k: -2 - k; hull triangle k: -1000 - k
-            labels.push_back(voronoi::Voronoi3::is_hull_face(l) ? -1000 - std::int64_t(l & 0x7fffffffu) : std::int32_t(l));
-          d["neighbors"] = copy_array(labels.data(), {py::ssize_t(labels.size())});
-          out.append(d);
-        }
-        return out;
-      },
-      py::arg("points"), py::arg("box") = py::none(), R"doc(
+  py::class_<voronoi::Voronoi3>(m, "Voronoi3", R"doc(
 The Voronoi cells of 3D points clipped to a box (x0, y0, z0, x1, y1, z1), or with
-box=None to the points' convex hull: one dict per distinct point with "site" (its
-index), "volume", "centroid", "vertices" (k, 3), "faces" (index loops into vertices,
-counter-clockwise seen from outside) and "neighbors" (per face the site across, -2 - k
-for box side k: -x, +x, -y, +y, -z, +z, or -1000 - k for Delaunay3.hull triangle k).
-The cells partition the box (or the hull).
-)doc");
+box=None to the points' convex hull, as closed convex polyhedra.
+)doc")
+      .def(py::init(&make_voronoi3),
+           py::arg("points"), py::arg("box") = py::none(), "points: float64 (n, 3); box: 6 numbers or None (the hull)")
+      .def_property_readonly(
+          "cells",
+          [](const voronoi::Voronoi3& vd) {
+            py::list out;
+            for (const auto& cell : vd.cells()) {
+              py::dict d;
+              d["site"] = std::int64_t(cell.site);
+              d["volume"] = cell.volume;
+              d["centroid"] = copy_array(cell.centroid.data(), {3});
+              d["vertices"] = points_array(cell.vertices);
+              py::list faces;
+              for (std::size_t f = 0; f < cell.face_count(); ++f)
+                faces.append(index_array(std::span<const std::uint32_t>(
+                    cell.face_vertices.data() + cell.face_offsets[f], cell.face_offsets[f + 1] - cell.face_offsets[f])));
+              d["faces"] = faces;
+              std::vector<std::int64_t> labels;
+              for (const std::uint32_t l : cell.face_neighbors)  // box side k: -2 - k; hull triangle k: -1000 - k
+                labels.push_back(voronoi::Voronoi3::is_hull_face(l) ? -1000 - std::int64_t(l & 0x7fffffffu)
+                                                                    : std::int32_t(l));
+              d["neighbors"] = copy_array(labels.data(), {py::ssize_t(labels.size())});
+              out.append(d);
+            }
+            return out;
+          },
+          R"doc(One dict per distinct point: "site" (its index), "volume", "centroid",
+"vertices" (k, 3), "faces" (index loops into vertices, counter-clockwise seen from
+outside) and "neighbors" (per face the site across, -2 - k for box side k: -x, +x,
+-y, +y, -z, +z, or -1000 - k for hull triangle k).)doc")
+      .def_property_readonly(
+          "box",
+          [](const voronoi::Voronoi3& vd) {
+            const double b[6] = {vd.box().lo[0], vd.box().lo[1], vd.box().lo[2],
+                                 vd.box().hi[0], vd.box().hi[1], vd.box().hi[2]};
+            return copy_array(b, {6});
+          },
+          "(6,) float64: the box, or the hull's bounding box")
+      .def("volume_total", &voronoi::Voronoi3::volume_total, "the sum of the cells' volumes: the box's or the hull's")
+      .def(
+          "mesh", [](const voronoi::Voronoi3& vd, double explode) { return mesh_arrays(vd.mesh(explode), false); },
+          py::arg("explode") = 0.0,
+          "(V float32 (n, 3), F (m, 3)): every cell a closed surface, moved from the box's centre by explode")
+      .def("stats", [](const voronoi::Voronoi3& vd) { return stats_dict(vd.stats()); },
+           "dict: sites, faces, vertices, empty, bytes")
+      .def("validate", &voronoi::Voronoi3::validate, py::call_guard<py::gil_scoped_release>(),
+           "Checks every invariant (closed convex cells on their bisectors, none overlapping, volumes adding up); "
+           "raises geods.Error if one fails.")
+      .def(
+          "save", [](const voronoi::Voronoi3& vd, const std::filesystem::path& path) { vd.save(path); }, py::arg("path"),
+          "writes the cells, points, box and hull to a geods archive")
+      .def_static(
+          "load", [](const std::filesystem::path& path) { return voronoi::Voronoi3::load(path); }, py::arg("path"),
+          "reads cells written by save() (indices and closedness checked)");
+  m.def(
+      "voronoi3", &make_voronoi3, py::arg("points"), py::arg("box") = py::none(),
+      "The Voronoi cells of 3D points (n, 3) clipped to box (x0, y0, z0, x1, y1, z1), or to their convex hull when "
+      "box is None: a Voronoi3.");
   m.def(
       "largest_empty_sphere",
       [](const py::handle& points_in) {

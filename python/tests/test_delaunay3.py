@@ -147,11 +147,22 @@ def test_cli_delaunay3(cli, tmp_path):
     assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1
 
 
-def test_voronoi3_cells_partition_the_box():
+def test_voronoi3_cells_partition_the_box(tmp_path):
     rng = np.random.default_rng(10)
     pts = rng.random((200, 3))
     box = [0, 0, 0, 1, 1, 1]
-    cells = geods.voronoi3(pts, box)
+    vd = geods.voronoi3(pts, box)
+    vd.validate()
+    assert vd.stats()["sites"] == 200 and vd.volume_total() == pytest.approx(1.0, rel=1e-9)
+    assert np.array_equal(vd.box, box)
+    v, f = vd.mesh()
+    assert f.shape[0] == sum(len(loop) - 2 for c in vd.cells for loop in c["faces"])
+    saved = tmp_path / "cells.geods"
+    vd.save(saved)
+    loaded = geods.Voronoi3.load(saved)
+    loaded.validate()
+    assert [c["volume"] for c in loaded.cells] == [c["volume"] for c in vd.cells]
+    cells = vd.cells
     assert len(cells) == 200 and sorted(c["site"] for c in cells) == list(range(200))
     assert sum(c["volume"] for c in cells) == pytest.approx(1.0, rel=1e-9)
     by_site = {c["site"]: c for c in cells}
@@ -208,7 +219,9 @@ def test_proximity_in_3d_against_brute_force():
 def test_voronoi3_cells_clipped_to_the_hull_and_the_largest_empty_sphere():
     rng = np.random.default_rng(13)
     pts = rng.normal(size=(150, 3))
-    cells = geods.voronoi3(pts)  # box=None: the convex hull
+    vd = geods.Voronoi3(pts)  # box=None: the convex hull
+    vd.validate()
+    cells = vd.cells
     hull = ConvexHull(pts)
     assert sum(c["volume"] for c in cells) == pytest.approx(hull.volume, rel=1e-9)
     inside = Delaunay(pts)
