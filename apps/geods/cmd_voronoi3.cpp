@@ -41,6 +41,7 @@ class Voronoi3Command : public Command {
         ->check(CLI::Range(0.0, 100.0));
     app.add_option("--volumes", volumes_,
                    "Output: float64 c x 5 per cell: site index, volume, centroid x, y, z (.npy)");
+    add_save(app, save_, "the cells", "Voronoi3.load");
   }
 
   void run(const RunContext&, Report& report) override {
@@ -65,6 +66,7 @@ class Voronoi3Command : public Command {
     if (hull_) box = vd.box();
     const voronoi::Voronoi3Stats stats = vd.stats();
     if (!output_.empty()) io::write_mesh(output_, vd.mesh(explode_));
+    if (!save_.empty()) vd.save(save_);
     if (!volumes_.empty()) {
       std::vector<double> rows;
       for (const auto& cell : vd.cells())
@@ -88,12 +90,12 @@ class Voronoi3Command : public Command {
                                          points.size(), vd.cells().size(), stats.empty, stats.faces, vd.volume_total(),
                                          (box.hi - box.lo).prod()));
     report.lines.push_back(fmt::format("  tetrahedralized in {:.3f} s, cells in {:.3f} s", build_s, cells_s));
-    for (const std::string* path : {&output_, &volumes_})
+    for (const std::string* path : {&output_, &volumes_, &save_})
       if (!path->empty()) report.lines.push_back("  wrote " + *path);
   }
 
  private:
-  std::string points_, box_, output_, volumes_;
+  std::string points_, box_, output_, volumes_, save_;
   double explode_ = 0;
   bool hull_ = false;
 };

@@ -187,7 +187,8 @@ def test_cli_voronoi3(cli, tmp_path):
     pts = np.random.default_rng(11).random((150, 3))
     np.save(tmp_path / "p.npy", pts)
     r = subprocess.run([str(cli), "voronoi3", str(tmp_path / "p.npy"), "--box", "0,0,0,1,1,1", "-o",
-                        str(tmp_path / "cells.ply"), "--volumes", str(tmp_path / "v.npy"), "--json"],
+                        str(tmp_path / "cells.ply"), "--volumes", str(tmp_path / "v.npy"), "--save",
+                        str(tmp_path / "cells.geods"), "--json"],
                        capture_output=True, text=True)
     assert r.returncode == 0, r.stderr
     info = json.loads(r.stdout)
@@ -195,6 +196,9 @@ def test_cli_voronoi3(cli, tmp_path):
     v = np.load(tmp_path / "v.npy")
     assert v.shape == (150, 5) and v[:, 1].sum() == pytest.approx(1.0, rel=1e-9)
     assert (tmp_path / "cells.ply").stat().st_size > 0
+    saved = geods.Voronoi3.load(tmp_path / "cells.geods")
+    saved.validate()
+    assert np.allclose(sorted(c["volume"] for c in saved.cells), np.sort(v[:, 1]), rtol=0, atol=0)
     r = subprocess.run([str(cli), "voronoi3", str(tmp_path / "p.npy"), "--box", "0,0,0,1,1"], capture_output=True,
                        text=True)
     assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1
