@@ -81,11 +81,8 @@ void clip(std::vector<Face>& faces, const Vec3d& normal, double offset, std::uin
       if ((sa < 0 && sb > 0) || (sa > 0 && sb < 0)) {
         const std::array<std::uint32_t, 2> edge{std::min(a.id, b.id), std::max(a.id, b.id)};
         auto it = std::find_if(cuts.begin(), cuts.end(), [&](const auto& c) { return c.first == edge; });
-        if (it == cuts.end()) {
-          // computed from the end with the smaller number, as the other face of the edge would
-          const bool forward = a.id < b.id;
-          const Vec3d x = forward ? Vec3d(a.x + (b.x - a.x) * (sa / (sa - sb))) : Vec3d(b.x + (a.x - b.x) * (sb / (sb - sa)));
-          cuts.push_back({edge, {x, next_id++}});
+        if (it == cuts.end()) {  // the edge's first face computes the corner, its other face takes it
+          cuts.push_back({edge, {Vec3d(a.x + (b.x - a.x) * (sa / (sa - sb))), next_id++}});
           on_plane.push_back(cuts.back().second.id);
           it = cuts.end() - 1;
         }
