@@ -454,8 +454,8 @@ void Voronoi3::validate() const {
     const Vec3d& p = points_[cell.site];
     const bool holds_site = !hull_.empty() || box_.contains(p);  // every site is in its hull
     if (cell.face_count() == 0) {
-      // Empty, unless it holds its site: then only when another site is
-      // nearer than the corners' resolution (and the cell merged into a point).
+      // Empty, unless it holds its site: then only when another site lies
+      // within the tolerance (the cell is no wider than a rounding).
       const auto nearest = tree.query(p, 2);
       if (holds_site && !(nearest.size() == 2 && std::sqrt(nearest[1].squared_distance) <= tolerance.norm()))
         throw Error(name + " is empty, but the site is inside the " + (hull_.empty() ? "box" : "hull"));

@@ -5,7 +5,8 @@
 // (of the sites inside it) or the hull.
 //
 // A cell is the box cut by the bisector planes between its site and the site's
-// Delaunay neighbours (only they bound a Voronoi cell), clipped in doubles.
+// Delaunay neighbours (only they bound a Voronoi cell), clipped in doubles
+// with its corners joined by identity (closed however close they lie).
 // Layout, flat per cell: its vertices, its faces as index loops into them
 // (counter-clockwise seen from outside), and per face the site across it, a
 // box side (Voronoi3::box_side(k), k = 0..5 for -x, +x, -y, +y, -z, +z) or a
@@ -94,21 +95,21 @@ class Voronoi3 {
   /// another kind or version, or fails those checks.
   static Voronoi3 load(const std::filesystem::path& path, Archive::Verify verify = Archive::Verify::checksums);
 
-  /// Checks, with a tolerance for the clipping's roundings (1e-9 of the box's
-  /// diagonal and the coordinates' rounding), what the cells promise; throws
+  /// Checks, with a tolerance for the clipping's roundings (1e-11 of the box's
+  /// extent per axis and the coordinates' rounding), what the cells promise; throws
   /// geods::Error naming the first violation. Independent of Delaunay3,
   /// O(size log n), and O(size h) more for h hull triangles:
   /// - every cell's faces are index loops into its vertices, each edge used
   ///   once in each direction (a closed, oriented surface);
   /// - every face label is another site's, a box side, or (clipped to the
-  ///   hull) a hull triangle, and every corner of the face lies on that
-  ///   bisector, box side or hull plane; no corner is outside another face's
-  ///   plane (the cell is convex);
+  ///   hull) a hull triangle; every corner of the face lies on that
+  ///   bisector, box side or hull plane, no corner of the cell beyond it (the
+  ///   cell is convex), and the face turns outwards;
   /// - no corner is nearer to another site than to its own (a k-d tree over
   ///   the sites), so the cells do not overlap, and their volumes add up to
   ///   the box's (or the hull's): together they cover it;
-  /// - a site inside the box has a cell with a positive volume that holds it,
-  ///   and each cell's volume and centroid are those of its faces.
+  /// - a site inside the box (or the hull) has a cell with faces that holds
+  ///   it, and each cell's volume and centroid are those of its faces.
   void validate() const;
 
  private:
