@@ -49,25 +49,32 @@ void clip(std::vector<Face>& faces, const Vec3d& normal, double offset, std::uin
   // (another of coplanar hull triangles, a face already cut by it) cuts
   // nothing: cut in rounding, it would leave slivers of no width.
   const double rounding = 16 * std::numeric_limits<double>::epsilon() * (normal.cwiseAbs().dot(reach) + std::abs(offset));
+  std::vector<double> sides;  // every face's corners' signed distances, face after face
   bool beyond_rounding = false;
   for (const Face& face : faces)
-    for (const Corner& c : face.loop) beyond_rounding |= normal.dot(c.x) - offset > rounding;
+    for (const Corner& c : face.loop) {
+      sides.push_back(normal.dot(c.x) - offset);
+      beyond_rounding |= sides.back() > rounding;
+    }
   if (!beyond_rounding) return;
   std::vector<std::uint32_t> on_plane;                                  // corners on the plane or cut into it
   std::vector<std::pair<std::array<std::uint32_t, 2>, Corner>> cuts;  // this plane's cuts, by their edge
   std::vector<Face> kept;
+  std::vector<std::size_t> touching;  // the kept faces with a corner on the plane
   kept.reserve(faces.size() + 1);
+  std::size_t first = 0;  // the face's first corner in sides
   for (Face& face : faces) {
     const std::size_t m = face.loop.size();
-    std::vector<double> side(m);
-    bool inside = false, outside = false;
+    const double* side = sides.data() + first;
+    first += m;
+    bool inside = false, outside = false, on = false;
     for (std::size_t k = 0; k < m; ++k) {
-      side[k] = normal.dot(face.loop[k].x) - offset;
       inside |= side[k] <= 0;
       outside |= side[k] > 0;
-      if (side[k] == 0) on_plane.push_back(face.loop[k].id);
+      if (side[k] == 0) on_plane.push_back(face.loop[k].id), on = true;
     }
     if (!outside) {
+      if (on) touching.push_back(kept.size());
       kept.push_back(std::move(face));
       continue;
     }
@@ -89,7 +96,7 @@ void clip(std::vector<Face>& faces, const Vec3d& normal, double offset, std::uin
         out.loop.push_back(it->second);
       }
     }
-    if (out.loop.size() >= 3) kept.push_back(std::move(out));
+    if (out.loop.size() >= 3) touching.push_back(kept.size()), kept.push_back(std::move(out));
   }
   faces.swap(kept);
   // The cap: the edges on the plane that no face has the other way round
@@ -97,8 +104,9 @@ void clip(std::vector<Face>& faces, const Vec3d& normal, double offset, std::uin
   std::sort(on_plane.begin(), on_plane.end());
   const auto on = [&](std::uint32_t id) { return std::binary_search(on_plane.begin(), on_plane.end(), id); };
   std::vector<std::pair<Corner, Corner>> edges;  // on the plane, as the faces run
-  for (const Face& face : faces)
-    for (std::size_t k = 0; k < face.loop.size(); ++k) {
+  for (const std::size_t f : touching)
+    for (std::size_t k = 0; k < faces[f].loop.size(); ++k) {
+      const Face& face = faces[f];
       const Corner& a = face.loop[k];
       const Corner& b = face.loop[(k + 1) % face.loop.size()];
       if (on(a.id) && on(b.id)) edges.push_back({a, b});
