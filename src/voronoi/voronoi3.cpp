@@ -49,7 +49,14 @@ void clip(std::vector<Face>& faces, const Vec3d& normal, double offset, std::uin
   // (another of coplanar hull triangles, a face already cut by it) cuts
   // nothing: cut in rounding, it would leave slivers of no width.
   const double rounding = 16 * std::numeric_limits<double>::epsilon() * (normal.cwiseAbs().dot(reach) + std::abs(offset));
-  std::vector<double> sides;  // every face's corners' signed distances, face after face
+  // Scratch arrays kept by each thread from cut to cut (a cell takes dozens of cuts).
+  thread_local std::vector<double> sides;  // every face's corners' signed distances, face after face
+  thread_local std::vector<std::uint32_t> on_plane;                                  // corners on the plane or cut into it
+  thread_local std::vector<std::pair<std::array<std::uint32_t, 2>, Corner>> cuts;  // this plane's cuts, by their edge
+  thread_local std::vector<std::size_t> touching;  // the kept faces with a corner on the plane
+  thread_local std::vector<std::pair<Corner, Corner>> edges, open;  // on the plane as the faces run; the cap's
+  thread_local std::vector<std::uint8_t> used;
+  sides.clear(), on_plane.clear(), cuts.clear(), touching.clear(), edges.clear(), open.clear();
   bool beyond_rounding = false;
   for (const Face& face : faces)
     for (const Corner& c : face.loop) {
@@ -57,10 +64,7 @@ void clip(std::vector<Face>& faces, const Vec3d& normal, double offset, std::uin
       beyond_rounding |= sides.back() > rounding;
     }
   if (!beyond_rounding) return;
-  std::vector<std::uint32_t> on_plane;                                  // corners on the plane or cut into it
-  std::vector<std::pair<std::array<std::uint32_t, 2>, Corner>> cuts;  // this plane's cuts, by their edge
   std::vector<Face> kept;
-  std::vector<std::size_t> touching;  // the kept faces with a corner on the plane
   kept.reserve(faces.size() + 1);
   std::size_t first = 0;  // the face's first corner in sides
   for (Face& face : faces) {
@@ -103,7 +107,6 @@ void clip(std::vector<Face>& faces, const Vec3d& normal, double offset, std::uin
   // (their other face was cut away), reversed and chained into loops.
   std::sort(on_plane.begin(), on_plane.end());
   const auto on = [&](std::uint32_t id) { return std::binary_search(on_plane.begin(), on_plane.end(), id); };
-  std::vector<std::pair<Corner, Corner>> edges;  // on the plane, as the faces run
   for (const std::size_t f : touching)
     for (std::size_t k = 0; k < faces[f].loop.size(); ++k) {
       const Face& face = faces[f];
@@ -111,13 +114,12 @@ void clip(std::vector<Face>& faces, const Vec3d& normal, double offset, std::uin
       const Corner& b = face.loop[(k + 1) % face.loop.size()];
       if (on(a.id) && on(b.id)) edges.push_back({a, b});
     }
-  std::vector<std::pair<Corner, Corner>> open;  // the cap's edges
   for (const auto& [a, b] : edges)
     if (std::none_of(edges.begin(), edges.end(), [&](const auto& e) { return e.first.id == b.id && e.second.id == a.id; }))
       open.push_back({b, a});
   // Each loop ends where it started: at a corner where the cut touches
   // itself, the next edge is any unused one leaving it.
-  std::vector<std::uint8_t> used(open.size(), 0);
+  used.assign(open.size(), 0);
   for (std::size_t start = 0; start < open.size(); ++start) {
     if (used[start]) continue;
     Face cap{{}, label};
