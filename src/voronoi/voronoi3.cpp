@@ -9,6 +9,7 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <tuple>
 #include <utility>
 
 #include "geods/core/coordinate_range.hpp"
@@ -147,11 +148,10 @@ void clip(std::vector<Face>& faces, const Vec3d& normal, double offset, std::uin
   }
 }
 
-// The cell's volume and centroid: tetrahedra from a point inside to the fan of each face.
-void measure(Voronoi3Cell& cell) {
-  cell.volume = 0;
-  cell.centroid = Vec3d::Zero();
-  if (cell.face_count() == 0) return;
+// The cell's volume and centroid from its faces: tetrahedra from a point
+// inside to the fan of each face.
+std::pair<double, Vec3d> measure(const Voronoi3Cell& cell) {
+  if (cell.face_count() == 0) return {0.0, Vec3d::Zero()};
   Vec3d reference = Vec3d::Zero();
   for (const Vec3d& x : cell.vertices) reference += x;
   reference /= double(cell.vertices.size());
@@ -160,6 +160,7 @@ void measure(Voronoi3Cell& cell) {
   double radius = 0;
   for (const Vec3d& x : cell.vertices) radius = std::max(radius, (x - reference).cwiseAbs().maxCoeff());
   if (!(radius > 0)) radius = 1;
+  double volume = 0;
   Vec3d moment = Vec3d::Zero();
   for (std::size_t f = 0; f < cell.face_count(); ++f) {
     const std::uint32_t* loop = &cell.face_vertices[cell.face_offsets[f]];
@@ -167,11 +168,11 @@ void measure(Voronoi3Cell& cell) {
       const Vec3d a = cell.vertices[loop[0]] - reference, b = cell.vertices[loop[k]] - reference,
                   c = cell.vertices[loop[k + 1]] - reference;
       const double v = a.dot(b.cross(c)) / 6;
-      cell.volume += v;
+      volume += v;
       moment += v * ((a + b + c) / (4 * radius));
     }
   }
-  cell.centroid = cell.volume > 0 ? Vec3d(reference + moment / cell.volume * radius) : reference;
+  return {volume, volume > 0 ? Vec3d(reference + moment / volume * radius) : reference};
 }
 
 // Twice face f's vector area (its normal by the loop's turn) and its perimeter.
@@ -225,8 +226,16 @@ Voronoi3Cell make_cell(std::uint32_t site, const std::vector<Face>& faces, std::
     cell.face_offsets.push_back(std::uint32_t(cell.face_vertices.size()));
     cell.face_neighbors.push_back(face.label);
   }
-  measure(cell);
+  std::tie(cell.volume, cell.centroid) = measure(cell);
   return cell;
+}
+
+// The bisector of sites p and w, its unit normal towards w. (With the sites'
+// difference itself as the normal, sites 1e-300 apart made products that
+// underflowed to 0, and cells vanished.)
+Plane bisector_plane(const Vec3d& p, const Vec3d& w) {
+  const Vec3d normal = (w - p).stableNormalized();
+  return {normal, normal.dot((p + w) * 0.5)};
 }
 
 // The plane of hull triangle t, its normal pointing out of the hull.
@@ -323,10 +332,8 @@ void Voronoi3::build(const Delaunay3& dt) {
         std::uint32_t corner_ids = 8;
         for (const std::uint32_t w : neighbors) {
           if (w == s) continue;
-          // A unit normal: with the sites' difference itself, sites 1e-300
-          // apart made products that underflowed to 0, and cells vanished.
-          const Vec3d normal = (points[w] - p).stableNormalized();
-          clip(faces, normal, normal.dot((points[w] + p) * 0.5), w, corner_ids, reach);
+          const Plane bisector = bisector_plane(p, points[w]);
+          clip(faces, bisector.normal, bisector.offset, w, corner_ids, reach);
           if (faces.empty()) break;
         }
         if (!hull.empty() && crosses_hull[s]) {
@@ -500,8 +507,7 @@ void Voronoi3::validate() const {
       } else if (is_hull_face(label)) {
         plane = hull[label & 0x7fffffffu];
       } else {
-        plane.normal = (points_[label] - p).stableNormalized();
-        plane.offset = plane.normal.dot((p + points_[label]) * 0.5);
+        plane = bisector_plane(p, points_[label]);
       }
       const double off_plane = across(plane.normal) + 64 * u * std::abs(plane.offset);
       const auto off = [&](const Vec3d& x) { return plane.normal.dot(x) - plane.offset; };
@@ -521,12 +527,11 @@ void Voronoi3::validate() const {
         throw Error(name + ": face " + std::to_string(f) + " turns the wrong way");
       cell_slack += area.stableNorm() / 2 * across(plane.normal);
     }
-    Voronoi3Cell measured = cell;
-    measure(measured);
-    if (!(std::abs(measured.volume - cell.volume) <= 1e-9 * std::abs(measured.volume) + cell_slack) ||
-        !((measured.centroid - cell.centroid).cwiseAbs().array() <= tolerance.array()).all())
+    const auto [volume, centroid] = measure(cell);
+    if (!(std::abs(volume - cell.volume) <= 1e-9 * std::abs(volume) + cell_slack) ||
+        !((centroid - cell.centroid).cwiseAbs().array() <= tolerance.array()).all())
       throw Error(name + ": its volume " + format_number(cell.volume) + " or centroid is not its faces' (" +
-                  format_number(measured.volume) + ")");
+                  format_number(volume) + ")");
     total += cell.volume;
     slack += cell_slack;
   }
