@@ -11,6 +11,7 @@
 #include "geods/core/aabb.hpp"
 #include "geods/core/coordinate_range.hpp"
 #include "geods/core/error.hpp"
+#include "geods/core/predicates.hpp"
 #include "geods/core/vec.hpp"
 #include "geods/voronoi/delaunay2.hpp"
 #include "geods/voronoi/polygon_clip.hpp"
@@ -41,47 +42,46 @@ inline std::vector<std::uint32_t> distinct_sites(const Delaunay2& dt, std::vecto
   return sites;
 }
 
-/// Counter-clockwise convex hull of floating-point points (monotone chain), without collinear points.
-inline std::vector<Vec2d> convex_polygon_of(std::vector<Vec2d> pts) {
-  std::sort(pts.begin(), pts.end(), [](const Vec2d& a, const Vec2d& b) { return a[0] < b[0] || (a[0] == b[0] && a[1] < b[1]); });
-  pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
-  if (pts.size() < 3) return {};
-  std::vector<Vec2d> hull(2 * pts.size());
-  std::size_t k = 0;
-  const auto cross = [](const Vec2d& o, const Vec2d& a, const Vec2d& b) {
-    return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
+/// The counter-clockwise convex hull of points (monotone chain, exact
+/// orientations), as indices into them; without collinear or repeated points.
+inline std::vector<std::uint32_t> convex_hull_of(const std::vector<Vec2d>& pts) {
+  std::vector<std::uint32_t> order(pts.size());
+  for (std::uint32_t i = 0; i < order.size(); ++i) order[i] = i;
+  const auto less = [&](std::uint32_t i, std::uint32_t j) {
+    return pts[i][0] < pts[j][0] || (pts[i][0] == pts[j][0] && pts[i][1] < pts[j][1]);
   };
-  for (std::size_t i = 0; i < pts.size(); ++i) {
-    while (k >= 2 && cross(hull[k - 2], hull[k - 1], pts[i]) <= 0) --k;
-    hull[k++] = pts[i];
+  std::sort(order.begin(), order.end(), less);
+  order.erase(std::unique(order.begin(), order.end(), [&](std::uint32_t i, std::uint32_t j) { return pts[i] == pts[j]; }),
+              order.end());
+  if (order.size() < 3) return {};
+  const auto cross = [&](std::uint32_t o, std::uint32_t a, std::uint32_t b) { return orient2d(pts[o], pts[a], pts[b]); };
+  std::vector<std::uint32_t> hull(2 * order.size());
+  std::size_t k = 0;
+  for (std::uint32_t i : order) {
+    while (k >= 2 && cross(hull[k - 2], hull[k - 1], i) <= 0) --k;
+    hull[k++] = i;
   }
-  for (std::size_t i = pts.size() - 1, lower = k + 1; i-- > 0;) {
-    while (k >= lower && cross(hull[k - 2], hull[k - 1], pts[i]) <= 0) --k;
-    hull[k++] = pts[i];
+  for (std::size_t r = order.size() - 1, lower = k + 1; r-- > 0;) {
+    while (k >= lower && cross(hull[k - 2], hull[k - 1], order[r]) <= 0) --k;
+    hull[k++] = order[r];
   }
   hull.resize(k - 1);
-  // Corners found twice (rounded apart by the clipping of neighbouring pieces) count once.
-  double extent = 0;
-  for (const Vec2d& p : pts) extent = std::max(extent, (p - pts.front()).cwiseAbs().maxCoeff());
-  std::vector<Vec2d> out;
-  for (const Vec2d& p : hull)
-    if (out.empty() || (p - out.back()).cwiseAbs().maxCoeff() > 1e-12 * extent) out.push_back(p);
-  while (out.size() > 1 && (out.front() - out.back()).cwiseAbs().maxCoeff() <= 1e-12 * extent) out.pop_back();
-  if (out.size() < 3) out.clear();
-  return out;
+  return hull;
 }
 
 /// Whether a polygon is no more than the rounding of its corners (u |corner|
-/// each, across its perimeter): a sliver that cutting by lines left, not a
-/// region. (Relative to the polygon, not the box: regions of sites 1e-7 of the
-/// box apart are 1e-14 of its area.)
+/// on each axis, across the edges along the other): a sliver that cutting by
+/// lines left, not a region. (Relative to the polygon, not the box: regions of
+/// sites 1e-7 of the box apart are 1e-14 of its area; and per axis: a strip
+/// 1e-12 high at x = 1e6 is a region, its y still exact to 1e-16.)
 inline bool negligible_area(const std::vector<Vec2d>& polygon) {
-  double perimeter = 0, far = 0;
+  Vec2d travel(0, 0), far(0, 0);
   for (std::size_t k = 0; k < polygon.size(); ++k) {
-    perimeter += (polygon[(k + 1) % polygon.size()] - polygon[k]).norm();
-    far = std::max(far, polygon[k].cwiseAbs().maxCoeff());
+    travel += (polygon[(k + 1) % polygon.size()] - polygon[k]).cwiseAbs();
+    far = far.cwiseMax(polygon[k].cwiseAbs());
   }
-  return polygon_area(polygon) <= 8 * std::numeric_limits<double>::epsilon() * far * perimeter;
+  return polygon_area(polygon) <=
+         8 * std::numeric_limits<double>::epsilon() * (far[0] * travel[1] + far[1] * travel[0]);
 }
 
 /// Checks a counter-clockwise polygon inside the box (to 1e-9 of its side).

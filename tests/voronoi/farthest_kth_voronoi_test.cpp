@@ -181,7 +181,8 @@ TEST(KthOrderVoronoi, SitesFarCloserThanTheBox) {
   // Nearly co-circular lattice sites 1e-7 and 1e-9 of a unit box apart:
   // regions under 1e-14 of the box's area were dropped as slivers, so that
   // 53 and 57 of 60 such subsets had points in no region near the sites.
-  for (const double spacing : {1e-7, 1e-9})
+  // At 1e-11 and 1e-12, regions lost corners merged within 1e-12 of the box.
+  for (const double spacing : {1e-7, 1e-9, 1e-11, 1e-12})
     for (std::uint64_t seed = 1; seed < 200; seed += 14) {
       SCOPED_TRACE("spacing " + std::to_string(spacing) + " seed " + std::to_string(seed));
       std::vector<Vec2d> sites = testing::lattice_subset(seed, true);
@@ -190,6 +191,47 @@ TEST(KthOrderVoronoi, SitesFarCloserThanTheBox) {
       const KthOrderVoronoi v(sites, 2, AABB2d(Vec2d(0, 0), Vec2d(1, 1)));
       expect_kth_matches_brute_force(v, seed, 200, near_sites);
     }
+}
+
+TEST(KthOrderVoronoi, ThinStripsFarFromTheOrigin) {
+  // Sites on the line x = 1e6 + 0.5, 1e-12 apart: the regions are strips
+  // 1e-12 high. They were dropped as slivers (the rounding of x = 1e6 taken
+  // for y's) and their corners merged (within 1e-12 of the box), leaving two
+  // regions of half the box each.
+  const double x = 1e6 + 0.5;
+  std::vector<Vec2d> sites;
+  for (double y : {3.01, 0.0, 5.01, 5.02, 3.02, 2.0, 2.01, 2.01, 2.02, 5.0, 1.0}) sites.push_back({x, 0.5 + 1e-12 * y});
+  const AABB2d box(Vec2d(1e6, 0), Vec2d(1e6 + 1, 1));
+  for (std::size_t k : {2u, 3u}) {
+    SCOPED_TRACE("k = " + std::to_string(k));
+    const KthOrderVoronoi v(sites, k, box);
+    v.validate();
+    EXPECT_EQ(v.regions().size(), 10u - k + 1);  // 10 distinct sites in a row
+    double area = 0;
+    for (const auto& r : v.regions()) area += polygon_area(r.polygon);
+    EXPECT_NEAR(area, 1.0, 1e-9);
+    // The sites share x, so a point's nearest are those nearest in y (exact
+    // differences of y near 0.5; x's rounding at 1e6 does not enter).
+    Rng rng(k);
+    for (int i = 0; i < 300; ++i) {
+      const Vec2d q(rng.uniform(1e6, 1e6 + 1), 0.5 + 1e-12 * rng.uniform(-3, 9));
+      std::vector<std::pair<double, std::uint32_t>> by_distance;
+      for (std::uint32_t j = 0; j < sites.size(); ++j)
+        if (v.representative(j) == j) by_distance.push_back({std::abs(q[1] - sites[j][1]), j});
+      std::sort(by_distance.begin(), by_distance.end());
+      if (by_distance[k].first - by_distance[k - 1].first < 1e-15) continue;  // on a boundary
+      std::vector<std::uint32_t> nearest;
+      for (std::size_t j = 0; j < k; ++j) nearest.push_back(by_distance[j].second);
+      std::sort(nearest.begin(), nearest.end());
+      int containing = 0;
+      for (const auto& r : v.regions())
+        if (point_in_polygon(q, r.polygon)) {
+          ++containing;
+          EXPECT_EQ(r.sites, nearest) << "sample " << q.transpose();
+        }
+      EXPECT_EQ(containing, 1) << q.transpose();
+    }
+  }
 }
 
 TEST(KthOrderVoronoi, BadInput) {

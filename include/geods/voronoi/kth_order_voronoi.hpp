@@ -4,8 +4,8 @@
 // is the intersection of the half-planes "nearer to t than to s" for t in its
 // set and s outside it.
 //
-// Construction, for small k: the order-1 regions are the Voronoi cells
-// (Delaunay2, Voronoi2) clipped to the box; each order-j region R(T) is split
+// Construction, for small k: the order-1 regions are the Voronoi cells (the
+// box cut by the bisectors of each site's Delaunay2 neighbours); each order-j region R(T) is split
 // by the Voronoi diagram of the sites outside T, restricted to R(T). Only the
 // Delaunay neighbours of T can be the (j+1)-th nearest site in R(T) (the
 // (j+1)-th nearest neighbour of a point is a Delaunay neighbour of one of its
@@ -13,7 +13,10 @@
 // the pieces with the same set T + s make up the convex region of that set,
 // the convex hull of their corners. O(k^2 n) regions and pieces times the
 // candidates per region; floating point for the polygons, the triangulation
-// exact.
+// exact. A corner two pieces share is computed by each in its own rounding:
+// it is joined by its name (its three equidistant sites, or the bisector and
+// box side it lies on), not by its coordinates, so that regions of sites
+// 1e-12 of the box apart keep corners 1e-14 apart.
 //
 // Degenerate input: duplicates count once (representative(); region sets
 // hold representatives); ties on region boundaries go either way; collinear
