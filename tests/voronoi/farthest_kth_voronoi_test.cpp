@@ -155,6 +155,29 @@ TEST(KthOrderVoronoi, RandomPointsMatchBruteForce) {
     }
 }
 
+TEST(KthOrderVoronoi, ACornerOfTwoPiecesIsOneCorner) {
+  // Two pieces of a region compute a corner they share each in its own
+  // rounding. Merged within 1e-12 of the region's extent, 24 such pairs of
+  // these 120 diagrams were rounded further apart than that and stayed as
+  // edges of 1e-12 to 3e-11 of the extent; real edges here are above 7e-6.
+  int diagrams = 0;
+  for (std::uint64_t seed = 1; seed <= 40; ++seed)
+    for (std::size_t k = 2; k <= 4; ++k) {
+      const auto p = uniform_points(60, seed);
+      const KthOrderVoronoi v(p, k, frame_around(p));
+      v.validate();
+      for (const auto& r : v.regions()) {
+        double extent = 0;
+        for (const Vec2d& c : r.polygon) extent = std::max(extent, (c - r.polygon[0]).cwiseAbs().maxCoeff());
+        for (std::size_t i = 0; i < r.polygon.size(); ++i)
+          EXPECT_GT((r.polygon[(i + 1) % r.polygon.size()] - r.polygon[i]).cwiseAbs().maxCoeff(), 1e-10 * extent)
+              << "seed " << seed << " k " << k;
+      }
+      ++diagrams;
+    }
+  EXPECT_EQ(diagrams, 120);
+}
+
 TEST(KthOrderVoronoi, DegenerateInputs) {
   std::vector<Vec2d> grid;
   for (int y = 0; y < 5; ++y)
