@@ -11,6 +11,7 @@
 #include "geods/core/aabb.hpp"
 #include "geods/core/error.hpp"
 #include "geods/core/parallel.hpp"
+#include "geods/core/segment.hpp"
 #include "geods/field/mesh_distance.hpp"
 #include "geods/voronoi/polygon_clip.hpp"
 
@@ -18,13 +19,6 @@ namespace geods::field {
 namespace {
 
 constexpr std::size_t kBlock = 16;  // pixels per block of a row's depth bounds
-
-double segment_distance2(const Vec2d& p, const Vec2d& a, const Vec2d& b) {
-  const Vec2d ab = b - a;
-  const double len2 = ab.squaredNorm();
-  const double t = len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
-  return (a + t * ab - p).squaredNorm();
-}
 
 void check_finite(const Vec3d& p, const char* what, std::size_t i) {
   if (!p.allFinite()) throw Error(fmt::format("project_distance: {} {} has a coordinate that is not finite", what, i));
@@ -65,10 +59,7 @@ double site_distance(const ProjectionSites& sites, std::uint32_t id, const Vec3d
   i -= sites.points.size();
   if (i < sites.segments.size()) {  // a tent: the cones of the ends joined by a wedge
     const auto& [a, b] = sites.segments[i];
-    const Vec3d ab = b - a;
-    const double len2 = ab.squaredNorm();
-    const double t = len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
-    return (a + t * ab - p).norm();
+    return (closest_point_on_segment(p, a, b) - p).norm();
   }
   i -= sites.segments.size();
   if (i >= sites.polygons.size()) throw Error(fmt::format("site_distance: no site {}", id));
@@ -79,7 +70,7 @@ double site_distance(const ProjectionSites& sites, std::uint32_t id, const Vec3d
   if (!voronoi::point_in_polygon(q, poly)) {
     d2 = std::numeric_limits<double>::infinity();
     for (std::size_t e = 0; e < poly.size(); ++e)
-      d2 = std::min(d2, segment_distance2(q, poly[e], poly[(e + 1) % poly.size()]));
+      d2 = std::min(d2, (closest_point_on_segment(q, poly[e], poly[(e + 1) % poly.size()]) - q).squaredNorm());
   }
   return std::sqrt(d2 + p.z() * p.z());
 }

@@ -3,6 +3,8 @@
 
 #include <algorithm>
 
+#include "geods/core/segment.hpp"
+
 namespace geods::voronoi {
 
 std::vector<Vec2d> clip_polygon_to_box(const std::vector<Vec2d>& polygon, const AABB2d& box) {
@@ -66,10 +68,7 @@ bool point_in_polygon(const Vec2d& p, const std::vector<Vec2d>& polygon) {
 }
 
 double point_segment_distance(const Vec2d& x, const Vec2d& a, const Vec2d& b) {
-  const Vec2d ab = b - a;
-  const double len2 = ab.squaredNorm();
-  const double t = len2 > 0 ? std::clamp((x - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
-  return (x - (a + t * ab)).norm();
+  return (x - closest_point_on_segment(x, a, b)).norm();
 }
 
 double polygon_area(const std::vector<Vec2d>& polygon) {

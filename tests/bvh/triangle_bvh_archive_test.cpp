@@ -4,6 +4,7 @@
 // corrupt, foreign and inconsistent files give geods::Error.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
 #include <string>
 #include <vector>
@@ -179,6 +180,53 @@ TEST(TriangleBvhArchive, FilesWithAnotherVolumeTypeOrBrokenNodesAreRefused) {
   bad_ids[0] = std::uint32_t(ids.size());
   write(std::uint32_t(BoundingVolume::sphere), 4, nodes, bad_ids);
   refused("permutation");
+  std::filesystem::remove(path);
+}
+
+TEST(TriangleBvhArchive, ChangedTriangleGroupsAreRefused) {
+  // The groups the wide traversal reads must hold the triangles as built,
+  // a zero-area triangle's NaN corners included (lane_holds).
+  TriMesh soup = test::random_soup(200, 17);
+  soup.vertices[soup.triangles[5][2]] = soup.vertices[soup.triangles[5][1]];  // triangle 5: zero area
+  BuildOptions options;
+  options.arity = 8;  // the wide layout the ray kernels read
+  const TriangleBvh bvh = TriangleBvh::build(soup, options);
+  ASSERT_FALSE(bvh.wide8_nodes().empty());
+  const auto path = geods::test::temp_archive("bvh_groups");
+  auto write = [&](const std::vector<TriangleGroup>& groups) {
+    ArchiveWriter out(TriangleBvh::kArchiveKind, TriangleBvh::kArchiveVersion);
+    const BuildOptions& o = bvh.options();
+    out.add_value("builder", std::uint32_t(o.builder));
+    out.add_value("bv", std::uint32_t(o.bv));
+    out.add_value("leaf_size", std::int32_t(o.leaf_size));
+    out.add_value("arity", std::int32_t(o.arity));
+    out.add_value("sah_bins", std::int32_t(o.sah_bins));
+    out.add("nodes", bvh.topology().nodes);
+    out.add("triangle_ids", bvh.triangle_ids());
+    out.add("volumes", std::get<FlatArray<AABB3f>>(bvh.volumes()));
+    out.add("triangles", bvh.triangles());
+    out.add("wide8", bvh.wide8_nodes());
+    out.add("groups", groups);
+    out.write(path);
+  };
+  const std::vector<TriangleGroup> groups = bvh.triangle_groups().to_vector();
+  write(groups);
+  EXPECT_NO_THROW(TriangleBvh::load(path));  // the writer is right
+  // The lane of triangle 5 (NaN corners) and of another one.
+  int zero_group = -1, zero_lane = -1;
+  for (std::size_t g = 0; g < groups.size() && zero_group < 0; ++g)
+    for (int lane = 0; lane < 4; ++lane)
+      if (std::isnan(groups[g].corner[0][0][lane])) zero_group = int(g), zero_lane = lane;
+  ASSERT_GE(zero_group, 0);
+  std::vector<TriangleGroup> changed = groups;
+  changed[zero_group].corner[1][2][zero_lane] = 0.5f;  // a NaN corner given a value
+  write(changed);
+  geods::test::expect_load_error(path, [](const auto& p) { TriangleBvh::load(p); }, {"triangle group"});
+  changed = groups;
+  const int other_group = zero_group == 0 ? 1 : 0;
+  changed[other_group].corner[2][0][0] = std::nextafter(changed[other_group].corner[2][0][0], 1e30f);  // one ulp
+  write(changed);
+  geods::test::expect_load_error(path, [](const auto& p) { TriangleBvh::load(p); }, {"triangle group"});
   std::filesystem::remove(path);
 }
 

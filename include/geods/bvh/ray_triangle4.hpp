@@ -6,6 +6,7 @@
 // same order, and a lane whose edge function rounds to zero is handed to the
 // scalar test itself (its double-precision recomputation), so t, u, v and the
 // hit decision are bit-identical to RayTriangleTest<float>.
+#include <bit>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -40,15 +41,15 @@ inline void set_lane(TriangleGroup& g, int lane, const Vec3f& a, const Vec3f& b,
   g.index[lane] = index;
 }
 
-/// Whether lane `lane` of g holds (a, b, c) as set_lane puts it there.
+/// Whether lane `lane` of g holds (a, b, c) as set_lane puts it there (bit
+/// for bit: a zero-area triangle's NaN corners included).
 inline bool lane_holds(const TriangleGroup& g, int lane, const Vec3f& a, const Vec3f& b, const Vec3f& c) {
-  const bool zero = has_zero_area(a, b, c);
-  const Vec3f* corners[3] = {&a, &b, &c};
+  TriangleGroup expected{};
+  set_lane(expected, lane, a, b, c, g.index[lane]);
   for (int k = 0; k < 3; ++k)
-    for (int x = 0; x < 3; ++x) {
-      const float stored = g.corner[k][x][lane];
-      if (zero ? !std::isnan(stored) : stored != (*corners[k])[x]) return false;
-    }
+    for (int x = 0; x < 3; ++x)
+      if (std::bit_cast<std::uint32_t>(g.corner[k][x][lane]) != std::bit_cast<std::uint32_t>(expected.corner[k][x][lane]))
+        return false;
   return true;
 }
 

@@ -7,6 +7,7 @@
 
 #include "geods/core/aabb.hpp"
 #include "geods/core/predicates.hpp"
+#include "geods/core/segment.hpp"
 
 namespace geods {
 
@@ -112,12 +113,7 @@ Vec<T, 3> closest_point_on_triangle(const Vec<T, 3>& p, const Vec<T, 3>& a, cons
   const T sum = va + vb + vc;
   if (!(sum > T(0))) {
     // Degenerate triangle whose regions did not catch p: nearest of the three edges.
-    auto on_segment = [&](const Vec<T, 3>& s, const Vec<T, 3>& e) {
-      const Vec<T, 3> d = e - s;
-      const T len2 = d.squaredNorm();
-      const T t = len2 > T(0) ? std::clamp(d.dot(p - s) / len2, T(0), T(1)) : T(0);
-      return Vec<T, 3>(s + t * d);
-    };
+    auto on_segment = [&](const Vec<T, 3>& s, const Vec<T, 3>& e) { return closest_point_on_segment(p, s, e); };
     Vec<T, 3> best = on_segment(a, b);
     region = R::edge_ab;
     const Vec<T, 3> q_bc = on_segment(b, c), q_ca = on_segment(c, a);
