@@ -53,10 +53,12 @@ void clip(std::vector<Face>& faces, const Vec3d& normal, double offset, std::uin
   // Scratch arrays kept by each thread from cut to cut (a cell takes dozens of cuts).
   thread_local std::vector<double> sides;  // every face's corners' signed distances, face after face
   thread_local std::vector<std::uint32_t> on_plane;                                  // corners on the plane or cut into it
-  thread_local std::vector<std::pair<std::array<std::uint32_t, 2>, Corner>> cuts;  // this plane's cuts, by their edge
+  thread_local std::vector<std::pair<std::uint64_t, Corner>> cuts;  // this plane's cuts, by their edge (its ids, low first)
   thread_local std::vector<std::size_t> touching;  // the kept faces with a corner on the plane
   thread_local std::vector<std::pair<Corner, Corner>> edges, open;  // on the plane as the faces run; the cap's
   thread_local std::vector<std::uint8_t> used;
+  thread_local std::vector<Corner> loop;  // a cut face's new loop, copied into the face's own storage
+  thread_local std::vector<Face> kept;    // swapped with faces: the two arrays take turns
   sides.clear(), on_plane.clear(), cuts.clear(), touching.clear(), edges.clear(), open.clear();
   bool beyond_rounding = false;
   for (const Face& face : faces)
@@ -65,8 +67,7 @@ void clip(std::vector<Face>& faces, const Vec3d& normal, double offset, std::uin
       beyond_rounding |= sides.back() > rounding;
     }
   if (!beyond_rounding) return;
-  std::vector<Face> kept;
-  kept.reserve(faces.size() + 1);
+  kept.clear();
   std::size_t first = 0;  // the face's first corner in sides
   for (Face& face : faces) {
     const std::size_t m = face.loop.size();
@@ -84,24 +85,28 @@ void clip(std::vector<Face>& faces, const Vec3d& normal, double offset, std::uin
       continue;
     }
     if (!inside) continue;
-    Face out{{}, face.label};
+    loop.clear();
     for (std::size_t k = 0; k < m; ++k) {
       const Corner& a = face.loop[k];
       const Corner& b = face.loop[(k + 1) % m];
       const double sa = side[k], sb = side[(k + 1) % m];
-      if (sa <= 0) out.loop.push_back(a);
+      if (sa <= 0) loop.push_back(a);
       if ((sa < 0 && sb > 0) || (sa > 0 && sb < 0)) {
-        const std::array<std::uint32_t, 2> edge{std::min(a.id, b.id), std::max(a.id, b.id)};
+        const std::uint64_t edge = std::uint64_t(std::min(a.id, b.id)) << 32 | std::max(a.id, b.id);
         auto it = std::find_if(cuts.begin(), cuts.end(), [&](const auto& c) { return c.first == edge; });
         if (it == cuts.end()) {  // the edge's first face computes the corner, its other face takes it
           cuts.push_back({edge, {Vec3d(a.x + (b.x - a.x) * (sa / (sa - sb))), next_id++}});
           on_plane.push_back(cuts.back().second.id);
           it = cuts.end() - 1;
         }
-        out.loop.push_back(it->second);
+        loop.push_back(it->second);
       }
     }
-    if (out.loop.size() >= 3) touching.push_back(kept.size()), kept.push_back(std::move(out));
+    if (loop.size() >= 3) {
+      face.loop.assign(loop.begin(), loop.end());  // in the face's storage: no allocation as a rule
+      touching.push_back(kept.size());
+      kept.push_back(std::move(face));
+    }
   }
   faces.swap(kept);
   // The cap: the edges on the plane that no face has the other way round
@@ -124,6 +129,7 @@ void clip(std::vector<Face>& faces, const Vec3d& normal, double offset, std::uin
   for (std::size_t start = 0; start < open.size(); ++start) {
     if (used[start]) continue;
     Face cap{{}, label};
+    cap.loop.reserve(open.size());
     for (std::size_t e = start;;) {
       used[e] = 1;
       cap.loop.push_back(open[e].first);
