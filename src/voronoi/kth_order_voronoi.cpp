@@ -8,6 +8,7 @@
 #include <atomic>
 #include <limits>
 #include <map>
+#include <numeric>
 #include <span>
 #include <string>
 #include <utility>
@@ -70,7 +71,7 @@ LinedPolygon cut(std::span<const Vec2d> sites, const LinedPolygon& poly, std::ui
                  std::span<const std::uint32_t> others) {
   const std::uint32_t m = std::uint32_t(poly.lines.size());
   detail::LabeledPolygon clipped{poly.points, std::vector<std::uint32_t>(m)};
-  for (std::uint32_t k = 0; k < m; ++k) clipped.labels[k] = k;  // poly's edges, then m + i: others[i]'s bisector
+  std::iota(clipped.labels.begin(), clipped.labels.end(), 0u);  // poly's edges, then m + i: others[i]'s bisector
   for (std::uint32_t i = 0; i < others.size() && !clipped.points.empty(); ++i) {
     if (others[i] == p) continue;
     const Vec2d d = sites[others[i]] - sites[p];  // nearer to p: 2 d.y <= |d|^2 for y = x - p
@@ -79,6 +80,11 @@ LinedPolygon cut(std::span<const Vec2d> sites, const LinedPolygon& poly, std::ui
   LinedPolygon out{std::move(clipped.points), {}};
   for (std::uint32_t l : clipped.labels) out.lines.push_back(l < m ? poly.lines[l] : bisector_line(p, others[l - m]));
   return out;
+}
+
+// Whether a cut left nothing, or a sliver of its rounding.
+bool negligible(const LinedPolygon& polygon) {
+  return polygon.points.empty() || detail::negligible_area(polygon.points);
 }
 
 // The convex region whose corners these are (named; each corner once, by
@@ -139,9 +145,7 @@ KthOrderVoronoi::KthOrderVoronoi(std::span<const Vec2d> points, std::size_t k, c
   parallel_for_each_index(0, sites.size(), [&](std::size_t i) {
     regions[i] = {{sites[i]}, cut(points_, whole, sites[i], neighbors[sites[i]])};
   }, 16);
-  std::erase_if(regions, [](const Working& r) {
-    return r.polygon.points.empty() || detail::negligible_area(r.polygon.points);
-  });
+  std::erase_if(regions, [](const Working& r) { return negligible(r.polygon); });
   std::atomic<LineId> own_lines = 0;
   for (std::size_t order = 1; order < k; ++order) {
     // Each region's pieces, in parallel.
@@ -156,7 +160,7 @@ KthOrderVoronoi::KthOrderVoronoi(std::span<const Vec2d> points, std::size_t k, c
       candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
       for (std::uint32_t s : candidates) {
         LinedPolygon piece = cut(points_, region.polygon, s, candidates);
-        if (piece.points.empty() || detail::negligible_area(piece.points)) continue;
+        if (negligible(piece)) continue;
         std::vector<std::uint32_t> set = region.sites;
         set.insert(std::upper_bound(set.begin(), set.end(), s), s);
         pieces[r].push_back({std::move(set), std::move(piece)});
@@ -173,18 +177,16 @@ KthOrderVoronoi::KthOrderVoronoi(std::span<const Vec2d> points, std::size_t k, c
                              piece.polygon.points[c]});
       }
     regions.assign(merged.size(), {});
-    std::vector<std::pair<const std::vector<std::uint32_t>, std::vector<std::pair<CornerKey, Vec2d>>>*> sets;
+    std::vector<decltype(merged)::value_type*> sets;
     for (auto& entry : merged) sets.push_back(&entry);
     parallel_for_each_index(0, sets.size(), [&](std::size_t i) {
       regions[i] = {sets[i]->first, region_of(sets[i]->second, own_lines)};
     }, 64);
-    std::erase_if(regions, [](const Working& r) {
-      return r.polygon.points.empty() || detail::negligible_area(r.polygon.points);
-    });
+    std::erase_if(regions, [](const Working& r) { return negligible(r.polygon); });
   }
+  // Already sorted by their sets: order 1 by site, the later orders in the map's order.
   regions_.clear();
   for (Working& r : regions) regions_.push_back({std::move(r.sites), std::move(r.polygon.points)});
-  std::sort(regions_.begin(), regions_.end(), [](const Region& a, const Region& b) { return a.sites < b.sites; });
 }
 
 KthOrderVoronoiStats KthOrderVoronoi::stats() const {

@@ -7,6 +7,7 @@
 
 #include "even_odd.hpp"
 #include "geods/core/error.hpp"
+#include "geods/core/segment.hpp"
 
 namespace geods::voronoi {
 namespace {
@@ -153,8 +154,7 @@ MotionPlanner::Retraction MotionPlanner::retract(const Vec2d& p) const {
     c = diagram_.point(s);
   } else {
     const auto sg = diagram_.segment(static_cast<std::uint32_t>(s - diagram_.num_points()));
-    const Vec2d a = diagram_.point(sg[0]), b = diagram_.point(sg[1]);
-    c = a + ((p - a).dot(b - a) / (b - a).squaredNorm()) * (b - a);
+    c = closest_point_on_segment(p, diagram_.point(sg[0]), diagram_.point(sg[1]));  // within it: elementary_distance chose s there
   }
   const Vec2d u = (p - c) / d0;
   double best = kInf;

@@ -113,10 +113,9 @@ Vec<T, 3> closest_point_on_triangle(const Vec<T, 3>& p, const Vec<T, 3>& a, cons
   const T sum = va + vb + vc;
   if (!(sum > T(0))) {
     // Degenerate triangle whose regions did not catch p: nearest of the three edges.
-    auto on_segment = [&](const Vec<T, 3>& s, const Vec<T, 3>& e) { return closest_point_on_segment(p, s, e); };
-    Vec<T, 3> best = on_segment(a, b);
+    Vec<T, 3> best = closest_point_on_segment(p, a, b);
     region = R::edge_ab;
-    const Vec<T, 3> q_bc = on_segment(b, c), q_ca = on_segment(c, a);
+    const Vec<T, 3> q_bc = closest_point_on_segment(p, b, c), q_ca = closest_point_on_segment(p, c, a);
     if ((q_bc - p).squaredNorm() < (best - p).squaredNorm()) best = q_bc, region = R::edge_bc;
     if ((q_ca - p).squaredNorm() < (best - p).squaredNorm()) best = q_ca, region = R::edge_ca;
     return best;
