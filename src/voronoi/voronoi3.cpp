@@ -8,12 +8,14 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <string>
 #include <tuple>
 #include <utility>
 
 #include "geods/core/coordinate_range.hpp"
 #include "geods/core/error.hpp"
+#include "geods/core/morton.hpp"
 #include "geods/core/parallel.hpp"
 #include "geods/spatial/kd_tree.hpp"
 #include "exact_compare.hpp"
@@ -251,6 +253,88 @@ Plane hull_plane(std::span<const Vec3d> points, const std::array<std::uint32_t, 
   return {normal, normal.dot(a)};
 }
 
+// The Voronoi vertices and the tetrahedra around each site, from which the
+// cells of sites off the hull are read off the tetrahedralization (seed
+// §5.3.1: the diagram is the dual of Delaunay3) instead of cut out of the box.
+struct Dual {
+  enum Place : std::uint8_t { inside, near, far };  // of a centre: in the box by a margin, within the box's size of it, beyond
+  const std::vector<std::uint32_t>& tets;  // Delaunay3::tetrahedra()
+  std::vector<std::uint32_t> adjacent;     // Delaunay3::neighbors()
+  std::vector<Vec3d> centre;               // per tetrahedron: its circumcentre, a Voronoi vertex
+  std::vector<Place> place;                // per tetrahedron: where its centre lies
+  std::vector<std::uint32_t> first;        // per point: a tetrahedron it is a vertex of (no_index: none)
+};
+
+// The cell of site s as the dual of its star, unclipped: a corner per
+// tetrahedron around s (its circumcentre, numbered in `star`'s order), a face
+// per Delaunay edge (s, w) through the centres of the tetrahedra around the
+// edge. `clipped` is set where a corner lies outside the box. False where the
+// dual cannot stand for the clipped cell: s on the hull (an unbounded cell),
+// a corner far beyond the box (a sliver near the hull: cut from there, its
+// faces would round), or two corners of a face within 2^-30 of the cell's
+// coordinates (five sites on a sphere or nearly: a face or an edge of no
+// length, which clipping drops).
+bool dual_faces(const Dual& d, std::uint32_t s, std::vector<std::uint32_t>& star, std::vector<Face>& faces,
+                bool& clipped) {
+  thread_local std::vector<std::uint32_t> done;
+  const std::uint32_t* tets = d.tets.data();
+  star.clear(), done.clear(), faces.clear();
+  clipped = false;
+  // The star: from one tetrahedron across the faces that hold s.
+  star.push_back(d.first[s]);
+  for (std::size_t k = 0; k < star.size(); ++k) {
+    const std::uint32_t t = star[k];
+    if (d.place[t] == Dual::far) return false;
+    clipped |= d.place[t] == Dual::near;
+    for (int i = 0; i < 4; ++i) {
+      if (tets[4 * t + i] == s) continue;
+      const std::uint32_t n = d.adjacent[4 * t + i];
+      if (n == Delaunay3::no_index) return false;  // s is on the hull
+      if (std::find(star.begin(), star.end(), n) == star.end()) star.push_back(n);
+    }
+  }
+  double scale = 0;
+  for (const std::uint32_t t : star) scale = std::max(scale, d.centre[t].cwiseAbs().maxCoeff());
+  const double tolerance = std::ldexp(scale, -30);
+  const auto corner = [&](std::uint32_t t) {
+    return Corner{d.centre[t], std::uint32_t(std::find(star.begin(), star.end(), t) - star.begin())};
+  };
+  for (const std::uint32_t t0 : star)
+    for (int i = 0; i < 4; ++i) {
+      const std::uint32_t w = tets[4 * t0 + i];
+      if (w == s || std::find(done.begin(), done.end(), w) != done.end()) continue;
+      done.push_back(w);
+      // Around the edge from s to w: in a tetrahedron (s, w, a, b), an even
+      // permutation of its positive order, b turns from a counter-clockwise
+      // seen from w (det(w - s, a - s, b - s) > 0), and the next tetrahedron
+      // that way shares the face (s, w, b): the one opposite a. The centres
+      // in that order run counter-clockwise seen from outside the cell.
+      Face face{{}, w};
+      std::uint32_t t = t0;
+      do {
+        const std::uint32_t* v = tets + 4 * t;
+        int is = 0, iw = 0;
+        while (v[is] != s) ++is;
+        while (v[iw] != w) ++iw;
+        int ia = 0;
+        while (ia == is || ia == iw) ++ia;
+        int ib = 6 - is - iw - ia;
+        // (is, iw, ia, ib) is even when it has an even number of inversions.
+        const int order[4] = {is, iw, ia, ib};
+        int inversions = 0;
+        for (int x = 0; x < 4; ++x)
+          for (int y = x + 1; y < 4; ++y) inversions += order[x] > order[y];
+        if (inversions % 2) std::swap(ia, ib);
+        const std::uint32_t next = d.adjacent[4 * t + ia];
+        if ((d.centre[next] - d.centre[t]).cwiseAbs().maxCoeff() <= tolerance) return false;
+        face.loop.push_back(corner(t));
+        t = next;
+      } while (t != t0);
+      faces.push_back(std::move(face));
+    }
+  return true;
+}
+
 }  // namespace
 
 Voronoi3::Voronoi3(const Delaunay3& dt, const AABB3d& box) : box_(box) {
@@ -321,11 +405,62 @@ void Voronoi3::build(const Delaunay3& dt) {
   initial.push_back({{c[2], c[6], c[7], c[3]}, box_side(3)});
   initial.push_back({{c[0], c[2], c[3], c[1]}, box_side(4)});
   initial.push_back({{c[4], c[5], c[7], c[6]}, box_side(5)});
+  // The dual: every tetrahedron's centre, and whether it lies inside the box
+  // by more than 2^-30 of the box's coordinates (a cell whose corners all do
+  // lies inside the box, and the box cuts nothing of it), within the box's
+  // size of it (the box cuts the cell), or beyond.
+  std::optional<Dual> dual;
+  if (dt.dimension() == 3) {
+    dual.emplace(Dual{dt.tetrahedra(), dt.neighbors(), {}, {}, {}});
+    const auto& tets = dual->tets;
+    const std::size_t m = dt.tetrahedron_count();
+    dual->centre.resize(m);
+    dual->place.resize(m);
+    const double margin = std::ldexp(reach.maxCoeff(), -30);
+    const AABB3d near(box.lo - (box.hi - box.lo), box.hi + (box.hi - box.lo));
+    parallel_for(0, m, 1 << 12, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t t = begin; t < end; ++t) {
+        const Vec3d c = detail::circumcentre(points[tets[4 * t]], points[tets[4 * t + 1]], points[tets[4 * t + 2]],
+                                             points[tets[4 * t + 3]]);
+        dual->centre[t] = c;
+        dual->place[t] = (c.array() > box.lo.array() + margin).all() && (c.array() < box.hi.array() - margin).all()
+                             ? Dual::inside
+                         : (c.array() >= near.lo.array()).all() && (c.array() <= near.hi.array()).all() ? Dual::near
+                                                                                                       : Dual::far;
+      }
+    });
+    dual->first.assign(points.size(), Delaunay3::no_index);
+    for (std::size_t i = tets.size(); i-- > 0;) dual->first[tets[i]] = std::uint32_t(i / 4);
+  }
   cells_.resize(sites.size());
+  // The cells in Z-order of their sites: neighbouring cells share most of
+  // their tetrahedra and bisectors, and find them still in cache.
+  std::vector<std::uint32_t> cell_of(points.size(), Delaunay3::no_index);
+  for (std::uint32_t k = 0; k < sites.size(); ++k) cell_of[sites[k]] = k;
+  std::vector<std::uint32_t> order;
+  order.reserve(sites.size());
+  for (const std::uint32_t i : morton_order(points_))
+    if (cell_of[i] != Delaunay3::no_index) order.push_back(cell_of[i]);
   parallel_for_each_index(
-      0, sites.size(),
-      [&](std::size_t k) {
+      0, order.size(),
+      [&](std::size_t j) {
+        const std::size_t k = order[j];
         const std::uint32_t s = sites[k];
+        thread_local std::vector<std::uint32_t> star;
+        thread_local std::vector<Face> faces;
+        bool clipped = false;
+        if (dual && dual->first[s] != Delaunay3::no_index && (hull.empty() || !crosses_hull[s]) &&
+            dual_faces(*dual, s, star, faces, clipped)) {
+          std::uint32_t corner_ids = std::uint32_t(star.size());
+          if (clipped)
+            for (int side = 0; side < 6 && !faces.empty(); ++side) {
+              const int a = side / 2;
+              const Vec3d normal = Vec3d::Unit(a) * (side % 2 ? 1.0 : -1.0);
+              clip(faces, normal, side % 2 ? box.hi[a] : -box.lo[a], box_side(side), corner_ids, reach);
+            }
+          cells_[k] = make_cell(s, faces, corner_ids);
+          if (cells_[k].volume > 0) return;
+        }
         std::vector<std::uint32_t> neighbors = dt.vertex_neighbors(s);
         if (dt.dimension() < 3) neighbors.assign(sites.begin(), sites.end());
         // Nearest neighbours first: their bisectors cut the most, the later ones less.
@@ -334,7 +469,7 @@ void Voronoi3::build(const Delaunay3& dt) {
           return (points[a] - p).squaredNorm() < (points[b] - p).squaredNorm() ||
                  ((points[a] - p).squaredNorm() == (points[b] - p).squaredNorm() && a < b);
         });
-        std::vector<Face> faces = initial;
+        faces = initial;
         std::uint32_t corner_ids = 8;
         for (const std::uint32_t w : neighbors) {
           if (w == s) continue;
@@ -343,15 +478,23 @@ void Voronoi3::build(const Delaunay3& dt) {
           if (faces.empty()) break;
         }
         if (!hull.empty() && crosses_hull[s]) {
-          for (std::uint32_t h = 0; h < hull.size() && !faces.empty(); ++h) {
-            // skip the planes the cell's bounding box lies within
+          // Skip the planes the cell's bounding box lies within (the box
+          // computed again only after a cut).
+          const auto bounds_of = [&] {
             AABB3d bounds;
             for (const Face& f : faces)
               for (const Corner& c : f.loop) bounds.extend(c.x);
+            return bounds;
+          };
+          AABB3d bounds = bounds_of();
+          for (std::uint32_t h = 0; h < hull.size() && !faces.empty(); ++h) {
             const Vec3d& n = hull[h].normal;
             double reach_h = 0;
             for (int a = 0; a < 3; ++a) reach_h += n[a] * (n[a] > 0 ? bounds.hi[a] : bounds.lo[a]);
-            if (reach_h > hull[h].offset) clip(faces, n, hull[h].offset, hull_face(h), corner_ids, reach);
+            if (reach_h > hull[h].offset) {
+              clip(faces, n, hull[h].offset, hull_face(h), corner_ids, reach);
+              bounds = bounds_of();
+            }
           }
         }
         cells_[k] = make_cell(s, faces, corner_ids);

@@ -151,6 +151,52 @@ TEST(Voronoi3, LowerDimensionalSitesAndBadBoxes) {
   EXPECT_THROW(Voronoi3(one, AABB3d(Vec3d(0, 0, 0), Vec3d(1, NAN, 1))), Error);
 }
 
+// A cell inside the box is the dual of its site's star: its faces are the
+// site's Delaunay neighbours, each with a corner per tetrahedron around the
+// edge, and every corner is the circumcentre of a tetrahedron around the site,
+// the same bits in every cell that has it. Cells at the box keep its faces.
+TEST(Voronoi3, CellsAreTheDualOfTheTetrahedra) {
+  Rng rng(21);
+  std::vector<Vec3d> sites;
+  for (int i = 0; i < 600; ++i) sites.emplace_back(rng.uniform(), rng.uniform(), rng.uniform());
+  const Delaunay3 dt(sites);
+  const Voronoi3 vd(dt, AABB3d(Vec3d(0, 0, 0), Vec3d(1, 1, 1)));
+  vd.validate();
+  const auto& tets = dt.tetrahedra();
+  std::size_t interior = 0, at_box = 0;
+  for (const Voronoi3Cell& cell : vd.cells()) {
+    const std::uint32_t s = cell.site;
+    std::vector<Vec3d> centres;  // of the tetrahedra around s
+    for (std::size_t t = 0; t < dt.tetrahedron_count(); ++t)
+      if (std::find(&tets[4 * t], &tets[4 * t + 4], s) != &tets[4 * t + 4])
+        centres.push_back(detail::circumcentre(sites[tets[4 * t]], sites[tets[4 * t + 1]], sites[tets[4 * t + 2]],
+                                               sites[tets[4 * t + 3]]));
+    const bool inside = std::all_of(centres.begin(), centres.end(), [](const Vec3d& c) {
+      return (c.array() > 0.01).all() && (c.array() < 0.99).all();
+    });
+    if (!inside) {
+      at_box += std::any_of(cell.face_neighbors.begin(), cell.face_neighbors.end(), Voronoi3::is_box_side);
+      continue;
+    }
+    ++interior;
+    std::vector<std::uint32_t> labels(cell.face_neighbors.begin(), cell.face_neighbors.end());
+    std::sort(labels.begin(), labels.end());
+    EXPECT_EQ(labels, dt.vertex_neighbors(s)) << "site " << s;
+    EXPECT_EQ(cell.vertices.size(), centres.size()) << "site " << s;
+    for (const Vec3d& x : cell.vertices)
+      EXPECT_NE(std::find(centres.begin(), centres.end(), x), centres.end()) << "site " << s;
+    for (std::size_t f = 0; f < cell.face_count(); ++f) {
+      std::size_t around = 0;
+      for (std::size_t t = 0; t < dt.tetrahedron_count(); ++t)
+        around += std::find(&tets[4 * t], &tets[4 * t + 4], s) != &tets[4 * t + 4] &&
+                  std::find(&tets[4 * t], &tets[4 * t + 4], cell.face_neighbors[f]) != &tets[4 * t + 4];
+      EXPECT_EQ(cell.face_offsets[f + 1] - cell.face_offsets[f], around) << "site " << s;
+    }
+  }
+  EXPECT_GT(interior, 200u);
+  EXPECT_GT(at_box, 100u);
+}
+
 // Clipped to the convex hull: the cells' volumes add up to the tetrahedra's,
 // every corner lies in the hull, samples of the hull lie in their nearest
 // site's cell, and cut faces carry hull labels.
