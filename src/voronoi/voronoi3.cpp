@@ -1,11 +1,14 @@
-// Voronoi3: each cell is the box clipped by the bisectors of its site and the
-// site's Delaunay neighbours (Sutherland-Hodgman on every face, the cut closed
-// by a cap made of the edges left without a twin), its corners joined by
-// identity, not by coordinates.
+// Voronoi3: a cell is the dual of its site's star of tetrahedra where that
+// stands for it (dual_cell), cut by the box's planes where it reaches out;
+// otherwise the box clipped by the bisectors of its site and the site's
+// Delaunay neighbours. Clipping is Sutherland-Hodgman on every face, the cut
+// closed by a cap made of the edges left without a twin, its corners joined
+// by identity, not by coordinates.
 #include "geods/voronoi/voronoi3.hpp"
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -258,30 +261,51 @@ Plane hull_plane(std::span<const Vec3d> points, const std::array<std::uint32_t, 
 // §5.3.1: the diagram is the dual of Delaunay3) instead of cut out of the box.
 struct Dual {
   enum Place : std::uint8_t { inside, near, far };  // of a centre: in the box by a margin, within the box's size of it, beyond
-  const std::vector<std::uint32_t>& tets;  // Delaunay3::tetrahedra()
-  std::vector<std::uint32_t> adjacent;     // Delaunay3::neighbors()
+  std::vector<std::uint32_t> tets;      // Delaunay3::tetrahedra(), in an order of their own
+  std::vector<std::uint32_t> adjacent;  // Delaunay3::neighbors(), in that order
   std::vector<Vec3d> centre;               // per tetrahedron: its circumcentre, a Voronoi vertex
   std::vector<Place> place;                // per tetrahedron: where its centre lies
   std::vector<std::uint32_t> first;        // per point: a tetrahedron it is a vertex of (no_index: none)
+  std::uint64_t id = next_id++;            // distinct for every Dual made (dual_cell's marks are per Dual)
+  static inline std::atomic<std::uint64_t> next_id{1};
 };
 
 // The cell of site s as the dual of its star, unclipped: a corner per
-// tetrahedron around s (its circumcentre, numbered in `star`'s order), a face
-// per Delaunay edge (s, w) through the centres of the tetrahedra around the
-// edge. `clipped` is set where a corner lies outside the box. False where the
-// dual cannot stand for the clipped cell: s on the hull (an unbounded cell),
-// a corner far beyond the box (a sliver near the hull: cut from there, its
-// faces would round), or two corners of a face within 2^-30 of the cell's
-// coordinates (five sites on a sphere or nearly: a face or an edge of no
-// length, which clipping drops).
-bool dual_faces(const Dual& d, std::uint32_t s, std::vector<std::uint32_t>& star, std::vector<Face>& faces,
-                bool& clipped) {
-  thread_local std::vector<std::uint32_t> done;
+// tetrahedron around s (its circumcentre), a face per Delaunay edge (s, w)
+// through the centres of the tetrahedra around the edge; volume and centroid
+// left to the caller. `clipped` is set where a corner lies outside the box.
+// False where the dual cannot stand for the clipped cell: s on the hull (an
+// unbounded cell), a corner far beyond the box (a sliver near the hull: cut
+// from there, its faces would round), or two corners of a face within 2^-30
+// of the cell's coordinates (five sites on a sphere or nearly: a face or an
+// edge of no length, which clipping drops).
+bool dual_cell(const Dual& d, std::uint32_t s, Voronoi3Cell& cell, bool& clipped) {
+  // Per thread and diagram: per tetrahedron, the site whose star last took it
+  // and its place in that star; per point, the site whose face to it was
+  // last made (site + 1: 0 is none). Searching the star instead took most of
+  // the time.
+  struct Marks {
+    std::uint64_t diagram = 0;  // Dual::id
+    std::vector<std::uint32_t> star_of, index, face_of;
+  };
+  thread_local Marks marks;
+  if (marks.diagram != d.id) {
+    marks.diagram = d.id;
+    marks.star_of.assign(d.place.size(), 0);
+    marks.index.resize(d.place.size());
+    marks.face_of.assign(d.first.size(), 0);
+  }
+  thread_local std::vector<std::uint32_t> star;
   const std::uint32_t* tets = d.tets.data();
-  star.clear(), done.clear(), faces.clear();
+  star.clear();
   clipped = false;
   // The star: from one tetrahedron across the faces that hold s.
-  star.push_back(d.first[s]);
+  const auto take = [&](std::uint32_t t) {
+    marks.star_of[t] = s + 1;
+    marks.index[t] = std::uint32_t(star.size());
+    star.push_back(t);
+  };
+  take(d.first[s]);
   for (std::size_t k = 0; k < star.size(); ++k) {
     const std::uint32_t t = star[k];
     if (d.place[t] == Dual::far) return false;
@@ -290,26 +314,30 @@ bool dual_faces(const Dual& d, std::uint32_t s, std::vector<std::uint32_t>& star
       if (tets[4 * t + i] == s) continue;
       const std::uint32_t n = d.adjacent[4 * t + i];
       if (n == Delaunay3::no_index) return false;  // s is on the hull
-      if (std::find(star.begin(), star.end(), n) == star.end()) star.push_back(n);
+      if (marks.star_of[n] != s + 1) take(n);
     }
   }
   double scale = 0;
   for (const std::uint32_t t : star) scale = std::max(scale, d.centre[t].cwiseAbs().maxCoeff());
   const double tolerance = std::ldexp(scale, -30);
-  const auto corner = [&](std::uint32_t t) {
-    return Corner{d.centre[t], std::uint32_t(std::find(star.begin(), star.end(), t) - star.begin())};
-  };
+  cell.site = s;
+  cell.vertices.resize(star.size());
+  for (std::size_t k = 0; k < star.size(); ++k) cell.vertices[k] = d.centre[star[k]];
+  // (Each tetrahedron of the star is a corner of 3 faces; a simple polytope
+  // with V corners has V / 2 + 2 faces.)
+  cell.face_vertices.clear(), cell.face_vertices.reserve(3 * star.size());
+  cell.face_neighbors.clear(), cell.face_neighbors.reserve(star.size() / 2 + 2);
+  cell.face_offsets.assign(1, 0), cell.face_offsets.reserve(star.size() / 2 + 3);
   for (const std::uint32_t t0 : star)
     for (int i = 0; i < 4; ++i) {
       const std::uint32_t w = tets[4 * t0 + i];
-      if (w == s || std::find(done.begin(), done.end(), w) != done.end()) continue;
-      done.push_back(w);
+      if (w == s || marks.face_of[w] == s + 1) continue;
+      marks.face_of[w] = s + 1;
       // Around the edge from s to w: in a tetrahedron (s, w, a, b), an even
       // permutation of its positive order, b turns from a counter-clockwise
       // seen from w (det(w - s, a - s, b - s) > 0), and the next tetrahedron
       // that way shares the face (s, w, b): the one opposite a. The centres
       // in that order run counter-clockwise seen from outside the cell.
-      Face face{{}, w};
       std::uint32_t t = t0;
       do {
         const std::uint32_t* v = tets + 4 * t;
@@ -327,12 +355,24 @@ bool dual_faces(const Dual& d, std::uint32_t s, std::vector<std::uint32_t>& star
         if (inversions % 2) std::swap(ia, ib);
         const std::uint32_t next = d.adjacent[4 * t + ia];
         if ((d.centre[next] - d.centre[t]).cwiseAbs().maxCoeff() <= tolerance) return false;
-        face.loop.push_back(corner(t));
+        cell.face_vertices.push_back(marks.index[t]);
         t = next;
       } while (t != t0);
-      faces.push_back(std::move(face));
+      cell.face_offsets.push_back(std::uint32_t(cell.face_vertices.size()));
+      cell.face_neighbors.push_back(w);
     }
   return true;
+}
+
+// The faces of a cell as loops of corners numbered by the cell's indices (to clip it further).
+void faces_of(const Voronoi3Cell& cell, std::vector<Face>& faces) {
+  faces.resize(cell.face_count());
+  for (std::size_t f = 0; f < cell.face_count(); ++f) {
+    faces[f].label = cell.face_neighbors[f];
+    faces[f].loop.clear();
+    for (std::uint32_t k = cell.face_offsets[f]; k < cell.face_offsets[f + 1]; ++k)
+      faces[f].loop.push_back({cell.vertices[cell.face_vertices[k]], cell.face_vertices[k]});
+  }
 }
 
 }  // namespace
@@ -405,61 +445,88 @@ void Voronoi3::build(const Delaunay3& dt) {
   initial.push_back({{c[2], c[6], c[7], c[3]}, box_side(3)});
   initial.push_back({{c[0], c[2], c[3], c[1]}, box_side(4)});
   initial.push_back({{c[4], c[5], c[7], c[6]}, box_side(5)});
-  // The dual: every tetrahedron's centre, and whether it lies inside the box
-  // by more than 2^-30 of the box's coordinates (a cell whose corners all do
-  // lies inside the box, and the box cuts nothing of it), within the box's
-  // size of it (the box cuts the cell), or beyond.
+  // The cells in Z-order of their sites: neighbouring cells share most of
+  // their tetrahedra and bisectors, and find them still in cache.
+  const std::vector<std::uint32_t> z_order = morton_order(points_);
+  std::vector<std::uint32_t> cell_of(points.size(), Delaunay3::no_index);
+  for (std::uint32_t k = 0; k < sites.size(); ++k) cell_of[sites[k]] = k;
+  std::vector<std::uint32_t> order;
+  order.reserve(sites.size());
+  for (const std::uint32_t i : z_order)
+    if (cell_of[i] != Delaunay3::no_index) order.push_back(cell_of[i]);
+  // The dual, its tetrahedra in the Z-order of their first vertex in it (so
+  // that a star lies in a few places of memory): every tetrahedron's centre,
+  // and whether it lies inside the box by more than 2^-30 of the box's
+  // coordinates (a cell whose corners all do lies inside the box, and the box
+  // cuts nothing of it), within the box's size of it (the box cuts the cell),
+  // or beyond.
   std::optional<Dual> dual;
   if (dt.dimension() == 3) {
-    dual.emplace(Dual{dt.tetrahedra(), dt.neighbors(), {}, {}, {}});
-    const auto& tets = dual->tets;
+    const auto& given = dt.tetrahedra();
+    const std::vector<std::uint32_t> given_adjacent = dt.neighbors();
     const std::size_t m = dt.tetrahedron_count();
+    std::vector<std::uint32_t> rank(points.size());
+    for (std::uint32_t r = 0; r < z_order.size(); ++r) rank[z_order[r]] = r;
+    std::vector<std::uint32_t> key(m), slot(points.size() + 1, 0), renumbered(m);
+    parallel_for(0, m, 1 << 14, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t t = begin; t < end; ++t)
+        key[t] = std::min(std::min(rank[given[4 * t]], rank[given[4 * t + 1]]),
+                          std::min(rank[given[4 * t + 2]], rank[given[4 * t + 3]]));
+    });
+    for (const std::uint32_t k : key) ++slot[k + 1];
+    for (std::size_t r = 0; r < points.size(); ++r) slot[r + 1] += slot[r];
+    for (std::size_t t = 0; t < m; ++t) renumbered[t] = slot[key[t]]++;
+    dual.emplace();
+    dual->tets.resize(4 * m);
+    dual->adjacent.resize(4 * m);
     dual->centre.resize(m);
     dual->place.resize(m);
     const double margin = std::ldexp(reach.maxCoeff(), -30);
     const AABB3d near(box.lo - (box.hi - box.lo), box.hi + (box.hi - box.lo));
     parallel_for(0, m, 1 << 12, [&](std::size_t begin, std::size_t end) {
       for (std::size_t t = begin; t < end; ++t) {
-        const Vec3d c = detail::circumcentre(points[tets[4 * t]], points[tets[4 * t + 1]], points[tets[4 * t + 2]],
-                                             points[tets[4 * t + 3]]);
-        dual->centre[t] = c;
-        dual->place[t] = (c.array() > box.lo.array() + margin).all() && (c.array() < box.hi.array() - margin).all()
+        const std::uint32_t u = renumbered[t];
+        for (int i = 0; i < 4; ++i) {
+          dual->tets[4 * u + i] = given[4 * t + i];
+          const std::uint32_t n = given_adjacent[4 * t + i];
+          dual->adjacent[4 * u + i] = n == Delaunay3::no_index ? n : renumbered[n];
+        }
+        const Vec3d c = detail::circumcentre(points[given[4 * t]], points[given[4 * t + 1]],
+                                             points[given[4 * t + 2]], points[given[4 * t + 3]]);
+        dual->centre[u] = c;
+        dual->place[u] = (c.array() > box.lo.array() + margin).all() && (c.array() < box.hi.array() - margin).all()
                              ? Dual::inside
                          : (c.array() >= near.lo.array()).all() && (c.array() <= near.hi.array()).all() ? Dual::near
                                                                                                        : Dual::far;
       }
     });
     dual->first.assign(points.size(), Delaunay3::no_index);
-    for (std::size_t i = tets.size(); i-- > 0;) dual->first[tets[i]] = std::uint32_t(i / 4);
+    for (std::size_t i = 4 * m; i-- > 0;) dual->first[dual->tets[i]] = std::uint32_t(i / 4);
   }
   cells_.resize(sites.size());
-  // The cells in Z-order of their sites: neighbouring cells share most of
-  // their tetrahedra and bisectors, and find them still in cache.
-  std::vector<std::uint32_t> cell_of(points.size(), Delaunay3::no_index);
-  for (std::uint32_t k = 0; k < sites.size(); ++k) cell_of[sites[k]] = k;
-  std::vector<std::uint32_t> order;
-  order.reserve(sites.size());
-  for (const std::uint32_t i : morton_order(points_))
-    if (cell_of[i] != Delaunay3::no_index) order.push_back(cell_of[i]);
   parallel_for_each_index(
       0, order.size(),
       [&](std::size_t j) {
         const std::size_t k = order[j];
         const std::uint32_t s = sites[k];
-        thread_local std::vector<std::uint32_t> star;
         thread_local std::vector<Face> faces;
         bool clipped = false;
+        Voronoi3Cell& cell = cells_[k];
         if (dual && dual->first[s] != Delaunay3::no_index && (hull.empty() || !crosses_hull[s]) &&
-            dual_faces(*dual, s, star, faces, clipped)) {
-          std::uint32_t corner_ids = std::uint32_t(star.size());
-          if (clipped)
+            dual_cell(*dual, s, cell, clipped)) {
+          if (clipped) {
+            faces_of(cell, faces);
+            std::uint32_t corner_ids = std::uint32_t(cell.vertices.size());
             for (int side = 0; side < 6 && !faces.empty(); ++side) {
               const int a = side / 2;
               const Vec3d normal = Vec3d::Unit(a) * (side % 2 ? 1.0 : -1.0);
               clip(faces, normal, side % 2 ? box.hi[a] : -box.lo[a], box_side(side), corner_ids, reach);
             }
-          cells_[k] = make_cell(s, faces, corner_ids);
-          if (cells_[k].volume > 0) return;
+            cell = make_cell(s, faces, corner_ids);
+          } else {
+            std::tie(cell.volume, cell.centroid) = measure(cell);
+          }
+          if (cell.volume > 0) return;
         }
         std::vector<std::uint32_t> neighbors = dt.vertex_neighbors(s);
         if (dt.dimension() < 3) neighbors.assign(sites.begin(), sites.end());
@@ -497,7 +564,7 @@ void Voronoi3::build(const Delaunay3& dt) {
             }
           }
         }
-        cells_[k] = make_cell(s, faces, corner_ids);
+        cell = make_cell(s, faces, corner_ids);
       },
       16);
 }

@@ -4,9 +4,14 @@
 // convex polyhedron with its volume and centroid. The cells partition the box
 // (of the sites inside it) or the hull.
 //
-// A cell is the box cut by the bisector planes between its site and the site's
-// Delaunay neighbours (only they bound a Voronoi cell), clipped in doubles
-// with its corners joined by identity (closed however close they lie).
+// A cell of a site off the hull is read off the tetrahedralization: a corner
+// per tetrahedron around the site (its circumcentre, the same bits in every
+// cell that has it), a face per Delaunay edge, through the centres of the
+// tetrahedra around the edge; the box's planes cut the cells that reach it.
+// The cells of hull sites, and of sites with five or more nearly cospherical
+// neighbours (corners within 2^-30 of each other), are the box cut by the
+// bisector planes between the site and its Delaunay neighbours, clipped in
+// doubles with the corners joined by identity (closed however close they lie).
 // Layout, flat per cell: its vertices, its faces as index loops into them
 // (counter-clockwise seen from outside), and per face the site across it, a
 // box side (Voronoi3::box_side(k), k = 0..5 for -x, +x, -y, +y, -z, +z) or a
