@@ -8,13 +8,14 @@
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <cmath>
 #include <limits>
 #include <optional>
 #include <string>
 #include <tuple>
 #include <utility>
+
+#include <tbb/enumerable_thread_specific.h>
 
 #include "geods/core/coordinate_range.hpp"
 #include "geods/core/error.hpp"
@@ -266,8 +267,16 @@ struct Dual {
   std::vector<Vec3d> centre;               // per tetrahedron: its circumcentre, a Voronoi vertex
   std::vector<Place> place;                // per tetrahedron: where its centre lies
   std::vector<std::uint32_t> first;        // per point: a tetrahedron it is a vertex of (no_index: none)
-  std::uint64_t id = next_id++;            // distinct for every Dual made (dual_cell's marks are per Dual)
-  static inline std::atomic<std::uint64_t> next_id{1};
+};
+
+// A thread's scratch for dual_cell: per tetrahedron, the site whose star last
+// took it (site + 1: 0 is none) and its place in that star; per point, the
+// site whose face to it was last made. (Searching the star instead took most
+// of the time.)
+struct DualMarks {
+  DualMarks(std::size_t tetrahedra, std::size_t points) : star_of(tetrahedra, 0), index(tetrahedra), face_of(points, 0) {}
+  std::vector<std::uint32_t> star_of, index, face_of;
+  std::vector<std::uint32_t> star;  // the star being gathered
 };
 
 // The cell of site s as the dual of its star, unclipped: a corner per
@@ -279,23 +288,8 @@ struct Dual {
 // from there, its faces would round), or two corners of a face within 2^-30
 // of the cell's coordinates (five sites on a sphere or nearly: a face or an
 // edge of no length, which clipping drops).
-bool dual_cell(const Dual& d, std::uint32_t s, Voronoi3Cell& cell, bool& clipped) {
-  // Per thread and diagram: per tetrahedron, the site whose star last took it
-  // and its place in that star; per point, the site whose face to it was
-  // last made (site + 1: 0 is none). Searching the star instead took most of
-  // the time.
-  struct Marks {
-    std::uint64_t diagram = 0;  // Dual::id
-    std::vector<std::uint32_t> star_of, index, face_of;
-  };
-  thread_local Marks marks;
-  if (marks.diagram != d.id) {
-    marks.diagram = d.id;
-    marks.star_of.assign(d.place.size(), 0);
-    marks.index.resize(d.place.size());
-    marks.face_of.assign(d.first.size(), 0);
-  }
-  thread_local std::vector<std::uint32_t> star;
+bool dual_cell(const Dual& d, DualMarks& marks, std::uint32_t s, Voronoi3Cell& cell, bool& clipped) {
+  std::vector<std::uint32_t>& star = marks.star;
   const std::uint32_t* tets = d.tets.data();
   star.clear();
   clipped = false;
@@ -412,26 +406,6 @@ void Voronoi3::build(const Delaunay3& dt) {
   std::vector<std::uint32_t> sites;
   for (std::uint32_t i = 0; i < points.size(); ++i)
     if (dt.representative(i) == i) sites.push_back(i);
-  // With a hull: the sites whose cells may cross it, those on it and those
-  // with a Voronoi vertex (a circumcentre) outside it.
-  std::vector<std::uint8_t> crosses_hull;
-  if (!hull.empty()) {
-    crosses_hull.assign(points.size(), 0);
-    for (const auto& t : hull_)
-      for (const std::uint32_t v : t) crosses_hull[v] = 1;
-    const auto& tets = dt.tetrahedra();
-    std::vector<std::uint8_t> outside(dt.tetrahedron_count());
-    parallel_for(0, outside.size(), 1 << 12, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t t = begin; t < end; ++t) {
-        const Vec3d c = detail::circumcentre(points[tets[4 * t]], points[tets[4 * t + 1]], points[tets[4 * t + 2]],
-                                             points[tets[4 * t + 3]]);
-        outside[t] = !std::isfinite(c[0] + c[1] + c[2]) || dt.locate(c, std::uint32_t(t)) == Delaunay3::no_index;
-      }
-    });
-    for (std::size_t t = 0; t < outside.size(); ++t)
-      if (outside[t])
-        for (int k = 0; k < 4; ++k) crosses_hull[tets[4 * t + k]] = 1;
-  }
   const Vec3d reach = box.lo.cwiseAbs().cwiseMax(box.hi.cwiseAbs());
   std::vector<Face> initial;
   const Vec3d& lo = box.lo;
@@ -461,13 +435,15 @@ void Voronoi3::build(const Delaunay3& dt) {
   // cuts nothing of it), within the box's size of it (the box cuts the cell),
   // or beyond.
   std::optional<Dual> dual;
+  std::vector<std::uint32_t> renumbered;  // per tetrahedron of dt: its index in the dual
   if (dt.dimension() == 3) {
     const auto& given = dt.tetrahedra();
     const std::vector<std::uint32_t> given_adjacent = dt.neighbors();
     const std::size_t m = dt.tetrahedron_count();
     std::vector<std::uint32_t> rank(points.size());
     for (std::uint32_t r = 0; r < z_order.size(); ++r) rank[z_order[r]] = r;
-    std::vector<std::uint32_t> key(m), slot(points.size() + 1, 0), renumbered(m);
+    std::vector<std::uint32_t> key(m), slot(points.size() + 1, 0);
+    renumbered.resize(m);
     parallel_for(0, m, 1 << 14, [&](std::size_t begin, std::size_t end) {
       for (std::size_t t = begin; t < end; ++t)
         key[t] = std::min(std::min(rank[given[4 * t]], rank[given[4 * t + 1]]),
@@ -503,6 +479,27 @@ void Voronoi3::build(const Delaunay3& dt) {
     dual->first.assign(points.size(), Delaunay3::no_index);
     for (std::size_t i = 4 * m; i-- > 0;) dual->first[dual->tets[i]] = std::uint32_t(i / 4);
   }
+  // With a hull: the sites whose cells may cross it, those on it and those
+  // with a Voronoi vertex (a circumcentre) outside it.
+  std::vector<std::uint8_t> crosses_hull;
+  if (!hull.empty()) {
+    crosses_hull.assign(points.size(), 0);
+    for (const auto& t : hull_)
+      for (const std::uint32_t v : t) crosses_hull[v] = 1;
+    const auto& tets = dt.tetrahedra();
+    std::vector<std::uint8_t> outside(dt.tetrahedron_count());
+    parallel_for(0, outside.size(), 1 << 12, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t t = begin; t < end; ++t) {
+        const Vec3d& c = dual->centre[renumbered[t]];
+        outside[t] = !std::isfinite(c[0] + c[1] + c[2]) || dt.locate(c, std::uint32_t(t)) == Delaunay3::no_index;
+      }
+    });
+    for (std::size_t t = 0; t < outside.size(); ++t)
+      if (outside[t])
+        for (int k = 0; k < 4; ++k) crosses_hull[tets[4 * t + k]] = 1;
+  }
+  tbb::enumerable_thread_specific<DualMarks> marks(
+      [&] { return DualMarks(dual ? dual->place.size() : 0, points.size()); });
   cells_.resize(sites.size());
   parallel_for_each_index(
       0, order.size(),
@@ -513,7 +510,7 @@ void Voronoi3::build(const Delaunay3& dt) {
         bool clipped = false;
         Voronoi3Cell& cell = cells_[k];
         if (dual && dual->first[s] != Delaunay3::no_index && (hull.empty() || !crosses_hull[s]) &&
-            dual_cell(*dual, s, cell, clipped)) {
+            dual_cell(*dual, marks.local(), s, cell, clipped)) {
           if (clipped) {
             faces_of(cell, faces);
             std::uint32_t corner_ids = std::uint32_t(cell.vertices.size());
