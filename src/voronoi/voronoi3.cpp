@@ -507,18 +507,39 @@ void Voronoi3::build(const Delaunay3& dt) {
         const std::size_t k = order[j];
         const std::uint32_t s = sites[k];
         thread_local std::vector<Face> faces;
-        bool clipped = false;
         Voronoi3Cell& cell = cells_[k];
-        if (dual && dual->first[s] != Delaunay3::no_index && (hull.empty() || !crosses_hull[s]) &&
-            dual_cell(*dual, marks.local(), s, cell, clipped)) {
-          if (clipped) {
+        const bool crosses = !hull.empty() && crosses_hull[s];
+        // The hull's planes that reach into the cell, skipping those its
+        // bounding box lies within (the box computed again only after a cut).
+        const auto clip_to_hull = [&](std::uint32_t& corner_ids) {
+          const auto bounds_of = [&] {
+            AABB3d bounds;
+            for (const Face& f : faces)
+              for (const Corner& c : f.loop) bounds.extend(c.x);
+            return bounds;
+          };
+          AABB3d bounds = bounds_of();
+          for (std::uint32_t h = 0; h < hull.size() && !faces.empty(); ++h) {
+            const Vec3d& n = hull[h].normal;
+            double reach_h = 0;
+            for (int a = 0; a < 3; ++a) reach_h += n[a] * (n[a] > 0 ? bounds.hi[a] : bounds.lo[a]);
+            if (reach_h > hull[h].offset) {
+              clip(faces, n, hull[h].offset, hull_face(h), corner_ids, reach);
+              bounds = bounds_of();
+            }
+          }
+        };
+        bool clipped = false;
+        if (dual && dual->first[s] != Delaunay3::no_index && dual_cell(*dual, marks.local(), s, cell, clipped)) {
+          if (clipped || crosses) {
             faces_of(cell, faces);
             std::uint32_t corner_ids = std::uint32_t(cell.vertices.size());
-            for (int side = 0; side < 6 && !faces.empty(); ++side) {
+            for (int side = 0; side < 6 && clipped && !faces.empty(); ++side) {
               const int a = side / 2;
               const Vec3d normal = Vec3d::Unit(a) * (side % 2 ? 1.0 : -1.0);
               clip(faces, normal, side % 2 ? box.hi[a] : -box.lo[a], box_side(side), corner_ids, reach);
             }
+            if (crosses) clip_to_hull(corner_ids);
             cell = make_cell(s, faces, corner_ids);
           } else {
             std::tie(cell.volume, cell.centroid) = measure(cell);
@@ -541,26 +562,7 @@ void Voronoi3::build(const Delaunay3& dt) {
           clip(faces, bisector.normal, bisector.offset, w, corner_ids, reach);
           if (faces.empty()) break;
         }
-        if (!hull.empty() && crosses_hull[s]) {
-          // Skip the planes the cell's bounding box lies within (the box
-          // computed again only after a cut).
-          const auto bounds_of = [&] {
-            AABB3d bounds;
-            for (const Face& f : faces)
-              for (const Corner& c : f.loop) bounds.extend(c.x);
-            return bounds;
-          };
-          AABB3d bounds = bounds_of();
-          for (std::uint32_t h = 0; h < hull.size() && !faces.empty(); ++h) {
-            const Vec3d& n = hull[h].normal;
-            double reach_h = 0;
-            for (int a = 0; a < 3; ++a) reach_h += n[a] * (n[a] > 0 ? bounds.hi[a] : bounds.lo[a]);
-            if (reach_h > hull[h].offset) {
-              clip(faces, n, hull[h].offset, hull_face(h), corner_ids, reach);
-              bounds = bounds_of();
-            }
-          }
-        }
+        if (crosses) clip_to_hull(corner_ids);
         cell = make_cell(s, faces, corner_ids);
       },
       16);
