@@ -459,6 +459,11 @@ void Voronoi3::build(const Delaunay3& dt) {
     dual->place.resize(m);
     const double margin = std::ldexp(reach.maxCoeff(), -30);
     const AABB3d near(box.lo - (box.hi - box.lo), box.hi + (box.hi - box.lo));
+    const auto place_of = [&](const Vec3d& c) {
+      if ((c.array() > box.lo.array() + margin).all() && (c.array() < box.hi.array() - margin).all()) return Dual::inside;
+      if ((c.array() >= near.lo.array()).all() && (c.array() <= near.hi.array()).all()) return Dual::near;
+      return Dual::far;  // (NaN too)
+    };
     parallel_for(0, m, 1 << 12, [&](std::size_t begin, std::size_t end) {
       for (std::size_t t = begin; t < end; ++t) {
         const std::uint32_t u = renumbered[t];
@@ -470,10 +475,7 @@ void Voronoi3::build(const Delaunay3& dt) {
         const Vec3d c = detail::circumcentre(points[given[4 * t]], points[given[4 * t + 1]],
                                              points[given[4 * t + 2]], points[given[4 * t + 3]]);
         dual->centre[u] = c;
-        dual->place[u] = (c.array() > box.lo.array() + margin).all() && (c.array() < box.hi.array() - margin).all()
-                             ? Dual::inside
-                         : (c.array() >= near.lo.array()).all() && (c.array() <= near.hi.array()).all() ? Dual::near
-                                                                                                       : Dual::far;
+        dual->place[u] = place_of(c);
       }
     });
     dual->first.assign(points.size(), Delaunay3::no_index);
